@@ -1,0 +1,62 @@
+//! `bowl kinematics`: paper Eq. 2 both ways.
+
+use anyhow::{Result, anyhow};
+use model_core::bowl::{BowlGeometry, MotorSpeeds};
+
+/// Flags of `bowl kinematics`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Precession speed omega1 (rod about the vertical), rad/s.
+    #[arg(long, default_value_t = 1.8)]
+    precession_rad_s: f64,
+    /// Spin speed omega2 (bowl about its own axis), rad/s.
+    #[arg(long, default_value_t = 1.8)]
+    spin_rad_s: f64,
+    /// Angle between the spin and precession axes, degrees (see the docs: not the rod's tilt).
+    #[arg(long, default_value_t = 60.0)]
+    axes_angle_deg: f64,
+    /// Instead: split this combined bowl speed (rad/s) into motor speeds.
+    #[arg(long)]
+    split_rad_s: Option<f64>,
+    /// Spin/precession ratio used by --split-rad-s.
+    #[arg(long, default_value_t = 1.0)]
+    ratio: f64,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs `bowl kinematics`.
+pub fn run(args: &Args) -> Result<()> {
+    let geometry = BowlGeometry::new(args.axes_angle_deg.to_radians())
+        .map_err(|e| anyhow!("invalid --axes-angle-deg {}: {e:?}", args.axes_angle_deg))?;
+    let speeds = match args.split_rad_s {
+        Some(omega) => geometry
+            .split(omega, args.ratio)
+            .map_err(|e| anyhow!("cannot split {omega} rad/s at ratio {}: {e:?}", args.ratio))?,
+        None => MotorSpeeds {
+            precession_rad_s: args.precession_rad_s,
+            spin_rad_s: args.spin_rad_s,
+        },
+    };
+    let omega = geometry
+        .combined_speed_rad_s(speeds)
+        .map_err(|e| anyhow!("invalid motor speeds: {e:?}"))?;
+    if args.json {
+        println!(
+            "{}",
+            serde_json::json!({
+                "precession_rad_s": speeds.precession_rad_s,
+                "spin_rad_s": speeds.spin_rad_s,
+                "axes_angle_deg": args.axes_angle_deg,
+                "combined_rad_s": omega,
+            })
+        );
+    } else {
+        println!(
+            "precession {:.6} rad/s, spin {:.6} rad/s, axes {:.1} deg -> bowl {:.6} rad/s",
+            speeds.precession_rad_s, speeds.spin_rad_s, args.axes_angle_deg, omega
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,27 @@
+//! `bowl`: the PC side of the bowl granulation rig.
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+
+mod kinematics;
+
+/// The PC side of the bowl granulation rig.
+#[derive(Parser)]
+#[command(name = "bowl", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Combined bowl speed from the two motor speeds (paper Eq. 2), or the split of a target speed.
+    Kinematics(kinematics::Args),
+}
+
+fn main() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Kinematics(args) => kinematics::run(&args),
+    }
+}
