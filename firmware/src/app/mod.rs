@@ -1,0 +1,1 @@
+//! The application logic, free of any HAL.
