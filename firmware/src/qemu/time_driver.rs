@@ -49,8 +49,7 @@ pub fn start(mut syst: SYST) {
     syst.clear_current();
     syst.enable_interrupt();
     syst.enable_counter();
-    // Taking `syst` by value keeps anyone else from reconfiguring SysTick: the driver owns it.
-    drop(syst);
+    // `syst` was taken by value, so nothing else can reconfigure SysTick: the driver owns it.
 }
 
 impl SysTickDriver {
