@@ -235,7 +235,7 @@ mod tests {
         }
         fn write(&mut self, offset: u32, data: &[u8]) -> Result<(), FlashError> {
             let o = offset as usize;
-            if o % 4 != 0 || data.len() % 4 != 0 || o + data.len() > S {
+            if !o.is_multiple_of(4) || !data.len().is_multiple_of(4) || o + data.len() > S {
                 return Err(FlashError::OutOfBounds);
             }
             let n = self.cut_next_write_at.take().unwrap_or(data.len());
