@@ -219,3 +219,34 @@ fn batch_without_required_column_fails_naming_it() {
     let _ = std::fs::remove_file(input);
     let _ = std::fs::remove_file(output);
 }
+
+#[test]
+fn integrators_agree_with_the_closed_form_and_report_cost() {
+    let closed = json(&["predict", "--model", "coriolis", "--json"]);
+    let t_ref = closed["results"][0]["residence_time_s"].as_f64().unwrap();
+    let dp = json(&[
+        "predict", "--model", "coriolis", "--method", "dp54", "--tol", "1e-11", "--json",
+    ]);
+    let r = &dp["results"][0];
+    assert!((r["residence_time_s"].as_f64().unwrap() - t_ref).abs() < 1e-9 * t_ref);
+    assert!(r["rhs_evaluations"].as_u64().unwrap() > 6);
+    let rk = json(&[
+        "predict", "--model", "coriolis", "--method", "rk4", "--step-s", "0.001", "--json",
+    ]);
+    assert!((rk["results"][0]["residence_time_s"].as_f64().unwrap() - t_ref).abs() < 1e-9 * t_ref);
+}
+
+#[test]
+fn a_step_beyond_stability_is_an_error_not_a_number() {
+    let out = bowl(&[
+        "predict",
+        "--method",
+        "euler",
+        "--step-s",
+        "1.0",
+        "--omega-rad-s",
+        "3",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("BeyondStabilityLimit"));
+}
