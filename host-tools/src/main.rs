@@ -4,6 +4,7 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 mod kinematics;
+mod sim;
 
 /// The PC side of the bowl granulation rig.
 #[derive(Parser)]
@@ -17,11 +18,14 @@ struct Cli {
 enum Command {
     /// Combined bowl speed from the two motor speeds (paper Eq. 2), or the split of a target speed.
     Kinematics(kinematics::Args),
+    /// The controller against the simulated rig: step, family, commission, sweep, stability.
+    Sim(sim::Args),
 }
 
 fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Kinematics(args) => kinematics::run(&args),
+        Command::Sim(args) => sim::run(&args),
     }
 }

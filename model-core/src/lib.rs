@@ -11,6 +11,8 @@
 #![warn(missing_docs)]
 
 pub mod bowl;
+pub mod control;
 pub mod real;
+pub mod sim;
 
 pub use real::Real;
