@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 
 mod kinematics;
 mod predict;
+mod sim;
 
 /// The PC side of the bowl granulation rig.
 #[derive(Parser)]
@@ -20,6 +21,8 @@ enum Command {
     Kinematics(kinematics::Args),
     /// Residence time and exit velocities of a particle (paper Eq. 5-12, corrected), or a batch CSV.
     Predict(predict::Args),
+    /// The controller against the simulated rig: step, family, commission, sweep, stability.
+    Sim(sim::Args),
 }
 
 fn main() -> Result<()> {
@@ -27,5 +30,6 @@ fn main() -> Result<()> {
     match cli.command {
         Command::Kinematics(args) => kinematics::run(&args),
         Command::Predict(args) => predict::run(&args),
+        Command::Sim(args) => sim::run(&args),
     }
 }

@@ -13,6 +13,8 @@
 pub mod bowl;
 pub mod ode;
 pub mod particle;
+pub mod control;
 pub mod real;
+pub mod sim;
 
 pub use real::Real;
