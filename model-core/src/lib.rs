@@ -12,5 +12,6 @@
 
 pub mod bowl;
 pub mod real;
+pub mod wire;
 
 pub use real::Real;
