@@ -110,7 +110,7 @@ impl<T: Real> BowlGeometry<T> {
         let along = a.cos() + rho;
         let across = a.sin();
         let gain = (along * along + across * across).sqrt();
-        if !(gain > T::ZERO) || !gain.is_finite() {
+        if gain.is_nan() || gain <= T::ZERO || !gain.is_finite() {
             return Err(BowlError::InvalidRatio);
         }
         let w1 = omega_rad_s / gain;

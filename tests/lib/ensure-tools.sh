@@ -1,0 +1,39 @@
+# Sourced by tests/run and the demo: installs what a fresh machine lacks. Each step is idempotent
+# and quiet when the tool is already there.
+
+# The Cortex-M4F target (RUSTUP_AUTO_INSTALL may be 0, so rust-toolchain.toml alone won't fetch it).
+ensure_thumb_target() {
+  if ! rustup target list --installed 2>/dev/null | grep -qx thumbv7em-none-eabihf; then
+    echo "== installing the thumbv7em-none-eabihf target"
+    rustup target add thumbv7em-none-eabihf
+  fi
+}
+
+# flip-link is the thumb linker (.cargo/config.toml).
+ensure_flip_link() {
+  if ! command -v flip-link >/dev/null; then
+    echo "== installing flip-link"
+    cargo install flip-link --locked --quiet
+  fi
+}
+
+# qemu-system-arm from Debian bookworm-backports: bookworm's own 7.2 conflicts with the
+# preinstalled qemu-utils 10.0 from backports. A private APT source list names the suite, so the
+# machine's APT configuration is left as it was.
+ensure_qemu() {
+  if command -v qemu-system-arm >/dev/null; then
+    return 0
+  fi
+  echo "== installing qemu-system-arm (bookworm-backports)"
+  local sudo=""
+  if [ "$(id -u)" != 0 ]; then sudo="sudo"; fi
+  local list
+  list=$(mktemp)
+  echo 'deb http://deb.debian.org/debian bookworm-backports main' >"$list"
+  $sudo apt-get update -qq -o Dir::Etc::sourcelist="$list" >/dev/null &&
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends \
+      -o Dir::Etc::sourcelist="$list" -t bookworm-backports qemu-system-arm >/dev/null
+  local status=$?
+  rm -f "$list"
+  return $status
+}
