@@ -11,7 +11,6 @@ use embassy_executor::Spawner;
 use embassy_stm32::gpio::{Level, Output, Speed};
 use embassy_time::Timer;
 use model_core::bowl::{BowlGeometry, MotorSpeeds};
-use panic_probe as _;
 
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
@@ -35,4 +34,10 @@ async fn main(_spawner: Spawner) {
         led.set_high();
         Timer::after_millis(900).await;
     }
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    defmt::error!("panic: {}", defmt::Display2Format(info));
+    cortex_m::peripheral::SCB::sys_reset()
 }

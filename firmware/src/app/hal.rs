@@ -1,0 +1,51 @@
+//! The traits a board implements. Small on purpose: each is one peripheral's job.
+
+/// One motor's PWM output with its direction input on the H-bridge.
+pub trait MotorOutput {
+    /// Drives the motor at `duty` in -1..=1: the magnitude sets the PWM compare value, the sign
+    /// the direction pin. Values outside the range, and NaN, are treated as 0 (off).
+    fn set_duty(&mut self, duty: f32);
+    /// PWM compare to 0 at once: the bridge input goes low (coast on a PWM/DIR bridge).
+    fn off(&mut self);
+}
+
+/// Timestamps of one proximity sensor's edges, from a free-running capture timer.
+#[allow(async_fn_in_trait)] // single-threaded executor: no Send bound wanted
+pub trait EdgeSource {
+    /// Waits for the next edge and returns its capture-timer value (wrapping).
+    async fn next_edge(&mut self) -> u32;
+}
+
+/// The free-running timer the edge timestamps come from.
+pub trait CaptureClock {
+    /// The timer's current value (same units and wrap as the edge timestamps).
+    fn now_ticks(&self) -> u32;
+}
+
+/// The independent watchdog: resets the MCU unless fed in time.
+pub trait Watchdog {
+    /// Restarts the watchdog's countdown.
+    fn feed(&mut self);
+}
+
+/// One erasable flash region reserved for parameter records.
+pub trait FlashRegion {
+    /// Size of the region in bytes (a multiple of 4).
+    const SIZE: u32;
+    /// Reads `buf.len()` bytes at `offset`.
+    fn read(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError>;
+    /// Programs `data` (a multiple of 4 bytes, into erased words) at `offset` (4-aligned).
+    fn write(&mut self, offset: u32, data: &[u8]) -> Result<(), FlashError>;
+    /// Erases the whole region (all bytes 0xFF). Slow: the caller keeps the motors off.
+    fn erase(&mut self) -> Result<(), FlashError>;
+}
+
+/// A flash operation that failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "blackpill", derive(defmt::Format))]
+pub enum FlashError {
+    /// Offset or length outside the region, or not 4-aligned.
+    OutOfBounds,
+    /// The flash controller reported an error (programming, erase or protection).
+    Hardware,
+}

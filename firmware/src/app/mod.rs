@@ -1,0 +1,18 @@
+//! The application logic, free of any HAL: the same code runs on the Black Pill and on the
+//! emulated board. A board supplies the [`hal`] traits; [`tasks`] are the async loops that
+//! the board's executor runs.
+//!
+//! - [`hal`]: the traits a board implements (motor output, edge source, capture clock,
+//!   watchdog, flash sector).
+//! - [`edges`]: the queue from the pulse-capture interrupt/task to the control tick.
+//! - [`params`]: parameters persisted in flash (version + CRC-32, append-only records).
+//! - [`reset`]: reset cause and a reset counter that survives resets in uninitialised RAM.
+//! - [`motors`]: the pair of motor outputs and the all-off path used by faults and panics.
+//! - [`tasks`]: capture, control tick, link (telemetry + commands), supervisor.
+
+pub mod edges;
+pub mod hal;
+pub mod motors;
+pub mod params;
+pub mod reset;
+pub mod tasks;

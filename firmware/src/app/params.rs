@@ -1,0 +1,338 @@
+//! Parameters persisted in flash: append-only records with a version and a CRC-32.
+//!
+//! The region (one flash sector on the STM32) is a row of fixed-size slots. Saving programs the
+//! next erased slot; only when every slot is used is the region erased (motors must be off: the
+//! CPU stalls during a sector erase). Loading takes the valid record with the highest sequence
+//! number. A record cut short by a reset fails its CRC and is skipped; the next save goes after
+//! it. A record of another layout version is never read as this one: defaults are used and
+//! the caller reports why.
+//!
+//! Slot layout (little-endian words): magic `BOWL`, version (u16) + value count (u16),
+//! sequence (u32), reserved (u32, 0), `MAX_VALUES` values (i32, unused ones 0), CRC-32 (IEEE)
+//! of all the preceding bytes of the slot.
+
+use super::hal::{FlashError, FlashRegion};
+
+/// `BOWL` in ASCII, little-endian.
+pub const MAGIC: u32 = u32::from_le_bytes(*b"BOWL");
+/// Layout version of the values: bump when their meaning or order changes.
+pub const RECORD_VERSION: u16 = 1;
+/// Values a slot can hold.
+pub const MAX_VALUES: usize = 48;
+/// Bytes per slot: 4 header words, the values, the CRC.
+pub const SLOT_BYTES: usize = 16 + 4 * MAX_VALUES + 4;
+const ERASED_WORD: u32 = u32::MAX;
+
+/// Why no parameters could be loaded (the caller then uses its defaults).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "blackpill", derive(defmt::Format))]
+pub enum LoadError {
+    /// The region holds no record at all (a new board, or just erased).
+    Empty,
+    /// Records exist but none passes its CRC check.
+    Corrupt,
+    /// The newest valid record has another layout version (found).
+    OtherVersion(u16),
+    /// The newest valid record holds another number of values (found).
+    OtherCount(u16),
+    /// The flash could not be read.
+    Flash(FlashError),
+}
+
+/// Why a save did not happen (the previous record stays in force).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "blackpill", derive(defmt::Format))]
+pub enum SaveError {
+    /// More values than a slot holds.
+    TooManyValues,
+    /// Programming or erasing failed.
+    Flash(FlashError),
+    /// The record read back differs from what was written.
+    Verify,
+}
+
+/// CRC-32 (IEEE 802.3, reflected, init and final xor all ones), bitwise: small, and only run
+/// on load and save.
+pub fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = u32::MAX;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            let mask = (crc & 1).wrapping_neg();
+            crc = (crc >> 1) ^ (0xEDB8_8320 & mask);
+        }
+    }
+    !crc
+}
+
+/// The parameter log over one flash region.
+pub struct ParamLog<F: FlashRegion> {
+    flash: F,
+}
+
+struct Scan {
+    /// Offset of the first never-written slot, if any.
+    first_free: Option<u32>,
+    /// The newest slot that passed its CRC: (sequence, offset).
+    newest: Option<(u32, u32)>,
+    /// Slots written but failing the check.
+    corrupt: u32,
+}
+
+impl<F: FlashRegion> ParamLog<F> {
+    const SLOTS: u32 = F::SIZE / SLOT_BYTES as u32;
+
+    /// Wraps a flash region.
+    pub fn new(flash: F) -> Self {
+        Self { flash }
+    }
+
+    /// Gives the flash region back.
+    pub fn into_inner(self) -> F {
+        self.flash
+    }
+
+    fn read_slot(&mut self, offset: u32) -> Result<[u8; SLOT_BYTES], FlashError> {
+        let mut slot = [0u8; SLOT_BYTES];
+        self.flash.read(offset, &mut slot)?;
+        Ok(slot)
+    }
+
+    fn scan(&mut self) -> Result<Scan, FlashError> {
+        let mut scan = Scan {
+            first_free: None,
+            newest: None,
+            corrupt: 0,
+        };
+        for i in 0..Self::SLOTS {
+            let offset = i * SLOT_BYTES as u32;
+            let slot = self.read_slot(offset)?;
+            if slot.iter().all(|&b| b == 0xFF) {
+                scan.first_free = Some(offset);
+                break; // slots are used in order: nothing was written after a free one
+            }
+            let (body, crc) = slot.split_at(SLOT_BYTES - 4);
+            if word(&slot, 0) != MAGIC
+                || u32::from_le_bytes(crc.try_into().unwrap_or([0; 4])) != crc32(body)
+            {
+                scan.corrupt += 1;
+                continue;
+            }
+            let seq = word(&slot, 8);
+            if scan.newest.is_none_or(|(s, _)| seq >= s) {
+                scan.newest = Some((seq, offset));
+            }
+        }
+        Ok(scan)
+    }
+
+    /// The values of the newest valid record, if it has this version and `N` values.
+    pub fn load<const N: usize>(&mut self) -> Result<[i32; N], LoadError> {
+        let scan = self.scan().map_err(LoadError::Flash)?;
+        let Some((_, offset)) = scan.newest else {
+            return Err(if scan.corrupt > 0 {
+                LoadError::Corrupt
+            } else {
+                LoadError::Empty
+            });
+        };
+        let slot = self.read_slot(offset).map_err(LoadError::Flash)?;
+        let header = word(&slot, 4);
+        let version = header as u16;
+        let count = (header >> 16) as u16;
+        if version != RECORD_VERSION {
+            return Err(LoadError::OtherVersion(version));
+        }
+        if usize::from(count) != N || N > MAX_VALUES {
+            return Err(LoadError::OtherCount(count));
+        }
+        let mut values = [0i32; N];
+        for (i, v) in values.iter_mut().enumerate() {
+            *v = word(&slot, 16 + 4 * i) as i32;
+        }
+        Ok(values)
+    }
+
+    /// Appends a record with `values` (nothing is written if they equal the newest record's).
+    /// Erases the region first when it is full: call only with the motors off.
+    pub fn save<const N: usize>(&mut self, values: &[i32; N]) -> Result<(), SaveError> {
+        if N > MAX_VALUES {
+            return Err(SaveError::TooManyValues);
+        }
+        if self.load::<N>().ok().as_ref() == Some(values) {
+            return Ok(());
+        }
+        let scan = self.scan().map_err(SaveError::Flash)?;
+        let seq = scan.newest.map_or(0, |(s, _)| s.wrapping_add(1));
+        let offset = match scan.first_free {
+            Some(offset) => offset,
+            None => {
+                self.flash.erase().map_err(SaveError::Flash)?;
+                0
+            }
+        };
+        let mut slot = [0u8; SLOT_BYTES];
+        put_word(&mut slot, 0, MAGIC);
+        put_word(&mut slot, 4, u32::from(RECORD_VERSION) | ((N as u32) << 16));
+        put_word(&mut slot, 8, seq);
+        for (i, &v) in values.iter().enumerate() {
+            put_word(&mut slot, 16 + 4 * i, v as u32);
+        }
+        let crc = crc32(&slot[..SLOT_BYTES - 4]);
+        put_word(&mut slot, SLOT_BYTES - 4, crc);
+        self.flash.write(offset, &slot).map_err(SaveError::Flash)?;
+        if self.read_slot(offset).map_err(SaveError::Flash)? != slot {
+            return Err(SaveError::Verify);
+        }
+        Ok(())
+    }
+}
+
+fn word(slot: &[u8], at: usize) -> u32 {
+    slot.get(at..at + 4)
+        .and_then(|w| w.try_into().ok())
+        .map_or(ERASED_WORD, u32::from_le_bytes)
+}
+
+fn put_word(slot: &mut [u8], at: usize, value: u32) {
+    if let Some(w) = slot.get_mut(at..at + 4) {
+        w.copy_from_slice(&value.to_le_bytes());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// NOR flash in RAM: programming can only clear bits, erase sets them all.
+    struct RamFlash<const S: usize> {
+        bytes: [u8; S],
+        erases: u32,
+        /// Bytes of the next write that actually land (simulates a reset mid-write).
+        cut_next_write_at: Option<usize>,
+    }
+
+    impl<const S: usize> RamFlash<S> {
+        fn new() -> Self {
+            Self {
+                bytes: [0xFF; S],
+                erases: 0,
+                cut_next_write_at: None,
+            }
+        }
+    }
+
+    impl<const S: usize> FlashRegion for RamFlash<S> {
+        const SIZE: u32 = S as u32;
+        fn read(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
+            let o = offset as usize;
+            let src = self
+                .bytes
+                .get(o..o + buf.len())
+                .ok_or(FlashError::OutOfBounds)?;
+            buf.copy_from_slice(src);
+            Ok(())
+        }
+        fn write(&mut self, offset: u32, data: &[u8]) -> Result<(), FlashError> {
+            let o = offset as usize;
+            if !o.is_multiple_of(4) || !data.len().is_multiple_of(4) || o + data.len() > S {
+                return Err(FlashError::OutOfBounds);
+            }
+            let n = self.cut_next_write_at.take().unwrap_or(data.len());
+            for (dst, &b) in self.bytes[o..o + n].iter_mut().zip(data) {
+                *dst &= b;
+            }
+            Ok(())
+        }
+        fn erase(&mut self) -> Result<(), FlashError> {
+            self.bytes = [0xFF; S];
+            self.erases += 1;
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn crc32_matches_the_standard_check_value() {
+        // The CRC-32/ISO-HDLC check value of "123456789" (Greg Cook's CRC catalogue).
+        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+    }
+
+    #[test]
+    fn empty_region_reports_empty_then_round_trips() {
+        let mut log = ParamLog::new(RamFlash::<{ 4 * SLOT_BYTES }>::new());
+        assert_eq!(log.load::<3>(), Err(LoadError::Empty));
+        log.save(&[1, -2, 300_000]).unwrap();
+        assert_eq!(log.load::<3>(), Ok([1, -2, 300_000]));
+    }
+
+    #[test]
+    fn newest_record_wins_and_a_full_region_is_erased_once() {
+        let mut log = ParamLog::new(RamFlash::<{ 3 * SLOT_BYTES }>::new());
+        for k in 0..7 {
+            log.save(&[k, k * 10]).unwrap();
+            assert_eq!(log.load::<2>(), Ok([k, k * 10]));
+        }
+        // 3 slots, 7 distinct saves: erased before the 4th and the 7th.
+        assert_eq!(log.into_inner().erases, 2);
+    }
+
+    #[test]
+    fn unchanged_values_are_not_rewritten() {
+        let mut log = ParamLog::new(RamFlash::<{ 2 * SLOT_BYTES }>::new());
+        for _ in 0..5 {
+            log.save(&[7, 8]).unwrap();
+        }
+        let flash = log.into_inner();
+        assert_eq!(flash.erases, 0);
+        assert!(flash.bytes[SLOT_BYTES..].iter().all(|&b| b == 0xFF));
+    }
+
+    #[test]
+    fn a_torn_write_keeps_the_previous_record_and_the_next_save_skips_it() {
+        let mut log = ParamLog::new(RamFlash::<{ 4 * SLOT_BYTES }>::new());
+        log.save(&[1, 2]).unwrap();
+        let mut flash = log.into_inner();
+        flash.cut_next_write_at = Some(40);
+        let mut log = ParamLog::new(flash);
+        // The cut write verifies wrong, and loading still gives the old record.
+        assert_eq!(log.save(&[3, 4]), Err(SaveError::Verify));
+        assert_eq!(log.load::<2>(), Ok([1, 2]));
+        log.save(&[5, 6]).unwrap();
+        assert_eq!(log.load::<2>(), Ok([5, 6]));
+    }
+
+    #[test]
+    fn flipped_bits_are_detected() {
+        let mut log = ParamLog::new(RamFlash::<{ 2 * SLOT_BYTES }>::new());
+        log.save(&[123_456, 789]).unwrap();
+        let flash = log.into_inner();
+        for bit in [0usize, 8 * 17, 8 * 20 + 3, 8 * (SLOT_BYTES - 1) + 7] {
+            let mut f = RamFlash::<{ 2 * SLOT_BYTES }>::new();
+            f.bytes = flash.bytes;
+            f.bytes[bit / 8] ^= 1 << (bit % 8);
+            assert_eq!(
+                ParamLog::new(f).load::<2>(),
+                Err(LoadError::Corrupt),
+                "bit {bit}"
+            );
+        }
+    }
+
+    #[test]
+    fn other_version_or_count_is_not_read_as_ours() {
+        let mut log = ParamLog::new(RamFlash::<{ 2 * SLOT_BYTES }>::new());
+        log.save(&[1, 2, 3]).unwrap();
+        assert_eq!(log.load::<2>(), Err(LoadError::OtherCount(3)));
+        // Rewrite the record as version 2 with a valid CRC.
+        let mut flash = log.into_inner();
+        let mut slot: [u8; SLOT_BYTES] = flash.bytes[..SLOT_BYTES].try_into().unwrap();
+        put_word(&mut slot, 4, 2 | (3 << 16));
+        let crc = crc32(&slot[..SLOT_BYTES - 4]);
+        put_word(&mut slot, SLOT_BYTES - 4, crc);
+        flash.bytes[..SLOT_BYTES].copy_from_slice(&slot);
+        assert_eq!(
+            ParamLog::new(flash).load::<3>(),
+            Err(LoadError::OtherVersion(2))
+        );
+    }
+}

@@ -1,0 +1,179 @@
+//! The async loops of the rig, generic over the board's peripherals and over the [`RigCore`]
+//! (controller + protocol). A board wraps each in an `#[embassy_executor::task]` (tasks cannot
+//! be generic) and spawns them.
+//!
+//! Task set and rates:
+//! - capture (one per axis): edge timestamps into an [`EdgeQueue`];
+//! - control: a fixed-rate tick ([`CONTROL_HZ`]): drain edges, run the controller, set duties;
+//! - link: commands in, answers and telemetry out over the byte stream;
+//! - supervisor: feeds the watchdog only while the control tick keeps running.
+
+use core::cell::RefCell;
+use core::sync::atomic::{AtomicU32, Ordering};
+
+use embassy_futures::select::{Either, select};
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_time::{Duration, Instant, Ticker};
+use embedded_io_async::{Read, Write};
+use heapless::Vec;
+
+use super::edges::{EDGES_PER_TICK, EdgeQueue};
+use super::hal::{CaptureClock, EdgeSource, MotorOutput, Watchdog};
+use super::motors::{AXES, Motors};
+
+/// The control tick rate (the controller's nominal `tick_hz`).
+pub const CONTROL_HZ: u64 = 1_000;
+/// Longest frame the link sends or receives.
+pub const FRAME_BYTES: usize = 256;
+/// How often the link task asks whether a telemetry frame is due (the protocol paces frames).
+pub const TELEMETRY_POLL: Duration = Duration::from_millis(2);
+/// Supervisor period: the watchdog is fed at most this often, and only if the control tick ran.
+pub const SUPERVISOR_PERIOD: Duration = Duration::from_millis(20);
+
+/// What the tasks need from the controller and the protocol. The binding to
+/// `model_core::control` and `model_core::wire` implements it.
+pub trait RigCore {
+    /// One control tick: the edges since the previous tick (oldest first) and the capture
+    /// clock read after draining them. Returns the duties (-1..=1, 0 = off).
+    fn control_tick(&mut self, now_ticks: u32, edges: [&[u32]; AXES]) -> [f32; AXES];
+    /// Whether a fault is latched (the motors are then kept off whatever the duties say).
+    fn faulted(&self) -> bool;
+    /// The boot announcement frame.
+    fn hello(&mut self, out: &mut [u8; FRAME_BYTES]) -> Option<usize>;
+    /// Bytes from the host; every answer frame goes to `send`.
+    fn receive(&mut self, bytes: &[u8], send: &mut dyn FnMut(&[u8]));
+    /// A telemetry frame, if one is due at `now_ms`.
+    fn poll_telemetry(&mut self, now_ms: u32, out: &mut [u8; FRAME_BYTES]) -> Option<usize>;
+    /// Tells the core how many edges the capture queues have dropped so far (per axis).
+    fn set_dropped_edges(&mut self, dropped: [u32; AXES]) {
+        let _ = dropped;
+    }
+}
+
+/// The core shared by the control and link tasks (both lock it briefly; no await inside).
+pub type SharedCore<C> = Mutex<CriticalSectionRawMutex, RefCell<C>>;
+
+/// Forwards one sensor's edges into its queue, forever.
+pub async fn capture<E: EdgeSource>(mut source: E, queue: &EdgeQueue) -> ! {
+    loop {
+        let t = source.next_edge().await;
+        queue.push(t);
+    }
+}
+
+/// Counts control ticks: the supervisor feeds the watchdog only while this advances.
+pub struct Heartbeat(AtomicU32);
+
+impl Default for Heartbeat {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Heartbeat {
+    /// A heartbeat at zero.
+    pub const fn new() -> Self {
+        Self(AtomicU32::new(0))
+    }
+    fn beat(&self) {
+        self.0.fetch_add(1, Ordering::Relaxed);
+    }
+    /// Ticks so far, modulo 2^32.
+    pub fn count(&self) -> u32 {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// The fixed-rate control loop, forever.
+pub async fn control<C: RigCore, M: MotorOutput, K: CaptureClock>(
+    core: &SharedCore<C>,
+    queues: &[EdgeQueue; AXES],
+    clock: &K,
+    motors: &mut Motors<M>,
+    heartbeat: &Heartbeat,
+) -> ! {
+    let mut buffers: [Vec<u32, EDGES_PER_TICK>; AXES] = [Vec::new(), Vec::new()];
+    let mut ticker = Ticker::every(Duration::from_hz(CONTROL_HZ));
+    loop {
+        ticker.next().await;
+        for (q, b) in queues.iter().zip(&mut buffers) {
+            q.drain_into(b);
+        }
+        // Read after draining: every edge handed over is older than `now`.
+        let now = clock.now_ticks();
+        let dropped = [queues[0].dropped(), queues[1].dropped()];
+        let (duties, faulted) = core.lock(|c| {
+            let mut c = c.borrow_mut();
+            c.set_dropped_edges(dropped);
+            let d = c.control_tick(now, [&buffers[0], &buffers[1]]);
+            (d, c.faulted())
+        });
+        if faulted {
+            motors.all_off();
+        } else {
+            motors.apply(duties);
+        }
+        heartbeat.beat();
+    }
+}
+
+/// Device time in ms since boot (wraps after 49.7 days, as the protocol's field does).
+pub fn now_ms() -> u32 {
+    Instant::now().as_millis() as u32
+}
+
+/// Commands in, answers and telemetry out, forever. A write error (a broken link) drops that
+/// frame: telemetry's sequence numbers show the host what it missed.
+pub async fn link<C: RigCore, R: Read, W: Write>(core: &SharedCore<C>, mut rx: R, mut tx: W) -> ! {
+    let mut frame = [0u8; FRAME_BYTES];
+    if let Some(n) = core.lock(|c| c.borrow_mut().hello(&mut frame)) {
+        let _ = tx.write_all(&frame[..n]).await;
+    }
+    let mut ticker = Ticker::every(TELEMETRY_POLL);
+    let mut rx_buf = [0u8; 64];
+    loop {
+        match select(rx.read(&mut rx_buf), ticker.next()).await {
+            Either::First(Ok(n)) => {
+                // One byte at a time: a byte completes at most one command, so at most one
+                // answer frame is pending at any moment and none can be lost to buffer space.
+                for &byte in &rx_buf[..n] {
+                    let mut len = 0;
+                    core.lock(|c| {
+                        c.borrow_mut().receive(&[byte], &mut |f: &[u8]| {
+                            if let Some(dst) = frame.get_mut(..f.len()) {
+                                dst.copy_from_slice(f);
+                                len = f.len();
+                            }
+                        })
+                    });
+                    if len > 0 {
+                        let _ = tx.write_all(&frame[..len]).await;
+                    }
+                }
+            }
+            Either::First(Err(_)) => {} // framing/noise error: the decoder resyncs on the next frame
+            Either::Second(()) => {
+                let due = core.lock(|c| c.borrow_mut().poll_telemetry(now_ms(), &mut frame));
+                if let Some(n) = due {
+                    let _ = tx.write_all(&frame[..n]).await;
+                }
+            }
+        }
+    }
+}
+
+/// Feeds the watchdog while the control tick runs; stops feeding (so the watchdog resets the
+/// MCU, and the bridge pull-downs hold the motors off) when it has not ticked for a period.
+pub async fn supervisor<W: Watchdog>(mut watchdog: W, heartbeat: &Heartbeat) -> ! {
+    let mut ticker = Ticker::every(SUPERVISOR_PERIOD);
+    let mut last = heartbeat.count();
+    loop {
+        ticker.next().await;
+        let now = heartbeat.count();
+        if now != last {
+            watchdog.feed();
+        }
+        last = now;
+    }
+}

@@ -1,0 +1,135 @@
+//! Host-side harness for the emulated board: builds a `qemu-*` image of this crate and boots it
+//! under QEMU netduinoplus2 with USART1 on a Unix socket the test holds.
+#![allow(dead_code)]
+
+use std::io::{BufRead, BufReader, Read};
+use std::os::unix::net::UnixStream;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The workspace root (parent of this crate).
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Builds `bin` for the emulated board (release profile) and returns the ELF path.
+pub fn build_image(bin: &str) -> PathBuf {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(workspace_root())
+        .args([
+            "build",
+            "--release",
+            "-p",
+            "firmware",
+            "--no-default-features",
+            "--features",
+            "qemu",
+            "--target",
+            "thumbv7em-none-eabihf",
+            "--bin",
+            bin,
+        ])
+        .status()
+        .expect("cargo runs");
+    assert!(status.success(), "building {bin} for QEMU failed");
+    let target_dir = std::env::var("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| workspace_root().join("target"));
+    target_dir.join("thumbv7em-none-eabihf/release").join(bin)
+}
+
+/// A running emulated board: QEMU's stdout carries the semihosting console.
+pub struct Board {
+    pub child: Child,
+    pub usart: UnixStream,
+    socket_path: PathBuf,
+}
+
+impl Board {
+    /// Boots `elf`; QEMU waits (`server=on,wait=on`) until we have connected to its USART1, so
+    /// no byte the board sends is lost.
+    pub fn boot(elf: &Path) -> Board {
+        let socket_path = std::env::temp_dir().join(format!(
+            "bowl-qemu-{}-{}.sock",
+            std::process::id(),
+            elf.file_name().unwrap().to_string_lossy()
+        ));
+        let _ = std::fs::remove_file(&socket_path);
+        let child = Command::new("qemu-system-arm")
+            .args([
+                "-machine",
+                "netduinoplus2",
+                "-cpu",
+                "cortex-m4",
+                "-nographic",
+            ])
+            .args(["-monitor", "none"])
+            .args(["-semihosting-config", "enable=on,target=native"])
+            .args(["-icount", "shift=0,sleep=off"])
+            .arg("-chardev")
+            .arg(format!(
+                "socket,id=usart1,path={},server=on,wait=on",
+                socket_path.display()
+            ))
+            .args(["-serial", "chardev:usart1"])
+            .arg("-kernel")
+            .arg(elf)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("qemu-system-arm is installed");
+        let deadline = Instant::now() + Duration::from_secs(20);
+        let usart = loop {
+            match UnixStream::connect(&socket_path) {
+                Ok(s) => break s,
+                Err(_) if Instant::now() < deadline => {
+                    std::thread::sleep(Duration::from_millis(20))
+                }
+                Err(e) => panic!("QEMU's USART socket never appeared: {e}"),
+            }
+        };
+        usart
+            .set_read_timeout(Some(Duration::from_secs(30)))
+            .unwrap();
+        Board {
+            child,
+            usart,
+            socket_path,
+        }
+    }
+
+    /// Reads one `\n`-terminated line from the USART (without the newline).
+    pub fn read_usart_line(&mut self) -> String {
+        let mut line = Vec::new();
+        let mut byte = [0u8; 1];
+        loop {
+            let n = self.usart.read(&mut byte).expect("USART read");
+            assert!(n == 1, "USART closed before a full line: {line:?}");
+            if byte[0] == b'\n' {
+                return String::from_utf8_lossy(&line).into_owned();
+            }
+            line.push(byte[0]);
+        }
+    }
+
+    /// Waits for QEMU to exit and returns (exit success, console lines).
+    pub fn finish(mut self) -> (bool, Vec<String>) {
+        let stdout = self.child.stdout.take().unwrap();
+        let lines: Vec<String> = BufReader::new(stdout)
+            .lines()
+            .map_while(Result::ok)
+            .collect();
+        let status = self.child.wait().expect("QEMU exits");
+        (status.success(), lines)
+    }
+}
+
+impl Drop for Board {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = std::fs::remove_file(&self.socket_path);
+    }
+}
