@@ -36,17 +36,19 @@ impl SimulatedRig {
             (ParamId::MuPpm, 29_000),
             (ParamId::K2Ppm, 714_286),
             (ParamId::AxesMdeg, 60_000),
-            (ParamId::Kp1Micro, 200_000),
-            (ParamId::Ki1Micro, 1_000_000),
-            (ParamId::Kp2Micro, 200_000),
-            (ParamId::Ki2Micro, 1_000_000),
-            (ParamId::SpeedMaxMradS, 5_000),
-            (ParamId::AccelMaxMradS2, 2_000),
-            (ParamId::DutyMaxBp, 9_500),
+            (ParamId::Bandwidth1MradS, 10_000),
+            (ParamId::Bandwidth2MradS, 10_000),
+            (ParamId::PerPulse1Ppm, 500_000),
+            (ParamId::PerPulse2Ppm, 500_000),
+            (ParamId::SpeedMax1MradS, 5_000),
+            (ParamId::SpeedMax2MradS, 5_000),
+            (ParamId::Accel1MradS2, 2_000),
+            (ParamId::Accel2MradS2, 2_000),
+            (ParamId::DutyMax1Bp, 9_500),
+            (ParamId::DutyMax2Bp, 9_500),
             (ParamId::Teeth1, 1),
             (ParamId::Teeth2, 1),
-            (ParamId::Ratio1Ppm, 1_000_000),
-            (ParamId::Ratio2Ppm, 1_000_000),
+            (ParamId::RatioPpm, 1_000_000),
             (ParamId::TelemetryHz, 50),
         ]) {
             debug_assert_eq!(id.index(), params_index(id));
@@ -71,7 +73,7 @@ impl SimulatedRig {
             self.now_ms = self.now_ms.wrapping_add(1);
             for axis in 0..2 {
                 let target = match self.state {
-                    DeviceState::Starting | DeviceState::Running => {
+                    DeviceState::SpinningUp | DeviceState::Running => {
                         f64::from(self.set_mrad_s[axis]) / 1000.0
                     }
                     _ => 0.0,
@@ -99,7 +101,7 @@ impl SimulatedRig {
             {
                 self.state = DeviceState::Idle;
             }
-            if self.state == DeviceState::Starting {
+            if self.state == DeviceState::SpinningUp {
                 self.state = DeviceState::Running;
             }
         }
@@ -172,7 +174,7 @@ impl Rig for SimulatedRig {
         if self.state == DeviceState::Faulted {
             return Err(Reason::State);
         }
-        self.state = DeviceState::Starting;
+        self.state = DeviceState::SpinningUp;
         Ok(())
     }
 

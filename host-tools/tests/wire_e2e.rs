@@ -102,7 +102,7 @@ fn send_and_monitor_against_the_virtual_rig() {
     // The rejected command changed nothing: the setpoints are still 1800/2100.
     let params = bowl(&["send", p, "params"]);
     assert_eq!(params.status.code(), Some(0));
-    assert!(stdout(&params).contains("SPEED_MAX_MRAD_S=5000"));
+    assert!(stdout(&params).contains("SPEED_MAX2_MRAD_S=5000"));
 
     let dir = temp_dir("monitor");
     let log = dir.join("log.csv");

@@ -40,7 +40,7 @@ fn widest_telemetry_is_max_telemetry_len() {
         time_ms: u32::MAX,
         seq: u16::MAX,
         state: DeviceState::Faulted,
-        fault: FaultCode::Internal,
+        fault: FaultCode::InvalidConfiguration,
         precession: widest_motor,
         spin: widest_motor,
         bowl_mrad_s: u16::MAX,

@@ -60,7 +60,7 @@ impl Rig for Recorder {
     }
     fn param(&self, id: ParamId) -> i32 {
         match id {
-            ParamId::SpeedMaxMradS => self.speed_max,
+            ParamId::SpeedMax1MradS | ParamId::SpeedMax2MradS => self.speed_max,
             _ => id.range().0,
         }
     }
@@ -138,7 +138,7 @@ fn each_command_gets_its_answer() {
     }
     match got[11] {
         Frame::Params { id: 12, values } => {
-            assert_eq!(values[ParamId::SpeedMaxMradS.index()], 5000);
+            assert_eq!(values[ParamId::SpeedMax2MradS.index()], 5000);
             assert_eq!(values[ParamId::TelemetryHz.index()], 25);
         }
         ref other => panic!("{other:?}"),

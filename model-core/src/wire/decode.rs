@@ -236,6 +236,8 @@ fn command(f: &mut Fields<'_>) -> Result<Command, Reason> {
             token_of(f.next_token()?, &Injection::ALL, Injection::token)
                 .ok_or(Reason::Malformed)?,
         ),
+        b"PING" => Command::Ping,
+        b"COMMISSION" => Command::Commission,
         _ => return Err(Reason::UnknownCommand),
     };
     f.end()?;

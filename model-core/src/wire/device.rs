@@ -16,7 +16,7 @@ pub trait Rig {
     fn telemetry(&self) -> Telemetry;
     /// Why and how often the device has reset.
     fn reset_info(&self) -> Hello;
-    /// New motor setpoints, mrad/s; [`Device`] has already checked 0..=SPEED_MAX_MRAD_S.
+    /// New motor setpoints, mrad/s; [`Device`] has already checked each against 0..=its SPEED_MAX.
     fn set_speeds(&mut self, precession_mrad_s: i16, spin_mrad_s: i16) -> Result<(), Reason>;
     /// Choose the setpoints whose predicted residence time is `time_ms`.
     fn set_residence(&mut self, model: ResidenceModel, time_ms: u32) -> Result<(), Reason>;
@@ -31,6 +31,12 @@ pub trait Rig {
     fn set_param(&mut self, id: ParamId, value: i32) -> Result<(), Reason>;
     /// The current value of a parameter (never asked for [`ParamId::TelemetryHz`]).
     fn param(&self, id: ParamId) -> i32;
+    /// A heartbeat from the PC (every command counts as one too; this is for PING).
+    fn heartbeat(&mut self) {}
+    /// Start the motor identification routine.
+    fn commission(&mut self) -> Result<(), Reason> {
+        Err(Reason::Unsupported)
+    }
     /// Make a simulated rig misbehave. Real hardware keeps the default: `Unsupported`.
     fn inject(&mut self, what: Injection) -> Result<(), Reason> {
         let _ = what;
@@ -128,9 +134,10 @@ impl Device {
                 precession_mrad_s,
                 spin_mrad_s,
             } => {
-                let max = rig.param(ParamId::SpeedMaxMradS);
-                let ok = |v: i16| (0..=max).contains(&i32::from(v));
-                if ok(precession_mrad_s) && ok(spin_mrad_s) {
+                let ok = |v: i16, limit: ParamId| (0..=rig.param(limit)).contains(&i32::from(v));
+                if ok(precession_mrad_s, ParamId::SpeedMax1MradS)
+                    && ok(spin_mrad_s, ParamId::SpeedMax2MradS)
+                {
                     rig.set_speeds(precession_mrad_s, spin_mrad_s)
                 } else {
                     Err(Reason::Range)
@@ -170,6 +177,11 @@ impl Device {
                 };
             }
             Command::Inject(what) => rig.inject(what),
+            Command::Ping => {
+                rig.heartbeat();
+                Ok(())
+            }
+            Command::Commission => rig.commission(),
         };
         match done {
             Ok(()) => Frame::Ack { id },

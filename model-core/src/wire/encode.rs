@@ -194,6 +194,8 @@ fn command_body(out: &mut Out<'_>, command: &Command) {
             out.token("INJECT");
             out.token(what.token());
         }
+        Command::Ping => out.token("PING"),
+        Command::Commission => out.token("COMMISSION"),
     }
 }
 

@@ -7,44 +7,42 @@
 /// Pulse-count, sequence-number and request-id fields wrap modulo 2^16.
 pub type Wrapping16 = u16;
 
-/// What the rig is doing.
+/// What the rig is doing (the numbers are the controller's `State as u8`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum DeviceState {
     /// Motors off, waiting for a command.
     Idle = 0,
-    /// Ramping towards the setpoints.
-    Starting = 1,
-    /// At the setpoints, speed loops closed.
-    Running = 2,
+    /// The identification routine drives one axis at a time, open loop.
+    Commissioning = 1,
+    /// Closed loop, ramping towards the setpoints.
+    SpinningUp = 2,
+    /// Closed loop, at the setpoints.
+    Running = 3,
     /// Ramping down after STOP.
-    Stopping = 3,
+    Stopping = 4,
     /// A fault stopped the motors; CLEAR returns to Idle.
-    Faulted = 4,
+    Faulted = 5,
 }
 
-/// Why the rig stopped itself (0 = no fault).
+/// Why the rig stopped itself (0 = no fault; the numbers are the controller's fault codes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum FaultCode {
     /// No fault.
     None = 0,
-    /// The precession sensor gave no pulses while its motor was driven.
-    SensorLostPrecession = 1,
-    /// The spin sensor gave no pulses while its motor was driven.
-    SensorLostSpin = 2,
-    /// The precession motor exceeded the speed limit.
+    /// Precession: duty above the stall threshold and no pulse (sensor dead or shaft blocked).
+    SensorLostOrStallPrecession = 1,
+    /// Spin: duty above the stall threshold and no pulse (sensor dead or shaft blocked).
+    SensorLostOrStallSpin = 2,
+    /// The precession motor exceeded its over-speed limit.
     OverspeedPrecession = 3,
-    /// The spin motor exceeded the speed limit.
+    /// The spin motor exceeded its over-speed limit.
     OverspeedSpin = 4,
-    /// The precession motor stayed far below its setpoint at full duty.
-    StallPrecession = 5,
-    /// The spin motor stayed far below its setpoint at full duty.
-    StallSpin = 6,
-    /// The control loop missed its deadline (watchdog).
-    Watchdog = 7,
-    /// An internal invariant failed (a bug).
-    Internal = 8,
+    /// No command or heartbeat (PING) from the PC within the host timeout.
+    HostSilent = 5,
+    /// The configuration is invalid, or commissioning failed.
+    InvalidConfiguration = 6,
 }
 
 /// What caused the last reset of the microcontroller (STM32 RCC_CSR flags).
@@ -195,34 +193,38 @@ pub enum ParamId {
     K2Ppm,
     /// Angle between the spin and precession axes (paper Eq. 2), millidegrees.
     AxesMdeg,
-    /// Precession PI proportional gain, 1e-6 duty per rad/s.
-    Kp1Micro,
-    /// Precession PI integral gain, 1e-6 duty per rad.
-    Ki1Micro,
-    /// Spin PI proportional gain, 1e-6 duty per rad/s.
-    Kp2Micro,
-    /// Spin PI integral gain, 1e-6 duty per rad.
-    Ki2Micro,
-    /// Speed limit of both motors (setpoints above it are rejected), mrad/s.
-    SpeedMaxMradS,
-    /// Setpoint ramp rate, mrad/s^2.
-    AccelMaxMradS2,
-    /// PWM duty limit, basis points.
-    DutyMaxBp,
-    /// Target-wheel teeth (pulses per revolution) on the precession sensor shaft.
+    /// Precession speed-loop bandwidth (the PI gains follow from it and the motor model), mrad/s.
+    Bandwidth1MradS,
+    /// Spin speed-loop bandwidth, mrad/s.
+    Bandwidth2MradS,
+    /// Precession loop bandwidth per pulse rate (caps the bandwidth at low speed), ppm.
+    PerPulse1Ppm,
+    /// Spin loop bandwidth per pulse rate, ppm.
+    PerPulse2Ppm,
+    /// Precession speed limit (setpoints above it are rejected), mrad/s.
+    SpeedMax1MradS,
+    /// Spin speed limit, mrad/s.
+    SpeedMax2MradS,
+    /// Precession setpoint ramp rate, mrad/s^2.
+    Accel1MradS2,
+    /// Spin setpoint ramp rate, mrad/s^2.
+    Accel2MradS2,
+    /// Precession PWM duty limit, basis points.
+    DutyMax1Bp,
+    /// Spin PWM duty limit, basis points.
+    DutyMax2Bp,
+    /// Target-wheel teeth (pulses per revolution) on the precession sensor.
     Teeth1,
-    /// Target-wheel teeth on the spin sensor shaft.
+    /// Target-wheel teeth on the spin sensor.
     Teeth2,
-    /// Revolutions of the precession sensor shaft per revolution of the axis, parts per million.
-    Ratio1Ppm,
-    /// Revolutions of the spin sensor shaft per revolution of the axis, parts per million.
-    Ratio2Ppm,
+    /// Spin speed per precession speed used to split a combined bowl speed (Eq. 2), ppm.
+    RatioPpm,
     /// Telemetry rate, frames per second, 0 = off (50 fills under half of 115 200 baud).
     TelemetryHz,
 }
 
 /// Number of parameters; a PARAMS answer carries this many values in [`ParamId::ALL`] order.
-pub const PARAM_COUNT: usize = 17;
+pub const PARAM_COUNT: usize = 19;
 
 /// The values of all parameters, indexed by [`ParamId::index`].
 pub type ParamValues = [i32; PARAM_COUNT];
@@ -235,17 +237,19 @@ impl ParamId {
         ParamId::MuPpm,
         ParamId::K2Ppm,
         ParamId::AxesMdeg,
-        ParamId::Kp1Micro,
-        ParamId::Ki1Micro,
-        ParamId::Kp2Micro,
-        ParamId::Ki2Micro,
-        ParamId::SpeedMaxMradS,
-        ParamId::AccelMaxMradS2,
-        ParamId::DutyMaxBp,
+        ParamId::Bandwidth1MradS,
+        ParamId::Bandwidth2MradS,
+        ParamId::PerPulse1Ppm,
+        ParamId::PerPulse2Ppm,
+        ParamId::SpeedMax1MradS,
+        ParamId::SpeedMax2MradS,
+        ParamId::Accel1MradS2,
+        ParamId::Accel2MradS2,
+        ParamId::DutyMax1Bp,
+        ParamId::DutyMax2Bp,
         ParamId::Teeth1,
         ParamId::Teeth2,
-        ParamId::Ratio1Ppm,
-        ParamId::Ratio2Ppm,
+        ParamId::RatioPpm,
         ParamId::TelemetryHz,
     ];
 
@@ -262,17 +266,19 @@ impl ParamId {
             ParamId::MuPpm => "MU_PPM",
             ParamId::K2Ppm => "K2_PPM",
             ParamId::AxesMdeg => "AXES_MDEG",
-            ParamId::Kp1Micro => "KP1_MICRO",
-            ParamId::Ki1Micro => "KI1_MICRO",
-            ParamId::Kp2Micro => "KP2_MICRO",
-            ParamId::Ki2Micro => "KI2_MICRO",
-            ParamId::SpeedMaxMradS => "SPEED_MAX_MRAD_S",
-            ParamId::AccelMaxMradS2 => "ACCEL_MAX_MRAD_S2",
-            ParamId::DutyMaxBp => "DUTY_MAX_BP",
+            ParamId::Bandwidth1MradS => "BW1_MRAD_S",
+            ParamId::Bandwidth2MradS => "BW2_MRAD_S",
+            ParamId::PerPulse1Ppm => "PER_PULSE1_PPM",
+            ParamId::PerPulse2Ppm => "PER_PULSE2_PPM",
+            ParamId::SpeedMax1MradS => "SPEED_MAX1_MRAD_S",
+            ParamId::SpeedMax2MradS => "SPEED_MAX2_MRAD_S",
+            ParamId::Accel1MradS2 => "ACCEL1_MRAD_S2",
+            ParamId::Accel2MradS2 => "ACCEL2_MRAD_S2",
+            ParamId::DutyMax1Bp => "DUTY_MAX1_BP",
+            ParamId::DutyMax2Bp => "DUTY_MAX2_BP",
             ParamId::Teeth1 => "TEETH1",
             ParamId::Teeth2 => "TEETH2",
-            ParamId::Ratio1Ppm => "RATIO1_PPM",
-            ParamId::Ratio2Ppm => "RATIO2_PPM",
+            ParamId::RatioPpm => "RATIO_PPM",
             ParamId::TelemetryHz => "TELEM_HZ",
         }
     }
@@ -285,14 +291,13 @@ impl ParamId {
             ParamId::MuPpm => (0, 1_000_000),
             ParamId::K2Ppm => (1, 1_000_000),
             ParamId::AxesMdeg => (0, 179_999),
-            ParamId::Kp1Micro | ParamId::Ki1Micro | ParamId::Kp2Micro | ParamId::Ki2Micro => {
-                (0, 100_000_000)
-            }
-            ParamId::SpeedMaxMradS => (0, i16::MAX as i32),
-            ParamId::AccelMaxMradS2 => (1, 1_000_000),
-            ParamId::DutyMaxBp => (0, DUTY_MAX_BP as i32),
+            ParamId::Bandwidth1MradS | ParamId::Bandwidth2MradS => (10, 1_000_000),
+            ParamId::PerPulse1Ppm | ParamId::PerPulse2Ppm => (10_000, 10_000_000),
+            ParamId::SpeedMax1MradS | ParamId::SpeedMax2MradS => (0, i16::MAX as i32),
+            ParamId::Accel1MradS2 | ParamId::Accel2MradS2 => (1, 1_000_000),
+            ParamId::DutyMax1Bp | ParamId::DutyMax2Bp => (0, DUTY_MAX_BP as i32),
             ParamId::Teeth1 | ParamId::Teeth2 => (1, 255),
-            ParamId::Ratio1Ppm | ParamId::Ratio2Ppm => (1_000, 100_000_000),
+            ParamId::RatioPpm => (1_000, 100_000_000),
             ParamId::TelemetryHz => (0, 50),
         }
     }
@@ -310,7 +315,7 @@ impl ParamId {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Command {
-    /// `SPEED,w1,w2`: set both motor setpoints, mrad/s (0..=SPEED_MAX_MRAD_S).
+    /// `SPEED,w1,w2`: set both motor setpoints, mrad/s (0 or up to the axis's SPEED_MAX).
     SetSpeeds {
         /// Precession setpoint omega1, mrad/s.
         precession_mrad_s: i16,
@@ -343,6 +348,10 @@ pub enum Command {
     GetParams,
     /// `INJECT,what`: make the simulated rig misbehave.
     Inject(Injection),
+    /// `PING`: a heartbeat; keeps the rig's host-silence watchdog from faulting.
+    Ping,
+    /// `COMMISSION`: run the motor identification routine (from Idle).
+    Commission,
 }
 
 /// Why a command was rejected. A rejected command changed nothing.
@@ -475,21 +484,20 @@ macro_rules! code_enum {
 
 code_enum!(DeviceState {
     Idle,
-    Starting,
+    Commissioning,
+    SpinningUp,
     Running,
     Stopping,
-    Faulted
+    Faulted,
 });
 code_enum!(FaultCode {
     None,
-    SensorLostPrecession,
-    SensorLostSpin,
+    SensorLostOrStallPrecession,
+    SensorLostOrStallSpin,
     OverspeedPrecession,
     OverspeedSpin,
-    StallPrecession,
-    StallSpin,
-    Watchdog,
-    Internal,
+    HostSilent,
+    InvalidConfiguration,
 });
 code_enum!(ResetCause {
     PowerOn,

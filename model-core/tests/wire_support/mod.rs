@@ -5,11 +5,11 @@ use model_core::wire::*;
 use proptest::prelude::*;
 
 pub fn device_state() -> impl Strategy<Value = DeviceState> {
-    (0i64..5).prop_map(|c| DeviceState::from_code(c).unwrap())
+    (0i64..6).prop_map(|c| DeviceState::from_code(c).unwrap())
 }
 
 pub fn fault() -> impl Strategy<Value = FaultCode> {
-    (0i64..9).prop_map(|c| FaultCode::from_code(c).unwrap())
+    (0i64..7).prop_map(|c| FaultCode::from_code(c).unwrap())
 }
 
 pub fn reset_cause() -> impl Strategy<Value = ResetCause> {
@@ -101,6 +101,8 @@ pub fn command() -> impl Strategy<Value = Command> {
         param,
         Just(Command::GetStatus),
         Just(Command::GetParams),
+        Just(Command::Ping),
+        Just(Command::Commission),
         (0..Injection::ALL.len()).prop_map(|i| Command::Inject(Injection::ALL[i])),
     ]
 }
