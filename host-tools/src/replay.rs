@@ -39,14 +39,15 @@ pub fn stats_json(s: &DecodeStats) -> serde_json::Value {
     })
 }
 
-/// Decodes `bytes`, calling `on_frame` for every good frame; returns the statistics.
-pub fn decode_capture(bytes: &[u8], mut on_frame: impl FnMut(&Decoder, &Frame)) -> DecodeStats {
+/// Decodes `bytes`, calling `on_frame` for every good frame (with the counters right after
+/// it); returns the final statistics.
+pub fn decode_capture(bytes: &[u8], mut on_frame: impl FnMut(&DecodeStats, &Frame)) -> DecodeStats {
     let mut decoder = Decoder::new();
-    for &b in bytes {
-        if let Some(Ok(frame)) = decoder.push(b) {
-            on_frame(&decoder, &frame);
+    decoder.push_slice(bytes, |r, stats| {
+        if let Ok(frame) = r {
+            on_frame(stats, &frame);
         }
-    }
+    });
     decoder.finish();
     *decoder.stats()
 }
@@ -68,12 +69,12 @@ pub fn run(args: &Args) -> Result<()> {
     let mut telemetry = 0u64;
     let mut csv_error = None;
     let started = Instant::now();
-    let stats = decode_capture(&bytes, |decoder, frame| {
+    let stats = decode_capture(&bytes, |stats, frame| {
         if let Frame::Telemetry(t) = frame {
             telemetry += 1;
             if let Some(w) = csv.as_mut()
                 && csv_error.is_none()
-                && let Err(e) = telemetry_csv::write_row(w, decoder.stats().restarts, t)
+                && let Err(e) = telemetry_csv::write_row(w, stats.restarts, t)
             {
                 csv_error = Some(e);
             }

@@ -38,7 +38,7 @@ fn capture(base: &Telemetry, n: usize, noise: &[Vec<u8>]) -> (Vec<u8>, Vec<Place
 fn decode_all(bytes: &[u8]) -> (Vec<Frame>, DecodeStats) {
     let mut d = Decoder::new();
     let mut frames = Vec::new();
-    d.push_slice(bytes, |r| {
+    d.push_slice(bytes, |r, _| {
         if let Ok(f) = r {
             frames.push(f)
         }
@@ -298,6 +298,34 @@ fn one_percent_corrupted_bytes_lose_only_the_touched_frames() {
         stats.frames_corrupt,
         stats.bytes_skipped
     );
+}
+
+proptest! {
+    /// The bulk path and the byte-wise path agree on every input, however it is split.
+    #[test]
+    fn push_slice_equals_push(
+        base in telemetry(),
+        noise in noise_strategy(8),
+        damage in proptest::collection::vec(damage_strategy(1000), 0..8),
+        split in 1usize..300,
+    ) {
+        let (clean, _) = capture(&base, 8, &noise);
+        let bytes = apply(&clean, &damage);
+        let mut bytewise = Decoder::new();
+        let mut expected = Vec::new();
+        for &b in &bytes {
+            if let Some(r) = bytewise.push(b) {
+                expected.push(r);
+            }
+        }
+        let mut bulk = Decoder::new();
+        let mut got = Vec::new();
+        for chunk in bytes.chunks(split) {
+            bulk.push_slice(chunk, |r, _| got.push(r));
+        }
+        prop_assert_eq!(got, expected);
+        prop_assert_eq!(bulk.stats(), bytewise.stats());
+    }
 }
 
 #[test]

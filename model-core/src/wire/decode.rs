@@ -472,15 +472,49 @@ impl Decoder {
         Some(FrameError::Truncated)
     }
 
-    /// Feeds a slice, calling `on_frame` for every line that ended or was dropped.
+    /// Feeds a slice, calling `on_frame` for every line that ended or was dropped (with the
+    /// counters as they are right after it). Same result as [`Decoder::push`] byte by byte,
+    /// but runs of ordinary bytes are scanned and copied in bulk (the host's replay speed).
     pub fn push_slice(
         &mut self,
-        bytes: &[u8],
-        mut on_frame: impl FnMut(Result<Frame, FrameError>),
+        mut bytes: &[u8],
+        mut on_frame: impl FnMut(Result<Frame, FrameError>, &DecodeStats),
     ) {
-        for &b in bytes {
-            if let Some(r) = self.push(b) {
-                on_frame(r);
+        while !bytes.is_empty() {
+            if !self.in_frame {
+                // Line noise: skip to the next `$`.
+                let noise = bytes
+                    .iter()
+                    .position(|&b| b == FRAME_START)
+                    .unwrap_or(bytes.len());
+                self.stats.bytes += noise as u64;
+                self.stats.bytes_skipped += noise as u64;
+                bytes = bytes.get(noise..).unwrap_or(&[]);
+            } else {
+                // Frame body: take the printable run that fits in the buffer.
+                let room = self.buf.len().saturating_sub(self.len);
+                let limit = bytes.len().min(room);
+                let head = bytes.get(..limit).unwrap_or(&[]);
+                let plain = head
+                    .iter()
+                    .position(|&b| !(0x20..=0x7E).contains(&b) || b == FRAME_START)
+                    .unwrap_or(limit);
+                if let (Some(dst), Some(src)) = (
+                    self.buf.get_mut(self.len..self.len + plain),
+                    bytes.get(..plain),
+                ) {
+                    dst.copy_from_slice(src);
+                    self.len += plain;
+                    self.stats.bytes += plain as u64;
+                }
+                bytes = bytes.get(plain..).unwrap_or(&[]);
+            }
+            // The next byte is a delimiter, a control byte or an overflow: the byte-wise path.
+            if let Some((&b, rest)) = bytes.split_first() {
+                bytes = rest;
+                if let Some(r) = self.push(b) {
+                    on_frame(r, &self.stats);
+                }
             }
         }
     }
