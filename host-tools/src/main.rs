@@ -6,6 +6,13 @@ use clap::{Parser, Subcommand};
 mod kinematics;
 mod predict;
 mod sim;
+mod monitor;
+mod replay;
+mod rig_binding;
+mod send;
+mod serial;
+mod telemetry_csv;
+mod virtual_rig;
 
 /// The PC side of the bowl granulation rig.
 #[derive(Parser)]
@@ -21,8 +28,25 @@ enum Command {
     Kinematics(kinematics::Args),
     /// Residence time and exit velocities of a particle (paper Eq. 5-12, corrected), or a batch CSV.
     Predict(predict::Args),
-    /// The controller against the simulated rig: step, family, commission, sweep, stability.
-    Sim(sim::Args),
+    /// Live view of the rig's telemetry, with CSV log and frame counters.
+    Monitor(monitor::Args),
+    /// Send one command to the rig and print its answer.
+    Send(send::Args),
+    /// Decode a raw capture of the rig's output; print statistics as JSON.
+    Replay(replay::Args),
+    /// The simulated rig: serve it on a pseudo-terminal (--pty) or capture its bytes (--capture),
+    /// or report on the controller against it (step, family, commission, sweep, stability, trace).
+    Sim(SimCommand),
+}
+
+/// `bowl sim`: either a report subcommand or the virtual rig's flags.
+#[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true)]
+struct SimCommand {
+    #[command(subcommand)]
+    report: Option<sim::What>,
+    #[command(flatten)]
+    rig: virtual_rig::Args,
 }
 
 fn main() -> Result<()> {
@@ -30,6 +54,12 @@ fn main() -> Result<()> {
     match cli.command {
         Command::Kinematics(args) => kinematics::run(&args),
         Command::Predict(args) => predict::run(&args),
-        Command::Sim(args) => sim::run(&args),
+        Command::Monitor(args) => monitor::run(&args),
+        Command::Send(args) => send::run(&args).map(|code| std::process::exit(code)),
+        Command::Replay(args) => replay::run(&args),
+        Command::Sim(args) => match &args.report {
+            Some(report) => sim::run(report),
+            None => virtual_rig::run(&args.rig),
+        },
     }
 }

@@ -16,15 +16,8 @@ use model_core::sim::prng::Prng;
 use model_core::sim::{ClosedLoop, Rig, RigParams, StepMetrics, StepReport};
 use serde::Serialize;
 
-/// Flags of `bowl sim`.
-#[derive(clap::Args)]
-pub struct Args {
-    #[command(subcommand)]
-    what: What,
-}
-
 #[derive(clap::Subcommand)]
-enum What {
+pub(crate) enum What {
     /// Step 0 -> 3 rad/s on the nominal rig; JSON.
     Step(StepArgs),
     /// The step on a seeded family of perturbed plants; JSON with worst case and median.
@@ -40,7 +33,7 @@ enum What {
 }
 
 #[derive(clap::Args)]
-struct TraceArgs {
+pub(crate) struct TraceArgs {
     #[command(flatten)]
     common: CommonArgs,
     /// Family plant index; without it, the nominal rig.
@@ -49,14 +42,14 @@ struct TraceArgs {
 }
 
 #[derive(clap::Args, Clone)]
-struct CommonArgs {
+pub(crate) struct CommonArgs {
     /// Seed of tooth errors, jitter and the family.
     #[arg(long, default_value_t = 1)]
     seed: u32,
 }
 
 #[derive(clap::Args)]
-struct StepArgs {
+pub(crate) struct StepArgs {
     #[command(flatten)]
     common: CommonArgs,
     /// Pulses per revolution of both sensors.
@@ -77,7 +70,7 @@ struct StepArgs {
 }
 
 #[derive(clap::Args)]
-struct FamilyArgs {
+pub(crate) struct FamilyArgs {
     #[command(flatten)]
     common: CommonArgs,
     /// Number of plants (at least 50).
@@ -92,7 +85,7 @@ struct FamilyArgs {
 }
 
 #[derive(clap::Args)]
-struct StabilityArgs {
+pub(crate) struct StabilityArgs {
     #[command(flatten)]
     common: CommonArgs,
     /// Speed of the test, rad/s.
@@ -101,8 +94,8 @@ struct StabilityArgs {
 }
 
 /// Runs `bowl sim`.
-pub fn run(args: &Args) -> Result<()> {
-    match &args.what {
+pub(crate) fn run(what: &What) -> Result<()> {
+    match what {
         What::Step(a) => {
             let mut rig = rig_with_pulses(a.pulses_per_rev);
             if let Some(r) = a.ripple_nm {

@@ -16,5 +16,6 @@ pub mod particle;
 pub mod control;
 pub mod real;
 pub mod sim;
+pub mod wire;
 
 pub use real::Real;

@@ -1,0 +1,100 @@
+//! `bowl replay FILE [--csv OUT]`: decode a raw byte capture of the rig's serial output and print
+//! one JSON line of statistics (and the decoding speed) on stdout.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use model_core::wire::{DecodeStats, Decoder, Frame};
+use serde_json::json;
+
+use crate::telemetry_csv;
+
+/// Flags of `bowl replay`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The raw capture (the bytes exactly as they came off the serial line).
+    file: PathBuf,
+    /// Write the decoded telemetry as CSV, keyed on device time.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+}
+
+/// Statistics as one JSON object.
+pub fn stats_json(s: &DecodeStats) -> serde_json::Value {
+    json!({
+        "bytes": s.bytes,
+        "frames_ok": s.frames_ok,
+        "frames_corrupt": s.frames_corrupt,
+        "frames_missing": s.frames_missing,
+        "bytes_skipped": s.bytes_skipped,
+        "bad_crc": s.bad_crc,
+        "malformed": s.malformed,
+        "oversize": s.oversize,
+        "truncated": s.truncated,
+        "duplicates": s.duplicates,
+        "restarts": s.restarts,
+    })
+}
+
+/// Decodes `bytes`, calling `on_frame` for every good frame (with the counters right after
+/// it); returns the final statistics.
+pub fn decode_capture(bytes: &[u8], mut on_frame: impl FnMut(&DecodeStats, &Frame)) -> DecodeStats {
+    let mut decoder = Decoder::new();
+    decoder.push_slice(bytes, |r, stats| {
+        if let Ok(frame) = r {
+            on_frame(stats, &frame);
+        }
+    });
+    decoder.finish();
+    *decoder.stats()
+}
+
+/// Runs `bowl replay`.
+pub fn run(args: &Args) -> Result<()> {
+    let bytes = std::fs::read(&args.file)
+        .with_context(|| format!("cannot read {}", args.file.display()))?;
+    let mut csv = match &args.csv {
+        Some(path) => {
+            let mut w = BufWriter::new(
+                File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
+            );
+            writeln!(w, "{}", telemetry_csv::HEADER)?;
+            Some(w)
+        }
+        None => None,
+    };
+    let mut telemetry = 0u64;
+    let mut csv_error = None;
+    let started = Instant::now();
+    let stats = decode_capture(&bytes, |stats, frame| {
+        if let Frame::Telemetry(t) = frame {
+            telemetry += 1;
+            if let Some(w) = csv.as_mut()
+                && csv_error.is_none()
+                && let Err(e) = telemetry_csv::write_row(w, stats.restarts, t)
+            {
+                csv_error = Some(e);
+            }
+        }
+    });
+    let seconds = started.elapsed().as_secs_f64();
+    if let Some(e) = csv_error {
+        return Err(e.context("writing the CSV"));
+    }
+    if let Some(mut w) = csv {
+        w.flush().context("writing the CSV")?;
+    }
+    let mut out = stats_json(&stats);
+    out["telemetry_frames"] = json!(telemetry);
+    out["decode_seconds"] = json!(seconds);
+    out["decode_mb_s"] = json!(if seconds > 0.0 {
+        bytes.len() as f64 / 1e6 / seconds
+    } else {
+        0.0
+    });
+    println!("{out}");
+    Ok(())
+}

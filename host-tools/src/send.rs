@@ -1,0 +1,160 @@
+//! `bowl send PORT COMMAND ...`: send one command, print the rig's answer. Exit status 0 when the
+//! rig did it, 2 when it (or the local check) rejected it, 3 when no answer came in time.
+
+use std::time::{Duration, Instant};
+
+use anyhow::{Result, bail};
+use model_core::wire::crc::crc32;
+use model_core::wire::{
+    Decoder, Frame, FrameError, PROTOCOL_VERSION, ParamId, Reason, decode_frame,
+};
+
+use crate::serial::{Port, ReadOutcome};
+
+/// Exit status of a rejected command.
+pub const EXIT_REJECTED: i32 = 2;
+/// Exit status when no answer came.
+pub const EXIT_TIMEOUT: i32 = 3;
+
+/// Flags of `bowl send`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The serial port or pseudo-terminal of the rig.
+    port: String,
+    /// The command and its arguments, e.g. `speed 1800 2100`, `rtime cori 2500`, `start`, `stop`,
+    /// `clear`, `set MU_PPM 29000`, `status`, `params`, `inject sensor2` (see docs/protocol.md).
+    #[arg(required = true, num_args = 1..)]
+    command: Vec<String>,
+    /// Baud rate.
+    #[arg(long, default_value_t = 115_200)]
+    baud: u32,
+    /// Request id echoed by the rig (default: derived from the clock).
+    #[arg(long)]
+    id: Option<u16>,
+    /// How long to wait for the answer, ms.
+    #[arg(long, default_value_t = 1000)]
+    timeout_ms: u64,
+}
+
+/// Builds the command line `$C1,id,WORDS...*CRC\n` and checks it with the shared decoder, so a
+/// command the rig would refuse as malformed or out of range never leaves the PC.
+pub fn command_line(id: u16, words: &[String]) -> Result<Vec<u8>, Reason> {
+    let mut payload = format!("C{PROTOCOL_VERSION},{id}");
+    for w in words {
+        for part in w.split(',').filter(|p| !p.is_empty()) {
+            payload.push(',');
+            payload.push_str(&part.to_ascii_uppercase());
+        }
+    }
+    let line = format!("${payload}*{:08X}\n", crc32(payload.as_bytes())).into_bytes();
+    match decode_frame(&line) {
+        Ok(Frame::Command { .. }) => Ok(line),
+        Err(FrameError::BadCommand { reason, .. }) => Err(reason),
+        _ => Err(Reason::Malformed),
+    }
+}
+
+/// What a rejection reason means, for people.
+pub fn explain(reason: Reason) -> &'static str {
+    match reason {
+        Reason::Malformed => "the fields did not parse",
+        Reason::UnknownCommand => "unknown command word",
+        Reason::UnknownParam => "unknown parameter name",
+        Reason::Range => "a value was outside its range (nothing was clamped or changed)",
+        Reason::State => "not allowed in the rig's current state",
+        Reason::Infeasible => "the target cannot be reached within the limits",
+        Reason::Unsupported => "this rig does not support that command",
+        Reason::Version => "the rig speaks another protocol version",
+        Reason::Internal => "the rig could not build its answer (a bug)",
+    }
+}
+
+/// A one-line description of an answer frame.
+pub fn describe(frame: &Frame) -> String {
+    match frame {
+        Frame::Ack { id } => format!("ok (id {id})"),
+        Frame::Reject { id, reason } => {
+            format!(
+                "rejected (id {id}): {} - {}",
+                reason.token(),
+                explain(*reason)
+            )
+        }
+        Frame::Status { id, status: s } => format!(
+            "status (id {id}): state={:?} fault={:?} reset_cause={:?} reset_count={} uptime_ms={} telemetry_hz={}",
+            s.state, s.fault, s.reset_cause, s.reset_count, s.uptime_ms, s.telemetry_hz
+        ),
+        Frame::Params { id, values } => {
+            let mut out = format!("params (id {id}):");
+            for (p, v) in ParamId::ALL.iter().zip(values.iter()) {
+                out.push_str(&format!(" {}={v}", p.token()));
+            }
+            out
+        }
+        other => format!("{other:?}"),
+    }
+}
+
+/// Sends `line` and waits for the frame answering `id`.
+pub fn transact(port: &mut Port, id: u16, line: &[u8], timeout: Duration) -> Result<Option<Frame>> {
+    port.write_all(line)?;
+    let deadline = Instant::now() + timeout;
+    let mut decoder = Decoder::new();
+    let mut buf = [0u8; 4096];
+    while let Some(left) = deadline.checked_duration_since(Instant::now()) {
+        match port.read(&mut buf, left.min(Duration::from_millis(50)))? {
+            ReadOutcome::Data(n) => {
+                for &b in &buf[..n] {
+                    if let Some(Ok(frame)) = decoder.push(b)
+                        && frame.answer_id() == Some(id)
+                    {
+                        return Ok(Some(frame));
+                    }
+                }
+            }
+            ReadOutcome::Timeout => {}
+            ReadOutcome::Gone => bail!("the port went away while waiting for the answer"),
+        }
+    }
+    Ok(None)
+}
+
+/// Runs `bowl send`; returns the process exit status.
+pub fn run(args: &Args) -> Result<i32> {
+    let id = args.id.unwrap_or_else(|| {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.subsec_nanos())
+            .unwrap_or(0);
+        (nanos % 65_521) as u16
+    });
+    let line = match command_line(id, &args.command) {
+        Ok(line) => line,
+        Err(reason) => {
+            println!(
+                "rejected locally: {} - {} (not sent)",
+                reason.token(),
+                explain(reason)
+            );
+            return Ok(EXIT_REJECTED);
+        }
+    };
+    let mut port = Port::open(&args.port, args.baud)?;
+    match transact(&mut port, id, &line, Duration::from_millis(args.timeout_ms))? {
+        Some(frame) => {
+            println!("{}", describe(&frame));
+            Ok(if matches!(frame, Frame::Reject { .. }) {
+                EXIT_REJECTED
+            } else {
+                0
+            })
+        }
+        None => {
+            println!(
+                "timeout: no answer to id {id} within {} ms",
+                args.timeout_ms
+            );
+            Ok(EXIT_TIMEOUT)
+        }
+    }
+}

@@ -1,0 +1,284 @@
+//! End to end: `bowl monitor` and `bowl send` against `bowl sim --pty`, and `bowl replay` on
+//! `bowl sim --capture`.
+
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const BOWL: &str = env!("CARGO_BIN_EXE_bowl");
+
+/// A `bowl sim --pty` process, killed when dropped.
+struct Sim {
+    child: Child,
+    path: String,
+}
+
+impl Sim {
+    fn start(extra: &[&str]) -> Sim {
+        let mut child = Command::new(BOWL)
+            .args(["sim", "--pty"])
+            .args(extra)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("bowl sim starts");
+        let mut line = String::new();
+        BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut line)
+            .expect("bowl sim prints its pty");
+        let path = line.trim().to_string();
+        assert!(path.starts_with("/dev/"), "pty path, got {path:?}");
+        Sim { child, path }
+    }
+}
+
+impl Drop for Sim {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn bowl(args: &[&str]) -> Output {
+    Command::new(BOWL).args(args).output().expect("bowl runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn last_json(o: &Output) -> serde_json::Value {
+    let text = stdout(o);
+    let line = text.lines().last().expect("a summary line");
+    serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("bowl-e2e-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// CSV rows as (boot, device_time_ms).
+fn csv_keys(path: &Path) -> Vec<(u64, u64)> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    assert!(lines.next().unwrap().starts_with("boot,device_time_ms,seq"));
+    lines
+        .map(|l| {
+            let mut f = l.split(',');
+            (
+                f.next().unwrap().parse().unwrap(),
+                f.next().unwrap().parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn send_and_monitor_against_the_virtual_rig() {
+    let sim = Sim::start(&["--seconds", "30"]);
+    let p = sim.path.as_str();
+
+    let ok = bowl(&["send", p, "speed", "1800", "2100"]);
+    assert_eq!(ok.status.code(), Some(0), "{}", stdout(&ok));
+    assert!(stdout(&ok).starts_with("ok"));
+    let start = bowl(&["send", p, "start"]);
+    assert_eq!(start.status.code(), Some(0), "{}", stdout(&start));
+
+    // Above the rig's speed limit (5000 mrad/s by default): rejected, not clamped.
+    let too_fast = bowl(&["send", p, "speed", "9000", "2100"]);
+    assert_eq!(too_fast.status.code(), Some(2));
+    assert!(stdout(&too_fast).contains("RANGE"), "{}", stdout(&too_fast));
+    // Outside the wire range: refused before it is sent.
+    let local = bowl(&["send", p, "set", "TEETH1", "0"]);
+    assert_eq!(local.status.code(), Some(2));
+    assert!(stdout(&local).contains("rejected locally"));
+    let unknown = bowl(&["send", p, "set", "NO_SUCH", "1"]);
+    assert_eq!(unknown.status.code(), Some(2));
+
+    // The rejected command changed nothing: the setpoints are still 1800/2100.
+    let params = bowl(&["send", p, "params"]);
+    assert_eq!(params.status.code(), Some(0));
+    assert!(stdout(&params).contains("SPEED_MAX2_MRAD_S=5000"));
+
+    let dir = temp_dir("monitor");
+    let log = dir.join("log.csv");
+    let mon = bowl(&[
+        "monitor",
+        p,
+        "--seconds",
+        "2",
+        "--plain",
+        "--log",
+        log.to_str().unwrap(),
+    ]);
+    assert_eq!(mon.status.code(), Some(0), "{}", stdout(&mon));
+    let summary = last_json(&mon);
+    let ok = summary["frames_ok"].as_u64().unwrap();
+    assert!(
+        (80..=200).contains(&ok),
+        "about 100 frames in 2 s at 50 Hz: {summary}"
+    );
+    assert_eq!(summary["frames_corrupt"], 0, "{summary}");
+    assert_eq!(summary["frames_missing"], 0, "{summary}");
+    assert!(stdout(&mon).contains("state=Running"), "{}", stdout(&mon));
+    assert!(stdout(&mon).contains("w1=1.7") || stdout(&mon).contains("w1=1.8"));
+
+    // The log: one row per telemetry frame, keyed on device time, 20 ms apart.
+    let keys = csv_keys(&log);
+    assert_eq!(keys.len() as u64, summary["logged_rows"].as_u64().unwrap());
+    assert!(keys.len() >= 80);
+    for w in keys.windows(2) {
+        assert_eq!(w[1].1 - w[0].1, 20, "{w:?}");
+    }
+
+    let status = bowl(&["send", p, "status"]);
+    assert!(
+        stdout(&status).contains("state=Running"),
+        "{}",
+        stdout(&status)
+    );
+    let stop = bowl(&["send", p, "stop"]);
+    assert_eq!(stop.status.code(), Some(0));
+}
+
+#[test]
+fn monitor_reopens_the_port_and_keeps_the_log() {
+    let dir = temp_dir("reopen");
+    let link = dir.join("rig");
+    let log = dir.join("log.csv");
+    let first = Sim::start(&["--seconds", "2", "--link", link.to_str().unwrap()]);
+    let monitor = Command::new(BOWL)
+        .args([
+            "monitor",
+            link.to_str().unwrap(),
+            "--seconds",
+            "6",
+            "--plain",
+        ])
+        .args(["--log", log.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The first rig goes away after 2 s (an unplug); a new one appears on the same name.
+    std::thread::sleep(Duration::from_millis(2800));
+    drop(first);
+    let _second = Sim::start(&["--seconds", "10", "--link", link.to_str().unwrap()]);
+    let out = monitor.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let text = stdout(&out);
+    assert!(text.contains("lost; reopening"), "{text}");
+    assert!(text.contains("reopened"), "{text}");
+    let summary = last_json(&out);
+    assert!(summary["reconnects"].as_u64().unwrap() >= 1, "{summary}");
+    // Both sessions are in the one log; the device clock restarted in between.
+    let keys = csv_keys(&log);
+    let restarts = keys.windows(2).filter(|w| w[1].1 < w[0].1).count();
+    assert_eq!(restarts, 1, "one restart of the device clock");
+    assert!(keys.len() > 100, "{} rows", keys.len());
+}
+
+#[test]
+fn send_times_out_when_nobody_answers() {
+    use nix::fcntl::OFlag;
+    use nix::pty::{grantpt, posix_openpt, ptsname_r, unlockpt};
+    let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY).unwrap();
+    grantpt(&master).unwrap();
+    unlockpt(&master).unwrap();
+    let path = ptsname_r(&master).unwrap();
+    let started = Instant::now();
+    let out = bowl(&["send", &path, "status", "--timeout-ms", "300"]);
+    assert_eq!(out.status.code(), Some(3), "{}", stdout(&out));
+    assert!(stdout(&out).contains("timeout"));
+    assert!(started.elapsed() >= Duration::from_millis(300));
+}
+
+#[test]
+fn pty_sends_exactly_the_bytes_of_the_capture() {
+    let dir = temp_dir("same-bytes");
+    let capture = dir.join("cap.bin");
+    let sim = Sim::start(&["--seconds", "10"]);
+    // Read the pty from its start: the sim keeps the slave open, so nothing is lost before we
+    // open it (the first second is well under the terminal's buffer).
+    let mut port = std::fs::File::open(&sim.path).unwrap();
+    let mut got = Vec::new();
+    let deadline = Instant::now() + Duration::from_millis(1500);
+    let mut buf = [0u8; 4096];
+    while Instant::now() < deadline && got.len() < 3000 {
+        let n = port.read(&mut buf).unwrap();
+        got.extend_from_slice(&buf[..n]);
+    }
+    let made = bowl(&[
+        "sim",
+        "--capture",
+        capture.to_str().unwrap(),
+        "--seconds",
+        "2",
+    ]);
+    assert!(made.status.success());
+    let expected = std::fs::read(&capture).unwrap();
+    assert!(got.len() > 1000, "read {} bytes", got.len());
+    assert_eq!(
+        &expected[..got.len()],
+        &got[..],
+        "pty and capture agree byte for byte"
+    );
+}
+
+#[test]
+fn replay_counts_what_the_capture_holds_and_what_damage_removed() {
+    let dir = temp_dir("replay");
+    let capture = dir.join("cap.bin");
+    let made = bowl(&[
+        "sim",
+        "--capture",
+        capture.to_str().unwrap(),
+        "--seconds",
+        "5",
+        "--command",
+        "0:speed,1800,2100",
+        "--command",
+        "0:start",
+    ]);
+    assert!(made.status.success());
+    let csv = dir.join("t.csv");
+    let clean = bowl(&[
+        "replay",
+        capture.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(clean.status.success());
+    let s = last_json(&clean);
+    // 1 hello + 2 acks + 5 s x 50 Hz telemetry.
+    assert_eq!(s["frames_ok"], 253, "{s}");
+    assert_eq!(s["telemetry_frames"], 250, "{s}");
+    assert_eq!(s["frames_corrupt"], 0);
+    assert_eq!(s["frames_missing"], 0);
+    assert_eq!(s["bytes_skipped"], 0);
+    assert_eq!(csv_keys(&csv).len(), 250);
+
+    // Damage three telemetry frames in the middle and add line noise: exactly those are lost.
+    let mut bytes = std::fs::read(&capture).unwrap();
+    let starts: Vec<usize> = bytes
+        .windows(3)
+        .enumerate()
+        .filter(|(_, w)| w == b"$T1")
+        .map(|(i, _)| i)
+        .collect();
+    for k in [50, 100, 101] {
+        bytes[starts[k] + 10] ^= 0x04;
+    }
+    let noise = b"\x00\xff garbage $$$ \n\n";
+    let at = starts[200];
+    bytes.splice(at..at, noise.iter().copied());
+    let damaged = dir.join("damaged.bin");
+    std::fs::write(&damaged, &bytes).unwrap();
+    let s = last_json(&bowl(&["replay", damaged.to_str().unwrap()]));
+    assert_eq!(s["telemetry_frames"], 247, "{s}");
+    assert_eq!(s["frames_missing"], 3, "{s}");
+    assert!(s["frames_corrupt"].as_u64().unwrap() >= 3, "{s}");
+}

@@ -1,0 +1,574 @@
+//! The decoder: one line to a [`Frame`] ([`parse_line`]), and the streaming [`Decoder`] that
+//! finds lines in a byte stream, resynchronises after garbage and keeps the statistics.
+
+use super::crc::crc32;
+use super::types::{
+    Command, DeviceState, FaultCode, Frame, Hello, Injection, MotorTelemetry, PARAM_COUNT, ParamId,
+    ParamValues, Reason, ResetCause, Residence, ResidenceModel, Status, Telemetry,
+};
+use super::{FRAME_END, FRAME_START, MAX_FRAME_LEN, PROTOCOL_VERSION};
+
+/// Why a line was not accepted as a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FrameError {
+    /// The line did not end in `*` and 8 upper-case hex digits.
+    BadTrailer,
+    /// The CRC did not match: the line was damaged on the way.
+    BadCrc,
+    /// The CRC matched but the kind letter is not one of `T H C A R S P`.
+    UnknownKind,
+    /// The CRC matched but the protocol version is not the one spoken here.
+    UnsupportedVersion,
+    /// The CRC matched but a field is missing, extra, not a canonical integer, or out of range.
+    Malformed,
+    /// A command whose CRC matched but whose content is wrong: the device answers
+    /// `Reject { id, reason }` (id 0 if the id itself did not parse).
+    BadCommand {
+        /// The request id, or 0.
+        id: u16,
+        /// The rejection to send.
+        reason: Reason,
+    },
+    /// The line grew past [`MAX_FRAME_LEN`] bytes without an end: dropped, decoder resynchronises.
+    Oversize,
+    /// A `$` or a byte that cannot appear in a frame (control character, non-ASCII) arrived
+    /// before the end of the line: the partial frame was dropped.
+    Truncated,
+}
+
+/// Error of one field: `Malformed` (not there, not a canonical integer or known token) or
+/// `Range` (a well-formed number outside the field's range).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum FieldError {
+    Malformed,
+    Range,
+}
+
+impl From<FieldError> for Reason {
+    fn from(e: FieldError) -> Reason {
+        match e {
+            FieldError::Malformed => Reason::Malformed,
+            FieldError::Range => Reason::Range,
+        }
+    }
+}
+
+/// The comma-separated fields of a payload.
+struct Fields<'a> {
+    rest: Option<&'a [u8]>,
+}
+
+impl<'a> Fields<'a> {
+    fn next_token(&mut self) -> Result<&'a [u8], FieldError> {
+        let rest = self.rest.ok_or(FieldError::Malformed)?;
+        match rest.iter().position(|&b| b == b',') {
+            Some(i) => {
+                self.rest = rest.get(i + 1..);
+                rest.get(..i).ok_or(FieldError::Malformed)
+            }
+            None => {
+                self.rest = None;
+                Ok(rest)
+            }
+        }
+    }
+
+    fn int(&mut self, lo: i64, hi: i64) -> Result<i64, FieldError> {
+        let v = parse_int(self.next_token()?)?;
+        if (lo..=hi).contains(&v) {
+            Ok(v)
+        } else {
+            Err(FieldError::Range)
+        }
+    }
+
+    fn end(&self) -> Result<(), FieldError> {
+        match self.rest {
+            None => Ok(()),
+            Some(_) => Err(FieldError::Malformed),
+        }
+    }
+}
+
+/// Canonical decimal: optional `-`, 1 to 18 digits, no leading zero, no `-0`.
+fn parse_int(tok: &[u8]) -> Result<i64, FieldError> {
+    let (neg, digits) = match tok.split_first() {
+        Some((b'-', d)) => (true, d),
+        _ => (false, tok),
+    };
+    if digits.is_empty() || digits.len() > 18 {
+        return Err(FieldError::Malformed);
+    }
+    if digits.len() > 1 && digits[0] == b'0' {
+        return Err(FieldError::Malformed);
+    }
+    let mut v: i64 = 0;
+    for &d in digits {
+        if !d.is_ascii_digit() {
+            return Err(FieldError::Malformed);
+        }
+        // 18 digits < 9.2e18: no overflow.
+        v = v * 10 + i64::from(d - b'0');
+    }
+    if neg {
+        if v == 0 {
+            return Err(FieldError::Malformed);
+        }
+        v = -v;
+    }
+    Ok(v)
+}
+
+fn hex_value(b: u8) -> Option<u32> {
+    match b {
+        b'0'..=b'9' => Some(u32::from(b - b'0')),
+        b'A'..=b'F' => Some(u32::from(b - b'A' + 10)),
+        _ => None,
+    }
+}
+
+// The narrowing casts below follow a range check in `Fields::int`, so they are exact.
+fn u16_field(f: &mut Fields<'_>) -> Result<u16, FieldError> {
+    Ok(f.int(0, u16::MAX.into())? as u16)
+}
+
+fn i16_field(f: &mut Fields<'_>) -> Result<i16, FieldError> {
+    Ok(f.int(i16::MIN.into(), i16::MAX.into())? as i16)
+}
+
+fn u32_field(f: &mut Fields<'_>) -> Result<u32, FieldError> {
+    Ok(f.int(0, u32::MAX.into())? as u32)
+}
+
+fn motor(f: &mut Fields<'_>) -> Result<MotorTelemetry, FieldError> {
+    Ok(MotorTelemetry {
+        set_mrad_s: i16_field(f)?,
+        measured_mrad_s: i16_field(f)?,
+        duty_bp: f.int(-10_000, 10_000)? as i16,
+        pulses: u16_field(f)?,
+    })
+}
+
+fn coded<T>(f: &mut Fields<'_>, from: fn(i64) -> Option<T>) -> Result<T, FieldError> {
+    from(f.int(0, 255)?).ok_or(FieldError::Range)
+}
+
+fn residence(f: &mut Fields<'_>) -> Result<Residence, FieldError> {
+    Residence::from_wire(f.int(-2, 9_999_999)?).ok_or(FieldError::Range)
+}
+
+fn telemetry(f: &mut Fields<'_>) -> Result<Telemetry, FieldError> {
+    Ok(Telemetry {
+        time_ms: u32_field(f)?,
+        seq: u16_field(f)?,
+        state: coded(f, DeviceState::from_code)?,
+        fault: coded(f, FaultCode::from_code)?,
+        precession: motor(f)?,
+        spin: motor(f)?,
+        bowl_mrad_s: u16_field(f)?,
+        residence_flat: residence(f)?,
+        residence_coriolis: residence(f)?,
+    })
+}
+
+fn status(f: &mut Fields<'_>) -> Result<Status, FieldError> {
+    Ok(Status {
+        state: coded(f, DeviceState::from_code)?,
+        fault: coded(f, FaultCode::from_code)?,
+        reset_cause: coded(f, ResetCause::from_code)?,
+        reset_count: u16_field(f)?,
+        uptime_ms: u32_field(f)?,
+        telemetry_hz: param_value(f, ParamId::TelemetryHz)? as u8,
+    })
+}
+
+fn param_value(f: &mut Fields<'_>, id: ParamId) -> Result<i32, FieldError> {
+    let (lo, hi) = id.range();
+    Ok(f.int(lo.into(), hi.into())? as i32)
+}
+
+fn params(f: &mut Fields<'_>) -> Result<ParamValues, FieldError> {
+    let mut values = [0i32; PARAM_COUNT];
+    for (slot, &id) in values.iter_mut().zip(ParamId::ALL.iter()) {
+        *slot = param_value(f, id)?;
+    }
+    Ok(values)
+}
+
+fn token_of<T: Copy>(tok: &[u8], all: &[T], token: fn(T) -> &'static str) -> Option<T> {
+    all.iter().copied().find(|&t| token(t).as_bytes() == tok)
+}
+
+/// Parses the command word and its arguments. Unknown words and parameters get their own
+/// reasons; a well-formed number outside its range is `Range`.
+fn command(f: &mut Fields<'_>) -> Result<Command, Reason> {
+    let word = f.next_token().map_err(Reason::from)?;
+    let cmd = match word {
+        b"SPEED" => Command::SetSpeeds {
+            precession_mrad_s: i16_field(f)?,
+            spin_mrad_s: i16_field(f)?,
+        },
+        b"RTIME" => {
+            let model = match f.next_token()? {
+                b"FLAT" => ResidenceModel::Flat,
+                b"CORI" => ResidenceModel::Coriolis,
+                _ => return Err(Reason::Malformed),
+            };
+            Command::SetResidence {
+                model,
+                time_ms: f.int(1, 9_999_999)? as u32,
+            }
+        }
+        b"START" => Command::Start,
+        b"STOP" => Command::Stop,
+        b"CLEAR" => Command::ClearFault,
+        b"SET" => {
+            let id = ParamId::from_token(f.next_token()?).ok_or(Reason::UnknownParam)?;
+            Command::SetParam {
+                id,
+                value: param_value(f, id)?,
+            }
+        }
+        b"STATUS" => Command::GetStatus,
+        b"PARAMS" => Command::GetParams,
+        b"INJECT" => Command::Inject(
+            token_of(f.next_token()?, &Injection::ALL, Injection::token)
+                .ok_or(Reason::Malformed)?,
+        ),
+        b"PING" => Command::Ping,
+        b"COMMISSION" => Command::Commission,
+        _ => return Err(Reason::UnknownCommand),
+    };
+    f.end()?;
+    Ok(cmd)
+}
+
+impl From<FieldError> for FrameError {
+    fn from(_: FieldError) -> FrameError {
+        FrameError::Malformed
+    }
+}
+
+/// Parses one line: the bytes after `$` and before `\n` (a trailing `\r` is allowed).
+pub fn parse_line(line: &[u8]) -> Result<Frame, FrameError> {
+    let line = match line.split_last() {
+        Some((b'\r', rest)) => rest,
+        _ => line,
+    };
+    // Kind letter, version digit, `*`, 8 hex digits at least.
+    if line.len() < 11 {
+        return Err(FrameError::BadTrailer);
+    }
+    let star = line.len() - 9;
+    let (payload, trailer) = line.split_at(star);
+    if trailer[0] != b'*' {
+        return Err(FrameError::BadTrailer);
+    }
+    let mut sent = 0u32;
+    for &h in &trailer[1..] {
+        sent = (sent << 4) | hex_value(h).ok_or(FrameError::BadTrailer)?;
+    }
+    if crc32(payload) != sent {
+        return Err(FrameError::BadCrc);
+    }
+    parse_payload(payload)
+}
+
+/// Parses a payload whose CRC has been checked.
+fn parse_payload(payload: &[u8]) -> Result<Frame, FrameError> {
+    let mut f = Fields {
+        rest: Some(payload),
+    };
+    let head = f.next_token()?;
+    let (&kind, version) = head.split_first().ok_or(FrameError::Malformed)?;
+    if version != [b'0' + PROTOCOL_VERSION] {
+        if kind == b'C' {
+            let id = u16_field(&mut f).unwrap_or(0);
+            return Err(FrameError::BadCommand {
+                id,
+                reason: Reason::Version,
+            });
+        }
+        return Err(FrameError::UnsupportedVersion);
+    }
+    let frame = match kind {
+        b'T' => Frame::Telemetry(telemetry(&mut f)?),
+        b'H' => Frame::Hello(Hello {
+            reset_cause: coded(&mut f, ResetCause::from_code)?,
+            reset_count: u16_field(&mut f)?,
+        }),
+        b'C' => {
+            let id = u16_field(&mut f).map_err(|_| FrameError::BadCommand {
+                id: 0,
+                reason: Reason::Malformed,
+            })?;
+            let command =
+                command(&mut f).map_err(|reason| FrameError::BadCommand { id, reason })?;
+            return Ok(Frame::Command { id, command });
+        }
+        b'A' => Frame::Ack {
+            id: u16_field(&mut f)?,
+        },
+        b'R' => Frame::Reject {
+            id: u16_field(&mut f)?,
+            reason: token_of(f.next_token()?, &Reason::ALL, Reason::token)
+                .ok_or(FrameError::Malformed)?,
+        },
+        b'S' => Frame::Status {
+            id: u16_field(&mut f)?,
+            status: status(&mut f)?,
+        },
+        b'P' => Frame::Params {
+            id: u16_field(&mut f)?,
+            values: params(&mut f)?,
+        },
+        _ => return Err(FrameError::UnknownKind),
+    };
+    f.end()?;
+    Ok(frame)
+}
+
+/// Decodes one complete frame `$...\n` (for tests and one-shot use).
+pub fn decode_frame(bytes: &[u8]) -> Result<Frame, FrameError> {
+    match bytes {
+        [FRAME_START, line @ .., FRAME_END] => parse_line(line),
+        _ => Err(FrameError::BadTrailer),
+    }
+}
+
+/// Counters of a [`Decoder`]. Every byte fed is either in a good frame or in `bytes_skipped`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct DecodeStats {
+    /// Bytes fed.
+    pub bytes: u64,
+    /// Frames accepted.
+    pub frames_ok: u64,
+    /// Frame candidates (a `$` followed by bytes) that were dropped: the sum of the four
+    /// counters below. One damaged frame can count twice (a `$` hit inside it splits it).
+    pub frames_corrupt: u64,
+    /// Telemetry frames lost: the sum of the sequence-number gaps between accepted telemetry
+    /// frames (frames lost before the first or after the last accepted one cannot be seen).
+    pub frames_missing: u64,
+    /// Bytes not part of an accepted frame: line noise plus the bytes of dropped frames.
+    pub bytes_skipped: u64,
+    /// Dropped: CRC mismatch.
+    pub bad_crc: u64,
+    /// Dropped: bad trailer, unknown kind or version, malformed fields (CRC matched or absent).
+    pub malformed: u64,
+    /// Dropped: longer than [`MAX_FRAME_LEN`].
+    pub oversize: u64,
+    /// Dropped: cut by a `$` or a byte that cannot be in a frame.
+    pub truncated: u64,
+    /// Telemetry frames that repeated the previous sequence number.
+    pub duplicates: u64,
+    /// Device restarts seen (a Hello frame, or telemetry time going backwards): the sequence
+    /// gap across a restart is not counted as missing.
+    pub restarts: u64,
+}
+
+/// A streaming decoder with a fixed [`MAX_FRAME_LEN`]-byte buffer: feed it bytes as they come.
+///
+/// Resynchronisation: a frame starts at every `$`. A `$` inside a frame drops the partial frame
+/// and starts a new one, so a damaged end-of-line costs only its own frame, never the next.
+#[derive(Clone)]
+pub struct Decoder {
+    buf: [u8; MAX_FRAME_LEN],
+    len: usize,
+    in_frame: bool,
+    stats: DecodeStats,
+    last_seq: Option<u16>,
+    last_time_ms: u32,
+}
+
+impl Default for Decoder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Decoder {
+    /// A decoder waiting for the first `$`.
+    pub const fn new() -> Self {
+        Self {
+            buf: [0; MAX_FRAME_LEN],
+            len: 0,
+            in_frame: false,
+            stats: DecodeStats {
+                bytes: 0,
+                frames_ok: 0,
+                frames_corrupt: 0,
+                frames_missing: 0,
+                bytes_skipped: 0,
+                bad_crc: 0,
+                malformed: 0,
+                oversize: 0,
+                truncated: 0,
+                duplicates: 0,
+                restarts: 0,
+            },
+            last_seq: None,
+            last_time_ms: 0,
+        }
+    }
+
+    /// The counters so far.
+    pub fn stats(&self) -> &DecodeStats {
+        &self.stats
+    }
+
+    /// Feeds one byte; returns a frame or an error when a line ends or is dropped.
+    pub fn push(&mut self, byte: u8) -> Option<Result<Frame, FrameError>> {
+        self.stats.bytes += 1;
+        if !self.in_frame {
+            if byte == FRAME_START {
+                self.in_frame = true;
+                self.len = 0;
+            } else {
+                self.stats.bytes_skipped += 1;
+            }
+            return None;
+        }
+        match byte {
+            FRAME_END => {
+                self.in_frame = false;
+                let result = parse_line(self.buf.get(..self.len).unwrap_or(&[]));
+                Some(self.account(result))
+            }
+            FRAME_START => {
+                // Drop the partial frame (its `$` and body), start again at this `$`.
+                self.drop_partial(FrameError::Truncated, 1 + self.len as u64);
+                self.in_frame = true;
+                self.len = 0;
+                Some(Err(FrameError::Truncated))
+            }
+            b'\r' | 0x20..=0x7E => {
+                if let Some(slot) = self.buf.get_mut(self.len) {
+                    *slot = byte;
+                    self.len += 1;
+                    None
+                } else {
+                    self.in_frame = false;
+                    self.drop_partial(FrameError::Oversize, 2 + self.len as u64);
+                    Some(Err(FrameError::Oversize))
+                }
+            }
+            _ => {
+                self.in_frame = false;
+                self.drop_partial(FrameError::Truncated, 2 + self.len as u64);
+                Some(Err(FrameError::Truncated))
+            }
+        }
+    }
+
+    /// Ends the stream (end of a capture file): a partial frame still waiting for its `\n` is
+    /// dropped and counted as truncated, so every byte fed is accounted for.
+    pub fn finish(&mut self) -> Option<FrameError> {
+        if !self.in_frame {
+            return None;
+        }
+        self.in_frame = false;
+        self.drop_partial(FrameError::Truncated, 1 + self.len as u64);
+        Some(FrameError::Truncated)
+    }
+
+    /// Feeds a slice, calling `on_frame` for every line that ended or was dropped (with the
+    /// counters as they are right after it). Same result as [`Decoder::push`] byte by byte,
+    /// but runs of ordinary bytes are scanned and copied in bulk (the host's replay speed).
+    pub fn push_slice(
+        &mut self,
+        mut bytes: &[u8],
+        mut on_frame: impl FnMut(Result<Frame, FrameError>, &DecodeStats),
+    ) {
+        while !bytes.is_empty() {
+            if !self.in_frame {
+                // Line noise: skip to the next `$`.
+                let noise = bytes
+                    .iter()
+                    .position(|&b| b == FRAME_START)
+                    .unwrap_or(bytes.len());
+                self.stats.bytes += noise as u64;
+                self.stats.bytes_skipped += noise as u64;
+                bytes = bytes.get(noise..).unwrap_or(&[]);
+            } else {
+                // Frame body: take the printable run that fits in the buffer.
+                let room = self.buf.len().saturating_sub(self.len);
+                let limit = bytes.len().min(room);
+                let head = bytes.get(..limit).unwrap_or(&[]);
+                let plain = head
+                    .iter()
+                    .position(|&b| !(0x20..=0x7E).contains(&b) || b == FRAME_START)
+                    .unwrap_or(limit);
+                if let (Some(dst), Some(src)) = (
+                    self.buf.get_mut(self.len..self.len + plain),
+                    bytes.get(..plain),
+                ) {
+                    dst.copy_from_slice(src);
+                    self.len += plain;
+                    self.stats.bytes += plain as u64;
+                }
+                bytes = bytes.get(plain..).unwrap_or(&[]);
+            }
+            // The next byte is a delimiter, a control byte or an overflow: the byte-wise path.
+            if let Some((&b, rest)) = bytes.split_first() {
+                bytes = rest;
+                if let Some(r) = self.push(b) {
+                    on_frame(r, &self.stats);
+                }
+            }
+        }
+    }
+
+    fn drop_partial(&mut self, error: FrameError, bytes: u64) {
+        self.stats.bytes_skipped += bytes;
+        self.count_error(error);
+    }
+
+    fn count_error(&mut self, error: FrameError) {
+        self.stats.frames_corrupt += 1;
+        match error {
+            FrameError::BadCrc => self.stats.bad_crc += 1,
+            FrameError::Oversize => self.stats.oversize += 1,
+            FrameError::Truncated => self.stats.truncated += 1,
+            _ => self.stats.malformed += 1,
+        }
+    }
+
+    fn account(&mut self, result: Result<Frame, FrameError>) -> Result<Frame, FrameError> {
+        // `$`, body, `\n`.
+        let frame_bytes = self.len as u64 + 2;
+        match &result {
+            Ok(frame) => {
+                self.stats.frames_ok += 1;
+                self.track_sequence(frame);
+            }
+            Err(e) => {
+                self.stats.bytes_skipped += frame_bytes;
+                self.count_error(*e);
+            }
+        }
+        result
+    }
+
+    fn track_sequence(&mut self, frame: &Frame) {
+        match frame {
+            Frame::Hello(_) => {
+                self.stats.restarts += 1;
+                self.last_seq = None;
+            }
+            Frame::Telemetry(t) => {
+                match self.last_seq {
+                    Some(_) if t.time_ms < self.last_time_ms => self.stats.restarts += 1,
+                    Some(last) if t.seq == last => self.stats.duplicates += 1,
+                    Some(last) => {
+                        self.stats.frames_missing += u64::from(t.seq.wrapping_sub(last) - 1)
+                    }
+                    None => {}
+                }
+                self.last_seq = Some(t.seq);
+                self.last_time_ms = t.time_ms;
+            }
+            _ => {}
+        }
+    }
+}

@@ -1,0 +1,256 @@
+//! The rig's side of the protocol: answer every command, pace the telemetry. No heap, no
+//! hardware: the firmware and the virtual rig both drive a [`Device`] over their own [`Rig`].
+
+use super::decode::{Decoder, FrameError};
+use super::encode::{EncodeError, encode};
+use super::types::{
+    Command, Frame, Hello, Injection, PARAM_COUNT, ParamId, ParamValues, Reason, ResidenceModel,
+    Status, Telemetry,
+};
+use super::{MAX_FRAME_LEN, max_telemetry_hz};
+
+/// What the protocol needs from the controller, in wire units. Every setter either applies the
+/// whole change and returns `Ok`, or changes nothing and returns the reason.
+pub trait Rig {
+    /// The current values for a telemetry frame (the `seq` field is overwritten by [`Device`]).
+    fn telemetry(&self) -> Telemetry;
+    /// Why and how often the device has reset.
+    fn reset_info(&self) -> Hello;
+    /// New motor setpoints, mrad/s; [`Device`] has already checked each against 0..=its SPEED_MAX.
+    fn set_speeds(&mut self, precession_mrad_s: i16, spin_mrad_s: i16) -> Result<(), Reason>;
+    /// Choose the setpoints whose predicted residence time is `time_ms`.
+    fn set_residence(&mut self, model: ResidenceModel, time_ms: u32) -> Result<(), Reason>;
+    /// Run the motors towards the setpoints.
+    fn start(&mut self) -> Result<(), Reason>;
+    /// Ramp the motors down. Always possible.
+    fn stop(&mut self);
+    /// Leave the fault state (motors stay off).
+    fn clear_fault(&mut self) -> Result<(), Reason>;
+    /// Set one parameter (never [`ParamId::TelemetryHz`]: [`Device`] owns that one); the value
+    /// is inside [`ParamId::range`].
+    fn set_param(&mut self, id: ParamId, value: i32) -> Result<(), Reason>;
+    /// The current value of a parameter (never asked for [`ParamId::TelemetryHz`]).
+    fn param(&self, id: ParamId) -> i32;
+    /// A heartbeat from the PC (every command counts as one too; this is for PING).
+    fn heartbeat(&mut self) {}
+    /// Start the motor identification routine.
+    fn commission(&mut self) -> Result<(), Reason> {
+        Err(Reason::Unsupported)
+    }
+    /// Make a simulated rig misbehave. Real hardware keeps the default: `Unsupported`.
+    fn inject(&mut self, what: Injection) -> Result<(), Reason> {
+        let _ = what;
+        Err(Reason::Unsupported)
+    }
+}
+
+/// The protocol state of the device: its command decoder, the telemetry sequence number and
+/// the telemetry schedule.
+pub struct Device {
+    decoder: Decoder,
+    seq: u16,
+    telemetry_hz: u8,
+    /// Frames sent since `schedule_start_ms`; frame k is due at start + k * 1000 / hz.
+    frames_scheduled: u32,
+    schedule_start_ms: Option<u32>,
+    encode_failures: u32,
+}
+
+/// The default telemetry rate, frames per second.
+pub const DEFAULT_TELEMETRY_HZ: u8 = 50;
+
+impl Default for Device {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Device {
+    /// A device sending telemetry at [`DEFAULT_TELEMETRY_HZ`].
+    pub const fn new() -> Self {
+        Self {
+            decoder: Decoder::new(),
+            seq: 0,
+            telemetry_hz: DEFAULT_TELEMETRY_HZ,
+            frames_scheduled: 0,
+            schedule_start_ms: None,
+            encode_failures: 0,
+        }
+    }
+
+    /// The telemetry rate, frames per second.
+    pub fn telemetry_hz(&self) -> u8 {
+        self.telemetry_hz
+    }
+
+    /// Frames that could not be encoded (a rig value outside the wire range). A telemetry frame
+    /// lost this way still uses up its sequence number, so the PC counts it as missing.
+    pub fn encode_failures(&self) -> u32 {
+        self.encode_failures
+    }
+
+    /// The counters of the command decoder.
+    pub fn decoder(&self) -> &Decoder {
+        &self.decoder
+    }
+
+    /// The boot announcement, to send once after reset.
+    pub fn hello<R: Rig>(&mut self, rig: &R, out: &mut [u8; MAX_FRAME_LEN]) -> Option<usize> {
+        self.encoded(&Frame::Hello(rig.reset_info()), out)
+    }
+
+    /// Feeds received bytes; `send` gets every answer as one complete frame.
+    pub fn receive<R: Rig>(&mut self, rig: &mut R, bytes: &[u8], mut send: impl FnMut(&[u8])) {
+        let mut out = [0u8; MAX_FRAME_LEN];
+        for &b in bytes {
+            let answer = match self.decoder.push(b) {
+                Some(Ok(Frame::Command { id, command })) => self.execute(rig, id, command),
+                Some(Err(FrameError::BadCommand { id, reason })) => Frame::Reject { id, reason },
+                // Not a command, or damaged beyond reading an id: the PC times out and retries.
+                _ => continue,
+            };
+            let n = match encode(&answer, &mut out) {
+                Ok(n) => n,
+                Err(_) => {
+                    self.encode_failures = self.encode_failures.saturating_add(1);
+                    let reject = Frame::Reject {
+                        id: answer.answer_id().unwrap_or(0),
+                        reason: Reason::Internal,
+                    };
+                    // A reject always fits and is in range.
+                    encode(&reject, &mut out).unwrap_or(0)
+                }
+            };
+            if let Some(frame) = out.get(..n) {
+                send(frame);
+            }
+        }
+    }
+
+    /// Carries out one command and returns the answer frame.
+    pub fn execute<R: Rig>(&mut self, rig: &mut R, id: u16, command: Command) -> Frame {
+        let done = match command {
+            Command::SetSpeeds {
+                precession_mrad_s,
+                spin_mrad_s,
+            } => {
+                let ok = |v: i16, limit: ParamId| (0..=rig.param(limit)).contains(&i32::from(v));
+                if ok(precession_mrad_s, ParamId::SpeedMax1MradS)
+                    && ok(spin_mrad_s, ParamId::SpeedMax2MradS)
+                {
+                    rig.set_speeds(precession_mrad_s, spin_mrad_s)
+                } else {
+                    Err(Reason::Range)
+                }
+            }
+            Command::SetResidence { model, time_ms } => rig.set_residence(model, time_ms),
+            Command::Start => rig.start(),
+            Command::Stop => {
+                rig.stop();
+                Ok(())
+            }
+            Command::ClearFault => rig.clear_fault(),
+            Command::SetParam {
+                id: ParamId::TelemetryHz,
+                value,
+            } => self.set_telemetry_hz(value),
+            Command::SetParam { id: param, value } => rig.set_param(param, value),
+            Command::GetStatus => {
+                let t = rig.telemetry();
+                let reset = rig.reset_info();
+                return Frame::Status {
+                    id,
+                    status: Status {
+                        state: t.state,
+                        fault: t.fault,
+                        reset_cause: reset.reset_cause,
+                        reset_count: reset.reset_count,
+                        uptime_ms: t.time_ms,
+                        telemetry_hz: self.telemetry_hz,
+                    },
+                };
+            }
+            Command::GetParams => {
+                return Frame::Params {
+                    id,
+                    values: self.params(rig),
+                };
+            }
+            Command::Inject(what) => rig.inject(what),
+            Command::Ping => {
+                rig.heartbeat();
+                Ok(())
+            }
+            Command::Commission => rig.commission(),
+        };
+        match done {
+            Ok(()) => Frame::Ack { id },
+            Err(reason) => Frame::Reject { id, reason },
+        }
+    }
+
+    /// Every parameter value, in wire order.
+    pub fn params<R: Rig>(&self, rig: &R) -> ParamValues {
+        let mut values = [0i32; PARAM_COUNT];
+        for (slot, &p) in values.iter_mut().zip(ParamId::ALL.iter()) {
+            *slot = match p {
+                ParamId::TelemetryHz => i32::from(self.telemetry_hz),
+                _ => rig.param(p),
+            };
+        }
+        values
+    }
+
+    fn set_telemetry_hz(&mut self, hz: i32) -> Result<(), Reason> {
+        let max = max_telemetry_hz(super::DEFAULT_BAUD) as i32;
+        match u8::try_from(hz) {
+            Ok(hz) if i32::from(hz) <= max => {
+                self.telemetry_hz = hz;
+                self.schedule_start_ms = None;
+                Ok(())
+            }
+            _ => Err(Reason::Range),
+        }
+    }
+
+    /// Builds the telemetry frame if one is due at `now_ms` (call at least once per period).
+    pub fn poll_telemetry<R: Rig>(
+        &mut self,
+        rig: &R,
+        now_ms: u32,
+        out: &mut [u8; MAX_FRAME_LEN],
+    ) -> Option<usize> {
+        if self.telemetry_hz == 0 {
+            return None;
+        }
+        let start = *self.schedule_start_ms.get_or_insert(now_ms);
+        let hz = u64::from(self.telemetry_hz);
+        let elapsed_ms = now_ms.wrapping_sub(start);
+        // The frame due now; if polls were late, skip the missed slots instead of bursting.
+        let due_now = u64::from(elapsed_ms) * hz / 1000;
+        if due_now < u64::from(self.frames_scheduled) {
+            return None;
+        }
+        // due_now <= (2^32 - 1) * 50 / 1000 fits in u32.
+        self.frames_scheduled = (due_now + 1) as u32;
+        if elapsed_ms >= 1_000_000 {
+            // Move the origin by 1000 s (a whole number of periods) to keep the numbers small.
+            self.schedule_start_ms = Some(start.wrapping_add(1_000_000));
+            self.frames_scheduled -= (hz * 1000) as u32;
+        }
+        let mut t = rig.telemetry();
+        t.seq = self.seq;
+        self.seq = self.seq.wrapping_add(1);
+        self.encoded(&Frame::Telemetry(t), out)
+    }
+
+    fn encoded(&mut self, frame: &Frame, out: &mut [u8; MAX_FRAME_LEN]) -> Option<usize> {
+        match encode(frame, out) {
+            Ok(n) => Some(n),
+            Err(EncodeError::BufferTooSmall | EncodeError::FieldOutOfRange) => {
+                self.encode_failures = self.encode_failures.saturating_add(1);
+                None
+            }
+        }
+    }
+}

@@ -1,0 +1,50 @@
+//! The serial protocol between the rig and the PC: one text line per frame, shared by the
+//! firmware and the host tools. The specification with worked examples is `docs/protocol.md`.
+//!
+//! A frame is `$`, a kind letter, the protocol version digit, comma-separated fields, `*`, the
+//! CRC-32 of the bytes between `$` and `*` in 8 upper-case hex digits, and `\n`:
+//!
+//! ```text
+//! $T1,123456,6172,2,0,1800,1796,4521,315,2100,2101,5230,367,3381,2345,2410*9B4507F3\n
+//! ```
+//!
+//! Numbers are scaled integers (no float formatting on the MCU). The longest telemetry frame is
+//! [`MAX_TELEMETRY_LEN`] bytes: 50 frames/s use 48 % of a 115 200 baud link.
+//!
+//! - [`types`]: the plain data (telemetry, commands, answers);
+//! - [`encode()`] and [`decode`]: the codec and the streaming [`Decoder`];
+//! - [`device`]: the rig's side (command dispatch, telemetry pacing) over the [`device::Rig`] trait.
+
+pub mod crc;
+pub mod decode;
+pub mod device;
+pub mod encode;
+pub mod types;
+
+pub use decode::{DecodeStats, Decoder, FrameError, decode_frame, parse_line};
+pub use encode::{EncodeError, encode};
+pub use types::*;
+
+/// The protocol version in every frame header (`$T1`): one decimal digit.
+pub const PROTOCOL_VERSION: u8 = 1;
+
+/// The first byte of every frame.
+pub const FRAME_START: u8 = b'$';
+
+/// The last byte of every frame.
+pub const FRAME_END: u8 = b'\n';
+
+/// The longest frame, `$` to `\n` included (a PARAMS answer is the longest kind). The decoder
+/// drops longer lines as oversize.
+pub const MAX_FRAME_LEN: usize = 256;
+
+/// The longest telemetry frame: every field at its widest.
+pub const MAX_TELEMETRY_LEN: usize = 110;
+
+/// The default link: 115 200 baud, 8N1 (10 bits a byte).
+pub const DEFAULT_BAUD: u32 = 115_200;
+
+/// Largest telemetry rate that keeps the longest telemetry frames under half of `baud` (8N1).
+pub const fn max_telemetry_hz(baud: u32) -> u32 {
+    baud / 10 / 2 / MAX_TELEMETRY_LEN as u32
+}

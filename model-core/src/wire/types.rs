@@ -1,0 +1,576 @@
+//! The plain data that travels over the wire: telemetry, commands, answers.
+//!
+//! Every number is a scaled integer with its unit in its name (`_mrad_s` = milliradians per
+//! second, `_ms` = milliseconds, `_bp` = basis points, 1/10 000). Each enum has a fixed numeric or
+//! token form, listed in `docs/protocol.md`.
+
+/// Pulse-count, sequence-number and request-id fields wrap modulo 2^16.
+pub type Wrapping16 = u16;
+
+/// What the rig is doing (the numbers are the controller's `State as u8`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum DeviceState {
+    /// Motors off, waiting for a command.
+    Idle = 0,
+    /// The identification routine drives one axis at a time, open loop.
+    Commissioning = 1,
+    /// Closed loop, ramping towards the setpoints.
+    SpinningUp = 2,
+    /// Closed loop, at the setpoints.
+    Running = 3,
+    /// Ramping down after STOP.
+    Stopping = 4,
+    /// A fault stopped the motors; CLEAR returns to Idle.
+    Faulted = 5,
+}
+
+/// Why the rig stopped itself (0 = no fault; the numbers are the controller's fault codes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FaultCode {
+    /// No fault.
+    None = 0,
+    /// Precession: duty above the stall threshold and no pulse (sensor dead or shaft blocked).
+    SensorLostOrStallPrecession = 1,
+    /// Spin: duty above the stall threshold and no pulse (sensor dead or shaft blocked).
+    SensorLostOrStallSpin = 2,
+    /// The precession motor exceeded its over-speed limit.
+    OverspeedPrecession = 3,
+    /// The spin motor exceeded its over-speed limit.
+    OverspeedSpin = 4,
+    /// No command or heartbeat (PING) from the PC within the host timeout.
+    HostSilent = 5,
+    /// The configuration is invalid, or commissioning failed.
+    InvalidConfiguration = 6,
+}
+
+/// What caused the last reset of the microcontroller (STM32 RCC_CSR flags).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ResetCause {
+    /// Power-on or brown-out reset.
+    PowerOn = 0,
+    /// The NRST pin (reset button, debugger).
+    Pin = 1,
+    /// A software reset request.
+    Software = 2,
+    /// The independent watchdog.
+    IndependentWatchdog = 3,
+    /// The window watchdog.
+    WindowWatchdog = 4,
+    /// A low-power management reset.
+    LowPower = 5,
+    /// No flag set, or a simulated rig.
+    Unknown = 6,
+}
+
+/// Which residence-time model a target refers to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ResidenceModel {
+    /// Rolling sphere without the Coriolis term (paper Eq. 5-7). Token `FLAT`.
+    Flat,
+    /// With the Coriolis friction term (paper Eq. 9-11, coefficients corrected). Token `CORI`.
+    Coriolis,
+}
+
+/// A predicted residence time as sent in telemetry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Residence {
+    /// The particle reaches the rim after this many milliseconds (at most [`RESIDENCE_MAX_MS`]).
+    Ms(u32),
+    /// The particle never leaves: its start radius is inside the equilibrium radius. Wire: `-1`.
+    NeverLeaves,
+    /// No prediction (bowl at rest, model not configured, or longer than [`RESIDENCE_MAX_MS`]).
+    /// Wire: `-2`.
+    Unavailable,
+}
+
+/// The largest residence time telemetry can carry, ms (2.8 hours; 7 digits keep the frame short).
+pub const RESIDENCE_MAX_MS: u32 = 9_999_999;
+
+/// The largest PWM duty magnitude, basis points (10 000 = 100 %).
+pub const DUTY_MAX_BP: i16 = 10_000;
+
+/// One motor's line in a telemetry frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MotorTelemetry {
+    /// Speed setpoint, mrad/s at the output shaft.
+    pub set_mrad_s: i16,
+    /// Measured speed from the pulse estimator, mrad/s.
+    pub measured_mrad_s: i16,
+    /// PWM duty, basis points, -10 000..=10 000 (sign = direction).
+    pub duty_bp: i16,
+    /// Sensor pulses counted since reset, modulo 2^16.
+    pub pulses: Wrapping16,
+}
+
+/// One telemetry frame (`$T1,...`): the periodic report of the rig.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Telemetry {
+    /// Device time since reset, ms (wraps after 49.7 days).
+    pub time_ms: u32,
+    /// Telemetry sequence number, +1 per frame, modulo 2^16: gaps count the lost frames.
+    pub seq: Wrapping16,
+    /// Device state.
+    pub state: DeviceState,
+    /// Active fault (None unless `state` is Faulted).
+    pub fault: FaultCode,
+    /// Precession motor (omega1, the rod about the vertical).
+    pub precession: MotorTelemetry,
+    /// Spin motor (omega2, the bowl about its own axis).
+    pub spin: MotorTelemetry,
+    /// Combined bowl speed from the measured motor speeds (paper Eq. 2), mrad/s.
+    pub bowl_mrad_s: u16,
+    /// Predicted residence time without the Coriolis term at the measured speeds.
+    pub residence_flat: Residence,
+    /// Predicted residence time with the Coriolis term at the measured speeds.
+    pub residence_coriolis: Residence,
+}
+
+/// The boot announcement (`$H1,...`), sent once after every reset.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Hello {
+    /// Why the device reset.
+    pub reset_cause: ResetCause,
+    /// Resets since the counter was last cleared (kept in backup RAM on the MCU), modulo 2^16.
+    pub reset_count: Wrapping16,
+}
+
+/// The answer to STATUS (`$S1,...`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Status {
+    /// Device state.
+    pub state: DeviceState,
+    /// Active fault.
+    pub fault: FaultCode,
+    /// Why the device last reset.
+    pub reset_cause: ResetCause,
+    /// Reset counter, modulo 2^16.
+    pub reset_count: Wrapping16,
+    /// Device time since reset, ms.
+    pub uptime_ms: u32,
+    /// Telemetry rate, frames per second (0 = off).
+    pub telemetry_hz: u8,
+}
+
+/// A fault the simulated or emulated rig can be told to produce (real hardware rejects it with
+/// [`Reason::Unsupported`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Injection {
+    /// Remove every injected fault. Token `NONE`.
+    None,
+    /// The precession sensor stops giving pulses. Token `SENSOR1`.
+    SensorLostPrecession,
+    /// The spin sensor stops giving pulses. Token `SENSOR2`.
+    SensorLostSpin,
+    /// The precession motor is blocked. Token `STALL1`.
+    StallPrecession,
+    /// The spin motor is blocked. Token `STALL2`.
+    StallSpin,
+}
+
+/// The settable parameters, each with a token, a unit and a wire range (inclusive).
+/// The rig may reject a value inside the wire range that conflicts with another parameter
+/// (for instance a start radius beyond the rim) with [`Reason::Range`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ParamId {
+    /// Bowl rim radius R, micrometres.
+    RimUm,
+    /// Particle start radius ri, micrometres.
+    StartUm,
+    /// Effective rolling-resistance coefficient mu, parts per million.
+    MuPpm,
+    /// Inertia factor k2 = m rp^2 / (I + m rp^2), parts per million (solid sphere 714 286).
+    K2Ppm,
+    /// Angle between the spin and precession axes (paper Eq. 2), millidegrees.
+    AxesMdeg,
+    /// Precession speed-loop bandwidth (the PI gains follow from it and the motor model), mrad/s.
+    Bandwidth1MradS,
+    /// Spin speed-loop bandwidth, mrad/s.
+    Bandwidth2MradS,
+    /// Precession loop bandwidth per pulse rate (caps the bandwidth at low speed), ppm.
+    PerPulse1Ppm,
+    /// Spin loop bandwidth per pulse rate, ppm.
+    PerPulse2Ppm,
+    /// Precession speed limit (setpoints above it are rejected), mrad/s.
+    SpeedMax1MradS,
+    /// Spin speed limit, mrad/s.
+    SpeedMax2MradS,
+    /// Precession setpoint ramp rate, mrad/s^2.
+    Accel1MradS2,
+    /// Spin setpoint ramp rate, mrad/s^2.
+    Accel2MradS2,
+    /// Precession PWM duty limit, basis points.
+    DutyMax1Bp,
+    /// Spin PWM duty limit, basis points.
+    DutyMax2Bp,
+    /// Target-wheel teeth (pulses per revolution) on the precession sensor.
+    Teeth1,
+    /// Target-wheel teeth on the spin sensor.
+    Teeth2,
+    /// Spin speed per precession speed used to split a combined bowl speed (Eq. 2), ppm.
+    RatioPpm,
+    /// Telemetry rate, frames per second, 0 = off (50 fills under half of 115 200 baud).
+    TelemetryHz,
+}
+
+/// Number of parameters; a PARAMS answer carries this many values in [`ParamId::ALL`] order.
+pub const PARAM_COUNT: usize = 19;
+
+/// The values of all parameters, indexed by [`ParamId::index`].
+pub type ParamValues = [i32; PARAM_COUNT];
+
+impl ParamId {
+    /// Every parameter, in wire order.
+    pub const ALL: [ParamId; PARAM_COUNT] = [
+        ParamId::RimUm,
+        ParamId::StartUm,
+        ParamId::MuPpm,
+        ParamId::K2Ppm,
+        ParamId::AxesMdeg,
+        ParamId::Bandwidth1MradS,
+        ParamId::Bandwidth2MradS,
+        ParamId::PerPulse1Ppm,
+        ParamId::PerPulse2Ppm,
+        ParamId::SpeedMax1MradS,
+        ParamId::SpeedMax2MradS,
+        ParamId::Accel1MradS2,
+        ParamId::Accel2MradS2,
+        ParamId::DutyMax1Bp,
+        ParamId::DutyMax2Bp,
+        ParamId::Teeth1,
+        ParamId::Teeth2,
+        ParamId::RatioPpm,
+        ParamId::TelemetryHz,
+    ];
+
+    /// Position in [`ParamId::ALL`] and in a PARAMS answer.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The token used in `SET` commands.
+    pub fn token(self) -> &'static str {
+        match self {
+            ParamId::RimUm => "RIM_UM",
+            ParamId::StartUm => "START_UM",
+            ParamId::MuPpm => "MU_PPM",
+            ParamId::K2Ppm => "K2_PPM",
+            ParamId::AxesMdeg => "AXES_MDEG",
+            ParamId::Bandwidth1MradS => "BW1_MRAD_S",
+            ParamId::Bandwidth2MradS => "BW2_MRAD_S",
+            ParamId::PerPulse1Ppm => "PER_PULSE1_PPM",
+            ParamId::PerPulse2Ppm => "PER_PULSE2_PPM",
+            ParamId::SpeedMax1MradS => "SPEED_MAX1_MRAD_S",
+            ParamId::SpeedMax2MradS => "SPEED_MAX2_MRAD_S",
+            ParamId::Accel1MradS2 => "ACCEL1_MRAD_S2",
+            ParamId::Accel2MradS2 => "ACCEL2_MRAD_S2",
+            ParamId::DutyMax1Bp => "DUTY_MAX1_BP",
+            ParamId::DutyMax2Bp => "DUTY_MAX2_BP",
+            ParamId::Teeth1 => "TEETH1",
+            ParamId::Teeth2 => "TEETH2",
+            ParamId::RatioPpm => "RATIO_PPM",
+            ParamId::TelemetryHz => "TELEM_HZ",
+        }
+    }
+
+    /// The wire range (inclusive); values outside it are rejected with [`Reason::Range`].
+    pub fn range(self) -> (i32, i32) {
+        match self {
+            ParamId::RimUm => (10_000, 1_000_000),
+            ParamId::StartUm => (0, 1_000_000),
+            ParamId::MuPpm => (0, 1_000_000),
+            ParamId::K2Ppm => (1, 1_000_000),
+            ParamId::AxesMdeg => (0, 179_999),
+            ParamId::Bandwidth1MradS | ParamId::Bandwidth2MradS => (10, 1_000_000),
+            ParamId::PerPulse1Ppm | ParamId::PerPulse2Ppm => (10_000, 10_000_000),
+            ParamId::SpeedMax1MradS | ParamId::SpeedMax2MradS => (0, i16::MAX as i32),
+            ParamId::Accel1MradS2 | ParamId::Accel2MradS2 => (1, 1_000_000),
+            ParamId::DutyMax1Bp | ParamId::DutyMax2Bp => (0, DUTY_MAX_BP as i32),
+            ParamId::Teeth1 | ParamId::Teeth2 => (1, 255),
+            ParamId::RatioPpm => (1_000, 100_000_000),
+            ParamId::TelemetryHz => (0, 50),
+        }
+    }
+
+    /// The parameter with this token.
+    pub fn from_token(token: &[u8]) -> Option<ParamId> {
+        ParamId::ALL
+            .iter()
+            .copied()
+            .find(|p| p.token().as_bytes() == token)
+    }
+}
+
+/// A command from the PC.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Command {
+    /// `SPEED,w1,w2`: set both motor setpoints, mrad/s (0 or up to the axis's SPEED_MAX).
+    SetSpeeds {
+        /// Precession setpoint omega1, mrad/s.
+        precession_mrad_s: i16,
+        /// Spin setpoint omega2, mrad/s.
+        spin_mrad_s: i16,
+    },
+    /// `RTIME,model,ms`: choose the bowl speed whose predicted residence time is `time_ms`.
+    SetResidence {
+        /// Which model the target refers to.
+        model: ResidenceModel,
+        /// Target residence time, ms (1..=RESIDENCE_MAX_MS).
+        time_ms: u32,
+    },
+    /// `START`: run the motors towards the setpoints.
+    Start,
+    /// `STOP`: ramp the motors down (always accepted).
+    Stop,
+    /// `CLEAR`: clear a fault (motors stay off).
+    ClearFault,
+    /// `SET,name,value`: set one parameter.
+    SetParam {
+        /// Which parameter.
+        id: ParamId,
+        /// The new value, in the parameter's unit.
+        value: i32,
+    },
+    /// `STATUS`: answered by a [`Status`] frame.
+    GetStatus,
+    /// `PARAMS`: answered by a PARAMS frame with every value.
+    GetParams,
+    /// `INJECT,what`: make the simulated rig misbehave.
+    Inject(Injection),
+    /// `PING`: a heartbeat; keeps the rig's host-silence watchdog from faulting.
+    Ping,
+    /// `COMMISSION`: run the motor identification routine (from Idle).
+    Commission,
+}
+
+/// Why a command was rejected. A rejected command changed nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Reason {
+    /// The frame's CRC was right but its fields did not parse. Token `MALFORMED`.
+    Malformed,
+    /// The command word is not known. Token `UNKNOWN`.
+    UnknownCommand,
+    /// The parameter name is not known. Token `PARAM`.
+    UnknownParam,
+    /// A value was outside its range (never clamped). Token `RANGE`.
+    Range,
+    /// Not allowed in the current state (for instance START while faulted). Token `STATE`.
+    State,
+    /// The target cannot be reached (for instance a residence time the bowl cannot produce
+    /// within the speed limit, or a particle that never leaves). Token `INFEASIBLE`.
+    Infeasible,
+    /// This device does not do that (fault injection on real hardware). Token `UNSUPPORTED`.
+    Unsupported,
+    /// The frame's protocol version is not spoken here. Token `VERSION`.
+    Version,
+    /// The device could not build its answer (a value it holds is outside the wire range:
+    /// a bug). Token `INTERNAL`.
+    Internal,
+}
+
+impl Reason {
+    /// Every reason.
+    pub const ALL: [Reason; 9] = [
+        Reason::Malformed,
+        Reason::UnknownCommand,
+        Reason::UnknownParam,
+        Reason::Range,
+        Reason::State,
+        Reason::Infeasible,
+        Reason::Unsupported,
+        Reason::Version,
+        Reason::Internal,
+    ];
+
+    /// The wire token.
+    pub fn token(self) -> &'static str {
+        match self {
+            Reason::Malformed => "MALFORMED",
+            Reason::UnknownCommand => "UNKNOWN",
+            Reason::UnknownParam => "PARAM",
+            Reason::Range => "RANGE",
+            Reason::State => "STATE",
+            Reason::Infeasible => "INFEASIBLE",
+            Reason::Unsupported => "UNSUPPORTED",
+            Reason::Version => "VERSION",
+            Reason::Internal => "INTERNAL",
+        }
+    }
+}
+
+/// One decoded frame, in either direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Frame {
+    /// `$T1`: periodic telemetry (device to PC).
+    Telemetry(Telemetry),
+    /// `$H1`: boot announcement (device to PC).
+    Hello(Hello),
+    /// `$C1`: a command with its request id (PC to device).
+    Command {
+        /// Request id chosen by the PC, echoed in the answer.
+        id: Wrapping16,
+        /// The command.
+        command: Command,
+    },
+    /// `$A1`: the command with this id was done.
+    Ack {
+        /// Request id.
+        id: Wrapping16,
+    },
+    /// `$R1`: the command with this id was rejected and changed nothing.
+    Reject {
+        /// Request id (0 if the command was too broken to read one).
+        id: Wrapping16,
+        /// Why.
+        reason: Reason,
+    },
+    /// `$S1`: the answer to STATUS.
+    Status {
+        /// Request id.
+        id: Wrapping16,
+        /// The status.
+        status: Status,
+    },
+    /// `$P1`: the answer to PARAMS, every value in [`ParamId::ALL`] order.
+    Params {
+        /// Request id.
+        id: Wrapping16,
+        /// The values.
+        values: ParamValues,
+    },
+}
+
+impl Frame {
+    /// The request id this frame answers, if it is an answer.
+    pub fn answer_id(&self) -> Option<Wrapping16> {
+        match *self {
+            Frame::Ack { id }
+            | Frame::Reject { id, .. }
+            | Frame::Status { id, .. }
+            | Frame::Params { id, .. } => Some(id),
+            _ => None,
+        }
+    }
+}
+
+macro_rules! code_enum {
+    ($ty:ident { $($variant:ident),* $(,)? }) => {
+        impl $ty {
+            /// The numeric wire code.
+            pub fn code(self) -> u8 {
+                self as u8
+            }
+            /// The value with this wire code.
+            pub fn from_code(code: i64) -> Option<Self> {
+                $(if code == $ty::$variant as i64 { return Some($ty::$variant); })*
+                None
+            }
+        }
+    };
+}
+
+code_enum!(DeviceState {
+    Idle,
+    Commissioning,
+    SpinningUp,
+    Running,
+    Stopping,
+    Faulted,
+});
+code_enum!(FaultCode {
+    None,
+    SensorLostOrStallPrecession,
+    SensorLostOrStallSpin,
+    OverspeedPrecession,
+    OverspeedSpin,
+    HostSilent,
+    InvalidConfiguration,
+});
+code_enum!(ResetCause {
+    PowerOn,
+    Pin,
+    Software,
+    IndependentWatchdog,
+    WindowWatchdog,
+    LowPower,
+    Unknown,
+});
+
+impl ResidenceModel {
+    /// The wire token.
+    pub fn token(self) -> &'static str {
+        match self {
+            ResidenceModel::Flat => "FLAT",
+            ResidenceModel::Coriolis => "CORI",
+        }
+    }
+}
+
+impl Injection {
+    /// Every injection.
+    pub const ALL: [Injection; 5] = [
+        Injection::None,
+        Injection::SensorLostPrecession,
+        Injection::SensorLostSpin,
+        Injection::StallPrecession,
+        Injection::StallSpin,
+    ];
+
+    /// The wire token.
+    pub fn token(self) -> &'static str {
+        match self {
+            Injection::None => "NONE",
+            Injection::SensorLostPrecession => "SENSOR1",
+            Injection::SensorLostSpin => "SENSOR2",
+            Injection::StallPrecession => "STALL1",
+            Injection::StallSpin => "STALL2",
+        }
+    }
+}
+
+impl Residence {
+    /// The wire integer: ms, or -1 (never leaves), or -2 (unavailable).
+    pub fn to_wire(self) -> i64 {
+        match self {
+            Residence::Ms(ms) => i64::from(ms),
+            Residence::NeverLeaves => -1,
+            Residence::Unavailable => -2,
+        }
+    }
+
+    /// Parses the wire integer; `None` outside -2..=RESIDENCE_MAX_MS.
+    pub fn from_wire(v: i64) -> Option<Self> {
+        match v {
+            -1 => Some(Residence::NeverLeaves),
+            -2 => Some(Residence::Unavailable),
+            0..=9_999_999 => u32::try_from(v).ok().map(Residence::Ms),
+            _ => None,
+        }
+    }
+
+    /// Converts a predicted time in seconds (`None` = never leaves). NaN, negative or longer
+    /// than [`RESIDENCE_MAX_MS`] becomes [`Residence::Unavailable`], rounding to the nearest ms.
+    pub fn from_seconds(time_s: Option<f32>) -> Self {
+        match time_s {
+            None => Residence::NeverLeaves,
+            Some(t) if t >= 0.0 && t * 1000.0 <= RESIDENCE_MAX_MS as f32 => {
+                // In range and not NaN: the cast cannot saturate.
+                Residence::Ms(((t * 1000.0 + 0.5) as u32).min(RESIDENCE_MAX_MS))
+            }
+            Some(_) => Residence::Unavailable,
+        }
+    }
+}

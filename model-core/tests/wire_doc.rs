@@ -1,0 +1,102 @@
+//! The worked examples of docs/protocol.md, checked against the codec so the spec cannot drift.
+
+use model_core::wire::crc::crc32;
+use model_core::wire::*;
+
+fn doc() -> String {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/protocol.md");
+    std::fs::read_to_string(path).expect("docs/protocol.md is readable")
+}
+
+/// The lines of every fenced block with this info string.
+fn blocks(doc: &str, info: &str) -> Vec<Vec<String>> {
+    let mut out = Vec::new();
+    let mut current: Option<Vec<String>> = None;
+    for line in doc.lines() {
+        let fence = line.trim().starts_with("```");
+        match current.take() {
+            None if line.trim() == format!("```{info}") => current = Some(Vec::new()),
+            None => {}
+            Some(lines) if fence => out.push(lines),
+            Some(mut lines) => {
+                lines.push(line.to_string());
+                current = Some(lines);
+            }
+        }
+    }
+    out
+}
+
+fn pairs(block: &[String]) -> Vec<(String, String)> {
+    assert!(
+        block.len().is_multiple_of(2),
+        "examples come in pairs: {block:?}"
+    );
+    block
+        .chunks(2)
+        .map(|c| (c[0].clone(), c[1].clone()))
+        .collect()
+}
+
+#[test]
+fn decoded_examples_match_the_doc_and_re_encode_byte_for_byte() {
+    let doc = doc();
+    let mut checked = 0;
+    for block in blocks(&doc, "wire") {
+        for (line, meaning) in pairs(&block) {
+            let bytes = format!("{line}\n").into_bytes();
+            let frame = decode_frame(&bytes).unwrap_or_else(|e| panic!("{line}: {e:?}"));
+            assert_eq!(format!("{frame:?}"), meaning, "meaning of {line}");
+            let mut buf = [0u8; MAX_FRAME_LEN];
+            let n = encode(&frame, &mut buf).unwrap();
+            assert_eq!(&buf[..n], &bytes[..], "re-encoding of {line}");
+            checked += 1;
+        }
+    }
+    assert!(checked >= 18, "only {checked} examples found");
+}
+
+#[test]
+fn rejected_examples_fail_as_the_doc_says() {
+    let doc = doc();
+    let mut checked = 0;
+    for block in blocks(&doc, "reject") {
+        for (line, error) in pairs(&block) {
+            let got = decode_frame(format!("{line}\n").as_bytes());
+            assert_eq!(
+                format!("{:?}", got.err()),
+                format!("Some({error})"),
+                "{line}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 7);
+}
+
+#[test]
+fn crc_examples_match() {
+    let doc = doc();
+    let crc_blocks = blocks(&doc, "crc");
+    assert!(!crc_blocks.is_empty());
+    for block in crc_blocks {
+        let payload = block[0].strip_prefix("payload: ").unwrap();
+        let crc = block[1].strip_prefix("crc32: ").unwrap();
+        assert_eq!(format!("{:08X}", crc32(payload.as_bytes())), crc);
+    }
+}
+
+#[test]
+fn link_budget_figures_in_the_doc_hold() {
+    let doc = doc();
+    // The longest telemetry frame of the doc is the widest possible one.
+    assert!(doc.contains(&format!(
+        "| longest telemetry (every field at its widest) | {MAX_TELEMETRY_LEN} |"
+    )));
+    let rate_hz = 50;
+    let bytes_per_s = rate_hz * MAX_TELEMETRY_LEN;
+    let link_bytes_per_s = DEFAULT_BAUD as usize / 10;
+    assert!(2 * bytes_per_s < link_bytes_per_s);
+    assert!(doc.contains(&format!("50 x {MAX_TELEMETRY_LEN} = {bytes_per_s} bytes/s")));
+    assert_eq!(max_telemetry_hz(DEFAULT_BAUD), 52);
+}
