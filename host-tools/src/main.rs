@@ -3,6 +3,7 @@
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
+mod chart;
 mod kinematics;
 
 /// The PC side of the bowl granulation rig.

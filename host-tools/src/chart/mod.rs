@@ -1,0 +1,3 @@
+//! `bowl chart`: the speed-against-accuracy chart and the paper-style figures (issue 3).
+
+pub mod plot;
