@@ -1,0 +1,72 @@
+//! Residence time of the Coriolis model (paper Eq. 10, 11 with MODEL-NOTES' corrected A, B).
+
+use super::{Exit, Model, Scene, SceneError, Shape, condition};
+use crate::Real;
+
+/// Newton iterations allowed; from the upper bracket it needs 3 to 6.
+const MAX_NEWTON: u32 = 40;
+
+/// The root `u = l1 T` of `F(u) = x`, with `F` of [`Shape::eval`], and `F'` at the root.
+///
+/// `F` is convex and increasing with `F'(0) = 0`, so Newton from 0 divides by zero; from any
+/// point above the root it decreases monotonically onto it. We start at the upper bracket of
+/// MODEL-NOTES, `min(ln((1 + x)/A), sqrt(2 x / A))` (`F >= A (e^u - 1) - B` and
+/// `F >= A u^2 / 2`), and never go below the lower bracket `ln((1 + x - B)/A) = log1p(x / A)`.
+/// Stop test: after a Newton step `d` the remaining error is about `F''/(2 F') d^2`; we stop when
+/// that is below a quarter of an ulp of `u`, which saves the customary extra iteration.
+pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneError> {
+    let (ac, bc) = (shape.a_coef, shape.b_coef);
+    let lower = (x / ac).ln_1p();
+    let upper = ((x + bc) / ac).ln_1p().min((T::TWO * x / ac).sqrt());
+    let mut u = upper;
+    for _ in 0..MAX_NEWTON {
+        let (f, fp, fpp) = shape.eval(u);
+        if !(f.is_finite() && fp.is_finite() && fpp.is_finite()) {
+            return Err(SceneError::OutOfRange);
+        }
+        if fp <= T::ZERO {
+            // Only at u = 0, i.e. x = 0 (R - ri underflowed against ri - a): T = 0.
+            return Ok((u, fp));
+        }
+        let d = (f - x) / fp;
+        let mut next = u - d;
+        if next < lower {
+            next = lower;
+        }
+        // F' at the new point to first order, for the exit velocity.
+        let fp_next = fp - fpp * (u - next);
+        let converged = d <= T::ZERO || fpp * d * d <= T::HALF * T::EPSILON * fp * next;
+        u = next;
+        if converged {
+            return Ok((u, fp_next));
+        }
+    }
+    // Monotone Newton cannot cycle; if rounding made it crawl, u is still within the bracket.
+    let (_, fp, _) = shape.eval(u);
+    Ok((u, fp))
+}
+
+/// Coriolis model, `a < ri < R` (checked by the caller). `T = u / l1`, `l1 = k omega/(s + k mu)`;
+/// `r'(T) = (ri - a) l1 F'(u)` (paper Eq. 11: `(ri - a)(k omega/(2 s))(e^{l1 T} - e^{l2 T})`).
+pub(crate) fn residence<T: Real>(scene: &Scene<T>, a: T) -> Result<Exit<T>, SceneError> {
+    let shape = Shape::new(scene, Model::Coriolis)?;
+    let (ri, rim) = (scene.ri_m, scene.rim_radius_m);
+    let den = ri - a;
+    let x = (rim - ri) / den;
+    if !x.is_finite() {
+        return Err(SceneError::OutOfRange);
+    }
+    let (u, fp) = solve_u(&shape, x)?;
+    let l1 = shape.c1 * scene.omega_rad_s;
+    // kx = x / (u F'(u)); as x -> 0, F ~ A (1 + q) u^2 / 2, so the ratio tends to 1/2.
+    let kx = if u * fp > T::ZERO {
+        x / (u * fp)
+    } else {
+        T::HALF
+    };
+    Ok(Exit {
+        time: u / l1,
+        radial: den * l1 * fp,
+        condition: condition(kx, a, ri),
+    })
+}

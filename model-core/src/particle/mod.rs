@@ -1,0 +1,407 @@
+//! A sphere rolling outward in the spinning bowl: paper Eq. 5 to 12, corrected as in
+//! `shared/MODEL-NOTES.md`.
+//!
+//! The particle starts at rest at radius `ri_m` on a bowl turning at `omega_rad_s`; the
+//! centrifugal term pushes it out, an *effective rolling resistance* `mu` (times `g`) holds it
+//! back, and in the [`Model::Coriolis`] model the Coriolis force, pressing the rolling sphere
+//! against the bowl, adds a friction `2 mu omega r'`. It leaves at the rim radius
+//! `rim_radius_m` after the residence time `T`.
+//!
+//! * [`residence`]: `T` and the exit velocities, as an explicit [`Outcome`] (leaves / already at
+//!   the rim / never leaves) with a condition number, never NaN.
+//! * [`position_m`], [`radial_velocity_m_s`]: `r(t)` and `r'(t)` (paper Eq. 6, 7, 10, 11).
+//! * [`omega_for_residence_time`]: the inverse, the bowl speed that gives a target `T`.
+//!
+//! # The resistance coefficient
+//! The paper uses a *sliding* friction coefficient 0.4 in a *rolling* model; with it the
+//! equilibrium radius `a = mu g / omega^2` exceeds every bowl and nothing ever leaves. We name the
+//! coefficient for what the model needs, an effective rolling resistance, and default it to the
+//! paper's own "correction factor" 0.029 (see MODEL-NOTES, "The parameter problem"); 0.4 stays
+//! reachable and then gives [`Outcome::NeverLeaves`].
+
+mod coriolis;
+mod flat;
+mod inverse;
+mod phi;
+
+pub use inverse::{InverseError, omega_for_residence_time};
+
+use crate::Real;
+use phi::phi_expm1;
+
+/// Which equation of motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Model {
+    /// Paper Eq. 5: `r'' = k2 (r omega^2 - mu g)`; solution Eq. 6, 7 (correct in the paper).
+    Flat,
+    /// Paper Eq. 9: `r'' = k2 (r omega^2 - mu g - 2 mu omega r')`; solution Eq. 10, 11 with the
+    /// corrected coefficients `A = (1 + k mu/s)/2`, `B = (1 - k mu/s)/2` (the paper prints 0.5
+    /// and 0.45, which break `r(0) = ri`).
+    Coriolis,
+}
+
+/// One particle in one bowl: everything the model needs. SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scene<T> {
+    /// Combined bowl speed omega (paper Eq. 2), rad/s.
+    pub omega_rad_s: T,
+    /// Effective rolling resistance coefficient (dimensionless); the paper's `mu`.
+    pub mu: T,
+    /// Gravity, m/s^2.
+    pub g_m_s2: T,
+    /// `k2 = m rp^2 / (I + m rp^2)`: 5/7 for a solid sphere, 3/5 for a hollow one. In (0, 1].
+    /// (The paper's 0.845 is `sqrt(5/7)`.)
+    pub k2: T,
+    /// Start radius `ri` (the particle starts at rest), m.
+    pub ri_m: T,
+    /// Rim radius `R` of the bowl, m.
+    pub rim_radius_m: T,
+}
+
+impl<T: Real> Default for Scene<T> {
+    /// The default scene, chosen so that the particle moves (see the module docs):
+    /// omega 3.0 rad/s, mu 0.029, g 9.81 m/s^2, k2 5/7, ri 0.05 m, R 0.1 m.
+    ///
+    /// R = 0.1 m reads the paper's bowl "sizes" 150 to 300 mm as *diameters* (its conclusion's
+    /// reading): 200 mm, the middle of the range. Its nomenclature calls them radii; then pass
+    /// `rim_radius_m` 0.15 to 0.3. The start radius is half the rim radius.
+    fn default() -> Self {
+        Self {
+            omega_rad_s: T::from_f64(3.0),
+            mu: T::from_f64(0.029),
+            g_m_s2: T::from_f64(9.81),
+            k2: T::from_f64(5.0 / 7.0),
+            ri_m: T::from_f64(0.05),
+            rim_radius_m: T::from_f64(0.1),
+        }
+    }
+}
+
+/// What was wrong with a scene (or a time), or why a result cannot be represented.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SceneError {
+    /// The bowl speed was NaN, infinite or negative.
+    InvalidOmega,
+    /// The resistance coefficient mu was NaN, infinite or negative.
+    InvalidResistance,
+    /// Gravity was NaN, infinite or negative.
+    InvalidGravity,
+    /// k2 was NaN, infinite, or outside (0, 1] (it is `m rp^2 / (I + m rp^2)`).
+    InvalidK2,
+    /// The start radius was NaN, infinite or negative.
+    InvalidStartRadius,
+    /// The rim radius was NaN, infinite or negative.
+    InvalidRimRadius,
+    /// The time was NaN, infinite or negative.
+    InvalidTime,
+    /// The inputs are valid but a result (or an intermediate of it) overflows the number type,
+    /// e.g. `cosh(k omega t)` for a long time in `f32`, or absurd magnitudes. Rescale the units.
+    OutOfRange,
+}
+
+/// The result of [`residence`]. Never NaN; the three physical cases are explicit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Outcome<T> {
+    /// The particle reaches the rim.
+    Leaves {
+        /// Residence time `T`, s.
+        residence_time_s: T,
+        /// Radial velocity at the rim `r'(T)`, m/s (paper Eq. 7 / 11 at `T`).
+        exit_radial_velocity_m_s: T,
+        /// Total exit speed `sqrt(r'(T)^2 + (omega R)^2)`, m/s (paper Eq. 12).
+        exit_total_velocity_m_s: T,
+        /// Relative condition number of `T` with respect to relative perturbations of the
+        /// equilibrium radius `a = mu g / omega^2` and of the ratio it enters: about
+        /// `1 / (d ln x)` just above the threshold `ri = a (1 + d)`, about 1 to 2 elsewhere.
+        /// The achievable relative error is about this times the type's epsilon.
+        condition_number: T,
+        /// True when `condition_number > 1/sqrt(epsilon)`: more than half the digits of `T` may
+        /// be lost (the start radius is very close above the threshold `a`).
+        ill_conditioned: bool,
+    },
+    /// `ri >= R`: the particle starts at (or beyond) the rim, `T = 0`, radial velocity 0.
+    AlreadyAtRim {
+        /// `omega R`, m/s (paper Eq. 12 with `r' = 0`).
+        exit_total_velocity_m_s: T,
+    },
+    /// `ri <= a`: static friction holds the particle; it never leaves (the ODE would drag it
+    /// inward, which is unphysical). Also when `omega = 0`.
+    NeverLeaves {
+        /// `a = mu g / omega^2`, m (infinite when `omega = 0`).
+        equilibrium_radius_m: T,
+        /// True when `ri` is within rounding of `a`: the verdict itself is uncertain (in `f32`,
+        /// `ri = a (1 + d)` with `d` below about 1e-7 lands here).
+        near_threshold: bool,
+    },
+}
+
+impl<T: Real> Outcome<T> {
+    /// `T` in seconds: 0 at the rim, infinity when it never leaves.
+    pub fn residence_time_s(&self) -> T {
+        match *self {
+            Outcome::Leaves {
+                residence_time_s, ..
+            } => residence_time_s,
+            Outcome::AlreadyAtRim { .. } => T::ZERO,
+            Outcome::NeverLeaves { .. } => T::INFINITY,
+        }
+    }
+
+    /// `(radial, total)` exit velocities in m/s, `None` when it never leaves.
+    pub fn exit_velocities_m_s(&self) -> Option<(T, T)> {
+        match *self {
+            Outcome::Leaves {
+                exit_radial_velocity_m_s,
+                exit_total_velocity_m_s,
+                ..
+            } => Some((exit_radial_velocity_m_s, exit_total_velocity_m_s)),
+            Outcome::AlreadyAtRim {
+                exit_total_velocity_m_s,
+            } => Some((T::ZERO, exit_total_velocity_m_s)),
+            Outcome::NeverLeaves { .. } => None,
+        }
+    }
+}
+
+fn nonneg_finite<T: Real>(x: T) -> bool {
+    x.is_finite() && x >= T::ZERO
+}
+
+impl<T: Real> Scene<T> {
+    /// Checks every parameter: finite and non-negative, `k2` in (0, 1].
+    pub fn validate(&self) -> Result<(), SceneError> {
+        self.validate_except_omega()?;
+        if !nonneg_finite(self.omega_rad_s) {
+            return Err(SceneError::InvalidOmega);
+        }
+        Ok(())
+    }
+
+    /// As [`Scene::validate`] but ignores `omega_rad_s` (the inverse solves for it).
+    pub fn validate_except_omega(&self) -> Result<(), SceneError> {
+        if !nonneg_finite(self.mu) {
+            return Err(SceneError::InvalidResistance);
+        }
+        if !nonneg_finite(self.g_m_s2) {
+            return Err(SceneError::InvalidGravity);
+        }
+        if !(self.k2.is_finite() && self.k2 > T::ZERO && self.k2 <= T::ONE) {
+            return Err(SceneError::InvalidK2);
+        }
+        if !nonneg_finite(self.ri_m) {
+            return Err(SceneError::InvalidStartRadius);
+        }
+        if !nonneg_finite(self.rim_radius_m) {
+            return Err(SceneError::InvalidRimRadius);
+        }
+        Ok(())
+    }
+
+    /// The equilibrium radius `a = mu g / omega^2`, m (MODEL-NOTES): infinite at `omega = 0`.
+    /// Divides twice by omega rather than once by `omega^2` so a large omega cannot overflow.
+    pub fn equilibrium_radius_m(&self) -> T {
+        if self.omega_rad_s > T::ZERO {
+            self.mu * self.g_m_s2 / self.omega_rad_s / self.omega_rad_s
+        } else {
+            T::INFINITY
+        }
+    }
+}
+
+/// The model's solution in one shape: with `u = l1 t` (`l1 = c1 omega`),
+/// `r(t) = ri + (ri - a) F(u)`, `F(u) = A (e^u - 1) + B (e^{-q u} - 1)`, `A = B q`, `A + B = 1`.
+///
+/// Coriolis (Eq. 10, corrected): `m = k mu`, `s = sqrt(1 + m^2)`, `A = (1 + m/s)/2`,
+/// `B = 1/(2 s (s + m))` (= `(1 - m/s)/2` without its cancellation), `q = (s + m)^2`,
+/// `c1 = k/(s + m)`; so `l2 = -q l1 = -k omega (s + m)`. Flat (Eq. 6): `m = 0`, so
+/// `A = B = 1/2`, `q = 1`, `c1 = k` and `F(u) = cosh u - 1`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Shape<T> {
+    pub c1: T,
+    pub a_coef: T,
+    pub b_coef: T,
+    pub q: T,
+}
+
+impl<T: Real> Shape<T> {
+    pub(crate) fn new(scene: &Scene<T>, model: Model) -> Result<Self, SceneError> {
+        let k = scene.k2.sqrt();
+        match model {
+            Model::Flat => Ok(Self {
+                c1: k,
+                a_coef: T::HALF,
+                b_coef: T::HALF,
+                q: T::ONE,
+            }),
+            Model::Coriolis => {
+                let m = k * scene.mu;
+                // s = sqrt(1 + m^2) without overflowing m^2.
+                let s = if m <= T::ONE {
+                    (T::ONE + m * m).sqrt()
+                } else {
+                    let inv = T::ONE / m;
+                    m * (T::ONE + inv * inv).sqrt()
+                };
+                let sm = s + m;
+                let shape = Self {
+                    c1: k / sm,
+                    a_coef: T::HALF * (T::ONE + m / s),
+                    b_coef: T::HALF / (s * sm),
+                    q: sm * sm,
+                };
+                if shape.q.is_finite() && shape.c1 > T::ZERO && shape.b_coef > T::ZERO {
+                    Ok(shape)
+                } else {
+                    Err(SceneError::OutOfRange)
+                }
+            }
+        }
+    }
+
+    /// `(F(u), F'(u), F''(u))` for `u >= 0`, free of cancellation (see `phi`):
+    /// `F = A phi(u) + B phi(-q u)`, `F' = A (expm1(u) - expm1(-q u))`,
+    /// `F'' = A (e^u + q e^{-q u})`.
+    #[inline]
+    pub(crate) fn eval(&self, u: T) -> (T, T, T) {
+        let (pa, ea) = phi_expm1(u);
+        let qu = self.q * u;
+        let (pb, eb) = phi_expm1(-qu);
+        // For q u >= 1, B phi(-q u) = B expm1(-q u) + A u (as B q = A): no B * (q u) overflow.
+        let b_term = if qu < T::ONE {
+            self.b_coef * pb
+        } else {
+            self.b_coef * eb + self.a_coef * u
+        };
+        let f = self.a_coef * pa + b_term;
+        let fp = self.a_coef * (ea - eb);
+        let fpp = self.a_coef * ((T::ONE + ea) + self.q * (T::ONE + eb));
+        (f, fp, fpp)
+    }
+}
+
+/// Residence time `T` and exit velocities (paper Eq. 7, 11, 12; MODEL-NOTES "Residence time").
+///
+/// `ri >= R` gives [`Outcome::AlreadyAtRim`], `ri <= a` (or `omega = 0`)
+/// [`Outcome::NeverLeaves`]. Flat: `T = log1p(x + sqrt(x (x + 2))) / (k omega)` with
+/// `x = (R - ri)/(ri - a)` (the naive `acosh(1 + x)` loses everything near the rim).
+/// Coriolis: bracketed monotone Newton from the upper bracket on
+/// `A (e^{l1 T} - 1) + B (e^{l2 T} - 1) = x`.
+pub fn residence<T: Real>(scene: &Scene<T>, model: Model) -> Result<Outcome<T>, SceneError> {
+    scene.validate()?;
+    let (ri, rim, omega) = (scene.ri_m, scene.rim_radius_m, scene.omega_rad_s);
+    if ri >= rim {
+        let v = omega * rim;
+        return if v.is_finite() {
+            Ok(Outcome::AlreadyAtRim {
+                exit_total_velocity_m_s: v,
+            })
+        } else {
+            Err(SceneError::OutOfRange)
+        };
+    }
+    let a = scene.equilibrium_radius_m();
+    if ri <= a {
+        // a carries about 3 roundings (mu g, two divisions).
+        let near = a.is_finite() && a - ri <= T::from_f64(4.0) * T::EPSILON * a;
+        return Ok(Outcome::NeverLeaves {
+            equilibrium_radius_m: a,
+            near_threshold: near,
+        });
+    }
+    let exit = match model {
+        Model::Flat => flat::residence(scene, a),
+        Model::Coriolis => coriolis::residence(scene, a)?,
+    };
+    let total = (exit.radial * exit.radial + (omega * rim) * (omega * rim)).sqrt();
+    let cond = exit.condition;
+    if !(exit.time.is_finite() && exit.radial.is_finite() && total.is_finite() && cond.is_finite())
+    {
+        return Err(SceneError::OutOfRange);
+    }
+    Ok(Outcome::Leaves {
+        residence_time_s: exit.time,
+        exit_radial_velocity_m_s: exit.radial,
+        exit_total_velocity_m_s: total,
+        condition_number: cond,
+        ill_conditioned: cond * cond * T::EPSILON > T::ONE,
+    })
+}
+
+/// What the per-model solvers return (the caller adds the total speed and checks ranges).
+pub(crate) struct Exit<T> {
+    pub time: T,
+    pub radial: T,
+    pub condition: T,
+}
+
+/// Condition number of `T` from that of `T(x)`, `kx = x T'(x) / T`: a relative perturbation `e`
+/// of `a` moves `x` by `e a / (ri - a)` relatively; one more unit for `x`'s own rounding and one
+/// for `omega`.
+pub(crate) fn condition<T: Real>(kx: T, a: T, ri: T) -> T {
+    T::ONE + kx * (T::ONE + a / (ri - a))
+}
+
+fn checked_time<T: Real>(t_s: T) -> Result<(), SceneError> {
+    if nonneg_finite(t_s) {
+        Ok(())
+    } else {
+        Err(SceneError::InvalidTime)
+    }
+}
+
+/// Shared set-up of `r(t)` and `r'(t)`: `None` when the particle does not move (`ri <= a`).
+fn moving<T: Real>(scene: &Scene<T>, model: Model) -> Result<Option<(Shape<T>, T)>, SceneError> {
+    scene.validate()?;
+    let a = scene.equilibrium_radius_m();
+    if scene.ri_m <= a {
+        return Ok(None);
+    }
+    Ok(Some((Shape::new(scene, model)?, a)))
+}
+
+/// `r(t)`, m: paper Eq. 6 (flat) or Eq. 10 (Coriolis, corrected `A`, `B`), written as
+/// `ri + (ri - a) F(l1 t)` so that it is accurate at small `t`.
+///
+/// This is the trajectory of the ODE for every `t >= 0`; the particle physically leaves at the
+/// rim at `T` ([`residence`]). When static friction holds it (`ri <= a`) it stays at `ri`.
+pub fn position_m<T: Real>(scene: &Scene<T>, model: Model, t_s: T) -> Result<T, SceneError> {
+    checked_time(t_s)?;
+    let Some((shape, a)) = moving(scene, model)? else {
+        return Ok(scene.ri_m);
+    };
+    let u = shape.c1 * scene.omega_rad_s * t_s;
+    let (f, _, _) = shape.eval(u);
+    let r = scene.ri_m + (scene.ri_m - a) * f;
+    if r.is_finite() {
+        Ok(r)
+    } else {
+        Err(SceneError::OutOfRange)
+    }
+}
+
+/// `r'(t)`, m/s: paper Eq. 7 (flat) or Eq. 11 (Coriolis):
+/// `(ri - a) (k omega / (2 s)) (e^{l1 t} - e^{l2 t})`; 0 when the particle does not move.
+pub fn radial_velocity_m_s<T: Real>(
+    scene: &Scene<T>,
+    model: Model,
+    t_s: T,
+) -> Result<T, SceneError> {
+    checked_time(t_s)?;
+    let Some((shape, a)) = moving(scene, model)? else {
+        return Ok(T::ZERO);
+    };
+    let l1 = shape.c1 * scene.omega_rad_s;
+    let (_, fp, _) = shape.eval(l1 * t_s);
+    let v = (scene.ri_m - a) * l1 * fp;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(SceneError::OutOfRange)
+    }
+}
+
+#[cfg(test)]
+mod tests;

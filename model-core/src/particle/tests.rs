@@ -1,0 +1,315 @@
+//! Unit tests of the particle model against independent formulas. The high-precision accuracy
+//! grid lives in `model-core/tests/`.
+
+use super::*;
+use proptest::prelude::*;
+
+fn scene(omega: f64, mu: f64, ri: f64, rim: f64) -> Scene<f64> {
+    Scene {
+        omega_rad_s: omega,
+        mu,
+        g_m_s2: 9.81,
+        k2: 5.0 / 7.0,
+        ri_m: ri,
+        rim_radius_m: rim,
+    }
+}
+
+fn leaves(o: Outcome<f64>) -> (f64, f64, f64) {
+    match o {
+        Outcome::Leaves {
+            residence_time_s,
+            exit_radial_velocity_m_s,
+            condition_number,
+            ..
+        } => (residence_time_s, exit_radial_velocity_m_s, condition_number),
+        other => panic!("expected Leaves, got {other:?}"),
+    }
+}
+
+/// Independent reference for the Coriolis time: bisection on the printed form
+/// `a + (ri - a)(A e^{l1 t} + B e^{l2 t}) = R` with MODEL-NOTES' A, B, l1, l2 computed directly.
+fn coriolis_time_bisection(s: &Scene<f64>) -> f64 {
+    let k = s.k2.sqrt();
+    let root = (1.0 + s.k2 * s.mu * s.mu).sqrt();
+    let (w, a) = (
+        s.omega_rad_s,
+        s.mu * s.g_m_s2 / (s.omega_rad_s * s.omega_rad_s),
+    );
+    let l1 = k * w / (root + k * s.mu);
+    let l2 = -k * w * (root + k * s.mu);
+    let ca = (1.0 + k * s.mu / root) / 2.0;
+    let cb = (1.0 - k * s.mu / root) / 2.0;
+    let r = |t: f64| a + (s.ri_m - a) * (ca * (l1 * t).exp() + cb * (l2 * t).exp());
+    let (mut lo, mut hi) = (0.0, 1.0);
+    while r(hi) < s.rim_radius_m {
+        hi *= 2.0;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if r(mid) < s.rim_radius_m {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+#[test]
+fn corrected_coefficients_are_exact_at_mu_0_2() {
+    // MODEL-NOTES check value: mu = 0.2, k2 = 5/7 -> l1 = 5 omega/7, l2 = -omega, A = 7/12.
+    let s = scene(2.0, 0.2, 0.05, 0.1);
+    let sh = Shape::new(&s, Model::Coriolis).unwrap();
+    assert!((sh.c1 - 5.0 / 7.0).abs() < 1e-15);
+    assert!((sh.c1 * sh.q - 1.0).abs() < 1e-15);
+    assert!((sh.a_coef - 7.0 / 12.0).abs() < 1e-15);
+    assert!((sh.b_coef - 5.0 / 12.0).abs() < 1e-15);
+    // A + B = 1 and A l1 + B l2 = 0 -> r(0) = ri and r'(0) = 0.
+    assert!((sh.a_coef + sh.b_coef - 1.0).abs() < 1e-15);
+    assert_eq!(position_m(&s, Model::Coriolis, 0.0), Ok(0.05));
+    assert_eq!(radial_velocity_m_s(&s, Model::Coriolis, 0.0), Ok(0.0));
+}
+
+#[test]
+fn flat_time_matches_acosh_and_energy() {
+    for &(w, mu, ri) in &[(3.0, 0.029, 0.05), (1.8, 0.01, 0.04), (3.6, 0.0, 0.001)] {
+        let s = scene(w, mu, ri, 0.1);
+        let (t, v, _) = leaves(residence(&s, Model::Flat).unwrap());
+        let a = mu * 9.81 / (w * w);
+        let k = (5.0f64 / 7.0).sqrt();
+        let want = ((0.1 - a) / (ri - a)).acosh() / (k * w);
+        assert!((t - want).abs() < 1e-13 * want, "{t} vs {want}");
+        // Energy: r'^2 = k2 omega^2 ((R - a)^2 - (ri - a)^2).
+        let v_want = (5.0 / 7.0 * w * w * ((0.1 - a).powi(2) - (ri - a).powi(2))).sqrt();
+        assert!((v - v_want).abs() < 1e-13 * v_want);
+        // And the trajectory reaches the rim at T.
+        let r = position_m(&s, Model::Flat, t).unwrap();
+        assert!((r - 0.1).abs() < 1e-14);
+    }
+}
+
+#[test]
+fn coriolis_time_matches_bisection_and_is_slower() {
+    for &(w, mu, ri) in &[
+        (3.0, 0.029, 0.05),
+        (1.8, 0.01, 0.04),
+        (3.6, 0.05, 0.09),
+        (3.6, 0.0, 0.05),
+    ] {
+        let s = scene(w, mu, ri, 0.1);
+        let (t, v, _) = leaves(residence(&s, Model::Coriolis).unwrap());
+        let want = coriolis_time_bisection(&s);
+        assert!((t - want).abs() < 1e-13 * want, "{t} vs {want}");
+        let (tf, _, _) = leaves(residence(&s, Model::Flat).unwrap());
+        if mu > 0.0 {
+            assert!(t > tf, "Coriolis friction slows the particle");
+        } else {
+            assert!((t - tf).abs() < 1e-14 * tf);
+        }
+        let v_traj = radial_velocity_m_s(&s, Model::Coriolis, t).unwrap();
+        assert!((v - v_traj).abs() < 1e-12 * v_traj);
+    }
+}
+
+#[test]
+fn coriolis_effect_is_small_at_mu_0_029() {
+    // MODEL-NOTES: 0.3 to 2 % at a coefficient near 0.03 for omega >= 1.8.
+    for &w in &[1.8, 2.5, 3.6] {
+        let s = scene(w, 0.029, 0.09, 0.1);
+        let tf = residence(&s, Model::Flat).unwrap().residence_time_s();
+        let tc = residence(&s, Model::Coriolis).unwrap().residence_time_s();
+        let ratio = tc / tf;
+        assert!(ratio > 1.003 && ratio < 1.03, "ratio {ratio} at {w}");
+    }
+}
+
+#[test]
+fn explicit_outcomes() {
+    let paper_literal = scene(3.6, 0.4, 0.05, 0.1);
+    assert!(matches!(
+        residence(&paper_literal, Model::Coriolis),
+        Ok(Outcome::NeverLeaves {
+            near_threshold: false,
+            ..
+        })
+    ));
+    let at_rim = scene(2.0, 0.029, 0.1, 0.1);
+    assert_eq!(
+        residence(&at_rim, Model::Flat),
+        Ok(Outcome::AlreadyAtRim {
+            exit_total_velocity_m_s: 0.2
+        })
+    );
+    let still = scene(0.0, 0.0, 0.05, 0.1);
+    assert!(matches!(
+        residence(&still, Model::Flat),
+        Ok(Outcome::NeverLeaves { .. })
+    ));
+    assert_eq!(
+        residence(&scene(-1.0, 0.0, 0.05, 0.1), Model::Flat),
+        Err(SceneError::InvalidOmega)
+    );
+    assert_eq!(
+        residence(&scene(1.0, f64::NAN, 0.05, 0.1), Model::Flat),
+        Err(SceneError::InvalidResistance)
+    );
+    let mut bad_k2 = scene(1.0, 0.0, 0.05, 0.1);
+    bad_k2.k2 = 1.5;
+    assert_eq!(residence(&bad_k2, Model::Flat), Err(SceneError::InvalidK2));
+    assert_eq!(
+        position_m(&scene(1.0, 0.0, 0.05, 0.1), Model::Flat, -1.0),
+        Err(SceneError::InvalidTime)
+    );
+}
+
+#[test]
+fn condition_number_grows_near_threshold() {
+    // ri = a (1 + d): condition about 1/(d ln x).
+    let w = 3.0;
+    let a = 0.029 * 9.81 / (w * w);
+    for &d in &[1e-2, 1e-5, 1e-8] {
+        let s = scene(w, 0.029, a * (1.0 + d), 0.1);
+        let (_, _, c) = leaves(residence(&s, Model::Flat).unwrap());
+        let x = (0.1 - a * (1.0 + d)) / (a * d);
+        let approx = 1.0 / (d * x.ln());
+        assert!(
+            c > 0.5 * approx && c < 3.0 * approx,
+            "d {d}: {c} vs {approx}"
+        );
+    }
+}
+
+#[test]
+fn inverse_round_trips() {
+    for model in [Model::Flat, Model::Coriolis] {
+        for &(mu, ri, target) in &[
+            (0.029, 0.05, 0.78),
+            (0.0, 0.05, 2.0),
+            (0.029, 0.099, 0.01),
+            (0.2, 0.05, 5.0),
+            (0.029, 0.01, 3.0),
+        ] {
+            let s = scene(0.0, mu, ri, 0.1);
+            let w = omega_for_residence_time(&s, model, target).unwrap();
+            let back = residence(
+                &Scene {
+                    omega_rad_s: w,
+                    ..s
+                },
+                model,
+            )
+            .unwrap();
+            let (t, _, c) = leaves(back);
+            assert!(
+                (t - target).abs() < 1e-12 * c * target,
+                "{model:?} {mu} {ri}: {t} vs {target}"
+            );
+        }
+    }
+    let s = scene(0.0, 0.029, 0.05, 0.1);
+    assert_eq!(
+        omega_for_residence_time(&s, Model::Flat, 0.0),
+        Err(InverseError::InvalidTarget)
+    );
+    // 30 s from ri = 0.01 needs ri - a near 1e-60 m: between two adjacent f64 speeds.
+    let far = scene(0.0, 0.029, 0.01, 0.1);
+    assert_eq!(
+        omega_for_residence_time(&far, Model::Flat, 30.0),
+        Err(InverseError::BeyondPrecision)
+    );
+    let rim = scene(0.0, 0.029, 0.1, 0.1);
+    assert_eq!(
+        omega_for_residence_time(&rim, Model::Flat, 1.0),
+        Err(InverseError::AlreadyAtRim)
+    );
+}
+
+#[test]
+fn inverse_is_monotone() {
+    let s = scene(0.0, 0.029, 0.05, 0.1);
+    let mut last = f64::INFINITY;
+    for i in 1..40 {
+        let w = omega_for_residence_time(&s, Model::Coriolis, 0.1 * i as f64).unwrap();
+        assert!(w < last);
+        last = w;
+    }
+}
+
+fn any_finite_f64() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        -1.0f64..10.0,
+        0.0f64..1e-3,
+        (-300i32..300, 0.1f64..10.0).prop_map(|(e, m)| m * 10f64.powi(e)),
+        Just(0.0),
+    ]
+}
+
+fn check_outcome<T: Real>(o: Result<Outcome<T>, SceneError>) -> Result<(), TestCaseError> {
+    if let Ok(o) = o {
+        match o {
+            Outcome::Leaves {
+                residence_time_s: t,
+                exit_radial_velocity_m_s: v,
+                exit_total_velocity_m_s: vt,
+                condition_number: c,
+                ..
+            } => {
+                prop_assert!(t.is_finite() && t >= T::ZERO);
+                prop_assert!(v.is_finite() && v >= T::ZERO);
+                prop_assert!(vt.is_finite() && c.is_finite() && c >= T::ONE);
+            }
+            Outcome::AlreadyAtRim {
+                exit_total_velocity_m_s: v,
+            } => prop_assert!(v.is_finite()),
+            Outcome::NeverLeaves {
+                equilibrium_radius_m: a,
+                ..
+            } => prop_assert!(!a.is_nan()),
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3000))]
+    #[test]
+    fn never_nan_or_panic(w in any_finite_f64(), mu in any_finite_f64(), g in any_finite_f64(),
+                          k2 in any_finite_f64(), ri in any_finite_f64(), rim in any_finite_f64(),
+                          t in any_finite_f64()) {
+        let s = Scene { omega_rad_s: w, mu, g_m_s2: g, k2, ri_m: ri, rim_radius_m: rim };
+        let s32 = Scene { omega_rad_s: w as f32, mu: mu as f32, g_m_s2: g as f32, k2: k2 as f32,
+                          ri_m: ri as f32, rim_radius_m: rim as f32 };
+        for model in [Model::Flat, Model::Coriolis] {
+            check_outcome(residence(&s, model))?;
+            check_outcome(residence(&s32, model))?;
+            for v in [position_m(&s, model, t), radial_velocity_m_s(&s, model, t)].into_iter().flatten() {
+                prop_assert!(v.is_finite());
+            }
+            for v in [position_m(&s32, model, t as f32), radial_velocity_m_s(&s32, model, t as f32)].into_iter().flatten() {
+                prop_assert!(v.is_finite());
+            }
+            if let Ok(v) = omega_for_residence_time(&s, model, t) { prop_assert!(v.is_finite() && v > 0.0); }
+            if let Ok(v) = omega_for_residence_time(&s32, model, t as f32) { prop_assert!(v.is_finite() && v > 0.0); }
+        }
+    }
+
+    #[test]
+    fn inverse_round_trips_on_physical_scenes(mu in 0.0f64..0.3, ri_frac in 0.01f64..0.999,
+                                              rim in 0.05f64..0.3, target in 0.01f64..100.0) {
+        let s = scene(0.0, mu, ri_frac * rim, rim);
+        for model in [Model::Flat, Model::Coriolis] {
+            let sh = Shape::new(&s, model).unwrap();
+            let z_th = sh.c1 * (mu * 9.81 / s.ri_m).sqrt() * target;
+            let w = match omega_for_residence_time(&s, model, target) {
+                Ok(w) => w,
+                // Only where ri - a would have to be below ~1e-11 ri: e^{z_th} beyond 1/eps.
+                Err(InverseError::BeyondPrecision) if z_th > 25.0 => return Ok(()),
+                Err(e) => panic!("{e:?} at z_th {z_th}"),
+            };
+            let back = residence(&Scene { omega_rad_s: w, ..s }, model).unwrap();
+            let (t, c) = match back { Outcome::Leaves { residence_time_s, condition_number, .. } => (residence_time_s, condition_number), o => panic!("{o:?}") };
+            prop_assert!((t - target).abs() < 1e-12 * c * target, "{:?}: {} vs {}", model, t, target);
+        }
+    }
+}
