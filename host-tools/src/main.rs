@@ -18,11 +18,14 @@ struct Cli {
 enum Command {
     /// Combined bowl speed from the two motor speeds (paper Eq. 2), or the split of a target speed.
     Kinematics(kinematics::Args),
+    /// Charts: work-precision (error against cost), and the paper's Figures 5-7 redrawn.
+    Chart(chart::Args),
 }
 
 fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Kinematics(args) => kinematics::run(&args),
+        Command::Chart(args) => chart::run(&args),
     }
 }
