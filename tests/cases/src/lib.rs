@@ -11,6 +11,7 @@
 
 pub mod bowl;
 pub mod check;
+pub mod cost;
 
 pub use check::{Bench, Case, Failure};
 
@@ -18,7 +19,7 @@ pub use check::{Bench, Case, Failure};
 pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES];
 
 /// Every benchmark, grouped likewise.
-pub static BENCH_GROUPS: &[&[Bench]] = &[bowl::BENCHES];
+pub static BENCH_GROUPS: &[&[Bench]] = &[cost::BENCHES, bowl::BENCHES];
 
 /// All cases in one iterator.
 pub fn all_cases() -> impl Iterator<Item = &'static Case> {
