@@ -62,6 +62,11 @@ pub struct Method {
 }
 
 impl Method {
+    /// The setting as `name=value` (step `h*omega=..`, tolerance `tol=..`), empty for closed forms.
+    pub fn setting(&self) -> String {
+        String::new()
+    }
+
     /// The name used in the CSV and in the QEMU benchmark names (`cost::SCENE::MODEL::KEY`).
     pub fn key(&self) -> String {
         format!("{}-{}", self.family.key(), self.precision.key())
@@ -292,6 +297,13 @@ pub fn table(points: &[Point]) -> Table {
         "method",
         "family",
         "precision",
+        "setting",
+        "w_rad_s",
+        "mu",
+        "g",
+        "k2",
+        "ri_m",
+        "R_m",
         "residence_time_s",
         "ref_residence_time_s",
         "rel_error",
@@ -308,6 +320,13 @@ pub fn table(points: &[Point]) -> Table {
             p.method.key(),
             p.method.family.key().into(),
             p.method.precision.key().into(),
+            p.method.setting(),
+            format!("{:.17e}", p.run.inputs.omega_rad_s),
+            format!("{:.17e}", p.run.inputs.mu),
+            format!("{:.17e}", p.run.inputs.g_m_s2),
+            format!("{:.17e}", p.run.inputs.k2),
+            format!("{:.17e}", p.run.inputs.ri_m),
+            format!("{:.17e}", p.run.inputs.rim_radius_m),
             p.run
                 .time_s
                 .map_or_else(|| "inf".into(), |x| format!("{x:.17e}")),
