@@ -214,7 +214,7 @@ fn sweep(which: Sweep) -> anyhow::Result<(Figure, Table)> {
                     format!("{size}"),
                     format!("{}", s.rim_radius_m),
                     model_name(model).into(),
-                    format!("{w:.6}"),
+                    format!("{w}"),
                     kind.into(),
                     format!("{t:.17e}"),
                     format!("{v:.17e}"),

@@ -78,7 +78,7 @@ impl Ctx {
     fn exp(&mut self, v: &BigFloat) -> BigFloat {
         v.exp(P, RM, &mut self.cc)
     }
-    fn to_f64(&mut self, v: &BigFloat) -> f64 {
+    fn round_to_f64(&mut self, v: &BigFloat) -> f64 {
         // Decimal with far more digits than f64 holds, then one correctly rounded parse.
         v.format(astro_float::Radix::Dec, RM, &mut self.cc)
             .ok()
@@ -160,8 +160,8 @@ pub fn outcome(scene: &RefScene, model: RefModel) -> RefOutcome {
         }
     };
     RefOutcome::Leaves {
-        time_s: c.to_f64(&t),
-        radial_velocity_m_s: c.to_f64(&v),
+        time_s: c.round_to_f64(&t),
+        radial_velocity_m_s: c.round_to_f64(&v),
     }
 }
 
