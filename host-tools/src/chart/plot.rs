@@ -164,6 +164,8 @@ pub struct Axis {
     pub hi: f64,
     /// Tick positions.
     pub ticks: Vec<f64>,
+    /// Light grid lines between ticks (log axes: 2..9 times each decade).
+    pub minor: Vec<f64>,
 }
 
 /// Our own coordinate: a linear map with exactly our ticks (plotters' key-point wrapper loses
@@ -181,6 +183,11 @@ impl Ranged for Axis {
     fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
         if hint.max_num_points() == 0 {
             Vec::new()
+        } else if hint.weight().allow_light_points() {
+            // plotters draws light lines for the points not also in the bold set.
+            let mut all = self.ticks.clone();
+            all.extend(&self.minor);
+            all
         } else {
             self.ticks.clone()
         }
@@ -205,8 +212,9 @@ pub fn axis_for(scale: Scale, values: &[f64]) -> Option<Axis> {
     match scale {
         Scale::Log => {
             // Whole decades around the data; at least one decade.
-            let mut lo = lo.floor();
-            let mut hi = hi.ceil();
+            // A little room so points on a whole decade do not sit on the frame.
+            let mut lo = (lo - 0.1).floor();
+            let mut hi = (hi + 0.1).ceil();
             if hi - lo < 1.0 {
                 lo -= 0.5;
                 hi += 0.5;
@@ -220,7 +228,19 @@ pub fn axis_for(scale: Scale, values: &[f64]) -> Option<Axis> {
                 ticks.push(t);
                 t += step;
             }
-            Some(Axis { lo, hi, ticks })
+            let minor = if step == 1.0 && hi - lo <= 6.0 {
+                (lo as i64..hi as i64)
+                    .flat_map(|d| (2..10).map(move |m| d as f64 + f64::from(m).log10()))
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            Some(Axis {
+                lo,
+                hi,
+                ticks,
+                minor,
+            })
         }
         Scale::Linear => {
             let span = if hi > lo { hi - lo } else { lo.abs().max(1.0) };
@@ -242,6 +262,7 @@ pub fn axis_for(scale: Scale, values: &[f64]) -> Option<Axis> {
                 lo: lo_t,
                 hi: hi_t,
                 ticks,
+                minor: Vec::new(),
             })
         }
     }
@@ -353,7 +374,7 @@ impl Figure {
             .y_label_formatter(&y_fmt)
             .label_style((FONT, 15))
             .axis_desc_style((FONT, 17))
-            .light_line_style(WHITE)
+            .light_line_style(RGBColor(242, 242, 242))
             .bold_line_style(RGBColor(225, 225, 225))
             .draw()
             .map_err(be)?;
@@ -476,7 +497,7 @@ mod tests {
 
     #[test]
     fn log_axis_covers_data_with_whole_decades() {
-        let a = axis_for(Scale::Log, &[-6.3, -1.2]).unwrap();
+        let a = axis_for(Scale::Log, &[-6.3, -1.5]).unwrap();
         assert_eq!((a.lo, a.hi), (-7.0, -1.0));
         assert_eq!(a.ticks.first(), Some(&-7.0));
         assert_eq!(a.ticks.last(), Some(&-1.0));
