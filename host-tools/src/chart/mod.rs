@@ -9,6 +9,7 @@ use anyhow::{Context, Result};
 use clap::Subcommand;
 
 pub mod figures;
+pub mod pitfalls;
 pub mod plot;
 pub mod qemu_log;
 pub mod reference;
