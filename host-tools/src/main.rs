@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 
 mod chart;
 mod kinematics;
+mod predict;
 
 /// The PC side of the bowl granulation rig.
 #[derive(Parser)]
@@ -20,6 +21,8 @@ enum Command {
     Kinematics(kinematics::Args),
     /// Charts: work-precision (error against cost), and the paper's Figures 5-7 redrawn.
     Chart(chart::Args),
+    /// Residence time and exit velocities of a particle (paper Eq. 5-12, corrected), or a batch CSV.
+    Predict(predict::Args),
 }
 
 fn main() -> Result<()> {
@@ -27,5 +30,6 @@ fn main() -> Result<()> {
     match cli.command {
         Command::Kinematics(args) => kinematics::run(&args),
         Command::Chart(args) => chart::run(&args),
+        Command::Predict(args) => predict::run(&args),
     }
 }

@@ -379,8 +379,10 @@ impl Figure {
             .draw()
             .map_err(be)?;
 
-        for v in &self.vlines {
+        for (i, v) in self.vlines.iter().enumerate() {
             if let Some(x) = to_axis(self.x_scale, v.x) {
+                // Labels staggered downwards so neighbouring lines stay readable.
+                let label_y = ya.hi - (ya.hi - ya.lo) * 0.035 * (i % 8) as f64;
                 let c = colour(v.color);
                 chart
                     .draw_series(DashedLineSeries::new(
@@ -393,7 +395,7 @@ impl Figure {
                 chart
                     .draw_series(std::iter::once(Text::new(
                         v.label.clone(),
-                        (x, ya.hi),
+                        (x, label_y),
                         (FONT, 13).into_font().color(&c),
                     )))
                     .map_err(be)?;
