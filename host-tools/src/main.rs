@@ -3,6 +3,7 @@
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
+mod chart;
 mod kinematics;
 mod predict;
 mod sim;
@@ -26,6 +27,8 @@ struct Cli {
 enum Command {
     /// Combined bowl speed from the two motor speeds (paper Eq. 2), or the split of a target speed.
     Kinematics(kinematics::Args),
+    /// Charts: work-precision (error against cost), and the paper's Figures 5-7 redrawn.
+    Chart(chart::Args),
     /// Residence time and exit velocities of a particle (paper Eq. 5-12, corrected), or a batch CSV.
     Predict(predict::Args),
     /// Live view of the rig's telemetry, with CSV log and frame counters.
@@ -53,6 +56,7 @@ fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Kinematics(args) => kinematics::run(&args),
+        Command::Chart(args) => chart::run(&args),
         Command::Predict(args) => predict::run(&args),
         Command::Monitor(args) => monitor::run(&args),
         Command::Send(args) => send::run(&args).map(|code| std::process::exit(code)),

@@ -11,6 +11,7 @@
 
 pub mod bowl;
 pub mod check;
+pub mod cost;
 pub mod particle;
 
 pub use check::{Bench, Case, Failure};
@@ -19,7 +20,7 @@ pub use check::{Bench, Case, Failure};
 pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES, particle::CASES];
 
 /// Every benchmark, grouped likewise.
-pub static BENCH_GROUPS: &[&[Bench]] = &[bowl::BENCHES, particle::BENCHES];
+pub static BENCH_GROUPS: &[&[Bench]] = &[bowl::BENCHES, particle::BENCHES, cost::BENCHES];
 
 /// All cases in one iterator.
 pub fn all_cases() -> impl Iterator<Item = &'static Case> {
