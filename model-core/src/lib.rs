@@ -12,6 +12,7 @@
 
 pub mod bowl;
 pub mod control;
+pub mod choose;
 pub mod ode;
 pub mod particle;
 pub mod real;
