@@ -74,6 +74,12 @@ struct StepArgs {
     /// Override the loop's per-pulse bandwidth.
     #[arg(long)]
     per_pulse_bandwidth: Option<f32>,
+    /// Override the estimator's filter weight.
+    #[arg(long)]
+    filter_weight: Option<f32>,
+    /// Override the setpoint ramp, rad/s^2.
+    #[arg(long)]
+    accel_rad_s2: Option<f32>,
 }
 
 #[derive(clap::Args)]
@@ -111,9 +117,15 @@ pub fn run(args: &Args) -> Result<()> {
                 }
             }
             let mut cfg = ControllerConfig::nominal();
-            if let Some(p) = a.per_pulse_bandwidth {
-                for ax in &mut cfg.axes {
+            for ax in &mut cfg.axes {
+                if let Some(p) = a.per_pulse_bandwidth {
                     ax.per_pulse_bandwidth = p;
+                }
+                if let Some(w) = a.filter_weight {
+                    ax.filter_weight = w;
+                }
+                if let Some(acc) = a.accel_rad_s2 {
+                    ax.accel_limit_rad_s2 = acc;
                 }
             }
             let out = StepJson {
@@ -121,7 +133,14 @@ pub fn run(args: &Args) -> Result<()> {
                 pulses_per_rev: a.pulses_per_rev,
                 target_rad_s: a.target_rad_s,
                 feedback: !a.no_feedback,
-                outcome: step_run_with(rig, cfg, a.common.seed, a.target_rad_s, !a.no_feedback),
+                outcome: step_run_with(
+                    rig,
+                    cfg,
+                    a.common.seed,
+                    a.target_rad_s,
+                    !a.no_feedback,
+                    [0.0; 2],
+                ),
             };
             println!("{}", serde_json::to_string_pretty(&out)?);
         }
@@ -188,7 +207,14 @@ const STEADY_FROM_S: f32 = 5.0;
 
 /// Commissions the controller on `rig`, then steps both axes from 0 to `target`.
 pub fn step_run(rig: RigParams, seed: u32, target: f32, feedback: bool) -> StepOutcome {
-    step_run_with(rig, ControllerConfig::nominal(), seed, target, feedback)
+    step_run_with(
+        rig,
+        ControllerConfig::nominal(),
+        seed,
+        target,
+        feedback,
+        [0.0; 2],
+    )
 }
 
 /// [`step_run`] with a given controller configuration (its pulses per revolution are set from
@@ -199,6 +225,7 @@ pub fn step_run_with(
     seed: u32,
     target: f32,
     feedback: bool,
+    load_after_commissioning_nm: [f32; 2],
 ) -> StepOutcome {
     for i in 0..2 {
         cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
@@ -207,6 +234,18 @@ pub fn step_run_with(
     let mut cl = ClosedLoop::new(Rig::new(rig, seed), ctrl);
     let commissioned = cl.commission(300.0) == State::Idle;
     cl.ctrl.set_feedback_enabled(feedback);
+    // The material goes in after commissioning: a load the identified model does not know.
+    let now = cl.rig.time_s() as f32;
+    for (a, load) in cl
+        .rig
+        .params_mut()
+        .axes
+        .iter_mut()
+        .zip(load_after_commissioning_nm)
+    {
+        a.faults.load_step_from_s = now;
+        a.faults.load_step_nm = load;
+    }
     let mut m = [
         StepMetrics::new(target, STEADY_FROM_S),
         StepMetrics::new(target, STEADY_FROM_S),
@@ -289,8 +328,9 @@ pub struct StepJson {
     pub outcome: StepOutcome,
 }
 
-/// One perturbed plant of the family (seeded).
-pub fn family_plant(seed: u32, index: u32) -> RigParams {
+/// One perturbed plant of the family (seeded), and the material's load torque
+/// `[precession, spin]` that is added after commissioning.
+pub fn family_plant(seed: u32, index: u32) -> (RigParams, [f32; 2]) {
     let mut rng = Prng::new(seed.wrapping_mul(0x9e37_79b9) ^ index);
     let mut rig = RigParams::nominal();
     for a in &mut rig.axes {
@@ -306,7 +346,10 @@ pub fn family_plant(seed: u32, index: u32) -> RigParams {
         a.ripple_nm *= rng.range(0.5, 2.0);
     }
     rig.coupling = 0.5 * rng.range(0.8, 1.2);
-    rig
+    // Granulating material: 0.2 to 0.5 kg rolling in the bowl drags the spin axis; the
+    // precession axis sees less.
+    let load = [rng.range(0.0, 0.05), rng.range(0.02, 0.1)];
+    (rig, load)
 }
 
 /// `bowl sim family`'s JSON.
@@ -332,7 +375,17 @@ pub struct FamilyJson {
 
 fn family(seed: u32, plants: u32, feedback: bool) -> FamilyJson {
     let outcomes: Vec<StepOutcome> = (0..plants)
-        .map(|i| step_run(family_plant(seed, i), seed.wrapping_add(i), 3.0, feedback))
+        .map(|i| {
+            let (rig, load) = family_plant(seed, i);
+            step_run_with(
+                rig,
+                ControllerConfig::nominal(),
+                seed.wrapping_add(i),
+                3.0,
+                feedback,
+                load,
+            )
+        })
         .collect();
     if std::env::var_os("BOWL_SIM_VERBOSE").is_some() {
         for (i, o) in outcomes.iter().enumerate() {
@@ -341,7 +394,7 @@ fn family(seed: u32, plants: u32, feedback: bool) -> FamilyJson {
     }
     let worsts: Vec<AxisFigures> = outcomes.iter().map(|o| o.worst).collect();
     FamilyJson {
-        scenario: "family: inertia +/-30 %, torque constant +/-15 %, friction x0.5..x2, 1 % tooth error, 200 us jitter, load ripple, axis coupling; each commissioned; 0 -> 3 rad/s, 12 pulses/rev",
+        scenario: "family: inertia +/-30 %, torque constant +/-15 %, friction x0.5..x2, 1 % tooth error, 200 us jitter, load ripple x0.5..x2, axis coupling +/-20 %; each commissioned, then a material load (precession 0..0.05 N m, spin 0.02..0.1 N m) the model does not know; 0 -> 3 rad/s, 12 pulses/rev",
         plants,
         seed,
         feedback,
@@ -481,9 +534,12 @@ fn stability(seed: u32, speed: f32) {
 }
 
 fn trace(seed: u32, plant: Option<u32>) {
-    let (rig, rig_seed) = match plant {
-        Some(i) => (family_plant(seed, i), seed.wrapping_add(i)),
-        None => (RigParams::nominal(), seed),
+    let (rig, rig_seed, load) = match plant {
+        Some(i) => {
+            let (rig, load) = family_plant(seed, i);
+            (rig, seed.wrapping_add(i), load)
+        }
+        None => (RigParams::nominal(), seed, [0.0; 2]),
     };
     let ctrl = Controller::new(ControllerConfig::nominal()).expect("valid");
     let mut cl = ClosedLoop::new(Rig::new(rig, rig_seed), ctrl);
@@ -492,6 +548,11 @@ fn trace(seed: u32, plant: Option<u32>) {
         "commissioning: {state:?}, identified {:?}",
         cl.ctrl.identified()
     );
+    let now = cl.rig.time_s() as f32;
+    for (a, l) in cl.rig.params_mut().axes.iter_mut().zip(load) {
+        a.faults.load_step_from_s = now;
+        a.faults.load_step_nm = l;
+    }
     let _ = cl.ctrl.set_motor_speeds(3.0, 3.0);
     let _ = cl.ctrl.start();
     println!(

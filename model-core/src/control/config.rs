@@ -147,10 +147,10 @@ impl AxisConfig {
             },
             bandwidth_rad_s: 8.0,
             per_pulse_bandwidth: 0.5,
-            accel_limit_rad_s2: 4.0,
+            accel_limit_rad_s2: 6.0,
             duty_limit: 0.95,
             duty_slew_per_s: 4.0,
-            filter_weight: 0.5,
+            filter_weight: 0.7,
         }
     }
 }

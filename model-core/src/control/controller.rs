@@ -102,6 +102,7 @@ pub struct Controller {
     identified: [Option<Identified>; 2],
     identify_error: Option<IdentifyError>,
     feedback: bool,
+    cos_axes: f32,
 }
 
 impl Controller {
@@ -155,6 +156,7 @@ impl Controller {
             identified: [None; 2],
             identify_error: None,
             feedback: true,
+            cos_axes: libm::cosf(cfg.axes_angle_rad),
         }
     }
 
@@ -220,7 +222,9 @@ impl Controller {
         let established =
             self.est[0].is_valid() && self.measured[0].abs() >= 0.5 * r0.abs() && r0 != 0.0;
         let ramped = self.planner.step(dt, self.max_step, stopped, established);
-        for i in 0..2 {
+        // Spin first: its model's acceleration feeds the precession axis's decoupling.
+        let mut decouple = 0.0;
+        for i in [1usize, 0] {
             if ramped[i] > 0.0 {
                 self.direction[i] = 1.0;
             } else if ramped[i] < 0.0 {
@@ -229,10 +233,22 @@ impl Controller {
             let input = LoopInput {
                 reference_rad_s: ramped[i],
                 measured_rad_s: self.measured[i],
+                direction: self.direction[i],
                 measurement_valid: self.est[i].is_valid(),
+                events: self.est[i].window_events(),
                 feedback: self.feedback,
+                extra_duty: if i == 0 { decouple } else { 0.0 },
             };
             let duty = self.loops[i].step(&self.k[i], input);
+            if i == 1 {
+                // The spin's accelerating torque reacts on the rod: J2 a2 projected on the
+                // vertical. With J2 a2 = tau2 k2 a2 dr_p/dt / R2 and the same motor type on both
+                // axes, the precession duty that cancels it is
+                // cos(angle) * (r - r_p) * duty_per_rad_s of the spin model.
+                decouple = self.cos_axes
+                    * (ramped[1] - self.loops[1].model_rad_s())
+                    * self.k[1].duty_per_rad_s();
+            }
             self.duties[i] = duty;
             let r_abs = ramped[i].abs();
             let expected_period_s = if r_abs > 0.0 {

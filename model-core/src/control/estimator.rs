@@ -39,6 +39,28 @@ use super::config::{AxisConfig, ControllerConfig};
 /// Shortest counting window, s: at high pulse rates a raw sample averages over at least this.
 pub const WINDOW_S: f32 = 0.025;
 
+/// A closed counting window: the raw speed over a known interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindowSample {
+    /// How long before the tick's `now` the window closed (its last edge), s.
+    pub ago_s: f32,
+    /// The window's span, first to last edge, s.
+    pub span_s: f32,
+    /// Mean speed over the window, rad/s (magnitude, unfiltered).
+    pub raw_speed_rad_s: f32,
+}
+
+/// What happened to the counting window during the last tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindowEvents {
+    /// A new measurement began (first edge after rest) this long before `now`, s.
+    pub restarted_s_ago: Option<f32>,
+    /// A window closed.
+    pub closed: Option<WindowSample>,
+    /// The stall bound is below the filtered speed: the shaft is slowing between edges.
+    pub bound_active: bool,
+}
+
 /// Speed estimator of one axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PulseSpeedEstimator {
@@ -63,6 +85,11 @@ pub struct PulseSpeedEstimator {
     speed_filt: f32,
     speed: f32,
     updated: bool,
+    bound_active: bool,
+    restart_at: Option<u32>,
+    closed_at: Option<u32>,
+    closed_span: u32,
+    closed_raw: f32,
     accepted: u32,
     rejected: u32,
     missing: u32,
@@ -97,6 +124,11 @@ impl PulseSpeedEstimator {
             speed_filt: 0.0,
             speed: 0.0,
             updated: false,
+            bound_active: false,
+            restart_at: None,
+            closed_at: None,
+            closed_span: 0,
+            closed_raw: 0.0,
             accepted: 0,
             rejected: 0,
             missing: 0,
@@ -124,6 +156,8 @@ impl PulseSpeedEstimator {
         }
         let span = now.wrapping_sub(self.prev_now) & self.mask;
         self.updated = false;
+        self.restart_at = None;
+        self.closed_at = None;
         for &t in edges {
             let mut offset = t.wrapping_sub(self.prev_now) & self.mask;
             if offset > span {
@@ -149,6 +183,7 @@ impl PulseSpeedEstimator {
             self.last_edge = at;
             self.win_start = at;
             self.win_pulses = 0;
+            self.restart_at = Some(at);
             self.accepted = self.accepted.wrapping_add(1);
             return Some(1);
         }
@@ -192,6 +227,9 @@ impl PulseSpeedEstimator {
                 self.valid = true;
             }
             self.updated = true;
+            self.closed_at = Some(at);
+            self.closed_span = wspan;
+            self.closed_raw = raw;
             self.win_start = at;
             self.win_pulses = 0;
         }
@@ -199,6 +237,7 @@ impl PulseSpeedEstimator {
     }
 
     fn bounded_speed(&mut self) -> f32 {
+        self.bound_active = false;
         if !self.has_edge {
             return 0.0;
         }
@@ -218,10 +257,26 @@ impl PulseSpeedEstimator {
         if since > self.last_interval && since > 0 {
             let bound = self.rad_per_pulse * self.ticks_per_s / since as f32;
             if bound < self.speed_filt {
+                self.bound_active = true;
                 return bound;
             }
         }
         self.speed_filt
+    }
+
+    /// The window events of the last tick, for a loop that compares the measurement with a
+    /// model over exactly the same interval (see `pi`).
+    pub fn window_events(&self) -> WindowEvents {
+        let ago = |at: u32| self.clock.wrapping_sub(at) as f32 / self.ticks_per_s;
+        WindowEvents {
+            restarted_s_ago: self.restart_at.map(ago),
+            closed: self.closed_at.map(|at| WindowSample {
+                ago_s: ago(at),
+                span_s: self.closed_span as f32 / self.ticks_per_s,
+                raw_speed_rad_s: self.closed_raw,
+            }),
+            bound_active: self.bound_active,
+        }
     }
 
     /// The last estimate, rad/s (magnitude).
