@@ -19,7 +19,8 @@
 //! # Stall bound
 //! Between edges the shaft has turned less than one pitch since the last edge, so the speed is at
 //! most `pitch / time since the last edge`. Once that bound is below the filtered value, it is
-//! the estimate: a stopping shaft reads a falling speed, and after one pitch at the configured
+//! the estimate (at steady speed the bound allows two pitches, so that one missing pulse does not
+//! halve the reading): a stopping shaft reads a falling speed, and after one pitch at the configured
 //! minimum speed without an edge it reads exactly zero and the estimator starts afresh.
 //!
 //! # Bounce and missing pulses
@@ -173,7 +174,7 @@ impl PulseSpeedEstimator {
         }
         self.clock = self.clock.wrapping_add(span);
         self.prev_now = now;
-        self.speed = self.bounded_speed();
+        self.speed = self.bounded_speed(if steady { 2 } else { 1 });
         self.speed
     }
 
@@ -236,7 +237,9 @@ impl PulseSpeedEstimator {
         Some(pulses)
     }
 
-    fn bounded_speed(&mut self) -> f32 {
+    /// `pitches`: how many pitches the shaft may have turned since the last edge (2 at steady
+    /// speed, where one missing pulse must not halve the reading; 1 otherwise).
+    fn bounded_speed(&mut self, pitches: u32) -> f32 {
         self.bound_active = false;
         if !self.has_edge {
             return 0.0;
@@ -254,8 +257,8 @@ impl PulseSpeedEstimator {
         if !self.valid {
             return 0.0;
         }
-        if since > self.last_interval && since > 0 {
-            let bound = self.rad_per_pulse * self.ticks_per_s / since as f32;
+        if since > self.last_interval.saturating_mul(pitches) && since > 0 {
+            let bound = pitches as f32 * self.rad_per_pulse * self.ticks_per_s / since as f32;
             if bound < self.speed_filt {
                 self.bound_active = true;
                 return bound;
