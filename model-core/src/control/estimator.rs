@@ -99,7 +99,7 @@ pub struct PulseSpeedEstimator {
 
 impl PulseSpeedEstimator {
     /// An estimator for `axis` of a validated configuration.
-    pub fn new(cfg: &ControllerConfig, axis: &AxisConfig) -> Self {
+    pub const fn new(cfg: &ControllerConfig, axis: &AxisConfig) -> Self {
         let ticks_per_s = cfg.timer_hz as f32;
         let rad_per_pulse = core::f32::consts::TAU / axis.pulses_per_rev as f32;
         let min_period_s = rad_per_pulse / axis.overspeed_rad_s;

@@ -81,7 +81,7 @@ pub struct LoopConstants {
 
 impl LoopConstants {
     /// Constants for `axis` at tick period `dt_s` and supply `supply_v`.
-    pub fn new(axis: &AxisConfig, dt_s: f32, supply_v: f32) -> Self {
+    pub const fn new(axis: &AxisConfig, dt_s: f32, supply_v: f32) -> Self {
         let pulses_per_rad = axis.pulses_per_rev as f32 / core::f32::consts::TAU;
         let w = axis.filter_weight;
         Self {
@@ -127,12 +127,24 @@ impl LoopConstants {
 }
 
 impl SpeedLoop {
+    /// At rest: zero output, zero integral.
+    pub const REST: Self = Self {
+        integral: 0.0,
+        duty: 0.0,
+        model_rad_s: 0.0,
+        model_angle_rad: 0.0,
+        window_open: false,
+        have_error: false,
+        error: 0.0,
+        kp_prev: 0.0,
+    };
+
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
     #[inline]
     pub fn step(&mut self, k: &LoopConstants, input: LoopInput) -> f32 {
         let r = input.reference_rad_s;
         if r == 0.0 {
-            *self = Self::default();
+            *self = Self::REST;
             return 0.0;
         }
         let r_abs = r.abs();
@@ -219,6 +231,6 @@ impl SpeedLoop {
     }
     /// Back to rest (zero output, zero integral).
     pub fn reset(&mut self) {
-        *self = Self::default();
+        *self = Self::REST;
     }
 }

@@ -72,6 +72,9 @@ pub struct SensorWatch {
 }
 
 impl SensorWatch {
+    /// A cleared watch.
+    pub const CLEAR: Self = Self { blind_s: 0.0 };
+
     /// Advances the watch; true when the axis must fault.
     ///
     /// `expected_period_s` is one pulse period at the current reference speed; the timeout is
