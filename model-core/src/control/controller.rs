@@ -256,19 +256,14 @@ impl Controller {
                     * self.k[1].duty_per_rad_s();
             }
             self.duties[i] = duty;
-            let r_abs = ramped[i].abs();
-            let expected_period_s = if r_abs > 0.0 {
-                self.est[i].rad_per_pulse() / r_abs
-            } else {
-                f32::MAX
-            };
             if self.watch[i].step(
                 dt,
                 duty.abs(),
                 self.cfg.stall_duty,
                 seen[i],
                 self.cfg.sensor_timeout_floor_s,
-                expected_period_s,
+                ramped[i].abs(),
+                self.est[i].rad_per_pulse(),
             ) {
                 self.latch(Fault::SensorLostOrStall(i as u8));
                 return;
@@ -339,15 +334,14 @@ impl Controller {
                 // Blocked shaft or dead sensor during identification: the expected period is
                 // unknown, so allow 3 periods at the lowest speed.
                 for i in 0..2 {
-                    let slow_period =
-                        self.est[i].rad_per_pulse() / self.cfg.axes[i].min_speed_rad_s;
                     if self.watch[i].step(
                         dt,
                         self.duties[i].abs(),
                         self.cfg.stall_duty,
                         seen[i],
                         self.cfg.sensor_timeout_floor_s,
-                        slow_period,
+                        self.cfg.axes[i].min_speed_rad_s,
+                        self.est[i].rad_per_pulse(),
                     ) {
                         self.latch(Fault::SensorLostOrStall(i as u8));
                         return;

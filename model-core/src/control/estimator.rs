@@ -68,6 +68,8 @@ pub struct PulseSpeedEstimator {
     mask: u32,
     rad_per_pulse: f32,
     ticks_per_s: f32,
+    s_per_tick: f32,
+    rad_ticks_per_pulse_s: f32,
     lockout_ticks: u32,
     window_ticks: u32,
     stall_ticks: u32,
@@ -108,6 +110,8 @@ impl PulseSpeedEstimator {
             mask: cfg.timer_mask(),
             rad_per_pulse,
             ticks_per_s,
+            s_per_tick: 1.0 / ticks_per_s,
+            rad_ticks_per_pulse_s: rad_per_pulse * ticks_per_s,
             lockout_ticks: (0.5 * min_period_s * ticks_per_s) as u32,
             window_ticks: (WINDOW_S * ticks_per_s) as u32,
             stall_ticks: (stall_s * ticks_per_s).min(4.0e9) as u32,
@@ -217,7 +221,7 @@ impl PulseSpeedEstimator {
         let wspan = at.wrapping_sub(self.win_start);
         if wspan >= self.window_ticks {
             let period = wspan as f32 / self.win_pulses as f32;
-            let raw = self.rad_per_pulse * self.ticks_per_s / period;
+            let raw = self.rad_ticks_per_pulse_s / period;
             if self.valid {
                 let w = self.filter_weight;
                 self.speed_filt += w * (raw - self.speed_filt);
@@ -258,7 +262,7 @@ impl PulseSpeedEstimator {
             return 0.0;
         }
         if since > self.last_interval.saturating_mul(pitches) && since > 0 {
-            let bound = pitches as f32 * self.rad_per_pulse * self.ticks_per_s / since as f32;
+            let bound = pitches as f32 * self.rad_ticks_per_pulse_s / since as f32;
             if bound < self.speed_filt {
                 self.bound_active = true;
                 return bound;
@@ -270,12 +274,12 @@ impl PulseSpeedEstimator {
     /// The window events of the last tick, for a loop that compares the measurement with a
     /// model over exactly the same interval (see `pi`).
     pub fn window_events(&self) -> WindowEvents {
-        let ago = |at: u32| self.clock.wrapping_sub(at) as f32 / self.ticks_per_s;
+        let ago = |at: u32| self.clock.wrapping_sub(at) as f32 * self.s_per_tick;
         WindowEvents {
             restarted_s_ago: self.restart_at.map(ago),
             closed: self.closed_at.map(|at| WindowSample {
                 ago_s: ago(at),
-                span_s: self.closed_span as f32 / self.ticks_per_s,
+                span_s: self.closed_span as f32 * self.s_per_tick,
                 raw_speed_rad_s: self.closed_raw,
             }),
             bound_active: self.bound_active,

@@ -71,7 +71,9 @@ pub struct LoopConstants {
     dt_s: f32,
     duty_per_rad_s: f32,
     friction_duty: f32,
-    tau_s: f32,
+    model_alpha: f32,
+    kp_per_wc: f32,
+    ki_dt_per_wc: f32,
     bandwidth_rad_s: f32,
     per_pulse_bw_times_pulses_per_rad: f32,
     filter_weight: f32,
@@ -88,7 +90,10 @@ impl LoopConstants {
             dt_s,
             duty_per_rad_s: axis.model.volts_per_rad_s / supply_v,
             friction_duty: axis.model.friction_duty,
-            tau_s: axis.model.time_constant_s,
+            // Backward-Euler step of the first-order plant model, precomputed.
+            model_alpha: dt_s / (axis.model.time_constant_s + dt_s),
+            kp_per_wc: axis.model.time_constant_s * axis.model.volts_per_rad_s / supply_v,
+            ki_dt_per_wc: dt_s * axis.model.volts_per_rad_s / supply_v,
             bandwidth_rad_s: axis.bandwidth_rad_s,
             per_pulse_bw_times_pulses_per_rad: axis.per_pulse_bandwidth * pulses_per_rad,
             filter_weight: w,
@@ -149,7 +154,7 @@ impl SpeedLoop {
         }
         let r_abs = r.abs();
         // The plant model's speed and its angle over the estimator's current window.
-        self.model_rad_s += (r - self.model_rad_s) * (k.dt_s / (k.tau_s + k.dt_s));
+        self.model_rad_s += (r - self.model_rad_s) * k.model_alpha;
         let rp = self.model_rad_s;
         self.model_angle_rad += rp * k.dt_s;
         let ev = input.events;
@@ -195,8 +200,8 @@ impl SpeedLoop {
         }
 
         let wc = k.scheduled_bandwidth(r_abs);
-        let ki_dt = wc * k.duty_per_rad_s * k.dt_s;
-        let kp = wc * k.tau_s * k.duty_per_rad_s;
+        let ki_dt = wc * k.ki_dt_per_wc;
+        let kp = wc * k.kp_per_wc;
         // Bumpless gain change: the proportional jump is absorbed by the integral.
         self.integral += (self.kp_prev - kp) * e;
         self.kp_prev = kp;
@@ -209,10 +214,10 @@ impl SpeedLoop {
         let slew_pushing = (unclamped - self.duty > k.slew_per_tick && e > 0.0)
             || (unclamped - self.duty < -k.slew_per_tick && e < 0.0);
         if !saturating && !slew_pushing {
-            self.integral = candidate_i.clamp(-lim, lim);
+            self.integral = clamp(candidate_i, lim);
         }
-        let target = (ff + kp * e + self.integral).clamp(-lim, lim);
-        let step = (target - self.duty).clamp(-k.slew_per_tick, k.slew_per_tick);
+        let target = clamp(ff + kp * e + self.integral, lim);
+        let step = clamp(target - self.duty, k.slew_per_tick);
         self.duty += step;
         self.duty
     }
@@ -232,5 +237,17 @@ impl SpeedLoop {
     /// Back to rest (zero output, zero integral).
     pub fn reset(&mut self) {
         *self = Self::REST;
+    }
+}
+
+/// `x` limited to `[-lim, lim]` (`lim >= 0`); no panic path, unlike `f32::clamp`.
+#[inline(always)]
+fn clamp(x: f32, lim: f32) -> f32 {
+    if x > lim {
+        lim
+    } else if x < -lim {
+        -lim
+    } else {
+        x
     }
 }
