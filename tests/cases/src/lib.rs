@@ -11,6 +11,7 @@
 
 pub mod bowl;
 pub mod check;
+pub mod control;
 pub mod cost;
 pub mod ode;
 pub mod particle;
@@ -18,11 +19,16 @@ pub mod particle;
 pub use check::{Bench, Case, Failure};
 
 /// Every case, grouped by the module it tests.
-pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES, particle::CASES, ode::CASES];
+pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES, particle::CASES, ode::CASES, control::CASES];
 
 /// Every benchmark, grouped likewise.
-pub static BENCH_GROUPS: &[&[Bench]] =
-    &[bowl::BENCHES, particle::BENCHES, ode::BENCHES, cost::BENCHES];
+pub static BENCH_GROUPS: &[&[Bench]] = &[
+    bowl::BENCHES,
+    particle::BENCHES,
+    ode::BENCHES,
+    cost::BENCHES,
+    control::BENCHES,
+];
 
 /// All cases in one iterator.
 pub fn all_cases() -> impl Iterator<Item = &'static Case> {
