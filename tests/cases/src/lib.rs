@@ -11,14 +11,15 @@
 
 pub mod bowl;
 pub mod check;
+pub mod wire;
 
 pub use check::{Bench, Case, Failure};
 
 /// Every case, grouped by the module it tests.
-pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES];
+pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES, wire::CASES];
 
 /// Every benchmark, grouped likewise.
-pub static BENCH_GROUPS: &[&[Bench]] = &[bowl::BENCHES];
+pub static BENCH_GROUPS: &[&[Bench]] = &[bowl::BENCHES, wire::BENCHES];
 
 /// All cases in one iterator.
 pub fn all_cases() -> impl Iterator<Item = &'static Case> {
