@@ -10,5 +10,7 @@
 
 pub mod app;
 
+#[cfg(feature = "blackpill")]
+pub mod blackpill;
 #[cfg(feature = "qemu")]
 pub mod qemu;

@@ -3,7 +3,10 @@
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
+mod chart;
 mod kinematics;
+mod predict;
+mod sim;
 mod monitor;
 mod replay;
 mod rig_binding;
@@ -24,23 +27,43 @@ struct Cli {
 enum Command {
     /// Combined bowl speed from the two motor speeds (paper Eq. 2), or the split of a target speed.
     Kinematics(kinematics::Args),
+    /// Charts: work-precision (error against cost), and the paper's Figures 5-7 redrawn.
+    Chart(chart::Args),
+    /// Residence time and exit velocities of a particle (paper Eq. 5-12, corrected), or a batch CSV.
+    Predict(predict::Args),
     /// Live view of the rig's telemetry, with CSV log and frame counters.
     Monitor(monitor::Args),
     /// Send one command to the rig and print its answer.
     Send(send::Args),
     /// Decode a raw capture of the rig's output; print statistics as JSON.
     Replay(replay::Args),
-    /// The virtual rig: on a pseudo-terminal (--pty) or into a capture file (--capture).
-    Sim(virtual_rig::Args),
+    /// The simulated rig: serve it on a pseudo-terminal (--pty) or capture its bytes (--capture),
+    /// or report on the controller against it (step, family, commission, sweep, stability, trace).
+    Sim(SimCommand),
+}
+
+/// `bowl sim`: either a report subcommand or the virtual rig's flags.
+#[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true)]
+struct SimCommand {
+    #[command(subcommand)]
+    report: Option<sim::What>,
+    #[command(flatten)]
+    rig: virtual_rig::Args,
 }
 
 fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Kinematics(args) => kinematics::run(&args),
+        Command::Chart(args) => chart::run(&args),
+        Command::Predict(args) => predict::run(&args),
         Command::Monitor(args) => monitor::run(&args),
         Command::Send(args) => send::run(&args).map(|code| std::process::exit(code)),
         Command::Replay(args) => replay::run(&args),
-        Command::Sim(args) => virtual_rig::run(&args),
+        Command::Sim(args) => match &args.report {
+            Some(report) => sim::run(report),
+            None => virtual_rig::run(&args.rig),
+        },
     }
 }

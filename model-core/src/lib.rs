@@ -11,8 +11,11 @@
 #![warn(missing_docs)]
 
 pub mod bowl;
+pub mod ode;
 pub mod particle;
+pub mod control;
 pub mod real;
+pub mod sim;
 pub mod wire;
 
 pub use real::Real;

@@ -43,6 +43,9 @@ pub trait Real:
     fn is_finite(self) -> bool;
     /// True if NaN.
     fn is_nan(self) -> bool;
+    /// True for `+0`, `-0` and every finite positive value; false for NaN, infinities and
+    /// negatives. One integer compare on the bits (input validation runs on every call).
+    fn is_nonneg_finite(self) -> bool;
     /// Absolute value.
     fn abs(self) -> Self;
     /// Square root (hardware `VSQRT` on the Cortex-M4F for `f32`).
@@ -104,11 +107,17 @@ impl Real for f64 {
     }
     #[inline]
     fn is_finite(self) -> bool {
-        f64::is_finite(self)
+        // One compare (NaN fails it); core's bit test costs ~20 instructions on the M4F.
+        f64::abs(self) <= f64::MAX
     }
     #[inline]
     fn is_nan(self) -> bool {
         f64::is_nan(self)
+    }
+    #[inline]
+    fn is_nonneg_finite(self) -> bool {
+        let bits = self.to_bits();
+        bits < 0x7FF0_0000_0000_0000 || bits == 0x8000_0000_0000_0000
     }
     #[inline]
     fn abs(self) -> Self {
@@ -174,11 +183,17 @@ impl Real for f32 {
     }
     #[inline]
     fn is_finite(self) -> bool {
-        f32::is_finite(self)
+        // VABS + VCMP: core's bit-twiddling version costs ~20 instructions on the M4F.
+        f32::abs(self) <= f32::MAX
     }
     #[inline]
     fn is_nan(self) -> bool {
         f32::is_nan(self)
+    }
+    #[inline]
+    fn is_nonneg_finite(self) -> bool {
+        let bits = self.to_bits();
+        bits < 0x7F80_0000 || bits == 0x8000_0000
     }
     #[inline]
     fn abs(self) -> Self {
@@ -228,19 +243,34 @@ impl Real for f32 {
 
 /// `f32` square root: the FPU instruction on the Cortex-M4F, libm elsewhere.
 /// Both are correctly rounded (IEEE 754 requires it of VSQRT), so results agree bit for bit.
+///
+/// Selected by the hard-float ABI. Stable Rust neither exposes the ARM FPU features to `cfg`
+/// (a `target_feature = "vfp2"` test is always false, which silently picked libm's software
+/// `sqrtf`, about 52 instructions) nor accepts the `sreg` operand class on this target (it wants
+/// the double-precision `vfp2`, which the single-precision FPv4-SP lacks). So the value travels
+/// in a core register and the asm borrows `s15`, saving and restoring it itself.
 #[inline]
 fn sqrt_f32(x: f32) -> f32 {
-    #[cfg(all(target_arch = "arm", target_feature = "vfp2"))]
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
     {
-        let r: f32;
-        // SAFETY: VSQRT.F32 reads one S register and writes one; no memory, no flags beyond FPSCR.
+        let mut bits = x.to_bits();
+        // SAFETY: only register moves and VSQRT.F32; s15 is restored before the asm ends, so
+        // the compiler's view of every FPU register is unchanged. No memory, no stack.
         unsafe {
-            core::arch::asm!("vsqrt.f32 {r}, {x}", r = lateout(sreg) r, x = in(sreg) x,
-                options(pure, nomem, nostack));
+            core::arch::asm!(
+                "vmov {saved}, s15",
+                "vmov s15, {bits}",
+                "vsqrt.f32 s15, s15",
+                "vmov {bits}, s15",
+                "vmov s15, {saved}",
+                bits = inout(reg) bits,
+                saved = out(reg) _,
+                options(pure, nomem, nostack),
+            );
         }
-        r
+        f32::from_bits(bits)
     }
-    #[cfg(not(all(target_arch = "arm", target_feature = "vfp2")))]
+    #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
     {
         libm::sqrtf(x)
     }
@@ -255,6 +285,34 @@ mod tests {
         for &x in &[0.0f32, 1.0, 2.0, 0.5, 1e-30, 3.4e38, 12345.678] {
             let want = (x as f64).sqrt() as f32;
             assert_eq!(Real::sqrt(x), want, "sqrt({x})");
+        }
+    }
+
+    #[test]
+    fn nonneg_finite_classifies() {
+        for (x, want) in [
+            (0.0f64, true),
+            (-0.0, true),
+            (1e-310, true),
+            (f64::MAX, true),
+            (f64::INFINITY, false),
+            (f64::NAN, false),
+            (-1e-310, false),
+            (-1.0, false),
+        ] {
+            assert_eq!(x.is_nonneg_finite(), want, "{x}");
+        }
+        for (x, want) in [
+            (0.0f32, true),
+            (-0.0, true),
+            (1e-40, true),
+            (f32::MAX, true),
+            (f32::INFINITY, false),
+            (f32::NAN, false),
+            (-1e-40, false),
+            (-f32::MAX, false),
+        ] {
+            assert_eq!(x.is_nonneg_finite(), want, "{x}");
         }
     }
 

@@ -54,6 +54,15 @@ impl EdgeQueue {
         });
     }
 
+    /// Counts edges the hardware lost before they could be queued (over-capture).
+    pub fn count_lost(&self, n: u32) {
+        critical_section::with(|cs| {
+            let mut inner = self.inner.borrow_ref_mut(cs);
+            inner.total = inner.total.wrapping_add(n);
+            inner.dropped = inner.dropped.saturating_add(n);
+        });
+    }
+
     /// Moves every queued edge into `out` (cleared first), oldest first.
     pub fn drain_into(&self, out: &mut Vec<u32, EDGES_PER_TICK>) {
         out.clear();
@@ -66,7 +75,7 @@ impl EdgeQueue {
         });
     }
 
-    /// Edges dropped because the queue was full, since reset.
+    /// Edges lost (queue full or over-capture), since reset.
     pub fn dropped(&self) -> u32 {
         critical_section::with(|cs| self.inner.borrow_ref(cs).dropped)
     }

@@ -1,24 +1,30 @@
 //! Residence time of the Coriolis model (paper Eq. 10, 11 with MODEL-NOTES' corrected A, B).
 
+use super::flat::acosh_1p_ratio;
 use super::{Exit, Model, Scene, SceneError, Shape, condition};
 use crate::Real;
 
-/// Newton iterations allowed; from the upper bracket it needs 3 to 6.
+/// Newton iterations allowed; it needs 2 to 4.
 const MAX_NEWTON: u32 = 40;
 
 /// The root `u = l1 T` of `F(u) = x`, with `F` of [`Shape::eval`], and `F'` at the root.
 ///
 /// `F` is convex and increasing with `F'(0) = 0`, so Newton from 0 divides by zero; from any
-/// point above the root it decreases monotonically onto it. We start at the upper bracket of
-/// MODEL-NOTES, `min(ln((1 + x)/A), sqrt(2 x / A))` (`F >= A (e^u - 1) - B` and
-/// `F >= A u^2 / 2`), and never go below the lower bracket `ln((1 + x - B)/A) = log1p(x / A)`.
-/// Stop test: after a Newton step `d` the remaining error is about `F''/(2 F') d^2`; we stop when
-/// that is below a quarter of an ulp of `u`, which saves the customary extra iteration.
+/// point above the root it decreases monotonically onto it, and from a point below it the first
+/// step lands above the root (the tangent of a convex function lies below it). We start at the
+/// flat model's closed form scaled to the same curvature at 0,
+/// `u0 = acosh(1 + x / (A (1 + q)))` (exact at `mu = 0`, within about `k mu` otherwise). If
+/// `F(u0) < x`, `u0` becomes the lower bracket and one step takes us above the root; from there
+/// Newton is monotone. Every iterate is clamped to the bracket, whose upper end is MODEL-NOTES'
+/// `sqrt(2 x / A)` (`F >= A u^2 / 2`); the notes' tighter `ln((1 + x)/A)` costs a logarithm and
+/// the start makes it unnecessary.
+/// Stop test: after a step `d` the remaining error is about `F''/(2 F') d^2`; we stop when that
+/// is below a quarter of an ulp of `u`, which saves the customary extra iteration.
 pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneError> {
-    let (ac, bc) = (shape.a_coef, shape.b_coef);
-    let lower = (x / ac).ln_1p();
-    let upper = ((x + bc) / ac).ln_1p().min((T::TWO * x / ac).sqrt());
-    let mut u = upper;
+    let ac = shape.a_coef;
+    let mut lower = T::ZERO;
+    let mut upper = (T::TWO * x / ac).sqrt();
+    let mut u = acosh_1p_ratio(x, ac * (T::ONE + shape.q)).min(upper);
     for _ in 0..MAX_NEWTON {
         let (f, fp, fpp) = shape.eval(u);
         if !(f.is_finite() && fp.is_finite() && fpp.is_finite()) {
@@ -28,20 +34,22 @@ pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneEr
             // Only at u = 0, i.e. x = 0 (R - ri underflowed against ri - a): T = 0.
             return Ok((u, fp));
         }
-        let d = (f - x) / fp;
-        let mut next = u - d;
-        if next < lower {
-            next = lower;
+        if f < x {
+            lower = u;
+        } else {
+            upper = u;
         }
+        let d = (f - x) / fp;
+        let next = (u - d).max(lower).min(upper);
         // F' at the new point to first order, for the exit velocity.
         let fp_next = fp - fpp * (u - next);
-        let converged = d <= T::ZERO || fpp * d * d <= T::HALF * T::EPSILON * fp * next;
+        let converged = fpp * d * d <= T::HALF * T::EPSILON * fp * next;
         u = next;
         if converged {
             return Ok((u, fp_next));
         }
     }
-    // Monotone Newton cannot cycle; if rounding made it crawl, u is still within the bracket.
+    // Newton from above cannot cycle; if rounding made it crawl, u is still within the bracket.
     let (_, fp, _) = shape.eval(u);
     Ok((u, fp))
 }

@@ -1,20 +1,23 @@
 //! The inverse problem: the bowl speed omega that gives a target residence time.
 //!
-//! With `z = c1 omega T` (`c1 = l1 / omega`, see [`Shape`]) the residence condition reads
-//! `F(z) = x(omega) = (R - ri) / (ri - mu g / omega^2)`. We solve
-//! `Lambda(omega) = ln(F(z) / x(omega)) = 0`, which increases strictly with omega (`F` grows with
-//! `z`, `x` falls as `a` does), by Newton in `ln omega`:
-//! `d Lambda / d ln omega = z F'(z)/F(z) + 2 a / (ri - a)`, safeguarded by a bracket and geometric
-//! bisection. Since `T(omega)` falls from infinity (at the threshold `omega_th = sqrt(mu g / ri)`,
-//! where `a = ri`) to 0, every positive target is reachable in exact arithmetic; the errors say
-//! why a particular one is not.
+//! With `z = c1 omega T` (`c1 = l1 / omega`, see [`Shape`]) the particle is at the rim at `T`
+//! when `F(z) = x = (R - ri) / (ri - a)`, i.e. when
+//! `G(omega) = (ri - mu g / omega^2) - (R - ri) / F(c1 T omega) = 0`.
+//! `G` increases strictly with omega (both terms do) and is concave (`-1/omega^2` is, and so is
+//! `-1/F` for the convex, log-convex `F` of both models), so Newton started *below* the root
+//! climbs monotonically onto it. Unlike `ln T` it stays smooth at the threshold
+//! `omega_th = sqrt(mu g / ri)`, where `a = ri` and `T` is infinite. We start at a lower bound
+//! that is exact for `mu = 0` in the flat model and within `sqrt(q)` for Coriolis, and keep a
+//! bracket with bisection as a safeguard. Since `T(omega)` falls from infinity at `omega_th` to
+//! 0, every positive target is reachable in exact arithmetic; the errors say why a particular
+//! one is not.
 
 use super::flat::acosh_1p_ratio;
 use super::{Model, Scene, SceneError, Shape};
 use crate::Real;
 
-/// Iterations allowed; the safeguarded Newton needs 4 to 10.
-const MAX_ITERATIONS: u32 = 80;
+/// Iterations allowed; Newton from the lower bound needs 2 to 6, bisection at most ~60 more.
+const MAX_ITERATIONS: u32 = 100;
 
 /// Why no bowl speed was returned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,9 +34,9 @@ pub enum InverseError {
     NeverLeaves,
     /// The speed needed overflows the number type (a target far too short for the units).
     OutOfRange,
-    /// The target lies so close above the threshold speed that the residence time jumps past
-    /// it between two adjacent representable speeds (`T` grows like `-ln(omega - omega_th)`):
-    /// no speed of this number type gives it. Use a wider type or a shorter target.
+    /// The target lies so close above the threshold speed that the particle must start within
+    /// rounding of the equilibrium radius (`T` grows like `-ln(omega - omega_th)`): no speed
+    /// of this number type gives it reliably. Use a wider type or a shorter target.
     BeyondPrecision,
     /// The iteration did not settle (not expected; reported rather than returning a guess).
     NotConverged,
@@ -65,89 +68,81 @@ pub fn omega_for_residence_time<T: Real>(
     let l = shape.c1 * target_s; // z = l omega
     let y0 = (rim - ri) / ri;
     let y1 = T::TWO * y0;
-    // Bracket. Lower: below omega_th, or where F(z) <= y0 (then x >= y0 >= F). Upper: where
-    // a <= ri/2 and F(z) >= 2 y0 >= x. Flat F = cosh z - 1 inverts exactly; for Coriolis
-    // A (e^z - 1) - B <= F <= A (e^z - 1) and F >= A z^2 / 2.
+    // Bracket. Lower: omega_th, or where F(z) <= y0 (then x >= y0 >= F, G <= 0). Upper: where
+    // a <= ri/2 and F(z) >= 2 y0 >= x. Flat F = cosh z - 1 inverts exactly. Coriolis: from the
+    // series F = sum A (1 + (-1)^n q^(n-1)) z^n / n!, F <= A (1 + 1/q)(cosh(q z) - 1) and
+    // F <= A (e^z - 1); F >= A (e^z - 1) - B and F >= A z^2 / 2.
     let (z_lo, z_hi) = match model {
         Model::Flat => (
             acosh_1p_ratio(rim - ri, ri),
             acosh_1p_ratio(T::TWO * (rim - ri), ri),
         ),
-        Model::Coriolis => (
-            (y0 / ac).ln_1p(),
-            ((y1 + bc) / ac).ln_1p().min((T::TWO * y1 / ac).sqrt()),
-        ),
+        Model::Coriolis => {
+            let q = shape.q;
+            let by_cosh = acosh_1p_ratio(y0 * q, ac * (T::ONE + q)) / q;
+            (
+                (y0 / ac).ln_1p().max(by_cosh),
+                ((y1 + bc) / ac).ln_1p().min((T::TWO * y1 / ac).sqrt()),
+            )
+        }
     };
     let mut lo = omega_th.max(z_lo / l);
     let mut hi = (omega_th * T::from_f64(core::f64::consts::SQRT_2)).max(z_hi / l);
     if !(hi.is_finite() && lo.is_finite()) {
         return Err(InverseError::OutOfRange);
     }
-    // Stop when a Newton step moves omega by a few ulps. Near the threshold Lambda bends
-    // sharply, so a quadratic-convergence shortcut would stop early: we take the extra step.
-    let tol = T::from_f64(8.0) * T::EPSILON;
-    // Relative error of T implied by the last Lambda, and its floor (T's jump between adjacent
-    // omegas): Lambda / (z F'/F) against epsilon (1 + (2 a/(ri - a)) / (z F'/F)).
-    let mut t_err: T;
-    let mut t_floor = T::ZERO;
-    let mut omega = hi;
+    let tol = T::from_f64(4.0) * T::EPSILON;
+    let settle = |omega: T| {
+        // Forward would find ri within rounding of a: T is not determined by this omega.
+        let a = mu_g / omega / omega;
+        if a >= ri * (T::ONE - T::from_f64(8.0) * T::EPSILON) {
+            Err(InverseError::BeyondPrecision)
+        } else {
+            Ok(omega)
+        }
+    };
+    let mut omega = lo;
     for _ in 0..MAX_ITERATIONS {
         let a = mu_g / omega / omega;
-        let step = if a < ri {
-            let den = ri - a;
-            let x = (rim - ri) / den;
-            let z = l * omega;
-            let (f, fp, _) = shape.eval(z);
-            if f > T::ZERO && f.is_finite() && x.is_finite() && fp.is_finite() {
-                let lambda = (f / x).ln();
-                if lambda > T::ZERO {
-                    hi = omega;
-                } else if lambda < T::ZERO {
-                    lo = omega;
-                } else {
-                    return Ok(omega);
-                }
-                let slope_f = z * fp / f;
-                let slope_a = T::TWO * a / den;
-                t_err = lambda.abs() / slope_f;
-                t_floor = T::EPSILON * (T::ONE + slope_a / slope_f);
-                Some(lambda / (slope_f + slope_a))
-            } else {
+        let z = l * omega;
+        let (f, fp, _) = shape.eval(z);
+        // F may overflow to infinity for a large z: then the particle is long gone by T,
+        // gap = 0 and G = ri - a > 0, which is the right sign (omega is too high).
+        let step = if f > T::ZERO && !f.is_nan() && !fp.is_nan() {
+            let gap = (rim - ri) / f;
+            let g = (ri - a) - gap;
+            if g < T::ZERO {
                 lo = omega;
-                t_err = T::INFINITY;
+            } else if g > T::ZERO {
+                hi = omega;
+            } else {
+                return settle(omega);
+            }
+            // G' = 2 a / omega + (R - ri) c1 T F'(z) / F(z)^2.
+            let gp = if gap > T::ZERO {
+                T::TWO * a / omega + gap * l * (fp / f)
+            } else {
+                T::TWO * a / omega
+            };
+            if gp > T::ZERO && gp.is_finite() {
+                Some(g / gp)
+            } else {
                 None
             }
         } else {
             lo = omega;
-            t_err = T::INFINITY;
             None
         };
-        let newton = step.map(|d| {
-            // omega e^{-d}; the second-order Taylor form for small d saves an exp and keeps
-            // the quadratic convergence (its error is O(d^3)).
-            let next = if d.abs() < T::from_f64(0.125) {
-                omega * (T::ONE - d + T::HALF * d * d)
-            } else {
-                omega * (-d).exp()
-            };
-            (d, next)
-        });
-        match newton {
-            Some((d, next)) if next > lo && next < hi => {
-                if d.abs() <= tol {
-                    return Ok(next);
-                }
-                omega = next;
+        match step {
+            Some(d) if d.abs() <= tol * omega => {
+                return settle((omega - d).max(lo).min(hi));
             }
+            Some(d) if omega - d > lo && omega - d < hi => omega -= d,
             _ => {
                 if hi - lo <= tol * hi {
-                    return if t_err <= T::from_f64(64.0) * t_floor {
-                        Ok(omega)
-                    } else {
-                        Err(InverseError::BeyondPrecision)
-                    };
+                    return settle(hi);
                 }
-                omega = (lo * hi).sqrt();
+                omega = T::HALF * (lo + hi);
             }
         }
     }

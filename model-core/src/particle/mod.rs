@@ -166,8 +166,9 @@ impl<T: Real> Outcome<T> {
     }
 }
 
+/// `0 <= x <= MAX`, false for NaN and infinities (one integer compare, see [`Real`]).
 fn nonneg_finite<T: Real>(x: T) -> bool {
-    x.is_finite() && x >= T::ZERO
+    x.is_nonneg_finite()
 }
 
 impl<T: Real> Scene<T> {
@@ -341,7 +342,8 @@ pub(crate) struct Exit<T> {
 /// of `a` moves `x` by `e a / (ri - a)` relatively; one more unit for `x`'s own rounding and one
 /// for `omega`.
 pub(crate) fn condition<T: Real>(kx: T, a: T, ri: T) -> T {
-    T::ONE + kx * (T::ONE + a / (ri - a))
+    // 1 + a / (ri - a) = ri / (ri - a).
+    T::ONE + kx * (ri / (ri - a))
 }
 
 fn checked_time<T: Real>(t_s: T) -> Result<(), SceneError> {

@@ -11,7 +11,9 @@ use crate::Real;
 ///
 /// For `|z| < 1` the series `z^2/2 (1 + z/3 (1 + z/4 (...)))`, truncated where the next term is
 /// below the type's epsilon (10 terms for `f32`, 18 for `f64`); `expm1 = phi + z` then has no
-/// cancellation worth a bit. Otherwise `expm1(z) - z`, which loses at most 1.5 bits at `|z| = 1`.
+/// cancellation worth a bit. Otherwise `e^z - 1` (no cancellation for `|z| >= 1`: `e^z - 1`
+/// is at least 0.63 in magnitude; `exp` is also ~25 instructions cheaper than `expm1` in `f32`)
+/// and `phi = (e^z - 1) - z`, which loses at most 1.5 bits at `|z| = 1`.
 #[inline]
 pub(crate) fn phi_expm1<T: Real>(z: T) -> (T, T) {
     if z.abs() < T::ONE {
@@ -25,7 +27,7 @@ pub(crate) fn phi_expm1<T: Real>(z: T) -> (T, T) {
         let phi = z * z * T::HALF * p;
         (phi, phi + z)
     } else {
-        let e = z.exp_m1();
+        let e = z.exp() - T::ONE;
         (e - z, e)
     }
 }

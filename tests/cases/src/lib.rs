@@ -11,15 +11,22 @@
 
 pub mod bowl;
 pub mod check;
+pub mod cost;
+pub mod particle;
 pub mod wire;
 
 pub use check::{Bench, Case, Failure};
 
 /// Every case, grouped by the module it tests.
-pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES, wire::CASES];
+pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES, particle::CASES, wire::CASES];
 
 /// Every benchmark, grouped likewise.
-pub static BENCH_GROUPS: &[&[Bench]] = &[bowl::BENCHES, wire::BENCHES];
+pub static BENCH_GROUPS: &[&[Bench]] = &[
+    bowl::BENCHES,
+    particle::BENCHES,
+    cost::BENCHES,
+    wire::BENCHES,
+];
 
 /// All cases in one iterator.
 pub fn all_cases() -> impl Iterator<Item = &'static Case> {

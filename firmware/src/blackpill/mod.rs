@@ -1,0 +1,25 @@
+//! The STM32F411CE Black Pill board: embassy-stm32 peripherals behind the [`crate::app::hal`]
+//! traits. Pin map (docs/wiring.md has the wiring):
+//!
+//! | Function                     | Pin  | Peripheral                                   |
+//! |------------------------------|------|----------------------------------------------|
+//! | Precession motor PWM         | PA8  | TIM1_CH1 (AF1), 20 kHz                       |
+//! | Spin motor PWM               | PA9  | TIM1_CH2 (AF1), 20 kHz                       |
+//! | Precession motor direction   | PB12 | GPIO out                                     |
+//! | Spin motor direction         | PB13 | GPIO out                                     |
+//! | Precession proximity sensor  | PA15 | TIM2_CH1 (AF1) input capture, 1 MHz, 32 bit  |
+//! | Spin proximity sensor        | PB3  | TIM2_CH2 (AF1) input capture, same counter   |
+//! | Host link TX                 | PA2  | USART2_TX, DMA1 stream 6                      |
+//! | Host link RX                 | PA3  | USART2_RX, DMA1 stream 5 (circular)           |
+//! | Heartbeat LED (active low)   | PC13 | GPIO out                                     |
+//! | Debug probe                  | PA13/PA14 | SWDIO/SWCLK, defmt over RTT            |
+//!
+//! Timers: TIM1 PWM, TIM2 capture (both sensors on one 32-bit counter, so their timestamps and
+//! the controller's `now` share one time base), TIM5 embassy's time driver. The IWDG resets the
+//! MCU if the control tick stops; parameters live in flash sector 7 (0x0806_0000, 128 KiB).
+
+pub mod capture;
+pub mod clocks;
+pub mod flash_region;
+pub mod motor_pwm;
+pub mod reset_cause;

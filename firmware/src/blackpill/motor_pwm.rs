@@ -1,0 +1,65 @@
+//! The two motor outputs: TIM1 PWM channels (PA8, PA9) at 20 kHz plus a direction GPIO each.
+//!
+//! A PWM/DIR H-bridge input pair: PWM low = outputs off. The bridge inputs have pull-downs
+//! (docs/wiring.md), so the motors are also off while the MCU is in reset or unprogrammed.
+
+use embassy_stm32::gpio::{Level, Output};
+use embassy_stm32::peripherals::TIM1;
+use embassy_stm32::timer::simple_pwm::SimplePwmChannel;
+
+use crate::app::hal::MotorOutput;
+
+/// PWM frequency: above hearing, and slow enough for a bridge's switching losses.
+pub const PWM_HZ: u32 = 20_000;
+
+/// One motor: a TIM1 channel and its direction pin.
+pub struct PwmMotor {
+    channel: SimplePwmChannel<'static, TIM1>,
+    direction: Output<'static>,
+}
+
+impl PwmMotor {
+    /// Takes an enabled PWM channel (compare 0) and a direction pin (low = forward).
+    pub fn new(mut channel: SimplePwmChannel<'static, TIM1>, direction: Output<'static>) -> Self {
+        channel.set_duty_cycle_fully_off();
+        channel.enable();
+        Self { channel, direction }
+    }
+}
+
+impl MotorOutput for PwmMotor {
+    fn set_duty(&mut self, duty: f32) {
+        let duty = crate::app::motors::sanitize_duty(duty);
+        if duty == 0.0 {
+            self.off();
+            return;
+        }
+        let reverse = duty < 0.0;
+        let level = if reverse { Level::High } else { Level::Low };
+        if self.direction.get_output_level() != level {
+            // Never drive the old direction with the new duty: off, turn, then drive.
+            self.channel.set_duty_cycle_fully_off();
+            self.direction.set_level(level);
+        }
+        let max = self.channel.max_duty_cycle();
+        // |duty| <= 1, so the product fits; rounding to the nearest compare step.
+        let compare = (libm::fabsf(duty) * max as f32 + 0.5) as u32;
+        self.channel.set_duty_cycle(compare.min(max));
+    }
+
+    fn off(&mut self) {
+        self.channel.set_duty_cycle_fully_off();
+    }
+}
+
+/// Both PWM outputs to zero and TIM1's main output off, by raw register writes: no lock, no
+/// driver state, safe to call from the panic and fault handlers at any moment.
+pub fn emergency_off() {
+    let tim1 = embassy_stm32::pac::TIM1;
+    tim1.ccr(0)
+        .write_value(embassy_stm32::pac::timer::regs::Ccr1ch(0));
+    tim1.ccr(1)
+        .write_value(embassy_stm32::pac::timer::regs::Ccr1ch(0));
+    // MOE off: the outputs go to their idle level (low, OISx = 0) at once.
+    tim1.bdtr().modify(|w| w.set_moe(false));
+}

@@ -1,0 +1,183 @@
+//! `bowl chart`: the speed-against-accuracy chart and the paper-style figures (issue 3).
+//!
+//! Every chart is written three ways from one `--out FILE.svg`: `FILE.svg`, `FILE.png` (same
+//! drawing, text rendered with the embedded DejaVu font) and `FILE.csv` (the numbers behind it).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Subcommand;
+
+pub mod figures;
+pub mod pitfalls;
+pub mod plot;
+pub mod qemu_log;
+pub mod reference;
+pub mod table;
+pub mod timing;
+pub mod workprec;
+
+/// Which chart to draw.
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    which: Which,
+}
+
+#[derive(Subcommand)]
+enum Which {
+    /// Error in the residence time against cost (host ns, RHS evaluations, QEMU instructions)
+    /// for every method and setting, on the named scenes.
+    WorkPrecision(WorkPrecision),
+    /// r(t) at 3.6 rad/s, flat and Coriolis (cf. paper Fig. 5).
+    Radial(Out),
+    /// Total exit speed against bowl speed for 150-300 mm bowls (cf. paper Fig. 6).
+    Velocity(Out),
+    /// Residence time against bowl speed for 150-300 mm bowls (cf. paper Fig. 7).
+    Residence(Out),
+}
+
+/// Where to write.
+#[derive(clap::Args)]
+struct Out {
+    /// The SVG file; the PNG and CSV go beside it with the same stem.
+    #[arg(long)]
+    out: PathBuf,
+    /// Write only the CSV (no drawing).
+    #[arg(long)]
+    csv_only: bool,
+}
+
+/// Options of `bowl chart work-precision`.
+#[derive(clap::Args)]
+struct WorkPrecision {
+    #[command(flatten)]
+    out: Out,
+    /// The QEMU run's output (`target/test-logs/qemu-cases.log` after `tests/run`): adds the
+    /// instruction counts of the `cost::` benchmarks to the CSV and draws FILE-qemu.svg.
+    #[arg(long)]
+    qemu_log: Option<PathBuf>,
+    /// Shorter timing (3 batches of 0.2 ms instead of 15 of 2 ms): for tests and quick looks.
+    #[arg(long)]
+    quick: bool,
+}
+
+/// `FILE.svg` -> `FILE-suffix.svg`.
+fn suffixed(path: &Path, suffix: &str) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    path.with_file_name(format!("{stem}-{suffix}.svg"))
+}
+
+fn work_precision(args: &WorkPrecision) -> Result<()> {
+    use model_core::particle::Model;
+    use workprec::CostAxis;
+    let qemu = match &args.qemu_log {
+        Some(p) => {
+            let text = std::fs::read_to_string(p)
+                .with_context(|| format!("reading QEMU log {}", p.display()))?;
+            qemu_log::parse(&text)?
+        }
+        None => Default::default(),
+    };
+    let budget = if args.quick {
+        timing::Budget::QUICK
+    } else {
+        timing::Budget::FULL
+    };
+    if cfg!(debug_assertions) {
+        eprintln!("note: debug build; host times are not representative (use --release)");
+    }
+    let points = workprec::measure(budget, &qemu)?;
+    let table = workprec::table(&points);
+    let main = workprec::figure(&points, "paper", Model::Coriolis, CostAxis::HostNs);
+    write_all(&args.out, &main, &table)?;
+    if args.out.csv_only {
+        return Ok(());
+    }
+    let mut extra = vec![
+        (
+            "near-threshold",
+            workprec::figure(&points, "near-threshold", Model::Coriolis, CostAxis::HostNs),
+        ),
+        (
+            "near-rim",
+            workprec::figure(&points, "near-rim", Model::Flat, CostAxis::HostNs),
+        ),
+        (
+            "rhs",
+            workprec::figure(&points, "paper", Model::Coriolis, CostAxis::RhsEvals),
+        ),
+    ];
+    if points.iter().any(|p| p.qemu.is_some()) {
+        extra.push((
+            "qemu",
+            workprec::figure(
+                &points,
+                "paper",
+                Model::Coriolis,
+                CostAxis::QemuInstructions,
+            ),
+        ));
+    }
+    for (suffix, fig) in extra {
+        if fig.series.is_empty() {
+            eprintln!("skipping {suffix}: no points for this cost axis");
+            continue;
+        }
+        let svg = suffixed(&args.out.out, suffix);
+        let png = svg.with_extension("png");
+        fig.write_svg(&svg)?;
+        fig.write_png(&png)?;
+        report(&[&svg, &png]);
+    }
+    Ok(())
+}
+
+/// Writes `fig` and `table` as `out` (.svg), .png and .csv.
+fn write_all(out: &Out, fig: &plot::Figure, table: &table::Table) -> Result<()> {
+    if let Some(dir) = out.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let csv = out.out.with_extension("csv");
+    table
+        .write(&csv)
+        .with_context(|| format!("writing {}", csv.display()))?;
+    if !out.csv_only {
+        let svg = out.out.with_extension("svg");
+        let png = out.out.with_extension("png");
+        fig.write_svg(&svg)?;
+        fig.write_png(&png)?;
+        report(&[&svg, &png, &csv]);
+    } else {
+        report(&[&csv]);
+    }
+    Ok(())
+}
+
+fn report(paths: &[&Path]) {
+    for p in paths {
+        println!("wrote {}", p.display());
+    }
+}
+
+/// Runs `bowl chart ...`.
+pub fn run(args: &Args) -> Result<()> {
+    match &args.which {
+        Which::WorkPrecision(wp) => work_precision(wp),
+        Which::Radial(out) => {
+            let (f, t) = figures::radial()?;
+            write_all(out, &f, &t)
+        }
+        Which::Velocity(out) => {
+            let (f, t) = figures::velocity()?;
+            write_all(out, &f, &t)
+        }
+        Which::Residence(out) => {
+            let (f, t) = figures::residence_time()?;
+            write_all(out, &f, &t)
+        }
+    }
+}

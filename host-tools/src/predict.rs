@@ -1,0 +1,466 @@
+//! `bowl predict`: residence time and exit velocities of a particle (paper Eq. 5 to 12, corrected
+//! per MODEL-NOTES), for one scene from flags or for every row of a CSV file.
+//!
+//! Batch format: a header row naming at least `model,w_rad_s,mu,ri_m,R_m` (any order; `g` and
+//! `k2` default to 9.81 and 5/7 when their columns are absent), any extra columns carried
+//! through unchanged. Output: the same rows plus `residence_time_s`,
+//! `exit_radial_velocity_m_s`, `exit_total_velocity_m_s` in shortest round-trip f64 form;
+//! `inf` (and `nan` velocities) when the particle never leaves, `0` (radial 0, total omega R)
+//! when it starts at the rim. A bad row is reported on stderr with its line number and left
+//! out; the others are written; the exit status is non-zero if any row failed.
+
+use anyhow::{Context, Result, anyhow, bail};
+use model_core::particle::{self, Model, Outcome, Scene};
+
+mod ode;
+
+/// Which model(s) to evaluate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ModelChoice {
+    /// Paper Eq. 5 to 7: no Coriolis term.
+    Flat,
+    /// Paper Eq. 9 to 11 with the corrected A, B.
+    Coriolis,
+    /// Both, side by side.
+    Both,
+}
+
+/// How to compute the residence time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodChoice {
+    /// The closed forms (log1p / bracketed Newton): exact to rounding.
+    Closed,
+    /// Explicit Euler with fixed step --step-s.
+    Euler,
+    /// Semi-implicit (symplectic) Euler with fixed step --step-s.
+    SemiImplicit,
+    /// Classical Runge-Kutta 4 with fixed step --step-s.
+    Rk4,
+    /// Adaptive Dormand-Prince 5(4) with tolerance --tol, dense-output event location.
+    Dp54,
+}
+
+/// Flags of `bowl predict`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Combined bowl speed omega (paper Eq. 2), rad/s.
+    #[arg(long, visible_alias = "w-rad-s", default_value_t = 3.0)]
+    omega_rad_s: f64,
+    /// Effective rolling resistance coefficient mu (the paper's literal 0.4 makes nothing move).
+    #[arg(long, default_value_t = 0.029)]
+    mu: f64,
+    /// Start radius ri, m (the particle starts at rest).
+    #[arg(long, default_value_t = 0.05)]
+    ri_m: f64,
+    /// Rim radius R, m (0.1 m: a 200 mm bowl, reading the paper's sizes as diameters).
+    #[arg(long, visible_alias = "r-m", default_value_t = 0.1)]
+    rim_radius_m: f64,
+    /// Gravity, m/s^2.
+    #[arg(long, default_value_t = 9.81)]
+    g: f64,
+    /// k2 = m rp^2 / (I + m rp^2): 5/7 solid sphere, 3/5 hollow.
+    #[arg(long, default_value_t = 5.0 / 7.0)]
+    k2: f64,
+    /// Model: flat, coriolis or both.
+    #[arg(long, value_enum, default_value_t = ModelChoice::Both)]
+    model: ModelChoice,
+    /// Method: closed form or one of the integrators.
+    #[arg(long, value_enum, default_value_t = MethodChoice::Closed)]
+    method: MethodChoice,
+    /// Fixed step of euler / semi-implicit / rk4, s (default: 0.01 / omega).
+    #[arg(long)]
+    step_s: Option<f64>,
+    /// Relative tolerance of dp54.
+    #[arg(long, default_value_t = 1e-9)]
+    tol: f64,
+    /// Instead of the residence time: the bowl speed that gives this residence time, s.
+    #[arg(long)]
+    target_time_s: Option<f64>,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Batch mode: read scenes from this CSV file (see the module docs for the columns).
+    #[arg(long, requires = "out")]
+    batch: Option<std::path::PathBuf>,
+    /// Batch mode: write results to this CSV file.
+    #[arg(long, requires = "batch")]
+    out: Option<std::path::PathBuf>,
+}
+
+/// One computed result, whatever the method.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prediction {
+    /// The outcome (closed forms and integrators alike).
+    pub outcome: Outcome<f64>,
+    /// Right-hand-side evaluations (0 for closed forms).
+    pub rhs_evaluations: u64,
+    /// Steps taken (0 for closed forms).
+    pub steps: u64,
+}
+
+fn model_name(m: Model) -> &'static str {
+    match m {
+        Model::Flat => "flat",
+        Model::Coriolis => "coriolis",
+    }
+}
+
+fn method_name(m: MethodChoice) -> &'static str {
+    match m {
+        MethodChoice::Closed => "closed",
+        MethodChoice::Euler => "euler",
+        MethodChoice::SemiImplicit => "semi-implicit",
+        MethodChoice::Rk4 => "rk4",
+        MethodChoice::Dp54 => "dp54",
+    }
+}
+
+/// Computes one scene with one model and method.
+pub fn predict(
+    scene: &Scene<f64>,
+    model: Model,
+    method: MethodChoice,
+    step_s: Option<f64>,
+    tol: f64,
+) -> Result<Prediction> {
+    match method {
+        MethodChoice::Closed => {
+            let outcome =
+                particle::residence(scene, model).map_err(|e| anyhow!("invalid scene: {e:?}"))?;
+            Ok(Prediction {
+                outcome,
+                rhs_evaluations: 0,
+                steps: 0,
+            })
+        }
+        other => ode::predict(scene, model, other, step_s, tol),
+    }
+}
+
+/// Runs `bowl predict`.
+pub fn run(args: &Args) -> Result<()> {
+    if let (Some(input), Some(output)) = (&args.batch, &args.out) {
+        return run_batch(input, output, args);
+    }
+    let scene = Scene {
+        omega_rad_s: args.omega_rad_s,
+        mu: args.mu,
+        g_m_s2: args.g,
+        k2: args.k2,
+        ri_m: args.ri_m,
+        rim_radius_m: args.rim_radius_m,
+    };
+    let models: &[Model] = match args.model {
+        ModelChoice::Flat => &[Model::Flat],
+        ModelChoice::Coriolis => &[Model::Coriolis],
+        ModelChoice::Both => &[Model::Flat, Model::Coriolis],
+    };
+    if let Some(target) = args.target_time_s {
+        return run_inverse(&scene, models, target, args.json);
+    }
+    let mut rows = Vec::new();
+    for &model in models {
+        let p = predict(&scene, model, args.method, args.step_s, args.tol)?;
+        rows.push((model, p));
+    }
+    if args.json {
+        let results: Vec<_> = rows
+            .iter()
+            .map(|(m, p)| json_result(*m, args.method, p))
+            .collect();
+        println!(
+            "{}",
+            serde_json::json!({ "scene": json_scene(&scene), "results": results })
+        );
+    } else {
+        println!("{}", describe_scene(&scene));
+        for (m, p) in &rows {
+            println!("{}", describe(*m, args.method, p));
+        }
+    }
+    Ok(())
+}
+
+fn json_scene(s: &Scene<f64>) -> serde_json::Value {
+    serde_json::json!({
+        "omega_rad_s": s.omega_rad_s, "mu": s.mu, "g_m_s2": s.g_m_s2, "k2": s.k2,
+        "ri_m": s.ri_m, "rim_radius_m": s.rim_radius_m,
+        "equilibrium_radius_m": finite_or_null(s.equilibrium_radius_m()),
+    })
+}
+
+fn finite_or_null(x: f64) -> serde_json::Value {
+    if x.is_finite() {
+        serde_json::json!(x)
+    } else {
+        serde_json::Value::Null
+    }
+}
+
+fn json_result(model: Model, method: MethodChoice, p: &Prediction) -> serde_json::Value {
+    let base = serde_json::json!({
+        "model": model_name(model), "method": method_name(method),
+        "rhs_evaluations": p.rhs_evaluations, "steps": p.steps,
+    });
+    let extra = match p.outcome {
+        Outcome::Leaves {
+            residence_time_s,
+            exit_radial_velocity_m_s,
+            exit_total_velocity_m_s,
+            condition_number,
+            ill_conditioned,
+        } => serde_json::json!({
+            "outcome": "leaves", "residence_time_s": residence_time_s,
+            "exit_radial_velocity_m_s": exit_radial_velocity_m_s,
+            "exit_total_velocity_m_s": exit_total_velocity_m_s,
+            "condition_number": condition_number, "ill_conditioned": ill_conditioned,
+        }),
+        Outcome::AlreadyAtRim {
+            exit_total_velocity_m_s,
+        } => serde_json::json!({
+            "outcome": "already_at_rim", "residence_time_s": 0.0,
+            "exit_radial_velocity_m_s": 0.0,
+            "exit_total_velocity_m_s": exit_total_velocity_m_s,
+        }),
+        Outcome::NeverLeaves {
+            equilibrium_radius_m,
+            near_threshold,
+        } => serde_json::json!({
+            "outcome": "never_leaves", "residence_time_s": null,
+            "equilibrium_radius_m": finite_or_null(equilibrium_radius_m),
+            "near_threshold": near_threshold,
+        }),
+    };
+    let mut v = base;
+    if let (Some(obj), serde_json::Value::Object(more)) = (v.as_object_mut(), extra) {
+        obj.extend(more);
+    }
+    v
+}
+
+fn describe_scene(s: &Scene<f64>) -> String {
+    format!(
+        "scene: omega {} rad/s, mu {}, g {} m/s^2, k2 {:.6}, ri {} m, R {} m; equilibrium radius a = mu g / omega^2 = {:.6} m",
+        s.omega_rad_s,
+        s.mu,
+        s.g_m_s2,
+        s.k2,
+        s.ri_m,
+        s.rim_radius_m,
+        s.equilibrium_radius_m()
+    )
+}
+
+fn describe(model: Model, method: MethodChoice, p: &Prediction) -> String {
+    let head = format!("{:<8} {:<13}", model_name(model), method_name(method));
+    let cost = if p.rhs_evaluations > 0 {
+        format!(
+            " [{} steps, {} rhs evaluations]",
+            p.steps, p.rhs_evaluations
+        )
+    } else {
+        String::new()
+    };
+    match p.outcome {
+        Outcome::Leaves {
+            residence_time_s,
+            exit_radial_velocity_m_s,
+            exit_total_velocity_m_s,
+            condition_number,
+            ill_conditioned,
+        } => format!(
+            "{head} leaves after T = {residence_time_s:.9} s; exit radial {exit_radial_velocity_m_s:.6} m/s, total {exit_total_velocity_m_s:.6} m/s; condition {condition_number:.3}{}{cost}",
+            if ill_conditioned {
+                " (ILL-CONDITIONED: start just above the threshold a)"
+            } else {
+                ""
+            }
+        ),
+        Outcome::AlreadyAtRim {
+            exit_total_velocity_m_s,
+        } => {
+            format!("{head} starts at the rim: T = 0, exit total {exit_total_velocity_m_s:.6} m/s")
+        }
+        Outcome::NeverLeaves {
+            equilibrium_radius_m,
+            near_threshold,
+        } => format!(
+            "{head} NEVER LEAVES: ri <= a = {equilibrium_radius_m:.6} m, friction holds it{}",
+            if near_threshold {
+                " (within rounding of the threshold)"
+            } else {
+                ""
+            }
+        ),
+    }
+}
+
+fn run_inverse(scene: &Scene<f64>, models: &[Model], target: f64, json: bool) -> Result<()> {
+    let mut out = Vec::new();
+    for &model in models {
+        let w = particle::omega_for_residence_time(scene, model, target)
+            .map_err(|e| anyhow!("no bowl speed for T = {target} s ({model:?}): {e:?}"))?;
+        out.push((model, w));
+    }
+    if json {
+        let v: Vec<_> = out
+            .iter()
+            .map(|(m, w)| serde_json::json!({"model": model_name(*m), "target_time_s": target, "omega_rad_s": w}))
+            .collect();
+        println!(
+            "{}",
+            serde_json::json!({ "scene": json_scene(scene), "inverse": v })
+        );
+    } else {
+        for (m, w) in out {
+            println!(
+                "{:<8} omega = {w:.9} rad/s gives T = {target} s",
+                model_name(m)
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Formats an f64 for the batch output: shortest round-trip digits, `inf`, `nan`.
+pub fn format_f64(x: f64) -> String {
+    if x.is_nan() {
+        "nan".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "inf".into() } else { "-inf".into() }
+    } else {
+        format!("{x}")
+    }
+}
+
+/// The columns a batch file must (or may) have.
+struct Columns {
+    model: usize,
+    omega: usize,
+    mu: usize,
+    ri: usize,
+    rim: usize,
+    g: Option<usize>,
+    k2: Option<usize>,
+}
+
+impl Columns {
+    fn find(header: &csv::StringRecord) -> Result<Self> {
+        let pos = |name: &str| header.iter().position(|h| h.trim() == name);
+        let need = |name: &str| {
+            pos(name).ok_or_else(|| anyhow!("header row has no `{name}` column (need model,w_rad_s,mu,ri_m,R_m; g,k2 optional)"))
+        };
+        Ok(Self {
+            model: need("model")?,
+            omega: need("w_rad_s")?,
+            mu: need("mu")?,
+            ri: need("ri_m")?,
+            rim: need("R_m")?,
+            g: pos("g"),
+            k2: pos("k2"),
+        })
+    }
+}
+
+fn parse_row(row: &csv::StringRecord, cols: &Columns) -> Result<(Model, Scene<f64>)> {
+    let field = |i: usize, name: &str| -> Result<f64> {
+        let text = row
+            .get(i)
+            .ok_or_else(|| anyhow!("missing `{name}` (row has {} fields)", row.len()))?
+            .trim();
+        text.parse::<f64>()
+            .map_err(|_| anyhow!("`{name}` = {text:?} is not a number"))
+    };
+    let model = match row.get(cols.model).map(|s| s.trim().to_ascii_lowercase()) {
+        Some(m) if m == "flat" => Model::Flat,
+        Some(m) if m == "coriolis" => Model::Coriolis,
+        Some(m) => bail!("`model` = {m:?}: expected flat or coriolis"),
+        None => bail!("missing `model` (row has {} fields)", row.len()),
+    };
+    let scene = Scene {
+        omega_rad_s: field(cols.omega, "w_rad_s")?,
+        mu: field(cols.mu, "mu")?,
+        g_m_s2: match cols.g {
+            Some(i) => field(i, "g")?,
+            None => 9.81,
+        },
+        k2: match cols.k2 {
+            Some(i) => field(i, "k2")?,
+            None => 5.0 / 7.0,
+        },
+        ri_m: field(cols.ri, "ri_m")?,
+        rim_radius_m: field(cols.rim, "R_m")?,
+    };
+    scene
+        .validate()
+        .map_err(|e| anyhow!("invalid scene: {e:?}"))?;
+    Ok((model, scene))
+}
+
+fn run_batch(input: &std::path::Path, output: &std::path::Path, args: &Args) -> Result<()> {
+    let mut reader = csv::ReaderBuilder::new()
+        .flexible(true)
+        .from_path(input)
+        .with_context(|| format!("cannot open {}", input.display()))?;
+    let header = reader
+        .headers()
+        .with_context(|| format!("{}: cannot read the header row", input.display()))?
+        .clone();
+    let cols = Columns::find(&header).with_context(|| format!("{}: line 1", input.display()))?;
+    let mut writer = csv::Writer::from_path(output)
+        .with_context(|| format!("cannot create {}", output.display()))?;
+    let mut out_header = header.clone();
+    for name in [
+        "residence_time_s",
+        "exit_radial_velocity_m_s",
+        "exit_total_velocity_m_s",
+    ] {
+        out_header.push_field(name);
+    }
+    writer.write_record(&out_header)?;
+    let (mut failed, mut written) = (0usize, 0usize);
+    for (index, record) in reader.records().enumerate() {
+        // Line numbers as a user sees them: the header is line 1. (For rows with embedded
+        // newlines the csv reader's own position is the truth.)
+        let line = record
+            .as_ref()
+            .ok()
+            .and_then(|r| r.position().map(|p| p.line()))
+            .unwrap_or(index as u64 + 2);
+        let result = record.map_err(|e| anyhow!("{e}")).and_then(|row| {
+            let (model, scene) = parse_row(&row, &cols)?;
+            let p = predict(&scene, model, args.method, args.step_s, args.tol)?;
+            Ok((row, p))
+        });
+        match result {
+            Ok((row, p)) => {
+                let (t, vr, vt) = match p.outcome {
+                    Outcome::NeverLeaves { .. } => (f64::INFINITY, f64::NAN, f64::NAN),
+                    o => {
+                        let (vr, vt) = o.exit_velocities_m_s().unwrap_or((f64::NAN, f64::NAN));
+                        (o.residence_time_s(), vr, vt)
+                    }
+                };
+                let mut out = row.clone();
+                for x in [t, vr, vt] {
+                    out.push_field(&format_f64(x));
+                }
+                writer.write_record(&out)?;
+                written += 1;
+            }
+            Err(e) => {
+                failed += 1;
+                eprintln!("{}: line {line}: {e:#}", input.display());
+            }
+        }
+    }
+    writer.flush()?;
+    if failed > 0 {
+        bail!(
+            "{failed} row(s) of {} failed (see above); {written} written to {}",
+            input.display(),
+            output.display()
+        );
+    }
+    Ok(())
+}

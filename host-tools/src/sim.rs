@@ -1,0 +1,515 @@
+//! `bowl sim`: the controller against the simulated rig (model-core's `sim`), on the host.
+//!
+//! - `bowl sim step`: 0 to 3 rad/s on both axes of the nominal rig (12 pulses/rev), after
+//!   commissioning; JSON with rise time, overshoot, 2 % settling, steady-state error, RMS ripple
+//!   of the rig's *true* speed.
+//! - `bowl sim family`: the same step on a seeded family of plants the controller is not told
+//!   about, each commissioned first; JSON with the worst case and the median.
+//! - `bowl sim commission`: identification on the simulated rig, identified vs true model.
+//! - `bowl sim sweep`: CSV of settling time against pulses per revolution.
+//! - `bowl sim stability`: CSV map of the limit-cycle amplitude at low speed against loop gain
+//!   (per-pulse bandwidth) and pulse rate, with and without the pulse-rate schedule.
+
+use anyhow::{Result, bail};
+use model_core::control::{Controller, ControllerConfig, Fault, State};
+use model_core::sim::prng::Prng;
+use model_core::sim::{ClosedLoop, Rig, RigParams, StepMetrics, StepReport};
+use serde::Serialize;
+
+#[derive(clap::Subcommand)]
+pub(crate) enum What {
+    /// Step 0 -> 3 rad/s on the nominal rig; JSON.
+    Step(StepArgs),
+    /// The step on a seeded family of perturbed plants; JSON with worst case and median.
+    Family(FamilyArgs),
+    /// Identification on the simulated rig; JSON.
+    Commission(CommonArgs),
+    /// CSV: settling time against pulses per revolution.
+    Sweep(CommonArgs),
+    /// CSV: limit-cycle amplitude at low speed against loop gain and pulse rate.
+    Stability(StabilityArgs),
+    /// CSV trace (every 10 ms) of the 0 -> 3 rad/s step on one family plant (or the nominal rig).
+    Trace(TraceArgs),
+}
+
+#[derive(clap::Args)]
+pub(crate) struct TraceArgs {
+    #[command(flatten)]
+    common: CommonArgs,
+    /// Family plant index; without it, the nominal rig.
+    #[arg(long)]
+    plant: Option<u32>,
+}
+
+#[derive(clap::Args, Clone)]
+pub(crate) struct CommonArgs {
+    /// Seed of tooth errors, jitter and the family.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct StepArgs {
+    #[command(flatten)]
+    common: CommonArgs,
+    /// Pulses per revolution of both sensors.
+    #[arg(long, default_value_t = 12)]
+    pulses_per_rev: u16,
+    /// Step target, rad/s.
+    #[arg(long, default_value_t = 3.0)]
+    target_rad_s: f32,
+    /// Feedforward only (feedback off): shows what the loop adds.
+    #[arg(long)]
+    no_feedback: bool,
+    /// Override the once-per-revolution load ripple of both axes, N m.
+    #[arg(long)]
+    ripple_nm: Option<f32>,
+    /// Override the loop's per-pulse bandwidth.
+    #[arg(long)]
+    per_pulse_bandwidth: Option<f32>,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct FamilyArgs {
+    #[command(flatten)]
+    common: CommonArgs,
+    /// Number of plants (at least 50).
+    #[arg(long, default_value_t = 50)]
+    plants: u32,
+    /// Feedforward only (feedback off): the family must then fail.
+    #[arg(long)]
+    no_feedback: bool,
+    /// Allow fewer than 50 plants (for quick tests).
+    #[arg(long, hide = true)]
+    allow_small: bool,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct StabilityArgs {
+    #[command(flatten)]
+    common: CommonArgs,
+    /// Speed of the test, rad/s.
+    #[arg(long, default_value_t = 0.5)]
+    speed_rad_s: f32,
+}
+
+/// Runs `bowl sim`.
+pub(crate) fn run(what: &What) -> Result<()> {
+    match what {
+        What::Step(a) => {
+            let mut rig = rig_with_pulses(a.pulses_per_rev);
+            if let Some(r) = a.ripple_nm {
+                for ax in &mut rig.axes {
+                    ax.ripple_nm = r;
+                }
+            }
+            let mut cfg = ControllerConfig::nominal();
+            if let Some(p) = a.per_pulse_bandwidth {
+                for ax in &mut cfg.axes {
+                    ax.per_pulse_bandwidth = p;
+                }
+            }
+            let out = StepJson {
+                scenario: "nominal rig, both axes 0 -> target, commissioned first, true speed",
+                pulses_per_rev: a.pulses_per_rev,
+                target_rad_s: a.target_rad_s,
+                feedback: !a.no_feedback,
+                outcome: step_run_with(rig, cfg, a.common.seed, a.target_rad_s, !a.no_feedback),
+            };
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::Family(a) => {
+            if a.plants < 50 && !a.allow_small {
+                bail!("--plants must be at least 50 (the issue's family size)");
+            }
+            let out = family(a.common.seed, a.plants, !a.no_feedback);
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::Commission(a) => {
+            let out = commission_report(a.seed);
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::Sweep(a) => sweep(a.seed),
+        What::Stability(a) => stability(a.common.seed, a.speed_rad_s),
+        What::Trace(a) => trace(a.common.seed, a.plant),
+    }
+    Ok(())
+}
+
+/// The step-response figures of one axis.
+#[derive(Serialize, Clone, Copy, Debug)]
+pub struct AxisFigures {
+    /// 10-90 % rise time, s.
+    pub rise_time_s: f32,
+    /// Overshoot, percent of the target.
+    pub overshoot_pct: f32,
+    /// 2 % settling time, s.
+    pub settling_time_s: f32,
+    /// Steady-state error, percent of the target.
+    pub steady_state_error_pct: f32,
+    /// RMS ripple of the true speed, percent of the target.
+    pub rms_ripple_pct: f32,
+}
+
+impl From<StepReport> for AxisFigures {
+    fn from(r: StepReport) -> Self {
+        Self {
+            rise_time_s: r.rise_time_s,
+            overshoot_pct: 100.0 * r.overshoot,
+            settling_time_s: r.settling_time_s,
+            steady_state_error_pct: 100.0 * r.steady_state_error,
+            rms_ripple_pct: 100.0 * r.rms_ripple,
+        }
+    }
+}
+
+/// One step run.
+#[derive(Serialize, Clone, Debug)]
+pub struct StepOutcome {
+    /// `[precession, spin]`.
+    pub axes: [AxisFigures; 2],
+    /// The worse axis of each figure.
+    pub worst: AxisFigures,
+    /// Fault code latched during the run (0 = none).
+    pub fault_code: u8,
+    /// Commissioning ended in Idle (not a fault).
+    pub commissioned: bool,
+}
+
+const STEP_RUN_S: f32 = 8.0;
+const STEADY_FROM_S: f32 = 5.0;
+
+/// Commissions the controller on `rig`, then steps both axes from 0 to `target`.
+pub fn step_run(rig: RigParams, seed: u32, target: f32, feedback: bool) -> StepOutcome {
+    step_run_with(rig, ControllerConfig::nominal(), seed, target, feedback)
+}
+
+/// [`step_run`] with a given controller configuration (its pulses per revolution are set from
+/// the rig).
+pub fn step_run_with(
+    rig: RigParams,
+    mut cfg: ControllerConfig,
+    seed: u32,
+    target: f32,
+    feedback: bool,
+) -> StepOutcome {
+    for i in 0..2 {
+        cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
+    }
+    let ctrl = Controller::new(cfg).expect("nominal config is valid");
+    let mut cl = ClosedLoop::new(Rig::new(rig, seed), ctrl);
+    let commissioned = cl.commission(300.0) == State::Idle;
+    cl.ctrl.set_feedback_enabled(feedback);
+    let mut m = [
+        StepMetrics::new(target, STEADY_FROM_S),
+        StepMetrics::new(target, STEADY_FROM_S),
+    ];
+    let mut fault: Option<Fault> = None;
+    if commissioned && cl.ctrl.set_motor_speeds(target, target).is_ok() && cl.ctrl.start().is_ok() {
+        let dt = cl.dt_s();
+        let mut t = 0.0f32;
+        cl.run(STEP_RUN_S, |c| {
+            t += dt;
+            m[0].add(t, c.rig.speed_rad_s(0));
+            m[1].add(t, c.rig.speed_rad_s(1));
+            if fault.is_none() {
+                fault = c.ctrl.fault();
+            }
+        });
+    } else {
+        fault = cl.ctrl.fault();
+    }
+    let axes = [
+        AxisFigures::from(m[0].report()),
+        AxisFigures::from(m[1].report()),
+    ];
+    StepOutcome {
+        worst: worst_of(&axes),
+        axes,
+        fault_code: fault.map_or(0, Fault::code),
+        commissioned,
+    }
+}
+
+fn worst_of(a: &[AxisFigures]) -> AxisFigures {
+    let mut w = a[0];
+    for x in &a[1..] {
+        w.rise_time_s = w.rise_time_s.max(x.rise_time_s);
+        w.overshoot_pct = w.overshoot_pct.max(x.overshoot_pct);
+        w.settling_time_s = w.settling_time_s.max(x.settling_time_s);
+        w.steady_state_error_pct = w.steady_state_error_pct.max(x.steady_state_error_pct);
+        w.rms_ripple_pct = w.rms_ripple_pct.max(x.rms_ripple_pct);
+    }
+    w
+}
+
+fn median_of(a: &[AxisFigures]) -> AxisFigures {
+    let med = |f: fn(&AxisFigures) -> f32| {
+        let mut v: Vec<f32> = a.iter().map(f).collect();
+        v.sort_by(f32::total_cmp);
+        v[v.len() / 2]
+    };
+    AxisFigures {
+        rise_time_s: med(|x| x.rise_time_s),
+        overshoot_pct: med(|x| x.overshoot_pct),
+        settling_time_s: med(|x| x.settling_time_s),
+        steady_state_error_pct: med(|x| x.steady_state_error_pct),
+        rms_ripple_pct: med(|x| x.rms_ripple_pct),
+    }
+}
+
+fn rig_with_pulses(n: u16) -> RigParams {
+    let mut rig = RigParams::nominal();
+    for a in &mut rig.axes {
+        a.sensor.pulses_per_rev = n;
+    }
+    rig
+}
+
+/// `bowl sim step`'s JSON.
+#[derive(Serialize)]
+pub struct StepJson {
+    /// What was run.
+    pub scenario: &'static str,
+    /// Pulses per revolution.
+    pub pulses_per_rev: u16,
+    /// Target, rad/s.
+    pub target_rad_s: f32,
+    /// Feedback on.
+    pub feedback: bool,
+    /// The outcome.
+    #[serde(flatten)]
+    pub outcome: StepOutcome,
+}
+
+/// One perturbed plant of the family (seeded).
+pub fn family_plant(seed: u32, index: u32) -> RigParams {
+    let mut rng = Prng::new(seed.wrapping_mul(0x9e37_79b9) ^ index);
+    let mut rig = RigParams::nominal();
+    for a in &mut rig.axes {
+        let m = &mut a.motor;
+        m.inertia_kg_m2 *= rng.range(0.7, 1.3);
+        m.torque_constant *= rng.range(0.85, 1.15);
+        let friction = libm::expf(rng.range(libm::logf(0.5), libm::logf(2.0)));
+        m.viscous_nm_s *= friction;
+        m.coulomb_nm *= friction;
+        m.stiction_nm *= friction;
+        a.sensor.tooth_error = 0.01;
+        a.sensor.jitter_s = 200e-6;
+        a.ripple_nm *= rng.range(0.5, 2.0);
+    }
+    rig.coupling = 0.5 * rng.range(0.8, 1.2);
+    rig
+}
+
+/// `bowl sim family`'s JSON.
+#[derive(Serialize)]
+pub struct FamilyJson {
+    /// What was run.
+    pub scenario: &'static str,
+    /// Plants.
+    pub plants: u32,
+    /// Seed.
+    pub seed: u32,
+    /// Feedback on.
+    pub feedback: bool,
+    /// Worst of every figure over all plants and both axes.
+    pub worst: AxisFigures,
+    /// Median of every figure over all plants (worse axis of each).
+    pub median: AxisFigures,
+    /// Plants whose run latched a fault (any fault is false: the plants are healthy).
+    pub faulted_plants: u32,
+    /// Plants whose commissioning failed.
+    pub commissioning_failures: u32,
+}
+
+fn family(seed: u32, plants: u32, feedback: bool) -> FamilyJson {
+    let outcomes: Vec<StepOutcome> = (0..plants)
+        .map(|i| step_run(family_plant(seed, i), seed.wrapping_add(i), 3.0, feedback))
+        .collect();
+    if std::env::var_os("BOWL_SIM_VERBOSE").is_some() {
+        for (i, o) in outcomes.iter().enumerate() {
+            eprintln!("plant {i}: {o:?}");
+        }
+    }
+    let worsts: Vec<AxisFigures> = outcomes.iter().map(|o| o.worst).collect();
+    FamilyJson {
+        scenario: "family: inertia +/-30 %, torque constant +/-15 %, friction x0.5..x2, 1 % tooth error, 200 us jitter, load ripple, axis coupling; each commissioned; 0 -> 3 rad/s, 12 pulses/rev",
+        plants,
+        seed,
+        feedback,
+        worst: worst_of(&worsts),
+        median: median_of(&worsts),
+        faulted_plants: outcomes.iter().filter(|o| o.fault_code != 0).count() as u32,
+        commissioning_failures: outcomes.iter().filter(|o| !o.commissioned).count() as u32,
+    }
+}
+
+/// Identified vs true model of one axis.
+#[derive(Serialize)]
+pub struct AxisIdentification {
+    /// Identified effective back-EMF constant, V s/rad.
+    pub volts_per_rad_s: f32,
+    /// True value (`k + R b / k`).
+    pub true_volts_per_rad_s: f32,
+    /// Identified friction duty.
+    pub friction_duty: f32,
+    /// True value (`R Tc / (k V)`).
+    pub true_friction_duty: f32,
+    /// Identified time constant, s.
+    pub time_constant_s: f32,
+    /// True value (`J R / (k^2 + R b)`).
+    pub true_time_constant_s: f32,
+}
+
+/// `bowl sim commission`'s JSON.
+#[derive(Serialize)]
+pub struct CommissionJson {
+    /// Final state after the routine.
+    pub state: String,
+    /// Seconds the routine took.
+    pub duration_s: f32,
+    /// `[precession, spin]`, if identified.
+    pub axes: Vec<Option<AxisIdentification>>,
+}
+
+fn commission_report(seed: u32) -> CommissionJson {
+    let rig = RigParams::nominal();
+    let ctrl = Controller::new(ControllerConfig::nominal()).expect("valid");
+    let mut cl = ClosedLoop::new(Rig::new(rig, seed), ctrl);
+    let state = cl.commission(300.0);
+    let ids = cl.ctrl.identified();
+    let axes = (0..2)
+        .map(|i| {
+            ids[i].map(|id| {
+                let (a, fd, tau) = rig.axes[i].motor.ideal_model(rig.supply_v);
+                AxisIdentification {
+                    volts_per_rad_s: id.model.volts_per_rad_s,
+                    true_volts_per_rad_s: a,
+                    friction_duty: id.model.friction_duty,
+                    true_friction_duty: fd,
+                    time_constant_s: id.model.time_constant_s,
+                    true_time_constant_s: tau,
+                }
+            })
+        })
+        .collect();
+    CommissionJson {
+        state: format!("{state:?}"),
+        duration_s: cl.rig.time_s() as f32,
+        axes,
+    }
+}
+
+fn sweep(seed: u32) {
+    println!("pulses_per_rev,settling_time_s,overshoot_pct,rms_ripple_pct,rise_time_s,fault_code");
+    for n in [1u16, 2, 4, 6, 8, 12, 16, 24, 32, 48, 60, 90, 120, 180, 240] {
+        let o = step_run(rig_with_pulses(n), seed, 3.0, true);
+        println!(
+            "{n},{:.3},{:.3},{:.4},{:.3},{}",
+            o.worst.settling_time_s,
+            o.worst.overshoot_pct,
+            o.worst.rms_ripple_pct,
+            o.worst.rise_time_s,
+            o.fault_code
+        );
+    }
+}
+
+/// Low-speed hold: half peak-to-peak of the true speed over a window, percent of the target.
+pub fn low_speed_cycle(
+    seed: u32,
+    pulses: u16,
+    speed: f32,
+    per_pulse_bandwidth: f32,
+    scheduled: bool,
+) -> (f32, u8) {
+    let rig = rig_with_pulses(pulses);
+    let mut cfg = ControllerConfig::nominal();
+    for i in 0..2 {
+        cfg.axes[i].pulses_per_rev = pulses;
+        let (a, fd, tau) = rig.axes[i].motor.ideal_model(rig.supply_v);
+        cfg.axes[i].model.volts_per_rad_s = a;
+        cfg.axes[i].model.friction_duty = fd;
+        cfg.axes[i].model.time_constant_s = tau;
+        cfg.axes[i].per_pulse_bandwidth = per_pulse_bandwidth;
+        if !scheduled {
+            // Unscheduled: the bandwidth the schedule allows at 3 rad/s, at every speed.
+            let at3 = per_pulse_bandwidth * pulses as f32 * 3.0 / core::f32::consts::TAU;
+            cfg.axes[i].bandwidth_rad_s = at3.min(cfg.axes[i].bandwidth_rad_s);
+            cfg.axes[i].per_pulse_bandwidth = 10.0;
+        }
+        cfg.axes[i].min_speed_rad_s = cfg.axes[i].min_speed_rad_s.min(0.5 * speed);
+    }
+    let mut cl = ClosedLoop::new(Rig::new(rig, seed), Controller::new(cfg).expect("valid"));
+    let _ = cl.ctrl.set_motor_speeds(speed, speed);
+    let _ = cl.ctrl.start();
+    cl.run(20.0, |_| {});
+    let mut m = StepMetrics::new(speed, 0.0);
+    let dt = cl.dt_s();
+    let mut t = 0.0;
+    cl.run(20.0, |c| {
+        t += dt;
+        m.add(t, c.rig.speed_rad_s(1));
+    });
+    (
+        100.0 * m.report().half_peak_to_peak,
+        cl.ctrl.fault().map_or(0, Fault::code),
+    )
+}
+
+fn stability(seed: u32, speed: f32) {
+    println!(
+        "pulses_per_rev,pulse_rate_hz,per_pulse_bandwidth,scheduled,half_peak_to_peak_pct,fault_code"
+    );
+    for n in [4u16, 12, 60] {
+        for ppb in [0.1f32, 0.25, 0.5, 1.0, 2.0, 4.0] {
+            for scheduled in [true, false] {
+                let (cycle, fault) = low_speed_cycle(seed, n, speed, ppb, scheduled);
+                let rate = speed * n as f32 / core::f32::consts::TAU;
+                println!("{n},{rate:.3},{ppb},{scheduled},{cycle:.3},{fault}");
+            }
+        }
+    }
+}
+
+fn trace(seed: u32, plant: Option<u32>) {
+    let (rig, rig_seed) = match plant {
+        Some(i) => (family_plant(seed, i), seed.wrapping_add(i)),
+        None => (RigParams::nominal(), seed),
+    };
+    let ctrl = Controller::new(ControllerConfig::nominal()).expect("valid");
+    let mut cl = ClosedLoop::new(Rig::new(rig, rig_seed), ctrl);
+    let state = cl.commission(300.0);
+    eprintln!(
+        "commissioning: {state:?}, identified {:?}",
+        cl.ctrl.identified()
+    );
+    let _ = cl.ctrl.set_motor_speeds(3.0, 3.0);
+    let _ = cl.ctrl.start();
+    println!(
+        "t_s,true_prec,true_spin,meas_prec,meas_spin,ref_prec,ref_spin,duty_prec,duty_spin,state,fault"
+    );
+    let dt = cl.dt_s();
+    let mut k = 0u32;
+    cl.run(STEP_RUN_S, |c| {
+        k += 1;
+        if k % 10 == 0 {
+            let s = c.ctrl.status();
+            println!(
+                "{:.3},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:?},{}",
+                k as f32 * dt,
+                c.rig.speed_rad_s(0),
+                c.rig.speed_rad_s(1),
+                s.axes[0].measured_rad_s,
+                s.axes[1].measured_rad_s,
+                s.axes[0].reference_rad_s,
+                s.axes[1].reference_rad_s,
+                s.axes[0].duty,
+                s.axes[1].duty,
+                s.state,
+                s.fault_code
+            );
+        }
+    });
+}

@@ -1,0 +1,252 @@
+//! `bowl predict` end to end: runs the built binary and checks its output against independent
+//! formulas (the textbook acosh form of paper Eq. 6, the energy identity of Eq. 7).
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn bowl(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bowl"))
+        .args(args)
+        .env_remove("RUST_BACKTRACE")
+        .env_remove("RUST_LIB_BACKTRACE")
+        .output()
+        .expect("run bowl")
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = bowl(args);
+    assert!(
+        out.status.success(),
+        "bowl {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid JSON")
+}
+
+/// Flat residence time by the textbook formula, `acosh((R - a)/(ri - a)) / (k omega)`.
+fn flat_time(w: f64, mu: f64, ri: f64, rim: f64) -> f64 {
+    let a = mu * 9.81 / (w * w);
+    ((rim - a) / (ri - a)).acosh() / ((5.0f64 / 7.0).sqrt() * w)
+}
+
+fn temp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("bowl-predict-{}-{name}", std::process::id()))
+}
+
+#[test]
+fn single_case_text_names_both_models() {
+    let out = bowl(&["predict"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("flat") && text.contains("coriolis"), "{text}");
+    assert!(text.contains("leaves after T ="), "{text}");
+}
+
+#[test]
+fn single_case_json_matches_the_textbook_formula() {
+    let v = json(&[
+        "predict",
+        "--omega-rad-s",
+        "3.6",
+        "--mu",
+        "0.01",
+        "--ri-m",
+        "0.03",
+        "--model",
+        "flat",
+        "--json",
+    ]);
+    let r = &v["results"][0];
+    assert_eq!(r["outcome"], "leaves");
+    let t = r["residence_time_s"].as_f64().unwrap();
+    let want = flat_time(3.6, 0.01, 0.03, 0.1);
+    assert!((t - want).abs() < 1e-12 * want, "{t} vs {want}");
+    // Energy: r'^2 = k2 omega^2 ((R - a)^2 - (ri - a)^2).
+    let a: f64 = 0.01 * 9.81 / (3.6 * 3.6);
+    let vr = r["exit_radial_velocity_m_s"].as_f64().unwrap();
+    let vr_want = (5.0 / 7.0 * 3.6f64.powi(2) * ((0.1 - a).powi(2) - (0.03 - a).powi(2))).sqrt();
+    assert!((vr - vr_want).abs() < 1e-12);
+    let vt = r["exit_total_velocity_m_s"].as_f64().unwrap();
+    assert!((vt - (vr * vr + 0.36f64.powi(2)).sqrt()).abs() < 1e-12);
+}
+
+#[test]
+fn paper_literal_mu_never_leaves_and_says_so() {
+    let v = json(&["predict", "--mu", "0.4", "--omega-rad-s", "3.6", "--json"]);
+    for r in v["results"].as_array().unwrap() {
+        assert_eq!(r["outcome"], "never_leaves");
+        assert!(r["residence_time_s"].is_null());
+    }
+    let text = String::from_utf8(bowl(&["predict", "--mu", "0.4"]).stdout).unwrap();
+    assert!(text.contains("NEVER LEAVES"), "{text}");
+}
+
+#[test]
+fn inverse_gives_a_speed_that_gives_the_target() {
+    let v = json(&[
+        "predict",
+        "--target-time-s",
+        "0.6",
+        "--model",
+        "coriolis",
+        "--json",
+    ]);
+    let w = v["inverse"][0]["omega_rad_s"].as_f64().unwrap();
+    let back = json(&[
+        "predict",
+        "--omega-rad-s",
+        &w.to_string(),
+        "--model",
+        "coriolis",
+        "--json",
+    ]);
+    let t = back["results"][0]["residence_time_s"].as_f64().unwrap();
+    assert!((t - 0.6).abs() < 1e-12, "{t}");
+}
+
+#[test]
+fn bad_scene_is_a_clear_error() {
+    let out = bowl(&["predict", "--k2", "1.5"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("InvalidK2"));
+}
+
+#[test]
+fn batch_writes_every_good_row_and_names_bad_lines() {
+    let input = temp("in.csv");
+    let output = temp("out.csv");
+    std::fs::write(
+        &input,
+        "label,model,w_rad_s,mu,ri_m,R_m,g,k2\n\
+         \"a, quoted\",flat,3.6,0.01,0.03,0.1,9.81,0.7142857142857143\n\
+         b,coriolis,3.6,0.4,0.05,0.1,9.81,0.7142857142857143\n\
+         c,flat,2,0.029,0.1,0.1,9.81,0.7142857142857143\n\
+         d,flat,fast,0.029,0.05,0.1,9.81,0.7142857142857143\n\
+         e,sideways,3,0.029,0.05,0.1,9.81,0.7142857142857143\n\
+         f,coriolis,3,0.029,0.05,0.1,9.81,0.7142857142857143\n",
+    )
+    .unwrap();
+    let out = bowl(&[
+        "predict",
+        "--batch",
+        input.to_str().unwrap(),
+        "--out",
+        output.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success(), "a failed row must fail the run");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("line 5") && err.contains("\"fast\""), "{err}");
+    assert!(err.contains("line 6") && err.contains("sideways"), "{err}");
+
+    let mut rdr = csv::Reader::from_path(&output).unwrap();
+    let header: Vec<String> = rdr.headers().unwrap().iter().map(String::from).collect();
+    assert_eq!(header.len(), 11);
+    assert_eq!(
+        &header[8..],
+        [
+            "residence_time_s",
+            "exit_radial_velocity_m_s",
+            "exit_total_velocity_m_s"
+        ]
+    );
+    let rows: Vec<csv::StringRecord> = rdr.records().map(|r| r.unwrap()).collect();
+    assert_eq!(rows.len(), 4, "rows a, b, c, f");
+    // a: extra column carried through (with its comma), full-precision time.
+    assert_eq!(&rows[0][0], "a, quoted");
+    let t: f64 = rows[0][8].parse().unwrap();
+    assert_eq!(t.to_string(), &rows[0][8], "shortest round-trip form");
+    let want = flat_time(3.6, 0.01, 0.03, 0.1);
+    assert!((t - want).abs() < 1e-12 * want);
+    // b: never leaves.
+    assert_eq!(
+        (&rows[1][8], &rows[1][9], &rows[1][10]),
+        ("inf", "nan", "nan")
+    );
+    // c: at the rim: T 0, radial 0, total omega R.
+    assert_eq!((&rows[2][8], &rows[2][9]), ("0", "0"));
+    assert_eq!(rows[2][10].parse::<f64>().unwrap(), 2.0 * 0.1);
+    // f: Coriolis slower than flat at the same scene.
+    let tc: f64 = rows[3][8].parse().unwrap();
+    assert!(tc > flat_time(3.0, 0.029, 0.05, 0.1));
+    let _ = std::fs::remove_file(input);
+    let _ = std::fs::remove_file(output);
+}
+
+#[test]
+fn batch_without_g_and_k2_uses_the_defaults() {
+    let input = temp("defaults.csv");
+    let output = temp("defaults-out.csv");
+    std::fs::write(
+        &input,
+        "R_m,ri_m,mu,w_rad_s,model\n0.1,0.03,0.01,3.6,flat\n",
+    )
+    .unwrap();
+    let out = bowl(&[
+        "predict",
+        "--batch",
+        input.to_str().unwrap(),
+        "--out",
+        output.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&output).unwrap();
+    let last = text.lines().nth(1).unwrap();
+    let t: f64 = last.split(',').nth(5).unwrap().parse().unwrap();
+    let want = flat_time(3.6, 0.01, 0.03, 0.1);
+    assert!((t - want).abs() < 1e-12 * want);
+    let _ = std::fs::remove_file(input);
+    let _ = std::fs::remove_file(output);
+}
+
+#[test]
+fn batch_without_required_column_fails_naming_it() {
+    let input = temp("nocol.csv");
+    let output = temp("nocol-out.csv");
+    std::fs::write(&input, "model,mu,ri_m,R_m\nflat,0.01,0.03,0.1\n").unwrap();
+    let out = bowl(&[
+        "predict",
+        "--batch",
+        input.to_str().unwrap(),
+        "--out",
+        output.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("w_rad_s"));
+    let _ = std::fs::remove_file(input);
+    let _ = std::fs::remove_file(output);
+}
+
+#[test]
+fn integrators_agree_with_the_closed_form_and_report_cost() {
+    let closed = json(&["predict", "--model", "coriolis", "--json"]);
+    let t_ref = closed["results"][0]["residence_time_s"].as_f64().unwrap();
+    let dp = json(&[
+        "predict", "--model", "coriolis", "--method", "dp54", "--tol", "1e-11", "--json",
+    ]);
+    let r = &dp["results"][0];
+    assert!((r["residence_time_s"].as_f64().unwrap() - t_ref).abs() < 1e-9 * t_ref);
+    assert!(r["rhs_evaluations"].as_u64().unwrap() > 6);
+    let rk = json(&[
+        "predict", "--model", "coriolis", "--method", "rk4", "--step-s", "0.001", "--json",
+    ]);
+    assert!((rk["results"][0]["residence_time_s"].as_f64().unwrap() - t_ref).abs() < 1e-9 * t_ref);
+}
+
+#[test]
+fn a_step_beyond_stability_is_an_error_not_a_number() {
+    let out = bowl(&[
+        "predict",
+        "--method",
+        "euler",
+        "--step-s",
+        "1.0",
+        "--omega-rad-s",
+        "3",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("BeyondStabilityLimit"));
+}

@@ -1,0 +1,277 @@
+//! Commissioning: open-loop identification of each axis from duty steps and edge times.
+//!
+//! # Routine (spin first, then precession; one at a time, the other at zero duty)
+//! 1. *Low step*: duty `low_duty` from rest, held at least `step_time_s` and until
+//!    `min_fit_edges` edges fell in the step's second half. A straight line fitted to
+//!    (edge time, edge angle) over the second half gives the steady speed `w_L` (its slope).
+//! 2. *High step*: duty `high_duty`, same rule, gives `w_H` and the line's intercept.
+//! 3. *Coast*: zero duty until the estimator reads zero, then the next axis.
+//!
+//! # What is estimated
+//! - Steady state `d V = a |w| + c`: two points give the effective back-EMF constant
+//!   `a = V (d_H - d_L) / (w_H - w_L)` (V per rad/s; it includes viscous friction, see
+//!   [`MotorModel`]) and the friction duty `c / V = d_L - a w_L / V`.
+//! - Time constant: for a first-order response to the step at `t_s`, the angle approaches the
+//!   asymptote `theta(t) = theta(t_s) + w_H (t - t_s) - (w_H - w_L) tau`. The low step's line gives
+//!   `theta(t_s)`, the high step's line the asymptote, so
+//!   `tau = (theta_L(t_s) - theta_H(t_s)) / (w_H - w_L)`. Angles are edge counts times the pitch,
+//!   counted continuously across both steps, so the unknown angle of the first edge cancels.
+//!   This works with sparse pulses (one pitch may take longer than tau), where timing the 63 %
+//!   point of a speed step could not.
+//!
+//! The feedforward and the PI gains follow from the model (see `pi`).
+
+use super::config::{CommissioningConfig, MotorModel};
+
+/// Least-squares straight line `y = b + m x`, accumulated without storage.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LineFit {
+    n: f32,
+    sx: f32,
+    sy: f32,
+    sxx: f32,
+    sxy: f32,
+}
+
+impl LineFit {
+    /// Adds a point.
+    pub fn add(&mut self, x: f32, y: f32) {
+        self.n += 1.0;
+        self.sx += x;
+        self.sy += y;
+        self.sxx += x * x;
+        self.sxy += x * y;
+    }
+    /// Number of points.
+    pub fn count(&self) -> u32 {
+        self.n as u32
+    }
+    /// `(intercept, slope)`, or `None` with fewer than 2 distinct abscissae.
+    pub fn solve(&self) -> Option<(f32, f32)> {
+        if self.n < 2.0 {
+            return None;
+        }
+        let mx = self.sx / self.n;
+        let my = self.sy / self.n;
+        let var = self.sxx / self.n - mx * mx;
+        if var.partial_cmp(&(1e-12 * (1.0 + mx * mx))) != Some(core::cmp::Ordering::Greater) {
+            return None;
+        }
+        let m = (self.sxy / self.n - mx * my) / var;
+        let b = my - m * mx;
+        if m.is_finite() && b.is_finite() {
+            Some((b, m))
+        } else {
+            None
+        }
+    }
+}
+
+/// Where the routine stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Phase {
+    /// Low duty step on the axis.
+    Low,
+    /// High duty step on the axis.
+    High,
+    /// Coasting to rest.
+    Coast,
+    /// Both axes identified.
+    Done,
+}
+
+/// Why identification failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum IdentifyError {
+    /// Too few edges to fit a line in a step (sensor or shaft problem).
+    TooFewEdges,
+    /// The high step was not faster than the low step.
+    NoSpeedIncrease,
+    /// The identified model fails the plausibility check.
+    Implausible,
+    /// The routine exceeded its timeout.
+    Timeout,
+}
+
+/// One axis's identification result, with the raw fit for reports.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Identified {
+    /// The model for feedforward and gains.
+    pub model: MotorModel,
+    /// Steady speed at the low duty, rad/s.
+    pub low_speed_rad_s: f32,
+    /// Steady speed at the high duty, rad/s.
+    pub high_speed_rad_s: f32,
+}
+
+/// The identification routine's state (driven by the controller's tick).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Commissioning {
+    cfg: CommissioningConfig,
+    supply_v: f32,
+    axis: usize,
+    phase: Phase,
+    t0_ticks: Option<u32>,
+    ticks_per_s: f32,
+    coast_s: f32,
+    total_s: f32,
+    step_at_s: f32,
+    angle_pulses: u32,
+    low_fit: LineFit,
+    high_fit: LineFit,
+    results: [Option<Identified>; 2],
+}
+
+impl Commissioning {
+    /// A routine starting with the spin axis (its reaction torque may drag the coasting
+    /// precession axis; the precession axis is identified afterwards, with the spin at rest).
+    pub fn new(cfg: CommissioningConfig, supply_v: f32, ticks_per_s: f32) -> Self {
+        Self {
+            cfg,
+            supply_v,
+            axis: 1,
+            phase: Phase::Low,
+            t0_ticks: None,
+            ticks_per_s,
+            coast_s: 0.0,
+            total_s: 0.0,
+            step_at_s: 0.0,
+            angle_pulses: 0,
+            low_fit: LineFit::default(),
+            high_fit: LineFit::default(),
+            results: [None, None],
+        }
+    }
+
+    /// The axis being identified and the phase.
+    pub fn progress(&self) -> (usize, Phase) {
+        (self.axis, self.phase)
+    }
+
+    /// Results so far.
+    pub fn results(&self) -> [Option<Identified>; 2] {
+        self.results
+    }
+
+    /// An accepted edge on the axis under test at `at_ticks` on the estimator's extended clock,
+    /// carrying `pulses` pulses (more than one if the estimator inferred missing ones).
+    pub fn on_edge(&mut self, at_ticks: u32, pulses: u32, rad_per_pulse: f32) {
+        if self.phase == Phase::Coast || self.phase == Phase::Done {
+            return;
+        }
+        let Some(t0) = self.t0_ticks else { return };
+        let t_s = at_ticks.wrapping_sub(t0) as f32 / self.ticks_per_s;
+        self.angle_pulses += pulses;
+        let angle = self.angle_pulses as f32 * rad_per_pulse;
+        let phase_start = if self.phase == Phase::Low {
+            0.0
+        } else {
+            self.step_at_s
+        };
+        // Second half of the step only: by then the speed is steady.
+        if t_s - phase_start >= 0.5 * self.cfg.step_time_s {
+            match self.phase {
+                Phase::Low => self.low_fit.add(t_s, angle),
+                _ => self.high_fit.add(t_s, angle),
+            }
+        }
+    }
+
+    /// Advances by `dt_s`; `clock_ticks` is the estimator's extended clock now, `stopped` is
+    /// true when both axes' estimators read zero. Returns the duties to apply, or the error that ends the
+    /// routine.
+    pub fn step(
+        &mut self,
+        dt_s: f32,
+        clock_ticks: u32,
+        stopped: bool,
+    ) -> Result<[f32; 2], IdentifyError> {
+        self.total_s += dt_s;
+        if self.total_s > self.cfg.timeout_s {
+            return Err(IdentifyError::Timeout);
+        }
+        let t0 = *self.t0_ticks.get_or_insert(clock_ticks);
+        let t_s = clock_ticks.wrapping_sub(t0) as f32 / self.ticks_per_s;
+        let min_edges = self.cfg.min_fit_edges as u32;
+        let mut duty = 0.0;
+        match self.phase {
+            Phase::Low => {
+                duty = self.cfg.low_duty;
+                if t_s >= self.cfg.step_time_s && self.low_fit.count() >= min_edges {
+                    self.step_at_s = t_s;
+                    self.phase = Phase::High;
+                    duty = self.cfg.high_duty;
+                }
+            }
+            Phase::High => {
+                duty = self.cfg.high_duty;
+                if t_s - self.step_at_s >= self.cfg.step_time_s
+                    && self.high_fit.count() >= min_edges
+                {
+                    self.results[self.axis] = Some(self.identify()?);
+                    self.phase = Phase::Coast;
+                    self.coast_s = 0.0;
+                    duty = 0.0;
+                }
+            }
+            Phase::Coast => {
+                self.coast_s += dt_s;
+                if stopped && self.coast_s > 0.05 {
+                    if self.axis == 1 {
+                        self.axis = 0;
+                        self.phase = Phase::Low;
+                        self.t0_ticks = None;
+                        self.total_s = 0.0;
+                        self.angle_pulses = 0;
+                        self.low_fit = LineFit::default();
+                        self.high_fit = LineFit::default();
+                    } else {
+                        self.phase = Phase::Done;
+                    }
+                }
+            }
+            Phase::Done => {}
+        }
+        let mut duties = [0.0; 2];
+        duties[self.axis] = duty;
+        Ok(duties)
+    }
+
+    fn identify(&self) -> Result<Identified, IdentifyError> {
+        let (b_l, w_l) = self.low_fit.solve().ok_or(IdentifyError::TooFewEdges)?;
+        let (b_h, w_h) = self.high_fit.solve().ok_or(IdentifyError::TooFewEdges)?;
+        if !(w_h > w_l * 1.05) || !(w_l > 0.0) {
+            return Err(IdentifyError::NoSpeedIncrease);
+        }
+        let v = self.supply_v;
+        let (d_l, d_h) = (self.cfg.low_duty, self.cfg.high_duty);
+        let a = v * (d_h - d_l) / (w_h - w_l);
+        let mut friction_duty = d_l - a * w_l / v;
+        // A slightly negative offset is fit noise around zero friction.
+        if friction_duty < 0.0 && friction_duty > -0.02 {
+            friction_duty = 0.0;
+        }
+        let t_s = self.step_at_s;
+        let mut tau = ((b_l + w_l * t_s) - (b_h + w_h * t_s)) / (w_h - w_l);
+        // Below a millisecond the estimate is noise; the loop design only needs its order.
+        if tau < 1e-3 && tau > -0.02 {
+            tau = 1e-3;
+        }
+        let model = MotorModel {
+            volts_per_rad_s: a,
+            friction_duty,
+            time_constant_s: tau,
+        };
+        model
+            .validate(self.axis as u8)
+            .map_err(|_| IdentifyError::Implausible)?;
+        Ok(Identified {
+            model,
+            low_speed_rad_s: w_l,
+            high_speed_rad_s: w_h,
+        })
+    }
+}

@@ -1,0 +1,624 @@
+//! The top-level controller: both axes, the supervisor, the planner and commissioning.
+
+use super::commission::{Commissioning, Identified, IdentifyError, Phase};
+use super::config::{ConfigError, ControllerConfig, in_range};
+use super::estimator::PulseSpeedEstimator;
+use super::pi::{LoopConstants, LoopInput, SpeedLoop};
+use super::planner::{
+    BowlSpeedForResidence, InverseFailure, ResidenceForBowlSpeed, SetpointPlanner, split_combined,
+};
+use super::supervisor::{Fault, SensorWatch, State, fault_code};
+use crate::bowl::{BowlGeometry, MotorSpeeds};
+
+/// Why a command was refused. A refused command changes nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Rejection {
+    /// A value was NaN or infinite.
+    NotFinite,
+    /// A speed's magnitude is above this axis's `max_speed_rad_s` (0 = precession, 1 = spin).
+    AboveMaxSpeed(u8),
+    /// A nonzero speed's magnitude is below this axis's `min_speed_rad_s`, the lowest speed the
+    /// pulse sensor can hold (zero itself is accepted).
+    BelowMinSpeed(u8),
+    /// The target residence time is not a positive, finite number of seconds.
+    InvalidResidenceTime,
+    /// The particle model's inverse gave no bowl speed for the target residence time.
+    Inverse(InverseFailure),
+    /// Eq. 2 could not split the bowl speed at the configured ratio.
+    SplitFailed,
+    /// The command is not allowed in this state.
+    WrongState(State),
+    /// A fault is latched: clear it first.
+    Faulted(Fault),
+    /// `clear_fault` was sent with no fault latched.
+    NotFaulted,
+    /// The parameters failed validation (the configuration error says which).
+    InvalidConfig(ConfigError),
+    /// Loop tuning values out of range (bandwidth in (0.01, 1000] rad/s, per-pulse bandwidth
+    /// in (0.01, 10]).
+    InvalidTuning,
+}
+
+/// Per-axis part of the status snapshot.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AxisStatus {
+    /// Commanded target, rad/s (signed).
+    pub target_rad_s: f32,
+    /// Ramped reference the loop follows now, rad/s.
+    pub reference_rad_s: f32,
+    /// Measured speed with the commanded sign, rad/s.
+    pub measured_rad_s: f32,
+    /// Duty applied, -1..=1 (0 = bridge coasting).
+    pub duty: f32,
+    /// Edges accepted since start (wrapping).
+    pub pulses: u32,
+    /// Edges rejected as bounces.
+    pub rejected_edges: u32,
+    /// Pulses inferred as missing.
+    pub inferred_missing: u32,
+    /// The estimator has a valid measurement.
+    pub measurement_valid: bool,
+}
+
+/// A snapshot of the controller for telemetry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Status {
+    /// Operating state.
+    pub state: State,
+    /// Latched fault, if any.
+    pub fault: Option<Fault>,
+    /// Fault code (0 = none), see [`Fault::code`].
+    pub fault_code: u8,
+    /// Per axis, indexed by `PRECESSION` and `SPIN`.
+    pub axes: [AxisStatus; 2],
+    /// Combined bowl speed of the targets (Eq. 2), rad/s.
+    pub combined_target_rad_s: f32,
+    /// Combined bowl speed of the measured speeds (Eq. 2), rad/s.
+    pub combined_measured_rad_s: f32,
+}
+
+/// The rig's controller. See the module docs of [`crate::control`] for the contract.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Controller {
+    cfg: ControllerConfig,
+    dt_s: f32,
+    est: [PulseSpeedEstimator; 2],
+    k: [LoopConstants; 2],
+    loops: [SpeedLoop; 2],
+    watch: [SensorWatch; 2],
+    planner: SetpointPlanner,
+    max_step: [f32; 2],
+    state: State,
+    fault: Option<Fault>,
+    config_error: Option<ConfigError>,
+    host_silence_s: f32,
+    duties: [f32; 2],
+    measured: [f32; 2],
+    direction: [f32; 2],
+    commissioning: Option<Commissioning>,
+    identified: [Option<Identified>; 2],
+    identify_error: Option<IdentifyError>,
+    feedback: bool,
+}
+
+impl Controller {
+    /// A controller in [`State::Idle`] for a configuration that passes validation.
+    pub fn new(cfg: ControllerConfig) -> Result<Self, ConfigError> {
+        cfg.validate()?;
+        Ok(Self::build(cfg))
+    }
+
+    /// Like [`Controller::new`], but an invalid configuration gives a controller running the
+    /// nominal configuration with [`Fault::InvalidConfiguration`] latched; the fault cannot be
+    /// cleared until [`Controller::set_parameters`] succeeds. For firmware that must boot.
+    pub fn new_or_faulted(cfg: ControllerConfig) -> Self {
+        match cfg.validate() {
+            Ok(()) => Self::build(cfg),
+            Err(e) => {
+                let mut c = Self::build(ControllerConfig::nominal());
+                c.config_error = Some(e);
+                c.latch(Fault::InvalidConfiguration);
+                c
+            }
+        }
+    }
+
+    fn build(cfg: ControllerConfig) -> Self {
+        let dt_s = 1.0 / cfg.tick_hz as f32;
+        let [a0, a1] = cfg.axes;
+        Self {
+            cfg,
+            dt_s,
+            est: [
+                PulseSpeedEstimator::new(&cfg, &a0),
+                PulseSpeedEstimator::new(&cfg, &a1),
+            ],
+            k: [
+                LoopConstants::new(&a0, dt_s, cfg.supply_v),
+                LoopConstants::new(&a1, dt_s, cfg.supply_v),
+            ],
+            loops: [SpeedLoop::default(); 2],
+            watch: [SensorWatch::default(); 2],
+            planner: SetpointPlanner::default(),
+            max_step: [a0.accel_limit_rad_s2 * dt_s, a1.accel_limit_rad_s2 * dt_s],
+            state: State::Idle,
+            fault: None,
+            config_error: None,
+            host_silence_s: 0.0,
+            duties: [0.0; 2],
+            measured: [0.0; 2],
+            direction: [1.0; 2],
+            commissioning: None,
+            identified: [None; 2],
+            identify_error: None,
+            feedback: true,
+        }
+    }
+
+    /// One control tick, called at exactly `tick_hz`.
+    ///
+    /// `now_ticks` is the capture timer read *after* collecting `edges`; `edges[axis]` holds
+    /// the timestamps captured on that axis since the previous tick, oldest first. Returns the
+    /// duties `[precession, spin]` in -1..=1 (sign = direction; 0 = coast).
+    pub fn tick(&mut self, now_ticks: u32, edges: [&[u32]; 2]) -> [f32; 2] {
+        let dt = self.dt_s;
+        let steady = self.planner.steady_s();
+        let mut seen = [false; 2];
+        let comm_axis = match &self.commissioning {
+            Some(c) => c.progress().0,
+            None => 2,
+        };
+        for i in 0..2 {
+            let steady_i = steady[i] > 0.5;
+            let rad_per_pulse = self.est[i].rad_per_pulse();
+            let comm = if i == comm_axis {
+                self.commissioning.as_mut()
+            } else {
+                None
+            };
+            let mut comm = comm;
+            let seen_i = &mut seen[i];
+            let speed = self.est[i].tick(now_ticks, edges[i], steady_i, |at, pulses| {
+                *seen_i = true;
+                if let Some(c) = comm.as_deref_mut() {
+                    c.on_edge(at, pulses, rad_per_pulse);
+                }
+            });
+            self.measured[i] = self.direction[i] * speed;
+            if speed > self.cfg.axes[i].overspeed_rad_s {
+                self.latch(Fault::Overspeed(i as u8));
+            }
+        }
+
+        match self.state {
+            State::Idle | State::Fault => self.duties = [0.0; 2],
+            State::Commissioning => self.commission_step(dt, &seen),
+            State::SpinningUp | State::Running | State::Stopping => {
+                self.closed_loop_step(dt, &seen)
+            }
+        }
+
+        let driving = !matches!(self.state, State::Idle | State::Fault);
+        if driving && self.cfg.host_timeout_s > 0.0 {
+            self.host_silence_s += dt;
+            if self.host_silence_s > self.cfg.host_timeout_s {
+                self.latch(Fault::HostSilent);
+            }
+        }
+        if self.fault.is_some() {
+            self.duties = [0.0; 2];
+        }
+        self.duties
+    }
+
+    fn closed_loop_step(&mut self, dt: f32, seen: &[bool; 2]) {
+        let stopped = [self.est[0].is_stopped(), self.est[1].is_stopped()];
+        let r0 = self.planner.ramped()[0];
+        let established =
+            self.est[0].is_valid() && self.measured[0].abs() >= 0.5 * r0.abs() && r0 != 0.0;
+        let ramped = self.planner.step(dt, self.max_step, stopped, established);
+        for i in 0..2 {
+            if ramped[i] > 0.0 {
+                self.direction[i] = 1.0;
+            } else if ramped[i] < 0.0 {
+                self.direction[i] = -1.0;
+            }
+            let input = LoopInput {
+                reference_rad_s: ramped[i],
+                measured_rad_s: self.measured[i],
+                measurement_valid: self.est[i].is_valid(),
+                feedback: self.feedback,
+            };
+            let duty = self.loops[i].step(&self.k[i], input);
+            self.duties[i] = duty;
+            let r_abs = ramped[i].abs();
+            let expected_period_s = if r_abs > 0.0 {
+                self.est[i].rad_per_pulse() / r_abs
+            } else {
+                f32::MAX
+            };
+            if self.watch[i].step(
+                dt,
+                duty.abs(),
+                self.cfg.stall_duty,
+                seen[i],
+                self.cfg.sensor_timeout_floor_s,
+                expected_period_s,
+            ) {
+                self.latch(Fault::SensorLostOrStall(i as u8));
+                return;
+            }
+        }
+        let target = self.planner.targets();
+        match self.state {
+            State::Stopping => {
+                if ramped == [0.0; 2] && stopped == [true; 2] {
+                    self.state = State::Idle;
+                }
+            }
+            _ => {
+                let reached = (0..2).all(|i| {
+                    ramped[i] == target[i]
+                        && (self.measured[i] - ramped[i]).abs() <= 0.05 * ramped[i].abs() + 0.05
+                });
+                self.state = if reached {
+                    State::Running
+                } else {
+                    State::SpinningUp
+                };
+            }
+        }
+    }
+
+    fn commission_step(&mut self, dt: f32, seen: &[bool; 2]) {
+        let Some(c) = self.commissioning.as_mut() else {
+            self.state = State::Idle;
+            return;
+        };
+        let axis = c.progress().0;
+        let clock = self.est[axis].clock_ticks();
+        match c.step(
+            dt,
+            clock,
+            self.est[0].is_stopped() && self.est[1].is_stopped(),
+        ) {
+            Err(e) => {
+                self.identify_error = Some(e);
+                self.commissioning = None;
+                self.latch(Fault::InvalidConfiguration);
+            }
+            Ok(duties) => {
+                self.duties = duties;
+                if c.progress().1 == Phase::Done {
+                    let results = c.results();
+                    self.commissioning = None;
+                    self.identified = results;
+                    let mut cfg = self.cfg;
+                    for (i, r) in results.iter().enumerate() {
+                        if let Some(r) = r {
+                            cfg.axes[i].model = r.model;
+                        }
+                    }
+                    match cfg.validate() {
+                        Ok(()) => {
+                            self.rebuild_keep_state(cfg);
+                            self.state = State::Idle;
+                        }
+                        Err(e) => {
+                            self.config_error = Some(e);
+                            self.latch(Fault::InvalidConfiguration);
+                        }
+                    }
+                    return;
+                }
+                // Blocked shaft or dead sensor during identification: the expected period is
+                // unknown, so allow 3 periods at the lowest speed.
+                for i in 0..2 {
+                    let slow_period =
+                        self.est[i].rad_per_pulse() / self.cfg.axes[i].min_speed_rad_s;
+                    if self.watch[i].step(
+                        dt,
+                        self.duties[i].abs(),
+                        self.cfg.stall_duty,
+                        seen[i],
+                        self.cfg.sensor_timeout_floor_s,
+                        slow_period,
+                    ) {
+                        self.latch(Fault::SensorLostOrStall(i as u8));
+                        return;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Replaces the configuration, keeping the estimators' clocks.
+    fn rebuild_keep_state(&mut self, cfg: ControllerConfig) {
+        let est = self.est;
+        let identified = self.identified;
+        let feedback = self.feedback;
+        *self = Self::build(cfg);
+        self.est = est;
+        self.identified = identified;
+        self.feedback = feedback;
+    }
+
+    fn latch(&mut self, fault: Fault) {
+        if self.fault.is_none() {
+            self.fault = Some(fault);
+        }
+        self.state = State::Fault;
+        self.duties = [0.0; 2];
+        self.loops = [SpeedLoop::default(); 2];
+        self.watch = [SensorWatch::default(); 2];
+        self.planner.reset();
+        self.commissioning = None;
+    }
+
+    fn check_speed(&self, axis: usize, w: f32) -> Result<(), Rejection> {
+        if !w.is_finite() {
+            return Err(Rejection::NotFinite);
+        }
+        let a = &self.cfg.axes[axis];
+        let m = w.abs();
+        if m > a.max_speed_rad_s {
+            return Err(Rejection::AboveMaxSpeed(axis as u8));
+        }
+        if m != 0.0 && m < a.min_speed_rad_s {
+            return Err(Rejection::BelowMinSpeed(axis as u8));
+        }
+        Ok(())
+    }
+
+    fn check_state_for_setpoint(&self) -> Result<(), Rejection> {
+        match self.state {
+            State::Fault => Err(Rejection::Faulted(
+                self.fault.unwrap_or(Fault::InvalidConfiguration),
+            )),
+            State::Commissioning | State::Stopping => Err(Rejection::WrongState(self.state)),
+            _ => Ok(()),
+        }
+    }
+
+    /// Sets both motor speeds, rad/s (signed; sign = direction). Zero, or a magnitude within
+    /// `[min_speed_rad_s, max_speed_rad_s]` of the axis. Allowed in Idle (taken at `start`),
+    /// SpinningUp and Running; the planner ramps to it.
+    pub fn set_motor_speeds(
+        &mut self,
+        precession_rad_s: f32,
+        spin_rad_s: f32,
+    ) -> Result<(), Rejection> {
+        self.host_silence_s = 0.0;
+        self.check_state_for_setpoint()?;
+        self.check_speed(0, precession_rad_s)?;
+        self.check_speed(1, spin_rad_s)?;
+        self.planner.set_targets([precession_rad_s, spin_rad_s]);
+        Ok(())
+    }
+
+    /// Sets the motor speeds from a target residence time, s: the particle model's inverse
+    /// gives the combined bowl speed, Eq. 2 splits it at `spin_per_precession`, and the result
+    /// must pass the same checks as [`Controller::set_motor_speeds`]. Returns the speeds set.
+    pub fn set_target_residence_time(
+        &mut self,
+        target_s: f32,
+        model: &dyn BowlSpeedForResidence,
+    ) -> Result<[f32; 2], Rejection> {
+        self.host_silence_s = 0.0;
+        self.check_state_for_setpoint()?;
+        if !in_range(target_s, 1e-6, 1e6) {
+            return Err(Rejection::InvalidResidenceTime);
+        }
+        let omega = model.omega_rad_s(target_s).map_err(Rejection::Inverse)?;
+        let speeds = split_combined(omega, self.cfg.axes_angle_rad, self.cfg.spin_per_precession)
+            .ok_or(Rejection::SplitFailed)?;
+        self.check_speed(0, speeds[0])?;
+        self.check_speed(1, speeds[1])?;
+        self.planner.set_targets(speeds);
+        Ok(speeds)
+    }
+
+    /// Starts the closed loop (Idle -> SpinningUp) toward the current targets.
+    pub fn start(&mut self) -> Result<(), Rejection> {
+        self.host_silence_s = 0.0;
+        match self.state {
+            State::Idle => {
+                self.loops = [SpeedLoop::default(); 2];
+                self.watch = [SensorWatch::default(); 2];
+                self.state = State::SpinningUp;
+                Ok(())
+            }
+            State::Fault => Err(Rejection::Faulted(
+                self.fault.unwrap_or(Fault::InvalidConfiguration),
+            )),
+            s => Err(Rejection::WrongState(s)),
+        }
+    }
+
+    /// Stops: ramps both axes to zero (Stopping, then Idle once both read zero). Aborts
+    /// commissioning at once (zero duty). In Idle or Fault it does nothing and succeeds.
+    pub fn stop(&mut self) -> Result<(), Rejection> {
+        self.host_silence_s = 0.0;
+        match self.state {
+            State::SpinningUp | State::Running => {
+                self.planner.set_targets([0.0; 2]);
+                self.state = State::Stopping;
+            }
+            State::Commissioning => {
+                self.commissioning = None;
+                self.duties = [0.0; 2];
+                self.state = State::Idle;
+            }
+            State::Idle | State::Stopping | State::Fault => {}
+        }
+        Ok(())
+    }
+
+    /// Clears a latched fault (Fault -> Idle, targets zero). Refused while the configuration
+    /// is invalid.
+    pub fn clear_fault(&mut self) -> Result<(), Rejection> {
+        self.host_silence_s = 0.0;
+        if self.state != State::Fault {
+            return Err(Rejection::NotFaulted);
+        }
+        if let Some(e) = self.config_error {
+            return Err(Rejection::InvalidConfig(e));
+        }
+        self.fault = None;
+        self.state = State::Idle;
+        self.planner.reset();
+        Ok(())
+    }
+
+    /// Replaces all parameters (Idle or Fault only). A valid configuration also lifts the
+    /// block on clearing an invalid-configuration fault (the fault stays latched until cleared).
+    pub fn set_parameters(&mut self, cfg: ControllerConfig) -> Result<(), Rejection> {
+        self.host_silence_s = 0.0;
+        if !matches!(self.state, State::Idle | State::Fault) {
+            return Err(Rejection::WrongState(self.state));
+        }
+        cfg.validate().map_err(Rejection::InvalidConfig)?;
+        let (state, fault) = (self.state, self.fault);
+        self.rebuild_keep_state(cfg);
+        self.state = state;
+        self.fault = fault;
+        Ok(())
+    }
+
+    /// Changes one axis's loop bandwidth and per-pulse bandwidth while running (bumpless: the
+    /// integral absorbs the proportional change). Refused during commissioning.
+    pub fn set_loop_tuning(
+        &mut self,
+        axis: usize,
+        bandwidth_rad_s: f32,
+        per_pulse_bandwidth: f32,
+    ) -> Result<(), Rejection> {
+        self.host_silence_s = 0.0;
+        if self.state == State::Commissioning {
+            return Err(Rejection::WrongState(self.state));
+        }
+        if axis > 1
+            || !in_range(bandwidth_rad_s, 0.01, 1000.0)
+            || !in_range(per_pulse_bandwidth, 0.01, 10.0)
+        {
+            return Err(Rejection::InvalidTuning);
+        }
+        let mut a = self.cfg.axes[axis];
+        a.bandwidth_rad_s = bandwidth_rad_s;
+        a.per_pulse_bandwidth = per_pulse_bandwidth;
+        self.cfg.axes[axis] = a;
+        self.k[axis] = LoopConstants::new(&a, self.dt_s, self.cfg.supply_v);
+        Ok(())
+    }
+
+    /// Starts the identification routine (Idle only); at the end the identified models
+    /// replace the configured ones and the state returns to Idle, or an implausible result
+    /// latches [`Fault::InvalidConfiguration`].
+    pub fn start_commissioning(&mut self) -> Result<(), Rejection> {
+        self.host_silence_s = 0.0;
+        match self.state {
+            State::Idle => {
+                self.commissioning = Some(Commissioning::new(
+                    self.cfg.commissioning,
+                    self.cfg.supply_v,
+                    self.cfg.timer_hz as f32,
+                ));
+                self.identify_error = None;
+                self.watch = [SensorWatch::default(); 2];
+                self.state = State::Commissioning;
+                Ok(())
+            }
+            State::Fault => Err(Rejection::Faulted(
+                self.fault.unwrap_or(Fault::InvalidConfiguration),
+            )),
+            s => Err(Rejection::WrongState(s)),
+        }
+    }
+
+    /// Resets the host-silence timer (any command does too).
+    pub fn host_heartbeat(&mut self) {
+        self.host_silence_s = 0.0;
+    }
+
+    /// Feedback on or off (diagnostics and the test that shows the feedforward alone is not
+    /// enough). On by default.
+    pub fn set_feedback_enabled(&mut self, on: bool) {
+        self.feedback = on;
+    }
+
+    /// Operating state.
+    pub fn state(&self) -> State {
+        self.state
+    }
+
+    /// Latched fault, if any.
+    pub fn fault(&self) -> Option<Fault> {
+        self.fault
+    }
+
+    /// The configuration in force (with identified models after commissioning).
+    pub fn config(&self) -> &ControllerConfig {
+        &self.cfg
+    }
+
+    /// Results of the last commissioning run, per axis.
+    pub fn identified(&self) -> [Option<Identified>; 2] {
+        self.identified
+    }
+
+    /// Why the last commissioning run failed, if it did.
+    pub fn identify_error(&self) -> Option<IdentifyError> {
+        self.identify_error
+    }
+
+    /// Status snapshot for telemetry (computes Eq. 2; call at telemetry rate, not per tick).
+    pub fn status(&self) -> Status {
+        let targets = self.planner.targets();
+        let ramped = self.planner.ramped();
+        let mut axes = [AxisStatus::default(); 2];
+        for (i, a) in axes.iter_mut().enumerate() {
+            *a = AxisStatus {
+                target_rad_s: targets[i],
+                reference_rad_s: ramped[i],
+                measured_rad_s: self.measured[i],
+                duty: self.duties[i],
+                pulses: self.est[i].accepted_edges(),
+                rejected_edges: self.est[i].rejected_edges(),
+                inferred_missing: self.est[i].inferred_missing(),
+                measurement_valid: self.est[i].is_valid(),
+            };
+        }
+        let g = BowlGeometry {
+            axes_angle_rad: self.cfg.axes_angle_rad,
+        };
+        let combined = |w: [f32; 2]| {
+            g.combined_speed_rad_s(MotorSpeeds {
+                precession_rad_s: w[0],
+                spin_rad_s: w[1],
+            })
+            .unwrap_or(0.0)
+        };
+        Status {
+            state: self.state,
+            fault: self.fault,
+            fault_code: fault_code(self.fault),
+            axes,
+            combined_target_rad_s: combined(targets),
+            combined_measured_rad_s: combined(self.measured),
+        }
+    }
+
+    /// Predicted residence time at the measured combined bowl speed, s, from a forward particle
+    /// model (flat or Coriolis). For telemetry: call at the telemetry rate, never per tick.
+    pub fn predicted_residence_time_s(&self, model: &dyn ResidenceForBowlSpeed) -> Option<f32> {
+        let w = self.status().combined_measured_rad_s;
+        if w > 0.0 {
+            model.residence_time_s(w)
+        } else {
+            None
+        }
+    }
+}

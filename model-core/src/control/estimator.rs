@@ -1,0 +1,275 @@
+//! Shaft speed from proximity-sensor edges.
+//!
+//! # Inputs
+//! Edge timestamps come from a free-running capture timer (`timer_hz`, 16 or 32 bits, wrapping).
+//! Once per control tick the estimator gets the timer's current value and the edges captured
+//! since the previous tick. It keeps an *extended clock* (a `u32` tick count that never wraps
+//! within a pulse period) by adding the wrapped difference between consecutive ticks, so a
+//! 16-bit timer at 1 MHz (wrapping every 65 ms) still measures a pulse period of seconds. This
+//! needs at least one tick per timer wrap, which the configuration check guarantees.
+//!
+//! # Method (M/T: period at low speed, counting at high speed)
+//! Every accepted edge adds its pulses to a counting window. When the window spans at least
+//! [`WINDOW_S`], the raw speed is `pulses * pitch / (time from the window's first to last edge)`
+//! and a new window starts at that edge. At low speed one pulse interval is longer than the window,
+//! so this is a period measurement; at high speed several pulses fall in the window, so it is a
+//! count over a window whose ends are exact edge times (no +/-1 count quantisation). The raw
+//! speed goes through an exponential filter with the configured weight.
+//!
+//! # Stall bound
+//! Between edges the shaft has turned less than one pitch since the last edge, so the speed is at
+//! most `pitch / time since the last edge`. Once that bound is below the filtered value, it is
+//! the estimate: a stopping shaft reads a falling speed, and after one pitch at the configured
+//! minimum speed without an edge it reads exactly zero and the estimator starts afresh.
+//!
+//! # Bounce and missing pulses
+//! An edge closer to the previous accepted edge than half the pulse period at the over-speed
+//! limit, or than 40 % of the current filtered period, is a bounce and is ignored (counted in
+//! [`PulseSpeedEstimator::rejected_edges`]). When the caller says the speed is steady, an
+//! interval of about 2 or 3 filtered periods (within 0.3 of the integer) is taken as that many
+//! pulses with the middle ones missing (counted in [`PulseSpeedEstimator::inferred_missing`]).
+//!
+//! # Direction
+//! One proximity sensor cannot tell the direction of rotation: the estimate is a magnitude.
+//! The controller gives it the sign of the commanded (ramped) direction, and the planner only
+//! reverses once this estimator reads zero.
+
+use super::config::{AxisConfig, ControllerConfig};
+
+/// Shortest counting window, s: at high pulse rates a raw sample averages over at least this.
+pub const WINDOW_S: f32 = 0.025;
+
+/// Speed estimator of one axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PulseSpeedEstimator {
+    mask: u32,
+    rad_per_pulse: f32,
+    ticks_per_s: f32,
+    lockout_ticks: u32,
+    window_ticks: u32,
+    stall_ticks: u32,
+    filter_weight: f32,
+
+    started: bool,
+    prev_now: u32,
+    clock: u32,
+    has_edge: bool,
+    last_edge: u32,
+    last_interval: u32,
+    win_start: u32,
+    win_pulses: u32,
+    valid: bool,
+    period_ticks: f32,
+    speed_filt: f32,
+    speed: f32,
+    updated: bool,
+    accepted: u32,
+    rejected: u32,
+    missing: u32,
+    late_edges: u32,
+}
+
+impl PulseSpeedEstimator {
+    /// An estimator for `axis` of a validated configuration.
+    pub fn new(cfg: &ControllerConfig, axis: &AxisConfig) -> Self {
+        let ticks_per_s = cfg.timer_hz as f32;
+        let rad_per_pulse = core::f32::consts::TAU / axis.pulses_per_rev as f32;
+        let min_period_s = rad_per_pulse / axis.overspeed_rad_s;
+        let stall_s = rad_per_pulse / axis.min_speed_rad_s;
+        Self {
+            mask: cfg.timer_mask(),
+            rad_per_pulse,
+            ticks_per_s,
+            lockout_ticks: (0.5 * min_period_s * ticks_per_s) as u32,
+            window_ticks: (WINDOW_S * ticks_per_s) as u32,
+            stall_ticks: (stall_s * ticks_per_s).min(4.0e9) as u32,
+            filter_weight: axis.filter_weight,
+            started: false,
+            prev_now: 0,
+            clock: 0,
+            has_edge: false,
+            last_edge: 0,
+            last_interval: 0,
+            win_start: 0,
+            win_pulses: 0,
+            valid: false,
+            period_ticks: 0.0,
+            speed_filt: 0.0,
+            speed: 0.0,
+            updated: false,
+            accepted: 0,
+            rejected: 0,
+            missing: 0,
+            late_edges: 0,
+        }
+    }
+
+    /// One control tick: `now` is the capture timer's value read *after* the edges were
+    /// collected, `edges` the timestamps captured since the previous tick, oldest first.
+    /// `steady` allows the missing-pulse inference (the reference has not changed lately).
+    /// `on_edge(extended_ticks, pulses)` is called for each accepted edge.
+    ///
+    /// Returns the speed magnitude, rad/s.
+    #[inline]
+    pub fn tick(
+        &mut self,
+        now: u32,
+        edges: &[u32],
+        steady: bool,
+        mut on_edge: impl FnMut(u32, u32),
+    ) -> f32 {
+        if !self.started {
+            self.started = true;
+            self.prev_now = now;
+        }
+        let span = now.wrapping_sub(self.prev_now) & self.mask;
+        self.updated = false;
+        for &t in edges {
+            let mut offset = t.wrapping_sub(self.prev_now) & self.mask;
+            if offset > span {
+                // Captured after `now` was read (a race in the caller) or stale: place it at
+                // `now`, count it, never lose it.
+                offset = span;
+                self.late_edges = self.late_edges.wrapping_add(1);
+            }
+            let at = self.clock.wrapping_add(offset);
+            if let Some(pulses) = self.edge(at, steady) {
+                on_edge(at, pulses);
+            }
+        }
+        self.clock = self.clock.wrapping_add(span);
+        self.prev_now = now;
+        self.speed = self.bounded_speed();
+        self.speed
+    }
+
+    fn edge(&mut self, at: u32, steady: bool) -> Option<u32> {
+        if !self.has_edge {
+            self.has_edge = true;
+            self.last_edge = at;
+            self.win_start = at;
+            self.win_pulses = 0;
+            self.accepted = self.accepted.wrapping_add(1);
+            return Some(1);
+        }
+        let dt = at.wrapping_sub(self.last_edge);
+        let relative_lockout = if self.valid {
+            0.4 * self.period_ticks
+        } else {
+            0.0
+        };
+        if dt < self.lockout_ticks || (dt as f32) < relative_lockout {
+            self.rejected = self.rejected.wrapping_add(1);
+            return None;
+        }
+        let mut pulses = 1u32;
+        if steady && self.valid {
+            let ratio = dt as f32 / self.period_ticks;
+            if ratio > 1.6 && ratio < 3.4 {
+                let k = (ratio + 0.5) as u32;
+                let off = ratio - k as f32;
+                if off > -0.3 && off < 0.3 {
+                    pulses = k;
+                    self.missing = self.missing.wrapping_add(k - 1);
+                }
+            }
+        }
+        self.accepted = self.accepted.wrapping_add(1);
+        self.last_edge = at;
+        self.last_interval = dt / pulses;
+        self.win_pulses += pulses;
+        let wspan = at.wrapping_sub(self.win_start);
+        if wspan >= self.window_ticks {
+            let period = wspan as f32 / self.win_pulses as f32;
+            let raw = self.rad_per_pulse * self.ticks_per_s / period;
+            if self.valid {
+                let w = self.filter_weight;
+                self.speed_filt += w * (raw - self.speed_filt);
+                self.period_ticks += w * (period - self.period_ticks);
+            } else {
+                self.speed_filt = raw;
+                self.period_ticks = period;
+                self.valid = true;
+            }
+            self.updated = true;
+            self.win_start = at;
+            self.win_pulses = 0;
+        }
+        Some(pulses)
+    }
+
+    fn bounded_speed(&mut self) -> f32 {
+        if !self.has_edge {
+            return 0.0;
+        }
+        let since = self.clock.wrapping_sub(self.last_edge);
+        if since > self.stall_ticks {
+            // Stopped (or slower than the minimum speed): forget the old reference edge so the
+            // next edge starts a fresh measurement instead of a bogus long period.
+            self.has_edge = false;
+            self.valid = false;
+            self.speed_filt = 0.0;
+            self.period_ticks = 0.0;
+            return 0.0;
+        }
+        if !self.valid {
+            return 0.0;
+        }
+        if since > self.last_interval && since > 0 {
+            let bound = self.rad_per_pulse * self.ticks_per_s / since as f32;
+            if bound < self.speed_filt {
+                return bound;
+            }
+        }
+        self.speed_filt
+    }
+
+    /// The last estimate, rad/s (magnitude).
+    pub fn speed_rad_s(&self) -> f32 {
+        self.speed
+    }
+    /// True once at least one pulse interval has been measured since the shaft last stopped.
+    pub fn is_valid(&self) -> bool {
+        self.valid
+    }
+    /// True if the last tick produced a new raw sample.
+    pub fn updated(&self) -> bool {
+        self.updated
+    }
+    /// True when the estimate is exactly zero (stopped or never moved).
+    pub fn is_stopped(&self) -> bool {
+        self.speed == 0.0
+    }
+    /// Seconds since the last accepted edge (0 if none since the last stop).
+    pub fn since_edge_s(&self) -> f32 {
+        if self.has_edge {
+            self.clock.wrapping_sub(self.last_edge) as f32 / self.ticks_per_s
+        } else {
+            0.0
+        }
+    }
+    /// Edges accepted so far (wrapping counter).
+    pub fn accepted_edges(&self) -> u32 {
+        self.accepted
+    }
+    /// Edges rejected as bounces so far.
+    pub fn rejected_edges(&self) -> u32 {
+        self.rejected
+    }
+    /// Pulses inferred as missing so far.
+    pub fn inferred_missing(&self) -> u32 {
+        self.missing
+    }
+    /// Edges whose timestamp was after the tick's `now` (placed at `now`).
+    pub fn late_edges(&self) -> u32 {
+        self.late_edges
+    }
+    /// Radians per pulse.
+    pub fn rad_per_pulse(&self) -> f32 {
+        self.rad_per_pulse
+    }
+    /// Extended clock at the last tick, timer ticks (wrapping).
+    pub fn clock_ticks(&self) -> u32 {
+        self.clock
+    }
+}

@@ -1,0 +1,135 @@
+//! Setpoints: motor speeds asked for directly, or a target residence time turned into motor
+//! speeds through the particle model's inverse and paper Eq. 2; then ramps.
+//!
+//! The residence-time inverse is behind [`BowlSpeedForResidence`] so the controller does not
+//! depend on which particle model (flat Eq. 6/7 or Coriolis Eq. 10/11, with the MODEL-NOTES
+//! corrections) or which scene (bowl radius, start radius, resistance coefficient) is in use:
+//! the caller passes the model in with the command.
+
+use crate::bowl::BowlGeometry;
+
+/// Why the particle model's inverse gave no bowl speed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum InverseFailure {
+    /// No bowl speed gives this residence time in this scene (for example, the particle never
+    /// leaves, or the time is shorter than the fastest allowed speed gives).
+    Unreachable,
+    /// The model rejected its inputs (scene or target invalid).
+    ModelRejected,
+}
+
+/// The particle model's inverse: the combined bowl speed that gives a residence time.
+pub trait BowlSpeedForResidence {
+    /// Combined bowl speed (paper Eq. 2's omega), rad/s, for the residence time `target_s`.
+    fn omega_rad_s(&self, target_s: f32) -> Result<f32, InverseFailure>;
+}
+
+/// The particle model's forward direction, used for telemetry's predicted residence time.
+pub trait ResidenceForBowlSpeed {
+    /// Residence time, s, at combined bowl speed `omega_rad_s`; `None` if the particle never
+    /// leaves (or the model rejects the inputs).
+    fn residence_time_s(&self, omega_rad_s: f32) -> Option<f32>;
+}
+
+/// Combined bowl speed split into motor speeds by Eq. 2 at a fixed spin/precession ratio.
+/// Returns `[precession, spin]`, rad/s, or `None` if the geometry rejects the split.
+pub fn split_combined(
+    omega_rad_s: f32,
+    axes_angle_rad: f32,
+    spin_per_precession: f32,
+) -> Option<[f32; 2]> {
+    let g = BowlGeometry { axes_angle_rad };
+    let s = g.split(omega_rad_s, spin_per_precession).ok()?;
+    Some([s.precession_rad_s, s.spin_rad_s])
+}
+
+/// Ramps both axes' references toward their targets.
+///
+/// Two rules beyond the ramps, both because the sensors cannot see direction:
+/// - A reversal ramps to zero and holds there until the axis's estimator reads zero.
+/// - The spin axis starts ramping only once the precession axis is established (valid
+///   measurement, at least half its ramped reference), if precession is asked to turn at all.
+///   The spin motor rides on the rod: its accelerating torque reacts on the precession axis.
+///   Started together, a lightly loaded precession axis can be dragged *backwards* before its
+///   own motor gets going, and a direction-blind loop would then read that as forward motion.
+///   Started first, the precession motor holds its direction against the reaction.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SetpointPlanner {
+    target: [f32; 2],
+    ramped: [f32; 2],
+    steady_s: [f32; 2],
+    reversing: [bool; 2],
+    spin_released: bool,
+}
+
+impl SetpointPlanner {
+    /// Sets the targets (already validated), rad/s.
+    pub fn set_targets(&mut self, target: [f32; 2]) {
+        self.target = target;
+    }
+
+    /// Targets, rad/s.
+    pub fn targets(&self) -> [f32; 2] {
+        self.target
+    }
+
+    /// Ramped references, rad/s.
+    pub fn ramped(&self) -> [f32; 2] {
+        self.ramped
+    }
+
+    /// Seconds since each axis's ramp last moved.
+    pub fn steady_s(&self) -> [f32; 2] {
+        self.steady_s
+    }
+
+    /// Drops everything to rest at once (fault, abort).
+    pub fn reset(&mut self) {
+        *self = Self::default();
+    }
+
+    /// Advances the ramps by `dt_s`. `max_step` is the largest change per step of each axis,
+    /// `stopped` says whether each axis's estimator reads zero, `precession_established`
+    /// whether the precession axis turns at at least half its ramped reference.
+    #[inline]
+    pub fn step(
+        &mut self,
+        dt_s: f32,
+        max_step: [f32; 2],
+        stopped: [bool; 2],
+        precession_established: bool,
+    ) -> [f32; 2] {
+        if self.ramped[0] == 0.0 {
+            self.spin_released = self.target[0] == 0.0;
+        }
+        if precession_established {
+            self.spin_released = true;
+        }
+        for i in 0..2 {
+            let (t, r) = (self.target[i], self.ramped[i]);
+            let mut next = r + (t - r).clamp(-max_step[i], max_step[i]);
+            if (r > 0.0 && next < 0.0) || (r < 0.0 && next > 0.0) {
+                next = 0.0;
+                self.reversing[i] = true;
+            }
+            if self.reversing[i] {
+                if r == 0.0 && stopped[i] {
+                    self.reversing[i] = false;
+                } else if r == 0.0 {
+                    next = 0.0;
+                }
+            }
+            if i == 1 && r == 0.0 && !self.spin_released {
+                next = 0.0;
+            }
+            if next == r {
+                self.steady_s[i] += dt_s;
+            } else {
+                self.steady_s[i] = 0.0;
+            }
+            self.ramped[i] = next;
+        }
+        self.ramped
+    }
+}

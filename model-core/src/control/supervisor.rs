@@ -1,0 +1,103 @@
+//! Operating states and faults.
+//!
+//! ```text
+//!   Idle --start--> SpinningUp --(both references reached)--> Running
+//!    ^  \                |  ^                                  |
+//!    |   \--commission-->|  '------(new setpoint: ramping)-----'
+//!    |                   v
+//!    '--(both at rest)-- Stopping <--stop-- (SpinningUp | Running)
+//!   any state --fault--> Fault --clear_fault--> Idle
+//! ```
+//! On a fault both duties go to zero in the same tick it is detected, and the bridge *coasts*
+//! (zero duty means both half-bridges off, not shorted): a 150 to 300 mm bowl carrying a load
+//! is not braked hard. A fault latches until [`crate::control::Controller::clear_fault`].
+
+/// Operating state. The numeric value (`as u8`) is what telemetry carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
+pub enum State {
+    /// Motors off (zero duty); setpoints and parameters may be changed.
+    Idle = 0,
+    /// The identification routine drives one axis at a time open loop.
+    Commissioning = 1,
+    /// Closed loop, at least one reference still ramping or not yet reached.
+    SpinningUp = 2,
+    /// Closed loop, both references reached and steady.
+    Running = 3,
+    /// Closed loop, ramping both references down to zero after a stop command.
+    Stopping = 4,
+    /// A fault latched: both duties zero until cleared.
+    Fault = 5,
+}
+
+/// A latched fault. [`Fault::code`] is the number telemetry carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Fault {
+    /// Duty above the stall threshold and no pulse for `max(floor, 3 expected pulse periods)`
+    /// on this axis (0 = precession, 1 = spin): the sensor is dead or the shaft is blocked.
+    /// Without a current measurement the two cannot be told apart.
+    SensorLostOrStall(u8),
+    /// Measured speed above the axis's over-speed limit.
+    Overspeed(u8),
+    /// No command or heartbeat from the host for longer than the configured timeout.
+    HostSilent,
+    /// The configuration is invalid, or commissioning identified an implausible model or timed out.
+    InvalidConfiguration,
+}
+
+impl Fault {
+    /// Telemetry code: 0 means no fault; 1/2 sensor lost or stall on precession/spin,
+    /// 3/4 over-speed on precession/spin, 5 host silent, 6 invalid configuration.
+    pub fn code(self) -> u8 {
+        match self {
+            Fault::SensorLostOrStall(a) => 1 + a.min(1),
+            Fault::Overspeed(a) => 3 + a.min(1),
+            Fault::HostSilent => 5,
+            Fault::InvalidConfiguration => 6,
+        }
+    }
+}
+
+/// Telemetry code of an optional fault (0 = none).
+pub fn fault_code(f: Option<Fault>) -> u8 {
+    f.map_or(0, Fault::code)
+}
+
+/// The sensor-lost watch of one axis: time spent driving above the stall duty without an edge.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SensorWatch {
+    blind_s: f32,
+}
+
+impl SensorWatch {
+    /// Advances the watch; true when the axis must fault.
+    ///
+    /// `expected_period_s` is one pulse period at the current reference speed; the timeout is
+    /// `max(floor_s, 3 * expected_period_s)`.
+    #[inline]
+    pub fn step(
+        &mut self,
+        dt_s: f32,
+        duty_abs: f32,
+        stall_duty: f32,
+        edge_seen: bool,
+        floor_s: f32,
+        expected_period_s: f32,
+    ) -> bool {
+        if edge_seen || duty_abs <= stall_duty {
+            self.blind_s = 0.0;
+            return false;
+        }
+        self.blind_s += dt_s;
+        let three = 3.0 * expected_period_s;
+        let limit = if three > floor_s { three } else { floor_s };
+        self.blind_s > limit
+    }
+
+    /// Clears the watch.
+    pub fn reset(&mut self) {
+        self.blind_s = 0.0;
+    }
+}

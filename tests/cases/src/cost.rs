@@ -1,0 +1,136 @@
+//! Cost points for the work-precision chart (`bowl chart work-precision`): the instructions each
+//! method executes on the Cortex-M4F for each of the chart's named scenes.
+//!
+//! The model's own benchmarks (`particle.rs`) report the worst case over a grid against the
+//! issue's budgets; the chart needs one point per (scene, model, method, setting) instead. The
+//! names are `cost::SCENE::MODEL::METHOD`; `bowl chart work-precision --qemu-log FILE` reads them
+//! back by that name from the QEMU run's output. The scenes are defined here once and used by the
+//! chart too, so the host and the target measure the same inputs.
+
+use crate::check::Bench;
+use model_core::particle::{Model, Scene, residence};
+
+/// Names of the chart's scenes, in the order of [`scene`].
+pub const SCENE_NAMES: [&str; 3] = ["paper", "near-threshold", "near-rim"];
+
+/// Relative distance above the threshold `ri = a (1 + d)` of the "near-threshold" scene:
+/// condition number of T about `1/(d ln x)`, a few thousand.
+pub const NEAR_THRESHOLD_D: f64 = 1e-4;
+/// Relative distance below the rim `ri = R (1 - e)` of the "near-rim" scene, where the naive
+/// `acosh(1 + x)` loses about half the digits.
+pub const NEAR_RIM_E: f64 = 1e-5;
+
+/// The chart's named scenes in f64.
+///
+/// * `paper`: 3.6 rad/s (the paper's top speed, its Fig. 5) in a 150 mm bowl read as a diameter
+///   (rim radius 75 mm), start radius R/2, effective rolling resistance 0.029, g 9.81, k2 5/7.
+/// * `near-threshold`: the same with the start radius just above the equilibrium radius `a`.
+/// * `near-rim`: the same with the start radius just inside the rim.
+///
+/// Out-of-range indices give the `paper` scene.
+pub const fn scene(i: usize) -> Scene<f64> {
+    let paper = Scene {
+        omega_rad_s: 3.6,
+        mu: 0.029,
+        g_m_s2: 9.81,
+        k2: 5.0 / 7.0,
+        ri_m: 0.0375,
+        rim_radius_m: 0.075,
+    };
+    match i {
+        1 => {
+            let a = paper.mu * paper.g_m_s2 / (paper.omega_rad_s * paper.omega_rad_s);
+            Scene {
+                ri_m: a * (1.0 + NEAR_THRESHOLD_D),
+                ..paper
+            }
+        }
+        2 => Scene {
+            ri_m: paper.rim_radius_m * (1.0 - NEAR_RIM_E),
+            ..paper
+        },
+        _ => paper,
+    }
+}
+
+/// The scene rounded to f32, as the target sees it.
+pub const fn scene_f32(i: usize) -> Scene<f32> {
+    let s = scene(i);
+    Scene {
+        omega_rad_s: s.omega_rad_s as f32,
+        mu: s.mu as f32,
+        g_m_s2: s.g_m_s2 as f32,
+        k2: s.k2 as f32,
+        ri_m: s.ri_m as f32,
+        rim_radius_m: s.rim_radius_m as f32,
+    }
+}
+
+const fn model(coriolis: bool) -> Model {
+    if coriolis {
+        Model::Coriolis
+    } else {
+        Model::Flat
+    }
+}
+
+/// The f32 scenes, rounded at compile time: the M4F has no f64 unit, so building them inside
+/// the measured call would add hundreds of soft-float instructions that are not the method's.
+static SCENES_F32: [Scene<f32>; 3] = [scene_f32(0), scene_f32(1), scene_f32(2)];
+
+/// Closed-form residence time in f32 with libm (the model's `Real for f32`).
+fn closed_f32<const S: usize, const CORIOLIS: bool>(_: usize) -> f32 {
+    // black_box: the scene is a compile-time constant and must not be folded into the call.
+    let s = core::hint::black_box(&SCENES_F32[S]);
+    match residence(s, model(CORIOLIS)) {
+        Ok(o) => o.residence_time_s(),
+        Err(_) => f32::NAN,
+    }
+}
+
+/// One closed-form bench per scene and model.
+macro_rules! closed {
+    ($s:literal, $name:literal) => {
+        [
+            Bench {
+                name: concat!("cost::", $name, "::flat::closed-f32-libm"),
+                inputs: 1,
+                run: closed_f32::<$s, false>,
+                budget_instructions: None,
+            },
+            Bench {
+                name: concat!("cost::", $name, "::coriolis::closed-f32-libm"),
+                inputs: 1,
+                run: closed_f32::<$s, true>,
+                budget_instructions: None,
+            },
+        ]
+    };
+}
+
+static CLOSED: [[Bench; 2]; 3] = [
+    closed!(0, "paper"),
+    closed!(1, "near-threshold"),
+    closed!(2, "near-rim"),
+];
+
+/// Benchmarks of this module.
+pub static BENCHES: &[Bench] = CLOSED.as_flattened();
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bench_names_match_the_scene_names() {
+        for (i, pair) in CLOSED.iter().enumerate() {
+            for b in pair {
+                let rest = b
+                    .name
+                    .strip_prefix("cost::")
+                    .and_then(|r| r.strip_prefix(SCENE_NAMES[i]));
+                assert!(rest.is_some_and(|r| r.starts_with("::")), "{}", b.name);
+            }
+        }
+    }
+}

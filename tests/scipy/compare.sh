@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Side by side with scipy: one run makes a Python venv (numpy, scipy from PyPI), has `bowl`
+# measure our integrators (CSV), runs scipy.integrate.solve_ivp (RK45, DOP853) with a terminal
+# event at r = R on the same scenes, and writes docs/charts/scipy-comparison.{md,csv}.
+# Not part of tests/run: it downloads scipy. Usage: tests/scipy/compare.sh [--quick]
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+venv=target/scipy-venv
+if [ ! -x "$venv/bin/python" ]; then
+  python3 -m venv "$venv"
+fi
+"$venv/bin/python" -m pip install --quiet --disable-pip-version-check numpy scipy
+mkdir -p target/scipy
+cargo run --release -q -p host-tools -- chart work-precision --csv-only \
+  --out target/scipy/ours.svg ${1:+--quick}
+"$venv/bin/python" tests/scipy/compare.py target/scipy/ours.csv docs/charts/scipy-comparison
