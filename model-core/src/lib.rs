@@ -11,8 +11,8 @@
 #![warn(missing_docs)]
 
 pub mod bowl;
-pub mod control;
 pub mod choose;
+pub mod control;
 pub mod ode;
 pub mod particle;
 pub mod real;

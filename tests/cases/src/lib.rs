@@ -15,11 +15,18 @@ pub mod control;
 pub mod cost;
 pub mod ode;
 pub mod particle;
+pub mod wire;
 
 pub use check::{Bench, Case, Failure};
 
 /// Every case, grouped by the module it tests.
-pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES, particle::CASES, ode::CASES, control::CASES];
+pub static CASE_GROUPS: &[&[Case]] = &[
+    bowl::CASES,
+    particle::CASES,
+    ode::CASES,
+    control::CASES,
+    wire::CASES,
+];
 
 /// Every benchmark, grouped likewise.
 pub static BENCH_GROUPS: &[&[Bench]] = &[
@@ -28,6 +35,7 @@ pub static BENCH_GROUPS: &[&[Bench]] = &[
     ode::BENCHES,
     cost::BENCHES,
     control::BENCHES,
+    wire::BENCHES,
 ];
 
 /// All cases in one iterator.
