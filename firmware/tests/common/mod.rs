@@ -51,6 +51,11 @@ impl Board {
     /// Boots `elf`; QEMU waits (`server=on,wait=on`) until we have connected to its USART1, so
     /// no byte the board sends is lost.
     pub fn boot(elf: &Path) -> Board {
+        Self::boot_with(elf, &[])
+    }
+
+    /// Boots `elf` with extra QEMU arguments (e.g. `-append seconds=30`).
+    pub fn boot_with(elf: &Path, extra: &[&str]) -> Board {
         let socket_path = std::env::temp_dir().join(format!(
             "bowl-qemu-{}-{}.sock",
             std::process::id(),
@@ -76,6 +81,7 @@ impl Board {
             .args(["-serial", "chardev:usart1"])
             .arg("-kernel")
             .arg(elf)
+            .args(extra)
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
