@@ -15,7 +15,7 @@
 //! A value the controller's validation refuses is rejected with `RANGE` and changes nothing.
 
 use model_core::control::{
-    BowlSpeedForResidence, Controller, ControllerConfig, Fault, InverseFailure,
+    BowlSpeedForResidence, Controller, ControllerConfig, Fault, InverseFailure, MotorModel,
     ResidenceForBowlSpeed, State,
 };
 use model_core::particle::{self, Model, Outcome, Scene};
@@ -117,6 +117,56 @@ pub fn default_params() -> ParamValues {
     v
 }
 
+/// Values persisted in flash: the wire parameters (wire order), then per axis the motor model
+/// in force (identified by commissioning, or nominal): back-EMF constant, friction duty, time
+/// constant, as f32 bit patterns.
+pub const PERSISTED_COUNT: usize = PARAM_COUNT + 3 * AXES;
+/// One persisted record's values.
+pub type Persisted = [i32; PERSISTED_COUNT];
+
+/// Joins parameters and motor models into a record.
+pub fn persisted(params: &ParamValues, models: &[MotorModel; AXES]) -> Persisted {
+    let mut v = [0i32; PERSISTED_COUNT];
+    v[..PARAM_COUNT].copy_from_slice(params);
+    for (i, m) in models.iter().enumerate() {
+        let at = PARAM_COUNT + 3 * i;
+        v[at] = m.volts_per_rad_s.to_bits() as i32;
+        v[at + 1] = m.friction_duty.to_bits() as i32;
+        v[at + 2] = m.time_constant_s.to_bits() as i32;
+    }
+    v
+}
+
+/// Splits a record into parameters and motor models.
+pub fn split_persisted(v: &Persisted) -> (ParamValues, [MotorModel; AXES]) {
+    let mut params = [0i32; PARAM_COUNT];
+    params.copy_from_slice(&v[..PARAM_COUNT]);
+    let f = |k: usize| f32::from_bits(v[k] as u32);
+    let model = |i: usize| {
+        let at = PARAM_COUNT + 3 * i;
+        MotorModel {
+            volts_per_rad_s: f(at),
+            friction_duty: f(at + 1),
+            time_constant_s: f(at + 2),
+        }
+    };
+    (params, [model(0), model(1)])
+}
+
+/// The record a new board starts with: [`default_params`] and the nominal motor models.
+pub fn default_persisted() -> Persisted {
+    let cfg = ControllerConfig::nominal();
+    persisted(&default_params(), &[cfg.axes[0].model, cfg.axes[1].model])
+}
+
+fn with_models(base: &ControllerConfig, models: &[MotorModel; AXES]) -> ControllerConfig {
+    let mut cfg = *base;
+    for (a, m) in cfg.axes.iter_mut().zip(models) {
+        a.model = *m;
+    }
+    cfg
+}
+
 /// Controller configuration and scene for a set of wire parameters, or why they do not fit.
 fn derive(
     base: &ControllerConfig,
@@ -216,23 +266,27 @@ pub struct ControlledRig<I: Injector> {
     hello: Hello,
     now_ms: u32,
     params_dirty: bool,
+    saved_models: [MotorModel; AXES],
     injector: I,
 }
 
 impl<I: Injector> ControlledRig<I> {
-    /// A controller for `params` (checked; invalid ones give the defaults and `Err` says why,
-    /// so the board still boots and reports it).
+    /// A controller for a persisted record (checked: parameters or motor models that fail
+    /// validation give the defaults, and `Err` says why, so the board still boots and reports
+    /// it). `base` supplies what the wire does not carry (tick rate, timer, supervisor limits).
     pub fn new(
         base: ControllerConfig,
-        params: ParamValues,
+        stored: Persisted,
         hello: Hello,
         injector: I,
     ) -> (Self, Result<(), Reason>) {
-        let (checked, outcome) = match derive(&base, &params) {
-            Ok(_) => (params, Ok(())),
-            Err(r) => (default_params(), Err(r)),
+        let (params, models) = split_persisted(&stored);
+        let stored_base = with_models(&base, &models);
+        let (base, params, outcome) = match derive(&stored_base, &params) {
+            Ok(_) => (stored_base, params, Ok(())),
+            Err(r) => (base, default_params(), Err(r)),
         };
-        let (cfg, scene) = match derive(&base, &checked) {
+        let (cfg, scene) = match derive(&base, &params) {
             Ok(x) => x,
             // The defaults are derived from the nominal configuration and always pass; if
             // they somehow do not, the controller boots faulted instead of trusting them.
@@ -242,13 +296,19 @@ impl<I: Injector> ControlledRig<I> {
             ctrl: Controller::new_or_faulted(cfg),
             base,
             scene,
-            params: checked,
+            params,
             hello,
             now_ms: 0,
             params_dirty: false,
+            saved_models: [cfg.axes[0].model, cfg.axes[1].model],
             injector,
         };
         (rig, outcome)
+    }
+
+    fn models(&self) -> [MotorModel; AXES] {
+        let a = &self.ctrl.config().axes;
+        [a[0].model, a[1].model]
     }
 
     /// The controller (for the control tick and diagnostics).
@@ -261,13 +321,15 @@ impl<I: Injector> ControlledRig<I> {
         &self.params
     }
 
-    /// Parameters changed since the last call, to be persisted (only while idle: a flash
-    /// erase stalls the CPU).
+    /// Whether parameters or motor models (after commissioning) changed since the last call
+    /// and should be persisted now (only while idle: a flash erase stalls the CPU).
     pub fn take_params_to_save(&mut self) -> bool {
         let idle = matches!(self.ctrl.state(), State::Idle | State::Fault);
-        let due = self.params_dirty && idle;
+        let models = self.models();
+        let due = idle && (self.params_dirty || models != self.saved_models);
         if due {
             self.params_dirty = false;
+            self.saved_models = models;
         }
         due
     }
@@ -352,7 +414,8 @@ impl<I: Injector> Rig for ControlledRig<I> {
     fn set_param(&mut self, id: ParamId, value: i32) -> Result<(), Reason> {
         let mut next = self.params;
         next[id.index()] = value;
-        let (cfg, scene) = derive(&self.base, &next)?;
+        // The motor models in force (perhaps from commissioning) stay as they are.
+        let (cfg, scene) = derive(&with_models(&self.base, &self.models()), &next)?;
         self.ctrl.set_parameters(cfg).map_err(reason)?;
         self.scene = scene;
         self.params = next;
@@ -407,9 +470,9 @@ impl<I: Injector> Station<I> {
         s
     }
 
-    /// Every parameter including the telemetry rate, for persisting.
-    pub fn params_to_persist(&self) -> ParamValues {
-        self.device.params(&self.rig)
+    /// Every parameter including the telemetry rate, and the motor models, for persisting.
+    pub fn params_to_persist(&self) -> Persisted {
+        persisted(&self.device.params(&self.rig), &self.rig.models())
     }
 
     /// Edges lost in capture so far, per axis.
@@ -457,7 +520,7 @@ mod tests {
         };
         let (rig, ok) = ControlledRig::new(
             ControllerConfig::nominal(),
-            default_params(),
+            default_persisted(),
             hello,
             NoInjection,
         );
@@ -479,7 +542,10 @@ mod tests {
     #[test]
     fn defaults_round_trip_through_params_and_persisting() {
         let s = station();
-        assert_eq!(s.params_to_persist(), default_params());
+        assert_eq!(s.params_to_persist(), default_persisted());
+        let (params, models) = split_persisted(&default_persisted());
+        assert_eq!(params, default_params());
+        assert_eq!(models[1], ControllerConfig::nominal().axes[1].model);
     }
 
     #[test]
@@ -526,7 +592,7 @@ mod tests {
 
     #[test]
     fn invalid_stored_params_fall_back_to_defaults_and_say_so() {
-        let mut bad = default_params();
+        let mut bad = default_persisted();
         bad[ParamId::RimUm.index()] = 10_000;
         bad[ParamId::StartUm.index()] = 20_000;
         let (rig, outcome) = ControlledRig::new(
@@ -540,6 +606,44 @@ mod tests {
         );
         assert_eq!(outcome, Err(Reason::Range));
         assert_eq!(rig.params(), &default_params());
+    }
+
+    #[test]
+    fn stored_motor_models_are_used_and_bad_ones_refused() {
+        let hello = Hello {
+            reset_cause: ResetCause::Software,
+            reset_count: 2,
+        };
+        let (params, mut models) = split_persisted(&default_persisted());
+        models[0].time_constant_s = 0.11;
+        let (mut rig, ok) = ControlledRig::new(
+            ControllerConfig::nominal(),
+            persisted(&params, &models),
+            hello,
+            NoInjection,
+        );
+        assert_eq!(ok, Ok(()));
+        assert_eq!(
+            rig.controller().config().axes[0].model.time_constant_s,
+            0.11
+        );
+        models[1].volts_per_rad_s = f32::NAN;
+        let (mut rig, ok) = ControlledRig::new(
+            ControllerConfig::nominal(),
+            persisted(&params, &models),
+            hello,
+            NoInjection,
+        );
+        assert_eq!(ok, Err(Reason::Range));
+        let nominal = ControllerConfig::nominal();
+        assert_eq!(
+            rig.controller().config().axes[1].model,
+            nominal.axes[1].model
+        );
+        assert_eq!(
+            rig.controller().config().axes[0].model,
+            nominal.axes[0].model
+        );
     }
 
     #[test]

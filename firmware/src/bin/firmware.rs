@@ -26,7 +26,9 @@ use embassy_stm32::{bind_interrupts, dma, gpio::OutputType};
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
 use embassy_time::{Duration, Ticker};
-use firmware::app::binding::{ControlledRig, NoInjection, Station, default_params};
+use firmware::app::binding::{
+    ControlledRig, NoInjection, PERSISTED_COUNT, Station, default_persisted,
+};
 use firmware::app::hal::Watchdog;
 use firmware::app::motors::Motors;
 use firmware::app::params::ParamLog;
@@ -39,7 +41,7 @@ use firmware::blackpill::flash_region::ParamSector;
 use firmware::blackpill::motor_pwm::{self, PWM_HZ, PwmMotor};
 use firmware::blackpill::reset_cause::{self, ResetFlag};
 use model_core::control::ControllerConfig;
-use model_core::wire::{Hello, PARAM_COUNT, ResetCause};
+use model_core::wire::{Hello, ResetCause};
 
 bind_interrupts!(struct Irqs {
     USART2 => usart::InterruptHandler<USART2>;
@@ -113,14 +115,14 @@ async fn main(spawner: Spawner) {
             p.FLASH,
         ))))
         .unwrap_or_else(|| halt("parameter log slot"));
-    let stored = match log.load::<PARAM_COUNT>() {
+    let stored = match log.load::<PERSISTED_COUNT>() {
         Ok(v) => {
             info!("params: loaded from flash");
             v
         }
         Err(e) => {
             warn!("params: {}, using defaults", e);
-            default_params()
+            default_persisted()
         }
     };
     let hello = Hello {

@@ -19,7 +19,7 @@ use cortex_m_semihosting::hprintln;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
 use embassy_time::{Duration, Timer};
-use firmware::app::binding::{ControlledRig, Station, default_params};
+use firmware::app::binding::{ControlledRig, Station, default_persisted};
 use firmware::app::motors::Motors;
 use firmware::app::reset;
 use firmware::app::slot::Slot;
@@ -116,7 +116,7 @@ fn main() -> ! {
     // The emulated board has no parameter flash: it boots with the defaults every time.
     let (rig, _) = ControlledRig::new(
         ControllerConfig::nominal(),
-        default_params(),
+        default_persisted(),
         hello,
         PlantInjector,
     );
