@@ -218,7 +218,10 @@ async fn supervisor_task(
             });
             if let Some(v) = values {
                 match log.save(&v) {
-                    Ok(()) => info!("params: saved"),
+                    Ok(()) => {
+                        let (_, models) = firmware::app::binding::split_persisted(&v);
+                        info!("params: saved; motor models {} / {}", models[0], models[1]);
+                    }
                     Err(e) => error!("params: save failed: {}", e),
                 }
             }
