@@ -7,193 +7,21 @@
 //!
 //! Run: `cargo test -p firmware --no-default-features --test qemu_rig_e2e`.
 
-mod common;
-
-use std::io::{Read, Write};
-use std::os::fd::{AsRawFd, OwnedFd};
-use std::os::unix::net::UnixStream;
-use std::path::PathBuf;
-use std::process::Command;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
-
-use model_core::wire::{Decoder, DeviceState, FaultCode, Frame, Residence, Telemetry};
-
-/// What the splitter saw from the board.
-#[derive(Default)]
-struct Seen {
-    telemetry: Vec<Telemetry>,
-    hello: usize,
-}
-
-/// Sits between the board's USART socket and a pseudo-terminal for `bowl send`: every byte
-/// from the board goes to the decoder here, and to the terminal while a `bowl send` runs;
-/// every byte from the terminal goes to the board.
-struct Splitter {
-    seen: Arc<Mutex<Seen>>,
-    forward: Arc<AtomicBool>,
-    pty_path: PathBuf,
-    slave: OwnedFd,
-}
-
-fn raw_pty() -> (OwnedFd, OwnedFd, PathBuf) {
-    use nix::sys::termios;
-    let pty = nix::pty::openpty(None, None).expect("openpty");
-    let mut t = termios::tcgetattr(&pty.slave).expect("tcgetattr");
-    termios::cfmakeraw(&mut t);
-    termios::tcsetattr(&pty.slave, termios::SetArg::TCSANOW, &t).expect("tcsetattr");
-    let path = std::fs::read_link(format!("/proc/self/fd/{}", pty.slave.as_raw_fd()))
-        .expect("the slave's path");
-    (pty.master, pty.slave, path)
-}
-
-impl Splitter {
-    fn start(usart: UnixStream) -> Splitter {
-        let (master, slave, pty_path) = raw_pty();
-        let seen = Arc::new(Mutex::new(Seen::default()));
-        let forward = Arc::new(AtomicBool::new(false));
-        let mut master_w = std::fs::File::from(master.try_clone().unwrap());
-        let mut master_r = std::fs::File::from(master);
-        let mut from_board = usart.try_clone().unwrap();
-        let mut to_board = usart;
-        {
-            let (seen, forward) = (seen.clone(), forward.clone());
-            std::thread::spawn(move || {
-                let mut decoder = Decoder::new();
-                let mut buf = [0u8; 4096];
-                while let Ok(n) = from_board.read(&mut buf) {
-                    if n == 0 {
-                        break;
-                    }
-                    if forward.load(Ordering::Acquire) {
-                        let _ = master_w.write_all(&buf[..n]);
-                    }
-                    let mut s = seen.lock().unwrap();
-                    for &b in &buf[..n] {
-                        match decoder.push(b) {
-                            Some(Ok(Frame::Telemetry(t))) => s.telemetry.push(t),
-                            Some(Ok(Frame::Hello(_))) => s.hello += 1,
-                            _ => {}
-                        }
-                    }
-                }
-            });
-        }
-        std::thread::spawn(move || {
-            let mut buf = [0u8; 256];
-            while let Ok(n) = master_r.read(&mut buf) {
-                if n == 0 || to_board.write_all(&buf[..n]).is_err() {
-                    break;
-                }
-            }
-        });
-        Splitter {
-            seen,
-            forward,
-            pty_path,
-            slave,
-        }
-    }
-
-    /// Runs `bowl send PTY words...` and returns its exit code and output.
-    fn send(&self, bowl: &PathBuf, words: &[&str]) -> (i32, String) {
-        // Stale telemetry queued while nobody listened must not reach this send.
-        let _ = nix::sys::termios::tcflush(&self.slave, nix::sys::termios::FlushArg::TCIFLUSH);
-        self.forward.store(true, Ordering::Release);
-        let out = Command::new(bowl)
-            .arg("send")
-            .arg(&self.pty_path)
-            .args(words)
-            .args(["--timeout-ms", "3000"])
-            .output()
-            .expect("bowl runs");
-        self.forward.store(false, Ordering::Release);
-        let text = String::from_utf8_lossy(&out.stdout).into_owned()
-            + &String::from_utf8_lossy(&out.stderr);
-        println!(
-            "bowl send {} -> {:?}: {}",
-            words.join(" "),
-            out.status.code(),
-            text.trim()
-        );
-        (out.status.code().unwrap_or(-1), text)
-    }
-
-    fn last(&self) -> Telemetry {
-        let s = self.seen.lock().unwrap();
-        *s.telemetry.last().expect("telemetry arrives")
-    }
-
-    /// Waits until the board's clock has advanced `ms` past `from_ms`; returns the frames of
-    /// that interval.
-    fn wait_device_ms(&self, from_ms: u32, ms: u32) -> Vec<Telemetry> {
-        let deadline = Instant::now() + Duration::from_secs(120);
-        loop {
-            {
-                let s = self.seen.lock().unwrap();
-                if s.telemetry
-                    .last()
-                    .is_some_and(|t| t.time_ms >= from_ms + ms)
-                {
-                    return s
-                        .telemetry
-                        .iter()
-                        .filter(|t| t.time_ms >= from_ms)
-                        .copied()
-                        .collect();
-                }
-            }
-            assert!(
-                Instant::now() < deadline,
-                "the board stopped sending telemetry"
-            );
-            std::thread::sleep(Duration::from_millis(5));
-        }
-    }
-}
-
-fn build_bowl() -> PathBuf {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .current_dir(common::workspace_root())
-        .args(["build", "-p", "host-tools", "--bin", "bowl"])
-        .status()
-        .expect("cargo runs");
-    assert!(status.success(), "building bowl failed");
-    let target_dir = std::env::var("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| common::workspace_root().join("target"));
-    target_dir.join("debug/bowl")
-}
-
-/// `plant t_ms=.. w1=.. w2=.. d1=.. d2=..` lines of the semihosting console.
-fn plant_truth(console: &[String]) -> Vec<(u32, f32, f32, f32, f32)> {
-    console
-        .iter()
-        .filter_map(|l| l.strip_prefix("plant "))
-        .filter_map(|l| {
-            let v: Vec<f32> = l
-                .split_whitespace()
-                .filter_map(|kv| kv.split_once('=').and_then(|(_, v)| v.parse().ok()))
-                .collect();
-            (v.len() == 5).then(|| (v[0] as u32, v[1], v[2], v[3], v[4]))
-        })
-        .collect()
-}
+use firmware::host::{self, Board, Splitter, plant_truth};
+use model_core::wire::{DeviceState, FaultCode, Residence};
 
 #[test]
 fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
-    let bowl = build_bowl();
-    let elf = common::build_image("qemu-rig");
-    let board = common::Board::boot_with(&elf, &["-append", "seconds=40"]);
+    let bowl = host::build_bowl();
+    let elf = host::build_image("qemu-rig");
+    let board = Board::boot_with(&elf, &["-append", "seconds=40"]);
     let usart = board.usart.try_clone().unwrap();
-    let split = Splitter::start(usart);
+    let split = Splitter::start(usart, false);
 
     // Boot: hello, idle, no fault, motors off.
     let t0 = split.wait_device_ms(0, 300);
     assert!(
-        split.seen.lock().unwrap().hello >= 1,
+        split.with_seen(|s| s.hello) >= 1,
         "the board announces itself"
     );
     assert!(t0.iter().all(|t| t.state == DeviceState::Idle
@@ -285,22 +113,19 @@ fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
     let truth = plant_truth(&console);
     let running: Vec<_> = truth
         .iter()
-        .filter(|r| r.0 >= started_ms + 4_000 && r.0 <= started_ms + 6_000)
+        .filter(|r| r.t_ms >= started_ms + 4_000 && r.t_ms <= started_ms + 6_000)
         .collect();
     assert!(!running.is_empty(), "plant log covers the run");
     for r in running {
         assert!(
-            (r.1 - 2.0).abs() < 0.06 && (r.2 - 3.0).abs() < 0.09,
+            (r.speed_rad_s[0] - 2.0).abs() < 0.06 && (r.speed_rad_s[1] - 3.0).abs() < 0.09,
             "true speeds {r:?}"
         );
     }
     let faulted: Vec<_> = truth
         .iter()
-        .filter(|r| r.0 > first_fault.time_ms + 100 && r.0 < first_fault.time_ms + 1_500)
+        .filter(|r| r.t_ms > first_fault.time_ms + 100 && r.t_ms < first_fault.time_ms + 1_500)
         .collect();
     assert!(!faulted.is_empty());
-    assert!(
-        faulted.iter().all(|r| r.3 == 0.0 && r.4 == 0.0),
-        "{faulted:?}"
-    );
+    assert!(faulted.iter().all(|r| r.duty == [0.0, 0.0]), "{faulted:?}");
 }
