@@ -104,3 +104,77 @@ fn a_malformed_qemu_log_is_a_clear_error() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("line 1") && err.contains("mean"), "{err}");
 }
+
+#[test]
+fn integrators_converge_and_dp54_meets_its_tolerance() {
+    let rows = work_precision(&[], "ode");
+    for scene in ["paper", "near-threshold", "near-rim"] {
+        for model in ["flat", "coriolis"] {
+            let sel = |family: &str, precision: &str| -> Vec<(f64, f64, u64)> {
+                let mut v: Vec<_> = rows
+                    .iter()
+                    .filter(|r| {
+                        r["scene"] == scene
+                            && r["model"] == model
+                            && r["family"] == family
+                            && r["precision"] == precision
+                    })
+                    .map(|r| {
+                        let setting: f64 = r["setting"].split('=').nth(1).unwrap().parse().unwrap();
+                        let err: f64 = r["rel_error"].parse().unwrap_or(f64::NAN);
+                        (setting, err, r["rhs_evals"].parse().unwrap_or(0))
+                    })
+                    .collect();
+                v.sort_by(|a, b| a.0.total_cmp(&b.0));
+                v
+            };
+            // DP5(4) in f64: the achieved error follows the tolerance (within a factor 100; the
+            // tolerance bounds the local error per step, not the global error in T), and a
+            // tighter tolerance costs more evaluations.
+            // Scaled by the problem's condition number (about 930 near the threshold).
+            let closed = rows
+                .iter()
+                .find(|r| r["scene"] == scene && r["model"] == model && r["method"] == "closed-f64")
+                .unwrap();
+            let c = cond(closed);
+            // The integrators carry r itself, not r - ri: near the rim the displacement
+            // R - ri is resolved only to eps R / (R - ri) relatively, a floor no tolerance beats.
+            let (rim, ri): (f64, f64) = (
+                closed["R_m"].parse().unwrap(),
+                closed["ri_m"].parse().unwrap(),
+            );
+            let floor = 100.0 * f64::EPSILON * rim / (rim - ri);
+            let dp = sel("dp54", "f64");
+            assert!(dp.len() >= 10, "{scene} {model}");
+            for &(tol, err, _) in &dp {
+                assert!(
+                    err <= 100.0 * tol * c + floor,
+                    "{scene} {model} dp54 tol {tol}: {err:e}, cond {c}, floor {floor:e}"
+                );
+            }
+            assert!(
+                dp.first().unwrap().2 >= dp.last().unwrap().2,
+                "{scene} {model} cost"
+            );
+            // RK4 in f64: 16x smaller error per halving, until round-off; check the coarse end.
+            // Not near the rim: there omega T = 0.006 and every step on the chart overshoots
+            // the rim in one step, so the error is the event interpolation's, not RK4's order.
+            if scene == "near-rim" {
+                continue;
+            }
+            let rk = sel("rk4", "f64");
+            let coarse: Vec<_> = rk.iter().rev().take(4).collect();
+            for w in coarse.windows(2) {
+                let (h_big, e_big, _) = *w[0];
+                let (h_small, e_small, _) = *w[1];
+                if e_small > 1e-13 {
+                    let order = (e_big / e_small).ln() / (h_big / h_small).ln();
+                    assert!(
+                        order > 3.0,
+                        "{scene} {model} rk4 order {order} at h {h_small}"
+                    );
+                }
+            }
+        }
+    }
+}

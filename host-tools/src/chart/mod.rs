@@ -9,10 +9,10 @@ use anyhow::{Context, Result};
 use clap::Subcommand;
 
 pub mod figures;
-pub mod pitfalls;
 pub mod plot;
 pub mod qemu_log;
 pub mod reference;
+pub mod stability;
 pub mod table;
 pub mod timing;
 pub mod workprec;
@@ -35,6 +35,8 @@ enum Which {
     Velocity(Out),
     /// Residence time against bowl speed for 150-300 mm bowls (cf. paper Fig. 7).
     Residence(Out),
+    /// Error against step h*omega for the fixed-step integrators, stability bounds marked.
+    Stability(Out),
 }
 
 /// Where to write.
@@ -177,6 +179,10 @@ pub fn run(args: &Args) -> Result<()> {
         }
         Which::Residence(out) => {
             let (f, t) = figures::residence_time()?;
+            write_all(out, &f, &t)
+        }
+        Which::Stability(out) => {
+            let (f, t) = stability::chart()?;
             write_all(out, &f, &t)
         }
     }

@@ -10,6 +10,7 @@
 use std::collections::BTreeMap;
 
 use bowl_test_cases::cost::{SCENE_NAMES, scene};
+use model_core::ode;
 use model_core::particle::{Model, Outcome, Scene, residence};
 
 use super::figures::scene_err;
@@ -42,12 +43,25 @@ impl Precision {
 pub enum Family {
     /// The model's closed forms (log1p flat form, bracketed Newton for Coriolis).
     Closed,
+    /// Explicit Euler, fixed step.
+    Euler,
+    /// Semi-implicit Euler, fixed step.
+    SemiImplicitEuler,
+    /// Classical RK4, fixed step.
+    Rk4,
+    /// Adaptive Dormand-Prince 5(4).
+    Dp54,
 }
 
 impl Family {
-    fn key(self) -> &'static str {
+    /// Short name used in keys and legends.
+    pub fn key(self) -> &'static str {
         match self {
             Family::Closed => "closed",
+            Family::Euler => "euler",
+            Family::SemiImplicitEuler => "semi-implicit-euler",
+            Family::Rk4 => "rk4",
+            Family::Dp54 => "dp54",
         }
     }
 }
@@ -59,30 +73,136 @@ pub struct Method {
     pub family: Family,
     /// Number type.
     pub precision: Precision,
+    /// Fixed-step methods: the step as `h omega` (dimensionless); DP5(4): the tolerance
+    /// (rtol = tol, atol = tol R for r and tol omega R for r', see [`dp54_tolerances`]);
+    /// closed forms: none.
+    pub setting: Option<f64>,
 }
 
 impl Method {
-    /// The setting as `name=value` (step `h*omega=..`, tolerance `tol=..`), empty for closed forms.
+    /// The setting as `h*omega=..` or `tol=..`, empty for closed forms.
     pub fn setting(&self) -> String {
-        String::new()
+        match (self.family, self.setting) {
+            (Family::Dp54, Some(t)) => format!("tol={t:e}"),
+            (_, Some(h)) => format!("h*omega={h}"),
+            (_, None) => String::new(),
+        }
     }
 
-    /// The name used in the CSV and in the QEMU benchmark names (`cost::SCENE::MODEL::KEY`).
+    /// The name used in the CSV and in the QEMU benchmark names (`cost::SCENE::MODEL::KEY`):
+    /// `rk4-f32-libm-h0.125`, `dp54-f64-tol1e-6`, `closed-f64`.
     pub fn key(&self) -> String {
-        format!("{}-{}", self.family.key(), self.precision.key())
+        let base = format!("{}-{}", self.family.key(), self.precision.key());
+        match (self.family, self.setting) {
+            (Family::Dp54, Some(t)) => format!("{base}-tol{t:e}"),
+            (_, Some(h)) => format!("{base}-h{h}"),
+            (_, None) => base,
+        }
     }
+}
+
+/// Steps `h omega = 2^-k` for `k` in the range.
+fn halvings(from: i32, to: i32) -> impl Iterator<Item = f64> {
+    (from..=to).map(|k| 2f64.powi(-k))
 }
 
 /// Every method and setting on the chart.
 pub fn methods() -> Vec<Method> {
     let mut v = Vec::new();
-    for precision in [Precision::F64, Precision::F32Libm] {
+    let mut add = |family, precision, setting| {
         v.push(Method {
-            family: Family::Closed,
+            family,
             precision,
-        });
+            setting,
+        })
+    };
+    for precision in [Precision::F64, Precision::F32Libm] {
+        add(Family::Closed, precision, None);
+        for h in halvings(1, 12) {
+            add(Family::Euler, precision, Some(h));
+            add(Family::SemiImplicitEuler, precision, Some(h));
+        }
+        for h in halvings(0, 10) {
+            add(Family::Rk4, precision, Some(h));
+        }
+        let tols: &[f64] = match precision {
+            Precision::F64 => &[
+                1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13,
+            ],
+            Precision::F32Libm => &[1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7],
+        };
+        for &t in tols {
+            add(Family::Dp54, precision, Some(t));
+        }
     }
     v
+}
+
+/// DP5(4) tolerances for a scene: relative `tol`, absolute `tol R` (same for r in m and r' in
+/// m/s; r' at the rim is of order omega R, a fraction of R per second at these speeds).
+pub fn dp54_tolerances<T: model_core::Real>(tol: T, s: &Scene<T>) -> (T, T) {
+    (tol, tol * s.rim_radius_m)
+}
+
+/// The model's ODE method for `m` on scene `s` (step in seconds from `h omega`).
+fn ode_method<T: model_core::Real>(m: &Method, s: &Scene<T>) -> Option<ode::Method<T>> {
+    let x = T::from_f64(m.setting?);
+    let h = x / s.omega_rad_s;
+    Some(match m.family {
+        Family::Closed => return None,
+        Family::Euler => ode::Method::Euler { step_s: h },
+        Family::SemiImplicitEuler => ode::Method::SemiImplicitEuler { step_s: h },
+        Family::Rk4 => ode::Method::Rk4 { step_s: h },
+        Family::Dp54 => {
+            let (rtol, atol) = dp54_tolerances(x, s);
+            ode::Method::Dp54 { rtol, atol }
+        }
+    })
+}
+
+fn ode_run<T: model_core::Real>(m: &Method, s: &Scene<T>, model: Model) -> Run {
+    let inputs = Scene {
+        omega_rad_s: s.omega_rad_s.to_f64(),
+        mu: s.mu.to_f64(),
+        g_m_s2: s.g_m_s2.to_f64(),
+        k2: s.k2.to_f64(),
+        ri_m: s.ri_m.to_f64(),
+        rim_radius_m: s.rim_radius_m.to_f64(),
+    };
+    let Some(method) = ode_method(m, s) else {
+        return Run {
+            inputs,
+            time_s: None,
+            rhs_evals: None,
+            note: "no ODE method".into(),
+        };
+    };
+    match ode::integrate_constant(s, model, method) {
+        Ok(rep) => {
+            let (time_s, note) = match rep.outcome {
+                ode::OdeOutcome::Leaves {
+                    residence_time_s, ..
+                } => (Some(residence_time_s.to_f64()), "leaves".to_string()),
+                ode::OdeOutcome::AlreadyAtRim { .. } => (Some(0.0), "at-rim".into()),
+                ode::OdeOutcome::NeverLeaves => (None, "never-leaves".into()),
+                ode::OdeOutcome::NotLeftBy { horizon_s, .. } => {
+                    (None, format!("not-left-by {:.3e} s", horizon_s.to_f64()))
+                }
+            };
+            Run {
+                inputs,
+                time_s,
+                rhs_evals: Some(u64::from(rep.rhs_evaluations)),
+                note: format!("{note} steps={} rejected={}", rep.steps, rep.rejected_steps),
+            }
+        }
+        Err(e) => Run {
+            inputs,
+            time_s: None,
+            rhs_evals: None,
+            note: format!("refused: {e:?}"),
+        },
+    }
 }
 
 fn model_key(m: Model) -> &'static str {
@@ -185,6 +305,8 @@ pub fn run(method: &Method, s: &Scene<f64>, model: Model) -> anyhow::Result<Run>
                 note,
             })
         }
+        (_, Precision::F64) => Ok(ode_run(method, s, model)),
+        (_, Precision::F32Libm) => Ok(ode_run(method, &to_f32(s), model)),
     }
 }
 
@@ -195,6 +317,17 @@ pub fn time(method: &Method, s: &Scene<f64>, model: Model, budget: Budget) -> f6
         (Family::Closed, Precision::F32Libm) => {
             let s32 = to_f32(s);
             ns_per_call(budget, || residence(&s32, model))
+        }
+        (_, Precision::F64) => match ode_method(method, s) {
+            Some(m) => ns_per_call(budget, || ode::integrate_constant(s, model, m)),
+            None => f64::NAN,
+        },
+        (_, Precision::F32Libm) => {
+            let s32 = to_f32(s);
+            match ode_method(method, &s32) {
+                Some(m) => ns_per_call(budget, || ode::integrate_constant(&s32, model, m)),
+                None => f64::NAN,
+            }
         }
     }
 }
@@ -255,12 +388,28 @@ impl Point {
 /// Measures every method on every scene and model.
 pub fn measure(budget: Budget, qemu: &BTreeMap<String, Counts>) -> anyhow::Result<Vec<Point>> {
     let mut out = Vec::new();
+    // The 256-bit reference is slow; f64 and f32 methods share two distinct input sets.
+    let mut refs: BTreeMap<([u64; 6], bool), Option<f64>> = BTreeMap::new();
     for (i, &name) in SCENE_NAMES.iter().enumerate() {
         let s = scene(i);
         for model in [Model::Flat, Model::Coriolis] {
             for m in methods() {
                 let r = run(&m, &s, model)?;
-                let ref_time_s = ref_time(&r.inputs, model);
+                let x = &r.inputs;
+                let key = (
+                    [
+                        x.omega_rad_s.to_bits(),
+                        x.mu.to_bits(),
+                        x.g_m_s2.to_bits(),
+                        x.k2.to_bits(),
+                        x.ri_m.to_bits(),
+                        x.rim_radius_m.to_bits(),
+                    ],
+                    model == Model::Coriolis,
+                );
+                let ref_time_s = *refs
+                    .entry(key)
+                    .or_insert_with(|| ref_time(&r.inputs, model));
                 let rel_error = match (r.time_s, ref_time_s) {
                     (Some(t), Some(tr)) if tr > 0.0 => Some(((t - tr) / tr).abs()),
                     (Some(t), Some(_)) => Some(t.abs()),
@@ -413,5 +562,31 @@ pub fn figure(points: &[Point], scene: &str, model: Model, axis: CostAxis) -> Fi
             format!("errors below {ERROR_FLOOR:.0e} drawn at {ERROR_FLOOR:.0e}"),
             "a missing point: the method gave no T".into(),
         ],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every `cost::` QEMU benchmark names a scene and a method the chart measures, so its
+    /// count lands in the CSV (a typo would silently drop it).
+    #[test]
+    fn qemu_cost_bench_names_match_chart_keys() {
+        let keys: Vec<String> = methods().iter().map(Method::key).collect();
+        let mut n = 0;
+        for b in bowl_test_cases::all_benches().filter(|b| b.name.starts_with("cost::")) {
+            let parts: Vec<&str> = b.name.split("::").collect();
+            assert_eq!(parts.len(), 4, "{}", b.name);
+            assert!(SCENE_NAMES.contains(&parts[1]), "{}", b.name);
+            assert!(["flat", "coriolis"].contains(&parts[2]), "{}", b.name);
+            assert!(
+                keys.iter().any(|k| k == parts[3]),
+                "{} has no chart method",
+                b.name
+            );
+            n += 1;
+        }
+        assert!(n >= 30, "{n} cost benches");
     }
 }

@@ -20,7 +20,12 @@ pub use check::{Bench, Case, Failure};
 pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES, particle::CASES];
 
 /// Every benchmark, grouped likewise.
-pub static BENCH_GROUPS: &[&[Bench]] = &[bowl::BENCHES, particle::BENCHES, cost::BENCHES];
+pub static BENCH_GROUPS: &[&[Bench]] = &[
+    bowl::BENCHES,
+    particle::BENCHES,
+    cost::BENCHES,
+    cost::ODE_BENCHES,
+];
 
 /// All cases in one iterator.
 pub fn all_cases() -> impl Iterator<Item = &'static Case> {
