@@ -46,7 +46,7 @@ fn cond(row: &HashMap<String, String>) -> f64 {
 
 #[test]
 fn closed_forms_meet_the_accuracy_targets() {
-    let rows = work_precision(&[], "targets");
+    let rows = work_precision(&["--families", "closed"], "targets");
     let mut seen = 0;
     for r in rows.iter().filter(|r| r["family"] == "closed") {
         let err: f64 = r["rel_error"].parse().unwrap();
@@ -77,7 +77,10 @@ fn qemu_counts_are_joined_by_benchmark_name() {
         "case x ok\nbench cost::paper::coriolis::closed-f32-libm inputs=1 min=123 mean=123 max=123\n",
     )
     .unwrap();
-    let rows = work_precision(&["--qemu-log", log.to_str().unwrap()], "join");
+    let rows = work_precision(
+        &["--qemu-log", log.to_str().unwrap(), "--families", "closed"],
+        "join",
+    );
     let hit: Vec<_> = rows
         .iter()
         .filter(|r| r["qemu_instructions_mean"] == "123")
@@ -94,7 +97,15 @@ fn a_malformed_qemu_log_is_a_clear_error() {
     std::fs::write(&log, "bench cost::x inputs=1 min=1 mean=? max=1\n").unwrap();
     let out = tmp("bad").join("wp.svg");
     let o = Command::new(env!("CARGO_BIN_EXE_bowl"))
-        .args(["chart", "work-precision", "--csv-only", "--quick", "--out"])
+        .args([
+            "chart",
+            "work-precision",
+            "--csv-only",
+            "--quick",
+            "--families",
+            "closed",
+            "--out",
+        ])
         .arg(&out)
         .arg("--qemu-log")
         .arg(&log)
@@ -107,7 +118,7 @@ fn a_malformed_qemu_log_is_a_clear_error() {
 
 #[test]
 fn integrators_converge_and_dp54_meets_its_tolerance() {
-    let rows = work_precision(&[], "ode");
+    let rows = work_precision(&["--families", "closed,rk4,dp54"], "ode");
     for scene in ["paper", "near-threshold", "near-rim"] {
         for model in ["flat", "coriolis"] {
             let sel = |family: &str, precision: &str| -> Vec<(f64, f64, u64)> {
@@ -177,4 +188,24 @@ fn integrators_converge_and_dp54_meets_its_tolerance() {
             }
         }
     }
+}
+
+#[test]
+fn an_unknown_family_is_a_clear_error() {
+    let out = tmp("fam").join("wp.svg");
+    let o = Command::new(env!("CARGO_BIN_EXE_bowl"))
+        .args([
+            "chart",
+            "work-precision",
+            "--csv-only",
+            "--families",
+            "rk5",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("unknown method family `rk5`"), "{err}");
 }

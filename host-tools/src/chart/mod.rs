@@ -62,6 +62,10 @@ struct WorkPrecision {
     /// Shorter timing (3 batches of 0.2 ms instead of 15 of 2 ms): for tests and quick looks.
     #[arg(long)]
     quick: bool,
+    /// Only these method families (comma-separated: closed, euler, semi-implicit-euler, rk4,
+    /// dp54); all when omitted.
+    #[arg(long, value_delimiter = ',')]
+    families: Vec<String>,
 }
 
 /// `FILE.svg` -> `FILE-suffix.svg`.
@@ -92,7 +96,7 @@ fn work_precision(args: &WorkPrecision) -> Result<()> {
     if cfg!(debug_assertions) {
         eprintln!("note: debug build; host times are not representative (use --release)");
     }
-    let points = workprec::measure(budget, &qemu)?;
+    let points = workprec::measure(budget, &qemu, &args.families)?;
     let table = workprec::table(&points);
     let main = workprec::figure(&points, "paper", Model::Coriolis, CostAxis::HostNs);
     write_all(&args.out, &main, &table)?;

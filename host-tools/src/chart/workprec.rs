@@ -53,6 +53,15 @@ pub enum Family {
     Dp54,
 }
 
+/// Every family, for option checking.
+pub const ALL_FAMILIES: [Family; 5] = [
+    Family::Closed,
+    Family::Euler,
+    Family::SemiImplicitEuler,
+    Family::Rk4,
+    Family::Dp54,
+];
+
 impl Family {
     /// Short name used in keys and legends.
     pub fn key(self) -> &'static str {
@@ -386,14 +395,30 @@ impl Point {
 }
 
 /// Measures every method on every scene and model.
-pub fn measure(budget: Budget, qemu: &BTreeMap<String, Counts>) -> anyhow::Result<Vec<Point>> {
+/// Only the methods whose family key is in `families` (all when empty).
+pub fn measure(
+    budget: Budget,
+    qemu: &BTreeMap<String, Counts>,
+    families: &[String],
+) -> anyhow::Result<Vec<Point>> {
+    for f in families {
+        if !ALL_FAMILIES.iter().any(|x| x.key() == f) {
+            anyhow::bail!(
+                "unknown method family `{f}` (known: {})",
+                ALL_FAMILIES.map(Family::key).join(", ")
+            );
+        }
+    }
     let mut out = Vec::new();
     // The 256-bit reference is slow; f64 and f32 methods share two distinct input sets.
     let mut refs: BTreeMap<([u64; 6], bool), Option<f64>> = BTreeMap::new();
     for (i, &name) in SCENE_NAMES.iter().enumerate() {
         let s = scene(i);
         for model in [Model::Flat, Model::Coriolis] {
-            for m in methods() {
+            for m in methods()
+                .into_iter()
+                .filter(|m| families.is_empty() || families.iter().any(|f| f == m.family.key()))
+            {
                 let r = run(&m, &s, model)?;
                 let x = &r.inputs;
                 let key = (
