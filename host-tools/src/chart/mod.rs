@@ -98,6 +98,28 @@ fn work_precision(args: &WorkPrecision) -> Result<()> {
     }
     let points = workprec::measure(budget, &qemu, &args.families)?;
     let table = workprec::table(&points);
+    // A compact view of the main scene for the terminal (the CSV has everything).
+    println!("paper scene, Coriolis model:");
+    println!(
+        "{:<40} {:>10} {:>8} {:>12} {:>10}",
+        "method", "rel.error", "RHS", "host ns", "M4F instr"
+    );
+    for p in points
+        .iter()
+        .filter(|p| p.scene == "paper" && p.model == Model::Coriolis)
+    {
+        println!(
+            "{:<40} {:>10} {:>8} {:>12.1} {:>10}",
+            p.method.key(),
+            p.rel_error
+                .map_or_else(|| "-".into(), |e| format!("{e:.2e}")),
+            p.run
+                .rhs_evals
+                .map_or_else(|| "-".into(), |n| n.to_string()),
+            p.host_ns,
+            p.qemu.map_or_else(|| "-".into(), |c| c.mean.to_string()),
+        );
+    }
     let main = workprec::figure(&points, "paper", Model::Coriolis, CostAxis::HostNs);
     write_all(&args.out, &main, &table)?;
     if args.out.csv_only {
