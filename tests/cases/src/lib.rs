@@ -12,17 +12,19 @@
 pub mod bowl;
 pub mod check;
 pub mod cost;
+pub mod ode;
 pub mod particle;
 
 pub use check::{Bench, Case, Failure};
 
 /// Every case, grouped by the module it tests.
-pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES, particle::CASES];
+pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES, particle::CASES, ode::CASES];
 
 /// Every benchmark, grouped likewise.
 pub static BENCH_GROUPS: &[&[Bench]] = &[
     bowl::BENCHES,
     particle::BENCHES,
+    ode::BENCHES,
     cost::BENCHES,
     cost::ODE_BENCHES,
 ];
