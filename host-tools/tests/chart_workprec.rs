@@ -54,7 +54,13 @@ fn closed_forms_meet_the_accuracy_targets() {
         // Issue 3: f64 within about 1e-12 x cond; f32 on the target within 2e-6 x cond.
         let bound = match r["precision"].as_str() {
             "f64" => 1e-12 * c,
-            _ => 2e-6 * c,
+            "f32-libm" => 2e-6 * c,
+            _ => {
+                // micromath is on the chart to be compared, not held to the target (its
+                // rough sqrt alone costs about 1e-2): it must still give a usable, finite T.
+                assert!(err.is_finite() && err < 0.05, "{r:?}");
+                continue;
+            }
         };
         assert!(
             err <= bound,

@@ -119,7 +119,7 @@ const LEGEND_WIDTH: u32 = 360;
 const FONT: &str = "DejaVu Sans, sans-serif";
 
 /// A palette readable on white and distinguishable in print (Okabe-Ito plus a few).
-const PALETTE: [RGBColor; 10] = [
+const PALETTE: [RGBColor; 12] = [
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
     RGBColor(0, 158, 115),
@@ -130,6 +130,8 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(120, 120, 120),
     RGBColor(160, 40, 40),
     RGBColor(100, 60, 160),
+    RGBColor(0, 60, 120),
+    RGBColor(140, 140, 0),
 ];
 
 fn colour(i: usize) -> RGBColor {

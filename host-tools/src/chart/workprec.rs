@@ -10,8 +10,10 @@
 use std::collections::BTreeMap;
 
 use bowl_test_cases::cost::{SCENE_NAMES, scene};
+use model_core::Real;
 use model_core::ode;
 use model_core::particle::{Model, Outcome, Scene, residence};
+use model_core::real::micro::{MicroF32, MicroF32HwSqrt};
 
 use super::figures::scene_err;
 use super::plot::{Figure, Mark, Scale, Series};
@@ -27,6 +29,10 @@ pub enum Precision {
     F64,
     /// f32 with libm (and VSQRT on the target): the model's `Real for f32`.
     F32Libm,
+    /// f32 with micromath's functions, its rough `sqrt` included (`MicroF32`).
+    F32Micromath,
+    /// f32 with micromath's functions but the correctly rounded square root (`MicroF32HwSqrt`).
+    F32MicromathHwSqrt,
 }
 
 impl Precision {
@@ -34,6 +40,8 @@ impl Precision {
         match self {
             Precision::F64 => "f64",
             Precision::F32Libm => "f32-libm",
+            Precision::F32Micromath => "f32-micromath",
+            Precision::F32MicromathHwSqrt => "f32-micromath-hwsqrt",
         }
     }
 }
@@ -138,23 +146,27 @@ pub fn methods() -> Vec<Method> {
             Precision::F64 => &[
                 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13,
             ],
-            Precision::F32Libm => &[1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7],
+            _ => &[1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7],
         };
         for &t in tols {
             add(Family::Dp54, precision, Some(t));
         }
     }
+    // micromath changes only the transcendental functions, which the integrators' steps do not
+    // call: the closed forms are where it can pay (or cost).
+    add(Family::Closed, Precision::F32Micromath, None);
+    add(Family::Closed, Precision::F32MicromathHwSqrt, None);
     v
 }
 
 /// DP5(4) tolerances for a scene: relative `tol`, absolute `tol R` (same for r in m and r' in
 /// m/s; r' at the rim is of order omega R, a fraction of R per second at these speeds).
-pub fn dp54_tolerances<T: model_core::Real>(tol: T, s: &Scene<T>) -> (T, T) {
+pub fn dp54_tolerances<T: Real>(tol: T, s: &Scene<T>) -> (T, T) {
     (tol, tol * s.rim_radius_m)
 }
 
 /// The model's ODE method for `m` on scene `s` (step in seconds from `h omega`).
-fn ode_method<T: model_core::Real>(m: &Method, s: &Scene<T>) -> Option<ode::Method<T>> {
+fn ode_method<T: Real>(m: &Method, s: &Scene<T>) -> Option<ode::Method<T>> {
     let x = T::from_f64(m.setting?);
     let h = x / s.omega_rad_s;
     Some(match m.family {
@@ -169,15 +181,8 @@ fn ode_method<T: model_core::Real>(m: &Method, s: &Scene<T>) -> Option<ode::Meth
     })
 }
 
-fn ode_run<T: model_core::Real>(m: &Method, s: &Scene<T>, model: Model) -> Run {
-    let inputs = Scene {
-        omega_rad_s: s.omega_rad_s.to_f64(),
-        mu: s.mu.to_f64(),
-        g_m_s2: s.g_m_s2.to_f64(),
-        k2: s.k2.to_f64(),
-        ri_m: s.ri_m.to_f64(),
-        rim_radius_m: s.rim_radius_m.to_f64(),
-    };
+fn ode_run<T: Real>(m: &Method, s: &Scene<T>, model: Model) -> Run {
+    let inputs = widen(s);
     let Some(method) = ode_method(m, s) else {
         return Run {
             inputs,
@@ -221,26 +226,41 @@ fn model_key(m: Model) -> &'static str {
     }
 }
 
-fn to_f32(s: &Scene<f64>) -> Scene<f32> {
+/// The scene in another number type (rounded to nearest).
+fn narrow<T: Real>(s: &Scene<f64>) -> Scene<T> {
     Scene {
-        omega_rad_s: s.omega_rad_s as f32,
-        mu: s.mu as f32,
-        g_m_s2: s.g_m_s2 as f32,
-        k2: s.k2 as f32,
-        ri_m: s.ri_m as f32,
-        rim_radius_m: s.rim_radius_m as f32,
+        omega_rad_s: T::from_f64(s.omega_rad_s),
+        mu: T::from_f64(s.mu),
+        g_m_s2: T::from_f64(s.g_m_s2),
+        k2: T::from_f64(s.k2),
+        ri_m: T::from_f64(s.ri_m),
+        rim_radius_m: T::from_f64(s.rim_radius_m),
     }
 }
 
-fn widen(s: &Scene<f32>) -> Scene<f64> {
+/// The scene as a number type holds it, read back exactly in f64.
+fn widen<T: Real>(s: &Scene<T>) -> Scene<f64> {
     Scene {
-        omega_rad_s: s.omega_rad_s as f64,
-        mu: s.mu as f64,
-        g_m_s2: s.g_m_s2 as f64,
-        k2: s.k2 as f64,
-        ri_m: s.ri_m as f64,
-        rim_radius_m: s.rim_radius_m as f64,
+        omega_rad_s: s.omega_rad_s.to_f64(),
+        mu: s.mu.to_f64(),
+        g_m_s2: s.g_m_s2.to_f64(),
+        k2: s.k2.to_f64(),
+        ri_m: s.ri_m.to_f64(),
+        rim_radius_m: s.rim_radius_m.to_f64(),
     }
+}
+
+/// The closed forms in number type `T`.
+fn closed_run<T: Real>(s: &Scene<f64>, model: Model) -> anyhow::Result<Run> {
+    let st = narrow::<T>(s);
+    let o = residence(&st, model).map_err(scene_err)?;
+    let (time_s, note) = outcome_note(&o);
+    Ok(Run {
+        inputs: widen(&st),
+        time_s,
+        rhs_evals: None,
+        note,
+    })
 }
 
 /// What one run of a method gave.
@@ -256,7 +276,7 @@ pub struct Run {
     pub note: String,
 }
 
-fn outcome_note<T: model_core::Real>(o: &Outcome<T>) -> (Option<f64>, String) {
+fn outcome_note<T: Real>(o: &Outcome<T>) -> (Option<f64>, String) {
     match *o {
         Outcome::Leaves {
             residence_time_s,
@@ -293,51 +313,38 @@ fn outcome_note<T: model_core::Real>(o: &Outcome<T>) -> (Option<f64>, String) {
 /// Runs `method` once on `s`.
 pub fn run(method: &Method, s: &Scene<f64>, model: Model) -> anyhow::Result<Run> {
     match (method.family, method.precision) {
-        (Family::Closed, Precision::F64) => {
-            let o = residence(s, model).map_err(scene_err)?;
-            let (time_s, note) = outcome_note(&o);
-            Ok(Run {
-                inputs: *s,
-                time_s,
-                rhs_evals: None,
-                note,
-            })
-        }
-        (Family::Closed, Precision::F32Libm) => {
-            let s32 = to_f32(s);
-            let o = residence(&s32, model).map_err(scene_err)?;
-            let (time_s, note) = outcome_note(&o);
-            Ok(Run {
-                inputs: widen(&s32),
-                time_s,
-                rhs_evals: None,
-                note,
-            })
-        }
+        (Family::Closed, Precision::F64) => closed_run::<f64>(s, model),
+        (Family::Closed, Precision::F32Libm) => closed_run::<f32>(s, model),
+        (Family::Closed, Precision::F32Micromath) => closed_run::<MicroF32>(s, model),
+        (Family::Closed, Precision::F32MicromathHwSqrt) => closed_run::<MicroF32HwSqrt>(s, model),
         (_, Precision::F64) => Ok(ode_run(method, s, model)),
-        (_, Precision::F32Libm) => Ok(ode_run(method, &to_f32(s), model)),
+        (_, Precision::F32Libm) => Ok(ode_run(method, &narrow::<f32>(s), model)),
+        (_, Precision::F32Micromath) => Ok(ode_run(method, &narrow::<MicroF32>(s), model)),
+        (_, Precision::F32MicromathHwSqrt) => {
+            Ok(ode_run(method, &narrow::<MicroF32HwSqrt>(s), model))
+        }
+    }
+}
+
+/// Host ns per call of `method` in number type `T`.
+fn time_in<T: Real>(method: &Method, s: &Scene<f64>, model: Model, budget: Budget) -> f64 {
+    let st = narrow::<T>(s);
+    if method.family == Family::Closed {
+        return ns_per_call(budget, || residence(&st, model));
+    }
+    match ode_method(method, &st) {
+        Some(m) => ns_per_call(budget, || ode::integrate_constant(&st, model, m)),
+        None => f64::NAN,
     }
 }
 
 /// Host nanoseconds per call of `method` on `s`.
 pub fn time(method: &Method, s: &Scene<f64>, model: Model, budget: Budget) -> f64 {
-    match (method.family, method.precision) {
-        (Family::Closed, Precision::F64) => ns_per_call(budget, || residence(s, model)),
-        (Family::Closed, Precision::F32Libm) => {
-            let s32 = to_f32(s);
-            ns_per_call(budget, || residence(&s32, model))
-        }
-        (_, Precision::F64) => match ode_method(method, s) {
-            Some(m) => ns_per_call(budget, || ode::integrate_constant(s, model, m)),
-            None => f64::NAN,
-        },
-        (_, Precision::F32Libm) => {
-            let s32 = to_f32(s);
-            match ode_method(method, &s32) {
-                Some(m) => ns_per_call(budget, || ode::integrate_constant(&s32, model, m)),
-                None => f64::NAN,
-            }
-        }
+    match method.precision {
+        Precision::F64 => time_in::<f64>(method, s, model, budget),
+        Precision::F32Libm => time_in::<f32>(method, s, model, budget),
+        Precision::F32Micromath => time_in::<MicroF32>(method, s, model, budget),
+        Precision::F32MicromathHwSqrt => time_in::<MicroF32HwSqrt>(method, s, model, budget),
     }
 }
 
@@ -563,7 +570,11 @@ pub fn figure(points: &[Point], scene: &str, model: Model, axis: CostAxis) -> Fi
                 } else {
                     Mark::Dashed
                 },
-                color: family as usize * 2 + precision as usize,
+                color: if family == Family::Closed {
+                    8 + precision as usize
+                } else {
+                    (family as usize - 1) * 2 + (precision as usize).min(1)
+                },
                 points: pts,
             }
         })

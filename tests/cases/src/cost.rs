@@ -10,6 +10,7 @@
 use crate::check::Bench;
 use model_core::ode;
 use model_core::particle::{Model, Scene, residence};
+use model_core::real::micro::{MicroF32, MicroF32HwSqrt};
 
 /// Names of the chart's scenes, in the order of [`scene`].
 pub const SCENE_NAMES: [&str; 3] = ["paper", "near-threshold", "near-rim"];
@@ -89,10 +90,83 @@ fn closed_f32<const S: usize, const CORIOLIS: bool>(_: usize) -> f32 {
     }
 }
 
-/// One closed-form bench per scene and model.
+/// The f32 scenes in one of micromath's newtypes (same values), at compile time.
+macro_rules! micro_scenes {
+    ($t:ident) => {{
+        let mut out = [Scene {
+            omega_rad_s: $t(0.0),
+            mu: $t(0.0),
+            g_m_s2: $t(0.0),
+            k2: $t(0.0),
+            ri_m: $t(0.0),
+            rim_radius_m: $t(0.0),
+        }; 3];
+        let mut i = 0;
+        while i < 3 {
+            let s = &SCENES_F32[i];
+            out[i] = Scene {
+                omega_rad_s: $t(s.omega_rad_s),
+                mu: $t(s.mu),
+                g_m_s2: $t(s.g_m_s2),
+                k2: $t(s.k2),
+                ri_m: $t(s.ri_m),
+                rim_radius_m: $t(s.rim_radius_m),
+            };
+            i += 1;
+        }
+        out
+    }};
+}
+
+static SCENES_MICRO: [Scene<MicroF32>; 3] = micro_scenes!(MicroF32);
+static SCENES_MICRO_HW: [Scene<MicroF32HwSqrt>; 3] = micro_scenes!(MicroF32HwSqrt);
+
+/// Closed-form residence time with micromath (its own rough sqrt).
+fn closed_micro<const S: usize, const CORIOLIS: bool>(_: usize) -> f32 {
+    let s = core::hint::black_box(&SCENES_MICRO[S]);
+    match residence(s, model(CORIOLIS)) {
+        Ok(o) => o.residence_time_s().0,
+        Err(_) => f32::NAN,
+    }
+}
+
+/// Closed-form residence time with micromath and the correctly rounded (VSQRT) square root.
+fn closed_micro_hw<const S: usize, const CORIOLIS: bool>(_: usize) -> f32 {
+    let s = core::hint::black_box(&SCENES_MICRO_HW[S]);
+    match residence(s, model(CORIOLIS)) {
+        Ok(o) => o.residence_time_s().0,
+        Err(_) => f32::NAN,
+    }
+}
+
+/// The closed-form benches of one scene: libm, micromath, micromath with VSQRT; both models.
 macro_rules! closed {
     ($s:literal, $name:literal) => {
         [
+            Bench {
+                name: concat!("cost::", $name, "::flat::closed-f32-micromath"),
+                inputs: 1,
+                run: closed_micro::<$s, false>,
+                budget_instructions: None,
+            },
+            Bench {
+                name: concat!("cost::", $name, "::coriolis::closed-f32-micromath"),
+                inputs: 1,
+                run: closed_micro::<$s, true>,
+                budget_instructions: None,
+            },
+            Bench {
+                name: concat!("cost::", $name, "::flat::closed-f32-micromath-hwsqrt"),
+                inputs: 1,
+                run: closed_micro_hw::<$s, false>,
+                budget_instructions: None,
+            },
+            Bench {
+                name: concat!("cost::", $name, "::coriolis::closed-f32-micromath-hwsqrt"),
+                inputs: 1,
+                run: closed_micro_hw::<$s, true>,
+                budget_instructions: None,
+            },
             Bench {
                 name: concat!("cost::", $name, "::flat::closed-f32-libm"),
                 inputs: 1,
@@ -109,7 +183,7 @@ macro_rules! closed {
     };
 }
 
-static CLOSED: [[Bench; 2]; 3] = [
+static CLOSED: [[Bench; 6]; 3] = [
     closed!(0, "paper"),
     closed!(1, "near-threshold"),
     closed!(2, "near-rim"),
