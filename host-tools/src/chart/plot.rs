@@ -36,6 +36,8 @@ pub enum Mark {
     Line,
     /// Dashed line.
     Dashed,
+    /// Dashed line with small open circles at the points.
+    DashedPoints,
     /// Filled circles only.
     Points,
     /// A line with filled circles at the points.
@@ -413,7 +415,7 @@ impl Figure {
                             .draw_series(LineSeries::new(part.clone(), c.stroke_width(2)))
                             .map_err(be)?;
                     }
-                    Mark::Dashed => {
+                    Mark::Dashed | Mark::DashedPoints => {
                         chart
                             .draw_series(DashedLineSeries::new(
                                 part.clone(),
@@ -434,6 +436,11 @@ impl Figure {
                     Mark::Crosses => {
                         chart
                             .draw_series(part.iter().map(|&p| Cross::new(p, 6, c.stroke_width(2))))
+                            .map_err(be)?;
+                    }
+                    Mark::DashedPoints => {
+                        chart
+                            .draw_series(part.iter().map(|&p| Circle::new(p, 3, c.stroke_width(1))))
                             .map_err(be)?;
                     }
                     _ => {}
@@ -479,6 +486,9 @@ impl Figure {
                 }
                 Mark::Crosses => {
                     area.draw(&Cross::new(((x0 + x1) / 2, ym), 6, c.stroke_width(2)))?;
+                }
+                Mark::DashedPoints => {
+                    area.draw(&Circle::new(((x0 + x1) / 2, ym), 3, c.stroke_width(1)))?;
                 }
                 _ => {}
             }

@@ -20,7 +20,7 @@ use super::plot::{Figure, Mark, Scale, Series};
 use super::qemu_log::Counts;
 use super::reference::{self, RefModel, RefOutcome, RefScene};
 use super::table::Table;
-use super::timing::{Budget, ns_per_call};
+use super::timing::{Budget, Timing, ns_per_call};
 
 /// Number type and maths library a method runs in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -327,19 +327,22 @@ pub fn run(method: &Method, s: &Scene<f64>, model: Model) -> anyhow::Result<Run>
 }
 
 /// Host ns per call of `method` in number type `T`.
-fn time_in<T: Real>(method: &Method, s: &Scene<f64>, model: Model, budget: Budget) -> f64 {
+fn time_in<T: Real>(method: &Method, s: &Scene<f64>, model: Model, budget: Budget) -> Timing {
     let st = narrow::<T>(s);
     if method.family == Family::Closed {
         return ns_per_call(budget, || residence(&st, model));
     }
     match ode_method(method, &st) {
         Some(m) => ns_per_call(budget, || ode::integrate_constant(&st, model, m)),
-        None => f64::NAN,
+        None => Timing {
+            median_ns: f64::NAN,
+            min_ns: f64::NAN,
+        },
     }
 }
 
 /// Host nanoseconds per call of `method` on `s`.
-pub fn time(method: &Method, s: &Scene<f64>, model: Model, budget: Budget) -> f64 {
+pub fn time(method: &Method, s: &Scene<f64>, model: Model, budget: Budget) -> Timing {
     match method.precision {
         Precision::F64 => time_in::<f64>(method, s, model, budget),
         Precision::F32Libm => time_in::<f32>(method, s, model, budget),
@@ -383,8 +386,10 @@ pub struct Point {
     pub ref_time_s: Option<f64>,
     /// Relative error (None when either side has no T).
     pub rel_error: Option<f64>,
-    /// Host ns per call.
+    /// Host ns per call (median over batches).
     pub host_ns: f64,
+    /// Host ns per call (fastest batch).
+    pub host_ns_min: f64,
     /// QEMU counts, when the log has `cost::SCENE::MODEL::KEY`.
     pub qemu: Option<Counts>,
 }
@@ -447,7 +452,7 @@ pub fn measure(
                     (Some(t), Some(_)) => Some(t.abs()),
                     _ => None,
                 };
-                let host_ns = time(&m, &s, model, budget);
+                let timing = time(&m, &s, model, budget);
                 let mut p = Point {
                     scene: name,
                     model,
@@ -455,7 +460,8 @@ pub fn measure(
                     run: r,
                     ref_time_s,
                     rel_error,
-                    host_ns,
+                    host_ns: timing.median_ns,
+                    host_ns_min: timing.min_ns,
                     qemu: None,
                 };
                 p.qemu = qemu.get(&p.bench_name()).copied();
@@ -490,6 +496,7 @@ pub fn table(points: &[Point]) -> Table {
         "rel_error",
         "rhs_evals",
         "host_ns_per_call",
+        "host_ns_min",
         "qemu_instructions_mean",
         "qemu_instructions_max",
         "note",
@@ -516,6 +523,7 @@ pub fn table(points: &[Point]) -> Table {
             opt(p.rel_error),
             p.run.rhs_evals.map_or_else(String::new, |n| n.to_string()),
             format!("{:.1}", p.host_ns),
+            format!("{:.1}", p.host_ns_min),
             p.qemu.map_or_else(String::new, |c| c.mean.to_string()),
             p.qemu.map_or_else(String::new, |c| c.max.to_string()),
             p.run.note.clone(),
@@ -540,7 +548,9 @@ pub enum CostAxis {
 
 /// Error-against-cost chart of one scene and model.
 pub fn figure(points: &[Point], scene: &str, model: Model, axis: CostAxis) -> Figure {
-    let mut groups: BTreeMap<(Family, Precision), Vec<(f64, f64)>> = BTreeMap::new();
+    // Points keep their setting so lines join neighbouring steps/tolerances, not neighbouring
+    // costs (host times are noisy; a line sorted by cost would zigzag between settings).
+    let mut groups: BTreeMap<(Family, Precision), Vec<(f64, f64, f64)>> = BTreeMap::new();
     for p in points
         .iter()
         .filter(|p| p.scene == scene && p.model == model)
@@ -555,12 +565,13 @@ pub fn figure(points: &[Point], scene: &str, model: Model, axis: CostAxis) -> Fi
         groups
             .entry((p.method.family, p.method.precision))
             .or_default()
-            .push((x, y));
+            .push((p.method.setting.unwrap_or(0.0), x, y));
     }
     let series = groups
         .into_iter()
         .map(|((family, precision), mut pts)| {
-            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            pts.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let pts: Vec<(f64, f64)> = pts.into_iter().map(|(_, x, y)| (x, y)).collect();
             Series {
                 name: format!("{} {}", family.key(), precision.key()),
                 mark: if pts.len() == 1 {
@@ -568,7 +579,7 @@ pub fn figure(points: &[Point], scene: &str, model: Model, axis: CostAxis) -> Fi
                 } else if precision == Precision::F64 {
                     Mark::LinePoints
                 } else {
-                    Mark::Dashed
+                    Mark::DashedPoints
                 },
                 color: if family == Family::Closed {
                     8 + precision as usize
