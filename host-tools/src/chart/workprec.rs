@@ -546,11 +546,14 @@ pub enum CostAxis {
     QemuInstructions,
 }
 
+/// `(setting, cost, error)` of one measured point.
+type SettingPoint = (f64, f64, f64);
+
 /// Error-against-cost chart of one scene and model.
 pub fn figure(points: &[Point], scene: &str, model: Model, axis: CostAxis) -> Figure {
     // Points keep their setting so lines join neighbouring steps/tolerances, not neighbouring
     // costs (host times are noisy; a line sorted by cost would zigzag between settings).
-    let mut groups: BTreeMap<(Family, Precision), Vec<(f64, f64, f64)>> = BTreeMap::new();
+    let mut groups: BTreeMap<(Family, Precision), Vec<SettingPoint>> = BTreeMap::new();
     for p in points
         .iter()
         .filter(|p| p.scene == scene && p.model == model)
