@@ -36,6 +36,7 @@ pub static BENCH_GROUPS: &[&[Bench]] = &[
     cost::BENCHES,
     control::BENCHES,
     wire::BENCHES,
+    cost::ODE_BENCHES,
 ];
 
 /// All cases in one iterator.
