@@ -441,7 +441,7 @@ fn trace(seed: u32, plant: Option<u32>) {
     let mut k = 0u32;
     cl.run(STEP_RUN_S, |c| {
         k += 1;
-        if k % 10 == 0 {
+        if k.is_multiple_of(10) {
             let s = c.ctrl.status();
             println!(
                 "{:.3},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:?},{}",

@@ -188,7 +188,7 @@ fn invalid_configuration_is_refused_or_boots_faulted() {
 fn rejected_commands_change_nothing() {
     let mut c = Controller::new(ControllerConfig::nominal()).unwrap();
     c.set_motor_speeds(1.0, 2.0).unwrap();
-    let before = c.clone();
+    let before = c;
     let cases = [
         (
             c.clone().set_motor_speeds(f32::NAN, 1.0),

@@ -333,6 +333,8 @@ impl Controller {
                 }
                 // Blocked shaft or dead sensor during identification: the expected period is
                 // unknown, so allow 3 periods at the lowest speed.
+                // The index walks five per-axis arrays in step; an iterator would hide that.
+                #[allow(clippy::needless_range_loop)]
                 for i in 0..2 {
                     if self.watch[i].step(
                         dt,
