@@ -145,7 +145,7 @@ impl SpeedLoop {
     };
 
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
-    #[inline]
+    #[inline(always)]
     pub fn step(&mut self, k: &LoopConstants, input: LoopInput) -> f32 {
         let r = input.reference_rad_s;
         if r == 0.0 {
@@ -190,7 +190,8 @@ impl SpeedLoop {
         } else {
             0.0
         };
-        if input.feedback && input.measurement_valid && ev.bound_active {
+        // The stall bound is only active with a valid measurement.
+        if ev.bound_active && input.feedback {
             let at_least = rp - input.measured_rad_s;
             e = if input.direction > 0.0 {
                 e.max(at_least)
@@ -206,20 +207,21 @@ impl SpeedLoop {
         self.integral += (self.kp_prev - kp) * e;
         self.kp_prev = kp;
 
-        let ff = k.feedforward(r) + input.extra_duty;
+        // r != 0 here, so its sign is the commanded direction.
+        let ff = k.friction_duty * input.direction + r * k.duty_per_rad_s + input.extra_duty;
         let candidate_i = self.integral + ki_dt * e;
-        let unclamped = ff + kp * e + candidate_i;
+        let unlimited = ff + kp * e + candidate_i;
         let lim = k.duty_limit;
-        let saturating = (unclamped > lim && e > 0.0) || (unclamped < -lim && e < 0.0);
-        let slew_pushing = (unclamped - self.duty > k.slew_per_tick && e > 0.0)
-            || (unclamped - self.duty < -k.slew_per_tick && e < 0.0);
-        if !saturating && !slew_pushing {
-            self.integral = clamp(candidate_i, lim);
+        let next = self.duty + clamp(clamp(unlimited, lim) - self.duty, k.slew_per_tick);
+        // Conditional integration: keep the new integral only if the clamp or the slew limit
+        // is not holding the output back in the direction the error pushes.
+        // (This also bounds the integral: once the output sits at the clamp, the integral stops
+        // growing toward it.)
+        if (unlimited - next) * e <= 0.0 {
+            self.integral = candidate_i;
         }
-        let target = clamp(ff + kp * e + self.integral, lim);
-        let step = clamp(target - self.duty, k.slew_per_tick);
-        self.duty += step;
-        self.duty
+        self.duty = next;
+        next
     }
 
     /// The plant model's speed (the reference through the identified lag), rad/s.

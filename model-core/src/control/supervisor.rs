@@ -80,7 +80,7 @@ impl SensorWatch {
     /// `reference_abs_rad_s` is the reference speed and `rad_per_pulse` the pitch: one expected
     /// pulse period is `rad_per_pulse / reference`, and the timeout is
     /// `max(floor_s, 3 * expected period)` (compared without dividing).
-    #[inline]
+    #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
