@@ -104,6 +104,9 @@ struct StabilityArgs {
     /// Speed of the test, rad/s.
     #[arg(long, default_value_t = 0.5)]
     speed_rad_s: f32,
+    /// Only this pulse count (default: 4, 12 and 60).
+    #[arg(long)]
+    pulses_per_rev: Option<u16>,
 }
 
 /// Runs `bowl sim`.
@@ -156,7 +159,7 @@ pub fn run(args: &Args) -> Result<()> {
             println!("{}", serde_json::to_string_pretty(&out)?);
         }
         What::Sweep(a) => sweep(a.seed),
-        What::Stability(a) => stability(a.common.seed, a.speed_rad_s),
+        What::Stability(a) => stability(a.common.seed, a.speed_rad_s, a.pulses_per_rev),
         What::Trace(a) => trace(a.common.seed, a.plant),
     }
     Ok(())
@@ -402,11 +405,14 @@ fn sweep(seed: u32) {
     }
 }
 
-fn stability(seed: u32, speed: f32) {
+fn stability(seed: u32, speed: f32, only: Option<u16>) {
     println!(
         "pulses_per_rev,pulse_rate_hz,per_pulse_bandwidth,scheduled,half_peak_to_peak_pct,fault_code"
     );
     for n in [4u16, 12, 60] {
+        if only.is_some_and(|o| o != n) {
+            continue;
+        }
         for ppb in [0.1f32, 0.25, 0.5, 1.0, 2.0, 4.0] {
             for scheduled in [true, false] {
                 let (r, fault) =
