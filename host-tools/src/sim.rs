@@ -104,7 +104,7 @@ struct StabilityArgs {
     /// Speed of the test, rad/s.
     #[arg(long, default_value_t = 0.5)]
     speed_rad_s: f32,
-    /// Only this pulse count (default: 4, 12 and 60).
+    /// Only this pulse count (default: 1, 4, 12 and 60).
     #[arg(long)]
     pulses_per_rev: Option<u16>,
 }
@@ -409,7 +409,7 @@ fn stability(seed: u32, speed: f32, only: Option<u16>) {
     println!(
         "pulses_per_rev,pulse_rate_hz,per_pulse_bandwidth,scheduled,half_peak_to_peak_pct,fault_code"
     );
-    for n in [4u16, 12, 60] {
+    for n in [1u16, 4, 12, 60] {
         if only.is_some_and(|o| o != n) {
             continue;
         }
@@ -454,7 +454,7 @@ fn trace(seed: u32, plant: Option<u32>) {
     let mut k = 0u32;
     cl.run(STEP_RUN_S, |c| {
         k += 1;
-        if k % 10 == 0 {
+        if k.is_multiple_of(10) {
             let s = c.ctrl.status();
             println!(
                 "{:.3},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:?},{}",

@@ -87,7 +87,7 @@ fn unreachable_or_invalid_targets_are_rejected_and_change_nothing() {
     let model = scene();
     let mut c = Controller::new(ControllerConfig::nominal()).unwrap();
     c.set_motor_speeds(1.0, 1.0).unwrap();
-    let before = c.clone();
+    let before = c;
     assert_eq!(
         c.set_target_residence_time(-1.0, &model),
         Err(Rejection::InvalidResidenceTime)

@@ -41,7 +41,7 @@ fn fault_after(
     let t0 = cl.rig.time_s() as f32;
     inject(cl.rig.params_mut(), t0);
     let dt = cl.dt_s();
-    for k in 0..5000 {
+    for k in 0..20_000 {
         let d = cl.tick();
         if cl.ctrl.fault().is_some() {
             assert_eq!(d, [0.0, 0.0], "duties not zero in the fault tick");
@@ -188,7 +188,7 @@ fn invalid_configuration_is_refused_or_boots_faulted() {
 fn rejected_commands_change_nothing() {
     let mut c = Controller::new(ControllerConfig::nominal()).unwrap();
     c.set_motor_speeds(1.0, 2.0).unwrap();
-    let before = c.clone();
+    let before = c;
     let cases = [
         (
             c.clone().set_motor_speeds(f32::NAN, 1.0),

@@ -251,10 +251,12 @@ impl Controller {
     fn closed_loop_step(&mut self, dt: f32, seen: &[bool; 2]) {
         let stopped = [self.est[0].is_stopped(), self.est[1].is_stopped()];
         let r0 = self.planner.ramped()[0];
+        // Precession established: measured at half its reference or more, or (sparse pulses:
+        // N = 1 needs two pulse periods for a first measurement) its ramp done for a second.
         let established = !self.planner.spin_released()
-            && self.est[0].is_valid()
-            && self.measured[0].abs() >= 0.5 * r0.abs()
-            && r0 != 0.0;
+            && r0 != 0.0
+            && ((self.est[0].is_valid() && self.measured[0].abs() >= 0.5 * r0.abs())
+                || self.planner.steady_s()[0] > 1.0);
         let ramped = self.planner.step(dt, self.max_step, stopped, established);
         // Spin first: its model's acceleration feeds the precession axis's decoupling.
         if self.axis_loop(1, ramped[1], 0.0, seen[1], dt) {
@@ -368,12 +370,12 @@ impl Controller {
                 }
                 // Blocked shaft or dead sensor during identification: the expected period is
                 // unknown, so allow 3 periods at the lowest speed.
-                for i in 0..2 {
+                for (i, &seen_i) in seen.iter().enumerate() {
                     if self.watch[i].step(
                         dt,
                         self.duties[i].abs(),
                         self.cfg.stall_duty,
-                        seen[i],
+                        seen_i,
                         self.cfg.sensor_timeout_floor_s,
                         self.cfg.axes[i].min_speed_rad_s,
                         self.est[i].rad_per_pulse(),
