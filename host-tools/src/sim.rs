@@ -407,7 +407,7 @@ fn sweep(seed: u32) {
 
 fn stability(seed: u32, speed: f32, only: Option<u16>) {
     println!(
-        "pulses_per_rev,pulse_rate_hz,per_pulse_bandwidth,scheduled,half_peak_to_peak_pct,fault_code"
+        "pulses_per_rev,pulse_rate_hz,per_pulse_bandwidth,scheduled,half_peak_to_peak_pct,fault_code,mean_error_pct"
     );
     for n in [1u16, 4, 12, 60] {
         if only.is_some_and(|o| o != n) {
@@ -417,9 +417,13 @@ fn stability(seed: u32, speed: f32, only: Option<u16>) {
             for scheduled in [true, false] {
                 let (r, fault) =
                     experiments::low_speed_hold(seed, n, speed, ppb, scheduled, 20.0, 20.0);
-                let (cycle, fault) = (100.0 * r.half_peak_to_peak, fault.map_or(0, Fault::code));
+                let (cycle, err, fault) = (
+                    100.0 * r.half_peak_to_peak,
+                    100.0 * r.steady_state_error,
+                    fault.map_or(0, Fault::code),
+                );
                 let rate = speed * n as f32 / core::f32::consts::TAU;
-                println!("{n},{rate:.3},{ppb},{scheduled},{cycle:.3},{fault}");
+                println!("{n},{rate:.3},{ppb},{scheduled},{cycle:.3},{fault},{err:.3}");
             }
         }
     }

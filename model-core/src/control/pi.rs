@@ -27,7 +27,8 @@
 //! changes the integral absorbs `(Kp_old - Kp_new) e`, so neither does that. Integration stops
 //! (conditional integration) while the output is clamped or slew-limited in the direction the
 //! error pushes, which holds a blocked motor's integral instead of letting it run away, and while
-//! the estimator has no valid measurement (no pulse interval yet). At a zero reference the output
+//! the estimator has no valid measurement (no pulse interval yet), until the plant model has
+//! turned 2.5 pitches without one: then the shaft is stuck and the loop pushes (see `step`). At a zero reference the output
 //! is exactly zero and the integral is cleared: no hum, no creep.
 
 use super::config::AxisConfig;
@@ -77,6 +78,7 @@ pub struct LoopConstants {
     bandwidth_rad_s: f32,
     per_pulse_bw_times_pulses_per_rad: f32,
     filter_weight: f32,
+    stuck_angle_rad: f32,
     duty_limit: f32,
     slew_per_tick: f32,
 }
@@ -97,6 +99,7 @@ impl LoopConstants {
             bandwidth_rad_s: axis.bandwidth_rad_s,
             per_pulse_bw_times_pulses_per_rad: axis.per_pulse_bandwidth * pulses_per_rad,
             filter_weight: w,
+            stuck_angle_rad: 2.5 / pulses_per_rad,
             duty_limit: axis.duty_limit,
             slew_per_tick: axis.duty_slew_per_s * dt_s,
         }
@@ -181,15 +184,25 @@ impl SpeedLoop {
             }
             self.model_angle_rad = rp * w.ago_s;
         }
-        if !input.measurement_valid {
-            self.have_error = false;
-            self.error = 0.0;
-        }
         let mut e = if input.feedback && self.have_error {
             self.error
         } else {
             0.0
         };
+        if !input.measurement_valid {
+            self.have_error = false;
+            self.error = 0.0;
+            // No measurement although the model has turned 2.5 pitches since the last window
+            // event: a shaft following the model would have given two edges by now, so it is
+            // stuck (stiction, a blocked shaft, a dead sensor). Push with the full model speed
+            // so that it breaks away, or the duty crosses the stall threshold and the
+            // supervisor's sensor watch latches the fault; never sit silently at a low duty.
+            e = if input.feedback && self.model_angle_rad.abs() > k.stuck_angle_rad {
+                rp
+            } else {
+                0.0
+            };
+        }
         // The stall bound is only active with a valid measurement.
         if ev.bound_active && input.feedback {
             let at_least = rp - input.measured_rad_s;
