@@ -317,7 +317,7 @@ impl Controller {
             self.cfg.stall_duty,
             seen,
             self.cfg.sensor_timeout_floor_s,
-            r.abs(),
+            self.loops[i].model_rad_s(),
             self.est[i].rad_per_pulse(),
         ) {
             self.latch(Fault::SensorLostOrStall(i as u8));
