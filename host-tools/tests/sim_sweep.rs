@@ -49,17 +49,17 @@ fn settling_against_pulses_per_rev() {
 #[test]
 fn stability_map_shows_the_schedule_keeps_the_low_speed_loop_quiet() {
     let rows = csv(&["sim", "stability", "--pulses-per-rev", "12"]);
-    assert_eq!(rows[0][4], "half_peak_to_peak_pct");
+    assert_eq!(rows[0][5], "half_peak_to_peak_pct");
     let find = |n: &str, ppb: &str, sched: &str| {
         rows.iter()
-            .find(|r| r[0] == n && r[2] == ppb && r[3] == sched)
+            .find(|r| r[1] == n && r[3] == ppb && r[4] == sched)
             .unwrap_or_else(|| panic!("row {n} {ppb} {sched}"))
             .clone()
     };
     // The nominal gain (0.5 per pulse) at 0.5 rad/s with 12 pulses/rev: no limit cycle above 5 %.
     let nominal = find("12", "0.5", "true");
-    assert!(nominal[4].parse::<f64>().unwrap() <= 5.0, "{nominal:?}");
-    assert_eq!(nominal[5], "0");
+    assert!(nominal[5].parse::<f64>().unwrap() <= 5.0, "{nominal:?}");
+    assert_eq!(nominal[6], "0");
     // The same per-pulse gain 1, unscheduled, cycles or faults.
     let fixed = find("12", "1", "false");
     assert!(
