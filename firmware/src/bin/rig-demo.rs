@@ -326,19 +326,24 @@ fn chart(frames: &[Telemetry]) -> String {
         "<svg xmlns='http://www.w3.org/2000/svg' width='{w}' height='{h}' font-family='sans-serif' font-size='12'>\n\
          <rect width='100%' height='100%' fill='white'/>\n"
     );
-    // Faulted intervals shaded.
-    for win in frames.windows(2) {
-        if win[0].state == DeviceState::Faulted {
-            let (a, b) = (
-                x(win[0].time_ms as f64 / 1000.0),
-                x(win[1].time_ms as f64 / 1000.0),
-            );
-            let _ = writeln!(
-                svg,
-                "<rect x='{a:.1}' y='{pad}' width='{:.1}' height='{}' fill='#fdd'/>",
-                b - a,
-                h - 2.0 * pad
-            );
+    // Faulted intervals shaded, one band per interval.
+    let mut start: Option<f64> = None;
+    for (i, t) in frames.iter().enumerate() {
+        let faulted = t.state == DeviceState::Faulted;
+        let t_s = t.time_ms as f64 / 1000.0;
+        match (faulted, start) {
+            (true, None) => start = Some(t_s),
+            (false, Some(s0)) | (true, Some(s0)) if !faulted || i + 1 == frames.len() => {
+                let (a, b) = (x(s0), x(t_s));
+                let _ = writeln!(
+                    svg,
+                    "<rect x='{a:.1}' y='{pad}' width='{:.1}' height='{}' fill='#fdd'/>",
+                    b - a,
+                    h - 2.0 * pad
+                );
+                start = None;
+            }
+            _ => {}
         }
     }
     let _ = writeln!(
