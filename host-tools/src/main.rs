@@ -5,13 +5,13 @@ use clap::{Parser, Subcommand};
 
 mod chart;
 mod kinematics;
-mod predict;
-mod sim;
 mod monitor;
+mod predict;
 mod replay;
 mod rig_binding;
 mod send;
 mod serial;
+mod sim;
 mod telemetry_csv;
 mod virtual_rig;
 

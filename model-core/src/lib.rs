@@ -11,9 +11,10 @@
 #![warn(missing_docs)]
 
 pub mod bowl;
+pub mod choose;
+pub mod control;
 pub mod ode;
 pub mod particle;
-pub mod control;
 pub mod real;
 pub mod sim;
 pub mod wire;
