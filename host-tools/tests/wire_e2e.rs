@@ -88,7 +88,7 @@ fn send_and_monitor_against_the_virtual_rig() {
     let start = bowl(&["send", p, "start"]);
     assert_eq!(start.status.code(), Some(0), "{}", stdout(&start));
 
-    // Above the rig's speed limit (5000 mrad/s by default): rejected, not clamped.
+    // Above the rig's speed limit (4000 mrad/s by default): rejected, not clamped.
     let too_fast = bowl(&["send", p, "speed", "9000", "2100"]);
     assert_eq!(too_fast.status.code(), Some(2));
     assert!(stdout(&too_fast).contains("RANGE"), "{}", stdout(&too_fast));
@@ -102,7 +102,7 @@ fn send_and_monitor_against_the_virtual_rig() {
     // The rejected command changed nothing: the setpoints are still 1800/2100.
     let params = bowl(&["send", p, "params"]);
     assert_eq!(params.status.code(), Some(0));
-    assert!(stdout(&params).contains("SPEED_MAX2_MRAD_S=5000"));
+    assert!(stdout(&params).contains("SPEED_MAX2_MRAD_S=4000"));
 
     let dir = temp_dir("monitor");
     let log = dir.join("log.csv");
@@ -124,8 +124,16 @@ fn send_and_monitor_against_the_virtual_rig() {
     );
     assert_eq!(summary["frames_corrupt"], 0, "{summary}");
     assert_eq!(summary["frames_missing"], 0, "{summary}");
-    assert!(stdout(&mon).contains("state=Running"), "{}", stdout(&mon));
-    assert!(stdout(&mon).contains("w1=1.7") || stdout(&mon).contains("w1=1.8"));
+    let text = stdout(&mon);
+    assert!(
+        text.contains("state=Running") || text.contains("state=SpinningUp"),
+        "{text}"
+    );
+    // The setpoints as sent, in rad/s.
+    assert!(
+        text.contains("/1.800 w2=") && text.contains("/2.100 rad/s"),
+        "{text}"
+    );
 
     // The log: one row per telemetry frame, keyed on device time, 20 ms apart.
     let keys = csv_keys(&log);
@@ -134,10 +142,15 @@ fn send_and_monitor_against_the_virtual_rig() {
     for w in keys.windows(2) {
         assert_eq!(w[1].1 - w[0].1, 20, "{w:?}");
     }
+    // The controller has the precession motor turning by the end of the log (mrad/s).
+    let last = std::fs::read_to_string(&log).unwrap();
+    let last = last.lines().last().unwrap().split(',').collect::<Vec<_>>();
+    let precession_measured: i32 = last[6].parse().unwrap();
+    assert!(precession_measured > 900, "{last:?}");
 
     let status = bowl(&["send", p, "status"]);
     assert!(
-        stdout(&status).contains("state=Running"),
+        stdout(&status).contains("fault=None"),
         "{}",
         stdout(&status)
     );
@@ -281,4 +294,64 @@ fn replay_counts_what_the_capture_holds_and_what_damage_removed() {
     assert_eq!(s["telemetry_frames"], 247, "{s}");
     assert_eq!(s["frames_missing"], 3, "{s}");
     assert!(s["frames_corrupt"].as_u64().unwrap() >= 3, "{s}");
+}
+
+#[test]
+fn an_injected_sensor_fault_stops_both_motors_and_is_reported() {
+    let dir = temp_dir("fault");
+    let capture = dir.join("cap.bin");
+    let made = bowl(&[
+        "sim",
+        "--capture",
+        capture.to_str().unwrap(),
+        "--seconds",
+        "8",
+        "--command",
+        "0:speed,1800,2100",
+        "--command",
+        "0:start",
+        "--command",
+        "4000:inject,sensor2",
+        "--command",
+        "7000:start",
+    ]);
+    assert!(made.status.success());
+    let csv = dir.join("t.csv");
+    let s = last_json(&bowl(&[
+        "replay",
+        capture.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]));
+    assert_eq!(s["frames_missing"], 0, "{s}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let faulted: Vec<&Vec<&str>> = rows.iter().filter(|r| r[3] == "Faulted").collect();
+    assert!(!faulted.is_empty(), "the lost spin sensor is detected");
+    let first_fault_ms: u64 = faulted[0][1].parse().unwrap();
+    assert!((4000..6000).contains(&first_fault_ms), "{first_fault_ms}");
+    for r in &faulted {
+        assert_eq!(r[4], "SensorLostOrStallSpin");
+        assert_eq!(
+            (r[7], r[11]),
+            ("0", "0"),
+            "both duties zero when faulted: {r:?}"
+        );
+    }
+    // Before the fault the rig ran with both motors driven.
+    assert!(
+        rows.iter()
+            .any(|r| r[3] == "Running" && r[7] != "0" && r[11] != "0")
+    );
+    // START while faulted is refused with a reason.
+    let raw = std::fs::read(&capture).unwrap();
+    let text = String::from_utf8_lossy(&raw);
+    assert!(
+        text.contains("$R1,4,STATE*"),
+        "START while faulted is rejected"
+    );
 }
