@@ -337,3 +337,57 @@ fn too_short_a_session_is_refused_with_a_clear_error() {
     assert!(!status.success());
     assert!(stderr.contains("--seconds must be between"), "{stderr}");
 }
+
+#[test]
+fn on_a_terminal_the_demo_draws_the_monitor_dashboard() {
+    use nix::fcntl::OFlag;
+    use nix::pty::{grantpt, posix_openpt, ptsname_r, unlockpt};
+    let dir = temp_dir("tty");
+    let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY).unwrap();
+    grantpt(&master).unwrap();
+    unlockpt(&master).unwrap();
+    let screen = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(ptsname_r(&master).unwrap())
+        .unwrap();
+    let mut child = Command::new(BOWL)
+        .args(["demo", "--fast", "--rig", "host", "--out"])
+        .arg(&dir)
+        .stdout(Stdio::from(screen))
+        .spawn()
+        .unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut master = master;
+        let mut all = Vec::new();
+        let mut buf = [0u8; 8192];
+        // Reading ends with EIO once the demo exits and its side closes.
+        while let Ok(n) = master.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            all.extend_from_slice(&buf[..n]);
+        }
+        all
+    });
+    let started = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if started.elapsed() > LIMIT {
+            let _ = child.kill();
+            panic!("the demo did not end by itself");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    assert!(status.success());
+    let screen = String::from_utf8_lossy(&reader.join().unwrap()).into_owned();
+    // The monitor's dashboard, redrawn in place, with the demo's steps in its event list.
+    assert!(screen.matches("\x1b[H\x1b[2J").count() >= 5, "redraws");
+    assert!(screen.contains("precession w1") && screen.contains("bowl speed (Eq. 2)"));
+    assert!(screen.contains("inject a sensor fault"));
+    // After the live view: the whole session log and the summary.
+    let tail = screen.rsplit("\x1b[H\x1b[2J").next().unwrap();
+    assert!(tail.contains("session log:") && tail.contains("== demo summary"));
+}

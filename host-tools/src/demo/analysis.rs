@@ -169,6 +169,8 @@ pub struct Summary {
     pub board_console: Vec<String>,
     /// Bytes the host rig could not deliver (a stuck reader; 0 expected).
     pub host_bytes_dropped: u64,
+    /// The rig's parameters at the start (PARAMS answer), by token.
+    pub params: Option<serde_json::Map<String, serde_json::Value>>,
     /// Tolerances applied.
     pub tolerances: Tolerances,
     /// Running steps.
@@ -558,6 +560,12 @@ pub fn summarise(
         aborted: info.aborted,
         board_console: info.board_console,
         host_bytes_dropped: info.host_bytes_dropped,
+        params: params.map(|p| {
+            ParamId::ALL
+                .iter()
+                .map(|id| (id.token().to_string(), serde_json::json!(p[id.index()])))
+                .collect()
+        }),
         tolerances: tol,
         steps,
         fault,

@@ -288,12 +288,13 @@ fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
     let elf = build_qemu_image()?;
     // The board ends its run by itself a little after the session (a safety net: we kill it).
     let run_s = (seconds * 1.5 + 60.0).ceil() as u64;
-    // -icount: virtual time counts instructions. sleep=off lets an idle board's clock jump ahead
-    // (faster than real time), sleep=on keeps it at the wall clock.
+    // -icount: virtual time counts instructions (1 ns each, as in firmware/qemu-rig-run and the
+    // QEMU tests). sleep=off lets an idle board's clock jump ahead (faster than real time),
+    // sleep=on keeps it with the wall clock.
     let icount = if fast {
-        "shift=7,align=off,sleep=off"
+        "shift=0,sleep=off"
     } else {
-        "shift=7,align=off,sleep=on"
+        "shift=0,sleep=on"
     };
     let mut child = Command::new("qemu-system-arm")
         .args([

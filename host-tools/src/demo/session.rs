@@ -264,7 +264,13 @@ impl Session {
             }) = answers.into_iter().find(|a| a.id == id)
             {
                 let accepted = !matches!(frame, Frame::Reject { .. });
-                let answer = describe(&frame);
+                let answer = match frame {
+                    // Nineteen values: kept whole in the summary, short here.
+                    Frame::Params { id, values } => {
+                        format!("params (id {id}): {} values", values.len())
+                    }
+                    _ => describe(&frame),
+                };
                 self.record.commands.push(CommandRecord {
                     step: step.to_string(),
                     command: text.clone(),
