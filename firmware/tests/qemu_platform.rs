@@ -2,14 +2,12 @@
 //! and the instruction clock, concurrent tasks on the WFI executor, and bytes both ways over the
 //! emulated USART1. Run: `cargo test -p firmware --no-default-features --test qemu_platform`.
 
-mod common;
-
 use std::io::Write;
 
 #[test]
 fn platform_checks_pass_under_qemu() {
-    let elf = common::build_image("qemu-fw-platform");
-    let mut board = common::Board::boot(&elf);
+    let elf = firmware::host::build_image("qemu-fw-platform");
+    let mut board = firmware::host::Board::boot(&elf);
 
     assert_eq!(board.read_usart_line(), "ready");
     board.usart.write_all(b"bowl rig 0123\n").unwrap();

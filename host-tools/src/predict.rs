@@ -68,7 +68,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = MethodChoice::Closed)]
     method: MethodChoice,
     /// Fixed step of euler / semi-implicit / rk4, s (default: 0.01 / omega).
-    #[arg(long)]
+    #[arg(long, visible_alias = "step")]
     step_s: Option<f64>,
     /// Relative tolerance of dp54.
     #[arg(long, default_value_t = 1e-9)]

@@ -11,9 +11,9 @@
 //!   (per-pulse bandwidth) and pulse rate, with and without the pulse-rate schedule.
 
 use anyhow::{Result, bail};
-use model_core::control::{Controller, ControllerConfig, Fault, State};
-use model_core::sim::prng::Prng;
-use model_core::sim::{ClosedLoop, Rig, RigParams, StepMetrics, StepReport};
+use model_core::control::{Controller, ControllerConfig, Fault};
+use model_core::sim::experiments::{self, STEP_RUN_S, family_plant, rig_with_pulses};
+use model_core::sim::{ClosedLoop, Rig, RigParams, StepReport};
 use serde::Serialize;
 
 #[derive(clap::Subcommand)]
@@ -67,6 +67,12 @@ pub(crate) struct StepArgs {
     /// Override the loop's per-pulse bandwidth.
     #[arg(long)]
     per_pulse_bandwidth: Option<f32>,
+    /// Override the estimator's filter weight.
+    #[arg(long)]
+    filter_weight: Option<f32>,
+    /// Override the setpoint ramp, rad/s^2.
+    #[arg(long)]
+    accel_rad_s2: Option<f32>,
 }
 
 #[derive(clap::Args)]
@@ -104,9 +110,15 @@ pub(crate) fn run(what: &What) -> Result<()> {
                 }
             }
             let mut cfg = ControllerConfig::nominal();
-            if let Some(p) = a.per_pulse_bandwidth {
-                for ax in &mut cfg.axes {
+            for ax in &mut cfg.axes {
+                if let Some(p) = a.per_pulse_bandwidth {
                     ax.per_pulse_bandwidth = p;
+                }
+                if let Some(w) = a.filter_weight {
+                    ax.filter_weight = w;
+                }
+                if let Some(acc) = a.accel_rad_s2 {
+                    ax.accel_limit_rad_s2 = acc;
                 }
             }
             let out = StepJson {
@@ -114,7 +126,14 @@ pub(crate) fn run(what: &What) -> Result<()> {
                 pulses_per_rev: a.pulses_per_rev,
                 target_rad_s: a.target_rad_s,
                 feedback: !a.no_feedback,
-                outcome: step_run_with(rig, cfg, a.common.seed, a.target_rad_s, !a.no_feedback),
+                outcome: step_run_with(
+                    rig,
+                    cfg,
+                    a.common.seed,
+                    a.target_rad_s,
+                    !a.no_feedback,
+                    [0.0; 2],
+                ),
             };
             println!("{}", serde_json::to_string_pretty(&out)?);
         }
@@ -176,59 +195,47 @@ pub struct StepOutcome {
     pub commissioned: bool,
 }
 
-const STEP_RUN_S: f32 = 8.0;
-const STEADY_FROM_S: f32 = 5.0;
-
-/// Commissions the controller on `rig`, then steps both axes from 0 to `target`.
-pub fn step_run(rig: RigParams, seed: u32, target: f32, feedback: bool) -> StepOutcome {
-    step_run_with(rig, ControllerConfig::nominal(), seed, target, feedback)
-}
-
-/// [`step_run`] with a given controller configuration (its pulses per revolution are set from
-/// the rig).
+/// Commissions, then steps both axes (see `model_core::sim::experiments::commissioned_step`).
 pub fn step_run_with(
     rig: RigParams,
-    mut cfg: ControllerConfig,
+    cfg: ControllerConfig,
     seed: u32,
     target: f32,
     feedback: bool,
+    load_after_commissioning_nm: [f32; 2],
 ) -> StepOutcome {
-    for i in 0..2 {
-        cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
-    }
-    let ctrl = Controller::new(cfg).expect("nominal config is valid");
-    let mut cl = ClosedLoop::new(Rig::new(rig, seed), ctrl);
-    let commissioned = cl.commission(300.0) == State::Idle;
-    cl.ctrl.set_feedback_enabled(feedback);
-    let mut m = [
-        StepMetrics::new(target, STEADY_FROM_S),
-        StepMetrics::new(target, STEADY_FROM_S),
-    ];
-    let mut fault: Option<Fault> = None;
-    if commissioned && cl.ctrl.set_motor_speeds(target, target).is_ok() && cl.ctrl.start().is_ok() {
-        let dt = cl.dt_s();
-        let mut t = 0.0f32;
-        cl.run(STEP_RUN_S, |c| {
-            t += dt;
-            m[0].add(t, c.rig.speed_rad_s(0));
-            m[1].add(t, c.rig.speed_rad_s(1));
-            if fault.is_none() {
-                fault = c.ctrl.fault();
-            }
-        });
-    } else {
-        fault = cl.ctrl.fault();
-    }
+    outcome_json(experiments::commissioned_step(
+        rig,
+        cfg,
+        seed,
+        target,
+        feedback,
+        load_after_commissioning_nm,
+    ))
+}
+
+fn outcome_json(o: experiments::StepOutcome) -> StepOutcome {
     let axes = [
-        AxisFigures::from(m[0].report()),
-        AxisFigures::from(m[1].report()),
+        AxisFigures::from(o.reports[0]),
+        AxisFigures::from(o.reports[1]),
     ];
     StepOutcome {
         worst: worst_of(&axes),
         axes,
-        fault_code: fault.map_or(0, Fault::code),
-        commissioned,
+        fault_code: o.fault.map_or(0, Fault::code),
+        commissioned: o.commissioned,
     }
+}
+
+fn step_run(rig: RigParams, seed: u32, target: f32, feedback: bool) -> StepOutcome {
+    step_run_with(
+        rig,
+        ControllerConfig::nominal(),
+        seed,
+        target,
+        feedback,
+        [0.0; 2],
+    )
 }
 
 fn worst_of(a: &[AxisFigures]) -> AxisFigures {
@@ -258,14 +265,6 @@ fn median_of(a: &[AxisFigures]) -> AxisFigures {
     }
 }
 
-fn rig_with_pulses(n: u16) -> RigParams {
-    let mut rig = RigParams::nominal();
-    for a in &mut rig.axes {
-        a.sensor.pulses_per_rev = n;
-    }
-    rig
-}
-
 /// `bowl sim step`'s JSON.
 #[derive(Serialize)]
 pub struct StepJson {
@@ -280,26 +279,6 @@ pub struct StepJson {
     /// The outcome.
     #[serde(flatten)]
     pub outcome: StepOutcome,
-}
-
-/// One perturbed plant of the family (seeded).
-pub fn family_plant(seed: u32, index: u32) -> RigParams {
-    let mut rng = Prng::new(seed.wrapping_mul(0x9e37_79b9) ^ index);
-    let mut rig = RigParams::nominal();
-    for a in &mut rig.axes {
-        let m = &mut a.motor;
-        m.inertia_kg_m2 *= rng.range(0.7, 1.3);
-        m.torque_constant *= rng.range(0.85, 1.15);
-        let friction = libm::expf(rng.range(libm::logf(0.5), libm::logf(2.0)));
-        m.viscous_nm_s *= friction;
-        m.coulomb_nm *= friction;
-        m.stiction_nm *= friction;
-        a.sensor.tooth_error = 0.01;
-        a.sensor.jitter_s = 200e-6;
-        a.ripple_nm *= rng.range(0.5, 2.0);
-    }
-    rig.coupling = 0.5 * rng.range(0.8, 1.2);
-    rig
 }
 
 /// `bowl sim family`'s JSON.
@@ -325,7 +304,7 @@ pub struct FamilyJson {
 
 fn family(seed: u32, plants: u32, feedback: bool) -> FamilyJson {
     let outcomes: Vec<StepOutcome> = (0..plants)
-        .map(|i| step_run(family_plant(seed, i), seed.wrapping_add(i), 3.0, feedback))
+        .map(|i| outcome_json(experiments::family_step(seed, i, feedback)))
         .collect();
     if std::env::var_os("BOWL_SIM_VERBOSE").is_some() {
         for (i, o) in outcomes.iter().enumerate() {
@@ -334,7 +313,7 @@ fn family(seed: u32, plants: u32, feedback: bool) -> FamilyJson {
     }
     let worsts: Vec<AxisFigures> = outcomes.iter().map(|o| o.worst).collect();
     FamilyJson {
-        scenario: "family: inertia +/-30 %, torque constant +/-15 %, friction x0.5..x2, 1 % tooth error, 200 us jitter, load ripple, axis coupling; each commissioned; 0 -> 3 rad/s, 12 pulses/rev",
+        scenario: "family: inertia +/-30 %, torque constant +/-15 %, friction x0.5..x2, 1 % tooth error, 200 us jitter, load ripple x0.5..x2, axis coupling +/-20 %; each commissioned, then a material load (precession 0..0.05 N m, spin 0.02..0.1 N m) the model does not know; 0 -> 3 rad/s, 12 pulses/rev",
         plants,
         seed,
         feedback,
@@ -416,48 +395,6 @@ fn sweep(seed: u32) {
     }
 }
 
-/// Low-speed hold: half peak-to-peak of the true speed over a window, percent of the target.
-pub fn low_speed_cycle(
-    seed: u32,
-    pulses: u16,
-    speed: f32,
-    per_pulse_bandwidth: f32,
-    scheduled: bool,
-) -> (f32, u8) {
-    let rig = rig_with_pulses(pulses);
-    let mut cfg = ControllerConfig::nominal();
-    for i in 0..2 {
-        cfg.axes[i].pulses_per_rev = pulses;
-        let (a, fd, tau) = rig.axes[i].motor.ideal_model(rig.supply_v);
-        cfg.axes[i].model.volts_per_rad_s = a;
-        cfg.axes[i].model.friction_duty = fd;
-        cfg.axes[i].model.time_constant_s = tau;
-        cfg.axes[i].per_pulse_bandwidth = per_pulse_bandwidth;
-        if !scheduled {
-            // Unscheduled: the bandwidth the schedule allows at 3 rad/s, at every speed.
-            let at3 = per_pulse_bandwidth * pulses as f32 * 3.0 / core::f32::consts::TAU;
-            cfg.axes[i].bandwidth_rad_s = at3.min(cfg.axes[i].bandwidth_rad_s);
-            cfg.axes[i].per_pulse_bandwidth = 10.0;
-        }
-        cfg.axes[i].min_speed_rad_s = cfg.axes[i].min_speed_rad_s.min(0.5 * speed);
-    }
-    let mut cl = ClosedLoop::new(Rig::new(rig, seed), Controller::new(cfg).expect("valid"));
-    let _ = cl.ctrl.set_motor_speeds(speed, speed);
-    let _ = cl.ctrl.start();
-    cl.run(20.0, |_| {});
-    let mut m = StepMetrics::new(speed, 0.0);
-    let dt = cl.dt_s();
-    let mut t = 0.0;
-    cl.run(20.0, |c| {
-        t += dt;
-        m.add(t, c.rig.speed_rad_s(1));
-    });
-    (
-        100.0 * m.report().half_peak_to_peak,
-        cl.ctrl.fault().map_or(0, Fault::code),
-    )
-}
-
 fn stability(seed: u32, speed: f32) {
     println!(
         "pulses_per_rev,pulse_rate_hz,per_pulse_bandwidth,scheduled,half_peak_to_peak_pct,fault_code"
@@ -465,7 +402,9 @@ fn stability(seed: u32, speed: f32) {
     for n in [4u16, 12, 60] {
         for ppb in [0.1f32, 0.25, 0.5, 1.0, 2.0, 4.0] {
             for scheduled in [true, false] {
-                let (cycle, fault) = low_speed_cycle(seed, n, speed, ppb, scheduled);
+                let (r, fault) =
+                    experiments::low_speed_hold(seed, n, speed, ppb, scheduled, 20.0, 20.0);
+                let (cycle, fault) = (100.0 * r.half_peak_to_peak, fault.map_or(0, Fault::code));
                 let rate = speed * n as f32 / core::f32::consts::TAU;
                 println!("{n},{rate:.3},{ppb},{scheduled},{cycle:.3},{fault}");
             }
@@ -474,9 +413,12 @@ fn stability(seed: u32, speed: f32) {
 }
 
 fn trace(seed: u32, plant: Option<u32>) {
-    let (rig, rig_seed) = match plant {
-        Some(i) => (family_plant(seed, i), seed.wrapping_add(i)),
-        None => (RigParams::nominal(), seed),
+    let (rig, rig_seed, load) = match plant {
+        Some(i) => {
+            let (rig, load) = family_plant(seed, i);
+            (rig, seed.wrapping_add(i), load)
+        }
+        None => (RigParams::nominal(), seed, [0.0; 2]),
     };
     let ctrl = Controller::new(ControllerConfig::nominal()).expect("valid");
     let mut cl = ClosedLoop::new(Rig::new(rig, rig_seed), ctrl);
@@ -485,6 +427,11 @@ fn trace(seed: u32, plant: Option<u32>) {
         "commissioning: {state:?}, identified {:?}",
         cl.ctrl.identified()
     );
+    let now = cl.rig.time_s() as f32;
+    for (a, l) in cl.rig.params_mut().axes.iter_mut().zip(load) {
+        a.faults.load_step_from_s = now;
+        a.faults.load_step_nm = l;
+    }
     let _ = cl.ctrl.set_motor_speeds(3.0, 3.0);
     let _ = cl.ctrl.start();
     println!(
@@ -494,7 +441,7 @@ fn trace(seed: u32, plant: Option<u32>) {
     let mut k = 0u32;
     cl.run(STEP_RUN_S, |c| {
         k += 1;
-        if k % 10 == 0 {
+        if k.is_multiple_of(10) {
             let s = c.ctrl.status();
             println!(
                 "{:.3},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:?},{}",

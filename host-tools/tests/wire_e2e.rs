@@ -355,3 +355,47 @@ fn an_injected_sensor_fault_stops_both_motors_and_is_reported() {
         "START while faulted is rejected"
     );
 }
+
+#[test]
+fn monitor_draws_the_dashboard_on_a_terminal() {
+    use nix::fcntl::OFlag;
+    use nix::pty::{grantpt, posix_openpt, ptsname_r, unlockpt};
+    let sim = Sim::start(&["--seconds", "10"]);
+    // The monitor's stdout is a pseudo-terminal, so it draws the dashboard.
+    let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY).unwrap();
+    grantpt(&master).unwrap();
+    unlockpt(&master).unwrap();
+    let screen = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(ptsname_r(&master).unwrap())
+        .unwrap();
+    let mut child = Command::new(BOWL)
+        .args(["monitor", &sim.path, "--seconds", "1.5"])
+        .stdout(Stdio::from(screen))
+        .spawn()
+        .unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut master = master;
+        let mut all = Vec::new();
+        let mut buf = [0u8; 8192];
+        // Reading ends with EIO once the monitor exits and its side closes.
+        while let Ok(n) = master.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            all.extend_from_slice(&buf[..n]);
+        }
+        all
+    });
+    assert!(child.wait().unwrap().success());
+    let screen = String::from_utf8_lossy(&reader.join().unwrap()).into_owned();
+    assert!(screen.contains("\x1b[H\x1b[2J"), "redraws in place");
+    assert!(screen.contains("bowl monitor"));
+    assert!(screen.contains("precession w1") && screen.contains("bowl speed (Eq. 2)"));
+    assert!(screen.contains("frames ok"));
+    assert!(
+        screen.chars().any(|c| ('▁'..='█').contains(&c)),
+        "trend lines"
+    );
+}

@@ -11,6 +11,7 @@
 #![warn(missing_docs)]
 
 pub mod bowl;
+pub mod choose;
 pub mod control;
 pub mod ode;
 pub mod particle;

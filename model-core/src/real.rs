@@ -6,6 +6,9 @@
 
 use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 
+#[cfg(feature = "micromath")]
+pub mod micro;
+
 /// A real number type the model is generic over (`f32` or `f64`).
 pub trait Real:
     Copy

@@ -120,6 +120,23 @@ proptest! {
         }
     }
 
+    /// Up to four flipped bits between `$` and `*` are always detected (Hamming distance 5 at
+    /// these lengths), whatever else the flips do to the fields.
+    #[test]
+    fn up_to_four_bit_errors_in_the_checked_part_are_detected(
+        frame in frame(),
+        bits in proptest::collection::vec(any::<prop::sample::Index>(), 1..=4),
+    ) {
+        let mut bytes = encode_vec(&frame);
+        let checked = 1..bytes.len() - 10;
+        let nbits = checked.len() * 8;
+        let positions: std::collections::BTreeSet<usize> = bits.iter().map(|i| i.index(nbits)).collect();
+        for p in &positions {
+            bytes[checked.start + p / 8] ^= 1 << (p % 8);
+        }
+        prop_assert!(decode_frame(&bytes).is_err(), "{} flips undetected", positions.len());
+    }
+
     /// One changed byte anywhere is always detected (CRC-32 catches every burst of <= 32 bits).
     #[test]
     fn single_byte_damage_is_always_detected(frame in frame(), pos in any::<prop::sample::Index>(), x in 1u8..=255) {

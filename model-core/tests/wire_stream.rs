@@ -358,3 +358,34 @@ fn restarts_and_duplicates_are_not_counted_as_missing() {
     assert_eq!(stats.duplicates, 1);
     assert_eq!(stats.restarts, 2);
 }
+
+/// A hit delimiter costs only its own frame: whatever replaces the `\n` of frame 1 or the `$`
+/// of frame 3 (any of the 255 other byte values), frames 0, 2 and 4 come out.
+#[test]
+fn a_hit_delimiter_never_takes_a_neighbour() {
+    let base = match decode_frame(b"$T1,2000,100,5,2,0,12,0,40,0,0,0,2,12,-1,-2*17BB20C2\n") {
+        Ok(Frame::Telemetry(t)) => t,
+        other => panic!("{other:?}"),
+    };
+    let (clean, placed) = capture(&base, 5, &[]);
+    for x in 1..=255u8 {
+        for (frame, at) in [(1, placed[1].end - 1), (3, placed[3].start)] {
+            let mut bytes = clean.clone();
+            bytes[at] ^= x;
+            let (frames, stats) = decode_all(&bytes);
+            let seqs: Vec<u16> = frames
+                .iter()
+                .map(|f| match f {
+                    Frame::Telemetry(t) => t.seq,
+                    other => panic!("{other:?}"),
+                })
+                .collect();
+            let want: Vec<u16> = (0..5).filter(|&s| s != frame).collect();
+            assert_eq!(
+                seqs, want,
+                "delimiter of frame {frame} hit with xor {x:#04x}"
+            );
+            assert_eq!(stats.frames_missing, 1);
+        }
+    }
+}

@@ -1,4 +1,6 @@
 //! The traits a board implements. Small on purpose: each is one peripheral's job.
+//! (Edge timestamps arrive through [`super::edges::EdgeQueue`], filled by the board; the byte
+//! stream is `embedded_io_async::{Read, Write}`.)
 
 /// One motor's PWM output with its direction input on the H-bridge.
 pub trait MotorOutput {
@@ -7,13 +9,6 @@ pub trait MotorOutput {
     fn set_duty(&mut self, duty: f32);
     /// PWM compare to 0 at once: the bridge input goes low (coast on a PWM/DIR bridge).
     fn off(&mut self);
-}
-
-/// Timestamps of one proximity sensor's edges, from a free-running capture timer.
-#[allow(async_fn_in_trait)] // single-threaded executor: no Send bound wanted
-pub trait EdgeSource {
-    /// Waits for the next edge and returns its capture-timer value (wrapping).
-    async fn next_edge(&mut self) -> u32;
 }
 
 /// The free-running timer the edge timestamps come from.

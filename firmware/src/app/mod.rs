@@ -2,17 +2,20 @@
 //! emulated board. A board supplies the [`hal`] traits; [`tasks`] are the async loops that
 //! the board's executor runs.
 //!
-//! - [`hal`]: the traits a board implements (motor output, edge source, capture clock,
-//!   watchdog, flash sector).
+//! - [`hal`]: the traits a board implements (motor output, capture clock, watchdog, flash
+//!   region); the byte stream is `embedded_io_async`.
+//! - [`binding`]: the controller + particle model behind the wire protocol (`RigCore`).
 //! - [`edges`]: the queue from the pulse-capture interrupt/task to the control tick.
 //! - [`params`]: parameters persisted in flash (version + CRC-32, append-only records).
 //! - [`reset`]: reset cause and a reset counter that survives resets in uninitialised RAM.
 //! - [`motors`]: the pair of motor outputs and the all-off path used by faults and panics.
 //! - [`tasks`]: capture, control tick, link (telemetry + commands), supervisor.
 
+pub mod binding;
 pub mod edges;
 pub mod hal;
 pub mod motors;
 pub mod params;
 pub mod reset;
+pub mod slot;
 pub mod tasks;

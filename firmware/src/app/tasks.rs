@@ -3,7 +3,8 @@
 //! be generic) and spawns them.
 //!
 //! Task set and rates:
-//! - capture (one per axis): edge timestamps into an [`EdgeQueue`];
+//! - pulse capture: the board's capture interrupt (STM32: TIM2) or the emulated plant pushes
+//!   edge timestamps into one [`EdgeQueue`] per axis;
 //! - control: a fixed-rate tick ([`CONTROL_HZ`]): drain edges, run the controller, set duties;
 //! - link: commands in, answers and telemetry out over the byte stream;
 //! - supervisor: feeds the watchdog only while the control tick keeps running.
@@ -13,13 +14,13 @@ use core::sync::atomic::{AtomicU32, Ordering};
 
 use embassy_futures::select::{Either, select};
 use embassy_sync::blocking_mutex::Mutex;
-use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::blocking_mutex::raw::RawMutex;
 use embassy_time::{Duration, Instant, Ticker};
 use embedded_io_async::{Read, Write};
 use heapless::Vec;
 
 use super::edges::{EDGES_PER_TICK, EdgeQueue};
-use super::hal::{CaptureClock, EdgeSource, MotorOutput, Watchdog};
+use super::hal::{CaptureClock, MotorOutput, Watchdog};
 use super::motors::{AXES, Motors};
 
 /// The control tick rate (the controller's nominal `tick_hz`).
@@ -52,15 +53,10 @@ pub trait RigCore {
 }
 
 /// The core shared by the control and link tasks (both lock it briefly; no await inside).
-pub type SharedCore<C> = Mutex<CriticalSectionRawMutex, RefCell<C>>;
-
-/// Forwards one sensor's edges into its queue, forever.
-pub async fn capture<E: EdgeSource>(mut source: E, queue: &EdgeQueue) -> ! {
-    loop {
-        let t = source.next_edge().await;
-        queue.push(t);
-    }
-}
+/// On the boards `M` is `ThreadModeRawMutex`: every task runs in thread mode on one executor,
+/// so the lock never masks interrupts (pulse capture keeps its latency while telemetry
+/// computes the residence-time prediction).
+pub type SharedCore<M, C> = Mutex<M, RefCell<C>>;
 
 /// Counts control ticks: the supervisor feeds the watchdog only while this advances.
 pub struct Heartbeat(AtomicU32);
@@ -86,8 +82,8 @@ impl Heartbeat {
 }
 
 /// The fixed-rate control loop, forever.
-pub async fn control<C: RigCore, M: MotorOutput, K: CaptureClock>(
-    core: &SharedCore<C>,
+pub async fn control<RM: RawMutex, C: RigCore, M: MotorOutput, K: CaptureClock>(
+    core: &SharedCore<RM, C>,
     queues: &[EdgeQueue; AXES],
     clock: &K,
     motors: &mut Motors<M>,
@@ -125,7 +121,11 @@ pub fn now_ms() -> u32 {
 
 /// Commands in, answers and telemetry out, forever. A write error (a broken link) drops that
 /// frame: telemetry's sequence numbers show the host what it missed.
-pub async fn link<C: RigCore, R: Read, W: Write>(core: &SharedCore<C>, mut rx: R, mut tx: W) -> ! {
+pub async fn link<RM: RawMutex, C: RigCore, R: Read, W: Write>(
+    core: &SharedCore<RM, C>,
+    mut rx: R,
+    mut tx: W,
+) -> ! {
     let mut frame = [0u8; FRAME_BYTES];
     if let Some(n) = core.lock(|c| c.borrow_mut().hello(&mut frame)) {
         let _ = tx.write_all(&frame[..n]).await;

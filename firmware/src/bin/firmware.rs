@@ -1,43 +1,260 @@
-//! Bowl rig controller firmware (STM32F411CE Black Pill).
+//! Bowl rig controller firmware for the STM32F411CE Black Pill.
 //!
-//! Bring-up image: clocks, the on-board LED on PC13 as a heartbeat, defmt logs over RTT.
-//! The control tasks arrive with the firmware issue; the logic they run lives in `model-core`.
+//! Boot: read the reset cause and count the reset, bring the outputs up *off*, load the
+//! parameters from flash, then run the tasks: control tick (1 kHz), host link (commands,
+//! answers, telemetry over USART2 with DMA), supervisor (watchdog, parameter persistence) and a
+//! heartbeat LED. Pulse capture is the TIM2 interrupt. Pin map: `firmware::blackpill` and
+//! docs/wiring.md. Flash and run: `cargo flash` (probe-rs; defmt logs over RTT).
 #![no_std]
 #![no_main]
 
-use defmt::info;
+use core::cell::RefCell;
+
+use cortex_m_rt::{ExceptionFrame, exception};
+use defmt::{error, info, warn};
 use defmt_rtt as _;
 use embassy_executor::Spawner;
+use embassy_stm32::flash::Flash;
 use embassy_stm32::gpio::{Level, Output, Speed};
-use embassy_time::Timer;
-use model_core::bowl::{BowlGeometry, MotorSpeeds};
+use embassy_stm32::peripherals::{DMA1_CH5, DMA1_CH6, USART2};
+use embassy_stm32::time::Hertz;
+use embassy_stm32::timer::low_level::CountingMode;
+use embassy_stm32::timer::simple_pwm::{PwmPin, SimplePwm};
+use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
+use embassy_stm32::wdg::IndependentWatchdog;
+use embassy_stm32::{bind_interrupts, dma, gpio::OutputType};
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
+use embassy_time::{Duration, Ticker};
+use firmware::app::binding::{
+    ControlledRig, NoInjection, PERSISTED_COUNT, Station, default_persisted,
+};
+use firmware::app::hal::Watchdog;
+use firmware::app::motors::Motors;
+use firmware::app::params::ParamLog;
+use firmware::app::reset;
+use firmware::app::slot::Slot;
+use firmware::app::tasks::{self, Heartbeat, SharedCore};
+use firmware::blackpill::capture::{self, Tim2Clock};
+use firmware::blackpill::clocks;
+use firmware::blackpill::flash_region::ParamSector;
+use firmware::blackpill::motor_pwm::{self, PWM_HZ, PwmMotor};
+use firmware::blackpill::reset_cause::{self, ResetFlag};
+use model_core::control::ControllerConfig;
+use model_core::wire::{Hello, ResetCause};
+
+bind_interrupts!(struct Irqs {
+    USART2 => usart::InterruptHandler<USART2>;
+    DMA1_STREAM5 => dma::InterruptHandler<DMA1_CH5>;
+    DMA1_STREAM6 => dma::InterruptHandler<DMA1_CH6>;
+});
+
+type Core = SharedCore<ThreadModeRawMutex, Station<NoInjection>>;
+
+/// Watchdog timeout: 25 control periods of slack over the supervisor's 20 ms feeding period.
+const WATCHDOG_TIMEOUT_US: u32 = 250_000;
+
+static CORE: Slot<Core> = Slot::new();
+static HEARTBEAT: Heartbeat = Heartbeat::new();
+static RX_RING: Slot<[u8; 256]> = Slot::new();
+static PARAM_LOG: Slot<ParamLog<ParamSector>> = Slot::new();
+
+struct Iwdg(IndependentWatchdog<'static, embassy_stm32::peripherals::IWDG>);
+
+impl Watchdog for Iwdg {
+    fn feed(&mut self) {
+        self.0.pet();
+    }
+}
+
+fn wire_cause(flag: ResetFlag) -> ResetCause {
+    match flag {
+        ResetFlag::IndependentWatchdog => ResetCause::IndependentWatchdog,
+        ResetFlag::WindowWatchdog => ResetCause::WindowWatchdog,
+        ResetFlag::Software => ResetCause::Software,
+        ResetFlag::LowPower => ResetCause::LowPower,
+        ResetFlag::PowerOn => ResetCause::PowerOn,
+        ResetFlag::Pin => ResetCause::Pin,
+        ResetFlag::Unknown => ResetCause::Unknown,
+    }
+}
 
 #[embassy_executor::main]
-async fn main(_spawner: Spawner) {
-    let p = embassy_stm32::init(Default::default());
-    // The Black Pill's blue LED is active low on PC13.
-    let mut led = Output::new(p.PC13, Level::High, Speed::Low);
-    let geometry = BowlGeometry::<f32>::default();
-    let omega = geometry
-        .combined_speed_rad_s(MotorSpeeds {
-            precession_rad_s: 1.8,
-            spin_rad_s: 1.8,
-        })
-        .unwrap_or(0.0);
-    info!(
-        "bowl rig firmware up; Eq. 2 self-check: 1.8 + 1.8 rad/s -> {} rad/s",
-        omega
+async fn main(spawner: Spawner) {
+    // Before anything else: the flags are cleared here, the counter lives in .uninit RAM.
+    let flag = reset_cause::take();
+    let resets = reset::count_this_boot();
+    let p = embassy_stm32::init(clocks::config());
+
+    // Outputs first, off: PWM compare 0, direction low.
+    let pwm = SimplePwm::new(
+        p.TIM1,
+        Some(PwmPin::new(p.PA8, OutputType::PushPull)),
+        Some(PwmPin::new(p.PA9, OutputType::PushPull)),
+        None,
+        None,
+        Hertz(PWM_HZ),
+        CountingMode::EdgeAlignedUp,
     );
+    let ch = pwm.split();
+    let mut motors = Motors::new([
+        PwmMotor::new(ch.ch1, Output::new(p.PB12, Level::Low, Speed::Low)),
+        PwmMotor::new(ch.ch2, Output::new(p.PB13, Level::Low, Speed::Low)),
+    ]);
+    motors.all_off();
+    let capture = capture::start(p.TIM2, p.PA15, p.PB3);
+
+    info!(
+        "boot: reset cause {}, resets since power-on {}",
+        flag, resets
+    );
+
+    // Parameters: the newest valid record, or the defaults (and why).
+    let log = PARAM_LOG
+        .put(ParamLog::new(ParamSector::new(Flash::new_blocking(
+            p.FLASH,
+        ))))
+        .unwrap_or_else(|| halt("parameter log slot"));
+    let stored = match log.load::<PERSISTED_COUNT>() {
+        Ok(v) => {
+            info!("params: loaded from flash");
+            v
+        }
+        Err(e) => {
+            warn!("params: {}, using defaults", e);
+            default_persisted()
+        }
+    };
+    let hello = Hello {
+        reset_cause: wire_cause(flag),
+        reset_count: resets as u16,
+    };
+    let (rig, outcome) =
+        ControlledRig::new(ControllerConfig::nominal(), stored, hello, NoInjection);
+    if let Err(r) = outcome {
+        warn!("params: stored values rejected ({}), using defaults", r);
+    }
+    let core = CORE
+        .put(Mutex::new(RefCell::new(Station::new(rig))))
+        .unwrap_or_else(|| halt("core slot"));
+
+    // Host link: USART2 115200 8N1, TX by DMA, RX into a circular DMA ring.
+    let mut cfg = usart::Config::default();
+    cfg.baudrate = model_core::wire::DEFAULT_BAUD;
+    let uart = Uart::new(p.USART2, p.PA3, p.PA2, p.DMA1_CH6, p.DMA1_CH5, Irqs, cfg)
+        .unwrap_or_else(|_| halt("USART2 config"));
+    let (tx, rx) = uart.split();
+    let ring = RX_RING
+        .put([0; 256])
+        .unwrap_or_else(|| halt("rx ring slot"));
+    let rx = rx.into_ring_buffered(ring);
+
+    let mut iwdg = IndependentWatchdog::new(p.IWDG, WATCHDOG_TIMEOUT_US);
+    iwdg.unleash();
+
+    let led = Output::new(p.PC13, Level::High, Speed::Low);
+    spawn(spawner, control_task(core, motors, capture));
+    spawn(spawner, link_task(core, rx, tx));
+    spawn(spawner, supervisor_task(Iwdg(iwdg), core, log));
+    spawn(spawner, heartbeat_task(led));
+    info!("running");
+}
+
+fn spawn<S>(
+    spawner: Spawner,
+    token: Result<embassy_executor::SpawnToken<S>, embassy_executor::SpawnError>,
+) {
+    match token {
+        Ok(t) => spawner.spawn(t),
+        Err(_) => halt("task pool"),
+    }
+}
+
+/// A startup invariant failed: motors off, log, and reset (the next boot reports `Software`).
+fn halt(what: &str) -> ! {
+    motor_pwm::emergency_off();
+    error!("startup failed: {}", what);
+    cortex_m::peripheral::SCB::sys_reset()
+}
+
+#[embassy_executor::task]
+async fn control_task(
+    core: &'static Core,
+    mut motors: Motors<PwmMotor>,
+    _capture: capture::Capture,
+) {
+    tasks::control(core, &capture::EDGES, &Tim2Clock, &mut motors, &HEARTBEAT).await
+}
+
+#[embassy_executor::task]
+async fn link_task(
+    core: &'static Core,
+    rx: RingBufferedUartRx<'static>,
+    tx: UartTx<'static, embassy_stm32::mode::Async>,
+) {
+    tasks::link(core, rx, tx).await
+}
+
+/// Feeds the watchdog while the control tick runs, and persists changed parameters while the
+/// motors are off.
+#[embassy_executor::task]
+async fn supervisor_task(
+    watchdog: Iwdg,
+    core: &'static Core,
+    log: &'static mut ParamLog<ParamSector>,
+) {
+    let feed = tasks::supervisor(watchdog, &HEARTBEAT);
+    let persist = async {
+        let mut ticker = Ticker::every(Duration::from_millis(500));
+        loop {
+            ticker.next().await;
+            let values = core.lock(|c| {
+                let mut c = c.borrow_mut();
+                if c.rig.take_params_to_save() {
+                    Some(c.params_to_persist())
+                } else {
+                    None
+                }
+            });
+            if let Some(v) = values {
+                match log.save(&v) {
+                    Ok(()) => {
+                        let (_, models) = firmware::app::binding::split_persisted(&v);
+                        info!("params: saved; motor models {} / {}", models[0], models[1]);
+                    }
+                    Err(e) => error!("params: save failed: {}", e),
+                }
+            }
+        }
+    };
+    embassy_futures::join::join(feed, persist).await;
+}
+
+#[embassy_executor::task]
+async fn heartbeat_task(mut led: Output<'static>) {
+    let mut ticker = Ticker::every(Duration::from_millis(500));
     loop {
-        led.set_low();
-        Timer::after_millis(100).await;
-        led.set_high();
-        Timer::after_millis(900).await;
+        ticker.next().await;
+        led.toggle();
     }
 }
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
-    defmt::error!("panic: {}", defmt::Display2Format(info));
+    // Motors first: raw register writes, no locks, nothing that could panic again.
+    motor_pwm::emergency_off();
+    // Only the location: formatting the message would link core's float formatting (about
+    // 18 KiB) for the float arguments of panic messages anywhere in the image.
+    match info.location() {
+        Some(l) => error!("panic at {}:{}", l.file(), l.line()),
+        None => error!("panic"),
+    }
+    cortex_m::peripheral::SCB::sys_reset()
+}
+
+#[exception]
+unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
+    motor_pwm::emergency_off();
+    error!("hard fault at pc {=u32:#010x}", frame.pc());
     cortex_m::peripheral::SCB::sys_reset()
 }

@@ -47,8 +47,49 @@ impl FlashRegion for ParamSector {
     }
 
     fn erase(&mut self) -> Result<(), FlashError> {
-        self.flash
+        // A 128 KiB sector erase takes 1 to 4 s (RM0383: t_ERASE128KB), with the CPU stalled
+        // on flash reads. The watchdog (250 ms) would reset the MCU half way: stretch it to its
+        // maximum for the erase, then put it back. Only called with the motors off.
+        let saved = stretch_watchdog();
+        let result = self
+            .flash
             .blocking_erase(SECTOR7_OFFSET, SECTOR7_OFFSET + Self::SIZE)
-            .map_err(|_| FlashError::Hardware)
+            .map_err(|_| FlashError::Hardware);
+        restore_watchdog(saved);
+        result
     }
+}
+
+const IWDG_KEY_RELOAD: u16 = 0xAAAA;
+const IWDG_KEY_UNLOCK: u16 = 0x5555;
+
+/// Sets the IWDG to its longest timeout (prescaler 256, reload 4095: about 32 s on the 32 kHz
+/// LSI) and reloads it; returns the previous (prescaler, reload) registers.
+fn stretch_watchdog() -> (u8, u16) {
+    use embassy_stm32::pac::iwdg::vals::{Key, Pr};
+    let iwdg = embassy_stm32::pac::IWDG;
+    let saved = (iwdg.pr().read().pr().to_bits(), iwdg.rlr().read().rl());
+    iwdg.kr()
+        .write(|w| w.set_key(Key::from_bits(IWDG_KEY_RELOAD)));
+    iwdg.kr()
+        .write(|w| w.set_key(Key::from_bits(IWDG_KEY_UNLOCK)));
+    iwdg.pr().write(|w| w.set_pr(Pr::DIVIDE_BY256));
+    iwdg.rlr().write(|w| w.set_rl(0x0FFF));
+    // The new values load on the next reload once the LSI domain has taken them (PVU/RVU).
+    while iwdg.sr().read().pvu() || iwdg.sr().read().rvu() {}
+    iwdg.kr()
+        .write(|w| w.set_key(Key::from_bits(IWDG_KEY_RELOAD)));
+    saved
+}
+
+fn restore_watchdog((pr, rl): (u8, u16)) {
+    use embassy_stm32::pac::iwdg::vals::{Key, Pr};
+    let iwdg = embassy_stm32::pac::IWDG;
+    iwdg.kr()
+        .write(|w| w.set_key(Key::from_bits(IWDG_KEY_UNLOCK)));
+    iwdg.pr().write(|w| w.set_pr(Pr::from_bits(pr)));
+    iwdg.rlr().write(|w| w.set_rl(rl));
+    while iwdg.sr().read().pvu() || iwdg.sr().read().rvu() {}
+    iwdg.kr()
+        .write(|w| w.set_key(Key::from_bits(IWDG_KEY_RELOAD)));
 }

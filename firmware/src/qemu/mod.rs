@@ -5,11 +5,25 @@
 //! Run it with `-icount shift=0,sleep=off` (see `firmware/qemu-rig-run`).
 
 pub mod executor;
+pub mod plant;
 pub mod reference_timer;
 pub mod time_driver;
 pub mod usart;
+pub mod watchdog;
 
 use cortex_m_semihosting::debug;
+
+/// Interrupts without a handler of their own land here (cortex-m-rt's `DefaultHandler`, which
+/// every device interrupt points to when no device crate provides a vector table).
+#[cortex_m_rt::exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    if irqn == usart::USART1_IRQ {
+        usart::on_interrupt();
+    } else {
+        cortex_m_semihosting::hprintln!("unexpected interrupt {}", irqn);
+        exit(false);
+    }
+}
 
 /// Ends the QEMU run with a pass or fail exit status (semihosting `SYS_EXIT`).
 pub fn exit(success: bool) -> ! {

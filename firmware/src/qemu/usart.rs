@@ -2,9 +2,9 @@
 //!
 //! QEMU transmits a byte synchronously when DR is written (TXE stays set), and hands over the next
 //! received byte only after DR has been read, so the host side is flow-controlled and nothing is
-//! lost. Reception is polled from the SysTick interrupt (every 100 us of virtual time, about the
-//! pace of 115200 baud) into a ring buffer that the async reader drains; when the ring is full
-//! the byte stays in QEMU until there is room.
+//! lost. Reception is by the RXNE interrupt (USART1 = IRQ 37, dispatched from cortex-m-rt's
+//! `DefaultHandler`) into a ring buffer that the async reader drains; when the ring is full the
+//! interrupt is masked and the byte stays in QEMU until the reader has made room.
 
 use core::cell::RefCell;
 use core::convert::Infallible;
@@ -22,6 +22,10 @@ const SR_TXE: u32 = 1 << 7;
 const CR1_UE: u32 = 1 << 13;
 const CR1_TE: u32 = 1 << 3;
 const CR1_RE: u32 = 1 << 2;
+const CR1_RXNEIE: u32 = 1 << 5;
+const CR1_ON: u32 = CR1_UE | CR1_TE | CR1_RE;
+/// USART1's interrupt number on QEMU's STM32F405 (as on the real part).
+pub const USART1_IRQ: i16 = 37;
 
 /// Received bytes waiting for the reader.
 const RX_CAPACITY: usize = 256;
@@ -32,16 +36,37 @@ static RX_WAKER: AtomicWaker = AtomicWaker::new();
 pub fn enable() -> (UsartTx, UsartRx) {
     // SAFETY: USART1's registers exist at this address on netduinoplus2; only this module
     // touches them, and `enable` hands out the single TX and RX halves.
-    unsafe { CR1.write_volatile(CR1_UE | CR1_TE | CR1_RE) };
+    unsafe { CR1.write_volatile(CR1_ON | CR1_RXNEIE) };
+    // SAFETY: unmasking USART1's line; its handler (`on_interrupt`) only touches RX state.
+    unsafe { cortex_m::peripheral::NVIC::unmask(Usart1Irq) };
     (UsartTx { _private: () }, UsartRx { _private: () })
 }
 
-/// Moves at most one waiting byte from the USART into the ring (called from SysTick).
-pub(crate) fn poll_from_tick() {
+#[derive(Clone, Copy)]
+struct Usart1Irq;
+
+// SAFETY: 37 is USART1's interrupt number on this SoC.
+unsafe impl cortex_m::interrupt::InterruptNumber for Usart1Irq {
+    fn number(self) -> u16 {
+        USART1_IRQ as u16
+    }
+}
+
+fn set_rx_interrupt(on: bool) {
+    let cr1 = if on { CR1_ON | CR1_RXNEIE } else { CR1_ON };
+    // SAFETY: see `enable`; CR1 holds nothing else we use.
+    unsafe { CR1.write_volatile(cr1) };
+}
+
+/// USART1 interrupt: moves the received byte into the ring; masks itself when the ring is full
+/// (the byte then waits in QEMU until the reader has made room).
+pub(crate) fn on_interrupt() {
     critical_section::with(|cs| {
         let mut rx = RX.borrow(cs).borrow_mut();
         if rx.is_full() {
-            return; // leave it in DR: QEMU holds further input until it is read
+            set_rx_interrupt(false);
+            RX_WAKER.wake();
+            return;
         }
         // SAFETY: see `enable`; reading SR/DR has no effect beyond the USART model's state.
         if unsafe { SR.read_volatile() } & SR_RXNE != 0 {
@@ -113,6 +138,9 @@ impl embedded_io_async::Read for UsartRx {
                         }
                         None => break,
                     }
+                }
+                if n > 0 {
+                    set_rx_interrupt(true); // there is room again
                 }
                 n
             });

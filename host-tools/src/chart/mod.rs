@@ -9,10 +9,10 @@ use anyhow::{Context, Result};
 use clap::Subcommand;
 
 pub mod figures;
-pub mod pitfalls;
 pub mod plot;
 pub mod qemu_log;
 pub mod reference;
+pub mod stability;
 pub mod table;
 pub mod timing;
 pub mod workprec;
@@ -35,6 +35,8 @@ enum Which {
     Velocity(Out),
     /// Residence time against bowl speed for 150-300 mm bowls (cf. paper Fig. 7).
     Residence(Out),
+    /// Error against step h*omega for the fixed-step integrators, stability bounds marked.
+    Stability(Out),
 }
 
 /// Where to write.
@@ -60,6 +62,10 @@ struct WorkPrecision {
     /// Shorter timing (3 batches of 0.2 ms instead of 15 of 2 ms): for tests and quick looks.
     #[arg(long)]
     quick: bool,
+    /// Only these method families (comma-separated: closed, euler, semi-implicit-euler, rk4,
+    /// dp54); all when omitted.
+    #[arg(long, value_delimiter = ',')]
+    families: Vec<String>,
 }
 
 /// `FILE.svg` -> `FILE-suffix.svg`.
@@ -90,8 +96,30 @@ fn work_precision(args: &WorkPrecision) -> Result<()> {
     if cfg!(debug_assertions) {
         eprintln!("note: debug build; host times are not representative (use --release)");
     }
-    let points = workprec::measure(budget, &qemu)?;
+    let points = workprec::measure(budget, &qemu, &args.families)?;
     let table = workprec::table(&points);
+    // A compact view of the main scene for the terminal (the CSV has everything).
+    println!("paper scene, Coriolis model:");
+    println!(
+        "{:<40} {:>10} {:>8} {:>12} {:>10}",
+        "method", "rel.error", "RHS", "host ns", "M4F instr"
+    );
+    for p in points
+        .iter()
+        .filter(|p| p.scene == "paper" && p.model == Model::Coriolis)
+    {
+        println!(
+            "{:<40} {:>10} {:>8} {:>12.1} {:>10}",
+            p.method.key(),
+            p.rel_error
+                .map_or_else(|| "-".into(), |e| format!("{e:.2e}")),
+            p.run
+                .rhs_evals
+                .map_or_else(|| "-".into(), |n| n.to_string()),
+            p.host_ns,
+            p.qemu.map_or_else(|| "-".into(), |c| c.mean.to_string()),
+        );
+    }
     let main = workprec::figure(&points, "paper", Model::Coriolis, CostAxis::HostNs);
     write_all(&args.out, &main, &table)?;
     if args.out.csv_only {
@@ -177,6 +205,10 @@ pub fn run(args: &Args) -> Result<()> {
         }
         Which::Residence(out) => {
             let (f, t) = figures::residence_time()?;
+            write_all(out, &f, &t)
+        }
+        Which::Stability(out) => {
+            let (f, t) = stability::chart()?;
             write_all(out, &f, &t)
         }
     }

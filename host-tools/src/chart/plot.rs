@@ -36,6 +36,8 @@ pub enum Mark {
     Line,
     /// Dashed line.
     Dashed,
+    /// Dashed line with small open circles at the points.
+    DashedPoints,
     /// Filled circles only.
     Points,
     /// A line with filled circles at the points.
@@ -119,7 +121,7 @@ const LEGEND_WIDTH: u32 = 360;
 const FONT: &str = "DejaVu Sans, sans-serif";
 
 /// A palette readable on white and distinguishable in print (Okabe-Ito plus a few).
-const PALETTE: [RGBColor; 10] = [
+const PALETTE: [RGBColor; 12] = [
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
     RGBColor(0, 158, 115),
@@ -130,6 +132,8 @@ const PALETTE: [RGBColor; 10] = [
     RGBColor(120, 120, 120),
     RGBColor(160, 40, 40),
     RGBColor(100, 60, 160),
+    RGBColor(0, 60, 120),
+    RGBColor(140, 140, 0),
 ];
 
 fn colour(i: usize) -> RGBColor {
@@ -411,7 +415,7 @@ impl Figure {
                             .draw_series(LineSeries::new(part.clone(), c.stroke_width(2)))
                             .map_err(be)?;
                     }
-                    Mark::Dashed => {
+                    Mark::Dashed | Mark::DashedPoints => {
                         chart
                             .draw_series(DashedLineSeries::new(
                                 part.clone(),
@@ -432,6 +436,11 @@ impl Figure {
                     Mark::Crosses => {
                         chart
                             .draw_series(part.iter().map(|&p| Cross::new(p, 6, c.stroke_width(2))))
+                            .map_err(be)?;
+                    }
+                    Mark::DashedPoints => {
+                        chart
+                            .draw_series(part.iter().map(|&p| Circle::new(p, 3, c.stroke_width(1))))
                             .map_err(be)?;
                     }
                     _ => {}
@@ -477,6 +486,9 @@ impl Figure {
                 }
                 Mark::Crosses => {
                     area.draw(&Cross::new(((x0 + x1) / 2, ym), 6, c.stroke_width(2)))?;
+                }
+                Mark::DashedPoints => {
+                    area.draw(&Circle::new(((x0 + x1) / 2, ym), 3, c.stroke_width(1)))?;
                 }
                 _ => {}
             }

@@ -29,8 +29,17 @@ impl Budget {
     };
 }
 
-/// Median nanoseconds per call of `f` (whose result is kept alive through `black_box`).
-pub fn ns_per_call<R>(budget: Budget, mut f: impl FnMut() -> R) -> f64 {
+/// Per-call times over the batches.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Timing {
+    /// Median over batches of the mean ns per call (the figure charted).
+    pub median_ns: f64,
+    /// Fastest batch's mean ns per call (least disturbed by other load on the machine).
+    pub min_ns: f64,
+}
+
+/// Nanoseconds per call of `f` (whose result is kept alive through `black_box`).
+pub fn ns_per_call<R>(budget: Budget, mut f: impl FnMut() -> R) -> Timing {
     // Calibrate: double the repetitions until one batch takes the target time.
     let mut reps: u64 = 1;
     loop {
@@ -54,7 +63,10 @@ pub fn ns_per_call<R>(budget: Budget, mut f: impl FnMut() -> R) -> f64 {
         })
         .collect();
     per_call.sort_by(f64::total_cmp);
-    per_call[per_call.len() / 2]
+    Timing {
+        median_ns: per_call[per_call.len() / 2],
+        min_ns: per_call[0],
+    }
 }
 
 #[cfg(test)]
@@ -65,14 +77,15 @@ mod tests {
     fn more_work_takes_longer() {
         // Not a timing assertion on absolute speed: only that 100x the work is measured as
         // clearly more (a factor 10 leaves room for noise on a shared machine).
-        let small = ns_per_call(Budget::QUICK, || black_box(1.0f64).sqrt());
+        let small = ns_per_call(Budget::QUICK, || black_box(1.0f64).sqrt()).median_ns;
         let big = ns_per_call(Budget::QUICK, || {
             let mut s = 0.0f64;
             for i in 0..1000 {
                 s += black_box(i as f64).sqrt();
             }
             s
-        });
+        })
+        .median_ns;
         assert!(
             small > 0.0 && big > 10.0 * small,
             "small {small} ns, big {big} ns"

@@ -10,14 +10,17 @@
 use std::collections::BTreeMap;
 
 use bowl_test_cases::cost::{SCENE_NAMES, scene};
+use model_core::Real;
+use model_core::ode;
 use model_core::particle::{Model, Outcome, Scene, residence};
+use model_core::real::micro::{MicroF32, MicroF32HwSqrt};
 
 use super::figures::scene_err;
 use super::plot::{Figure, Mark, Scale, Series};
 use super::qemu_log::Counts;
 use super::reference::{self, RefModel, RefOutcome, RefScene};
 use super::table::Table;
-use super::timing::{Budget, ns_per_call};
+use super::timing::{Budget, Timing, ns_per_call};
 
 /// Number type and maths library a method runs in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -26,6 +29,10 @@ pub enum Precision {
     F64,
     /// f32 with libm (and VSQRT on the target): the model's `Real for f32`.
     F32Libm,
+    /// f32 with micromath's functions, its rough `sqrt` included (`MicroF32`).
+    F32Micromath,
+    /// f32 with micromath's functions but the correctly rounded square root (`MicroF32HwSqrt`).
+    F32MicromathHwSqrt,
 }
 
 impl Precision {
@@ -33,6 +40,8 @@ impl Precision {
         match self {
             Precision::F64 => "f64",
             Precision::F32Libm => "f32-libm",
+            Precision::F32Micromath => "f32-micromath",
+            Precision::F32MicromathHwSqrt => "f32-micromath-hwsqrt",
         }
     }
 }
@@ -42,12 +51,34 @@ impl Precision {
 pub enum Family {
     /// The model's closed forms (log1p flat form, bracketed Newton for Coriolis).
     Closed,
+    /// Explicit Euler, fixed step.
+    Euler,
+    /// Semi-implicit Euler, fixed step.
+    SemiImplicitEuler,
+    /// Classical RK4, fixed step.
+    Rk4,
+    /// Adaptive Dormand-Prince 5(4).
+    Dp54,
 }
 
+/// Every family, for option checking.
+pub const ALL_FAMILIES: [Family; 5] = [
+    Family::Closed,
+    Family::Euler,
+    Family::SemiImplicitEuler,
+    Family::Rk4,
+    Family::Dp54,
+];
+
 impl Family {
-    fn key(self) -> &'static str {
+    /// Short name used in keys and legends.
+    pub fn key(self) -> &'static str {
         match self {
             Family::Closed => "closed",
+            Family::Euler => "euler",
+            Family::SemiImplicitEuler => "semi-implicit-euler",
+            Family::Rk4 => "rk4",
+            Family::Dp54 => "dp54",
         }
     }
 }
@@ -59,30 +90,133 @@ pub struct Method {
     pub family: Family,
     /// Number type.
     pub precision: Precision,
+    /// Fixed-step methods: the step as `h omega` (dimensionless); DP5(4): the tolerance
+    /// (rtol = tol, atol = tol R for r and tol omega R for r', see [`dp54_tolerances`]);
+    /// closed forms: none.
+    pub setting: Option<f64>,
 }
 
 impl Method {
-    /// The setting as `name=value` (step `h*omega=..`, tolerance `tol=..`), empty for closed forms.
+    /// The setting as `h*omega=..` or `tol=..`, empty for closed forms.
     pub fn setting(&self) -> String {
-        String::new()
+        match (self.family, self.setting) {
+            (Family::Dp54, Some(t)) => format!("tol={t:e}"),
+            (_, Some(h)) => format!("h*omega={h}"),
+            (_, None) => String::new(),
+        }
     }
 
-    /// The name used in the CSV and in the QEMU benchmark names (`cost::SCENE::MODEL::KEY`).
+    /// The name used in the CSV and in the QEMU benchmark names (`cost::SCENE::MODEL::KEY`):
+    /// `rk4-f32-libm-h0.125`, `dp54-f64-tol1e-6`, `closed-f64`.
     pub fn key(&self) -> String {
-        format!("{}-{}", self.family.key(), self.precision.key())
+        let base = format!("{}-{}", self.family.key(), self.precision.key());
+        match (self.family, self.setting) {
+            (Family::Dp54, Some(t)) => format!("{base}-tol{t:e}"),
+            (_, Some(h)) => format!("{base}-h{h}"),
+            (_, None) => base,
+        }
     }
+}
+
+/// Steps `h omega = 2^-k` for `k` in the range.
+fn halvings(from: i32, to: i32) -> impl Iterator<Item = f64> {
+    (from..=to).map(|k| 2f64.powi(-k))
 }
 
 /// Every method and setting on the chart.
 pub fn methods() -> Vec<Method> {
     let mut v = Vec::new();
-    for precision in [Precision::F64, Precision::F32Libm] {
+    let mut add = |family, precision, setting| {
         v.push(Method {
-            family: Family::Closed,
+            family,
             precision,
-        });
+            setting,
+        })
+    };
+    for precision in [Precision::F64, Precision::F32Libm] {
+        add(Family::Closed, precision, None);
+        for h in halvings(1, 12) {
+            add(Family::Euler, precision, Some(h));
+            add(Family::SemiImplicitEuler, precision, Some(h));
+        }
+        for h in halvings(0, 10) {
+            add(Family::Rk4, precision, Some(h));
+        }
+        let tols: &[f64] = match precision {
+            Precision::F64 => &[
+                1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13,
+            ],
+            _ => &[1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7],
+        };
+        for &t in tols {
+            add(Family::Dp54, precision, Some(t));
+        }
     }
+    // micromath changes only the transcendental functions, which the integrators' steps do not
+    // call: the closed forms are where it can pay (or cost).
+    add(Family::Closed, Precision::F32Micromath, None);
+    add(Family::Closed, Precision::F32MicromathHwSqrt, None);
     v
+}
+
+/// DP5(4) tolerances for a scene: relative `tol`, absolute `tol R` (same for r in m and r' in
+/// m/s; r' at the rim is of order omega R, a fraction of R per second at these speeds).
+pub fn dp54_tolerances<T: Real>(tol: T, s: &Scene<T>) -> (T, T) {
+    (tol, tol * s.rim_radius_m)
+}
+
+/// The model's ODE method for `m` on scene `s` (step in seconds from `h omega`).
+fn ode_method<T: Real>(m: &Method, s: &Scene<T>) -> Option<ode::Method<T>> {
+    let x = T::from_f64(m.setting?);
+    let h = x / s.omega_rad_s;
+    Some(match m.family {
+        Family::Closed => return None,
+        Family::Euler => ode::Method::Euler { step_s: h },
+        Family::SemiImplicitEuler => ode::Method::SemiImplicitEuler { step_s: h },
+        Family::Rk4 => ode::Method::Rk4 { step_s: h },
+        Family::Dp54 => {
+            let (rtol, atol) = dp54_tolerances(x, s);
+            ode::Method::Dp54 { rtol, atol }
+        }
+    })
+}
+
+fn ode_run<T: Real>(m: &Method, s: &Scene<T>, model: Model) -> Run {
+    let inputs = widen(s);
+    let Some(method) = ode_method(m, s) else {
+        return Run {
+            inputs,
+            time_s: None,
+            rhs_evals: None,
+            note: "no ODE method".into(),
+        };
+    };
+    match ode::integrate_constant(s, model, method) {
+        Ok(rep) => {
+            let (time_s, note) = match rep.outcome {
+                ode::OdeOutcome::Leaves {
+                    residence_time_s, ..
+                } => (Some(residence_time_s.to_f64()), "leaves".to_string()),
+                ode::OdeOutcome::AlreadyAtRim { .. } => (Some(0.0), "at-rim".into()),
+                ode::OdeOutcome::NeverLeaves => (None, "never-leaves".into()),
+                ode::OdeOutcome::NotLeftBy { horizon_s, .. } => {
+                    (None, format!("not-left-by {:.3e} s", horizon_s.to_f64()))
+                }
+            };
+            Run {
+                inputs,
+                time_s,
+                rhs_evals: Some(u64::from(rep.rhs_evaluations)),
+                note: format!("{note} steps={} rejected={}", rep.steps, rep.rejected_steps),
+            }
+        }
+        Err(e) => Run {
+            inputs,
+            time_s: None,
+            rhs_evals: None,
+            note: format!("refused: {e:?}"),
+        },
+    }
 }
 
 fn model_key(m: Model) -> &'static str {
@@ -92,26 +226,41 @@ fn model_key(m: Model) -> &'static str {
     }
 }
 
-fn to_f32(s: &Scene<f64>) -> Scene<f32> {
+/// The scene in another number type (rounded to nearest).
+fn narrow<T: Real>(s: &Scene<f64>) -> Scene<T> {
     Scene {
-        omega_rad_s: s.omega_rad_s as f32,
-        mu: s.mu as f32,
-        g_m_s2: s.g_m_s2 as f32,
-        k2: s.k2 as f32,
-        ri_m: s.ri_m as f32,
-        rim_radius_m: s.rim_radius_m as f32,
+        omega_rad_s: T::from_f64(s.omega_rad_s),
+        mu: T::from_f64(s.mu),
+        g_m_s2: T::from_f64(s.g_m_s2),
+        k2: T::from_f64(s.k2),
+        ri_m: T::from_f64(s.ri_m),
+        rim_radius_m: T::from_f64(s.rim_radius_m),
     }
 }
 
-fn widen(s: &Scene<f32>) -> Scene<f64> {
+/// The scene as a number type holds it, read back exactly in f64.
+fn widen<T: Real>(s: &Scene<T>) -> Scene<f64> {
     Scene {
-        omega_rad_s: s.omega_rad_s as f64,
-        mu: s.mu as f64,
-        g_m_s2: s.g_m_s2 as f64,
-        k2: s.k2 as f64,
-        ri_m: s.ri_m as f64,
-        rim_radius_m: s.rim_radius_m as f64,
+        omega_rad_s: s.omega_rad_s.to_f64(),
+        mu: s.mu.to_f64(),
+        g_m_s2: s.g_m_s2.to_f64(),
+        k2: s.k2.to_f64(),
+        ri_m: s.ri_m.to_f64(),
+        rim_radius_m: s.rim_radius_m.to_f64(),
     }
+}
+
+/// The closed forms in number type `T`.
+fn closed_run<T: Real>(s: &Scene<f64>, model: Model) -> anyhow::Result<Run> {
+    let st = narrow::<T>(s);
+    let o = residence(&st, model).map_err(scene_err)?;
+    let (time_s, note) = outcome_note(&o);
+    Ok(Run {
+        inputs: widen(&st),
+        time_s,
+        rhs_evals: None,
+        note,
+    })
 }
 
 /// What one run of a method gave.
@@ -127,7 +276,7 @@ pub struct Run {
     pub note: String,
 }
 
-fn outcome_note<T: model_core::Real>(o: &Outcome<T>) -> (Option<f64>, String) {
+fn outcome_note<T: Real>(o: &Outcome<T>) -> (Option<f64>, String) {
     match *o {
         Outcome::Leaves {
             residence_time_s,
@@ -164,38 +313,41 @@ fn outcome_note<T: model_core::Real>(o: &Outcome<T>) -> (Option<f64>, String) {
 /// Runs `method` once on `s`.
 pub fn run(method: &Method, s: &Scene<f64>, model: Model) -> anyhow::Result<Run> {
     match (method.family, method.precision) {
-        (Family::Closed, Precision::F64) => {
-            let o = residence(s, model).map_err(scene_err)?;
-            let (time_s, note) = outcome_note(&o);
-            Ok(Run {
-                inputs: *s,
-                time_s,
-                rhs_evals: None,
-                note,
-            })
-        }
-        (Family::Closed, Precision::F32Libm) => {
-            let s32 = to_f32(s);
-            let o = residence(&s32, model).map_err(scene_err)?;
-            let (time_s, note) = outcome_note(&o);
-            Ok(Run {
-                inputs: widen(&s32),
-                time_s,
-                rhs_evals: None,
-                note,
-            })
+        (Family::Closed, Precision::F64) => closed_run::<f64>(s, model),
+        (Family::Closed, Precision::F32Libm) => closed_run::<f32>(s, model),
+        (Family::Closed, Precision::F32Micromath) => closed_run::<MicroF32>(s, model),
+        (Family::Closed, Precision::F32MicromathHwSqrt) => closed_run::<MicroF32HwSqrt>(s, model),
+        (_, Precision::F64) => Ok(ode_run(method, s, model)),
+        (_, Precision::F32Libm) => Ok(ode_run(method, &narrow::<f32>(s), model)),
+        (_, Precision::F32Micromath) => Ok(ode_run(method, &narrow::<MicroF32>(s), model)),
+        (_, Precision::F32MicromathHwSqrt) => {
+            Ok(ode_run(method, &narrow::<MicroF32HwSqrt>(s), model))
         }
     }
 }
 
+/// Host ns per call of `method` in number type `T`.
+fn time_in<T: Real>(method: &Method, s: &Scene<f64>, model: Model, budget: Budget) -> Timing {
+    let st = narrow::<T>(s);
+    if method.family == Family::Closed {
+        return ns_per_call(budget, || residence(&st, model));
+    }
+    match ode_method(method, &st) {
+        Some(m) => ns_per_call(budget, || ode::integrate_constant(&st, model, m)),
+        None => Timing {
+            median_ns: f64::NAN,
+            min_ns: f64::NAN,
+        },
+    }
+}
+
 /// Host nanoseconds per call of `method` on `s`.
-pub fn time(method: &Method, s: &Scene<f64>, model: Model, budget: Budget) -> f64 {
-    match (method.family, method.precision) {
-        (Family::Closed, Precision::F64) => ns_per_call(budget, || residence(s, model)),
-        (Family::Closed, Precision::F32Libm) => {
-            let s32 = to_f32(s);
-            ns_per_call(budget, || residence(&s32, model))
-        }
+pub fn time(method: &Method, s: &Scene<f64>, model: Model, budget: Budget) -> Timing {
+    match method.precision {
+        Precision::F64 => time_in::<f64>(method, s, model, budget),
+        Precision::F32Libm => time_in::<f32>(method, s, model, budget),
+        Precision::F32Micromath => time_in::<MicroF32>(method, s, model, budget),
+        Precision::F32MicromathHwSqrt => time_in::<MicroF32HwSqrt>(method, s, model, budget),
     }
 }
 
@@ -234,8 +386,10 @@ pub struct Point {
     pub ref_time_s: Option<f64>,
     /// Relative error (None when either side has no T).
     pub rel_error: Option<f64>,
-    /// Host ns per call.
+    /// Host ns per call (median over batches).
     pub host_ns: f64,
+    /// Host ns per call (fastest batch).
+    pub host_ns_min: f64,
     /// QEMU counts, when the log has `cost::SCENE::MODEL::KEY`.
     pub qemu: Option<Counts>,
 }
@@ -253,20 +407,52 @@ impl Point {
 }
 
 /// Measures every method on every scene and model.
-pub fn measure(budget: Budget, qemu: &BTreeMap<String, Counts>) -> anyhow::Result<Vec<Point>> {
+/// Only the methods whose family key is in `families` (all when empty).
+pub fn measure(
+    budget: Budget,
+    qemu: &BTreeMap<String, Counts>,
+    families: &[String],
+) -> anyhow::Result<Vec<Point>> {
+    for f in families {
+        if !ALL_FAMILIES.iter().any(|x| x.key() == f) {
+            anyhow::bail!(
+                "unknown method family `{f}` (known: {})",
+                ALL_FAMILIES.map(Family::key).join(", ")
+            );
+        }
+    }
     let mut out = Vec::new();
+    // The 256-bit reference is slow; f64 and f32 methods share two distinct input sets.
+    let mut refs: BTreeMap<([u64; 6], bool), Option<f64>> = BTreeMap::new();
     for (i, &name) in SCENE_NAMES.iter().enumerate() {
         let s = scene(i);
         for model in [Model::Flat, Model::Coriolis] {
-            for m in methods() {
+            for m in methods()
+                .into_iter()
+                .filter(|m| families.is_empty() || families.iter().any(|f| f == m.family.key()))
+            {
                 let r = run(&m, &s, model)?;
-                let ref_time_s = ref_time(&r.inputs, model);
+                let x = &r.inputs;
+                let key = (
+                    [
+                        x.omega_rad_s.to_bits(),
+                        x.mu.to_bits(),
+                        x.g_m_s2.to_bits(),
+                        x.k2.to_bits(),
+                        x.ri_m.to_bits(),
+                        x.rim_radius_m.to_bits(),
+                    ],
+                    model == Model::Coriolis,
+                );
+                let ref_time_s = *refs
+                    .entry(key)
+                    .or_insert_with(|| ref_time(&r.inputs, model));
                 let rel_error = match (r.time_s, ref_time_s) {
                     (Some(t), Some(tr)) if tr > 0.0 => Some(((t - tr) / tr).abs()),
                     (Some(t), Some(_)) => Some(t.abs()),
                     _ => None,
                 };
-                let host_ns = time(&m, &s, model, budget);
+                let timing = time(&m, &s, model, budget);
                 let mut p = Point {
                     scene: name,
                     model,
@@ -274,7 +460,8 @@ pub fn measure(budget: Budget, qemu: &BTreeMap<String, Counts>) -> anyhow::Resul
                     run: r,
                     ref_time_s,
                     rel_error,
-                    host_ns,
+                    host_ns: timing.median_ns,
+                    host_ns_min: timing.min_ns,
                     qemu: None,
                 };
                 p.qemu = qemu.get(&p.bench_name()).copied();
@@ -309,6 +496,7 @@ pub fn table(points: &[Point]) -> Table {
         "rel_error",
         "rhs_evals",
         "host_ns_per_call",
+        "host_ns_min",
         "qemu_instructions_mean",
         "qemu_instructions_max",
         "note",
@@ -335,6 +523,7 @@ pub fn table(points: &[Point]) -> Table {
             opt(p.rel_error),
             p.run.rhs_evals.map_or_else(String::new, |n| n.to_string()),
             format!("{:.1}", p.host_ns),
+            format!("{:.1}", p.host_ns_min),
             p.qemu.map_or_else(String::new, |c| c.mean.to_string()),
             p.qemu.map_or_else(String::new, |c| c.max.to_string()),
             p.run.note.clone(),
@@ -357,9 +546,14 @@ pub enum CostAxis {
     QemuInstructions,
 }
 
+/// `(setting, cost, error)` of one measured point.
+type SettingPoint = (f64, f64, f64);
+
 /// Error-against-cost chart of one scene and model.
 pub fn figure(points: &[Point], scene: &str, model: Model, axis: CostAxis) -> Figure {
-    let mut groups: BTreeMap<(Family, Precision), Vec<(f64, f64)>> = BTreeMap::new();
+    // Points keep their setting so lines join neighbouring steps/tolerances, not neighbouring
+    // costs (host times are noisy; a line sorted by cost would zigzag between settings).
+    let mut groups: BTreeMap<(Family, Precision), Vec<SettingPoint>> = BTreeMap::new();
     for p in points
         .iter()
         .filter(|p| p.scene == scene && p.model == model)
@@ -374,12 +568,13 @@ pub fn figure(points: &[Point], scene: &str, model: Model, axis: CostAxis) -> Fi
         groups
             .entry((p.method.family, p.method.precision))
             .or_default()
-            .push((x, y));
+            .push((p.method.setting.unwrap_or(0.0), x, y));
     }
     let series = groups
         .into_iter()
         .map(|((family, precision), mut pts)| {
-            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            pts.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let pts: Vec<(f64, f64)> = pts.into_iter().map(|(_, x, y)| (x, y)).collect();
             Series {
                 name: format!("{} {}", family.key(), precision.key()),
                 mark: if pts.len() == 1 {
@@ -387,9 +582,13 @@ pub fn figure(points: &[Point], scene: &str, model: Model, axis: CostAxis) -> Fi
                 } else if precision == Precision::F64 {
                     Mark::LinePoints
                 } else {
-                    Mark::Dashed
+                    Mark::DashedPoints
                 },
-                color: family as usize * 2 + precision as usize,
+                color: if family == Family::Closed {
+                    8 + precision as usize
+                } else {
+                    (family as usize - 1) * 2 + (precision as usize).min(1)
+                },
                 points: pts,
             }
         })
@@ -413,5 +612,31 @@ pub fn figure(points: &[Point], scene: &str, model: Model, axis: CostAxis) -> Fi
             format!("errors below {ERROR_FLOOR:.0e} drawn at {ERROR_FLOOR:.0e}"),
             "a missing point: the method gave no T".into(),
         ],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every `cost::` QEMU benchmark names a scene and a method the chart measures, so its
+    /// count lands in the CSV (a typo would silently drop it).
+    #[test]
+    fn qemu_cost_bench_names_match_chart_keys() {
+        let keys: Vec<String> = methods().iter().map(Method::key).collect();
+        let mut n = 0;
+        for b in bowl_test_cases::all_benches().filter(|b| b.name.starts_with("cost::")) {
+            let parts: Vec<&str> = b.name.split("::").collect();
+            assert_eq!(parts.len(), 4, "{}", b.name);
+            assert!(SCENE_NAMES.contains(&parts[1]), "{}", b.name);
+            assert!(["flat", "coriolis"].contains(&parts[2]), "{}", b.name);
+            assert!(
+                keys.iter().any(|k| k == parts[3]),
+                "{} has no chart method",
+                b.name
+            );
+            n += 1;
+        }
+        assert!(n >= 30, "{n} cost benches");
     }
 }

@@ -147,10 +147,10 @@ impl AxisConfig {
             },
             bandwidth_rad_s: 8.0,
             per_pulse_bandwidth: 0.5,
-            accel_limit_rad_s2: 4.0,
+            accel_limit_rad_s2: 6.0,
             duty_limit: 0.95,
             duty_slew_per_s: 4.0,
-            filter_weight: 0.5,
+            filter_weight: 0.7,
         }
     }
 }
@@ -186,8 +186,10 @@ impl ControllerConfig {
     }
 
     /// Checks every field; the controller only accepts a configuration that passes.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        if !(100..=10_000).contains(&self.tick_hz) {
+    ///
+    /// A `const fn`, so a configuration fixed at build time is checked by the compiler.
+    pub const fn validate(&self) -> Result<(), ConfigError> {
+        if self.tick_hz < 100 || self.tick_hz > 10_000 {
             return Err(ConfigError::TickRate);
         }
         if (self.timer_bits != 16 && self.timer_bits != 32)
@@ -199,8 +201,12 @@ impl ControllerConfig {
         if !in_range(self.supply_v, 1.0, 60.0) {
             return Err(ConfigError::SupplyVoltage);
         }
-        for (i, a) in self.axes.iter().enumerate() {
-            a.validate(i as u8)?;
+        let mut i = 0;
+        while i < 2 {
+            if let Err(e) = self.axes[i].validate(i as u8) {
+                return Err(e);
+            }
+            i += 1;
         }
         let geometry_ok = self.axes_angle_rad.is_finite()
             && self.axes_angle_rad >= 0.0
@@ -220,7 +226,8 @@ impl ControllerConfig {
             || !in_range(c.high_duty, 0.05, 0.95)
             || c.high_duty < c.low_duty + 0.05
             || !in_range(c.step_time_s, 0.2, 60.0)
-            || !(2..=1000).contains(&c.min_fit_edges)
+            || c.min_fit_edges < 2
+            || c.min_fit_edges > 1000
             || !in_range(c.timeout_s, 1.0, 3600.0)
         {
             return Err(ConfigError::Commissioning);
@@ -229,7 +236,7 @@ impl ControllerConfig {
     }
 
     /// Timestamps wrap at `2^timer_bits`; differences are taken with this mask.
-    pub(crate) fn timer_mask(&self) -> u32 {
+    pub(crate) const fn timer_mask(&self) -> u32 {
         if self.timer_bits >= 32 {
             u32::MAX
         } else {
@@ -239,8 +246,8 @@ impl ControllerConfig {
 }
 
 impl AxisConfig {
-    fn validate(&self, axis: u8) -> Result<(), ConfigError> {
-        if !(1..=1000).contains(&self.pulses_per_rev) {
+    const fn validate(&self, axis: u8) -> Result<(), ConfigError> {
+        if self.pulses_per_rev < 1 || self.pulses_per_rev > 1000 {
             return Err(ConfigError::PulsesPerRev(axis));
         }
         let speeds_ok = in_range(self.min_speed_rad_s, 1e-3, 1e3)
@@ -251,7 +258,9 @@ impl AxisConfig {
         if !speeds_ok {
             return Err(ConfigError::SpeedLimits(axis));
         }
-        self.model.validate(axis)?;
+        if let Err(e) = self.model.validate(axis) {
+            return Err(e);
+        }
         let loop_ok = in_range(self.bandwidth_rad_s, 0.01, 1000.0)
             && in_range(self.per_pulse_bandwidth, 0.01, 10.0)
             && in_range(self.accel_limit_rad_s2, 0.01, 1000.0)
@@ -268,7 +277,7 @@ impl AxisConfig {
 
 impl MotorModel {
     /// Checks the model's plausibility; `axis` names the axis in the error.
-    pub fn validate(&self, axis: u8) -> Result<(), ConfigError> {
+    pub const fn validate(&self, axis: u8) -> Result<(), ConfigError> {
         let ok = self.volts_per_rad_s > 0.0
             && self.volts_per_rad_s <= 100.0
             && in_range(self.friction_duty, 0.0, 0.9)
@@ -283,6 +292,6 @@ impl MotorModel {
 }
 
 /// `lo <= x <= hi` and finite (NaN fails).
-pub(crate) fn in_range(x: f32, lo: f32, hi: f32) -> bool {
+pub(crate) const fn in_range(x: f32, lo: f32, hi: f32) -> bool {
     x.is_finite() && x >= lo && x <= hi
 }

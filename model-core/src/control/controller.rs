@@ -102,13 +102,19 @@ pub struct Controller {
     identified: [Option<Identified>; 2],
     identify_error: Option<IdentifyError>,
     feedback: bool,
+    cos_axes: f32,
 }
 
 impl Controller {
     /// A controller in [`State::Idle`] for a configuration that passes validation.
-    pub fn new(cfg: ControllerConfig) -> Result<Self, ConfigError> {
-        cfg.validate()?;
-        Ok(Self::build(cfg))
+    ///
+    /// A `const fn`: firmware can build its controller in a `static` from a configuration
+    /// the compiler has checked.
+    pub const fn new(cfg: ControllerConfig) -> Result<Self, ConfigError> {
+        match cfg.validate() {
+            Ok(()) => Ok(Self::build(cfg)),
+            Err(e) => Err(e),
+        }
     }
 
     /// Like [`Controller::new`], but an invalid configuration gives a controller running the
@@ -126,9 +132,10 @@ impl Controller {
         }
     }
 
-    fn build(cfg: ControllerConfig) -> Self {
+    const fn build(cfg: ControllerConfig) -> Self {
         let dt_s = 1.0 / cfg.tick_hz as f32;
-        let [a0, a1] = cfg.axes;
+        let a0 = cfg.axes[0];
+        let a1 = cfg.axes[1];
         Self {
             cfg,
             dt_s,
@@ -140,9 +147,9 @@ impl Controller {
                 LoopConstants::new(&a0, dt_s, cfg.supply_v),
                 LoopConstants::new(&a1, dt_s, cfg.supply_v),
             ],
-            loops: [SpeedLoop::default(); 2],
-            watch: [SensorWatch::default(); 2],
-            planner: SetpointPlanner::default(),
+            loops: [SpeedLoop::REST; 2],
+            watch: [SensorWatch::CLEAR; 2],
+            planner: SetpointPlanner::REST,
             max_step: [a0.accel_limit_rad_s2 * dt_s, a1.accel_limit_rad_s2 * dt_s],
             state: State::Idle,
             fault: None,
@@ -155,6 +162,7 @@ impl Controller {
             identified: [None; 2],
             identify_error: None,
             feedback: true,
+            cos_axes: cos_const(cfg.axes_angle_rad),
         }
     }
 
@@ -220,7 +228,9 @@ impl Controller {
         let established =
             self.est[0].is_valid() && self.measured[0].abs() >= 0.5 * r0.abs() && r0 != 0.0;
         let ramped = self.planner.step(dt, self.max_step, stopped, established);
-        for i in 0..2 {
+        // Spin first: its model's acceleration feeds the precession axis's decoupling.
+        let mut decouple = 0.0;
+        for i in [1usize, 0] {
             if ramped[i] > 0.0 {
                 self.direction[i] = 1.0;
             } else if ramped[i] < 0.0 {
@@ -229,24 +239,31 @@ impl Controller {
             let input = LoopInput {
                 reference_rad_s: ramped[i],
                 measured_rad_s: self.measured[i],
+                direction: self.direction[i],
                 measurement_valid: self.est[i].is_valid(),
+                events: self.est[i].window_events(),
                 feedback: self.feedback,
+                extra_duty: if i == 0 { decouple } else { 0.0 },
             };
             let duty = self.loops[i].step(&self.k[i], input);
+            if i == 1 {
+                // The spin's accelerating torque reacts on the rod: J2 a2 projected on the
+                // vertical. With J2 a2 = tau2 k2 a2 dr_p/dt / R2 and the same motor type on both
+                // axes, the precession duty that cancels it is
+                // cos(angle) * (r - r_p) * duty_per_rad_s of the spin model.
+                decouple = self.cos_axes
+                    * (ramped[1] - self.loops[1].model_rad_s())
+                    * self.k[1].duty_per_rad_s();
+            }
             self.duties[i] = duty;
-            let r_abs = ramped[i].abs();
-            let expected_period_s = if r_abs > 0.0 {
-                self.est[i].rad_per_pulse() / r_abs
-            } else {
-                f32::MAX
-            };
             if self.watch[i].step(
                 dt,
                 duty.abs(),
                 self.cfg.stall_duty,
                 seen[i],
                 self.cfg.sensor_timeout_floor_s,
-                expected_period_s,
+                ramped[i].abs(),
+                self.est[i].rad_per_pulse(),
             ) {
                 self.latch(Fault::SensorLostOrStall(i as u8));
                 return;
@@ -316,16 +333,17 @@ impl Controller {
                 }
                 // Blocked shaft or dead sensor during identification: the expected period is
                 // unknown, so allow 3 periods at the lowest speed.
+                // The index walks five per-axis arrays in step; an iterator would hide that.
+                #[allow(clippy::needless_range_loop)]
                 for i in 0..2 {
-                    let slow_period =
-                        self.est[i].rad_per_pulse() / self.cfg.axes[i].min_speed_rad_s;
                     if self.watch[i].step(
                         dt,
                         self.duties[i].abs(),
                         self.cfg.stall_duty,
                         seen[i],
                         self.cfg.sensor_timeout_floor_s,
-                        slow_period,
+                        self.cfg.axes[i].min_speed_rad_s,
+                        self.est[i].rad_per_pulse(),
                     ) {
                         self.latch(Fault::SensorLostOrStall(i as u8));
                         return;
@@ -352,13 +370,13 @@ impl Controller {
         }
         self.state = State::Fault;
         self.duties = [0.0; 2];
-        self.loops = [SpeedLoop::default(); 2];
-        self.watch = [SensorWatch::default(); 2];
+        self.loops = [SpeedLoop::REST; 2];
+        self.watch = [SensorWatch::CLEAR; 2];
         self.planner.reset();
         self.commissioning = None;
     }
 
-    fn check_speed(&self, axis: usize, w: f32) -> Result<(), Rejection> {
+    const fn check_speed(&self, axis: usize, w: f32) -> Result<(), Rejection> {
         if !w.is_finite() {
             return Err(Rejection::NotFinite);
         }
@@ -373,11 +391,16 @@ impl Controller {
         Ok(())
     }
 
-    fn check_state_for_setpoint(&self) -> Result<(), Rejection> {
+    const fn latched(&self) -> Fault {
+        match self.fault {
+            Some(f) => f,
+            None => Fault::InvalidConfiguration,
+        }
+    }
+
+    const fn check_state_for_setpoint(&self) -> Result<(), Rejection> {
         match self.state {
-            State::Fault => Err(Rejection::Faulted(
-                self.fault.unwrap_or(Fault::InvalidConfiguration),
-            )),
+            State::Fault => Err(Rejection::Faulted(self.latched())),
             State::Commissioning | State::Stopping => Err(Rejection::WrongState(self.state)),
             _ => Ok(()),
         }
@@ -386,15 +409,21 @@ impl Controller {
     /// Sets both motor speeds, rad/s (signed; sign = direction). Zero, or a magnitude within
     /// `[min_speed_rad_s, max_speed_rad_s]` of the axis. Allowed in Idle (taken at `start`),
     /// SpinningUp and Running; the planner ramps to it.
-    pub fn set_motor_speeds(
+    pub const fn set_motor_speeds(
         &mut self,
         precession_rad_s: f32,
         spin_rad_s: f32,
     ) -> Result<(), Rejection> {
         self.host_silence_s = 0.0;
-        self.check_state_for_setpoint()?;
-        self.check_speed(0, precession_rad_s)?;
-        self.check_speed(1, spin_rad_s)?;
+        if let Err(e) = self.check_state_for_setpoint() {
+            return Err(e);
+        }
+        if let Err(e) = self.check_speed(0, precession_rad_s) {
+            return Err(e);
+        }
+        if let Err(e) = self.check_speed(1, spin_rad_s) {
+            return Err(e);
+        }
         self.planner.set_targets([precession_rad_s, spin_rad_s]);
         Ok(())
     }
@@ -422,18 +451,16 @@ impl Controller {
     }
 
     /// Starts the closed loop (Idle -> SpinningUp) toward the current targets.
-    pub fn start(&mut self) -> Result<(), Rejection> {
+    pub const fn start(&mut self) -> Result<(), Rejection> {
         self.host_silence_s = 0.0;
         match self.state {
             State::Idle => {
-                self.loops = [SpeedLoop::default(); 2];
-                self.watch = [SensorWatch::default(); 2];
+                self.loops = [SpeedLoop::REST; 2];
+                self.watch = [SensorWatch::CLEAR; 2];
                 self.state = State::SpinningUp;
                 Ok(())
             }
-            State::Fault => Err(Rejection::Faulted(
-                self.fault.unwrap_or(Fault::InvalidConfiguration),
-            )),
+            State::Fault => Err(Rejection::Faulted(self.latched())),
             s => Err(Rejection::WrongState(s)),
         }
     }
@@ -527,13 +554,11 @@ impl Controller {
                     self.cfg.timer_hz as f32,
                 ));
                 self.identify_error = None;
-                self.watch = [SensorWatch::default(); 2];
+                self.watch = [SensorWatch::CLEAR; 2];
                 self.state = State::Commissioning;
                 Ok(())
             }
-            State::Fault => Err(Rejection::Faulted(
-                self.fault.unwrap_or(Fault::InvalidConfiguration),
-            )),
+            State::Fault => Err(Rejection::Faulted(self.latched())),
             s => Err(Rejection::WrongState(s)),
         }
     }
@@ -619,6 +644,37 @@ impl Controller {
             model.residence_time_s(w)
         } else {
             None
+        }
+    }
+}
+
+/// cos(x) for x in [0, pi), usable in `const fn` (the configuration's axes angle): the Taylor
+/// series about pi/2 in f64, which for |x - pi/2| <= pi/2 converges to below 1e-9 with these
+/// terms. (libm's `cosf` is not a `const fn`.)
+const fn cos_const(x: f32) -> f32 {
+    // cos(x) = -sin(x - pi/2) = -sin(y)
+    let y = x as f64 - core::f64::consts::FRAC_PI_2;
+    let y2 = y * y;
+    let mut term = y;
+    let mut sum = y;
+    let mut k = 1;
+    while k < 12 {
+        term = -term * y2 / ((2 * k) as f64 * (2 * k + 1) as f64);
+        sum += term;
+        k += 1;
+    }
+    (-sum) as f32
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn cos_const_matches_libm() {
+        let mut x = 0.0f32;
+        while x < core::f32::consts::PI {
+            let d = (super::cos_const(x) - libm::cosf(x)).abs();
+            assert!(d < 2e-7, "x {x}: {d}");
+            x += 0.01;
         }
     }
 }

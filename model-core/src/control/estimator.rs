@@ -19,7 +19,8 @@
 //! # Stall bound
 //! Between edges the shaft has turned less than one pitch since the last edge, so the speed is at
 //! most `pitch / time since the last edge`. Once that bound is below the filtered value, it is
-//! the estimate: a stopping shaft reads a falling speed, and after one pitch at the configured
+//! the estimate (at steady speed the bound allows two pitches, so that one missing pulse does not
+//! halve the reading): a stopping shaft reads a falling speed, and after one pitch at the configured
 //! minimum speed without an edge it reads exactly zero and the estimator starts afresh.
 //!
 //! # Bounce and missing pulses
@@ -39,12 +40,36 @@ use super::config::{AxisConfig, ControllerConfig};
 /// Shortest counting window, s: at high pulse rates a raw sample averages over at least this.
 pub const WINDOW_S: f32 = 0.025;
 
+/// A closed counting window: the raw speed over a known interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindowSample {
+    /// How long before the tick's `now` the window closed (its last edge), s.
+    pub ago_s: f32,
+    /// The window's span, first to last edge, s.
+    pub span_s: f32,
+    /// Mean speed over the window, rad/s (magnitude, unfiltered).
+    pub raw_speed_rad_s: f32,
+}
+
+/// What happened to the counting window during the last tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindowEvents {
+    /// A new measurement began (first edge after rest) this long before `now`, s.
+    pub restarted_s_ago: Option<f32>,
+    /// A window closed.
+    pub closed: Option<WindowSample>,
+    /// The stall bound is below the filtered speed: the shaft is slowing between edges.
+    pub bound_active: bool,
+}
+
 /// Speed estimator of one axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PulseSpeedEstimator {
     mask: u32,
     rad_per_pulse: f32,
     ticks_per_s: f32,
+    s_per_tick: f32,
+    rad_ticks_per_pulse_s: f32,
     lockout_ticks: u32,
     window_ticks: u32,
     stall_ticks: u32,
@@ -63,6 +88,11 @@ pub struct PulseSpeedEstimator {
     speed_filt: f32,
     speed: f32,
     updated: bool,
+    bound_active: bool,
+    restart_at: Option<u32>,
+    closed_at: Option<u32>,
+    closed_span: u32,
+    closed_raw: f32,
     accepted: u32,
     rejected: u32,
     missing: u32,
@@ -71,7 +101,7 @@ pub struct PulseSpeedEstimator {
 
 impl PulseSpeedEstimator {
     /// An estimator for `axis` of a validated configuration.
-    pub fn new(cfg: &ControllerConfig, axis: &AxisConfig) -> Self {
+    pub const fn new(cfg: &ControllerConfig, axis: &AxisConfig) -> Self {
         let ticks_per_s = cfg.timer_hz as f32;
         let rad_per_pulse = core::f32::consts::TAU / axis.pulses_per_rev as f32;
         let min_period_s = rad_per_pulse / axis.overspeed_rad_s;
@@ -80,6 +110,8 @@ impl PulseSpeedEstimator {
             mask: cfg.timer_mask(),
             rad_per_pulse,
             ticks_per_s,
+            s_per_tick: 1.0 / ticks_per_s,
+            rad_ticks_per_pulse_s: rad_per_pulse * ticks_per_s,
             lockout_ticks: (0.5 * min_period_s * ticks_per_s) as u32,
             window_ticks: (WINDOW_S * ticks_per_s) as u32,
             stall_ticks: (stall_s * ticks_per_s).min(4.0e9) as u32,
@@ -97,6 +129,11 @@ impl PulseSpeedEstimator {
             speed_filt: 0.0,
             speed: 0.0,
             updated: false,
+            bound_active: false,
+            restart_at: None,
+            closed_at: None,
+            closed_span: 0,
+            closed_raw: 0.0,
             accepted: 0,
             rejected: 0,
             missing: 0,
@@ -124,6 +161,8 @@ impl PulseSpeedEstimator {
         }
         let span = now.wrapping_sub(self.prev_now) & self.mask;
         self.updated = false;
+        self.restart_at = None;
+        self.closed_at = None;
         for &t in edges {
             let mut offset = t.wrapping_sub(self.prev_now) & self.mask;
             if offset > span {
@@ -139,7 +178,7 @@ impl PulseSpeedEstimator {
         }
         self.clock = self.clock.wrapping_add(span);
         self.prev_now = now;
-        self.speed = self.bounded_speed();
+        self.speed = self.bounded_speed(if steady { 2 } else { 1 });
         self.speed
     }
 
@@ -149,6 +188,7 @@ impl PulseSpeedEstimator {
             self.last_edge = at;
             self.win_start = at;
             self.win_pulses = 0;
+            self.restart_at = Some(at);
             self.accepted = self.accepted.wrapping_add(1);
             return Some(1);
         }
@@ -181,7 +221,7 @@ impl PulseSpeedEstimator {
         let wspan = at.wrapping_sub(self.win_start);
         if wspan >= self.window_ticks {
             let period = wspan as f32 / self.win_pulses as f32;
-            let raw = self.rad_per_pulse * self.ticks_per_s / period;
+            let raw = self.rad_ticks_per_pulse_s / period;
             if self.valid {
                 let w = self.filter_weight;
                 self.speed_filt += w * (raw - self.speed_filt);
@@ -192,13 +232,19 @@ impl PulseSpeedEstimator {
                 self.valid = true;
             }
             self.updated = true;
+            self.closed_at = Some(at);
+            self.closed_span = wspan;
+            self.closed_raw = raw;
             self.win_start = at;
             self.win_pulses = 0;
         }
         Some(pulses)
     }
 
-    fn bounded_speed(&mut self) -> f32 {
+    /// `pitches`: how many pitches the shaft may have turned since the last edge (2 at steady
+    /// speed, where one missing pulse must not halve the reading; 1 otherwise).
+    fn bounded_speed(&mut self, pitches: u32) -> f32 {
+        self.bound_active = false;
         if !self.has_edge {
             return 0.0;
         }
@@ -215,13 +261,29 @@ impl PulseSpeedEstimator {
         if !self.valid {
             return 0.0;
         }
-        if since > self.last_interval && since > 0 {
-            let bound = self.rad_per_pulse * self.ticks_per_s / since as f32;
+        if since > self.last_interval.saturating_mul(pitches) && since > 0 {
+            let bound = pitches as f32 * self.rad_ticks_per_pulse_s / since as f32;
             if bound < self.speed_filt {
+                self.bound_active = true;
                 return bound;
             }
         }
         self.speed_filt
+    }
+
+    /// The window events of the last tick, for a loop that compares the measurement with a
+    /// model over exactly the same interval (see `pi`).
+    pub fn window_events(&self) -> WindowEvents {
+        let ago = |at: u32| self.clock.wrapping_sub(at) as f32 * self.s_per_tick;
+        WindowEvents {
+            restarted_s_ago: self.restart_at.map(ago),
+            closed: self.closed_at.map(|at| WindowSample {
+                ago_s: ago(at),
+                span_s: self.closed_span as f32 * self.s_per_tick,
+                raw_speed_rad_s: self.closed_raw,
+            }),
+            bound_active: self.bound_active,
+        }
     }
 
     /// The last estimate, rad/s (magnitude).

@@ -52,12 +52,12 @@
 //! refused.
 //!
 //! # Modules
-//! - [`config`]: the configuration and its validation.
-//! - [`estimator`]: speed from edge timestamps.
-//! - [`pi`]: feedforward + PI per axis.
-//! - [`planner`]: setpoints, Eq. 2 split, ramps, the particle-model traits.
-//! - [`supervisor`]: states and faults.
-//! - [`commission`]: identification.
+//! - [`config`], the configuration and its validation.
+//! - [`estimator`], speed from edge timestamps.
+//! - [`pi`], feedforward + PI per axis.
+//! - [`planner`], setpoints, Eq. 2 split, ramps, the particle-model traits.
+//! - [`supervisor`], states and faults.
+//! - [`commission`], identification.
 
 pub mod commission;
 pub mod config;

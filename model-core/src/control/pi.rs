@@ -2,13 +2,18 @@
 //! on the measured speed, with gain scheduling, anti-windup, clamp and slew limit.
 //!
 //! # Structure (two degrees of freedom)
-//! `duty = ff(r) + Kp e + I`, with `e = r_m - y`:
+//! `duty = ff(r) + Kp e + I`:
 //! - `ff(r) = sign(r) (friction_duty + |r| volts_per_rad_s / V)`: the steady-state duty of the
 //!   identified model, so the loop only corrects the model's error.
-//! - `r_m` is the ramped reference `r` delayed by what the plant and the measurement add (plant
-//!   time constant, half a pulse interval, the estimator filter's lag). The pulse estimate of a
-//!   speed that follows `r` lags it by about that much; comparing it with `r` itself would wind
-//!   the integral up on every ramp and overshoot afterwards.
+//! - `e` compares like with like. The pulse estimate is the *mean* speed over a counting window
+//!   that ended at an edge, up to a pulse period ago; comparing it with today's reference would
+//!   wind the integral up on every ramp (a lag of up to a pulse period, 175 ms at 3 rad/s with
+//!   12 pulses/rev) and overshoot afterwards. So the loop runs the identified plant model
+//!   (`r_p`: the reference through the first-order lag `tau`), integrates the model's angle over
+//!   the same window as the estimator, and takes `e = model mean - measured mean` over exactly
+//!   that window. `e` is then held (and filtered with the estimator's weight) until the next
+//!   window closes. Between edges, once the stall bound says the shaft is slower than its last
+//!   measurement, `e` is at least `r_p - bound`.
 //!
 //! # Gains
 //! The plant from duty to speed is `K / (tau s + 1)` with `K = V / volts_per_rad_s`. The PI zero
@@ -26,13 +31,18 @@
 //! is exactly zero and the integral is cleared: no hum, no creep.
 
 use super::config::AxisConfig;
+use super::estimator::WindowEvents;
 
 /// State of one axis's loop.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SpeedLoop {
     integral: f32,
     duty: f32,
-    ref_model: f32,
+    model_rad_s: f32,
+    model_angle_rad: f32,
+    window_open: bool,
+    have_error: bool,
+    error: f32,
     kp_prev: f32,
 }
 
@@ -41,12 +51,18 @@ pub struct SpeedLoop {
 pub struct LoopInput {
     /// Ramped reference, rad/s (signed: the commanded direction).
     pub reference_rad_s: f32,
-    /// Measured speed with the commanded sign, rad/s.
+    /// Measured speed (with the stall bound) with the commanded sign, rad/s.
     pub measured_rad_s: f32,
+    /// Sign of the commanded direction, +1 or -1.
+    pub direction: f32,
     /// The estimator has a valid measurement.
     pub measurement_valid: bool,
+    /// The estimator's window events of this tick.
+    pub events: WindowEvents,
     /// Feedback on (false only in the open-loop test of the feedback's necessity).
     pub feedback: bool,
+    /// Extra feedforward duty (the precession axis's decoupling of the spin reaction).
+    pub extra_duty: f32,
 }
 
 /// Per-axis constants of the loop, precomputed from the configuration.
@@ -55,32 +71,32 @@ pub struct LoopConstants {
     dt_s: f32,
     duty_per_rad_s: f32,
     friction_duty: f32,
-    tau_s: f32,
+    model_alpha: f32,
+    kp_per_wc: f32,
+    ki_dt_per_wc: f32,
     bandwidth_rad_s: f32,
     per_pulse_bw_times_pulses_per_rad: f32,
-    meas_lag_pulses: f32,
-    rad_per_pulse: f32,
-    max_meas_lag_s: f32,
+    filter_weight: f32,
     duty_limit: f32,
     slew_per_tick: f32,
 }
 
 impl LoopConstants {
     /// Constants for `axis` at tick period `dt_s` and supply `supply_v`.
-    pub fn new(axis: &AxisConfig, dt_s: f32, supply_v: f32) -> Self {
+    pub const fn new(axis: &AxisConfig, dt_s: f32, supply_v: f32) -> Self {
         let pulses_per_rad = axis.pulses_per_rev as f32 / core::f32::consts::TAU;
         let w = axis.filter_weight;
         Self {
             dt_s,
             duty_per_rad_s: axis.model.volts_per_rad_s / supply_v,
             friction_duty: axis.model.friction_duty,
-            tau_s: axis.model.time_constant_s,
+            // Backward-Euler step of the first-order plant model, precomputed.
+            model_alpha: dt_s / (axis.model.time_constant_s + dt_s),
+            kp_per_wc: axis.model.time_constant_s * axis.model.volts_per_rad_s / supply_v,
+            ki_dt_per_wc: dt_s * axis.model.volts_per_rad_s / supply_v,
             bandwidth_rad_s: axis.bandwidth_rad_s,
             per_pulse_bw_times_pulses_per_rad: axis.per_pulse_bandwidth * pulses_per_rad,
-            // Half an interval of sampling delay plus the exponential filter's mean lag.
-            meas_lag_pulses: 0.5 + (1.0 - w) / w,
-            rad_per_pulse: 1.0 / pulses_per_rad,
-            max_meas_lag_s: 2.0,
+            filter_weight: w,
             duty_limit: axis.duty_limit,
             slew_per_tick: axis.duty_slew_per_s * dt_s,
         }
@@ -97,6 +113,11 @@ impl LoopConstants {
         }
     }
 
+    /// Duty per rad/s of the identified model (`volts_per_rad_s / V`).
+    pub fn duty_per_rad_s(&self) -> f32 {
+        self.duty_per_rad_s
+    }
+
     /// Steady-state duty of the model at `r` rad/s (signed).
     #[inline]
     pub fn feedforward(&self, r: f32) -> f32 {
@@ -111,36 +132,81 @@ impl LoopConstants {
 }
 
 impl SpeedLoop {
+    /// At rest: zero output, zero integral.
+    pub const REST: Self = Self {
+        integral: 0.0,
+        duty: 0.0,
+        model_rad_s: 0.0,
+        model_angle_rad: 0.0,
+        window_open: false,
+        have_error: false,
+        error: 0.0,
+        kp_prev: 0.0,
+    };
+
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
     #[inline]
     pub fn step(&mut self, k: &LoopConstants, input: LoopInput) -> f32 {
         let r = input.reference_rad_s;
         if r == 0.0 {
-            *self = Self::default();
+            *self = Self::REST;
             return 0.0;
         }
         let r_abs = r.abs();
-        // Reference model: the lag the measurement will show.
-        let mut lag_s = k.meas_lag_pulses * k.rad_per_pulse / r_abs;
-        if lag_s > k.max_meas_lag_s {
-            lag_s = k.max_meas_lag_s;
+        // The plant model's speed and its angle over the estimator's current window.
+        self.model_rad_s += (r - self.model_rad_s) * k.model_alpha;
+        let rp = self.model_rad_s;
+        self.model_angle_rad += rp * k.dt_s;
+        let ev = input.events;
+        if let Some(ago) = ev.restarted_s_ago {
+            self.model_angle_rad = rp * ago;
+            self.window_open = true;
         }
-        let tc = k.tau_s + lag_s;
-        self.ref_model += (r - self.ref_model) * (k.dt_s / (tc + k.dt_s));
-
-        let wc = k.scheduled_bandwidth(r_abs);
-        let ki_dt = wc * k.duty_per_rad_s * k.dt_s;
-        let kp = wc * k.tau_s * k.duty_per_rad_s;
-        let e = if input.feedback && input.measurement_valid {
-            self.ref_model - input.measured_rad_s
+        if let Some(w) = ev.closed
+            && !self.window_open
+        {
+            // The loop started in the middle of a window: compare from the next one on.
+            self.model_angle_rad = rp * w.ago_s;
+            self.window_open = true;
+        } else if let Some(w) = ev.closed
+            && w.span_s > 0.0
+        {
+            let model_mean = (self.model_angle_rad - rp * w.ago_s) / w.span_s;
+            let sample = model_mean - input.direction * w.raw_speed_rad_s;
+            if self.have_error {
+                self.error += k.filter_weight * (sample - self.error);
+            } else {
+                self.error = sample;
+                self.have_error = true;
+            }
+            self.model_angle_rad = rp * w.ago_s;
+        }
+        if !input.measurement_valid {
+            self.have_error = false;
+            self.error = 0.0;
+        }
+        let mut e = if input.feedback && self.have_error {
+            self.error
         } else {
             0.0
         };
+        if input.feedback && input.measurement_valid && ev.bound_active {
+            let at_least = rp - input.measured_rad_s;
+            e = if input.direction > 0.0 {
+                e.max(at_least)
+            } else {
+                e.min(at_least)
+            };
+        }
+
+        let wc = k.scheduled_bandwidth(r_abs);
+        let ki_dt = wc * k.ki_dt_per_wc;
+        let kp = wc * k.kp_per_wc;
         // Bumpless gain change: the proportional jump is absorbed by the integral.
         self.integral += (self.kp_prev - kp) * e;
         self.kp_prev = kp;
 
-        let ff = k.feedforward(r);
+        let ff = k.feedforward(r) + input.extra_duty;
         let candidate_i = self.integral + ki_dt * e;
         let unclamped = ff + kp * e + candidate_i;
         let lim = k.duty_limit;
@@ -148,14 +214,18 @@ impl SpeedLoop {
         let slew_pushing = (unclamped - self.duty > k.slew_per_tick && e > 0.0)
             || (unclamped - self.duty < -k.slew_per_tick && e < 0.0);
         if !saturating && !slew_pushing {
-            self.integral = candidate_i.clamp(-lim, lim);
+            self.integral = clamp(candidate_i, lim);
         }
-        let target = (ff + kp * e + self.integral).clamp(-lim, lim);
-        let step = (target - self.duty).clamp(-k.slew_per_tick, k.slew_per_tick);
+        let target = clamp(ff + kp * e + self.integral, lim);
+        let step = clamp(target - self.duty, k.slew_per_tick);
         self.duty += step;
         self.duty
     }
 
+    /// The plant model's speed (the reference through the identified lag), rad/s.
+    pub fn model_rad_s(&self) -> f32 {
+        self.model_rad_s
+    }
     /// The last output duty.
     pub fn duty(&self) -> f32 {
         self.duty
@@ -166,6 +236,18 @@ impl SpeedLoop {
     }
     /// Back to rest (zero output, zero integral).
     pub fn reset(&mut self) {
-        *self = Self::default();
+        *self = Self::REST;
+    }
+}
+
+/// `x` limited to `[-lim, lim]` (`lim >= 0`); no panic path, unlike `f32::clamp`.
+#[inline(always)]
+fn clamp(x: f32, lim: f32) -> f32 {
+    if x > lim {
+        lim
+    } else if x < -lim {
+        -lim
+    } else {
+        x
     }
 }

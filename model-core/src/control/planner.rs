@@ -64,8 +64,17 @@ pub struct SetpointPlanner {
 }
 
 impl SetpointPlanner {
+    /// Everything at rest.
+    pub const REST: Self = Self {
+        target: [0.0; 2],
+        ramped: [0.0; 2],
+        steady_s: [0.0; 2],
+        reversing: [false; 2],
+        spin_released: false,
+    };
+
     /// Sets the targets (already validated), rad/s.
-    pub fn set_targets(&mut self, target: [f32; 2]) {
+    pub const fn set_targets(&mut self, target: [f32; 2]) {
         self.target = target;
     }
 
@@ -86,7 +95,7 @@ impl SetpointPlanner {
 
     /// Drops everything to rest at once (fault, abort).
     pub fn reset(&mut self) {
-        *self = Self::default();
+        *self = Self::REST;
     }
 
     /// Advances the ramps by `dt_s`. `max_step` is the largest change per step of each axis,

@@ -72,11 +72,16 @@ pub struct SensorWatch {
 }
 
 impl SensorWatch {
+    /// A cleared watch.
+    pub const CLEAR: Self = Self { blind_s: 0.0 };
+
     /// Advances the watch; true when the axis must fault.
     ///
-    /// `expected_period_s` is one pulse period at the current reference speed; the timeout is
-    /// `max(floor_s, 3 * expected_period_s)`.
+    /// `reference_abs_rad_s` is the reference speed and `rad_per_pulse` the pitch: one expected
+    /// pulse period is `rad_per_pulse / reference`, and the timeout is
+    /// `max(floor_s, 3 * expected period)` (compared without dividing).
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
         dt_s: f32,
@@ -84,16 +89,15 @@ impl SensorWatch {
         stall_duty: f32,
         edge_seen: bool,
         floor_s: f32,
-        expected_period_s: f32,
+        reference_abs_rad_s: f32,
+        rad_per_pulse: f32,
     ) -> bool {
         if edge_seen || duty_abs <= stall_duty {
             self.blind_s = 0.0;
             return false;
         }
         self.blind_s += dt_s;
-        let three = 3.0 * expected_period_s;
-        let limit = if three > floor_s { three } else { floor_s };
-        self.blind_s > limit
+        self.blind_s > floor_s && self.blind_s * reference_abs_rad_s > 3.0 * rad_per_pulse
     }
 
     /// Clears the watch.

@@ -313,3 +313,29 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+    /// f32 inverse: the speed it returns, put through the f64 forward model with the same f32
+    /// inputs, gives the target within 2e-6 x condition (or it says BeyondPrecision, only where
+    /// the needed start lies within f32 rounding of the threshold).
+    #[test]
+    fn f32_inverse_round_trips_through_f64(mu in 0.0f32..0.3, ri_frac in 0.01f32..0.999,
+                                           rim in 0.05f32..0.3, target in 0.01f32..30.0) {
+        let s = Scene { omega_rad_s: 0.0f32, mu, g_m_s2: 9.81, k2: 5.0 / 7.0, ri_m: ri_frac * rim, rim_radius_m: rim };
+        let wide = Scene { omega_rad_s: 0.0f64, mu: mu as f64, g_m_s2: 9.81f32 as f64, k2: (5.0f32 / 7.0) as f64,
+                           ri_m: s.ri_m as f64, rim_radius_m: rim as f64 };
+        for model in [Model::Flat, Model::Coriolis] {
+            let sh = Shape::new(&wide, model).unwrap();
+            let z_th = sh.c1 * (wide.mu * wide.g_m_s2 / wide.ri_m).sqrt() * target as f64;
+            let w = match omega_for_residence_time(&s, model, target) {
+                Ok(w) => w,
+                Err(InverseError::BeyondPrecision) if z_th > 8.0 => continue,
+                Err(e) => panic!("{e:?} at z_th {z_th}"),
+            };
+            let back = residence(&Scene { omega_rad_s: w as f64, ..wide }, model).unwrap();
+            let (t, c) = match back { Outcome::Leaves { residence_time_s, condition_number, .. } => (residence_time_s, condition_number), o => panic!("{o:?}") };
+            prop_assert!((t - target as f64).abs() < 2e-6 * c * target as f64, "{:?}: {} vs {} (cond {})", model, t, target, c);
+        }
+    }
+}

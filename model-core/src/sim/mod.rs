@@ -8,6 +8,7 @@
 //! Left out on purpose: PWM ripple (20 kHz, averaged), gyroscopic torques between the axes
 //! (second order at these speeds), gearbox backlash.
 
+pub mod experiments;
 pub mod harness;
 pub mod motor;
 pub mod prng;

@@ -34,9 +34,9 @@ pub struct AxisFaults {
     pub dead_sensor_from_s: f32,
     /// From this time on, the shaft is blocked.
     pub blocked_from_s: f32,
-    /// From this time on, an extra load torque, N m.
+    /// From this time on, an extra friction-like load (material in the bowl), N m.
     pub load_step_from_s: f32,
-    /// The load step's size, N m.
+    /// The load step's size, N m (added to the Coulomb and stiction torques).
     pub load_step_nm: f32,
 }
 
@@ -73,8 +73,10 @@ pub struct RigParams {
     pub axes: [AxisParams; 2],
     /// Supply voltage, V.
     pub supply_v: f32,
-    /// Fraction of the spin motor's torque that reacts on the precession axis
-    /// (`cos` of the angle between the axes for a rigid mount; 0 turns coupling off).
+    /// Projection of the spin axis's reaction onto the precession axis (`cos` of the angle
+    /// between the axes; 0 turns coupling off). The spin motor's stator and the spin bearing sit
+    /// on the rod, so the rod feels the motor torque minus the bearing and gearbox friction:
+    /// the rate of change of the bowl's angular momentum, `J2 dw2/dt`.
     pub coupling: f32,
     /// Capture timer rate, Hz.
     pub timer_hz: u32,
@@ -180,6 +182,10 @@ impl Rig {
     pub fn params(&self) -> &RigParams {
         &self.p
     }
+    /// Parameters, to inject a fault or a load change mid-run.
+    pub fn params_mut(&mut self) -> &mut RigParams {
+        &mut self.p
+    }
     /// Simulation time, s.
     pub fn time_s(&self) -> f64 {
         self.time_s
@@ -224,8 +230,8 @@ impl Rig {
     fn substep(&mut self, duties: [f32; 2], h: f32) {
         let t0 = self.time_s;
         let t1 = t0 + h as f64;
-        // Spin first: its torque reacts on the precession axis in the same step.
-        let mut spin_torque = self.axes[1].torque_nm;
+        // Spin first: its reaction acts on the precession axis in the same step.
+        let mut spin_reaction = 0.0;
         for i in [1usize, 0] {
             let ap = self.p.axes[i];
             let f = ap.faults;
@@ -237,19 +243,22 @@ impl Rig {
                 Some(d * self.p.supply_v)
             };
             let mut load = ap.ripple_nm * libm::sin(ax.angle_rad) as f32;
+            let mut motor = ap.motor;
             if t0 as f32 >= f.load_step_from_s {
-                load += f.load_step_nm;
+                // Material drag: friction-like, it opposes motion and never drives the shaft.
+                motor.coulomb_nm += f.load_step_nm;
+                motor.stiction_nm += f.load_step_nm;
             }
             if i == 0 {
-                load += self.p.coupling * spin_torque;
+                load += self.p.coupling * spin_reaction;
             }
             let blocked = t0 as f32 >= f.blocked_from_s;
             let w0 = ax.motor.speed_rad_s;
-            ax.torque_nm = ax.motor.step(&ap.motor, volts, load, blocked, h);
-            if i == 1 {
-                spin_torque = ax.torque_nm;
-            }
+            ax.torque_nm = ax.motor.step(&motor, volts, load, blocked, h);
             let w1 = ax.motor.speed_rad_s;
+            if i == 1 {
+                spin_reaction = ap.motor.inertia_kg_m2 * (w1 - w0) / h;
+            }
             let a0 = ax.angle_rad;
             ax.angle_rad += 0.5 * (w0 + w1) as f64 * h as f64;
             self.emit_edges(i, a0, t0, t1);

@@ -3,8 +3,9 @@
 //!
 //! Why this CRC: anyone can check a frame by hand (`python3 -c "import zlib;
 //! print('%08X' % zlib.crc32(b'T1,...'))"`), it detects every burst up to 32 bits and every
-//! error of up to 3 bits in frames this short (Hamming distance 4 up to 91 607 bits), and a frame
-//! hit by random garbage is falsely accepted with probability 2^-32 = 2.3e-10.
+//! error of up to 4 bits in frames this short (at most 1 960 checked bits; Hamming distance 5
+//! up to 2 974 bits), and a frame hit by other damage is falsely accepted with probability
+//! 2^-32 = 2.3e-10.
 //! A 256-entry table (1 KiB of flash) keeps it at about one table look-up per byte, which the
 //! host decoder needs for its 100 MB/s and the MCU can afford.
 

@@ -11,16 +11,33 @@
 
 pub mod bowl;
 pub mod check;
+pub mod control;
 pub mod cost;
+pub mod ode;
 pub mod particle;
+pub mod wire;
 
 pub use check::{Bench, Case, Failure};
 
 /// Every case, grouped by the module it tests.
-pub static CASE_GROUPS: &[&[Case]] = &[bowl::CASES, particle::CASES];
+pub static CASE_GROUPS: &[&[Case]] = &[
+    bowl::CASES,
+    particle::CASES,
+    ode::CASES,
+    control::CASES,
+    wire::CASES,
+];
 
 /// Every benchmark, grouped likewise.
-pub static BENCH_GROUPS: &[&[Bench]] = &[bowl::BENCHES, particle::BENCHES, cost::BENCHES];
+pub static BENCH_GROUPS: &[&[Bench]] = &[
+    bowl::BENCHES,
+    particle::BENCHES,
+    ode::BENCHES,
+    cost::BENCHES,
+    control::BENCHES,
+    wire::BENCHES,
+    cost::ODE_BENCHES,
+];
 
 /// All cases in one iterator.
 pub fn all_cases() -> impl Iterator<Item = &'static Case> {

@@ -3,9 +3,11 @@
 //! the target path (residence time flat / Coriolis, the inverse) with the budgets.
 
 use crate::check::{Bench, Case, Failure, close, ensure};
+use model_core::Real;
 use model_core::particle::{
     self, InverseError, Model, Outcome, Scene, omega_for_residence_time, residence,
 };
+use model_core::real::micro::{MicroF32, MicroF32HwSqrt};
 
 /// Cases of this module.
 pub static CASES: &[Case] = &[
@@ -57,7 +59,63 @@ pub static BENCHES: &[Bench] = &[
         run: bench_inverse_flat,
         budget_instructions: Some(3000),
     },
+    // The same paths with micromath's functions (for the chart; no budget).
+    Bench {
+        name: "particle::residence_flat_micromath_hwsqrt_f32",
+        inputs: GRID,
+        run: |i| micro_time::<MicroF32HwSqrt>(i, Model::Flat),
+        budget_instructions: None,
+    },
+    Bench {
+        name: "particle::residence_coriolis_micromath_hwsqrt_f32",
+        inputs: GRID,
+        run: |i| micro_time::<MicroF32HwSqrt>(i, Model::Coriolis),
+        budget_instructions: None,
+    },
+    Bench {
+        name: "particle::residence_flat_micromath_f32",
+        inputs: GRID,
+        run: |i| micro_time::<MicroF32>(i, Model::Flat),
+        budget_instructions: None,
+    },
+    Bench {
+        name: "particle::residence_coriolis_micromath_f32",
+        inputs: GRID,
+        run: |i| micro_time::<MicroF32>(i, Model::Coriolis),
+        budget_instructions: None,
+    },
 ];
+
+/// The bench grid's scene in a micromath newtype.
+fn micro_time<T: Real + Into32>(i: usize, model: Model) -> f32 {
+    let s = scene_f32(i);
+    let m = Scene {
+        omega_rad_s: T::from_f64(s.omega_rad_s as f64),
+        mu: T::from_f64(s.mu as f64),
+        g_m_s2: T::from_f64(s.g_m_s2 as f64),
+        k2: T::from_f64(s.k2 as f64),
+        ri_m: T::from_f64(s.ri_m as f64),
+        rim_radius_m: T::from_f64(s.rim_radius_m as f64),
+    };
+    residence(&m, model)
+        .map(|o| o.residence_time_s().into_f32())
+        .unwrap_or(f32::NAN)
+}
+
+/// Back to a plain f32 (the harness wants one).
+trait Into32 {
+    fn into_f32(self) -> f32;
+}
+impl Into32 for MicroF32 {
+    fn into_f32(self) -> f32 {
+        self.0
+    }
+}
+impl Into32 for MicroF32HwSqrt {
+    fn into_f32(self) -> f32 {
+        self.0
+    }
+}
 
 const OMEGAS: [f64; 4] = [2.5, 3.0, 3.6, 5.0];
 const MUS: [f64; 3] = [0.0, 0.01, 0.029];

@@ -1,0 +1,366 @@
+//! Host side of the emulated board (Unix hosts only, never on the MCU): build a `qemu-*` image,
+//! boot it under QEMU netduinoplus2 with USART1 on a Unix socket, and share that link between
+//! the telemetry decoder and `bowl` commands. Used by the QEMU tests and by the demo
+//! (`rig-demo`).
+//!
+//! Why a splitter: a serial port (or pseudo-terminal) has one input queue, so two readers
+//! (`bowl monitor` and `bowl send`) would steal each other's bytes. The splitter reads the board
+//! once, decodes every frame for itself, and copies the bytes to one pseudo-terminal per
+//! client: the monitor's always, the command terminal's while a `bowl send` runs.
+extern crate std;
+
+use std::format;
+use std::io::{BufRead, BufReader, Read, Write};
+use std::os::fd::{AsRawFd, OwnedFd};
+use std::os::unix::net::UnixStream;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::string::String;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use std::vec::Vec;
+use std::{println, vec};
+
+use model_core::wire::{Decoder, Frame, Telemetry};
+
+/// The workspace root (parent of this crate).
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Builds `bin` for the emulated board (release profile) and returns the ELF path.
+pub fn build_image(bin: &str) -> PathBuf {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(workspace_root())
+        .args([
+            "build",
+            "--release",
+            "-p",
+            "firmware",
+            "--no-default-features",
+            "--features",
+            "qemu",
+            "--target",
+            "thumbv7em-none-eabihf",
+            "--bin",
+            bin,
+        ])
+        .status()
+        .expect("cargo runs");
+    assert!(status.success(), "building {bin} for QEMU failed");
+    target_dir().join("thumbv7em-none-eabihf/release").join(bin)
+}
+
+/// A running emulated board: QEMU's stdout carries the semihosting console.
+pub struct Board {
+    /// The QEMU process (stdout: the semihosting console).
+    pub child: Child,
+    /// The board's USART1.
+    pub usart: UnixStream,
+    socket_path: PathBuf,
+}
+
+impl Board {
+    /// Boots `elf`; QEMU waits (`server=on,wait=on`) until we have connected to its USART1, so
+    /// no byte the board sends is lost.
+    pub fn boot(elf: &Path) -> Board {
+        Self::boot_with(elf, &[])
+    }
+
+    /// Boots `elf` with extra QEMU arguments (e.g. `-append seconds=30`).
+    pub fn boot_with(elf: &Path, extra: &[&str]) -> Board {
+        let socket_path = std::env::temp_dir().join(format!(
+            "bowl-qemu-{}-{}.sock",
+            std::process::id(),
+            elf.file_name().unwrap().to_string_lossy()
+        ));
+        let _ = std::fs::remove_file(&socket_path);
+        let child = Command::new("qemu-system-arm")
+            .args([
+                "-machine",
+                "netduinoplus2",
+                "-cpu",
+                "cortex-m4",
+                "-nographic",
+            ])
+            .args(["-monitor", "none"])
+            .args(["-semihosting-config", "enable=on,target=native"])
+            .args(["-icount", "shift=0,sleep=off"])
+            .arg("-chardev")
+            .arg(format!(
+                "socket,id=usart1,path={},server=on,wait=on",
+                socket_path.display()
+            ))
+            .args(["-serial", "chardev:usart1"])
+            .arg("-kernel")
+            .arg(elf)
+            .args(extra)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("qemu-system-arm is installed");
+        let deadline = Instant::now() + Duration::from_secs(20);
+        let usart = loop {
+            match UnixStream::connect(&socket_path) {
+                Ok(s) => break s,
+                Err(_) if Instant::now() < deadline => {
+                    std::thread::sleep(Duration::from_millis(20))
+                }
+                Err(e) => panic!("QEMU's USART socket never appeared: {e}"),
+            }
+        };
+        usart
+            .set_read_timeout(Some(Duration::from_secs(30)))
+            .unwrap();
+        Board {
+            child,
+            usart,
+            socket_path,
+        }
+    }
+
+    /// Reads one `\n`-terminated line from the USART (without the newline).
+    pub fn read_usart_line(&mut self) -> String {
+        let mut line = Vec::new();
+        let mut byte = [0u8; 1];
+        loop {
+            let n = self.usart.read(&mut byte).expect("USART read");
+            assert!(n == 1, "USART closed before a full line: {line:?}");
+            if byte[0] == b'\n' {
+                return String::from_utf8_lossy(&line).into_owned();
+            }
+            line.push(byte[0]);
+        }
+    }
+
+    /// Waits for QEMU to exit and returns (exit success, console lines).
+    pub fn finish(mut self) -> (bool, Vec<String>) {
+        let stdout = self.child.stdout.take().unwrap();
+        let lines: Vec<String> = BufReader::new(stdout)
+            .lines()
+            .map_while(Result::ok)
+            .collect();
+        let status = self.child.wait().expect("QEMU exits");
+        (status.success(), lines)
+    }
+}
+
+impl Drop for Board {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = std::fs::remove_file(&self.socket_path);
+    }
+}
+
+/// What the splitter decoded from the board.
+#[derive(Default)]
+pub struct Seen {
+    /// Every telemetry frame, in arrival order.
+    pub telemetry: Vec<Telemetry>,
+    /// Boot announcements.
+    pub hello: usize,
+    /// Frames that failed their check or did not parse.
+    pub corrupt: usize,
+}
+
+/// Sits between the board's USART socket and pseudo-terminals (see the module docs).
+pub struct Splitter {
+    seen: Arc<Mutex<Seen>>,
+    forward: Arc<AtomicBool>,
+    command_pty: PathBuf,
+    command_slave: OwnedFd,
+    monitor_pty: Option<(PathBuf, OwnedFd)>,
+}
+
+fn raw_pty() -> (OwnedFd, OwnedFd, PathBuf) {
+    use nix::sys::termios;
+    let pty = nix::pty::openpty(None, None).expect("openpty");
+    let mut t = termios::tcgetattr(&pty.slave).expect("tcgetattr");
+    termios::cfmakeraw(&mut t);
+    termios::tcsetattr(&pty.slave, termios::SetArg::TCSANOW, &t).expect("tcsetattr");
+    let path = std::fs::read_link(format!("/proc/self/fd/{}", pty.slave.as_raw_fd()))
+        .expect("the slave's path");
+    (pty.master, pty.slave, path)
+}
+
+impl Splitter {
+    /// Starts relaying `usart`. With `monitor`, a second terminal receives every byte from the
+    /// board (someone must read it, or the relay blocks and with it the board's virtual time).
+    pub fn start(usart: UnixStream, monitor: bool) -> Splitter {
+        let (master, command_slave, command_pty) = raw_pty();
+        let mut monitor_w = None;
+        let monitor_pty = monitor.then(|| {
+            let (m, s, p) = raw_pty();
+            monitor_w = Some(std::fs::File::from(m));
+            (p, s)
+        });
+        let seen = Arc::new(Mutex::new(Seen::default()));
+        let forward = Arc::new(AtomicBool::new(false));
+        let mut command_w = std::fs::File::from(master.try_clone().expect("dup"));
+        let mut command_r = std::fs::File::from(master);
+        let mut from_board = usart.try_clone().expect("dup");
+        let mut to_board = usart;
+        {
+            let (seen, forward) = (seen.clone(), forward.clone());
+            std::thread::spawn(move || {
+                let mut decoder = Decoder::new();
+                let mut buf = vec![0u8; 4096];
+                while let Ok(n) = from_board.read(&mut buf) {
+                    if n == 0 {
+                        break;
+                    }
+                    if forward.load(Ordering::Acquire) {
+                        let _ = command_w.write_all(&buf[..n]);
+                    }
+                    if let Some(m) = monitor_w.as_mut() {
+                        let _ = m.write_all(&buf[..n]);
+                    }
+                    let mut s = seen.lock().expect("lock");
+                    for &b in &buf[..n] {
+                        match decoder.push(b) {
+                            Some(Ok(Frame::Telemetry(t))) => s.telemetry.push(t),
+                            Some(Ok(Frame::Hello(_))) => s.hello += 1,
+                            Some(Ok(_)) => {}
+                            Some(Err(_)) => s.corrupt += 1,
+                            None => {}
+                        }
+                    }
+                }
+            });
+        }
+        std::thread::spawn(move || {
+            let mut buf = [0u8; 256];
+            while let Ok(n) = command_r.read(&mut buf) {
+                if n == 0 || to_board.write_all(&buf[..n]).is_err() {
+                    break;
+                }
+            }
+        });
+        Splitter {
+            seen,
+            forward,
+            command_pty,
+            command_slave,
+            monitor_pty,
+        }
+    }
+
+    /// The monitor's terminal, if one was asked for.
+    pub fn monitor_pty(&self) -> Option<&Path> {
+        self.monitor_pty.as_ref().map(|(p, _)| p.as_path())
+    }
+
+    /// Runs `bowl send PTY words...` and returns its exit code and output.
+    pub fn send(&self, bowl: &Path, words: &[&str]) -> (i32, String) {
+        // Stale telemetry queued while nobody listened must not reach this send.
+        let _ =
+            nix::sys::termios::tcflush(&self.command_slave, nix::sys::termios::FlushArg::TCIFLUSH);
+        self.forward.store(true, Ordering::Release);
+        let out = Command::new(bowl)
+            .arg("send")
+            .arg(&self.command_pty)
+            .args(words)
+            .args(["--timeout-ms", "3000"])
+            .output()
+            .expect("bowl runs");
+        self.forward.store(false, Ordering::Release);
+        let text = String::from_utf8_lossy(&out.stdout).into_owned()
+            + &String::from_utf8_lossy(&out.stderr);
+        println!(
+            "bowl send {} -> {:?}: {}",
+            words.join(" "),
+            out.status.code(),
+            text.trim()
+        );
+        (out.status.code().unwrap_or(-1), text)
+    }
+
+    /// The newest telemetry frame.
+    pub fn last(&self) -> Telemetry {
+        let s = self.seen.lock().expect("lock");
+        *s.telemetry.last().expect("telemetry arrives")
+    }
+
+    /// Runs `f` on everything decoded so far.
+    pub fn with_seen<R>(&self, f: impl FnOnce(&Seen) -> R) -> R {
+        f(&self.seen.lock().expect("lock"))
+    }
+
+    /// Waits until the board's clock has advanced `ms` past `from_ms`; returns the frames of
+    /// that interval. Panics if no such frame comes within two minutes of host time.
+    pub fn wait_device_ms(&self, from_ms: u32, ms: u32) -> Vec<Telemetry> {
+        let deadline = Instant::now() + Duration::from_secs(120);
+        loop {
+            {
+                let s = self.seen.lock().expect("lock");
+                if s.telemetry
+                    .last()
+                    .is_some_and(|t| t.time_ms >= from_ms + ms)
+                {
+                    return s
+                        .telemetry
+                        .iter()
+                        .filter(|t| t.time_ms >= from_ms)
+                        .copied()
+                        .collect();
+                }
+            }
+            assert!(
+                Instant::now() < deadline,
+                "the board stopped sending telemetry"
+            );
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+}
+
+/// Builds the `bowl` command (host-tools, debug profile) and returns its path.
+pub fn build_bowl() -> PathBuf {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(workspace_root())
+        .args(["build", "-p", "host-tools", "--bin", "bowl"])
+        .status()
+        .expect("cargo runs");
+    assert!(status.success(), "building bowl failed");
+    target_dir().join("debug/bowl")
+}
+
+fn target_dir() -> PathBuf {
+    std::env::var("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| workspace_root().join("target"))
+}
+
+/// One line of the plant's semihosting log: the simulation's truth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlantSample {
+    /// Simulation time, ms.
+    pub t_ms: u32,
+    /// True speeds `[precession, spin]`, rad/s.
+    pub speed_rad_s: [f32; 2],
+    /// Duties the plant was driven with.
+    pub duty: [f32; 2],
+}
+
+/// The `plant t_ms=.. w1=.. w2=.. d1=.. d2=..` lines of the semihosting console.
+pub fn plant_truth(console: &[String]) -> Vec<PlantSample> {
+    console
+        .iter()
+        .filter_map(|l| l.strip_prefix("plant "))
+        .filter_map(|l| {
+            let v: Vec<f32> = l
+                .split_whitespace()
+                .filter_map(|kv| kv.split_once('=').and_then(|(_, v)| v.parse().ok()))
+                .collect();
+            (v.len() == 5).then(|| PlantSample {
+                t_ms: v[0] as u32,
+                speed_rad_s: [v[1], v[2]],
+                duty: [v[3], v[4]],
+            })
+        })
+        .collect()
+}

@@ -1,0 +1,107 @@
+//! The simulated rig (`model_core::sim::Rig`) standing in for the motors and the proximity
+//! sensors of the emulated board.
+//!
+//! The plant task advances the simulation by the embassy time that really passed (1 kHz),
+//! with the duties the control task last applied, and pushes the sensor edges into the same
+//! [`EdgeQueue`]s the STM32's capture interrupt fills. The simulation's capture clock (1 MHz,
+//! 32 bit, like TIM2 on the Black Pill) is the board's [`CaptureClock`].
+//!
+//! Injected sensor faults act where a real one would: the plant keeps turning, its edges no
+//! longer reach the firmware.
+
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+
+use embassy_time::{Duration, Instant, Ticker};
+use model_core::sim::{Rig, RigParams};
+use model_core::wire::{Injection, Reason};
+
+use crate::app::binding::Injector;
+use crate::app::edges::EdgeQueue;
+use crate::app::hal::{CaptureClock, MotorOutput};
+use crate::app::motors::sanitize_duty;
+
+/// The edge queues, `[precession, spin]`, filled by the plant task.
+pub static EDGES: [EdgeQueue; 2] = [EdgeQueue::new(), EdgeQueue::new()];
+/// Duties as the "bridge" sees them (f32 bits), written by [`SimMotor`].
+static DUTIES: [AtomicU32; 2] = [AtomicU32::new(0), AtomicU32::new(0)];
+/// The simulation's capture timer after its latest step.
+static NOW_TICKS: AtomicU32 = AtomicU32::new(0);
+/// Sensors whose edges no longer reach the firmware.
+static SENSOR_DEAD: [AtomicBool; 2] = [AtomicBool::new(false), AtomicBool::new(false)];
+
+/// Plant step: the control tick rate, so each tick sees the edges of one step.
+pub const PLANT_PERIOD: Duration = Duration::from_millis(1);
+
+/// One simulated motor output (the "PWM register").
+pub struct SimMotor(pub usize);
+
+impl MotorOutput for SimMotor {
+    fn set_duty(&mut self, duty: f32) {
+        DUTIES[self.0].store(sanitize_duty(duty).to_bits(), Ordering::Relaxed);
+    }
+    fn off(&mut self) {
+        DUTIES[self.0].store(0, Ordering::Relaxed);
+    }
+}
+
+/// Both outputs to zero: for the panic handler and the emulated watchdog.
+pub fn emergency_off() {
+    for d in &DUTIES {
+        d.store(0, Ordering::Relaxed);
+    }
+}
+
+/// The duties the plant is driven with now.
+pub fn duties() -> [f32; 2] {
+    [0, 1].map(|i| f32::from_bits(DUTIES[i].load(Ordering::Relaxed)))
+}
+
+/// The simulation's capture timer as the board's clock.
+pub struct PlantClock;
+
+impl CaptureClock for PlantClock {
+    fn now_ticks(&self) -> u32 {
+        NOW_TICKS.load(Ordering::Relaxed)
+    }
+}
+
+/// Sensor injections go to the plant; a blocked shaft needs support inside the simulation
+/// that it does not offer at run time, so those are refused.
+pub struct PlantInjector;
+
+impl Injector for PlantInjector {
+    fn inject(&mut self, what: Injection) -> Result<(), Reason> {
+        match what {
+            Injection::None => SENSOR_DEAD
+                .iter()
+                .for_each(|d| d.store(false, Ordering::Relaxed)),
+            Injection::SensorLostPrecession => SENSOR_DEAD[0].store(true, Ordering::Relaxed),
+            Injection::SensorLostSpin => SENSOR_DEAD[1].store(true, Ordering::Relaxed),
+            Injection::StallPrecession | Injection::StallSpin => return Err(Reason::Unsupported),
+        }
+        Ok(())
+    }
+}
+
+/// Runs the plant forever; `observe` sees the rig after every step (for the truth log).
+pub async fn run(params: RigParams, seed: u32, mut observe: impl FnMut(&Rig)) -> ! {
+    let mut rig = Rig::new(params, seed);
+    let mut ticker = Ticker::every(PLANT_PERIOD);
+    let mut last = Instant::now();
+    loop {
+        ticker.next().await;
+        let now = Instant::now();
+        let dt_s = (now - last).as_micros() as f32 * 1e-6;
+        last = now;
+        rig.advance(duties(), dt_s);
+        for (axis, queue) in EDGES.iter().enumerate() {
+            if !SENSOR_DEAD[axis].load(Ordering::Relaxed) {
+                for &t in rig.edges(axis) {
+                    queue.push(t);
+                }
+            }
+        }
+        NOW_TICKS.store(rig.now_ticks(), Ordering::Relaxed);
+        observe(&rig);
+    }
+}

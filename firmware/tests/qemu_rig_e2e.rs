@@ -1,0 +1,131 @@
+//! End to end on the emulated board: the firmware's application logic on QEMU netduinoplus2
+//! with the simulated plant, driven over its emulated USART by `bowl send`, its telemetry read
+//! with the shared host decoder, checked against the plant's true speeds (semihosting log).
+//!
+//! Time is the board's (`-icount shift=0,sleep=off`): every bound below is in device time,
+//! taken from the telemetry frames, never from the host clock.
+//!
+//! Run: `cargo test -p firmware --no-default-features --test qemu_rig_e2e`.
+
+use firmware::host::{self, Board, Splitter, plant_truth};
+use model_core::wire::{DeviceState, FaultCode, Residence};
+
+#[test]
+fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
+    let bowl = host::build_bowl();
+    let elf = host::build_image("qemu-rig");
+    let board = Board::boot_with(&elf, &["-append", "seconds=40"]);
+    let usart = board.usart.try_clone().unwrap();
+    let split = Splitter::start(usart, false);
+
+    // Boot: hello, idle, no fault, motors off.
+    let t0 = split.wait_device_ms(0, 300);
+    assert!(
+        split.with_seen(|s| s.hello) >= 1,
+        "the board announces itself"
+    );
+    assert!(t0.iter().all(|t| t.state == DeviceState::Idle
+        && t.fault == FaultCode::None
+        && t.precession.duty_bp == 0
+        && t.spin.duty_bp == 0));
+
+    // Speeds, start, and 6 s of device time.
+    assert_eq!(split.send(&bowl, &["speed", "2000", "3000"]).0, 0);
+    assert_eq!(split.send(&bowl, &["start"]).0, 0);
+    let started_ms = split.last().time_ms;
+    let run = split.wait_device_ms(started_ms, 6_000);
+    let tail: Vec<_> = run
+        .iter()
+        .filter(|t| t.time_ms >= started_ms + 4_000)
+        .collect();
+    assert!(!tail.is_empty());
+    for t in &tail {
+        assert_eq!(t.state, DeviceState::Running, "{t:?}");
+        assert_eq!((t.precession.set_mrad_s, t.spin.set_mrad_s), (2000, 3000));
+        // Measured (from pulses) within 2 % of the setpoint once settled.
+        assert!(
+            (i32::from(t.precession.measured_mrad_s) - 2000).abs() <= 40,
+            "{t:?}"
+        );
+        assert!(
+            (i32::from(t.spin.measured_mrad_s) - 3000).abs() <= 60,
+            "{t:?}"
+        );
+    }
+    // Telemetry sequence: no frame lost on the way.
+    for w in run.windows(2) {
+        assert_eq!(
+            w[1].seq,
+            w[0].seq.wrapping_add(1),
+            "frame lost between {w:?}"
+        );
+    }
+
+    // A residence-time target: the prediction the rig reports at its measured speeds
+    // converges on the target. 800 ms in the default scene needs a combined bowl speed of about
+    // 3 rad/s, well above the threshold speed sqrt(mu g / ri) = 2.39 rad/s where the time
+    // becomes ill-conditioned (2.5 s would sit at 2.40 rad/s: 1 % of speed, 30 % of time).
+    assert_eq!(split.send(&bowl, &["rtime", "flat", "800"]).0, 0);
+    let from = split.last().time_ms;
+    let settled = split.wait_device_ms(from, 8_000);
+    let last = settled.last().unwrap();
+    match last.residence_flat {
+        Residence::Ms(ms) => assert!((760..=840).contains(&ms), "{last:?}"),
+        other => panic!("no flat prediction at the end: {other:?} ({last:?})"),
+    }
+
+    // The spin sensor dies: fault within max(200 ms, 3 pulse periods) (+ one telemetry period
+    // and the command's transit), both outputs at zero, latched.
+    assert_eq!(split.send(&bowl, &["inject", "sensor2"]).0, 0);
+    let injected_ms = split.last().time_ms;
+    let after = split.wait_device_ms(injected_ms, 2_000);
+    let first_fault = after
+        .iter()
+        .find(|t| t.state == DeviceState::Faulted)
+        .expect("the lost sensor faults the rig");
+    assert_eq!(first_fault.fault, FaultCode::SensorLostOrStallSpin);
+    let w2 = f32::from(settled.last().unwrap().spin.measured_mrad_s) * 1e-3;
+    let pulse_period_ms = 1000.0 * core::f32::consts::TAU / (12.0 * w2);
+    let bound_ms = (200.0f32).max(3.0 * pulse_period_ms) + 20.0 + 150.0;
+    let latency = first_fault.time_ms - injected_ms;
+    println!("sensor fault after {latency} ms of device time (bound {bound_ms:.0} ms)");
+    assert!((latency as f32) <= bound_ms, "fault after {latency} ms");
+    for t in after.iter().filter(|t| t.time_ms >= first_fault.time_ms) {
+        assert_eq!(t.state, DeviceState::Faulted, "the fault latches");
+        assert_eq!((t.precession.duty_bp, t.spin.duty_bp), (0, 0), "{t:?}");
+    }
+    // Faulted: START is refused, CLEAR works once asked.
+    assert_eq!(split.send(&bowl, &["start"]).0, 2);
+    assert_eq!(split.send(&bowl, &["inject", "none"]).0, 0);
+    assert_eq!(split.send(&bowl, &["clear"]).0, 0);
+    let from = split.last().time_ms;
+    let cleared = split.wait_device_ms(from, 300);
+    assert_eq!(cleared.last().unwrap().state, DeviceState::Idle);
+
+    // The plant's own record: true speeds near the setpoints while running, duties zero
+    // after the fault.
+    let (ok, console) = board.finish();
+    assert!(
+        ok,
+        "the board ended with a failure:\n{}",
+        console.join("\n")
+    );
+    let truth = plant_truth(&console);
+    let running: Vec<_> = truth
+        .iter()
+        .filter(|r| r.t_ms >= started_ms + 4_000 && r.t_ms <= started_ms + 6_000)
+        .collect();
+    assert!(!running.is_empty(), "plant log covers the run");
+    for r in running {
+        assert!(
+            (r.speed_rad_s[0] - 2.0).abs() < 0.06 && (r.speed_rad_s[1] - 3.0).abs() < 0.09,
+            "true speeds {r:?}"
+        );
+    }
+    let faulted: Vec<_> = truth
+        .iter()
+        .filter(|r| r.t_ms > first_fault.time_ms + 100 && r.t_ms < first_fault.time_ms + 1_500)
+        .collect();
+    assert!(!faulted.is_empty());
+    assert!(faulted.iter().all(|r| r.duty == [0.0, 0.0]), "{faulted:?}");
+}

@@ -1,0 +1,161 @@
+//! The chooser's decisions checked against errors measured independently here.
+
+use super::*;
+use crate::ode::SpinUp;
+
+fn scene(omega: f64, mu: f64, ri: f64) -> Scene<f64> {
+    Scene {
+        omega_rad_s: omega,
+        mu,
+        g_m_s2: 9.81,
+        k2: 5.0 / 7.0,
+        ri_m: ri,
+        rim_radius_m: 0.1,
+    }
+}
+
+/// Measured spread: T over the corners of the uncertainty box (all combinations), relative
+/// half-width. Independent of the chooser's one-at-a-time sum.
+fn corner_spread(s: &Scene<f64>, k: &Knowledge<f64>) -> f64 {
+    let t0 = particle::residence(s, Model::Coriolis)
+        .unwrap()
+        .residence_time_s();
+    let mut worst: f64 = 0.0;
+    for &dm in &[-1.0, 1.0] {
+        for &dri in &[-1.0, 1.0] {
+            for &drim in &[-1.0, 1.0] {
+                for &dw in &[-1.0, 1.0] {
+                    let p = Scene {
+                        mu: s.mu * (1.0 + dm * k.mu_rel),
+                        ri_m: s.ri_m + dri * k.radius_m,
+                        rim_radius_m: s.rim_radius_m + drim * k.radius_m,
+                        omega_rad_s: s.omega_rad_s * (1.0 + dw * k.omega_rel),
+                        ..*s
+                    };
+                    let t = particle::residence(&p, Model::Coriolis)
+                        .unwrap()
+                        .residence_time_s();
+                    worst = worst.max((t - t0).abs() / t0);
+                }
+            }
+        }
+    }
+    worst
+}
+
+#[test]
+fn mu_known_to_20_percent_needs_only_the_flat_closed_form() {
+    let s = scene(3.0, 0.029, 0.05);
+    let k = Knowledge {
+        mu_rel: 0.2,
+        radius_m: 1e-3,
+        omega_rel: 0.01,
+    };
+    let c = choose_constant(&s, &k).unwrap();
+    assert_eq!((c.model, c.plan), (Model::Flat, Plan::ClosedForm));
+    // Measured: the spread really is at least 10x the tolerance, and the flat model's error
+    // (against the Coriolis closed form) is below the tolerance.
+    let measured_spread = corner_spread(&s, &k);
+    assert!(
+        c.tolerance_rel <= 0.1 * measured_spread * 1.0001,
+        "{c:?} vs {measured_spread}"
+    );
+    let tf = particle::residence(&s, Model::Flat)
+        .unwrap()
+        .residence_time_s();
+    let tc = particle::residence(&s, Model::Coriolis)
+        .unwrap()
+        .residence_time_s();
+    assert!((tf - tc).abs() / tc <= c.tolerance_rel * 1.05);
+}
+
+#[test]
+fn precisely_known_resistance_needs_the_coriolis_model() {
+    let s = scene(3.6, 0.1, 0.09);
+    let k = Knowledge {
+        mu_rel: 1e-4,
+        radius_m: 1e-7,
+        omega_rel: 1e-5,
+    };
+    let c = choose_constant(&s, &k).unwrap();
+    assert_eq!(c.model, Model::Coriolis);
+    let tf = particle::residence(&s, Model::Flat)
+        .unwrap()
+        .residence_time_s();
+    let tc = particle::residence(&s, Model::Coriolis)
+        .unwrap()
+        .residence_time_s();
+    assert!(
+        (tf - tc).abs() / tc > c.tolerance_rel,
+        "flat would be too far off"
+    );
+    assert!(c.coriolis_effect_rel > 0.01 && c.coriolis_effect_rel < 0.1);
+}
+
+#[test]
+fn spin_up_plan_meets_its_tolerance_when_run() {
+    let s = scene(0.0, 0.029, 0.05);
+    let profile = SpinUp {
+        start_rad_s: 0.0,
+        final_rad_s: 3.6,
+        time_constant_s: 0.3,
+    };
+    for k in [
+        Knowledge {
+            mu_rel: 0.2,
+            radius_m: 1e-3,
+            omega_rel: 0.01,
+        },
+        Knowledge {
+            mu_rel: 1e-5,
+            radius_m: 1e-8,
+            omega_rel: 1e-7,
+        },
+    ] {
+        let c = choose_varying(&s, &k, &profile).unwrap();
+        extern crate std;
+        std::println!("{k:?} -> {c:?}");
+        let Plan::Integrate(method) = c.plan else {
+            panic!("{c:?}")
+        };
+        let limits = Limits::for_scene(&s, &profile);
+        // Truth: the Coriolis model, integrated tightly. The chosen model + method must land
+        // within the tolerance of it (model error + method error, each budgeted).
+        let truth = run(&s, Model::Coriolis, &profile, dp(1e-12, &s), limits)
+            .unwrap()
+            .0;
+        let (t, evals) = run(&s, c.model, &profile, method, limits).unwrap();
+        let err = (t - truth).abs() / truth;
+        assert!(err <= 2.0 * c.tolerance_rel, "{c:?}: error {err:e}");
+        assert_eq!(evals, c.rhs_evaluations);
+        if k.mu_rel > 0.1 {
+            assert_eq!(c.model, Model::Flat, "{c:?}");
+        } else {
+            assert_eq!(c.model, Model::Coriolis, "{c:?}");
+            assert!(c.tolerance_rel < 1e-5);
+        }
+    }
+}
+
+#[test]
+fn bad_knowledge_and_stuck_particles_are_errors() {
+    let s = scene(3.0, 0.029, 0.05);
+    let bad = Knowledge {
+        mu_rel: f64::NAN,
+        radius_m: 0.0,
+        omega_rel: 0.0,
+    };
+    assert_eq!(
+        choose_constant(&s, &bad),
+        Err(ChooseError::InvalidKnowledge)
+    );
+    let k = Knowledge {
+        mu_rel: 0.1,
+        radius_m: 0.0,
+        omega_rel: 0.0,
+    };
+    assert_eq!(
+        choose_constant(&scene(3.0, 0.4, 0.05), &k),
+        Err(ChooseError::DoesNotLeave)
+    );
+}

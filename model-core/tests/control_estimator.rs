@@ -1,0 +1,196 @@
+//! Pulse speed estimator against synthetic edge trains whose true speed is known exactly.
+
+use model_core::control::estimator::PulseSpeedEstimator;
+use model_core::control::{AxisConfig, ControllerConfig};
+use proptest::prelude::*;
+
+struct Feed {
+    est: PulseSpeedEstimator,
+    mask: u32,
+    timer_hz: f64,
+    tick_s: f64,
+    t_s: f64,
+    steady: bool,
+}
+
+impl Feed {
+    fn new(pulses: u16, timer_bits: u8) -> Self {
+        let mut cfg = ControllerConfig::nominal();
+        cfg.timer_bits = timer_bits;
+        cfg.axes[0].pulses_per_rev = pulses;
+        cfg.axes[0].min_speed_rad_s = 0.1;
+        cfg.validate().unwrap();
+        let axis: AxisConfig = cfg.axes[0];
+        Self {
+            est: PulseSpeedEstimator::new(&cfg, &axis),
+            mask: if timer_bits == 32 {
+                u32::MAX
+            } else {
+                (1 << timer_bits) - 1
+            },
+            timer_hz: cfg.timer_hz as f64,
+            tick_s: 1.0 / cfg.tick_hz as f64,
+            t_s: 0.0,
+            steady: true,
+        }
+    }
+    fn ticks(&self, t: f64) -> u32 {
+        ((t * self.timer_hz) as u64 & self.mask as u64) as u32
+    }
+    /// Advances one tick with the given edge times (s) inside it.
+    fn tick(&mut self, edges_s: &[f64]) -> f32 {
+        self.t_s += self.tick_s;
+        let edges: Vec<u32> = edges_s.iter().map(|&t| self.ticks(t)).collect();
+        let now = self.ticks(self.t_s);
+        self.est.tick(now, &edges, self.steady, |_, _| {})
+    }
+    /// Runs `seconds` with edges at the given (sorted) times.
+    fn run(&mut self, seconds: f64, edge_times: &[f64]) -> f32 {
+        let end = self.t_s + seconds;
+        let mut k = edge_times.partition_point(|&t| t <= self.t_s);
+        let mut v = 0.0;
+        while self.t_s < end - 1e-12 {
+            let t1 = self.t_s + self.tick_s;
+            let start = k;
+            while k < edge_times.len() && edge_times[k] <= t1 {
+                k += 1;
+            }
+            v = self.tick(&edge_times[start..k]);
+        }
+        v
+    }
+}
+
+fn edges_at(speed: f64, pulses: u16, until: f64) -> Vec<f64> {
+    let period = std::f64::consts::TAU / (pulses as f64 * speed);
+    (1..)
+        .map(|k| 0.0123 + k as f64 * period)
+        .take_while(|&t| t < until)
+        .collect()
+}
+
+#[test]
+fn constant_speed_is_exact_for_1_12_and_60_pulses() {
+    for &n in &[1u16, 12, 60] {
+        for &w in &[0.5f64, 1.8, 3.6] {
+            let until = 8.0 + 3.0 * std::f64::consts::TAU / (n as f64 * w);
+            let e = edges_at(w, n, until);
+            let mut f = Feed::new(n, 32);
+            // Read just after an edge: the stall bound is not involved.
+            let last = *e.iter().rev().find(|&&t| t < until - 0.5).unwrap();
+            let v = f.run(last + 0.0005, &e);
+            assert!(
+                ((v as f64) - w).abs() < 2e-3 * w,
+                "N {n} w {w}: estimate {v}"
+            );
+        }
+    }
+}
+
+#[test]
+fn sixteen_bit_timer_wraps_every_65_ms_yet_one_second_periods_measure_right() {
+    // N = 12 at 0.5 rad/s: a pulse every 1.047 s, 16 timer wraps per period.
+    let e = edges_at(0.5, 12, 12.0);
+    let mut f = Feed::new(12, 16);
+    let last = *e.iter().rev().find(|&&t| t < 11.0).unwrap();
+    let v = f.run(last + 0.0005, &e);
+    assert!(((v as f64) - 0.5).abs() < 1e-3, "estimate {v}");
+}
+
+#[test]
+fn a_stopped_shaft_decays_then_reads_exactly_zero() {
+    // Steady: the bound allows two pitches (one missing pulse); otherwise one.
+    for (steady, pitches) in [(false, 1.0), (true, 2.0)] {
+        let e = edges_at(2.0, 12, 3.0);
+        let mut f = Feed::new(12, 32);
+        f.steady = steady;
+        let v_running = f.run(3.0, &e);
+        assert!((v_running - 2.0).abs() < 0.05);
+        // No more edges: bounded by pitches * pitch / time since the last edge, then zero after
+        // the stall time (one pitch at the minimum speed 0.1 rad/s: 5.2 s).
+        let mut prev = v_running;
+        let last_edge = *e.last().unwrap();
+        let pitch = std::f64::consts::TAU / 12.0;
+        for _ in 0..50 {
+            let v = f.run(0.1, &[]);
+            assert!(v <= prev + 1e-6, "estimate rose while stopped");
+            let bound = pitches * pitch / (f.t_s - last_edge);
+            assert!(
+                (v as f64) <= bound * 1.001 + 1e-6,
+                "{v} above the bound {bound}"
+            );
+            prev = v;
+        }
+        assert!(
+            (prev as f64) < pitches * pitch / 5.0,
+            "still reads {prev} five seconds after the last edge"
+        );
+        let v = f.run(0.5, &[]);
+        assert_eq!(v, 0.0);
+        assert!(f.est.is_stopped());
+    }
+}
+
+#[test]
+fn bouncing_edges_are_rejected() {
+    let mut e = edges_at(3.0, 12, 6.0);
+    let bounces: Vec<f64> = e.iter().step_by(2).map(|t| t + 60e-6).collect();
+    e.extend(bounces);
+    e.sort_by(f64::total_cmp);
+    let mut f = Feed::new(12, 32);
+    let v = f.run(5.5, &e);
+    assert!((v - 3.0).abs() < 0.01 * 3.0, "estimate {v}");
+    assert!(f.est.rejected_edges() > 10);
+}
+
+#[test]
+fn missing_pulses_are_inferred_at_steady_speed() {
+    let all = edges_at(3.0, 12, 10.0);
+    let e: Vec<f64> = all
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| k % 7 != 3)
+        .map(|(_, &t)| t)
+        .collect();
+    let mut f = Feed::new(12, 32);
+    let mut worst = 0.0f32;
+    let mut t = 0.0;
+    while t < 9.5 {
+        let v = f.run(0.01, &e);
+        t += 0.01;
+        if t > 3.0 {
+            worst = worst.max((v - 3.0).abs() / 3.0);
+        }
+    }
+    assert!(worst < 0.02, "worst relative error {worst}");
+    assert!(
+        f.est.inferred_missing() >= 5,
+        "{}",
+        f.est.inferred_missing()
+    );
+}
+
+proptest! {
+    #[test]
+    fn any_edge_stream_gives_a_finite_nonnegative_speed(
+        gaps in proptest::collection::vec(0u32..3_000_000, 1..200),
+        bits in prop_oneof![Just(16u8), Just(32u8)],
+        n in 1u16..100,
+    ) {
+        let mut f = Feed::new(n, bits);
+        let mut t = 0u64;
+        let mut now = 0u64;
+        for g in gaps {
+            t += g as u64;
+            // Deliver every edge in the tick that contains it.
+            while now + 1000 < t {
+                now += 1000;
+                let v = f.est.tick((now & f.mask as u64) as u32, &[], false, |_, _| {});
+                prop_assert!(v.is_finite() && v >= 0.0);
+            }
+            now += 1000;
+            let v = f.est.tick((now & f.mask as u64) as u32, &[(t & f.mask as u64) as u32], false, |_, _| {});
+            prop_assert!(v.is_finite() && v >= 0.0);
+        }
+    }
+}

@@ -1,0 +1,280 @@
+//! Supervisor and command contract, with faults injected on the simulated rig.
+
+use model_core::control::{ConfigError, Controller, ControllerConfig, Fault, Rejection, State};
+use model_core::sim::experiments::rig_with_pulses;
+use model_core::sim::{ClosedLoop, Rig, RigParams};
+
+/// A controller given the nominal rig's true model (no commissioning: faster tests).
+fn running_loop(rig: RigParams, cfg_edit: impl FnOnce(&mut ControllerConfig)) -> ClosedLoop {
+    let mut cfg = ControllerConfig::nominal();
+    for i in 0..2 {
+        let (a, fd, tau) = rig.axes[i].motor.ideal_model(rig.supply_v);
+        cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
+        cfg.axes[i].model.volts_per_rad_s = a;
+        cfg.axes[i].model.friction_duty = fd;
+        cfg.axes[i].model.time_constant_s = tau;
+    }
+    cfg_edit(&mut cfg);
+    ClosedLoop::new(Rig::new(rig, 7), Controller::new(cfg).unwrap())
+}
+
+/// Runs to steady 3 rad/s, injects with `inject` at t = 3 s, returns (time of the fault after
+/// injection, fault) and checks both duties are zero from the fault tick on.
+fn fault_after(
+    rig: RigParams,
+    inject: impl Fn(&mut RigParams, f32),
+    speed: f32,
+) -> (f32, Option<Fault>) {
+    let mut cl = running_loop(rig, |_| {});
+    cl.ctrl.set_motor_speeds(speed, speed).unwrap();
+    cl.ctrl.start().unwrap();
+    let n = rig.axes[0].sensor.pulses_per_rev as f32;
+    cl.run(
+        3.0f32.max(12.0 * std::f32::consts::TAU / (n * speed)),
+        |_| {},
+    );
+    assert_eq!(
+        cl.ctrl.state(),
+        State::Running,
+        "not running before the fault"
+    );
+    let t0 = cl.rig.time_s() as f32;
+    inject(cl.rig.params_mut(), t0);
+    let dt = cl.dt_s();
+    for k in 0..5000 {
+        let d = cl.tick();
+        if cl.ctrl.fault().is_some() {
+            assert_eq!(d, [0.0, 0.0], "duties not zero in the fault tick");
+            for _ in 0..100 {
+                assert_eq!(cl.tick(), [0.0, 0.0], "duties not held at zero");
+            }
+            assert_eq!(cl.ctrl.state(), State::Fault);
+            return ((k + 1) as f32 * dt, cl.ctrl.fault());
+        }
+    }
+    (f32::INFINITY, None)
+}
+
+#[test]
+fn dead_sensor_is_detected_within_max_200ms_or_3_pulse_periods() {
+    for (n, speed) in [(12u16, 3.0f32), (60, 3.0), (12, 1.0), (1, 3.0)] {
+        for axis in 0..2 {
+            let rig = rig_with_pulses(n);
+            let (t, fault) = fault_after(
+                rig,
+                |p, t0| p.axes[axis].faults.dead_sensor_from_s = t0,
+                speed,
+            );
+            let period = std::f32::consts::TAU / (n as f32 * speed);
+            let limit = (3.0 * period).max(0.2);
+            assert_eq!(
+                fault,
+                Some(Fault::SensorLostOrStall(axis as u8)),
+                "N {n} axis {axis}"
+            );
+            // One tick of slack for the detection tick itself.
+            assert!(t <= limit + 0.002, "N {n} axis {axis}: {t} s > {limit} s");
+        }
+    }
+}
+
+#[test]
+fn blocked_shaft_is_the_same_fault_and_stops_both_motors() {
+    let (t, fault) = fault_after(
+        rig_with_pulses(12),
+        |p, t0| p.axes[1].faults.blocked_from_s = t0,
+        3.0,
+    );
+    assert_eq!(fault, Some(Fault::SensorLostOrStall(1)));
+    assert!(t < 0.6, "{t}");
+}
+
+#[test]
+fn overspeed_latches_and_clear_returns_to_idle() {
+    let mut c = Controller::new(ControllerConfig::nominal()).unwrap();
+    // 12 pulses/rev at 7 rad/s (over the 5.5 rad/s limit): a pulse every 74.8 ms.
+    let period_ticks = (std::f32::consts::TAU / (12.0 * 7.0) * 1e6) as u32;
+    let mut next = 1000u32;
+    let mut fault = None;
+    for k in 1..2000u32 {
+        let now = k * 1000;
+        let mut e = Vec::new();
+        while next <= now {
+            e.push(next);
+            next += period_ticks;
+        }
+        c.tick(now, [&[], &e]);
+        if c.fault().is_some() {
+            fault = c.fault();
+            break;
+        }
+    }
+    assert_eq!(fault, Some(Fault::Overspeed(1)));
+    assert_eq!(fault.unwrap().code(), 4);
+    assert_eq!(c.start(), Err(Rejection::Faulted(Fault::Overspeed(1))));
+    assert_eq!(
+        c.set_motor_speeds(1.0, 1.0),
+        Err(Rejection::Faulted(Fault::Overspeed(1)))
+    );
+    assert_eq!(c.clear_fault(), Ok(()));
+    assert_eq!(c.state(), State::Idle);
+    assert_eq!(c.clear_fault(), Err(Rejection::NotFaulted));
+}
+
+#[test]
+fn host_silence_faults_only_when_enabled() {
+    for (timeout, heartbeat, want) in [
+        (0.0, false, None),
+        (0.5, false, Some(Fault::HostSilent)),
+        (0.5, true, None),
+    ] {
+        let mut cl = running_loop(rig_with_pulses(12), |c| c.host_timeout_s = timeout);
+        cl.ctrl.set_motor_speeds(2.0, 2.0).unwrap();
+        cl.ctrl.start().unwrap();
+        let mut fault_at = None;
+        for k in 0..3000 {
+            if heartbeat && k % 200 == 0 {
+                cl.ctrl.host_heartbeat();
+            }
+            cl.tick();
+            if fault_at.is_none() && cl.ctrl.fault().is_some() {
+                fault_at = Some(k);
+            }
+        }
+        assert_eq!(
+            cl.ctrl.fault(),
+            want,
+            "timeout {timeout} heartbeat {heartbeat}"
+        );
+        if want.is_some() {
+            let k = fault_at.unwrap();
+            assert!((499..=502).contains(&k), "host fault at tick {k}");
+            assert_eq!(cl.duties(), [0.0, 0.0]);
+        }
+    }
+}
+
+#[test]
+fn invalid_configuration_is_refused_or_boots_faulted() {
+    let mut bad = ControllerConfig::nominal();
+    bad.axes[1].pulses_per_rev = 0;
+    assert_eq!(
+        Controller::new(bad).err(),
+        Some(ConfigError::PulsesPerRev(1))
+    );
+    let mut c = Controller::new_or_faulted(bad);
+    assert_eq!(c.fault(), Some(Fault::InvalidConfiguration));
+    assert_eq!(c.fault().unwrap().code(), 6);
+    assert_eq!(c.tick(1000, [&[], &[]]), [0.0, 0.0]);
+    assert_eq!(
+        c.clear_fault(),
+        Err(Rejection::InvalidConfig(ConfigError::PulsesPerRev(1)))
+    );
+    assert_eq!(
+        c.set_parameters(bad),
+        Err(Rejection::InvalidConfig(ConfigError::PulsesPerRev(1)))
+    );
+    assert_eq!(c.set_parameters(ControllerConfig::nominal()), Ok(()));
+    assert_eq!(
+        c.state(),
+        State::Fault,
+        "the fault stays latched until cleared"
+    );
+    assert_eq!(c.clear_fault(), Ok(()));
+    assert_eq!(c.state(), State::Idle);
+}
+
+#[test]
+fn rejected_commands_change_nothing() {
+    let mut c = Controller::new(ControllerConfig::nominal()).unwrap();
+    c.set_motor_speeds(1.0, 2.0).unwrap();
+    let before = c;
+    let cases = [
+        (
+            c.clone().set_motor_speeds(f32::NAN, 1.0),
+            Rejection::NotFinite,
+        ),
+        (
+            c.clone().set_motor_speeds(1.0, 4.5),
+            Rejection::AboveMaxSpeed(1),
+        ),
+        (
+            c.clone().set_motor_speeds(-4.5, 1.0),
+            Rejection::AboveMaxSpeed(0),
+        ),
+        (
+            c.clone().set_motor_speeds(0.1, 1.0),
+            Rejection::BelowMinSpeed(0),
+        ),
+        (
+            c.clone().set_loop_tuning(0, -1.0, 0.5),
+            Rejection::InvalidTuning,
+        ),
+        (
+            c.clone().set_loop_tuning(2, 1.0, 0.5),
+            Rejection::InvalidTuning,
+        ),
+    ];
+    for (got, want) in cases {
+        assert_eq!(got, Err(want));
+    }
+    // The same commands on the controller itself leave it bit-for-bit unchanged, apart from the
+    // host-silence timer every command resets (zero here anyway).
+    let _ = c.set_motor_speeds(f32::NAN, 1.0);
+    let _ = c.set_motor_speeds(1.0, 4.5);
+    let _ = c.set_motor_speeds(0.1, 1.0);
+    let _ = c.set_loop_tuning(0, -1.0, 0.5);
+    let mut bad = ControllerConfig::nominal();
+    bad.supply_v = f32::INFINITY;
+    assert_eq!(
+        c.set_parameters(bad),
+        Err(Rejection::InvalidConfig(ConfigError::SupplyVoltage))
+    );
+    assert_eq!(c, before);
+    // Zero is always a valid speed, negative speeds are a direction.
+    assert_eq!(c.set_motor_speeds(0.0, -2.0), Ok(()));
+    assert_eq!(c.status().axes[1].target_rad_s, -2.0);
+}
+
+#[test]
+fn states_follow_start_stop_and_refuse_out_of_order_commands() {
+    let mut cl = running_loop(rig_with_pulses(12), |_| {});
+    assert_eq!(cl.ctrl.state(), State::Idle);
+    assert_eq!(cl.ctrl.stop(), Ok(()));
+    cl.ctrl.set_motor_speeds(2.0, 2.0).unwrap();
+    cl.ctrl.start().unwrap();
+    assert_eq!(
+        cl.ctrl.start(),
+        Err(Rejection::WrongState(State::SpinningUp))
+    );
+    assert_eq!(
+        cl.ctrl.set_parameters(ControllerConfig::nominal()),
+        Err(Rejection::WrongState(State::SpinningUp))
+    );
+    cl.run(3.0, |_| {});
+    assert_eq!(cl.ctrl.state(), State::Running);
+    cl.ctrl.stop().unwrap();
+    assert_eq!(cl.ctrl.state(), State::Stopping);
+    assert_eq!(
+        cl.ctrl.set_motor_speeds(1.0, 1.0),
+        Err(Rejection::WrongState(State::Stopping))
+    );
+    cl.run(6.0, |_| {});
+    assert_eq!(cl.ctrl.state(), State::Idle);
+    assert!(cl.rig.speed_rad_s(0).abs() < 1e-3 && cl.rig.speed_rad_s(1).abs() < 1e-3);
+    // Idle: zero duty, whatever edges arrive.
+    assert_eq!(cl.tick(), [0.0, 0.0]);
+}
+
+#[test]
+fn zero_setpoint_gives_exactly_zero_duty_no_hum() {
+    let mut cl = running_loop(rig_with_pulses(12), |_| {});
+    cl.ctrl.set_motor_speeds(0.0, 0.0).unwrap();
+    cl.ctrl.start().unwrap();
+    let mut max = 0.0f32;
+    cl.run(3.0, |c| {
+        max = max.max(c.duties()[0].abs()).max(c.duties()[1].abs())
+    });
+    assert_eq!(max, 0.0);
+    assert_eq!(cl.ctrl.fault(), None);
+}
