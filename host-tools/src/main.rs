@@ -4,6 +4,7 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 mod chart;
+mod demo;
 mod kinematics;
 mod monitor;
 mod predict;
@@ -40,6 +41,8 @@ enum Command {
     /// The simulated rig: serve it on a pseudo-terminal (--pty) or capture its bytes (--capture),
     /// or report on the controller against it (step, family, commission, sweep, stability, trace).
     Sim(SimCommand),
+    /// The rig without hardware: a simulated rig, a scripted session, the live view, a summary.
+    Demo(demo::Args),
 }
 
 /// `bowl sim`: either a report subcommand or the virtual rig's flags.
@@ -61,6 +64,7 @@ fn main() -> Result<()> {
         Command::Monitor(args) => monitor::run(&args),
         Command::Send(args) => send::run(&args).map(|code| std::process::exit(code)),
         Command::Replay(args) => replay::run(&args),
+        Command::Demo(args) => demo::run(&args),
         Command::Sim(args) => match &args.report {
             Some(report) => sim::run(report),
             None => virtual_rig::run(&args.rig),

@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
-use model_core::wire::{Decoder, Frame, FrameError, Hello, Residence, Telemetry};
+use model_core::wire::{Decoder, Frame, Hello, Residence, Telemetry};
 use serde_json::json;
 
 use crate::replay::stats_json;
@@ -101,7 +101,8 @@ fn residence_text(r: Residence) -> String {
     }
 }
 
-struct View {
+/// What the live view shows; also drawn by `bowl demo`.
+pub(crate) struct View {
     latest: Option<Telemetry>,
     hello: Option<Hello>,
     events: VecDeque<String>,
@@ -112,7 +113,47 @@ struct View {
 }
 
 impl View {
-    fn event(&mut self, plain: bool, text: String) {
+    pub(crate) fn new() -> Self {
+        View {
+            latest: None,
+            hello: None,
+            events: VecDeque::new(),
+            trends: [
+                Trend::new("w1 rad/s"),
+                Trend::new("w2 rad/s"),
+                Trend::new("bowl rad/s"),
+                Trend::new("T flat s"),
+                Trend::new("T Coriolis s"),
+            ],
+            reconnects: 0,
+            connected: false,
+            logged_rows: 0,
+        }
+    }
+
+    /// Takes in one decoded frame (the CSV log is the caller's).
+    pub(crate) fn on_frame(&mut self, plain: bool, frame: &Frame) {
+        match frame {
+            Frame::Telemetry(t) => self.latest = Some(*t),
+            Frame::Hello(h) => {
+                self.hello = Some(*h);
+                self.event(
+                    plain,
+                    format!(
+                        "rig booted: reset cause {:?}, reset count {}",
+                        h.reset_cause, h.reset_count
+                    ),
+                );
+            }
+            other => self.event(plain, format!("answer: {}", describe(other))),
+        }
+    }
+
+    pub(crate) fn set_connected(&mut self, connected: bool) {
+        self.connected = connected;
+    }
+
+    pub(crate) fn event(&mut self, plain: bool, text: String) {
         if plain {
             println!("{text}");
         }
@@ -122,7 +163,7 @@ impl View {
         self.events.push_back(text);
     }
 
-    fn sample_trends(&mut self) {
+    pub(crate) fn sample_trends(&mut self) {
         if let Some(t) = self.latest {
             let values = [
                 f64::from(t.precession.measured_mrad_s) / 1000.0,
@@ -145,7 +186,7 @@ impl View {
         )
     }
 
-    fn plain_line(&self, d: &Decoder) -> String {
+    pub(crate) fn plain_line(&self, d: &Decoder) -> String {
         let values = match self.latest {
             Some(t) => format!(
                 "t={:.3}s seq={} state={:?} fault={:?} w1={:.3}/{:.3} w2={:.3}/{:.3} rad/s bowl={:.3} rad/s T_flat={} T_cor={}",
@@ -166,7 +207,7 @@ impl View {
         format!("{values} | {}", self.counters(d))
     }
 
-    fn dashboard(&self, port: &str, d: &Decoder) -> String {
+    pub(crate) fn dashboard(&self, port: &str, d: &Decoder) -> String {
         let mut s = String::from("\x1b[H\x1b[2J");
         let link = if self.connected {
             "connected"
@@ -244,21 +285,7 @@ pub fn run(args: &Args) -> Result<()> {
         .seconds
         .map(|s| started + Duration::from_secs_f64(s.max(0.0)));
     let mut decoder = Decoder::new();
-    let mut view = View {
-        latest: None,
-        hello: None,
-        events: VecDeque::new(),
-        trends: [
-            Trend::new("w1 rad/s"),
-            Trend::new("w2 rad/s"),
-            Trend::new("bowl rad/s"),
-            Trend::new("T flat s"),
-            Trend::new("T Coriolis s"),
-        ],
-        reconnects: 0,
-        connected: false,
-        logged_rows: 0,
-    };
+    let mut view = View::new();
     let mut port: Option<Port> = None;
     let mut last_open_try: Option<Instant> = None;
     let mut next_redraw = Instant::now();
@@ -272,7 +299,7 @@ pub fn run(args: &Args) -> Result<()> {
             match Port::open(&args.port, args.baud) {
                 Ok(p) => {
                     port = Some(p);
-                    view.connected = true;
+                    view.set_connected(true);
                     if ever_connected {
                         view.reconnects += 1;
                         view.event(plain, format!("port {} reopened", args.port));
@@ -297,36 +324,20 @@ pub fn run(args: &Args) -> Result<()> {
         match outcome {
             ReadOutcome::Data(n) => {
                 for &b in &buf[..n] {
-                    match decoder.push(b) {
-                        Some(Ok(Frame::Telemetry(t))) => {
-                            if let Some(w) = log.as_mut() {
-                                telemetry_csv::write_row(w, decoder.stats().restarts, &t)?;
-                                view.logged_rows += 1;
-                            }
-                            view.latest = Some(t);
+                    // Damaged frames are counted by the decoder (corrupt, oversize, truncated).
+                    if let Some(Ok(frame)) = decoder.push(b) {
+                        if let (Frame::Telemetry(t), Some(w)) = (&frame, log.as_mut()) {
+                            telemetry_csv::write_row(w, decoder.stats().restarts, t)?;
+                            view.logged_rows += 1;
                         }
-                        Some(Ok(Frame::Hello(h))) => {
-                            view.hello = Some(h);
-                            view.event(
-                                plain,
-                                format!(
-                                    "rig booted: reset cause {:?}, reset count {}",
-                                    h.reset_cause, h.reset_count
-                                ),
-                            );
-                        }
-                        Some(Ok(other)) => {
-                            view.event(plain, format!("answer: {}", describe(&other)))
-                        }
-                        Some(Err(FrameError::Oversize | FrameError::Truncated)) | None => {}
-                        Some(Err(_)) => {}
+                        view.on_frame(plain, &frame);
                     }
                 }
             }
             ReadOutcome::Timeout => {}
             ReadOutcome::Gone => {
                 port = None;
-                view.connected = false;
+                view.set_connected(false);
                 decoder.finish();
                 view.event(plain, format!("port {} lost; reopening", args.port));
             }

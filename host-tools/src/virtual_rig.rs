@@ -68,14 +68,14 @@ fn parse_commands(specs: &[String]) -> Result<Vec<Scheduled>> {
 }
 
 /// The rig plus the protocol, advanced one millisecond at a time by either transport.
-struct VirtualRig {
+pub(crate) struct VirtualRig {
     rig: SimulatedRig,
     device: Device,
-    now_ms: u32,
+    pub(crate) now_ms: u32,
 }
 
 impl VirtualRig {
-    fn new(seed: u32) -> Result<Self> {
+    pub(crate) fn new(seed: u32) -> Result<Self> {
         Ok(Self {
             rig: SimulatedRig::new(seed)?,
             device: Device::new(),
@@ -84,7 +84,7 @@ impl VirtualRig {
     }
 
     /// The boot announcement.
-    fn boot(&mut self, out: &mut Vec<u8>) {
+    pub(crate) fn boot(&mut self, out: &mut Vec<u8>) {
         let mut buf = [0u8; MAX_FRAME_LEN];
         if let Some(n) = self.device.hello(&self.rig, &mut buf) {
             out.extend_from_slice(&buf[..n]);
@@ -92,7 +92,7 @@ impl VirtualRig {
     }
 
     /// One millisecond: take the received bytes, run the plant and controller, send what is due.
-    fn step_1ms(&mut self, received: &[u8], out: &mut Vec<u8>) {
+    pub(crate) fn step_1ms(&mut self, received: &[u8], out: &mut Vec<u8>) {
         self.device.receive(&mut self.rig, received, |answer| {
             out.extend_from_slice(answer)
         });
@@ -155,7 +155,7 @@ fn capture(path: &PathBuf, seconds: f64, commands: Vec<Scheduled>, seed: u32) ->
 
 /// Opens a pseudo-terminal pair; returns the master and the slave path. The slave is put in raw
 /// mode so nothing is echoed or line-buffered before a client configures it.
-fn open_pty() -> Result<(PtyMaster, String, File)> {
+pub(crate) fn open_pty() -> Result<(PtyMaster, String, File)> {
     let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY | OFlag::O_NONBLOCK)
         .context("posix_openpt")?;
     grantpt(&master).context("grantpt")?;

@@ -1,0 +1,138 @@
+//! `bowl demo`: the rig without hardware. A simulated rig running the controller (on the
+//! emulated board when QEMU and its image are available, otherwise on the host) is driven
+//! through the real serial protocol by a scripted session while the live monitor view runs;
+//! at the end a summary (JSON and text), the telemetry CSV and charts go to `--out`.
+
+mod analysis;
+mod charts;
+mod endpoint;
+mod script;
+mod session;
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+
+use endpoint::{Endpoint, RigChoice};
+
+/// Flags of `bowl demo`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Length of the scripted session in device seconds (real seconds unless --fast).
+    #[arg(long, default_value_t = script::NOMINAL_SECONDS)]
+    seconds: f64,
+    /// Run the rig faster than real time (for tests and CI).
+    #[arg(long)]
+    fast: bool,
+    /// Output directory for summary.json, telemetry.csv and the charts.
+    #[arg(long, default_value = "out/demo")]
+    out: PathBuf,
+    /// Which rig to drive.
+    #[arg(long, value_enum, default_value_t = RigChoice::Auto)]
+    rig: RigChoice,
+    /// Plain lines instead of the live dashboard (automatic when stdout is not a terminal).
+    #[arg(long)]
+    plain: bool,
+    /// Seed of the simulated plant's noise (host rig).
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+}
+
+/// Runs `bowl demo`.
+pub fn run(args: &Args) -> Result<()> {
+    if !(args.seconds.is_finite() && (10.0..=3600.0).contains(&args.seconds)) {
+        bail!("--seconds must be between 10 and 3600 (the steps need time to settle)");
+    }
+    let plain = args.plain || !std::io::stdout().is_terminal();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let started = Instant::now();
+
+    let rig = Endpoint::start(args.rig, args.fast, args.seed, args.seconds)?;
+    println!("bowl demo: {}", rig.description);
+    if let Some(why) = &rig.qemu_note {
+        println!("bowl demo: not on the emulated board: {why}; using the host rig");
+    }
+    println!(
+        "bowl demo: a {:.0} s scripted session over the serial protocol; output in {}",
+        args.seconds,
+        args.out.display()
+    );
+
+    let csv_path = args.out.join("telemetry.csv");
+    let label = format!("demo [{} rig]  {}", rig.kind, rig.port);
+    let session = session::Session::open(&rig.port, label, plain, &csv_path);
+    let mut session = match session {
+        Ok(s) => s,
+        Err(e) => {
+            let _ = rig.shutdown();
+            return Err(e);
+        }
+    };
+    let timing = script::Timing::for_seconds(args.seconds);
+    let boot_limit = std::time::Duration::from_secs(if rig.kind == "qemu" { 60 } else { 10 });
+    let outcome = match session.wait_first_telemetry(boot_limit) {
+        Ok(()) => script::run(&mut session, timing),
+        Err(e) => script::Outcome {
+            marks: Vec::new(),
+            params: None,
+            aborted: Some(format!("{e:#}")),
+        },
+    };
+    let (record, stats) = session.finish()?;
+    let kind = rig.kind.to_string();
+    let description = rig.description.clone();
+    let qemu_note = rig.qemu_note.clone();
+    let shutdown = rig.shutdown()?;
+    let host_bytes_dropped = shutdown.host.map_or(0, |h| h.bytes_dropped);
+    let console_from = shutdown.console.len().saturating_sub(10);
+    let board_console = shutdown.console[console_from..].to_vec();
+
+    if !plain {
+        println!("\nsession log:");
+        for line in &record.log {
+            println!("  {line}");
+        }
+    }
+    let summary = analysis::summarise(
+        analysis::RunInfo {
+            rig: kind,
+            description,
+            qemu_note,
+            fast: args.fast,
+            wall_s: started.elapsed().as_secs_f64(),
+            aborted: outcome.aborted.clone(),
+            board_console,
+            host_bytes_dropped,
+        },
+        &record.telemetry,
+        &outcome.marks,
+        outcome.params.as_ref(),
+        &stats,
+        record.commands.clone(),
+    );
+    print!("{}", analysis::text(&summary));
+    let json_path = args.out.join("summary.json");
+    std::fs::write(&json_path, serde_json::to_string_pretty(&summary)?)
+        .with_context(|| format!("cannot write {}", json_path.display()))?;
+    let mut files = vec![json_path, csv_path];
+    if record.telemetry.is_empty() {
+        println!("no telemetry: no charts");
+    } else {
+        let (written, skipped) = charts::write(&args.out, &record.telemetry, &outcome.marks)?;
+        files.extend(written);
+        for why in skipped {
+            println!("chart left out: {why}");
+        }
+    }
+    println!("written:");
+    for f in &files {
+        println!("  {}", f.display());
+    }
+    if let Some(why) = &outcome.aborted {
+        bail!("the session ended early: {why}");
+    }
+    Ok(())
+}

@@ -1,0 +1,226 @@
+//! The scripted session: what a lab engineer does with the rig, one step at a time, each
+//! printed as it happens. Durations are device time, scaled to the session length.
+
+use anyhow::{Result, bail};
+use model_core::wire::{DeviceState, FaultCode, Frame, ParamValues, Telemetry};
+
+use super::session::Session;
+
+/// Nominal session length the step durations below are written for, s.
+pub const NOMINAL_SECONDS: f64 = 40.0;
+
+/// Motor speeds of the first running step (precession, spin), mrad/s.
+pub const FIRST_SPEEDS_MRAD_S: [i16; 2] = [1500, 1800];
+/// Motor speeds of the "set motor speeds" step, mrad/s.
+pub const SECOND_SPEEDS_MRAD_S: [i16; 2] = [2600, 3000];
+/// The residence-time target: Coriolis model, ms.
+pub const RESIDENCE_TARGET_MS: u32 = 600;
+/// Motor speeds after the restart, mrad/s.
+pub const RESTART_SPEEDS_MRAD_S: [i16; 2] = [1800, 2400];
+/// The injected fault: the spin sensor stops giving pulses.
+pub const INJECTION: &str = "sensor2";
+
+/// What a point of the session was.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MarkKind {
+    /// New setpoints took effect with the loop running (start, speed, residence, restart).
+    Setpoint,
+    /// A fault was injected.
+    Inject,
+    /// The fault was cleared.
+    Clear,
+    /// STOP.
+    Stop,
+    /// The end of the session.
+    End,
+}
+
+/// A point of the session on device time (the last telemetry frame before the rig's answer).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Mark {
+    /// The step's name.
+    pub name: String,
+    /// What it was.
+    pub kind: MarkKind,
+    /// Device time, ms.
+    pub at_ms: u32,
+    /// The rig accepted the command.
+    pub accepted: bool,
+}
+
+/// Step durations, device ms.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Timing {
+    /// How long each running step is held.
+    pub dwell_ms: u32,
+    /// Longest wait for the fault to be detected and for the rig to reach Idle after STOP.
+    pub wait_limit_ms: u32,
+    /// How long the faulted rig is watched (motors must stay off).
+    pub faulted_ms: u32,
+    /// Pause after CLEAR and at the end.
+    pub pause_ms: u32,
+}
+
+impl Timing {
+    /// Durations for a session of about `seconds` device seconds.
+    pub fn for_seconds(seconds: f64) -> Timing {
+        let k = seconds / NOMINAL_SECONDS;
+        let ms = |s: f64| (s * k * 1000.0).round() as u32;
+        Timing {
+            dwell_ms: ms(7.0),
+            wait_limit_ms: ms(6.0).max(2000),
+            faulted_ms: ms(3.0),
+            pause_ms: ms(1.0),
+        }
+    }
+}
+
+/// What the script collected besides the session record.
+pub struct Outcome {
+    /// The session's points.
+    pub marks: Vec<Mark>,
+    /// The rig's parameters at the start (PARAMS answer).
+    pub params: Option<ParamValues>,
+    /// The session stopped early, and why.
+    pub aborted: Option<String>,
+}
+
+fn speeds(v: [i16; 2]) -> [String; 3] {
+    ["speed".into(), v[0].to_string(), v[1].to_string()]
+}
+
+fn mark(s: &Session, name: &str, kind: MarkKind, accepted: bool) -> Mark {
+    Mark {
+        name: name.to_string(),
+        kind,
+        at_ms: s
+            .record
+            .commands
+            .last()
+            .and_then(|c| c.at_ms)
+            .or(s.now_ms())
+            .unwrap_or(0),
+        accepted,
+    }
+}
+
+fn words(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
+fn motors_off(t: &Telemetry) -> bool {
+    t.state == DeviceState::Faulted && t.precession.duty_bp == 0 && t.spin.duty_bp == 0
+}
+
+/// Runs the session. An error of the link (no answer, port gone) ends it early; the record so
+/// far is still summarised.
+pub fn run(s: &mut Session, timing: Timing) -> Outcome {
+    let mut out = Outcome {
+        marks: Vec::new(),
+        params: None,
+        aborted: None,
+    };
+    if let Err(e) = steps(s, timing, &mut out) {
+        s.event(format!("session aborted: {e:#}"));
+        out.aborted = Some(format!("{e:#}"));
+    }
+    let end = s.now_ms().unwrap_or(0);
+    out.marks.push(Mark {
+        name: "end".into(),
+        kind: MarkKind::End,
+        at_ms: end,
+        accepted: true,
+    });
+    out
+}
+
+fn steps(s: &mut Session, timing: Timing, out: &mut Outcome) -> Result<()> {
+    let d = timing;
+    s.command("ask the rig's state", &["status"])?;
+    let (_, params) = s.command_answer("read the parameters", &["params"])?;
+    if let Frame::Params { values, .. } = params {
+        out.params = Some(values);
+    }
+
+    // 1. Start towards the first speeds (set while idle, taken at START).
+    s.command("first speeds", &words(&speeds(FIRST_SPEEDS_MRAD_S)))?;
+    let ok = s.command("start", &["start"])?;
+    out.marks.push(mark(s, "start", MarkKind::Setpoint, ok));
+    if !ok {
+        bail!("the rig refused START");
+    }
+    s.wait_ms(d.dwell_ms)?;
+
+    // 2. New motor speeds while running.
+    let ok = s.command("set motor speeds", &words(&speeds(SECOND_SPEEDS_MRAD_S)))?;
+    out.marks
+        .push(mark(s, "set motor speeds", MarkKind::Setpoint, ok));
+    s.wait_ms(d.dwell_ms)?;
+
+    // 3. A target residence time: the rig's inverse gives the bowl speed, Eq. 2 splits it.
+    let target = RESIDENCE_TARGET_MS.to_string();
+    let ok = s.command("set residence time", &["rtime", "cori", &target])?;
+    if !ok {
+        s.event("the rig cannot set a residence time: the speeds stay".into());
+    }
+    out.marks
+        .push(mark(s, "set residence time", MarkKind::Setpoint, ok));
+    s.wait_ms(d.dwell_ms)?;
+
+    // 4. Fault: the spin sensor goes dead. The rig must stop both motors.
+    let ok = s.command("inject a sensor fault", &["inject", INJECTION])?;
+    out.marks
+        .push(mark(s, "fault injected", MarkKind::Inject, ok));
+    let detected = s.wait_for(d.wait_limit_ms, |t| t.fault != FaultCode::None)?;
+    match detected {
+        Some(at) => {
+            let fault = s.latest().map_or(FaultCode::None, |t| t.fault);
+            s.event(format!(
+                "fault detected at t={:.3} s: {fault:?}",
+                f64::from(at) / 1000.0
+            ));
+            let already_off = s.latest().is_some_and(motors_off);
+            let off = if already_off {
+                s.now_ms()
+            } else {
+                s.wait_for(d.wait_limit_ms, motors_off)?
+            };
+            match off {
+                Some(at) => s.event(format!(
+                    "both motors off (duty 0) at t={:.3} s",
+                    f64::from(at) / 1000.0
+                )),
+                None => s.event("the motors did NOT go off".into()),
+            }
+        }
+        None => s.event(format!(
+            "no fault reported within {:.1} s",
+            f64::from(d.wait_limit_ms) / 1000.0
+        )),
+    }
+    s.wait_ms(d.faulted_ms)?;
+
+    // 5. Repair and clear.
+    s.command("sensor repaired", &["inject", "none"])?;
+    let ok = s.command("clear the fault", &["clear"])?;
+    out.marks
+        .push(mark(s, "fault cleared", MarkKind::Clear, ok));
+    s.wait_ms(d.pause_ms)?;
+
+    // 6. Restart.
+    s.command("restart speeds", &words(&speeds(RESTART_SPEEDS_MRAD_S)))?;
+    let ok = s.command("restart", &["start"])?;
+    out.marks.push(mark(s, "restart", MarkKind::Setpoint, ok));
+    s.wait_ms(d.dwell_ms)?;
+
+    // 7. Stop and wait for the rig to come to rest.
+    let ok = s.command("stop", &["stop"])?;
+    out.marks.push(mark(s, "stop", MarkKind::Stop, ok));
+    match s.wait_for(d.wait_limit_ms, |t| t.state == DeviceState::Idle)? {
+        Some(at) => s.event(format!("rig idle at t={:.3} s", f64::from(at) / 1000.0)),
+        None => s.event("the rig did not reach Idle".into()),
+    }
+    s.wait_ms(d.pause_ms)?;
+    Ok(())
+}
