@@ -109,7 +109,8 @@ pub struct FaultReaction {
     /// When the fault must be seen, s after the injection: the controller's sensor timeout
     /// `max(floor, 3 pulse periods)` at the spin setpoint counts from the *last* edge, which came
     /// up to one pulse period before the injection; plus one telemetry period either way for the
-    /// bracketing of the injection and the detection by telemetry frames.
+    /// bracketing of the injection and the detection by telemetry frames, and 5 ms for the
+    /// board to act on the command (its link task and 1 kHz control tick).
     pub expected_detection_s: Option<[f64; 2]>,
     /// From the injection to the first frame with both duties zero in the Faulted state, s.
     pub motors_off_s: Option<f64>,
@@ -396,7 +397,7 @@ fn fault_reaction(
             f64::from(model_core::control::ControllerConfig::nominal().sensor_timeout_floor_s);
         let timeout = (3.0 * period).max(floor);
         let frame = 1.0 / f64::from(p[ParamId::TelemetryHz.index()].max(1));
-        [(timeout - period - frame).max(0.0), timeout + frame]
+        [(timeout - period - frame).max(0.0), timeout + frame + 0.005]
     });
     let since = |t: &Telemetry| seconds(t.time_ms.wrapping_sub(inject.at_ms));
     let precession_at_clear = after.last().map(|t| measured(t, 0)).unwrap_or(f64::NAN);

@@ -289,8 +289,10 @@ fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
     // The board ends its run by itself a little after the session (a safety net: we kill it).
     let run_s = (seconds * 1.5 + 60.0).ceil() as u64;
     // -icount: virtual time counts instructions (1 ns each, as in firmware/qemu-rig-run and the
-    // QEMU tests). sleep=off lets an idle board's clock jump ahead (faster than real time),
-    // sleep=on keeps it with the wall clock.
+    // QEMU tests). sleep=off lets an idle board's clock jump ahead (about 4x real time here);
+    // sleep=on waits for the wall clock when idle (about 0.6x real time here: the busy parts
+    // take longer than their 1 ns per instruction). shift=auto would track the wall clock, but
+    // its varying instruction time trips the board's emulated watchdog.
     let icount = if fast {
         "shift=0,sleep=off"
     } else {
@@ -321,22 +323,26 @@ fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
         .stderr(Stdio::piped())
         .spawn()
         .context("cannot start qemu-system-arm")?;
-    // QEMU names the pseudo-terminal on stderr: "char device redirected to /dev/pts/N (label ...)".
-    let stderr = child.stderr.take().ok_or_else(|| anyhow!("no stderr"))?;
+    // QEMU names the pseudo-terminal ("char device redirected to /dev/pts/N (label serial0)")
+    // on stdout, among the board's semihosting lines; older versions on stderr.
     let (tx, rx) = mpsc::channel();
+    let stderr = child.stderr.take().ok_or_else(|| anyhow!("no stderr"))?;
+    let tx_err = tx.clone();
     std::thread::spawn(move || {
         for line in BufReader::new(stderr).lines().map_while(|l| l.ok()) {
-            if let Some(rest) = line.split("redirected to ").nth(1)
-                && let Some(path) = rest.split_whitespace().next()
-            {
-                let _ = tx.send(path.to_string());
-            }
+            let _ = tx_err.send(line);
         }
     });
     let stdout = child.stdout.take().ok_or_else(|| anyhow!("no stdout"))?;
     let console = std::thread::spawn(move || {
         let mut keep = Vec::new();
+        let mut reported = false;
         for line in BufReader::new(stdout).lines().map_while(|l| l.ok()) {
+            if !reported && line.contains("redirected to ") {
+                reported = true;
+                let _ = tx.send(line);
+                continue;
+            }
             if keep.len() == 200 {
                 keep.remove(0);
             }
@@ -344,15 +350,35 @@ fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
         }
         keep
     });
-    let port = match rx.recv_timeout(Duration::from_secs(10)) {
-        Ok(p) => p,
-        Err(_) => {
-            let _ = child.kill();
-            let _ = child.wait();
-            bail!("qemu-system-arm did not report its serial pseudo-terminal");
-        }
+    let pty_of = |line: &str| {
+        line.split("redirected to ")
+            .nth(1)
+            .and_then(|rest| rest.split_whitespace().next())
+            .map(str::to_string)
     };
-    let _ = std::io::stderr().flush();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let mut qemu_said = Vec::new();
+    let mut found = None;
+    while found.is_none() {
+        let left = deadline.saturating_duration_since(Instant::now());
+        match rx.recv_timeout(left) {
+            Ok(line) => match pty_of(&line) {
+                Some(p) => found = Some(p),
+                None => qemu_said.push(line),
+            },
+            Err(_) => break,
+        }
+    }
+    let Some(port) = found else {
+        let _ = child.kill();
+        let _ = child.wait();
+        bail!(
+            "qemu-system-arm did not report its serial pseudo-terminal{}",
+            qemu_said
+                .last()
+                .map_or(String::new(), |l| format!(" (it said: {l})"))
+        );
+    };
     Ok(Endpoint {
         description: format!(
             "emulated board: firmware image {} on QEMU netduinoplus2 (Cortex-M4F), USART1 on {port}{}",
