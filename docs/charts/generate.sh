@@ -10,7 +10,12 @@ cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 log=target/test-logs/qemu-cases.log
 mkdir -p target/test-logs
 if [ "${1:-}" != "--no-qemu" ]; then
-  cargo run --release -q -p qemu-tests --target thumbv7em-none-eabihf | tee "$log" | grep -E '^bench cost::' || true
+  if ! cargo run --release -q -p qemu-tests --target thumbv7em-none-eabihf >"$log" 2>&1; then
+    tail -n 20 "$log" >&2
+    echo "QEMU run failed (log: $log); rerun with --no-qemu to chart without fresh counts" >&2
+    exit 1
+  fi
+  grep -cE '^bench cost::' "$log" | sed 's/$/ cost benchmarks measured on the emulated Cortex-M4F/'
 fi
 qemu=()
 if [ -f "$log" ]; then qemu=(--qemu-log "$log"); fi

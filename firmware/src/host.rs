@@ -194,6 +194,12 @@ impl Splitter {
         let mut monitor_w = None;
         let monitor_pty = monitor.then(|| {
             let (m, s, p) = raw_pty();
+            // The monitor is a viewer: if it falls behind, its terminal drops bytes (it counts
+            // the frames it missed) instead of stalling this relay and with it the board.
+            let flags = nix::fcntl::fcntl(&m, nix::fcntl::FcntlArg::F_GETFL).expect("F_GETFL");
+            let flags =
+                nix::fcntl::OFlag::from_bits_truncate(flags) | nix::fcntl::OFlag::O_NONBLOCK;
+            nix::fcntl::fcntl(&m, nix::fcntl::FcntlArg::F_SETFL(flags)).expect("F_SETFL");
             monitor_w = Some(std::fs::File::from(m));
             (p, s)
         });

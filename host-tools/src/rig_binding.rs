@@ -27,6 +27,7 @@ use model_core::wire::{
 const COMMISSION_MAX_S: f32 = 300.0;
 
 /// The controller, the plant, the particle scene and the injected faults.
+#[derive(Clone)]
 pub struct SimulatedRig {
     plant: model_core::sim::Rig,
     ctrl: Controller,
@@ -282,7 +283,7 @@ impl Rig for SimulatedRig {
         let micro = v / 1_000_000.0;
         let axis = match id {
             ParamId::Bandwidth2MradS
-            | ParamId::PerPulse2Ppm
+            | ParamId::PerPulse2Milli
             | ParamId::SpeedMax2MradS
             | ParamId::Accel2MradS2
             | ParamId::DutyMax2Bp
@@ -301,10 +302,10 @@ impl Rig for SimulatedRig {
                     .set_loop_tuning(axis, milli, per_pulse)
                     .map_err(reason)
             }
-            ParamId::PerPulse1Ppm | ParamId::PerPulse2Ppm => {
+            ParamId::PerPulse1Milli | ParamId::PerPulse2Milli => {
                 let bandwidth = self.ctrl.config().axes[axis].bandwidth_rad_s;
                 self.ctrl
-                    .set_loop_tuning(axis, bandwidth, micro)
+                    .set_loop_tuning(axis, bandwidth, milli)
                     .map_err(reason)
             }
             ParamId::SpeedMax1MradS | ParamId::SpeedMax2MradS => {
@@ -336,8 +337,8 @@ impl Rig for SimulatedRig {
             ParamId::AxesMdeg => scaled(c.axes_angle_rad.to_degrees(), 1000.0),
             ParamId::Bandwidth1MradS => scaled(c.axes[0].bandwidth_rad_s, 1000.0),
             ParamId::Bandwidth2MradS => scaled(c.axes[1].bandwidth_rad_s, 1000.0),
-            ParamId::PerPulse1Ppm => scaled(c.axes[0].per_pulse_bandwidth, 1e6),
-            ParamId::PerPulse2Ppm => scaled(c.axes[1].per_pulse_bandwidth, 1e6),
+            ParamId::PerPulse1Milli => scaled(c.axes[0].per_pulse_bandwidth, 1000.0),
+            ParamId::PerPulse2Milli => scaled(c.axes[1].per_pulse_bandwidth, 1000.0),
             ParamId::SpeedMax1MradS => scaled(c.axes[0].max_speed_rad_s, 1000.0),
             ParamId::SpeedMax2MradS => scaled(c.axes[1].max_speed_rad_s, 1000.0),
             ParamId::Accel1MradS2 => scaled(c.axes[0].accel_limit_rad_s2, 1000.0),
@@ -437,5 +438,59 @@ mod tests {
         // A start radius beyond the rim is refused and changes nothing.
         assert_eq!(rig.set_param(ParamId::StartUm, 200_000), Err(Reason::Range));
         assert_eq!(rig.param(ParamId::StartUm), 40_000);
+    }
+
+    use model_core::wire::device::Device;
+    use model_core::wire::{Command, Frame};
+    use proptest::prelude::*;
+
+    /// Commissioning at boot dominates a debug-build test: do it once.
+    fn commissioned() -> &'static SimulatedRig {
+        static RIG: std::sync::OnceLock<SimulatedRig> = std::sync::OnceLock::new();
+        RIG.get_or_init(|| SimulatedRig::new(3).unwrap())
+    }
+
+    fn all_params(rig: &SimulatedRig) -> Vec<i32> {
+        ParamId::ALL.iter().map(|&id| rig.param(id)).collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// Through the real controller: a SET that is rejected changes no parameter, and one that
+        /// is accepted changes exactly that parameter (to the value sent).
+        #[test]
+        fn a_rejected_set_changes_nothing(
+            i in 0..ParamId::ALL.len() - 1,
+            frac in 0.0f64..=1.0,
+            running in any::<bool>(),
+        ) {
+            let id = ParamId::ALL[i];
+            let (lo, hi) = id.range();
+            let value = lo + ((f64::from(hi) - f64::from(lo)) * frac) as i32;
+            let mut rig = commissioned().clone();
+            let mut device = Device::new();
+            if running {
+                prop_assert_eq!(rig.set_speeds(1500, 1500), Ok(()));
+                prop_assert_eq!(rig.start(), Ok(()));
+                rig.advance_to_ms(200);
+            }
+            let before = all_params(&rig);
+            let answer = device.execute(&mut rig, 9, Command::SetParam { id, value });
+            let after = all_params(&rig);
+            match answer {
+                Frame::Ack { id: 9 } => {
+                    for (k, (b, a)) in before.iter().zip(&after).enumerate() {
+                        if k == id.index() {
+                            prop_assert_eq!(*a, value, "{} set", id.token());
+                        } else {
+                            prop_assert_eq!(a, b, "{} changed {}", id.token(), ParamId::ALL[k].token());
+                        }
+                    }
+                }
+                Frame::Reject { id: 9, .. } => prop_assert_eq!(before, after),
+                other => prop_assert!(false, "unexpected answer {:?}", other),
+            }
+        }
     }
 }

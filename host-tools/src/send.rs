@@ -57,7 +57,9 @@ pub fn command_line(id: u16, words: &[String]) -> Result<Vec<u8>, Reason> {
 /// What a rejection reason means, for people.
 pub fn explain(reason: Reason) -> &'static str {
     match reason {
-        Reason::Malformed => "the fields did not parse",
+        Reason::Malformed => {
+            "the fields did not parse (values are integers in the units of docs/protocol.md, e.g. mrad/s, ms)"
+        }
         Reason::UnknownCommand => "unknown command word",
         Reason::UnknownParam => "unknown parameter name",
         Reason::Range => "a value was outside its range (nothing was clamped or changed)",

@@ -97,6 +97,12 @@ pub(crate) struct StabilityArgs {
     /// Speed of the test, rad/s.
     #[arg(long, default_value_t = 0.5)]
     speed_rad_s: f32,
+    /// Only this pulse count (default: 1, 4, 12 and 60).
+    #[arg(long)]
+    pulses_per_rev: Option<u16>,
+    /// Control tick rate, Hz (the loop rate axis of the map).
+    #[arg(long, default_value_t = 1000)]
+    tick_hz: u32,
 }
 
 /// Runs `bowl sim`.
@@ -149,7 +155,7 @@ pub(crate) fn run(what: &What) -> Result<()> {
             println!("{}", serde_json::to_string_pretty(&out)?);
         }
         What::Sweep(a) => sweep(a.seed),
-        What::Stability(a) => stability(a.common.seed, a.speed_rad_s),
+        What::Stability(a) => stability(a.common.seed, a.speed_rad_s, a.pulses_per_rev, a.tick_hz),
         What::Trace(a) => trace(a.common.seed, a.plant),
     }
     Ok(())
@@ -395,18 +401,26 @@ fn sweep(seed: u32) {
     }
 }
 
-fn stability(seed: u32, speed: f32) {
+fn stability(seed: u32, speed: f32, only: Option<u16>, tick_hz: u32) {
     println!(
-        "pulses_per_rev,pulse_rate_hz,per_pulse_bandwidth,scheduled,half_peak_to_peak_pct,fault_code"
+        "tick_hz,pulses_per_rev,pulse_rate_hz,per_pulse_bandwidth,scheduled,half_peak_to_peak_pct,fault_code,mean_error_pct"
     );
-    for n in [4u16, 12, 60] {
+    for n in [1u16, 4, 12, 60] {
+        if only.is_some_and(|o| o != n) {
+            continue;
+        }
         for ppb in [0.1f32, 0.25, 0.5, 1.0, 2.0, 4.0] {
             for scheduled in [true, false] {
-                let (r, fault) =
-                    experiments::low_speed_hold(seed, n, speed, ppb, scheduled, 20.0, 20.0);
-                let (cycle, fault) = (100.0 * r.half_peak_to_peak, fault.map_or(0, Fault::code));
+                let (r, fault) = experiments::low_speed_hold_at_rate(
+                    tick_hz, seed, n, speed, ppb, scheduled, 20.0, 20.0,
+                );
+                let (cycle, err, fault) = (
+                    100.0 * r.half_peak_to_peak,
+                    100.0 * r.steady_state_error,
+                    fault.map_or(0, Fault::code),
+                );
                 let rate = speed * n as f32 / core::f32::consts::TAU;
-                println!("{n},{rate:.3},{ppb},{scheduled},{cycle:.3},{fault}");
+                println!("{tick_hz},{n},{rate:.3},{ppb},{scheduled},{cycle:.3},{fault},{err:.3}");
             }
         }
     }

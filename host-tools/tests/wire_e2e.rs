@@ -399,3 +399,51 @@ fn monitor_draws_the_dashboard_on_a_terminal() {
         "trend lines"
     );
 }
+
+#[test]
+fn a_residence_time_target_is_reached_in_closed_loop() {
+    let dir = temp_dir("rtime");
+    let capture = dir.join("cap.bin");
+    let made = bowl(&[
+        "sim",
+        "--capture",
+        capture.to_str().unwrap(),
+        "--seconds",
+        "12",
+        "--command",
+        "0:rtime,cori,700",
+        "--command",
+        "0:start",
+        // Unreachable: would need a bowl speed above the motors' limit.
+        "--command",
+        "100:rtime,cori,20",
+    ]);
+    assert!(made.status.success());
+    let raw = String::from_utf8_lossy(&std::fs::read(&capture).unwrap()).into_owned();
+    assert!(raw.contains("$A1,1*"), "RTIME accepted");
+    assert!(
+        raw.contains("$R1,3,INFEASIBLE*"),
+        "unreachable target refused"
+    );
+    let csv = dir.join("t.csv");
+    let s = last_json(&bowl(&[
+        "replay",
+        capture.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]));
+    assert_eq!(s["frames_missing"], 0);
+    // Over the last 2 s the Coriolis prediction at the measured speeds is within 3 % of 700 ms.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let tail = &rows[rows.len() - 100..];
+    for r in tail {
+        assert_eq!(r[3], "Running", "{r:?}");
+        let t_ms: f64 = r[15].parse().unwrap();
+        assert!((t_ms - 700.0).abs() < 21.0, "{r:?}");
+    }
+}

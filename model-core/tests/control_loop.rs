@@ -261,3 +261,21 @@ fn reversal_goes_through_zero_and_waits_for_rest() {
     );
     assert!(cl.ctrl.status().axes[1].measured_rad_s < 0.0);
 }
+
+#[test]
+fn a_shaft_stuck_in_stiction_at_low_duty_is_pushed_free_not_left_silent() {
+    // Stiction above what the feedforward gives at 0.5 rad/s (and below the stall-watch duty):
+    // without the stuck rule the integral would stay frozen (no measurement) forever.
+    let mut rig = rig_with_pulses(12);
+    rig.axes[1].motor.stiction_nm = 0.3;
+    let mut cl = true_model_loop(rig);
+    cl.ctrl.set_motor_speeds(0.5, 0.5).unwrap();
+    cl.ctrl.start().unwrap();
+    cl.run(20.0, |_| {});
+    let w = cl.rig.speed_rad_s(1);
+    assert!(
+        cl.ctrl.fault().is_some() || (w - 0.5).abs() < 0.05,
+        "stuck silently at {w} rad/s, duty {:?}",
+        cl.duties()
+    );
+}

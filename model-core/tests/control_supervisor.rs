@@ -41,7 +41,7 @@ fn fault_after(
     let t0 = cl.rig.time_s() as f32;
     inject(cl.rig.params_mut(), t0);
     let dt = cl.dt_s();
-    for k in 0..5000 {
+    for k in 0..20_000 {
         let d = cl.tick();
         if cl.ctrl.fault().is_some() {
             assert_eq!(d, [0.0, 0.0], "duties not zero in the fault tick");

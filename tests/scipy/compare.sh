@@ -1,16 +1,23 @@
 #!/usr/bin/env bash
 # Side by side with scipy: one run makes a Python venv (numpy, scipy from PyPI), has `bowl`
 # measure our integrators (CSV), runs scipy.integrate.solve_ivp (RK45, DOP853) with a terminal
-# event at r = R on the same scenes, and writes docs/charts/scipy-comparison.{md,csv}.
+# event at r = R on the same scenes, and writes docs/charts/scipy-comparison.{md,csv} plus the
+# charts docs/charts/scipy-comparison{,-time}.{svg,png}.
 # Not part of tests/run: it downloads scipy. Usage: tests/scipy/compare.sh [--quick]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 venv=target/scipy-venv
 if [ ! -x "$venv/bin/python" ]; then
-  python3 -m venv "$venv"
+  if ! python3 -m venv "$venv"; then
+    echo "python3 -m venv failed: on Debian/Ubuntu install it with 'apt-get install python3-venv'" >&2
+    exit 1
+  fi
 fi
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check numpy scipy
 mkdir -p target/scipy
-cargo run --release -q -p host-tools -- chart work-precision --csv-only \
+cargo build --release -q -p host-tools
+bowl=target/release/bowl
+"$bowl" chart work-precision --csv-only --families closed,rk4,dp54 \
   --out target/scipy/ours.svg ${1:+--quick}
 "$venv/bin/python" tests/scipy/compare.py target/scipy/ours.csv docs/charts/scipy-comparison
+"$bowl" chart scipy --csv docs/charts/scipy-comparison.csv --out docs/charts/scipy-comparison.svg

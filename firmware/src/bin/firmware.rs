@@ -206,16 +206,26 @@ async fn supervisor_task(
     let feed = tasks::supervisor(watchdog, &HEARTBEAT);
     let persist = async {
         let mut ticker = Ticker::every(Duration::from_millis(500));
+        let mut reported_lost = [0u32; 2];
         loop {
             ticker.next().await;
-            let values = core.lock(|c| {
+            let (values, lost) = core.lock(|c| {
                 let mut c = c.borrow_mut();
+                let lost = c.dropped_edges();
                 if c.rig.take_params_to_save() {
-                    Some(c.params_to_persist())
+                    (Some(c.params_to_persist()), lost)
                 } else {
-                    None
+                    (None, lost)
                 }
             });
+            // The wire has no field for capture losses: say so in the log, never silently.
+            if lost != reported_lost {
+                warn!(
+                    "capture: edges lost so far: precession {}, spin {}",
+                    lost[0], lost[1]
+                );
+                reported_lost = lost;
+            }
             if let Some(v) = values {
                 match log.save(&v) {
                     Ok(()) => {

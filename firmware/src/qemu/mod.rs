@@ -6,6 +6,7 @@
 
 pub mod executor;
 pub mod plant;
+pub mod ram_flash;
 pub mod reference_timer;
 pub mod time_driver;
 pub mod usart;

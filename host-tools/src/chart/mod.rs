@@ -12,6 +12,7 @@ pub mod figures;
 pub mod plot;
 pub mod qemu_log;
 pub mod reference;
+pub mod scipy;
 pub mod stability;
 pub mod table;
 pub mod timing;
@@ -37,6 +38,40 @@ enum Which {
     Residence(Out),
     /// Error against step h*omega for the fixed-step integrators, stability bounds marked.
     Stability(Out),
+    /// Draws the scipy side-by-side from tests/scipy/compare.py's CSV (error against RHS
+    /// evaluations in FILE.svg, against time in FILE-time.svg; paper scene, Coriolis model).
+    Scipy(ScipyArgs),
+}
+
+/// Options of `bowl chart scipy`.
+#[derive(clap::Args)]
+struct ScipyArgs {
+    /// The comparison CSV written by tests/scipy/compare.py.
+    #[arg(long)]
+    csv: PathBuf,
+    /// The SVG file (PNG beside it; the time chart as FILE-time.svg/png).
+    #[arg(long)]
+    out: PathBuf,
+    /// Scene to draw.
+    #[arg(long, default_value = "paper")]
+    scene: String,
+    /// Model to draw (flat or coriolis).
+    #[arg(long, default_value = "coriolis")]
+    model: String,
+}
+
+fn scipy_charts(a: &ScipyArgs) -> Result<()> {
+    for (cost, svg) in [
+        (scipy::Cost::RhsEvals, a.out.with_extension("svg")),
+        (scipy::Cost::Time, suffixed(&a.out, "time")),
+    ] {
+        let fig = scipy::figure(&a.csv, &a.scene, &a.model, cost)?;
+        let png = svg.with_extension("png");
+        fig.write_svg(&svg)?;
+        fig.write_png(&png)?;
+        report(&[&svg, &png]);
+    }
+    Ok(())
 }
 
 /// Where to write.
@@ -207,6 +242,7 @@ pub fn run(args: &Args) -> Result<()> {
             let (f, t) = figures::residence_time()?;
             write_all(out, &f, &t)
         }
+        Which::Scipy(a) => scipy_charts(a),
         Which::Stability(out) => {
             let (f, t) = stability::chart()?;
             write_all(out, &f, &t)

@@ -468,7 +468,7 @@ impl Figure {
                         c.stroke_width(2),
                     ))?;
                 }
-                Mark::Dashed => {
+                Mark::Dashed | Mark::DashedPoints => {
                     area.draw(&PathElement::new(
                         vec![(x0, ym), (x0 + 14, ym)],
                         c.stroke_width(2),

@@ -243,8 +243,8 @@ impl Commissioning {
     fn identify(&self) -> Result<Identified, IdentifyError> {
         let (b_l, w_l) = self.low_fit.solve().ok_or(IdentifyError::TooFewEdges)?;
         let (b_h, w_h) = self.high_fit.solve().ok_or(IdentifyError::TooFewEdges)?;
-        // Written so that a NaN fit also fails the check.
-        if w_h.is_nan() || w_l.is_nan() || w_h <= w_l * 1.05 || w_l <= 0.0 {
+        let increased = w_l > 0.0 && w_h > w_l * 1.05;
+        if !increased {
             return Err(IdentifyError::NoSpeedIncrease);
         }
         let v = self.supply_v;

@@ -103,6 +103,7 @@ pub struct Controller {
     identify_error: Option<IdentifyError>,
     feedback: bool,
     cos_axes: f32,
+    host_watch: bool,
 }
 
 impl Controller {
@@ -163,6 +164,7 @@ impl Controller {
             identify_error: None,
             feedback: true,
             cos_axes: cos_const(cfg.axes_angle_rad),
+            host_watch: cfg.host_timeout_s > 0.0,
         }
     }
 
@@ -172,24 +174,48 @@ impl Controller {
     /// the timestamps captured on that axis since the previous tick, oldest first. Returns the
     /// duties `[precession, spin]` in -1..=1 (sign = direction; 0 = coast).
     pub fn tick(&mut self, now_ticks: u32, edges: [&[u32]; 2]) -> [f32; 2] {
+        if self.state == State::Commissioning {
+            return self.tick_commissioning(now_ticks, edges);
+        }
         let dt = self.dt_s;
         let steady = self.planner.steady_s();
+        let mut seen = [false; 2];
+        for i in 0..2 {
+            let before = self.est[i].accepted_edges();
+            let speed = self.est[i].tick(now_ticks, edges[i], steady[i] > 0.5, |_, _| {});
+            seen[i] = self.est[i].accepted_edges() != before;
+            self.measured[i] = self.direction[i] * speed;
+            if speed > self.cfg.axes[i].overspeed_rad_s {
+                self.latch(Fault::Overspeed(i as u8));
+            }
+        }
+        match self.state {
+            State::SpinningUp | State::Running | State::Stopping => {
+                self.closed_loop_step(dt, &seen)
+            }
+            _ => self.duties = [0.0; 2],
+        }
+        self.after_tick(dt)
+    }
+
+    /// The tick while commissioning: the estimators also feed the identification routine.
+    #[inline(never)]
+    fn tick_commissioning(&mut self, now_ticks: u32, edges: [&[u32]; 2]) -> [f32; 2] {
+        let dt = self.dt_s;
         let mut seen = [false; 2];
         let comm_axis = match &self.commissioning {
             Some(c) => c.progress().0,
             None => 2,
         };
         for i in 0..2 {
-            let steady_i = steady[i] > 0.5;
             let rad_per_pulse = self.est[i].rad_per_pulse();
-            let comm = if i == comm_axis {
+            let mut comm = if i == comm_axis {
                 self.commissioning.as_mut()
             } else {
                 None
             };
-            let mut comm = comm;
             let seen_i = &mut seen[i];
-            let speed = self.est[i].tick(now_ticks, edges[i], steady_i, |at, pulses| {
+            let speed = self.est[i].tick(now_ticks, edges[i], false, |at, pulses| {
                 *seen_i = true;
                 if let Some(c) = comm.as_deref_mut() {
                     c.on_edge(at, pulses, rad_per_pulse);
@@ -200,17 +226,16 @@ impl Controller {
                 self.latch(Fault::Overspeed(i as u8));
             }
         }
-
-        match self.state {
-            State::Idle | State::Fault => self.duties = [0.0; 2],
-            State::Commissioning => self.commission_step(dt, &seen),
-            State::SpinningUp | State::Running | State::Stopping => {
-                self.closed_loop_step(dt, &seen)
-            }
+        if self.state == State::Commissioning {
+            self.commission_step(dt, &seen);
         }
+        self.after_tick(dt)
+    }
 
-        let driving = !matches!(self.state, State::Idle | State::Fault);
-        if driving && self.cfg.host_timeout_s > 0.0 {
+    /// Host-silence watch and the final say of a latched fault, common to both ticks.
+    #[inline(always)]
+    fn after_tick(&mut self, dt: f32) -> [f32; 2] {
+        if self.host_watch && !matches!(self.state, State::Idle | State::Fault) {
             self.host_silence_s += dt;
             if self.host_silence_s > self.cfg.host_timeout_s {
                 self.latch(Fault::HostSilent);
@@ -222,52 +247,29 @@ impl Controller {
         self.duties
     }
 
+    #[inline(never)]
     fn closed_loop_step(&mut self, dt: f32, seen: &[bool; 2]) {
         let stopped = [self.est[0].is_stopped(), self.est[1].is_stopped()];
         let r0 = self.planner.ramped()[0];
-        let established =
-            self.est[0].is_valid() && self.measured[0].abs() >= 0.5 * r0.abs() && r0 != 0.0;
+        // Precession established: measured at half its reference or more, or (sparse pulses:
+        // N = 1 needs two pulse periods for a first measurement) its ramp done for a second.
+        let established = !self.planner.spin_released()
+            && r0 != 0.0
+            && ((self.est[0].is_valid() && self.measured[0].abs() >= 0.5 * r0.abs())
+                || self.planner.steady_s()[0] > 1.0);
         let ramped = self.planner.step(dt, self.max_step, stopped, established);
         // Spin first: its model's acceleration feeds the precession axis's decoupling.
-        let mut decouple = 0.0;
-        for i in [1usize, 0] {
-            if ramped[i] > 0.0 {
-                self.direction[i] = 1.0;
-            } else if ramped[i] < 0.0 {
-                self.direction[i] = -1.0;
-            }
-            let input = LoopInput {
-                reference_rad_s: ramped[i],
-                measured_rad_s: self.measured[i],
-                direction: self.direction[i],
-                measurement_valid: self.est[i].is_valid(),
-                events: self.est[i].window_events(),
-                feedback: self.feedback,
-                extra_duty: if i == 0 { decouple } else { 0.0 },
-            };
-            let duty = self.loops[i].step(&self.k[i], input);
-            if i == 1 {
-                // The spin's accelerating torque reacts on the rod: J2 a2 projected on the
-                // vertical. With J2 a2 = tau2 k2 a2 dr_p/dt / R2 and the same motor type on both
-                // axes, the precession duty that cancels it is
-                // cos(angle) * (r - r_p) * duty_per_rad_s of the spin model.
-                decouple = self.cos_axes
-                    * (ramped[1] - self.loops[1].model_rad_s())
-                    * self.k[1].duty_per_rad_s();
-            }
-            self.duties[i] = duty;
-            if self.watch[i].step(
-                dt,
-                duty.abs(),
-                self.cfg.stall_duty,
-                seen[i],
-                self.cfg.sensor_timeout_floor_s,
-                ramped[i].abs(),
-                self.est[i].rad_per_pulse(),
-            ) {
-                self.latch(Fault::SensorLostOrStall(i as u8));
-                return;
-            }
+        if self.axis_loop(1, ramped[1], 0.0, seen[1], dt) {
+            return;
+        }
+        // The spin's accelerating torque reacts on the rod: J2 a2 projected on the vertical.
+        // With J2 a2 = tau2 k2 a2 dr_p/dt / R2 and the same motor type on both axes, the
+        // precession duty that cancels it is cos(angle) * (r - r_p) * duty_per_rad_s of the spin
+        // model.
+        let decouple =
+            self.cos_axes * (ramped[1] - self.loops[1].model_rad_s()) * self.k[1].duty_per_rad_s();
+        if self.axis_loop(0, ramped[0], decouple, seen[0], dt) {
+            return;
         }
         let target = self.planner.targets();
         match self.state {
@@ -290,6 +292,41 @@ impl Controller {
         }
     }
 
+    /// One axis's loop and sensor watch; true if it latched a fault.
+    #[inline(always)]
+    fn axis_loop(&mut self, i: usize, r: f32, extra_duty: f32, seen: bool, dt: f32) -> bool {
+        if r > 0.0 {
+            self.direction[i] = 1.0;
+        } else if r < 0.0 {
+            self.direction[i] = -1.0;
+        }
+        let input = LoopInput {
+            reference_rad_s: r,
+            measured_rad_s: self.measured[i],
+            direction: self.direction[i],
+            measurement_valid: self.est[i].is_valid(),
+            events: self.est[i].window_events(),
+            feedback: self.feedback,
+            extra_duty,
+        };
+        let duty = self.loops[i].step(&self.k[i], input);
+        self.duties[i] = duty;
+        if self.watch[i].step(
+            dt,
+            duty.abs(),
+            self.cfg.stall_duty,
+            seen,
+            self.cfg.sensor_timeout_floor_s,
+            self.loops[i].model_rad_s(),
+            self.est[i].rad_per_pulse(),
+        ) {
+            self.latch(Fault::SensorLostOrStall(i as u8));
+            return true;
+        }
+        false
+    }
+
+    #[inline(never)]
     fn commission_step(&mut self, dt: f32, seen: &[bool; 2]) {
         let Some(c) = self.commissioning.as_mut() else {
             self.state = State::Idle;
@@ -333,14 +370,12 @@ impl Controller {
                 }
                 // Blocked shaft or dead sensor during identification: the expected period is
                 // unknown, so allow 3 periods at the lowest speed.
-                // The index walks five per-axis arrays in step; an iterator would hide that.
-                #[allow(clippy::needless_range_loop)]
-                for i in 0..2 {
+                for (i, &seen_i) in seen.iter().enumerate() {
                     if self.watch[i].step(
                         dt,
                         self.duties[i].abs(),
                         self.cfg.stall_duty,
-                        seen[i],
+                        seen_i,
                         self.cfg.sensor_timeout_floor_s,
                         self.cfg.axes[i].min_speed_rad_s,
                         self.est[i].rad_per_pulse(),
@@ -354,6 +389,7 @@ impl Controller {
     }
 
     /// Replaces the configuration, keeping the estimators' clocks.
+    #[inline(never)]
     fn rebuild_keep_state(&mut self, cfg: ControllerConfig) {
         let est = self.est;
         let identified = self.identified;
@@ -364,6 +400,8 @@ impl Controller {
         self.feedback = feedback;
     }
 
+    #[cold]
+    #[inline(never)]
     fn latch(&mut self, fault: Fault) {
         if self.fault.is_none() {
             self.fault = Some(fault);

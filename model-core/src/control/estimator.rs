@@ -25,9 +25,9 @@
 //!
 //! # Bounce and missing pulses
 //! An edge closer to the previous accepted edge than half the pulse period at the over-speed
-//! limit, or than 40 % of the current filtered period, is a bounce and is ignored (counted in
+//! limit, or than 40 % of the last measured period, is a bounce and is ignored (counted in
 //! [`PulseSpeedEstimator::rejected_edges`]). When the caller says the speed is steady, an
-//! interval of about 2 or 3 filtered periods (within 0.3 of the integer) is taken as that many
+//! interval of about 2 or 3 measured periods (within 0.3 of the integer) is taken as that many
 //! pulses with the middle ones missing (counted in [`PulseSpeedEstimator::inferred_missing`]).
 //!
 //! # Direction
@@ -75,7 +75,6 @@ pub struct PulseSpeedEstimator {
     stall_ticks: u32,
     filter_weight: f32,
 
-    started: bool,
     prev_now: u32,
     clock: u32,
     has_edge: bool,
@@ -84,10 +83,11 @@ pub struct PulseSpeedEstimator {
     win_start: u32,
     win_pulses: u32,
     valid: bool,
-    period_ticks: f32,
+    raw_period_ticks: f32,
+    lockout_now: u32,
+    missing_from: u32,
     speed_filt: f32,
     speed: f32,
-    updated: bool,
     bound_active: bool,
     restart_at: Option<u32>,
     closed_at: Option<u32>,
@@ -116,7 +116,6 @@ impl PulseSpeedEstimator {
             window_ticks: (WINDOW_S * ticks_per_s) as u32,
             stall_ticks: (stall_s * ticks_per_s).min(4.0e9) as u32,
             filter_weight: axis.filter_weight,
-            started: false,
             prev_now: 0,
             clock: 0,
             has_edge: false,
@@ -125,10 +124,11 @@ impl PulseSpeedEstimator {
             win_start: 0,
             win_pulses: 0,
             valid: false,
-            period_ticks: 0.0,
+            raw_period_ticks: 0.0,
+            lockout_now: (0.5 * min_period_s * ticks_per_s) as u32,
+            missing_from: u32::MAX,
             speed_filt: 0.0,
             speed: 0.0,
-            updated: false,
             bound_active: false,
             restart_at: None,
             closed_at: None,
@@ -147,7 +147,7 @@ impl PulseSpeedEstimator {
     /// `on_edge(extended_ticks, pulses)` is called for each accepted edge.
     ///
     /// Returns the speed magnitude, rad/s.
-    #[inline]
+    #[inline(always)]
     pub fn tick(
         &mut self,
         now: u32,
@@ -155,12 +155,9 @@ impl PulseSpeedEstimator {
         steady: bool,
         mut on_edge: impl FnMut(u32, u32),
     ) -> f32 {
-        if !self.started {
-            self.started = true;
-            self.prev_now = now;
-        }
+        // The first tick after construction measures its span from timer value 0: the extended
+        // clock is relative, so that only shifts its origin.
         let span = now.wrapping_sub(self.prev_now) & self.mask;
-        self.updated = false;
         self.restart_at = None;
         self.closed_at = None;
         for &t in edges {
@@ -193,19 +190,16 @@ impl PulseSpeedEstimator {
             return Some(1);
         }
         let dt = at.wrapping_sub(self.last_edge);
-        let relative_lockout = if self.valid {
-            0.4 * self.period_ticks
-        } else {
-            0.0
-        };
-        if dt < self.lockout_ticks || (dt as f32) < relative_lockout {
+        // `lockout_now` = max(absolute lockout, 40 % of the filtered period), kept up to date
+        // when the period changes, so the common path is integer compares only.
+        if dt < self.lockout_now {
             self.rejected = self.rejected.wrapping_add(1);
             return None;
         }
         let mut pulses = 1u32;
-        if steady && self.valid {
-            let ratio = dt as f32 / self.period_ticks;
-            if ratio > 1.6 && ratio < 3.4 {
+        if steady && dt > self.missing_from {
+            let ratio = dt as f32 / self.raw_period_ticks;
+            if ratio < 3.4 {
                 let k = (ratio + 0.5) as u32;
                 let off = ratio - k as f32;
                 if off > -0.3 && off < 0.3 {
@@ -223,15 +217,21 @@ impl PulseSpeedEstimator {
             let period = wspan as f32 / self.win_pulses as f32;
             let raw = self.rad_ticks_per_pulse_s / period;
             if self.valid {
-                let w = self.filter_weight;
-                self.speed_filt += w * (raw - self.speed_filt);
-                self.period_ticks += w * (period - self.period_ticks);
+                self.speed_filt += self.filter_weight * (raw - self.speed_filt);
             } else {
                 self.speed_filt = raw;
-                self.period_ticks = period;
                 self.valid = true;
             }
-            self.updated = true;
+            // Bounce and missing-pulse thresholds from the last raw period (the error of one
+            // sample only moves them by its own few percent).
+            self.raw_period_ticks = period;
+            let rel = (0.4 * period) as u32;
+            self.lockout_now = if rel > self.lockout_ticks {
+                rel
+            } else {
+                self.lockout_ticks
+            };
+            self.missing_from = (1.6 * period) as u32;
             self.closed_at = Some(at);
             self.closed_span = wspan;
             self.closed_raw = raw;
@@ -255,7 +255,9 @@ impl PulseSpeedEstimator {
             self.has_edge = false;
             self.valid = false;
             self.speed_filt = 0.0;
-            self.period_ticks = 0.0;
+            self.raw_period_ticks = 0.0;
+            self.lockout_now = self.lockout_ticks;
+            self.missing_from = u32::MAX;
             return 0.0;
         }
         if !self.valid {
@@ -296,7 +298,7 @@ impl PulseSpeedEstimator {
     }
     /// True if the last tick produced a new raw sample.
     pub fn updated(&self) -> bool {
-        self.updated
+        self.closed_at.is_some()
     }
     /// True when the estimate is exactly zero (stopped or never moved).
     pub fn is_stopped(&self) -> bool {

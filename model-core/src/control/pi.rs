@@ -27,7 +27,8 @@
 //! changes the integral absorbs `(Kp_old - Kp_new) e`, so neither does that. Integration stops
 //! (conditional integration) while the output is clamped or slew-limited in the direction the
 //! error pushes, which holds a blocked motor's integral instead of letting it run away, and while
-//! the estimator has no valid measurement (no pulse interval yet). At a zero reference the output
+//! the estimator has no valid measurement (no pulse interval yet), until the plant model has
+//! turned 2.5 pitches without one: then the shaft is stuck and the loop pushes (see `step`). At a zero reference the output
 //! is exactly zero and the integral is cleared: no hum, no creep.
 
 use super::config::AxisConfig;
@@ -77,6 +78,7 @@ pub struct LoopConstants {
     bandwidth_rad_s: f32,
     per_pulse_bw_times_pulses_per_rad: f32,
     filter_weight: f32,
+    stuck_angle_rad: f32,
     duty_limit: f32,
     slew_per_tick: f32,
 }
@@ -97,6 +99,7 @@ impl LoopConstants {
             bandwidth_rad_s: axis.bandwidth_rad_s,
             per_pulse_bw_times_pulses_per_rad: axis.per_pulse_bandwidth * pulses_per_rad,
             filter_weight: w,
+            stuck_angle_rad: 2.5 / pulses_per_rad,
             duty_limit: axis.duty_limit,
             slew_per_tick: axis.duty_slew_per_s * dt_s,
         }
@@ -145,7 +148,7 @@ impl SpeedLoop {
     };
 
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
-    #[inline]
+    #[inline(always)]
     pub fn step(&mut self, k: &LoopConstants, input: LoopInput) -> f32 {
         let r = input.reference_rad_s;
         if r == 0.0 {
@@ -181,16 +184,27 @@ impl SpeedLoop {
             }
             self.model_angle_rad = rp * w.ago_s;
         }
-        if !input.measurement_valid {
-            self.have_error = false;
-            self.error = 0.0;
-        }
         let mut e = if input.feedback && self.have_error {
             self.error
         } else {
             0.0
         };
-        if input.feedback && input.measurement_valid && ev.bound_active {
+        if !input.measurement_valid {
+            self.have_error = false;
+            self.error = 0.0;
+            // No measurement although the model has turned 2.5 pitches since the last window
+            // event: a shaft following the model would have given two edges by now, so it is
+            // stuck (stiction, a blocked shaft, a dead sensor). Push with the full model speed
+            // so that it breaks away, or the duty crosses the stall threshold and the
+            // supervisor's sensor watch latches the fault; never sit silently at a low duty.
+            e = if input.feedback && self.model_angle_rad.abs() > k.stuck_angle_rad {
+                rp
+            } else {
+                0.0
+            };
+        }
+        // The stall bound is only active with a valid measurement.
+        if ev.bound_active && input.feedback {
             let at_least = rp - input.measured_rad_s;
             e = if input.direction > 0.0 {
                 e.max(at_least)
@@ -206,20 +220,21 @@ impl SpeedLoop {
         self.integral += (self.kp_prev - kp) * e;
         self.kp_prev = kp;
 
-        let ff = k.feedforward(r) + input.extra_duty;
+        // r != 0 here, so its sign is the commanded direction.
+        let ff = k.friction_duty * input.direction + r * k.duty_per_rad_s + input.extra_duty;
         let candidate_i = self.integral + ki_dt * e;
-        let unclamped = ff + kp * e + candidate_i;
+        let unlimited = ff + kp * e + candidate_i;
         let lim = k.duty_limit;
-        let saturating = (unclamped > lim && e > 0.0) || (unclamped < -lim && e < 0.0);
-        let slew_pushing = (unclamped - self.duty > k.slew_per_tick && e > 0.0)
-            || (unclamped - self.duty < -k.slew_per_tick && e < 0.0);
-        if !saturating && !slew_pushing {
-            self.integral = clamp(candidate_i, lim);
+        let next = self.duty + clamp(clamp(unlimited, lim) - self.duty, k.slew_per_tick);
+        // Conditional integration: keep the new integral only if the clamp or the slew limit
+        // is not holding the output back in the direction the error pushes.
+        // (This also bounds the integral: once the output sits at the clamp, the integral stops
+        // growing toward it.)
+        if (unlimited - next) * e <= 0.0 {
+            self.integral = candidate_i;
         }
-        let target = clamp(ff + kp * e + self.integral, lim);
-        let step = clamp(target - self.duty, k.slew_per_tick);
-        self.duty += step;
-        self.duty
+        self.duty = next;
+        next
     }
 
     /// The plant model's speed (the reference through the identified lag), rad/s.

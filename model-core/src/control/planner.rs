@@ -49,7 +49,8 @@ pub fn split_combined(
 /// Two rules beyond the ramps, both because the sensors cannot see direction:
 /// - A reversal ramps to zero and holds there until the axis's estimator reads zero.
 /// - The spin axis starts ramping only once the precession axis is established (valid
-///   measurement, at least half its ramped reference), if precession is asked to turn at all.
+///   measurement at least half its ramped reference, or its ramp finished for a second when the
+///   pulses are too sparse to measure that soon), if precession is asked to turn at all.
 ///   The spin motor rides on the rod: its accelerating torque reacts on the precession axis.
 ///   Started together, a lightly loaded precession axis can be dragged *backwards* before its
 ///   own motor gets going, and a direction-blind loop would then read that as forward motion.
@@ -93,6 +94,11 @@ impl SetpointPlanner {
         self.steady_s
     }
 
+    /// True once the spin axis may ramp (see the type's docs).
+    pub fn spin_released(&self) -> bool {
+        self.spin_released
+    }
+
     /// Drops everything to rest at once (fault, abort).
     pub fn reset(&mut self) {
         *self = Self::REST;
@@ -101,7 +107,7 @@ impl SetpointPlanner {
     /// Advances the ramps by `dt_s`. `max_step` is the largest change per step of each axis,
     /// `stopped` says whether each axis's estimator reads zero, `precession_established`
     /// whether the precession axis turns at at least half its ramped reference.
-    #[inline]
+    #[inline(always)]
     pub fn step(
         &mut self,
         dt_s: f32,
@@ -117,20 +123,31 @@ impl SetpointPlanner {
         }
         for i in 0..2 {
             let (t, r) = (self.target[i], self.ramped[i]);
-            let mut next = r + (t - r).clamp(-max_step[i], max_step[i]);
-            if (r > 0.0 && next < 0.0) || (r < 0.0 && next > 0.0) {
+            let d = t - r;
+            let m = max_step[i];
+            let mut next = if d > m {
+                r + m
+            } else if d < -m {
+                r - m
+            } else {
+                t
+            };
+            if r * next < 0.0 {
+                // Crossing zero (a reversal): stop at zero first.
                 next = 0.0;
                 self.reversing[i] = true;
             }
-            if self.reversing[i] {
-                if r == 0.0 && stopped[i] {
-                    self.reversing[i] = false;
-                } else if r == 0.0 {
+            if r == 0.0 {
+                if self.reversing[i] {
+                    if stopped[i] {
+                        self.reversing[i] = false;
+                    } else {
+                        next = 0.0;
+                    }
+                }
+                if i == 1 && !self.spin_released {
                     next = 0.0;
                 }
-            }
-            if i == 1 && r == 0.0 && !self.spin_released {
-                next = 0.0;
             }
             if next == r {
                 self.steady_s[i] += dt_s;

@@ -36,7 +36,7 @@ pub enum State {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Fault {
     /// Duty above the stall threshold and no pulse for `max(floor, 3 expected pulse periods)`
-    /// on this axis (0 = precession, 1 = spin): the sensor is dead or the shaft is blocked.
+    /// (expected from the plant model's speed) on this axis (0 = precession, 1 = spin): the sensor is dead or the shaft is blocked.
     /// Without a current measurement the two cannot be told apart.
     SensorLostOrStall(u8),
     /// Measured speed above the axis's over-speed limit.
@@ -65,22 +65,29 @@ pub fn fault_code(f: Option<Fault>) -> u8 {
     f.map_or(0, Fault::code)
 }
 
-/// The sensor-lost watch of one axis: time spent driving above the stall duty without an edge.
+/// The sensor-lost watch of one axis: time spent driving above the stall duty without an edge,
+/// and how far the shaft should have turned meanwhile.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SensorWatch {
     blind_s: f32,
+    expected_rad: f32,
 }
 
 impl SensorWatch {
     /// A cleared watch.
-    pub const CLEAR: Self = Self { blind_s: 0.0 };
+    pub const CLEAR: Self = Self {
+        blind_s: 0.0,
+        expected_rad: 0.0,
+    };
 
     /// Advances the watch; true when the axis must fault.
     ///
-    /// `reference_abs_rad_s` is the reference speed and `rad_per_pulse` the pitch: one expected
-    /// pulse period is `rad_per_pulse / reference`, and the timeout is
-    /// `max(floor_s, 3 * expected period)` (compared without dividing).
-    #[inline]
+    /// `expected_rad_s` is the speed the shaft should have now (the plant model's speed while
+    /// running, so an accelerating shaft is not blamed for the reference's lead), `rad_per_pulse`
+    /// the pitch. The fault comes when, with the duty above the stall threshold and no edge,
+    /// both `floor_s` has passed and the shaft should have turned three pitches: at a steady
+    /// speed that is `max(floor_s, 3 pulse periods)`.
+    #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
@@ -89,19 +96,20 @@ impl SensorWatch {
         stall_duty: f32,
         edge_seen: bool,
         floor_s: f32,
-        reference_abs_rad_s: f32,
+        expected_rad_s: f32,
         rad_per_pulse: f32,
     ) -> bool {
         if edge_seen || duty_abs <= stall_duty {
-            self.blind_s = 0.0;
+            *self = Self::CLEAR;
             return false;
         }
         self.blind_s += dt_s;
-        self.blind_s > floor_s && self.blind_s * reference_abs_rad_s > 3.0 * rad_per_pulse
+        self.expected_rad += expected_rad_s.abs() * dt_s;
+        self.blind_s > floor_s && self.expected_rad > 3.0 * rad_per_pulse
     }
 
     /// Clears the watch.
     pub fn reset(&mut self) {
-        self.blind_s = 0.0;
+        *self = Self::CLEAR;
     }
 }

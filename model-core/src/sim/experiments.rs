@@ -141,11 +141,38 @@ pub fn low_speed_hold(
     settle_s: f32,
     measure_s: f32,
 ) -> (StepReport, Option<Fault>) {
+    low_speed_hold_at_rate(
+        1000,
+        seed,
+        pulses,
+        speed_rad_s,
+        per_pulse_bandwidth,
+        scheduled,
+        settle_s,
+        measure_s,
+    )
+}
+
+/// [`low_speed_hold`] at control tick rate `tick_hz` (the physics keeps a step of 250 us or
+/// less).
+#[allow(clippy::too_many_arguments)]
+pub fn low_speed_hold_at_rate(
+    tick_hz: u32,
+    seed: u32,
+    pulses: u16,
+    speed_rad_s: f32,
+    per_pulse_bandwidth: f32,
+    scheduled: bool,
+    settle_s: f32,
+    measure_s: f32,
+) -> (StepReport, Option<Fault>) {
     let mut rig = rig_with_pulses(pulses);
+    rig.substeps = (4000 / tick_hz.max(1)).max(1);
     for a in &mut rig.axes {
         a.ripple_nm = 0.0;
     }
     let mut cfg = ControllerConfig::nominal();
+    cfg.tick_hz = tick_hz;
     for i in 0..2 {
         let (a, fd, tau) = rig.axes[i].motor.ideal_model(rig.supply_v);
         let ax = &mut cfg.axes[i];

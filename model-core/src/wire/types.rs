@@ -178,6 +178,10 @@ pub enum Injection {
 }
 
 /// The settable parameters, each with a token, a unit and a wire range (inclusive).
+///
+/// Every range stays below 2^23 steps, so a value survives the controller's f32 configuration
+/// exactly (relative f32 rounding 2^-24 is then under half a step): what PARAMS reports back is
+/// what SET sent, never a silently rounded neighbour.
 /// The rig may reject a value inside the wire range that conflicts with another parameter
 /// (for instance a start radius beyond the rim) with [`Reason::Range`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -197,10 +201,10 @@ pub enum ParamId {
     Bandwidth1MradS,
     /// Spin speed-loop bandwidth, mrad/s.
     Bandwidth2MradS,
-    /// Precession loop bandwidth per pulse rate (caps the bandwidth at low speed), ppm.
-    PerPulse1Ppm,
-    /// Spin loop bandwidth per pulse rate, ppm.
-    PerPulse2Ppm,
+    /// Precession loop bandwidth per pulse rate (caps the bandwidth at low speed), 1/1000.
+    PerPulse1Milli,
+    /// Spin loop bandwidth per pulse rate, 1/1000.
+    PerPulse2Milli,
     /// Precession speed limit (setpoints above it are rejected), mrad/s.
     SpeedMax1MradS,
     /// Spin speed limit, mrad/s.
@@ -239,8 +243,8 @@ impl ParamId {
         ParamId::AxesMdeg,
         ParamId::Bandwidth1MradS,
         ParamId::Bandwidth2MradS,
-        ParamId::PerPulse1Ppm,
-        ParamId::PerPulse2Ppm,
+        ParamId::PerPulse1Milli,
+        ParamId::PerPulse2Milli,
         ParamId::SpeedMax1MradS,
         ParamId::SpeedMax2MradS,
         ParamId::Accel1MradS2,
@@ -268,8 +272,8 @@ impl ParamId {
             ParamId::AxesMdeg => "AXES_MDEG",
             ParamId::Bandwidth1MradS => "BW1_MRAD_S",
             ParamId::Bandwidth2MradS => "BW2_MRAD_S",
-            ParamId::PerPulse1Ppm => "PER_PULSE1_PPM",
-            ParamId::PerPulse2Ppm => "PER_PULSE2_PPM",
+            ParamId::PerPulse1Milli => "PER_PULSE1_MILLI",
+            ParamId::PerPulse2Milli => "PER_PULSE2_MILLI",
             ParamId::SpeedMax1MradS => "SPEED_MAX1_MRAD_S",
             ParamId::SpeedMax2MradS => "SPEED_MAX2_MRAD_S",
             ParamId::Accel1MradS2 => "ACCEL1_MRAD_S2",
@@ -292,12 +296,12 @@ impl ParamId {
             ParamId::K2Ppm => (1, 1_000_000),
             ParamId::AxesMdeg => (0, 179_999),
             ParamId::Bandwidth1MradS | ParamId::Bandwidth2MradS => (10, 1_000_000),
-            ParamId::PerPulse1Ppm | ParamId::PerPulse2Ppm => (10_000, 10_000_000),
+            ParamId::PerPulse1Milli | ParamId::PerPulse2Milli => (10, 10_000),
             ParamId::SpeedMax1MradS | ParamId::SpeedMax2MradS => (0, i16::MAX as i32),
             ParamId::Accel1MradS2 | ParamId::Accel2MradS2 => (1, 1_000_000),
             ParamId::DutyMax1Bp | ParamId::DutyMax2Bp => (0, DUTY_MAX_BP as i32),
             ParamId::Teeth1 | ParamId::Teeth2 => (1, 255),
-            ParamId::RatioPpm => (1_000, 100_000_000),
+            ParamId::RatioPpm => (1_000, 8_000_000),
             ParamId::TelemetryHz => (0, 50),
         }
     }

@@ -203,7 +203,8 @@ fn commissioning_identifies_the_rig() -> Result<(), Failure> {
 /// commanded to 3 rad/s, built at compile time (so no set-up is counted in any call).
 struct BenchState {
     ctrl: Controller,
-    calls: u32,
+    now: u32,
+    countdown: u32,
 }
 
 struct BenchCell(UnsafeCell<BenchState>);
@@ -228,7 +229,8 @@ const fn bench_controller() -> Controller {
 
 static BENCH: BenchCell = BenchCell(UnsafeCell::new(BenchState {
     ctrl: bench_controller(),
-    calls: 0,
+    now: 0,
+    countdown: 35,
 }));
 
 /// One 1 kHz tick. Both sensors give an edge every 35 ticks (3 rad/s at 60 pulses/rev), in the
@@ -237,10 +239,15 @@ static BENCH: BenchCell = BenchCell(UnsafeCell::new(BenchState {
 fn bench_tick(_i: usize) -> f32 {
     // SAFETY: see `BenchCell`.
     let s = unsafe { &mut *BENCH.0.get() };
-    s.calls = s.calls.wrapping_add(1);
-    let now = s.calls.wrapping_mul(1000);
-    let edge = [now.wrapping_sub(300)];
-    let edges: &[u32] = if s.calls % 35 == 0 { &edge } else { &[] };
-    let d = s.ctrl.tick(now, [edges, edges]);
+    s.now = s.now.wrapping_add(1000);
+    s.countdown -= 1;
+    let edge = [s.now.wrapping_sub(300)];
+    let edges: &[u32] = if s.countdown == 0 {
+        s.countdown = 35;
+        &edge
+    } else {
+        &[]
+    };
+    let d = s.ctrl.tick(s.now, [edges, edges]);
     d[0] + d[1]
 }

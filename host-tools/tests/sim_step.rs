@@ -1,0 +1,60 @@
+//! `bowl sim step`: the nominal figures, read from the command's JSON.
+
+use std::process::Command;
+
+fn bowl(args: &[&str]) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_bowl"))
+        .args(args)
+        .output()
+        .expect("run bowl");
+    (
+        out.status.success(),
+        String::from_utf8(out.stdout).expect("utf-8"),
+    )
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let (ok, out) = bowl(args);
+    assert!(ok, "bowl {args:?} failed");
+    serde_json::from_str(&out).expect("JSON")
+}
+
+fn f(v: &serde_json::Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{key} missing or not a number in {v}"))
+}
+
+#[test]
+fn nominal_step_meets_overshoot_settling_and_ripple_targets() {
+    let v = json(&["sim", "step"]);
+    assert_eq!(v["pulses_per_rev"], 12);
+    assert_eq!(v["fault_code"], 0);
+    assert_eq!(v["commissioned"], true);
+    for axis in v["axes"].as_array().unwrap() {
+        assert!(f(axis, "overshoot_pct") <= 2.0, "{axis}");
+        assert!(f(axis, "settling_time_s") <= 2.5, "{axis}");
+        assert!(f(axis, "rms_ripple_pct") <= 0.5, "{axis}");
+        assert!(f(axis, "steady_state_error_pct") <= 1.0, "{axis}");
+        let rise = f(axis, "rise_time_s");
+        assert!(rise > 0.05 && rise < 2.0, "{axis}");
+    }
+    // `worst` is the worse axis of each figure.
+    let w = &v["worst"];
+    for key in ["overshoot_pct", "settling_time_s", "rms_ripple_pct"] {
+        let max = v["axes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|a| f(a, key))
+            .fold(f64::MIN, f64::max);
+        assert_eq!(f(w, key), max, "{key}");
+    }
+}
+
+#[test]
+fn sixty_pulses_per_rev_settles_within_one_second() {
+    let v = json(&["sim", "step", "--pulses-per-rev", "60"]);
+    assert_eq!(v["fault_code"], 0);
+    assert!(f(&v["worst"], "settling_time_s") <= 1.0, "{v}");
+}

@@ -1,0 +1,69 @@
+//! `bowl sim sweep` and `bowl sim stability`: the CSV charts.
+
+use std::process::Command;
+
+fn csv(args: &[&str]) -> Vec<Vec<String>> {
+    let out = Command::new(env!("CARGO_BIN_EXE_bowl"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| l.split(',').map(str::to_owned).collect())
+        .collect()
+}
+
+#[test]
+fn settling_against_pulses_per_rev() {
+    let rows = csv(&["sim", "sweep"]);
+    assert_eq!(rows[0][0], "pulses_per_rev");
+    assert_eq!(rows[0][1], "settling_time_s");
+    let data: Vec<(u32, f64, u32)> = rows[1..]
+        .iter()
+        .map(|r| {
+            (
+                r[0].parse().unwrap(),
+                r[1].parse().unwrap(),
+                r[5].parse().unwrap(),
+            )
+        })
+        .collect();
+    assert!(data.len() >= 10);
+    for &(n, settle, fault) in &data {
+        assert_eq!(fault, 0, "N {n}");
+        if n >= 60 {
+            assert!(settle <= 1.0, "N {n}: {settle}");
+        }
+        if n == 12 {
+            assert!(settle <= 2.5, "N {n}: {settle}");
+        }
+    }
+    // Where the pulse rate limits the loop: one pulse per revolution settles slowest.
+    let one = data.iter().find(|d| d.0 == 1).unwrap().1;
+    let sixty = data.iter().find(|d| d.0 == 60).unwrap().1;
+    assert!(one > 2.0 * sixty);
+}
+
+#[test]
+fn stability_map_shows_the_schedule_keeps_the_low_speed_loop_quiet() {
+    let rows = csv(&["sim", "stability", "--pulses-per-rev", "12"]);
+    assert_eq!(rows[0][5], "half_peak_to_peak_pct");
+    let find = |n: &str, ppb: &str, sched: &str| {
+        rows.iter()
+            .find(|r| r[1] == n && r[3] == ppb && r[4] == sched)
+            .unwrap_or_else(|| panic!("row {n} {ppb} {sched}"))
+            .clone()
+    };
+    // The nominal gain (0.5 per pulse) at 0.5 rad/s with 12 pulses/rev: no limit cycle above 5 %.
+    let nominal = find("12", "0.5", "true");
+    assert!(nominal[5].parse::<f64>().unwrap() <= 5.0, "{nominal:?}");
+    assert_eq!(nominal[6], "0");
+    // The same per-pulse gain 1, unscheduled, cycles or faults.
+    let fixed = find("12", "1", "false");
+    assert!(
+        fixed[4].parse::<f64>().unwrap() > 10.0 || fixed[5] != "0",
+        "{fixed:?}"
+    );
+}
