@@ -38,9 +38,50 @@ pub struct Args {
     /// `0:start` `5000:inject,sensor2` (repeatable; the answers appear in the output).
     #[arg(long = "command", value_name = "AT_MS:WORDS")]
     commands: Vec<String>,
-    /// Seed of the simulated plant's noise.
+    /// Seed of the simulated plant's noise (and of the line noise).
     #[arg(long, default_value_t = 1)]
     seed: u32,
+    /// A noisy line: this percentage of the bytes sent is replaced by a different random byte
+    /// (what the PC receives, to try the decoder and the counters; default 0).
+    #[arg(long, default_value_t = 0.0)]
+    line_noise_percent: f64,
+}
+
+/// Corrupts a fraction of the bytes on their way out (xorshift PRNG, seeded: reproducible).
+struct LineNoise {
+    state: u64,
+    threshold: u64,
+}
+
+impl LineNoise {
+    fn new(percent: f64, seed: u32) -> Result<Self> {
+        if !(percent.is_finite() && (0.0..=100.0).contains(&percent)) {
+            bail!("--line-noise-percent must be between 0 and 100");
+        }
+        Ok(Self {
+            state: 0x9E37_79B9_7F4A_7C15 ^ u64::from(seed),
+            threshold: (percent / 100.0 * u64::MAX as f64) as u64,
+        })
+    }
+
+    fn next(&mut self) -> u64 {
+        self.state ^= self.state << 13;
+        self.state ^= self.state >> 7;
+        self.state ^= self.state << 17;
+        self.state
+    }
+
+    fn apply(&mut self, bytes: &mut [u8]) {
+        if self.threshold == 0 {
+            return;
+        }
+        for b in bytes {
+            if self.next() < self.threshold {
+                // A non-zero mask: the byte always changes.
+                *b ^= (self.next() % 255 + 1) as u8;
+            }
+        }
+    }
 }
 
 /// A scheduled command: device time and the command line bytes.
@@ -110,7 +151,8 @@ pub fn run(args: &Args) -> Result<()> {
     let commands = parse_commands(&args.commands)?;
     if let Some(path) = &args.capture {
         let seconds = args.seconds.unwrap_or(0.0);
-        return capture(path, seconds, commands, args.seed);
+        let noise = LineNoise::new(args.line_noise_percent, args.seed)?;
+        return capture(path, seconds, commands, args.seed, noise);
     }
     if args.pty {
         return serve_pty(args, commands);
@@ -118,7 +160,13 @@ pub fn run(args: &Args) -> Result<()> {
     bail!("say --pty or --capture FILE --seconds S")
 }
 
-fn capture(path: &PathBuf, seconds: f64, commands: Vec<Scheduled>, seed: u32) -> Result<()> {
+fn capture(
+    path: &PathBuf,
+    seconds: f64,
+    commands: Vec<Scheduled>,
+    seed: u32,
+    mut noise: LineNoise,
+) -> Result<()> {
     if !(seconds.is_finite() && (0.0..=4_000_000.0).contains(&seconds)) {
         bail!("--seconds must be between 0 and 4e6");
     }
@@ -138,11 +186,13 @@ fn capture(path: &PathBuf, seconds: f64, commands: Vec<Scheduled>, seed: u32) ->
         }
         rig.step_1ms(&received, &mut out);
         if out.len() >= 4096 {
+            noise.apply(&mut out);
             file.write_all(&out)?;
             written += out.len() as u64;
             out.clear();
         }
     }
+    noise.apply(&mut out);
     file.write_all(&out)?;
     written += out.len() as u64;
     file.flush()?;
@@ -181,9 +231,11 @@ fn serve_pty(args: &Args, commands: Vec<Scheduled>) -> Result<()> {
     println!("{path}");
     std::io::stdout().flush()?;
 
+    let mut noise = LineNoise::new(args.line_noise_percent, args.seed)?;
     let mut rig = VirtualRig::new(args.seed)?;
     let mut out = Vec::with_capacity(4096);
     rig.boot(&mut out);
+    let mut noisy_from = 0;
     let started = Instant::now();
     let stop_after = args.seconds.map(Duration::from_secs_f64);
     let mut pending = commands.into_iter().peekable();
@@ -208,6 +260,10 @@ fn serve_pty(args: &Args, commands: Vec<Scheduled>) -> Result<()> {
             }
             rig.step_1ms(&received, &mut out);
         }
+        // Bytes not yet sent were already corrupted once; only the new ones get noise.
+        if let Some(fresh) = out.get_mut(noisy_from..) {
+            noise.apply(fresh);
+        }
         if !out.is_empty() {
             match master.write(&out) {
                 Ok(n) => {
@@ -222,6 +278,7 @@ fn serve_pty(args: &Args, commands: Vec<Scheduled>) -> Result<()> {
                 Err(_) => out.clear(),
             }
         }
+        noisy_from = out.len();
         std::thread::sleep(Duration::from_millis(1));
     }
     if let Some(link) = &args.link {

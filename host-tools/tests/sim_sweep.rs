@@ -63,7 +63,7 @@ fn stability_map_shows_the_schedule_keeps_the_low_speed_loop_quiet() {
     // The same per-pulse gain 1, unscheduled, cycles or faults.
     let fixed = find("12", "1", "false");
     assert!(
-        fixed[4].parse::<f64>().unwrap() > 10.0 || fixed[5] != "0",
+        fixed[5].parse::<f64>().unwrap() > 10.0 || fixed[6] != "0",
         "{fixed:?}"
     );
 }

@@ -447,3 +447,59 @@ fn a_residence_time_target_is_reached_in_closed_loop() {
         assert!((t_ms - 700.0).abs() < 21.0, "{r:?}");
     }
 }
+
+#[test]
+fn monitor_counts_what_a_noisy_line_destroys() {
+    let sim = Sim::start(&["--seconds", "10", "--line-noise-percent", "1"]);
+    let dir = temp_dir("noisy");
+    let log = dir.join("log.csv");
+    let mon = bowl(&[
+        "monitor",
+        &sim.path,
+        "--seconds",
+        "3",
+        "--plain",
+        "--log",
+        log.to_str().unwrap(),
+    ]);
+    assert_eq!(mon.status.code(), Some(0));
+    let s = last_json(&mon);
+    let ok = s["frames_ok"].as_u64().unwrap();
+    let missing = s["frames_missing"].as_u64().unwrap();
+    // About 55 % of the 50 frames a second are hit at 1 % byte noise (1 - 0.99^80).
+    assert!(s["frames_corrupt"].as_u64().unwrap() > 20, "{s}");
+    assert!(missing > 20 && ok > 20, "{s}");
+    // Every row logged is a frame that passed the CRC, in device-time order, 20 ms apart or a
+    // whole number of frames when some were lost.
+    let keys = csv_keys(&log);
+    assert_eq!(keys.len() as u64, s["logged_rows"].as_u64().unwrap());
+    for w in keys.windows(2) {
+        let step = w[1].1 - w[0].1;
+        assert!(step > 0 && step % 20 == 0, "{w:?}");
+    }
+    // The lost frames are exactly the gaps in the log.
+    let gaps: u64 = keys.windows(2).map(|w| (w[1].1 - w[0].1) / 20 - 1).sum();
+    assert_eq!(gaps, missing, "{s}");
+}
+
+#[test]
+fn a_noisy_capture_replays_with_every_loss_counted() {
+    let dir = temp_dir("noisy-capture");
+    let capture = dir.join("cap.bin");
+    let made = bowl(&[
+        "sim",
+        "--capture",
+        capture.to_str().unwrap(),
+        "--seconds",
+        "60",
+        "--line-noise-percent",
+        "1",
+    ]);
+    assert!(made.status.success());
+    let s = last_json(&bowl(&["replay", capture.to_str().unwrap()]));
+    let telemetry = s["telemetry_frames"].as_u64().unwrap();
+    let missing = s["frames_missing"].as_u64().unwrap();
+    // 3000 frames sent; the first and last may be lost unseen (nothing brackets them).
+    assert!((2990..=3000).contains(&(telemetry + missing)), "{s}");
+    assert!(missing > 1000, "{s}");
+}

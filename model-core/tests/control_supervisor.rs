@@ -278,3 +278,43 @@ fn zero_setpoint_gives_exactly_zero_duty_no_hum() {
     assert_eq!(max, 0.0);
     assert_eq!(cl.ctrl.fault(), None);
 }
+
+#[test]
+fn dead_sensor_from_power_up_faults_during_spin_up() {
+    let mut rig = rig_with_pulses(12);
+    rig.axes[0].faults.dead_sensor_from_s = 0.0;
+    let mut cl = running_loop(rig, |_| {});
+    cl.ctrl.set_motor_speeds(3.0, 3.0).unwrap();
+    cl.ctrl.start().unwrap();
+    let mut t_fault = None;
+    for k in 0..3000 {
+        cl.tick();
+        if cl.ctrl.fault().is_some() {
+            t_fault = Some(k as f32 * 1e-3);
+            assert_eq!(cl.duties(), [0.0, 0.0]);
+            break;
+        }
+    }
+    assert_eq!(cl.ctrl.fault(), Some(Fault::SensorLostOrStall(0)));
+    // The model needs about 0.8 s to turn three pitches from rest on this ramp.
+    assert!(t_fault.unwrap() < 1.2, "{t_fault:?}");
+}
+
+#[test]
+fn sixteen_bit_capture_timer_runs_the_same_loop() {
+    let mut rig = rig_with_pulses(12);
+    rig.timer_bits = 16;
+    let mut cl = running_loop(rig, |c| c.timer_bits = 16);
+    cl.ctrl.set_motor_speeds(0.5, 3.0).unwrap();
+    cl.ctrl.start().unwrap();
+    cl.run(8.0, |_| {});
+    assert_eq!(cl.ctrl.fault(), None);
+    assert!((cl.rig.speed_rad_s(0) - 0.5).abs() < 0.02);
+    assert!((cl.rig.speed_rad_s(1) - 3.0).abs() < 0.06);
+    let s = cl.ctrl.status();
+    assert!(
+        (s.axes[0].measured_rad_s - 0.5).abs() < 0.03,
+        "{:?}",
+        s.axes[0]
+    );
+}
