@@ -227,6 +227,21 @@ fn on_path(program: &str) -> bool {
         .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
 }
 
+/// The cargo arguments that build the emulated board's image.
+const QEMU_BUILD_ARGS: [&str; 11] = [
+    "build",
+    "--release",
+    "-p",
+    "firmware",
+    "--no-default-features",
+    "--features",
+    "qemu",
+    "--target",
+    "thumbv7em-none-eabihf",
+    "--bin",
+    QEMU_RIG_BIN,
+];
+
 /// Builds the emulated board's image; returns the ELF path or why it cannot be had.
 fn build_qemu_image() -> Result<PathBuf> {
     if !on_path("qemu-system-arm") {
@@ -243,33 +258,34 @@ fn build_qemu_image() -> Result<PathBuf> {
         "building the emulated board's image ({QEMU_RIG_BIN}; the first build takes minutes)..."
     );
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = Command::new(cargo)
+    let mut child = Command::new(cargo)
         .current_dir(&root)
-        .args([
-            "build",
-            "--release",
-            "-p",
-            "firmware",
-            "--no-default-features",
-            "--features",
-            "qemu",
-            "--target",
-            "thumbv7em-none-eabihf",
-            "--bin",
-            QEMU_RIG_BIN,
-        ])
+        .args(QEMU_BUILD_ARGS)
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
-        .output()
+        .spawn()
         .context("cannot run cargo to build the emulated board's image")?;
-    if !out.status.success() {
-        let err = String::from_utf8_lossy(&out.stderr);
-        let last = err
-            .lines()
-            .rfind(|l| l.contains("error"))
-            .unwrap_or("unknown error");
-        bail!("the emulated board's image did not build: {last}");
+    // Cargo's progress lines are shown as they come (a first build takes minutes); the first
+    // error is kept as the reason.
+    let mut first_error = None;
+    if let Some(stderr) = child.stderr.take() {
+        for line in BufReader::new(stderr).lines().map_while(|l| l.ok()) {
+            let trimmed = line.trim_start();
+            if trimmed.starts_with("Compiling") || trimmed.starts_with("Finished") {
+                eprintln!("  {trimmed}");
+            } else if first_error.is_none() && trimmed.starts_with("error") {
+                first_error = Some(trimmed.to_string());
+            }
+        }
+    }
+    let status = child.wait().context("waiting for cargo")?;
+    if !status.success() {
+        bail!(
+            "the emulated board's image did not build ({}; to see why: cargo {})",
+            first_error.as_deref().unwrap_or("unknown error"),
+            QEMU_BUILD_ARGS.join(" ")
+        );
     }
     let target_dir = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
