@@ -155,7 +155,8 @@ impl Session {
             ReadOutcome::Timeout => {}
             ReadOutcome::Gone => bail!("the rig's port went away"),
         }
-        if self.last_frame_at.elapsed() > SILENCE_LIMIT {
+        // Before the first frame the caller's boot limit applies instead.
+        if self.now_ms().is_some() && self.last_frame_at.elapsed() > SILENCE_LIMIT {
             bail!("the rig sent nothing for {} s", SILENCE_LIMIT.as_secs());
         }
         self.heartbeat()?;
