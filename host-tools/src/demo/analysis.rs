@@ -109,7 +109,8 @@ pub struct FaultReaction {
     /// When the fault must be seen, s after the injection: the controller's sensor timeout
     /// `max(floor, 3 pulse periods)` at the spin setpoint counts from the *last* edge, which came
     /// up to one pulse period before the injection; plus one telemetry period either way for the
-    /// bracketing of the injection and the detection by telemetry frames.
+    /// bracketing of the injection and the detection by telemetry frames, and 5 ms for the
+    /// board to act on the command (its link task and 1 kHz control tick).
     pub expected_detection_s: Option<[f64; 2]>,
     /// From the injection to the first frame with both duties zero in the Faulted state, s.
     pub motors_off_s: Option<f64>,
@@ -396,7 +397,7 @@ fn fault_reaction(
             f64::from(model_core::control::ControllerConfig::nominal().sensor_timeout_floor_s);
         let timeout = (3.0 * period).max(floor);
         let frame = 1.0 / f64::from(p[ParamId::TelemetryHz.index()].max(1));
-        [(timeout - period - frame).max(0.0), timeout + frame]
+        [(timeout - period - frame).max(0.0), timeout + frame + 0.005]
     });
     let since = |t: &Telemetry| seconds(t.time_ms.wrapping_sub(inject.at_ms));
     let precession_at_clear = after.last().map(|t| measured(t, 0)).unwrap_or(f64::NAN);
@@ -672,4 +673,139 @@ pub fn text(s: &Summary) -> String {
         s.ended_at_rest
     );
     o
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use model_core::wire::MotorTelemetry;
+
+    const FRAME_MS: u32 = 20;
+
+    /// A telemetry frame with both motors at `w` rad/s measured, set to `set`, driven at `duty_bp`.
+    fn frame(time_ms: u32, set_rad_s: f64, w: [f64; 2], duty_bp: [i16; 2]) -> Telemetry {
+        let motor = |axis: usize| MotorTelemetry {
+            set_mrad_s: (set_rad_s * 1000.0).round() as i16,
+            measured_mrad_s: (w[axis] * 1000.0).round() as i16,
+            duty_bp: duty_bp[axis],
+            pulses: 0,
+        };
+        Telemetry {
+            time_ms,
+            seq: 0,
+            state: DeviceState::Running,
+            fault: FaultCode::None,
+            precession: motor(0),
+            spin: motor(1),
+            bowl_mrad_s: 0,
+            residence_flat: Residence::Unavailable,
+            residence_coriolis: Residence::Unavailable,
+        }
+    }
+
+    fn sampled(y: impl Fn(f64) -> f64, set: f64, seconds: f64) -> Vec<Telemetry> {
+        (0..=(seconds * 1000.0) as u32 / FRAME_MS)
+            .map(|k| {
+                let t_ms = k * FRAME_MS;
+                let v = y(f64::from(t_ms) / 1000.0);
+                frame(t_ms, set, [v, v], [5000, 5000])
+            })
+            .collect()
+    }
+
+    /// A first-order response: 10-90 % rise tau ln 9, 5 % settling tau ln 20, no overshoot,
+    /// within the frame spacing (20 ms).
+    #[test]
+    fn first_order_step_measures_match_the_closed_forms() {
+        let (tau, set) = (0.4, 2.0);
+        let frames = sampled(|t| set * (1.0 - (-t / tau).exp()), set, 6.0);
+        let a = axis_step(&frames, 0, 0, &TOLERANCES).unwrap();
+        let rise = a.rise_time_s.unwrap();
+        assert!((rise - tau * 9f64.ln()).abs() <= 0.021, "rise {rise}");
+        let settle = a.settling_time_s.unwrap();
+        // One frame, plus one more where the mrad/s rounding of the wire sits on the band edge.
+        assert!(
+            (settle - tau * 20f64.ln()).abs() <= 0.041,
+            "settle {settle}"
+        );
+        assert_eq!(a.overshoot_pct, 0.0);
+        assert!(a.steady_error_pct < 0.1);
+        assert!(a.tracked);
+    }
+
+    /// A second-order response with damping 0.5 overshoots by exp(-zeta pi / sqrt(1 - zeta^2))
+    /// = 16.3 % of the step.
+    #[test]
+    fn underdamped_overshoot_matches_the_closed_form() {
+        let (zeta, wn, from, set) = (0.5f64, 6.0f64, 1.0, 3.0);
+        let wd = wn * (1.0 - zeta * zeta).sqrt();
+        let y = |t: f64| {
+            let e = (-zeta * wn * t).exp();
+            from + (set - from)
+                * (1.0 - e * ((wd * t).cos() + zeta / (1.0 - zeta * zeta).sqrt() * (wd * t).sin()))
+        };
+        let frames = sampled(y, set, 6.0);
+        let a = axis_step(&frames, 0, 0, &TOLERANCES).unwrap();
+        let expected = 100.0 * (-zeta * std::f64::consts::PI / (1.0 - zeta * zeta).sqrt()).exp();
+        assert!(
+            (a.overshoot_pct - expected).abs() < 0.5,
+            "{} vs {expected}",
+            a.overshoot_pct
+        );
+        assert_eq!(a.from_rad_s, from);
+    }
+
+    /// A response that never gets within the band is not tracked (the check can fail).
+    #[test]
+    fn a_motor_that_stays_short_of_its_setpoint_is_not_tracked() {
+        let frames = sampled(|t| 1.8 * (1.0 - (-t / 0.2).exp()), 2.0, 6.0);
+        let a = axis_step(&frames, 0, 0, &TOLERANCES).unwrap();
+        assert_eq!(a.settling_time_s, None);
+        assert!(a.steady_error_pct > 9.0);
+        assert!(!a.tracked);
+    }
+
+    fn faulted(mut t: Telemetry) -> Telemetry {
+        t.state = DeviceState::Faulted;
+        t.fault = FaultCode::SensorLostOrStallSpin;
+        t
+    }
+
+    /// The fault reaction: detection and motors-off times from the frames; a duty left on after
+    /// the fault, or a healthy motor still turning, is not "stopped both motors".
+    #[test]
+    fn fault_reaction_needs_both_duties_off_and_the_healthy_motor_at_rest() {
+        let inject = Mark {
+            name: "fault injected".into(),
+            kind: MarkKind::Inject,
+            at_ms: 1000,
+            accepted: true,
+        };
+        let mut tel: Vec<Telemetry> = (0..50)
+            .map(|k| frame(k * FRAME_MS, 2.0, [2.0, 2.0], [4000, 4000]))
+            .collect();
+        // Detected 0.6 s after the injection; the precession motor coasts down over 1 s.
+        for k in 50..200u32 {
+            let t_ms = k * FRAME_MS;
+            let f = if t_ms >= 1600 {
+                let w = (2.0 - 2.0 * f64::from(t_ms - 1600) / 1000.0).max(0.0);
+                faulted(frame(t_ms, 0.0, [w, 0.0], [0, 0]))
+            } else {
+                frame(t_ms, 2.0, [2.0, 2.0], [4000, 4000])
+            };
+            tel.push(f);
+        }
+        let r = fault_reaction(&tel, &inject, 4000, None, &TOLERANCES);
+        assert_eq!(r.detection_s, Some(0.6));
+        assert_eq!(r.motors_off_s, Some(0.6));
+        assert!(r.stayed_off && r.stopped_both_motors);
+        // Below 0.05 rad/s once 975 ms into the coast: the frame at 980 ms, 1.58 s after injection.
+        assert_eq!(r.precession_stopped_s, Some(1.58));
+
+        // One duty comes back on while faulted: not stopped.
+        let mut bad = tel.clone();
+        bad[120].spin.duty_bp = 300;
+        let r = fault_reaction(&bad, &inject, 4000, None, &TOLERANCES);
+        assert!(!r.stayed_off && !r.stopped_both_motors);
+    }
 }

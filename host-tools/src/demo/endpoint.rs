@@ -227,6 +227,21 @@ fn on_path(program: &str) -> bool {
         .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
 }
 
+/// The cargo arguments that build the emulated board's image.
+const QEMU_BUILD_ARGS: [&str; 11] = [
+    "build",
+    "--release",
+    "-p",
+    "firmware",
+    "--no-default-features",
+    "--features",
+    "qemu",
+    "--target",
+    "thumbv7em-none-eabihf",
+    "--bin",
+    QEMU_RIG_BIN,
+];
+
 /// Builds the emulated board's image; returns the ELF path or why it cannot be had.
 fn build_qemu_image() -> Result<PathBuf> {
     if !on_path("qemu-system-arm") {
@@ -243,33 +258,34 @@ fn build_qemu_image() -> Result<PathBuf> {
         "building the emulated board's image ({QEMU_RIG_BIN}; the first build takes minutes)..."
     );
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = Command::new(cargo)
+    let mut child = Command::new(cargo)
         .current_dir(&root)
-        .args([
-            "build",
-            "--release",
-            "-p",
-            "firmware",
-            "--no-default-features",
-            "--features",
-            "qemu",
-            "--target",
-            "thumbv7em-none-eabihf",
-            "--bin",
-            QEMU_RIG_BIN,
-        ])
+        .args(QEMU_BUILD_ARGS)
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
-        .output()
+        .spawn()
         .context("cannot run cargo to build the emulated board's image")?;
-    if !out.status.success() {
-        let err = String::from_utf8_lossy(&out.stderr);
-        let last = err
-            .lines()
-            .rfind(|l| l.contains("error"))
-            .unwrap_or("unknown error");
-        bail!("the emulated board's image did not build: {last}");
+    // Cargo's progress lines are shown as they come (a first build takes minutes); the first
+    // error is kept as the reason.
+    let mut first_error = None;
+    if let Some(stderr) = child.stderr.take() {
+        for line in BufReader::new(stderr).lines().map_while(|l| l.ok()) {
+            let trimmed = line.trim_start();
+            if trimmed.starts_with("Compiling") || trimmed.starts_with("Finished") {
+                eprintln!("  {trimmed}");
+            } else if first_error.is_none() && trimmed.starts_with("error") {
+                first_error = Some(trimmed.to_string());
+            }
+        }
+    }
+    let status = child.wait().context("waiting for cargo")?;
+    if !status.success() {
+        bail!(
+            "the emulated board's image did not build ({}; to see why: cargo {})",
+            first_error.as_deref().unwrap_or("unknown error"),
+            QEMU_BUILD_ARGS.join(" ")
+        );
     }
     let target_dir = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
@@ -289,8 +305,10 @@ fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
     // The board ends its run by itself a little after the session (a safety net: we kill it).
     let run_s = (seconds * 1.5 + 60.0).ceil() as u64;
     // -icount: virtual time counts instructions (1 ns each, as in firmware/qemu-rig-run and the
-    // QEMU tests). sleep=off lets an idle board's clock jump ahead (faster than real time),
-    // sleep=on keeps it with the wall clock.
+    // QEMU tests). sleep=off lets an idle board's clock jump ahead (about 4x real time here);
+    // sleep=on waits for the wall clock when idle (about 0.6x real time here: the busy parts
+    // take longer than their 1 ns per instruction). shift=auto would track the wall clock, but
+    // its varying instruction time trips the board's emulated watchdog.
     let icount = if fast {
         "shift=0,sleep=off"
     } else {
@@ -321,22 +339,26 @@ fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
         .stderr(Stdio::piped())
         .spawn()
         .context("cannot start qemu-system-arm")?;
-    // QEMU names the pseudo-terminal on stderr: "char device redirected to /dev/pts/N (label ...)".
-    let stderr = child.stderr.take().ok_or_else(|| anyhow!("no stderr"))?;
+    // QEMU names the pseudo-terminal ("char device redirected to /dev/pts/N (label serial0)")
+    // on stdout, among the board's semihosting lines; older versions on stderr.
     let (tx, rx) = mpsc::channel();
+    let stderr = child.stderr.take().ok_or_else(|| anyhow!("no stderr"))?;
+    let tx_err = tx.clone();
     std::thread::spawn(move || {
         for line in BufReader::new(stderr).lines().map_while(|l| l.ok()) {
-            if let Some(rest) = line.split("redirected to ").nth(1)
-                && let Some(path) = rest.split_whitespace().next()
-            {
-                let _ = tx.send(path.to_string());
-            }
+            let _ = tx_err.send(line);
         }
     });
     let stdout = child.stdout.take().ok_or_else(|| anyhow!("no stdout"))?;
     let console = std::thread::spawn(move || {
         let mut keep = Vec::new();
+        let mut reported = false;
         for line in BufReader::new(stdout).lines().map_while(|l| l.ok()) {
+            if !reported && line.contains("redirected to ") {
+                reported = true;
+                let _ = tx.send(line);
+                continue;
+            }
             if keep.len() == 200 {
                 keep.remove(0);
             }
@@ -344,15 +366,35 @@ fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
         }
         keep
     });
-    let port = match rx.recv_timeout(Duration::from_secs(10)) {
-        Ok(p) => p,
-        Err(_) => {
-            let _ = child.kill();
-            let _ = child.wait();
-            bail!("qemu-system-arm did not report its serial pseudo-terminal");
-        }
+    let pty_of = |line: &str| {
+        line.split("redirected to ")
+            .nth(1)
+            .and_then(|rest| rest.split_whitespace().next())
+            .map(str::to_string)
     };
-    let _ = std::io::stderr().flush();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let mut qemu_said = Vec::new();
+    let mut found = None;
+    while found.is_none() {
+        let left = deadline.saturating_duration_since(Instant::now());
+        match rx.recv_timeout(left) {
+            Ok(line) => match pty_of(&line) {
+                Some(p) => found = Some(p),
+                None => qemu_said.push(line),
+            },
+            Err(_) => break,
+        }
+    }
+    let Some(port) = found else {
+        let _ = child.kill();
+        let _ = child.wait();
+        bail!(
+            "qemu-system-arm did not report its serial pseudo-terminal{}",
+            qemu_said
+                .last()
+                .map_or(String::new(), |l| format!(" (it said: {l})"))
+        );
+    };
     Ok(Endpoint {
         description: format!(
             "emulated board: firmware image {} on QEMU netduinoplus2 (Cortex-M4F), USART1 on {port}{}",

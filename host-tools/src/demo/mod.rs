@@ -89,6 +89,12 @@ pub fn run(args: &Args) -> Result<()> {
     let host_bytes_dropped = shutdown.host.map_or(0, |h| h.bytes_dropped);
     let console_from = shutdown.console.len().saturating_sub(10);
     let board_console = shutdown.console[console_from..].to_vec();
+    if outcome.aborted.is_some() && !board_console.is_empty() {
+        println!("the emulated board's console, last lines:");
+        for line in &board_console {
+            println!("  {line}");
+        }
+    }
 
     if !plain {
         println!("\nsession log:");

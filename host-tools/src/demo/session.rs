@@ -125,7 +125,12 @@ impl Session {
     /// Shows a step line: printed at once in plain mode, in the dashboard's event list otherwise,
     /// and kept for the end.
     pub fn event(&mut self, text: String) {
-        let stamp = match self.now_ms() {
+        self.event_at(self.now_ms(), text);
+    }
+
+    /// As [`Session::event`], stamped with the device time `at_ms`.
+    fn event_at(&mut self, at_ms: Option<u32>, text: String) {
+        let stamp = match at_ms {
             Some(ms) => format!("[t={:>7.3} s] ", f64::from(ms) / 1000.0),
             None => "[t=   -    ] ".into(),
         };
@@ -150,7 +155,8 @@ impl Session {
             ReadOutcome::Timeout => {}
             ReadOutcome::Gone => bail!("the rig's port went away"),
         }
-        if self.last_frame_at.elapsed() > SILENCE_LIMIT {
+        // Before the first frame the caller's boot limit applies instead.
+        if self.now_ms().is_some() && self.last_frame_at.elapsed() > SILENCE_LIMIT {
             bail!("the rig sent nothing for {} s", SILENCE_LIMIT.as_secs());
         }
         self.heartbeat()?;
@@ -278,7 +284,7 @@ impl Session {
                     answer: answer.clone(),
                     at_ms: after_ms,
                 });
-                self.event(format!("{step}: {text} -> {answer}"));
+                self.event_at(after_ms, format!("{step}: {text} -> {answer}"));
                 return Ok((accepted, frame));
             }
             if Instant::now() >= deadline {
