@@ -7,7 +7,7 @@
 //! - `RIM_UM`, `START_UM`, `MU_PPM`, `K2_PPM`: the particle scene for `RTIME` and the predicted
 //!   residence times; gravity 9.81 m/s^2.
 //! - `AXES_MDEG`: `axes_angle_rad` (paper Eq. 2); `RATIO_PPM`: `spin_per_precession`.
-//! - per axis n: `BWn_MRAD_S` `bandwidth_rad_s`, `PER_PULSEn_PPM` `per_pulse_bandwidth`,
+//! - per axis n: `BWn_MRAD_S` `bandwidth_rad_s`, `PER_PULSEn_MILLI` `per_pulse_bandwidth`,
 //!   `SPEED_MAXn_MRAD_S` `max_speed_rad_s` (the over-speed fault limit follows at
 //!   [`OVERSPEED_PER_MAX`] times it), `ACCELn_MRAD_S2` `accel_limit_rad_s2`, `DUTY_MAXn_BP`
 //!   `duty_limit`, `TEETHn` `pulses_per_rev`.
@@ -100,8 +100,8 @@ pub fn default_params() -> ParamValues {
             ParamId::AxesMdeg => milli(cfg.axes_angle_rad.to_degrees()),
             ParamId::Bandwidth1MradS => milli(a.bandwidth_rad_s),
             ParamId::Bandwidth2MradS => milli(b.bandwidth_rad_s),
-            ParamId::PerPulse1Ppm => micro(a.per_pulse_bandwidth),
-            ParamId::PerPulse2Ppm => micro(b.per_pulse_bandwidth),
+            ParamId::PerPulse1Milli => milli(a.per_pulse_bandwidth),
+            ParamId::PerPulse2Milli => milli(b.per_pulse_bandwidth),
             ParamId::SpeedMax1MradS => milli(a.max_speed_rad_s),
             ParamId::SpeedMax2MradS => milli(b.max_speed_rad_s),
             ParamId::Accel1MradS2 => milli(a.accel_limit_rad_s2),
@@ -190,7 +190,7 @@ fn derive(
     let per_axis = [
         [
             ParamId::Bandwidth1MradS,
-            ParamId::PerPulse1Ppm,
+            ParamId::PerPulse1Milli,
             ParamId::SpeedMax1MradS,
             ParamId::Accel1MradS2,
             ParamId::DutyMax1Bp,
@@ -198,7 +198,7 @@ fn derive(
         ],
         [
             ParamId::Bandwidth2MradS,
-            ParamId::PerPulse2Ppm,
+            ParamId::PerPulse2Milli,
             ParamId::SpeedMax2MradS,
             ParamId::Accel2MradS2,
             ParamId::DutyMax2Bp,
@@ -207,7 +207,7 @@ fn derive(
     ];
     for (a, [bw, per_pulse, max, accel, duty, teeth]) in cfg.axes.iter_mut().zip(per_axis) {
         a.bandwidth_rad_s = p(bw) * 1e-3;
-        a.per_pulse_bandwidth = p(per_pulse) * 1e-6;
+        a.per_pulse_bandwidth = p(per_pulse) * 1e-3;
         a.max_speed_rad_s = p(max) * 1e-3;
         a.overspeed_rad_s = a.max_speed_rad_s * OVERSPEED_PER_MAX;
         a.accel_limit_rad_s2 = p(accel) * 1e-3;
