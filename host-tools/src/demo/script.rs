@@ -17,6 +17,8 @@ pub const SECOND_SPEEDS_MRAD_S: [i16; 2] = [2600, 3000];
 pub const RESIDENCE_TARGET_MS: u32 = 600;
 /// Motor speeds after the restart, mrad/s.
 pub const RESTART_SPEEDS_MRAD_S: [i16; 2] = [1800, 2400];
+/// A speed reading below this counts as at rest, mrad/s (the analysis's `stopped_rad_s`).
+const AT_REST_MRAD_S: u16 = 50;
 /// The injected fault: the spin sensor stops giving pulses.
 pub const INJECTION: &str = "sensor2";
 
@@ -56,7 +58,7 @@ pub struct Timing {
     pub dwell_ms: u32,
     /// Longest wait for the fault to be detected and for the rig to reach Idle after STOP.
     pub wait_limit_ms: u32,
-    /// How long the faulted rig is watched (motors must stay off).
+    /// The faulted rig is watched until both motors are at rest, at least this long.
     pub faulted_ms: u32,
     /// Pause after CLEAR and at the end.
     pub pause_ms: u32,
@@ -199,7 +201,25 @@ fn steps(s: &mut Session, timing: Timing, out: &mut Outcome) -> Result<()> {
             f64::from(d.wait_limit_ms) / 1000.0
         )),
     }
-    s.wait_ms(d.faulted_ms)?;
+    // Watch the motors coast to rest (the bridge coasts on a fault: no braking), then a little
+    // longer to show they stay off.
+    let coast_limit = d.wait_limit_ms.max(2 * d.faulted_ms);
+    let watch_from = s.now_ms().unwrap_or(0);
+    match s.wait_for(coast_limit, |t| {
+        t.precession.measured_mrad_s.unsigned_abs() < AT_REST_MRAD_S
+            && t.spin.measured_mrad_s.unsigned_abs() < AT_REST_MRAD_S
+    })? {
+        Some(at) => s.event(format!(
+            "both speed readings at rest at t={:.3} s",
+            f64::from(at) / 1000.0
+        )),
+        None => s.event(format!(
+            "the motors did not come to rest within {:.1} s",
+            f64::from(coast_limit) / 1000.0
+        )),
+    }
+    let watched = s.now_ms().unwrap_or(0).wrapping_sub(watch_from);
+    s.wait_ms(d.faulted_ms.saturating_sub(watched).max(d.pause_ms))?;
 
     // 5. Repair and clear.
     s.command("sensor repaired", &["inject", "none"])?;
