@@ -9,10 +9,10 @@ mod kinematics;
 mod monitor;
 mod predict;
 mod replay;
-mod rig_binding;
 mod send;
 mod serial;
 mod sim;
+mod simulated_rig;
 mod telemetry_csv;
 mod virtual_rig;
 

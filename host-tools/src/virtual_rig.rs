@@ -1,7 +1,7 @@
 //! The virtual rig's transport: `bowl sim --pty` (a pseudo-terminal speaking the protocol in real
 //! time) and `bowl sim --capture FILE --seconds S` (the same rig faster than real time, writing
 //! exactly the bytes it would send). The protocol side is `model_core::wire::device`, the same
-//! code the firmware runs; the rig behind it is [`crate::rig_binding`].
+//! code the firmware runs; the rig behind it is [`crate::simulated_rig`].
 
 use std::fs::File;
 use std::io::{BufWriter, Read, Write};
@@ -16,8 +16,8 @@ use nix::fcntl::OFlag;
 use nix::pty::{PtyMaster, grantpt, posix_openpt, ptsname_r, unlockpt};
 use nix::sys::termios::{FlushArg, tcflush};
 
-use crate::rig_binding::SimulatedRig;
 use crate::send::command_line;
+use crate::simulated_rig::SimulatedRig;
 
 /// Flags of the virtual rig (`bowl sim --pty` / `bowl sim --capture`).
 #[derive(clap::Args)]
@@ -127,20 +127,24 @@ impl VirtualRig {
     /// The boot announcement.
     pub(crate) fn boot(&mut self, out: &mut Vec<u8>) {
         let mut buf = [0u8; MAX_FRAME_LEN];
-        if let Some(n) = self.device.hello(&self.rig, &mut buf) {
+        if let Some(n) = self.device.hello(self.rig.bound(), &mut buf) {
             out.extend_from_slice(&buf[..n]);
         }
     }
 
     /// One millisecond: take the received bytes, run the plant and controller, send what is due.
     pub(crate) fn step_1ms(&mut self, received: &[u8], out: &mut Vec<u8>) {
-        self.device.receive(&mut self.rig, received, |answer| {
-            out.extend_from_slice(answer)
-        });
+        self.device
+            .receive(self.rig.bound_mut(), received, |answer| {
+                out.extend_from_slice(answer)
+            });
         self.now_ms = self.now_ms.wrapping_add(1);
         self.rig.advance_to_ms(self.now_ms);
         let mut buf = [0u8; MAX_FRAME_LEN];
-        if let Some(n) = self.device.poll_telemetry(&self.rig, self.now_ms, &mut buf) {
+        if let Some(n) = self
+            .device
+            .poll_telemetry(self.rig.bound(), self.now_ms, &mut buf)
+        {
             out.extend_from_slice(&buf[..n]);
         }
     }

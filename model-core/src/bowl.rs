@@ -69,60 +69,81 @@ impl<T: Real> BowlGeometry<T> {
     /// Evaluated as `sqrt((w1 sin a)^2 + (w1 cos a + w2)^2)`, the paper's printed form: a sum of
     /// squares, so it never takes the square root of a negative rounding residue.
     pub fn combined_speed_rad_s(&self, speeds: MotorSpeeds<T>) -> Result<T, BowlError> {
-        let (w1, w2) = (speeds.precession_rad_s, speeds.spin_rad_s);
-        if !w1.is_finite() || !w2.is_finite() {
-            return Err(BowlError::NonFiniteSpeed);
-        }
         let a = self.axes_angle_rad;
-        let along = w1 * a.cos() + w2;
-        let across = w1 * a.sin();
-        let omega = (along * along + across * across).sqrt();
-        if omega.is_finite() {
-            Ok(omega)
-        } else {
-            Err(BowlError::NonFiniteSpeed)
-        }
+        combined_speed_from_trig(a.cos(), a.sin(), speeds)
     }
 
-    /// The inverse of Eq. 2 at a fixed ratio `spin = ratio * precession`: the motor speeds that
-    /// give the combined speed `omega_rad_s`.
-    ///
-    /// From Eq. 2, `omega^2 = w1^2 (1 + ratio^2 + 2 ratio cos a)`, so
-    /// `w1 = omega / sqrt(1 + ratio^2 + 2 ratio cos a)` and `w2 = ratio * w1`. With `ratio >= 0`
-    /// and `a < pi` the root is positive.
+    /// The inverse of Eq. 2 at a fixed ratio `spin = ratio * precession`: see [`split_from_trig`].
     pub fn split(
         &self,
         omega_rad_s: T,
         spin_per_precession: T,
     ) -> Result<MotorSpeeds<T>, BowlError> {
-        if !omega_rad_s.is_finite() {
-            return Err(BowlError::NonFiniteSpeed);
-        }
-        if omega_rad_s < T::ZERO {
-            return Err(BowlError::NegativeTargetSpeed);
-        }
-        let rho = spin_per_precession;
-        if !rho.is_finite() || rho < T::ZERO {
-            return Err(BowlError::InvalidRatio);
-        }
         let a = self.axes_angle_rad;
-        // Same sum-of-squares form as Eq. 2 with w1 = 1: (cos a + rho)^2 + sin^2 a.
-        let along = a.cos() + rho;
-        let across = a.sin();
-        let gain = (along * along + across * across).sqrt();
-        if gain.is_nan() || gain <= T::ZERO || !gain.is_finite() {
-            return Err(BowlError::InvalidRatio);
-        }
-        let w1 = omega_rad_s / gain;
-        let w2 = rho * w1;
-        if !w1.is_finite() || !w2.is_finite() {
-            return Err(BowlError::NonFiniteSpeed);
-        }
-        Ok(MotorSpeeds {
-            precession_rad_s: w1,
-            spin_rad_s: w2,
-        })
+        split_from_trig(a.cos(), a.sin(), omega_rad_s, spin_per_precession)
     }
+}
+
+/// Paper Eq. 2 (see [`BowlGeometry::combined_speed_rad_s`]) with the cosine and sine of the
+/// angle between the axes already known: the controller computes them once per configuration,
+/// so the MCU evaluates no sine or cosine at run time.
+pub fn combined_speed_from_trig<T: Real>(
+    cos_axes: T,
+    sin_axes: T,
+    speeds: MotorSpeeds<T>,
+) -> Result<T, BowlError> {
+    let (w1, w2) = (speeds.precession_rad_s, speeds.spin_rad_s);
+    if !w1.is_finite() || !w2.is_finite() {
+        return Err(BowlError::NonFiniteSpeed);
+    }
+    let along = w1 * cos_axes + w2;
+    let across = w1 * sin_axes;
+    let omega = (along * along + across * across).sqrt();
+    if omega.is_finite() {
+        Ok(omega)
+    } else {
+        Err(BowlError::NonFiniteSpeed)
+    }
+}
+
+/// The inverse of Eq. 2 at a fixed ratio `spin = ratio * precession`: the motor speeds that
+/// give the combined speed `omega_rad_s`, with the cosine and sine of the axes angle known.
+///
+/// From Eq. 2, `omega^2 = w1^2 (1 + ratio^2 + 2 ratio cos a)`, so
+/// `w1 = omega / sqrt(1 + ratio^2 + 2 ratio cos a)` and `w2 = ratio * w1`. With `ratio >= 0`
+/// and `a < pi` the root is positive.
+pub fn split_from_trig<T: Real>(
+    cos_axes: T,
+    sin_axes: T,
+    omega_rad_s: T,
+    spin_per_precession: T,
+) -> Result<MotorSpeeds<T>, BowlError> {
+    if !omega_rad_s.is_finite() {
+        return Err(BowlError::NonFiniteSpeed);
+    }
+    if omega_rad_s < T::ZERO {
+        return Err(BowlError::NegativeTargetSpeed);
+    }
+    let rho = spin_per_precession;
+    if !rho.is_finite() || rho < T::ZERO {
+        return Err(BowlError::InvalidRatio);
+    }
+    // Same sum-of-squares form as Eq. 2 with w1 = 1: (cos a + rho)^2 + sin^2 a.
+    let along = cos_axes + rho;
+    let across = sin_axes;
+    let gain = (along * along + across * across).sqrt();
+    if gain.is_nan() || gain <= T::ZERO || !gain.is_finite() {
+        return Err(BowlError::InvalidRatio);
+    }
+    let w1 = omega_rad_s / gain;
+    let w2 = rho * w1;
+    if !w1.is_finite() || !w2.is_finite() {
+        return Err(BowlError::NonFiniteSpeed);
+    }
+    Ok(MotorSpeeds {
+        precession_rad_s: w1,
+        spin_rad_s: w2,
+    })
 }
 
 #[cfg(test)]

@@ -10,6 +10,7 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 #![warn(missing_docs)]
 
+pub mod binding;
 pub mod bowl;
 pub mod choose;
 pub mod control;

@@ -147,3 +147,19 @@ proptest! {
         prop_assert!(decode_frame(&bytes).is_err());
     }
 }
+
+proptest! {
+    /// The rig's command-only parser agrees with the full parser on every command frame, and
+    /// refuses every other kind as an unknown kind (it never reads their fields).
+    #[test]
+    fn command_parser_agrees_on_commands_and_skips_the_rest(frame in frame()) {
+        let bytes = encode_vec(&frame);
+        let line = &bytes[1..bytes.len() - 1];
+        let full = parse_line(line);
+        prop_assert_eq!(full, Ok(frame));
+        match frame {
+            Frame::Command { .. } => prop_assert_eq!(parse_command_line(line), full),
+            _ => prop_assert_eq!(parse_command_line(line), Err(FrameError::UnknownKind)),
+        }
+    }
+}

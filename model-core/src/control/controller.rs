@@ -8,7 +8,7 @@ use super::planner::{
     BowlSpeedForResidence, InverseFailure, ResidenceForBowlSpeed, SetpointPlanner, split_combined,
 };
 use super::supervisor::{Fault, SensorWatch, State, fault_code};
-use crate::bowl::{BowlGeometry, MotorSpeeds};
+use crate::bowl::{MotorSpeeds, combined_speed_from_trig};
 
 /// Why a command was refused. A refused command changes nothing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -103,6 +103,7 @@ pub struct Controller {
     identify_error: Option<IdentifyError>,
     feedback: bool,
     cos_axes: f32,
+    sin_axes: f32,
     host_watch: bool,
 }
 
@@ -164,6 +165,7 @@ impl Controller {
             identify_error: None,
             feedback: true,
             cos_axes: cos_const(cfg.axes_angle_rad),
+            sin_axes: sin_const(cfg.axes_angle_rad),
             host_watch: cfg.host_timeout_s > 0.0,
         }
     }
@@ -480,8 +482,13 @@ impl Controller {
             return Err(Rejection::InvalidResidenceTime);
         }
         let omega = model.omega_rad_s(target_s).map_err(Rejection::Inverse)?;
-        let speeds = split_combined(omega, self.cfg.axes_angle_rad, self.cfg.spin_per_precession)
-            .ok_or(Rejection::SplitFailed)?;
+        let speeds = split_combined(
+            omega,
+            self.cos_axes,
+            self.sin_axes,
+            self.cfg.spin_per_precession,
+        )
+        .ok_or(Rejection::SplitFailed)?;
         self.check_speed(0, speeds[0])?;
         self.check_speed(1, speeds[1])?;
         self.planner.set_targets(speeds);
@@ -654,14 +661,15 @@ impl Controller {
                 measurement_valid: self.est[i].is_valid(),
             };
         }
-        let g = BowlGeometry {
-            axes_angle_rad: self.cfg.axes_angle_rad,
-        };
         let combined = |w: [f32; 2]| {
-            g.combined_speed_rad_s(MotorSpeeds {
-                precession_rad_s: w[0],
-                spin_rad_s: w[1],
-            })
+            combined_speed_from_trig(
+                self.cos_axes,
+                self.sin_axes,
+                MotorSpeeds {
+                    precession_rad_s: w[0],
+                    spin_rad_s: w[1],
+                },
+            )
             .unwrap_or(0.0)
         };
         Status {
@@ -686,22 +694,36 @@ impl Controller {
     }
 }
 
-/// cos(x) for x in [0, pi), usable in `const fn` (the configuration's axes angle): the Taylor
-/// series about pi/2 in f64, which for |x - pi/2| <= pi/2 converges to below 1e-9 with these
-/// terms. (libm's `cosf` is not a `const fn`.)
-const fn cos_const(x: f32) -> f32 {
-    // cos(x) = -sin(x - pi/2) = -sin(y)
-    let y = x as f64 - core::f64::consts::FRAC_PI_2;
-    let y2 = y * y;
-    let mut term = y;
-    let mut sum = y;
-    let mut k = 1;
-    while k < 12 {
-        term = -term * y2 / ((2 * k) as f64 * (2 * k + 1) as f64);
-        sum += term;
-        k += 1;
+/// sin(z) for |z| <= pi/2 in f32, usable in `const fn`: the Taylor series to z^23 in Horner
+/// form (truncation below 1e-15 there; f32 rounding dominates, a few 1e-8). No libm sine or
+/// cosine and no f64 arithmetic reach the firmware image this way.
+const fn sin_series(z: f32) -> f32 {
+    let z2 = z * z;
+    // sin z = z (1 - z^2/(2*3) (1 - z^2/(4*5) (1 - ...))), innermost term first.
+    let mut acc = 1.0f32;
+    let mut k = 11;
+    while k > 0 {
+        acc = 1.0 - z2 / ((2 * k) as f32 * (2 * k + 1) as f32) * acc;
+        k -= 1;
     }
-    (-sum) as f32
+    z * acc
+}
+
+/// cos(x) for x in [0, pi) (the configuration's axes angle), usable in `const fn`:
+/// cos x = sin(pi/2 - x), |pi/2 - x| <= pi/2. (libm's `cosf` is not a `const fn`.)
+const fn cos_const(x: f32) -> f32 {
+    sin_series(core::f32::consts::FRAC_PI_2 - x)
+}
+
+/// sin(x) for x in [0, pi): sin x = cos(pi/2 - x) = sqrt(1 - sin^2(pi/2 - x)) would need a
+/// square root; instead sin x = sin(pi - x) folds x into [0, pi/2], where the series holds.
+const fn sin_const(x: f32) -> f32 {
+    let folded = if x > core::f32::consts::FRAC_PI_2 {
+        core::f32::consts::PI - x
+    } else {
+        x
+    };
+    sin_series(folded)
 }
 
 #[cfg(test)]
@@ -712,6 +734,8 @@ mod tests {
         while x < core::f32::consts::PI {
             let d = (super::cos_const(x) - libm::cosf(x)).abs();
             assert!(d < 2e-7, "x {x}: {d}");
+            let d = (super::sin_const(x) - libm::sinf(x)).abs();
+            assert!(d < 2e-7, "sin x {x}: {d}");
             x += 0.01;
         }
     }

@@ -6,7 +6,7 @@
 //! corrections) or which scene (bowl radius, start radius, resistance coefficient) is in use:
 //! the caller passes the model in with the command.
 
-use crate::bowl::BowlGeometry;
+use crate::bowl::split_from_trig;
 
 /// Why the particle model's inverse gave no bowl speed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -34,13 +34,14 @@ pub trait ResidenceForBowlSpeed {
 
 /// Combined bowl speed split into motor speeds by Eq. 2 at a fixed spin/precession ratio.
 /// Returns `[precession, spin]`, rad/s, or `None` if the geometry rejects the split.
+/// `cos_axes`, `sin_axes`: of the angle between the axes.
 pub fn split_combined(
     omega_rad_s: f32,
-    axes_angle_rad: f32,
+    cos_axes: f32,
+    sin_axes: f32,
     spin_per_precession: f32,
 ) -> Option<[f32; 2]> {
-    let g = BowlGeometry { axes_angle_rad };
-    let s = g.split(omega_rad_s, spin_per_precession).ok()?;
+    let s = split_from_trig(cos_axes, sin_axes, omega_rad_s, spin_per_precession).ok()?;
     Some([s.precession_rad_s, s.spin_rad_s])
 }
 

@@ -252,6 +252,26 @@ impl From<FieldError> for FrameError {
 
 /// Parses one line: the bytes after `$` and before `\n` (a trailing `\r` is allowed).
 pub fn parse_line(line: &[u8]) -> Result<Frame, FrameError> {
+    checked_payload(line).and_then(parse_payload)
+}
+
+/// Parses one line as the rig does: command frames only. Any other kind, CRC and version
+/// valid, is [`FrameError::UnknownKind`] without its fields being read, so the rig's image
+/// carries no parser for the frames it only ever sends.
+pub fn parse_command_line(line: &[u8]) -> Result<Frame, FrameError> {
+    checked_payload(line).and_then(|payload| {
+        let mut f = Fields {
+            rest: Some(payload),
+        };
+        match header(&mut f)? {
+            b'C' => command_frame(&mut f),
+            _ => Err(FrameError::UnknownKind),
+        }
+    })
+}
+
+/// The payload of a line whose trailer and CRC check out.
+fn checked_payload(line: &[u8]) -> Result<&[u8], FrameError> {
     let line = match line.split_last() {
         Some((b'\r', rest)) => rest,
         _ => line,
@@ -272,19 +292,17 @@ pub fn parse_line(line: &[u8]) -> Result<Frame, FrameError> {
     if crc32(payload) != sent {
         return Err(FrameError::BadCrc);
     }
-    parse_payload(payload)
+    Ok(payload)
 }
 
-/// Parses a payload whose CRC has been checked.
-fn parse_payload(payload: &[u8]) -> Result<Frame, FrameError> {
-    let mut f = Fields {
-        rest: Some(payload),
-    };
+/// Reads the kind letter and checks the version; a command of another version is answered
+/// (`VERSION`), any other frame of another version is dropped.
+fn header(f: &mut Fields<'_>) -> Result<u8, FrameError> {
     let head = f.next_token()?;
     let (&kind, version) = head.split_first().ok_or(FrameError::Malformed)?;
     if version != [b'0' + PROTOCOL_VERSION] {
         if kind == b'C' {
-            let id = u16_field(&mut f).unwrap_or(0);
+            let id = u16_field(f).unwrap_or(0);
             return Err(FrameError::BadCommand {
                 id,
                 reason: Reason::Version,
@@ -292,21 +310,31 @@ fn parse_payload(payload: &[u8]) -> Result<Frame, FrameError> {
         }
         return Err(FrameError::UnsupportedVersion);
     }
-    let frame = match kind {
+    Ok(kind)
+}
+
+/// A command frame's id and command (after the header).
+fn command_frame(f: &mut Fields<'_>) -> Result<Frame, FrameError> {
+    let id = u16_field(f).map_err(|_| FrameError::BadCommand {
+        id: 0,
+        reason: Reason::Malformed,
+    })?;
+    let command = command(f).map_err(|reason| FrameError::BadCommand { id, reason })?;
+    Ok(Frame::Command { id, command })
+}
+
+/// Parses a payload whose CRC has been checked.
+fn parse_payload(payload: &[u8]) -> Result<Frame, FrameError> {
+    let mut f = Fields {
+        rest: Some(payload),
+    };
+    let frame = match header(&mut f)? {
         b'T' => Frame::Telemetry(telemetry(&mut f)?),
         b'H' => Frame::Hello(Hello {
             reset_cause: coded(&mut f, ResetCause::from_code)?,
             reset_count: u16_field(&mut f)?,
         }),
-        b'C' => {
-            let id = u16_field(&mut f).map_err(|_| FrameError::BadCommand {
-                id: 0,
-                reason: Reason::Malformed,
-            })?;
-            let command =
-                command(&mut f).map_err(|reason| FrameError::BadCommand { id, reason })?;
-            return Ok(Frame::Command { id, command });
-        }
+        b'C' => return command_frame(&mut f),
         b'A' => Frame::Ack {
             id: u16_field(&mut f)?,
         },
@@ -419,6 +447,21 @@ impl Decoder {
 
     /// Feeds one byte; returns a frame or an error when a line ends or is dropped.
     pub fn push(&mut self, byte: u8) -> Option<Result<Frame, FrameError>> {
+        self.push_with(byte, parse_line)
+    }
+
+    /// Feeds one byte on the rig's side: like [`Decoder::push`], but complete lines are parsed
+    /// with [`parse_command_line`] (frames other than commands are counted as malformed).
+    pub fn push_command(&mut self, byte: u8) -> Option<Result<Frame, FrameError>> {
+        self.push_with(byte, parse_command_line)
+    }
+
+    #[inline(always)]
+    fn push_with(
+        &mut self,
+        byte: u8,
+        parse: impl FnOnce(&[u8]) -> Result<Frame, FrameError>,
+    ) -> Option<Result<Frame, FrameError>> {
         self.stats.bytes += 1;
         if !self.in_frame {
             if byte == FRAME_START {
@@ -432,7 +475,7 @@ impl Decoder {
         match byte {
             FRAME_END => {
                 self.in_frame = false;
-                let result = parse_line(self.buf.get(..self.len).unwrap_or(&[]));
+                let result = parse(self.buf.get(..self.len).unwrap_or(&[]));
                 Some(self.account(result))
             }
             FRAME_START => {

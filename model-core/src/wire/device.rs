@@ -103,7 +103,7 @@ impl Device {
     pub fn receive<R: Rig>(&mut self, rig: &mut R, bytes: &[u8], mut send: impl FnMut(&[u8])) {
         let mut out = [0u8; MAX_FRAME_LEN];
         for &b in bytes {
-            let answer = match self.decoder.push(b) {
+            let answer = match self.decoder.push_command(b) {
                 Some(Ok(Frame::Command { id, command })) => self.execute(rig, id, command),
                 Some(Err(FrameError::BadCommand { id, reason })) => Frame::Reject { id, reason },
                 // Not a command, or damaged beyond reading an id: the PC times out and retries.

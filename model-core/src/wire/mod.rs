@@ -21,7 +21,7 @@ pub mod device;
 pub mod encode;
 pub mod types;
 
-pub use decode::{DecodeStats, Decoder, FrameError, decode_frame, parse_line};
+pub use decode::{DecodeStats, Decoder, FrameError, decode_frame, parse_command_line, parse_line};
 pub use encode::{EncodeError, encode};
 pub use types::*;
 

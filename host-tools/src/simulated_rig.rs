@@ -1,0 +1,263 @@
+//! The virtual rig behind `bowl sim --pty` / `--capture`: the simulated plant
+//! (`model_core::sim::Rig`) in place of the motors and sensors, and in front of it the same
+//! binding of the controller and the particle model to the protocol that the firmware runs
+//! (`model_core::binding::ControlledRig`).
+//!
+//! Only the fault injection (INJECT) is particular to the simulation. It sits between the
+//! plant and the controller: a lost sensor withholds the plant's edges from the controller, a
+//! stalled motor gets no drive (its duty never reaches the plant).
+
+use anyhow::{Result, anyhow};
+use model_core::binding::{ControlledRig, Injector, default_params, persisted};
+use model_core::control::{ControllerConfig, State};
+use model_core::sim::RigParams;
+use model_core::wire::{Hello, Injection, ParamId, Reason, ResetCause};
+
+/// Simulated seconds of the identification run at boot (it ends much sooner).
+const COMMISSION_MAX_S: f32 = 300.0;
+
+/// The fault injected into the simulation, if any (INJECT replaces it; `NONE` clears it).
+#[derive(Debug, Clone, Copy)]
+pub struct SimFaults(Injection);
+
+impl Injector for SimFaults {
+    fn inject(&mut self, what: Injection) -> Result<(), Reason> {
+        self.0 = what;
+        Ok(())
+    }
+}
+
+impl SimFaults {
+    fn sensor_lost(&self, axis: usize) -> bool {
+        matches!(
+            (self.0, axis),
+            (Injection::SensorLostPrecession, 0) | (Injection::SensorLostSpin, 1)
+        )
+    }
+
+    fn stalled(&self, axis: usize) -> bool {
+        matches!(
+            (self.0, axis),
+            (Injection::StallPrecession, 0) | (Injection::StallSpin, 1)
+        )
+    }
+}
+
+/// The plant, and the controller bound to the protocol.
+#[derive(Clone)]
+pub struct SimulatedRig {
+    plant: model_core::sim::Rig,
+    rig: ControlledRig<SimFaults>,
+    ticks: u64,
+    total_ms: u64,
+    now_ms: u32,
+}
+
+impl SimulatedRig {
+    /// The nominal plant (seeded noise) and the nominal controller (told the plant's teeth),
+    /// commissioned on the plant as the real rig is once after assembly (through the same
+    /// COMMISSION path the wire uses), then at rest at device time 0.
+    pub fn new(seed: u32) -> Result<Self> {
+        let plant_params = RigParams::nominal();
+        let base = ControllerConfig::nominal();
+        let mut params = default_params();
+        for (id, axis) in [(ParamId::Teeth1, 0), (ParamId::Teeth2, 1)] {
+            params[id.index()] = i32::from(plant_params.axes[axis].sensor.pulses_per_rev);
+        }
+        let hello = Hello {
+            reset_cause: ResetCause::Unknown,
+            reset_count: 0,
+        };
+        let models = [base.axes[0].model, base.axes[1].model];
+        let (rig, checked) = ControlledRig::new(
+            base,
+            persisted(&params, &models),
+            hello,
+            SimFaults(Injection::None),
+        );
+        checked.map_err(|r| anyhow!("rig parameters refused: {}", r.token()))?;
+        let mut sim = Self {
+            plant: model_core::sim::Rig::new(plant_params, seed),
+            rig,
+            ticks: 0,
+            total_ms: 0,
+            now_ms: 0,
+        };
+        use model_core::wire::device::Rig as _;
+        sim.rig
+            .commission()
+            .map_err(|r| anyhow!("commissioning refused: {}", r.token()))?;
+        let dt_s = sim.dt_s();
+        for _ in 0..(COMMISSION_MAX_S / dt_s) as u32 {
+            if sim.rig.controller().state() != State::Commissioning {
+                break;
+            }
+            sim.tick(dt_s);
+        }
+        let ctrl = sim.rig.controller();
+        if ctrl.state() != State::Idle {
+            return Err(anyhow!(
+                "commissioning on the simulated plant ended in {:?} ({:?})",
+                ctrl.state(),
+                ctrl.identify_error()
+            ));
+        }
+        sim.ticks = 0;
+        sim.rig.set_now_ms(0);
+        Ok(sim)
+    }
+
+    /// The controller and particle model behind the protocol.
+    pub fn bound(&self) -> &ControlledRig<SimFaults> {
+        &self.rig
+    }
+
+    /// The same, to hand to the protocol device.
+    pub fn bound_mut(&mut self) -> &mut ControlledRig<SimFaults> {
+        &mut self.rig
+    }
+
+    fn dt_s(&self) -> f32 {
+        1.0 / self.rig.controller().config().tick_hz as f32
+    }
+
+    /// Runs the control ticks up to device time `now_ms`.
+    pub fn advance_to_ms(&mut self, now_ms: u32) {
+        let tick_hz = u64::from(self.rig.controller().config().tick_hz);
+        let dt_s = self.dt_s();
+        // Device time counts up from 0 and wraps after 49 days; the tick count does not.
+        self.total_ms += u64::from(now_ms.wrapping_sub(self.now_ms));
+        self.now_ms = now_ms;
+        self.rig.set_now_ms(now_ms);
+        let target = self.total_ms * tick_hz / 1000;
+        while self.ticks < target {
+            self.tick(dt_s);
+        }
+    }
+
+    fn tick(&mut self, dt_s: f32) {
+        let now = self.plant.now_ticks();
+        let faults = *self.rig.injector();
+        let plant = &self.plant;
+        let edges = |axis: usize| -> &[u32] {
+            if faults.sensor_lost(axis) {
+                &[]
+            } else {
+                plant.edges(axis)
+            }
+        };
+        let duties = self.rig.controller_mut().tick(now, [edges(0), edges(1)]);
+        let driven = [0, 1].map(|axis| {
+            if faults.stalled(axis) {
+                0.0
+            } else {
+                duties[axis]
+            }
+        });
+        self.plant.advance(driven, dt_s);
+        self.ticks += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use model_core::wire::device::Rig as _;
+
+    /// The nominal parameters are all inside their wire ranges (else PARAMS would fail).
+    #[test]
+    fn nominal_parameters_fit_the_wire() {
+        let rig = SimulatedRig::new(1).unwrap();
+        for id in ParamId::ALL {
+            if id == ParamId::TelemetryHz {
+                continue;
+            }
+            let (lo, hi) = id.range();
+            let v = rig.bound().param(id);
+            assert!((lo..=hi).contains(&v), "{} = {v}", id.token());
+        }
+    }
+
+    /// Setting a parameter and reading it back gives the value (a round trip through the
+    /// controller's float configuration).
+    #[test]
+    fn parameters_round_trip() {
+        let mut rig = SimulatedRig::new(1).unwrap();
+        for (id, v) in [
+            (ParamId::RimUm, 150_000),
+            (ParamId::StartUm, 40_000),
+            (ParamId::MuPpm, 20_000),
+            (ParamId::AxesMdeg, 30_000),
+            (ParamId::Bandwidth2MradS, 6_000),
+            (ParamId::SpeedMax1MradS, 3_500),
+            (ParamId::Teeth2, 24),
+            (ParamId::RatioPpm, 1_500_000),
+        ] {
+            rig.bound_mut().set_param(id, v).unwrap();
+            assert_eq!(rig.bound().param(id), v, "{}", id.token());
+        }
+        // A start radius beyond the rim is refused and changes nothing.
+        assert_eq!(
+            rig.bound_mut().set_param(ParamId::StartUm, 200_000),
+            Err(Reason::Range)
+        );
+        assert_eq!(rig.bound().param(ParamId::StartUm), 40_000);
+    }
+
+    use model_core::wire::device::Device;
+    use model_core::wire::{Command, Frame};
+    use proptest::prelude::*;
+
+    /// Commissioning at boot dominates a debug-build test: do it once.
+    fn commissioned() -> &'static SimulatedRig {
+        static RIG: std::sync::OnceLock<SimulatedRig> = std::sync::OnceLock::new();
+        RIG.get_or_init(|| SimulatedRig::new(3).unwrap())
+    }
+
+    fn all_params(rig: &SimulatedRig) -> Vec<i32> {
+        ParamId::ALL
+            .iter()
+            .map(|&id| rig.bound().param(id))
+            .collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// Through the real controller: a SET that is rejected changes no parameter, and one that
+        /// is accepted changes exactly that parameter (to the value sent).
+        #[test]
+        fn a_rejected_set_changes_nothing(
+            i in 0..ParamId::ALL.len() - 1,
+            frac in 0.0f64..=1.0,
+            running in any::<bool>(),
+        ) {
+            let id = ParamId::ALL[i];
+            let (lo, hi) = id.range();
+            let value = lo + ((f64::from(hi) - f64::from(lo)) * frac) as i32;
+            let mut rig = commissioned().clone();
+            let mut device = Device::new();
+            if running {
+                prop_assert_eq!(rig.bound_mut().set_speeds(1500, 1500), Ok(()));
+                prop_assert_eq!(rig.bound_mut().start(), Ok(()));
+                rig.advance_to_ms(200);
+            }
+            let before = all_params(&rig);
+            let answer = device.execute(rig.bound_mut(), 9, Command::SetParam { id, value });
+            let after = all_params(&rig);
+            match answer {
+                Frame::Ack { id: 9 } => {
+                    for (k, (b, a)) in before.iter().zip(&after).enumerate() {
+                        if k == id.index() {
+                            prop_assert_eq!(*a, value, "{} set", id.token());
+                        } else {
+                            prop_assert_eq!(a, b, "{} changed {}", id.token(), ParamId::ALL[k].token());
+                        }
+                    }
+                }
+                Frame::Reject { id: 9, .. } => prop_assert_eq!(before, after),
+                other => prop_assert!(false, "unexpected answer {:?}", other),
+            }
+        }
+    }
+}
