@@ -236,6 +236,8 @@ impl Rig {
             let ap = self.p.axes[i];
             let f = ap.faults;
             let ax = &mut self.axes[i];
+            // max/min, not clamp: a NaN duty comes out finite (max(NaN, -1) = -1), never NaN.
+            #[allow(clippy::manual_clamp)]
             let d = duties[i].max(-1.0).min(1.0);
             let volts = if d == 0.0 {
                 None
@@ -296,6 +298,8 @@ impl Rig {
                 break;
             }
             let frac = if a1 != a0 { (at - a0) / (a1 - a0) } else { 0.0 };
+            // max/min, not clamp: a NaN fraction maps to 0, never into the timestamp.
+            #[allow(clippy::manual_clamp)]
             let t = t0 + frac.max(0.0).min(1.0) * (t1 - t0);
             self.axes[i].tooth = if forward { k } else { k - 1 };
             let jitter = sensor.jitter_s * self.rng.symmetric();
