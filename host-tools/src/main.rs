@@ -4,6 +4,7 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 mod chart;
+mod commission;
 mod demo;
 mod kinematics;
 mod monitor;
@@ -36,6 +37,8 @@ enum Command {
     Monitor(monitor::Args),
     /// Send one command to the rig and print its answer.
     Send(send::Args),
+    /// Run the motor identification on the rig; print the identified models and gains.
+    Commission(commission::Args),
     /// Decode a raw capture of the rig's output; print statistics as JSON.
     Replay(replay::Args),
     /// The simulated rig: serve it on a pseudo-terminal (--pty) or capture its bytes (--capture),
@@ -63,6 +66,7 @@ fn main() -> Result<()> {
         Command::Predict(args) => predict::run(&args),
         Command::Monitor(args) => monitor::run(&args),
         Command::Send(args) => send::run(&args).map(|code| std::process::exit(code)),
+        Command::Commission(args) => commission::run(&args).map(|code| std::process::exit(code)),
         Command::Replay(args) => replay::run(&args),
         Command::Demo(args) => demo::run(&args),
         Command::Sim(args) => match &args.report {

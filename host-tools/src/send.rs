@@ -22,7 +22,8 @@ pub struct Args {
     /// The serial port or pseudo-terminal of the rig.
     port: String,
     /// The command and its arguments, e.g. `speed 1800 2100`, `rtime cori 2500`, `start`, `stop`,
-    /// `clear`, `set MU_PPM 29000`, `status`, `params`, `inject sensor2` (see docs/protocol.md).
+    /// `clear`, `set MU_PPM 29000`, `status`, `params`, `models`, `commission`, `inject sensor2`
+    /// (see docs/protocol.md).
     #[arg(required = true, num_args = 1..)]
     command: Vec<String>,
     /// Baud rate.

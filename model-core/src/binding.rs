@@ -26,8 +26,8 @@ use crate::control::{
 use crate::particle::{self, InverseError, Model, Outcome, Scene};
 use crate::wire::device::{DEFAULT_TELEMETRY_HZ, Rig};
 use crate::wire::{
-    DeviceState, FaultCode, Hello, Injection, MotorTelemetry, PARAM_COUNT, ParamId, ParamValues,
-    Reason, Residence, ResidenceModel, Telemetry,
+    AxisModel, DeviceState, FaultCode, Hello, Injection, MODEL_FIELD_MAX, MotorTelemetry,
+    PARAM_COUNT, ParamId, ParamValues, Reason, Residence, ResidenceModel, Telemetry,
 };
 
 /// Motor axes: precession (0) and spin (1).
@@ -78,7 +78,7 @@ impl BowlSpeedForResidence for SceneModel {
 impl SceneModel {
     /// The predicted residence time at bowl speed `omega_rad_s`, as telemetry carries it.
     fn predicted(&self, omega_rad_s: f32) -> Residence {
-        if !(omega_rad_s > 0.0) {
+        if omega_rad_s.is_nan() || omega_rad_s <= 0.0 {
             return Residence::Unavailable;
         }
         let scene = Scene {
@@ -504,6 +504,40 @@ impl<I: Injector> Rig for ControlledRig<I> {
     fn inject(&mut self, what: Injection) -> Result<(), Reason> {
         self.injector.inject(what)
     }
+
+    fn models(&self) -> Result<[AxisModel; AXES], Reason> {
+        let identified = self.ctrl.identified();
+        let mut out = [AxisModel::default(); AXES];
+        for (axis, slot) in out.iter_mut().enumerate() {
+            let m = self.ctrl.config().axes[axis].model;
+            let (kp, ki) = self.ctrl.loop_gains(axis).ok_or(Reason::Internal)?;
+            let mut v = [0u32; 5];
+            for (out, x) in v.iter_mut().zip([
+                m.volts_per_rad_s,
+                m.friction_duty,
+                m.time_constant_s,
+                kp,
+                ki,
+            ]) {
+                // Every field is in millionths. A value the wire cannot carry (negative, not
+                // finite, too large) would be a bug here: INTERNAL, never a wrong number.
+                let scaled = round(x * 1e6);
+                if !(scaled >= 0.0 && scaled <= MODEL_FIELD_MAX as f32) {
+                    return Err(Reason::Internal);
+                }
+                *out = scaled as u32;
+            }
+            *slot = AxisModel {
+                identified: identified[axis].is_some(),
+                back_emf_uv_per_rad_s: v[0],
+                friction_ppm: v[1],
+                time_constant_us: v[2],
+                kp_ppm_per_rad_s: v[3],
+                ki_ppm_per_rad: v[4],
+            };
+        }
+        Ok(out)
+    }
 }
 
 #[cfg(test)]
@@ -714,5 +748,30 @@ mod tests {
             assert_eq!(fault_code(Some(fault)).code(), fault.code(), "{fault:?}");
         }
         assert_eq!(fault_code(None), FaultCode::None);
+    }
+
+    /// MODELS reports the models in force and the PI gains that follow from them (the loop's
+    /// design rule: kp = tau Ke / V wc, ki = Ke / V wc, computed here from the configuration).
+    #[test]
+    fn models_report_the_models_and_gains_in_force() {
+        let mut s = station();
+        let Frame::Models { id: 20, axes } = command(&mut s, "C1,20,MODELS") else {
+            panic!("MODELS answers with a models frame");
+        };
+        let cfg = ControllerConfig::nominal();
+        for (a, c) in axes.iter().zip(cfg.axes.iter()) {
+            assert!(!a.identified, "nothing commissioned yet");
+            let m = c.model;
+            let ppm = |x: f32| libm::round(f64::from(x) * 1e6);
+            assert_eq!(f64::from(a.back_emf_uv_per_rad_s), ppm(m.volts_per_rad_s));
+            assert_eq!(f64::from(a.friction_ppm), ppm(m.friction_duty));
+            assert_eq!(f64::from(a.time_constant_us), ppm(m.time_constant_s));
+            let ke_v = f64::from(m.volts_per_rad_s) / f64::from(cfg.supply_v);
+            let wc = f64::from(c.bandwidth_rad_s);
+            let kp = f64::from(m.time_constant_s) * ke_v * wc * 1e6;
+            let ki = ke_v * wc * 1e6;
+            assert!((f64::from(a.kp_ppm_per_rad_s) - kp).abs() <= 1e-5 * kp + 1.0);
+            assert!((f64::from(a.ki_ppm_per_rad) - ki).abs() <= 1e-5 * ki + 1.0);
+        }
     }
 }

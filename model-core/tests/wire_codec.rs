@@ -91,6 +91,7 @@ proptest! {
     fn crc_table_matches_bitwise_definition(bytes in proptest::collection::vec(any::<u8>(), 0..300)) {
         prop_assert_eq!(crc32(&bytes), crc32_bitwise(&bytes));
         prop_assert_eq!(model_core::wire::crc::crc32_bytewise(&bytes), crc32_bitwise(&bytes));
+        prop_assert_eq!(model_core::wire::crc::crc32_nibblewise(&bytes), crc32_bitwise(&bytes));
     }
 
     #[test]

@@ -634,6 +634,14 @@ impl Controller {
         &self.cfg
     }
 
+    /// The speed loop's gains on `axis` at its full bandwidth (the schedule lowers both in
+    /// proportion at sparse pulses): `(kp, ki)` in duty per rad/s and duty per rad.
+    pub fn loop_gains(&self, axis: usize) -> Option<(f32, f32)> {
+        let k = self.k.get(axis)?;
+        let wc = self.cfg.axes.get(axis)?.bandwidth_rad_s;
+        Some((k.kp(wc), k.ki_per_s(wc)))
+    }
+
     /// Results of the last commissioning run, per axis.
     pub fn identified(&self) -> [Option<Identified>; 2] {
         self.identified

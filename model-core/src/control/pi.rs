@@ -116,6 +116,18 @@ impl LoopConstants {
         }
     }
 
+    /// Proportional gain at loop bandwidth `wc_rad_s`, duty per rad/s of speed error
+    /// (`tau * Ke / V * wc`: the PI zero cancels the model's pole).
+    pub fn kp(&self, wc_rad_s: f32) -> f32 {
+        self.kp_per_wc * wc_rad_s
+    }
+
+    /// Integral gain at loop bandwidth `wc_rad_s`, duty per rad of accumulated speed error
+    /// (`Ke / V * wc`).
+    pub fn ki_per_s(&self, wc_rad_s: f32) -> f32 {
+        self.ki_dt_per_wc / self.dt_s * wc_rad_s
+    }
+
     /// Duty per rad/s of the identified model (`volts_per_rad_s / V`).
     pub fn duty_per_rad_s(&self) -> f32 {
         self.duty_per_rad_s

@@ -236,7 +236,12 @@ impl Rig {
             let ap = self.p.axes[i];
             let f = ap.faults;
             let ax = &mut self.axes[i];
-            let d = duties[i].clamp(-1.0, 1.0);
+            // A NaN duty drives nothing (coast), never full reverse.
+            let d = if duties[i].is_nan() {
+                0.0
+            } else {
+                duties[i].clamp(-1.0, 1.0)
+            };
             let volts = if d == 0.0 {
                 None
             } else {
@@ -296,7 +301,13 @@ impl Rig {
                 break;
             }
             let frac = if a1 != a0 { (at - a0) / (a1 - a0) } else { 0.0 };
-            let t = t0 + frac.clamp(0.0, 1.0) * (t1 - t0);
+            // A NaN fraction maps to 0, never into the timestamp.
+            let frac = if frac.is_nan() {
+                0.0
+            } else {
+                frac.clamp(0.0, 1.0)
+            };
+            let t = t0 + frac * (t1 - t0);
             self.axes[i].tooth = if forward { k } else { k - 1 };
             let jitter = sensor.jitter_s * self.rng.symmetric();
             let te = t + jitter as f64;

@@ -3,8 +3,9 @@
 
 use super::crc::crc32;
 use super::types::{
-    Command, DeviceState, FaultCode, Frame, Hello, Injection, MotorTelemetry, PARAM_COUNT, ParamId,
-    ParamValues, Reason, ResetCause, Residence, ResidenceModel, Status, Telemetry,
+    AxisModel, Command, DeviceState, FaultCode, Frame, Hello, Injection, MODEL_FIELD_MAX,
+    MotorTelemetry, PARAM_COUNT, ParamId, ParamValues, Reason, ResetCause, Residence,
+    ResidenceModel, Status, Telemetry,
 };
 use super::{FRAME_END, FRAME_START, MAX_FRAME_LEN, PROTOCOL_VERSION};
 
@@ -16,7 +17,7 @@ pub enum FrameError {
     BadTrailer,
     /// The CRC did not match: the line was damaged on the way.
     BadCrc,
-    /// The CRC matched but the kind letter is not one of `T H C A R S P`.
+    /// The CRC matched but the kind letter is not one of `T H C A R S P M`.
     UnknownKind,
     /// The CRC matched but the protocol version is not the one spoken here.
     UnsupportedVersion,
@@ -196,6 +197,19 @@ fn params(f: &mut Fields<'_>) -> Result<ParamValues, FieldError> {
     Ok(values)
 }
 
+fn axis_model(f: &mut Fields<'_>) -> Result<AxisModel, FieldError> {
+    let identified = f.int(0, 1)? == 1;
+    let mut field = || f.int(0, i64::from(MODEL_FIELD_MAX)).map(|v| v as u32);
+    Ok(AxisModel {
+        identified,
+        back_emf_uv_per_rad_s: field()?,
+        friction_ppm: field()?,
+        time_constant_us: field()?,
+        kp_ppm_per_rad_s: field()?,
+        ki_ppm_per_rad: field()?,
+    })
+}
+
 fn token_of<T: Copy>(tok: &[u8], all: &[T], token: fn(T) -> &'static str) -> Option<T> {
     all.iter().copied().find(|&t| token(t).as_bytes() == tok)
 }
@@ -238,6 +252,7 @@ fn command(f: &mut Fields<'_>) -> Result<Command, Reason> {
         ),
         b"PING" => Command::Ping,
         b"COMMISSION" => Command::Commission,
+        b"MODELS" => Command::GetModels,
         _ => return Err(Reason::UnknownCommand),
     };
     f.end()?;
@@ -350,6 +365,10 @@ fn parse_payload(payload: &[u8]) -> Result<Frame, FrameError> {
         b'P' => Frame::Params {
             id: u16_field(&mut f)?,
             values: params(&mut f)?,
+        },
+        b'M' => Frame::Models {
+            id: u16_field(&mut f)?,
+            axes: [axis_model(&mut f)?, axis_model(&mut f)?],
         },
         _ => return Err(FrameError::UnknownKind),
     };

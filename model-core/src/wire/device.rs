@@ -4,8 +4,8 @@
 use super::decode::{Decoder, FrameError};
 use super::encode::{EncodeError, encode};
 use super::types::{
-    Command, Frame, Hello, Injection, PARAM_COUNT, ParamId, ParamValues, Reason, ResidenceModel,
-    Status, Telemetry,
+    AxisModel, Command, Frame, Hello, Injection, PARAM_COUNT, ParamId, ParamValues, Reason,
+    ResidenceModel, Status, Telemetry,
 };
 use super::{MAX_FRAME_LEN, max_telemetry_hz};
 
@@ -35,6 +35,10 @@ pub trait Rig {
     fn heartbeat(&mut self) {}
     /// Start the motor identification routine.
     fn commission(&mut self) -> Result<(), Reason> {
+        Err(Reason::Unsupported)
+    }
+    /// The motor models and loop gains in force, precession then spin (for MODELS).
+    fn models(&self) -> Result<[AxisModel; 2], Reason> {
         Err(Reason::Unsupported)
     }
     /// Make a simulated rig misbehave. Real hardware keeps the default: `Unsupported`.
@@ -182,6 +186,10 @@ impl Device {
                 Ok(())
             }
             Command::Commission => rig.commission(),
+            Command::GetModels => match rig.models() {
+                Ok(axes) => return Frame::Models { id, axes },
+                Err(reason) => Err(reason),
+            },
         };
         match done {
             Ok(()) => Frame::Ack { id },

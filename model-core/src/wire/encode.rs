@@ -2,8 +2,8 @@
 
 use super::crc::crc32;
 use super::types::{
-    Command, DUTY_MAX_BP, Frame, MotorTelemetry, PARAM_COUNT, ParamId, RESIDENCE_MAX_MS, Residence,
-    Telemetry,
+    AxisModel, Command, DUTY_MAX_BP, Frame, MODEL_FIELD_MAX, MotorTelemetry, PARAM_COUNT, ParamId,
+    RESIDENCE_MAX_MS, Residence, Telemetry,
 };
 use super::{FRAME_END, FRAME_START, MAX_FRAME_LEN, PROTOCOL_VERSION};
 
@@ -71,6 +71,23 @@ impl Out<'_> {
     }
 }
 
+/// The fields of a MODELS answer after its id, in wire order.
+#[inline(never)]
+fn model_fields(axes: &[AxisModel; 2]) -> [u32; 12] {
+    let mut v = [0u32; 12];
+    for (chunk, a) in v.chunks_exact_mut(6).zip(axes) {
+        chunk.copy_from_slice(&[
+            u32::from(a.identified),
+            a.back_emf_uv_per_rad_s,
+            a.friction_ppm,
+            a.time_constant_us,
+            a.kp_ppm_per_rad_s,
+            a.ki_ppm_per_rad,
+        ]);
+    }
+    v
+}
+
 fn hex_upper(nibble: u32) -> u8 {
     b"0123456789ABCDEF"[(nibble & 0xF) as usize]
 }
@@ -103,6 +120,7 @@ fn fields_in_range(frame: &Frame) -> bool {
         Frame::Status { status, .. } => {
             check_param(ParamId::TelemetryHz, i32::from(status.telemetry_hz))
         }
+        Frame::Models { axes, .. } => model_fields(axes).iter().all(|&v| v <= MODEL_FIELD_MAX),
         _ => true,
     }
 }
@@ -162,6 +180,12 @@ fn body(out: &mut Out<'_>, frame: &Frame) {
                 out.int((*v).into());
             }
         }
+        Frame::Models { id, axes } => {
+            out.int((*id).into());
+            for v in model_fields(axes) {
+                out.int(v.into());
+            }
+        }
     }
 }
 
@@ -196,6 +220,7 @@ fn command_body(out: &mut Out<'_>, command: &Command) {
         }
         Command::Ping => out.token("PING"),
         Command::Commission => out.token("COMMISSION"),
+        Command::GetModels => out.token("MODELS"),
     }
 }
 
@@ -209,6 +234,7 @@ pub fn kind_letter(frame: &Frame) -> u8 {
         Frame::Reject { .. } => b'R',
         Frame::Status { .. } => b'S',
         Frame::Params { .. } => b'P',
+        Frame::Models { .. } => b'M',
     }
 }
 

@@ -356,7 +356,32 @@ pub enum Command {
     Ping,
     /// `COMMISSION`: run the motor identification routine (from Idle).
     Commission,
+    /// `MODELS`: answered by a [`Frame::Models`] frame: the motor models and loop gains in force.
+    GetModels,
 }
+
+/// One axis's motor model and speed-loop gains as the rig uses them (a `M` answer), scaled
+/// integers like every wire field.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AxisModel {
+    /// Whether the model was identified by COMMISSION since the rig's last reset (otherwise it
+    /// is the stored or the nominal one).
+    pub identified: bool,
+    /// Effective back-EMF constant, microvolts per rad/s (0..=[`MODEL_FIELD_MAX`]).
+    pub back_emf_uv_per_rad_s: u32,
+    /// Duty that balances Coulomb friction, parts per million of full duty.
+    pub friction_ppm: u32,
+    /// Mechanical time constant, microseconds.
+    pub time_constant_us: u32,
+    /// Proportional gain at the full loop bandwidth, duty ppm per rad/s of speed error.
+    pub kp_ppm_per_rad_s: u32,
+    /// Integral gain at the full loop bandwidth, duty ppm per rad of accumulated speed error.
+    pub ki_ppm_per_rad: u32,
+}
+
+/// The largest value of an [`AxisModel`] field (the encoder refuses larger ones).
+pub const MODEL_FIELD_MAX: u32 = 2_000_000_000;
 
 /// Why a command was rejected. A rejected command changed nothing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -455,6 +480,13 @@ pub enum Frame {
         /// The values.
         values: ParamValues,
     },
+    /// `$M1`: the answer to MODELS, precession then spin.
+    Models {
+        /// Request id.
+        id: Wrapping16,
+        /// Per axis, precession then spin.
+        axes: [AxisModel; 2],
+    },
 }
 
 impl Frame {
@@ -464,7 +496,8 @@ impl Frame {
             Frame::Ack { id }
             | Frame::Reject { id, .. }
             | Frame::Status { id, .. }
-            | Frame::Params { id, .. } => Some(id),
+            | Frame::Params { id, .. }
+            | Frame::Models { id, .. } => Some(id),
             _ => None,
         }
     }

@@ -103,6 +103,7 @@ pub fn command() -> impl Strategy<Value = Command> {
         Just(Command::GetParams),
         Just(Command::Ping),
         Just(Command::Commission),
+        Just(Command::GetModels),
         (0..Injection::ALL.len()).prop_map(|i| Command::Inject(Injection::ALL[i])),
     ]
 }
@@ -143,7 +144,23 @@ pub fn frame() -> impl Strategy<Value = Frame> {
                 }
             }),
         1 => (any::<u16>(), param_values()).prop_map(|(id, values)| Frame::Params { id, values }),
+        1 => (any::<u16>(), axis_model(), axis_model())
+            .prop_map(|(id, a, b)| Frame::Models { id, axes: [a, b] }),
     ]
+}
+
+pub fn axis_model() -> impl Strategy<Value = AxisModel> {
+    let v = || 0..=MODEL_FIELD_MAX;
+    (any::<bool>(), v(), v(), v(), v(), v()).prop_map(|(identified, ke, fr, tau, kp, ki)| {
+        AxisModel {
+            identified,
+            back_emf_uv_per_rad_s: ke,
+            friction_ppm: fr,
+            time_constant_us: tau,
+            kp_ppm_per_rad_s: kp,
+            ki_ppm_per_rad: ki,
+        }
+    })
 }
 
 pub fn encode_vec(frame: &Frame) -> Vec<u8> {
