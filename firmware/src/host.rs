@@ -1,7 +1,7 @@
 //! Host side of the emulated board (Unix hosts only, never on the MCU): build a `qemu-*` image,
 //! boot it under QEMU netduinoplus2 with USART1 on a Unix socket, and share that link between
-//! the telemetry decoder and `bowl` commands. Used by the QEMU tests and by the demo
-//! (`rig-demo`).
+//! the telemetry decoder and `bowl` commands. Used by the QEMU tests. (The demo,
+//! `bowl demo`, starts the same image with USART1 on a pseudo-terminal instead.)
 //!
 //! Why a splitter: a serial port (or pseudo-terminal) has one input queue, so two readers
 //! (`bowl monitor` and `bowl send`) would steal each other's bytes. The splitter reads the board

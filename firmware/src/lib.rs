@@ -5,7 +5,7 @@
 //!   parameter store), so the same code runs on the STM32F411 and on the emulated board.
 //! - `blackpill` (feature `blackpill`): the STM32F411CE Black Pill's peripherals via embassy-stm32.
 //! - `qemu` (feature `qemu`): QEMU netduinoplus2: SysTick time driver, WFI executor, raw USART.
-//! - `host` (Unix hosts): boots the emulated board under QEMU and shares its link (tests, demo).
+//! - `host` (Unix hosts): boots the emulated board under QEMU and shares its link (the QEMU tests).
 #![cfg_attr(not(test), no_std)]
 #![warn(missing_docs)]
 
