@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Subcommand;
 
+pub mod control;
 pub mod figures;
 pub mod plot;
 pub mod qemu_log;
@@ -41,6 +42,23 @@ enum Which {
     /// Draws the scipy side-by-side from tests/scipy/compare.py's CSV (error against RHS
     /// evaluations in FILE.svg, against time in FILE-time.svg; paper scene, Coriolis model).
     Scipy(ScipyArgs),
+    /// Settling time of the simulated rig's 0 -> 3 rad/s step against pulses per revolution.
+    Settling(ControlArgs),
+    /// Limit cycle of the 0.5 rad/s hold against the per-pulse gain, with and without the schedule.
+    ControlStability(ControlArgs),
+}
+
+/// Options of the control charts (`settling`, `control-stability`).
+#[derive(clap::Args)]
+struct ControlArgs {
+    #[command(flatten)]
+    out: Out,
+    /// Only the points the tests assert on (see `control::Extent::Quick`).
+    #[arg(long)]
+    quick: bool,
+    /// Seed of the simulated rig.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
 }
 
 /// Options of `bowl chart scipy`.
@@ -72,6 +90,16 @@ fn scipy_charts(a: &ScipyArgs) -> Result<()> {
         report(&[&svg, &png]);
     }
     Ok(())
+}
+
+impl ControlArgs {
+    fn extent(&self) -> control::Extent {
+        if self.quick {
+            control::Extent::Quick
+        } else {
+            control::Extent::Full
+        }
+    }
 }
 
 /// Where to write.
@@ -243,6 +271,14 @@ pub fn run(args: &Args) -> Result<()> {
             write_all(out, &f, &t)
         }
         Which::Scipy(a) => scipy_charts(a),
+        Which::Settling(a) => {
+            let (f, t) = control::settling_chart(&control::settling_points(a.extent(), a.seed));
+            write_all(&a.out, &f, &t)
+        }
+        Which::ControlStability(a) => {
+            let (f, t) = control::stability_chart(&control::hold_points(a.extent(), a.seed));
+            write_all(&a.out, &f, &t)
+        }
         Which::Stability(out) => {
             let (f, t) = stability::chart()?;
             write_all(out, &f, &t)
