@@ -1,65 +1,14 @@
 //! End to end: `bowl monitor` and `bowl send` against `bowl sim --pty`, and `bowl replay` on
 //! `bowl sim --capture`.
 
-use std::io::{BufRead, BufReader, Read};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+mod common;
+
+use std::io::Read;
+use std::path::Path;
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-const BOWL: &str = env!("CARGO_BIN_EXE_bowl");
-
-/// A `bowl sim --pty` process, killed when dropped.
-struct Sim {
-    child: Child,
-    path: String,
-}
-
-impl Sim {
-    fn start(extra: &[&str]) -> Sim {
-        let mut child = Command::new(BOWL)
-            .args(["sim", "--pty"])
-            .args(extra)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .expect("bowl sim starts");
-        let mut line = String::new();
-        BufReader::new(child.stdout.take().unwrap())
-            .read_line(&mut line)
-            .expect("bowl sim prints its pty");
-        let path = line.trim().to_string();
-        assert!(path.starts_with("/dev/"), "pty path, got {path:?}");
-        Sim { child, path }
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-fn bowl(args: &[&str]) -> Output {
-    Command::new(BOWL).args(args).output().expect("bowl runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn last_json(o: &Output) -> serde_json::Value {
-    let text = stdout(o);
-    let line = text.lines().last().expect("a summary line");
-    serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"))
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bowl-e2e-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::{BOWL, Sim, bowl, last_json, open_pty, spawn_on_terminal, stdout, temp_dir};
 
 /// CSV rows as (boot, device_time_ms).
 fn csv_keys(path: &Path) -> Vec<(u64, u64)> {
@@ -196,12 +145,8 @@ fn monitor_reopens_the_port_and_keeps_the_log() {
 
 #[test]
 fn send_times_out_when_nobody_answers() {
-    use nix::fcntl::OFlag;
-    use nix::pty::{grantpt, posix_openpt, ptsname_r, unlockpt};
-    let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY).unwrap();
-    grantpt(&master).unwrap();
-    unlockpt(&master).unwrap();
-    let path = ptsname_r(&master).unwrap();
+    // A terminal nobody answers on (the master is held open, never read).
+    let (_master, path) = open_pty();
     let started = Instant::now();
     let out = bowl(&["send", &path, "status", "--timeout-ms", "300"]);
     assert_eq!(out.status.code(), Some(3), "{}", stdout(&out));
@@ -358,36 +303,10 @@ fn an_injected_sensor_fault_stops_both_motors_and_is_reported() {
 
 #[test]
 fn monitor_draws_the_dashboard_on_a_terminal() {
-    use nix::fcntl::OFlag;
-    use nix::pty::{grantpt, posix_openpt, ptsname_r, unlockpt};
     let sim = Sim::start(&["--seconds", "10"]);
     // The monitor's stdout is a pseudo-terminal, so it draws the dashboard.
-    let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY).unwrap();
-    grantpt(&master).unwrap();
-    unlockpt(&master).unwrap();
-    let screen = std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .open(ptsname_r(&master).unwrap())
-        .unwrap();
-    let mut child = Command::new(BOWL)
-        .args(["monitor", &sim.path, "--seconds", "1.5"])
-        .stdout(Stdio::from(screen))
-        .spawn()
-        .unwrap();
-    let reader = std::thread::spawn(move || {
-        let mut master = master;
-        let mut all = Vec::new();
-        let mut buf = [0u8; 8192];
-        // Reading ends with EIO once the monitor exits and its side closes.
-        while let Ok(n) = master.read(&mut buf) {
-            if n == 0 {
-                break;
-            }
-            all.extend_from_slice(&buf[..n]);
-        }
-        all
-    });
+    let (mut child, reader) =
+        spawn_on_terminal(Command::new(BOWL).args(["monitor", &sim.path, "--seconds", "1.5"]));
     assert!(child.wait().unwrap().success());
     let screen = String::from_utf8_lossy(&reader.join().unwrap()).into_owned();
     assert!(screen.contains("\x1b[H\x1b[2J"), "redraws in place");
