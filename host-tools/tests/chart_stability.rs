@@ -3,8 +3,12 @@
 //! the step; below it the method returns a T whose error shrinks with the step at the method's
 //! order.
 
+mod common;
+
 use std::collections::HashMap;
 use std::process::Command;
+
+use common::csv_rows;
 
 fn rows() -> Vec<HashMap<String, String>> {
     let dir = std::env::temp_dir().join(format!("bowl-chart-stab-{}", std::process::id()));
@@ -16,18 +20,7 @@ fn rows() -> Vec<HashMap<String, String>> {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let text = std::fs::read_to_string(out.with_extension("csv")).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    lines
-        .map(|l| {
-            header
-                .iter()
-                .zip(l.split(','))
-                .map(|(h, c)| (h.to_string(), c.to_string()))
-                .collect()
-        })
-        .collect()
+    csv_rows(&out.with_extension("csv"))
 }
 
 /// |l2| / omega for the two scenes of the chart (k2 = 5/7): mu 0.4 with Coriolis, mu 0 flat.

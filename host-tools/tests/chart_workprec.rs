@@ -1,9 +1,13 @@
 //! `bowl chart work-precision --csv-only --quick`: the measured errors meet the accuracy
 //! targets against the independent 256-bit reference, and the CSV joins QEMU counts by name.
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::process::Command;
+
+use common::csv_rows;
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("bowl-chart-wp-{}-{name}", std::process::id()));
@@ -22,18 +26,7 @@ fn work_precision(extra: &[&str], name: &str) -> Vec<HashMap<String, String>> {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let text = std::fs::read_to_string(out.with_extension("csv")).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    lines
-        .map(|l| {
-            header
-                .iter()
-                .zip(l.split(','))
-                .map(|(h, c)| (h.to_string(), c.to_string()))
-                .collect()
-        })
-        .collect()
+    csv_rows(&out.with_extension("csv"))
 }
 
 fn cond(row: &HashMap<String, String>) -> f64 {

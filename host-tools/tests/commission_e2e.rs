@@ -1,61 +1,19 @@
 //! End to end: `bowl commission` against `bowl sim --pty` (the virtual rig runs the same
 //! controller and protocol binding as the firmware, on the simulated plant, in real time).
 
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Output, Stdio};
+mod common;
 
-const BOWL: &str = env!("CARGO_BIN_EXE_bowl");
-
-/// A `bowl sim --pty` process, killed when dropped.
-struct Sim {
-    child: Child,
-    path: String,
-}
-
-impl Sim {
-    fn start() -> Sim {
-        let mut child = Command::new(BOWL)
-            .args(["sim", "--pty", "--seconds", "120"])
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .expect("bowl sim starts");
-        let mut line = String::new();
-        BufReader::new(child.stdout.take().unwrap())
-            .read_line(&mut line)
-            .expect("bowl sim prints its pty");
-        let path = line.trim().to_string();
-        assert!(path.starts_with("/dev/"), "pty path, got {path:?}");
-        Sim { child, path }
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-fn bowl(args: &[&str]) -> Output {
-    Command::new(BOWL).args(args).output().expect("bowl runs")
-}
-
-fn json(o: &Output) -> serde_json::Value {
-    let text = String::from_utf8_lossy(&o.stdout);
-    let line = text.lines().last().expect("a JSON line");
-    serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"))
-}
+use common::{Sim, bowl, last_json};
 
 /// Commissioning over the wire identifies the simulated motors (against the simulator's true
 /// models, which `bowl sim commission` reports, with that test's tolerances), and the gains it
 /// reports follow the loop's design rule (kp / ki = the identified time constant).
 #[test]
 fn commissioning_over_the_wire_identifies_the_simulated_motors() {
-    let sim = Sim::start();
+    let sim = Sim::start(&["--seconds", "120"]);
     let out = bowl(&["commission", &sim.path, "--json", "--timeout-s", "90"]);
     assert_eq!(out.status.code(), Some(0), "{out:?}");
-    let got = json(&out);
+    let got = last_json(&out);
     assert_eq!(got["result"], "ok");
     let truth: serde_json::Value =
         serde_json::from_slice(&bowl(&["sim", "commission"]).stdout).expect("JSON");
@@ -93,7 +51,7 @@ fn commissioning_over_the_wire_identifies_the_simulated_motors() {
 /// sensor is lost fails commissioning with a fault: exit 4, the fault named.
 #[test]
 fn refusal_and_fault_give_distinct_non_zero_exits() {
-    let sim = Sim::start();
+    let sim = Sim::start(&["--seconds", "120"]);
     let send = |words: &[&str]| {
         let mut args = vec!["send", sim.path.as_str()];
         args.extend_from_slice(words);
@@ -104,7 +62,7 @@ fn refusal_and_fault_give_distinct_non_zero_exits() {
     send(&["start"]);
     let out = bowl(&["commission", &sim.path, "--json"]);
     assert_eq!(out.status.code(), Some(2), "{out:?}");
-    let got = json(&out);
+    let got = last_json(&out);
     assert_eq!(got["result"], "rejected");
     assert_eq!(got["reason"], "STATE");
 
@@ -113,7 +71,7 @@ fn refusal_and_fault_give_distinct_non_zero_exits() {
     send(&["inject", "sensor1"]);
     let out = bowl(&["commission", &sim.path, "--json", "--timeout-s", "60"]);
     assert_eq!(out.status.code(), Some(4), "{out:?}");
-    let got = json(&out);
+    let got = last_json(&out);
     assert_eq!(got["result"], "fault");
     assert!(
         got["fault"]

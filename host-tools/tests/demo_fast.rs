@@ -2,25 +2,19 @@
 //! (checked here again from the telemetry CSV, independently of the demo's own analysis), and
 //! its summary, log and charts exist and parse.
 
+mod common;
+
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::sync::OnceLock;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
+use common::{BOWL, spawn_on_terminal, temp_dir, wait_within};
 use serde_json::Value;
-
-const BOWL: &str = env!("CARGO_BIN_EXE_bowl");
 
 /// The demo must end by itself well within this (it takes a few seconds in --fast mode).
 const LIMIT: Duration = Duration::from_secs(180);
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bowl-demo-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// Runs `bowl ARGS` with stdout piped (not a terminal); kills it and fails past `LIMIT`.
 fn run_with_limit(args: &[&str]) -> (ExitStatus, String, String) {
@@ -42,18 +36,7 @@ fn run_with_limit(args: &[&str]) -> (ExitStatus, String, String) {
         let _ = err.read_to_string(&mut s);
         s
     });
-    let started = Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if started.elapsed() > LIMIT {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("bowl {args:?} did not end by itself within {LIMIT:?}");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    };
+    let status = wait_within(&mut child, LIMIT, &format!("bowl {args:?}"));
     (status, out_t.join().unwrap(), err_t.join().unwrap())
 }
 
@@ -340,47 +323,13 @@ fn too_short_a_session_is_refused_with_a_clear_error() {
 
 #[test]
 fn on_a_terminal_the_demo_draws_the_monitor_dashboard() {
-    use nix::fcntl::OFlag;
-    use nix::pty::{grantpt, posix_openpt, ptsname_r, unlockpt};
     let dir = temp_dir("tty");
-    let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY).unwrap();
-    grantpt(&master).unwrap();
-    unlockpt(&master).unwrap();
-    let screen = std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .open(ptsname_r(&master).unwrap())
-        .unwrap();
-    let mut child = Command::new(BOWL)
-        .args(["demo", "--fast", "--rig", "host", "--out"])
-        .arg(&dir)
-        .stdout(Stdio::from(screen))
-        .spawn()
-        .unwrap();
-    let reader = std::thread::spawn(move || {
-        let mut master = master;
-        let mut all = Vec::new();
-        let mut buf = [0u8; 8192];
-        // Reading ends with EIO once the demo exits and its side closes.
-        while let Ok(n) = master.read(&mut buf) {
-            if n == 0 {
-                break;
-            }
-            all.extend_from_slice(&buf[..n]);
-        }
-        all
-    });
-    let started = Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if started.elapsed() > LIMIT {
-            let _ = child.kill();
-            panic!("the demo did not end by itself");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    };
+    let (mut child, reader) = spawn_on_terminal(
+        Command::new(BOWL)
+            .args(["demo", "--fast", "--rig", "host", "--out"])
+            .arg(&dir),
+    );
+    let status = wait_within(&mut child, LIMIT, "the demo");
     assert!(status.success());
     let screen = String::from_utf8_lossy(&reader.join().unwrap()).into_owned();
     // The monitor's dashboard, redrawn in place, with the demo's steps in its event list.

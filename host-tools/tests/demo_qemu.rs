@@ -3,19 +3,12 @@
 //! its emulated USART and shows the same behaviour as on the host rig; otherwise it says why it
 //! used the host rig, and asking for the board (`--rig qemu`) is a clear error.
 
-use std::path::PathBuf;
+mod common;
+
 use std::process::{Command, Output};
 
+use common::{BOWL, temp_dir};
 use serde_json::Value;
-
-const BOWL: &str = env!("CARGO_BIN_EXE_bowl");
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bowl-demo-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn qemu_installed() -> bool {
     std::env::var_os("PATH").is_some_and(|paths| {

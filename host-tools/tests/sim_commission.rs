@@ -1,13 +1,12 @@
 //! `bowl sim commission`: identified models against the simulator's true ones.
 
-use std::process::Command;
+mod common;
+
+use common::bowl;
 
 #[test]
 fn commissioning_identifies_both_axes() {
-    let out = Command::new(env!("CARGO_BIN_EXE_bowl"))
-        .args(["sim", "commission"])
-        .output()
-        .unwrap();
+    let out = bowl(&["sim", "commission"]);
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["state"], "Idle");

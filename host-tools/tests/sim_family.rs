@@ -1,12 +1,11 @@
 //! `bowl sim family`: the family targets, and the same family failing without feedback.
 
-use std::process::Command;
+mod common;
+
+use common::bowl;
 
 fn run(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_bowl"))
-        .args(args)
-        .output()
-        .expect("run bowl");
+    let out = bowl(args);
     (
         out.status.success(),
         String::from_utf8(out.stdout).unwrap(),

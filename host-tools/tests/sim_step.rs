@@ -1,12 +1,11 @@
 //! `bowl sim step`: the nominal figures, read from the command's JSON.
 
-use std::process::Command;
+mod common;
 
-fn bowl(args: &[&str]) -> (bool, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_bowl"))
-        .args(args)
-        .output()
-        .expect("run bowl");
+use common::bowl;
+
+fn run(args: &[&str]) -> (bool, String) {
+    let out = bowl(args);
     (
         out.status.success(),
         String::from_utf8(out.stdout).expect("utf-8"),
@@ -14,7 +13,7 @@ fn bowl(args: &[&str]) -> (bool, String) {
 }
 
 fn json(args: &[&str]) -> serde_json::Value {
-    let (ok, out) = bowl(args);
+    let (ok, out) = run(args);
     assert!(ok, "bowl {args:?} failed");
     serde_json::from_str(&out).expect("JSON")
 }

@@ -1,12 +1,11 @@
 //! `bowl sim sweep` and `bowl sim stability`: the CSV charts.
 
-use std::process::Command;
+mod common;
+
+use common::bowl;
 
 fn csv(args: &[&str]) -> Vec<Vec<String>> {
-    let out = Command::new(env!("CARGO_BIN_EXE_bowl"))
-        .args(args)
-        .output()
-        .unwrap();
+    let out = bowl(args);
     assert!(out.status.success());
     String::from_utf8(out.stdout)
         .unwrap()

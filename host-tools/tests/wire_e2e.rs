@@ -1,65 +1,14 @@
 //! End to end: `bowl monitor` and `bowl send` against `bowl sim --pty`, and `bowl replay` on
 //! `bowl sim --capture`.
 
-use std::io::{BufRead, BufReader, Read};
+mod common;
+
+use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-const BOWL: &str = env!("CARGO_BIN_EXE_bowl");
-
-/// A `bowl sim --pty` process, killed when dropped.
-struct Sim {
-    child: Child,
-    path: String,
-}
-
-impl Sim {
-    fn start(extra: &[&str]) -> Sim {
-        let mut child = Command::new(BOWL)
-            .args(["sim", "--pty"])
-            .args(extra)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .expect("bowl sim starts");
-        let mut line = String::new();
-        BufReader::new(child.stdout.take().unwrap())
-            .read_line(&mut line)
-            .expect("bowl sim prints its pty");
-        let path = line.trim().to_string();
-        assert!(path.starts_with("/dev/"), "pty path, got {path:?}");
-        Sim { child, path }
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-fn bowl(args: &[&str]) -> Output {
-    Command::new(BOWL).args(args).output().expect("bowl runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn last_json(o: &Output) -> serde_json::Value {
-    let text = stdout(o);
-    let line = text.lines().last().expect("a summary line");
-    serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"))
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bowl-e2e-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::{BOWL, Sim, bowl, last_json, open_pty, spawn_on_terminal, stdout, temp_dir};
 
 /// CSV rows as (boot, device_time_ms).
 fn csv_keys(path: &Path) -> Vec<(u64, u64)> {
@@ -74,6 +23,35 @@ fn csv_keys(path: &Path) -> Vec<(u64, u64)> {
                 f.next().unwrap().parse().unwrap(),
             )
         })
+        .collect()
+}
+
+/// Runs `bowl sim --capture DIR/cap.bin ARGS...` (the virtual rig writing its bytes to a file)
+/// and returns the capture's path.
+fn sim_capture(dir: &Path, args: &[&str]) -> PathBuf {
+    let capture = dir.join("cap.bin");
+    let mut all = vec!["sim", "--capture", capture.to_str().unwrap()];
+    all.extend_from_slice(args);
+    let made = bowl(&all);
+    assert!(made.status.success(), "{}", stdout(&made));
+    capture
+}
+
+/// `bowl replay CAPTURE --csv CSV`.
+fn replay_to_csv(capture: &Path, csv: &Path) -> Output {
+    bowl(&[
+        "replay",
+        capture.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ])
+}
+
+/// The cells of a telemetry CSV's data rows (header skipped).
+fn csv_cells(text: &str) -> Vec<Vec<&str>> {
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
         .collect()
 }
 
@@ -196,12 +174,8 @@ fn monitor_reopens_the_port_and_keeps_the_log() {
 
 #[test]
 fn send_times_out_when_nobody_answers() {
-    use nix::fcntl::OFlag;
-    use nix::pty::{grantpt, posix_openpt, ptsname_r, unlockpt};
-    let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY).unwrap();
-    grantpt(&master).unwrap();
-    unlockpt(&master).unwrap();
-    let path = ptsname_r(&master).unwrap();
+    // A terminal nobody answers on (the master is held open, never read).
+    let (_master, path) = open_pty();
     let started = Instant::now();
     let out = bowl(&["send", &path, "status", "--timeout-ms", "300"]);
     assert_eq!(out.status.code(), Some(3), "{}", stdout(&out));
@@ -212,7 +186,6 @@ fn send_times_out_when_nobody_answers() {
 #[test]
 fn pty_sends_exactly_the_bytes_of_the_capture() {
     let dir = temp_dir("same-bytes");
-    let capture = dir.join("cap.bin");
     let sim = Sim::start(&["--seconds", "10"]);
     // Read the pty from its start: the sim keeps the slave open, so nothing is lost before we
     // open it (the first second is well under the terminal's buffer).
@@ -224,14 +197,7 @@ fn pty_sends_exactly_the_bytes_of_the_capture() {
         let n = port.read(&mut buf).unwrap();
         got.extend_from_slice(&buf[..n]);
     }
-    let made = bowl(&[
-        "sim",
-        "--capture",
-        capture.to_str().unwrap(),
-        "--seconds",
-        "2",
-    ]);
-    assert!(made.status.success());
+    let capture = sim_capture(&dir, &["--seconds", "2"]);
     let expected = std::fs::read(&capture).unwrap();
     assert!(got.len() > 1000, "read {} bytes", got.len());
     assert_eq!(
@@ -244,26 +210,19 @@ fn pty_sends_exactly_the_bytes_of_the_capture() {
 #[test]
 fn replay_counts_what_the_capture_holds_and_what_damage_removed() {
     let dir = temp_dir("replay");
-    let capture = dir.join("cap.bin");
-    let made = bowl(&[
-        "sim",
-        "--capture",
-        capture.to_str().unwrap(),
-        "--seconds",
-        "5",
-        "--command",
-        "0:speed,1800,2100",
-        "--command",
-        "0:start",
-    ]);
-    assert!(made.status.success());
+    let capture = sim_capture(
+        &dir,
+        &[
+            "--seconds",
+            "5",
+            "--command",
+            "0:speed,1800,2100",
+            "--command",
+            "0:start",
+        ],
+    );
     let csv = dir.join("t.csv");
-    let clean = bowl(&[
-        "replay",
-        capture.to_str().unwrap(),
-        "--csv",
-        csv.to_str().unwrap(),
-    ]);
+    let clean = replay_to_csv(&capture, &csv);
     assert!(clean.status.success());
     let s = last_json(&clean);
     // 1 hello + 2 acks + 5 s x 50 Hz telemetry.
@@ -299,37 +258,26 @@ fn replay_counts_what_the_capture_holds_and_what_damage_removed() {
 #[test]
 fn an_injected_sensor_fault_stops_both_motors_and_is_reported() {
     let dir = temp_dir("fault");
-    let capture = dir.join("cap.bin");
-    let made = bowl(&[
-        "sim",
-        "--capture",
-        capture.to_str().unwrap(),
-        "--seconds",
-        "8",
-        "--command",
-        "0:speed,1800,2100",
-        "--command",
-        "0:start",
-        "--command",
-        "4000:inject,sensor2",
-        "--command",
-        "7000:start",
-    ]);
-    assert!(made.status.success());
+    let capture = sim_capture(
+        &dir,
+        &[
+            "--seconds",
+            "8",
+            "--command",
+            "0:speed,1800,2100",
+            "--command",
+            "0:start",
+            "--command",
+            "4000:inject,sensor2",
+            "--command",
+            "7000:start",
+        ],
+    );
     let csv = dir.join("t.csv");
-    let s = last_json(&bowl(&[
-        "replay",
-        capture.to_str().unwrap(),
-        "--csv",
-        csv.to_str().unwrap(),
-    ]));
+    let s = last_json(&replay_to_csv(&capture, &csv));
     assert_eq!(s["frames_missing"], 0, "{s}");
     let text = std::fs::read_to_string(&csv).unwrap();
-    let rows: Vec<Vec<&str>> = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').collect())
-        .collect();
+    let rows = csv_cells(&text);
     let faulted: Vec<&Vec<&str>> = rows.iter().filter(|r| r[3] == "Faulted").collect();
     assert!(!faulted.is_empty(), "the lost spin sensor is detected");
     let first_fault_ms: u64 = faulted[0][1].parse().unwrap();
@@ -358,36 +306,10 @@ fn an_injected_sensor_fault_stops_both_motors_and_is_reported() {
 
 #[test]
 fn monitor_draws_the_dashboard_on_a_terminal() {
-    use nix::fcntl::OFlag;
-    use nix::pty::{grantpt, posix_openpt, ptsname_r, unlockpt};
     let sim = Sim::start(&["--seconds", "10"]);
     // The monitor's stdout is a pseudo-terminal, so it draws the dashboard.
-    let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY).unwrap();
-    grantpt(&master).unwrap();
-    unlockpt(&master).unwrap();
-    let screen = std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .open(ptsname_r(&master).unwrap())
-        .unwrap();
-    let mut child = Command::new(BOWL)
-        .args(["monitor", &sim.path, "--seconds", "1.5"])
-        .stdout(Stdio::from(screen))
-        .spawn()
-        .unwrap();
-    let reader = std::thread::spawn(move || {
-        let mut master = master;
-        let mut all = Vec::new();
-        let mut buf = [0u8; 8192];
-        // Reading ends with EIO once the monitor exits and its side closes.
-        while let Ok(n) = master.read(&mut buf) {
-            if n == 0 {
-                break;
-            }
-            all.extend_from_slice(&buf[..n]);
-        }
-        all
-    });
+    let (mut child, reader) =
+        spawn_on_terminal(Command::new(BOWL).args(["monitor", &sim.path, "--seconds", "1.5"]));
     assert!(child.wait().unwrap().success());
     let screen = String::from_utf8_lossy(&reader.join().unwrap()).into_owned();
     assert!(screen.contains("\x1b[H\x1b[2J"), "redraws in place");
@@ -403,22 +325,20 @@ fn monitor_draws_the_dashboard_on_a_terminal() {
 #[test]
 fn a_residence_time_target_is_reached_in_closed_loop() {
     let dir = temp_dir("rtime");
-    let capture = dir.join("cap.bin");
-    let made = bowl(&[
-        "sim",
-        "--capture",
-        capture.to_str().unwrap(),
-        "--seconds",
-        "12",
-        "--command",
-        "0:rtime,cori,700",
-        "--command",
-        "0:start",
-        // Unreachable: would need a bowl speed above the motors' limit.
-        "--command",
-        "100:rtime,cori,20",
-    ]);
-    assert!(made.status.success());
+    let capture = sim_capture(
+        &dir,
+        &[
+            "--seconds",
+            "12",
+            "--command",
+            "0:rtime,cori,700",
+            "--command",
+            "0:start",
+            // Unreachable: would need a bowl speed above the motors' limit.
+            "--command",
+            "100:rtime,cori,20",
+        ],
+    );
     let raw = String::from_utf8_lossy(&std::fs::read(&capture).unwrap()).into_owned();
     assert!(raw.contains("$A1,1*"), "RTIME accepted");
     assert!(
@@ -426,20 +346,11 @@ fn a_residence_time_target_is_reached_in_closed_loop() {
         "unreachable target refused"
     );
     let csv = dir.join("t.csv");
-    let s = last_json(&bowl(&[
-        "replay",
-        capture.to_str().unwrap(),
-        "--csv",
-        csv.to_str().unwrap(),
-    ]));
+    let s = last_json(&replay_to_csv(&capture, &csv));
     assert_eq!(s["frames_missing"], 0);
     // Over the last 2 s the Coriolis prediction at the measured speeds is within 3 % of 700 ms.
     let text = std::fs::read_to_string(&csv).unwrap();
-    let rows: Vec<Vec<&str>> = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').collect())
-        .collect();
+    let rows = csv_cells(&text);
     let tail = &rows[rows.len() - 100..];
     for r in tail {
         assert_eq!(r[3], "Running", "{r:?}");
@@ -485,17 +396,7 @@ fn monitor_counts_what_a_noisy_line_destroys() {
 #[test]
 fn a_noisy_capture_replays_with_every_loss_counted() {
     let dir = temp_dir("noisy-capture");
-    let capture = dir.join("cap.bin");
-    let made = bowl(&[
-        "sim",
-        "--capture",
-        capture.to_str().unwrap(),
-        "--seconds",
-        "60",
-        "--line-noise-percent",
-        "1",
-    ]);
-    assert!(made.status.success());
+    let capture = sim_capture(&dir, &["--seconds", "60", "--line-noise-percent", "1"]);
     let s = last_json(&bowl(&["replay", capture.to_str().unwrap()]));
     let telemetry = s["telemetry_frames"].as_u64().unwrap();
     let missing = s["frames_missing"].as_u64().unwrap();

@@ -5,19 +5,12 @@ use model_core::control::estimator::WindowEvents;
 use model_core::control::pi::{LoopConstants, LoopInput, SpeedLoop};
 use model_core::control::{AxisConfig, ControllerConfig, State};
 use model_core::sim::experiments::{
-    commissioned_step, family_step, low_speed_hold, rig_with_pulses,
+    commissioned_step, family_step, low_speed_hold, rig_with_pulses, true_model_config,
 };
 use model_core::sim::{ClosedLoop, Rig, RigParams, StepMetrics};
 
 fn true_model_loop(rig: RigParams) -> ClosedLoop {
-    let mut cfg = ControllerConfig::nominal();
-    for i in 0..2 {
-        let (a, fd, tau) = rig.axes[i].motor.ideal_model(rig.supply_v);
-        cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
-        cfg.axes[i].model.volts_per_rad_s = a;
-        cfg.axes[i].model.friction_duty = fd;
-        cfg.axes[i].model.time_constant_s = tau;
-    }
+    let cfg = true_model_config(&rig);
     ClosedLoop::new(
         Rig::new(rig, 3),
         model_core::control::Controller::new(cfg).unwrap(),

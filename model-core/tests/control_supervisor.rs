@@ -1,19 +1,12 @@
 //! Supervisor and command contract, with faults injected on the simulated rig.
 
 use model_core::control::{ConfigError, Controller, ControllerConfig, Fault, Rejection, State};
-use model_core::sim::experiments::rig_with_pulses;
+use model_core::sim::experiments::{rig_with_pulses, true_model_config};
 use model_core::sim::{ClosedLoop, Rig, RigParams};
 
 /// A controller given the nominal rig's true model (no commissioning: faster tests).
 fn running_loop(rig: RigParams, cfg_edit: impl FnOnce(&mut ControllerConfig)) -> ClosedLoop {
-    let mut cfg = ControllerConfig::nominal();
-    for i in 0..2 {
-        let (a, fd, tau) = rig.axes[i].motor.ideal_model(rig.supply_v);
-        cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
-        cfg.axes[i].model.volts_per_rad_s = a;
-        cfg.axes[i].model.friction_duty = fd;
-        cfg.axes[i].model.time_constant_s = tau;
-    }
+    let mut cfg = true_model_config(&rig);
     cfg_edit(&mut cfg);
     ClosedLoop::new(Rig::new(rig, 7), Controller::new(cfg).unwrap())
 }

@@ -4,15 +4,9 @@ use super::*;
 use crate::particle::{self, Outcome};
 use proptest::prelude::*;
 
+/// The particle tests' scene with the rim at 0.1 m.
 fn scene(omega: f64, mu: f64, ri: f64) -> Scene<f64> {
-    Scene {
-        omega_rad_s: omega,
-        mu,
-        g_m_s2: 9.81,
-        k2: 5.0 / 7.0,
-        ri_m: ri,
-        rim_radius_m: 0.1,
-    }
+    crate::particle::tests::scene(omega, mu, ri, 0.1)
 }
 
 fn exit(r: Result<Report<f64>, OdeError>) -> (f64, f64, u32) {

@@ -406,4 +406,4 @@ pub fn radial_velocity_m_s<T: Real>(
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -4,7 +4,8 @@
 use super::*;
 use proptest::prelude::*;
 
-fn scene(omega: f64, mu: f64, ri: f64, rim: f64) -> Scene<f64> {
+/// A test scene: Earth gravity, a rolling sphere (k2 = 5/7); also used by the ode and choose tests.
+pub(crate) fn scene(omega: f64, mu: f64, ri: f64, rim: f64) -> Scene<f64> {
     Scene {
         omega_rad_s: omega,
         mu,

@@ -32,6 +32,20 @@ pub fn rig_with_pulses(n: u16) -> RigParams {
     rig
 }
 
+/// The nominal controller configuration given `rig`'s true motor models and pulse counts, as if
+/// commissioning had identified them exactly (tests that are not about commissioning start here).
+pub fn true_model_config(rig: &RigParams) -> ControllerConfig {
+    let mut cfg = ControllerConfig::nominal();
+    for (ax, rig_ax) in cfg.axes.iter_mut().zip(&rig.axes) {
+        let (a, fd, tau) = rig_ax.motor.ideal_model(rig.supply_v);
+        ax.pulses_per_rev = rig_ax.sensor.pulses_per_rev;
+        ax.model.volts_per_rad_s = a;
+        ax.model.friction_duty = fd;
+        ax.model.time_constant_s = tau;
+    }
+    cfg
+}
+
 /// Commissions a controller (configuration `cfg`, pulses per revolution taken from the rig) on
 /// `rig`, adds `load_after_commissioning_nm` of material drag per axis (a load the identified
 /// model does not know), then steps both axes from 0 to `target_rad_s` and measures the true
@@ -171,15 +185,10 @@ pub fn low_speed_hold_at_rate(
     for a in &mut rig.axes {
         a.ripple_nm = 0.0;
     }
-    let mut cfg = ControllerConfig::nominal();
+    // rig_with_pulses gives both axes `pulses`, so the true-model config counts `pulses` too.
+    let mut cfg = true_model_config(&rig);
     cfg.tick_hz = tick_hz;
-    for i in 0..2 {
-        let (a, fd, tau) = rig.axes[i].motor.ideal_model(rig.supply_v);
-        let ax = &mut cfg.axes[i];
-        ax.pulses_per_rev = pulses;
-        ax.model.volts_per_rad_s = a;
-        ax.model.friction_duty = fd;
-        ax.model.time_constant_s = tau;
+    for ax in &mut cfg.axes {
         ax.per_pulse_bandwidth = per_pulse_bandwidth;
         if !scheduled {
             let at3 = per_pulse_bandwidth * pulses as f32 * 3.0 / core::f32::consts::TAU;

@@ -7,7 +7,7 @@ use crate::check::{Bench, Case, Failure, close, ensure};
 use core::cell::UnsafeCell;
 use model_core::control::estimator::PulseSpeedEstimator;
 use model_core::control::{Controller, ControllerConfig, Fault, Rejection, State};
-use model_core::sim::experiments::rig_with_pulses;
+use model_core::sim::experiments::{rig_with_pulses, true_model_config};
 use model_core::sim::{ClosedLoop, Rig, RigParams, StepMetrics};
 
 /// Cases of this module.
@@ -103,14 +103,7 @@ fn rejected_commands_change_nothing() -> Result<(), Failure> {
 }
 
 fn true_model_loop(rig: RigParams) -> Result<ClosedLoop, Failure> {
-    let mut cfg = ControllerConfig::nominal();
-    for i in 0..2 {
-        let (a, fd, tau) = rig.axes[i].motor.ideal_model(rig.supply_v);
-        cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
-        cfg.axes[i].model.volts_per_rad_s = a;
-        cfg.axes[i].model.friction_duty = fd;
-        cfg.axes[i].model.time_constant_s = tau;
-    }
+    let cfg = true_model_config(&rig);
     let ctrl = Controller::new(cfg).map_err(|_| fail("config"))?;
     Ok(ClosedLoop::new(Rig::new(rig, 2), ctrl))
 }

@@ -57,15 +57,7 @@ pub const fn scene(i: usize) -> Scene<f64> {
 
 /// The scene rounded to f32, as the target sees it.
 pub const fn scene_f32(i: usize) -> Scene<f32> {
-    let s = scene(i);
-    Scene {
-        omega_rad_s: s.omega_rad_s as f32,
-        mu: s.mu as f32,
-        g_m_s2: s.g_m_s2 as f32,
-        k2: s.k2 as f32,
-        ri_m: s.ri_m as f32,
-        rim_radius_m: s.rim_radius_m as f32,
-    }
+    crate::particle::to_f32(&scene(i))
 }
 
 const fn model(coriolis: bool) -> Model {

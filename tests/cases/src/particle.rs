@@ -136,7 +136,8 @@ fn scene_f64(i: usize) -> Scene<f64> {
     }
 }
 
-fn to_f32(s: &Scene<f64>) -> Scene<f32> {
+/// The scene rounded to f32, as the target sees it.
+pub(crate) const fn to_f32(s: &Scene<f64>) -> Scene<f32> {
     Scene {
         omega_rad_s: s.omega_rad_s as f32,
         mu: s.mu as f32,

@@ -1,0 +1,145 @@
+//! Helpers shared by the end-to-end tests that run the built `bowl` binary: a `bowl sim --pty`
+//! virtual rig, one-shot `bowl` runs, scratch directories, and a pseudo-terminal standing in for
+//! the user's screen.
+//!
+//! Each test file is its own crate and uses only some of these, hence the `dead_code` allowance.
+#![allow(dead_code)]
+
+use std::collections::HashMap;
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Output, Stdio};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use nix::fcntl::OFlag;
+use nix::pty::{PtyMaster, grantpt, posix_openpt, ptsname_r, unlockpt};
+
+/// The `bowl` binary under test.
+pub const BOWL: &str = env!("CARGO_BIN_EXE_bowl");
+
+/// A `bowl sim --pty` process (the virtual rig on a pseudo-terminal), killed when dropped.
+pub struct Sim {
+    child: Child,
+    /// The pty's device path, as `bowl sim` printed it.
+    pub path: String,
+}
+
+impl Sim {
+    /// Starts `bowl sim --pty EXTRA...` and waits for the pty path it prints first.
+    pub fn start(extra: &[&str]) -> Sim {
+        let mut child = Command::new(BOWL)
+            .args(["sim", "--pty"])
+            .args(extra)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("bowl sim starts");
+        let mut line = String::new();
+        BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut line)
+            .expect("bowl sim prints its pty");
+        let path = line.trim().to_string();
+        assert!(path.starts_with("/dev/"), "pty path, got {path:?}");
+        Sim { child, path }
+    }
+}
+
+impl Drop for Sim {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Runs `bowl ARGS` to its end and returns what it printed.
+pub fn bowl(args: &[&str]) -> Output {
+    Command::new(BOWL).args(args).output().expect("bowl runs")
+}
+
+/// Standard output as text.
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// The last line of standard output (the JSON summary), parsed.
+pub fn last_json(o: &Output) -> serde_json::Value {
+    let text = stdout(o);
+    let line = text.lines().last().expect("a JSON summary line");
+    serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"))
+}
+
+/// An empty scratch directory named after the test and this process.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("bowl-test-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A fresh pseudo-terminal: its master side and the path of its slave side.
+pub fn open_pty() -> (PtyMaster, String) {
+    let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY).unwrap();
+    grantpt(&master).unwrap();
+    unlockpt(&master).unwrap();
+    let path = ptsname_r(&master).unwrap();
+    (master, path)
+}
+
+/// Spawns `command` with its stdout on a terminal (a fresh pty) and collects everything drawn
+/// on that terminal until the child exits; join the handle to get the bytes.
+pub fn spawn_on_terminal(command: &mut Command) -> (Child, JoinHandle<Vec<u8>>) {
+    let (master, path) = open_pty();
+    let screen = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(path)
+        .unwrap();
+    let child = command.stdout(Stdio::from(screen)).spawn().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut master = master;
+        let mut all = Vec::new();
+        let mut buf = [0u8; 8192];
+        // Reading ends with EIO once the child exits and its side closes.
+        while let Ok(n) = master.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            all.extend_from_slice(&buf[..n]);
+        }
+        all
+    });
+    (child, reader)
+}
+
+/// Waits for `child` to end by itself; kills it and fails the test past `limit`.
+pub fn wait_within(child: &mut Child, limit: Duration, what: &str) -> ExitStatus {
+    let started = Instant::now();
+    loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            return s;
+        }
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{what} did not end by itself within {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// A CSV file with a header line, as one column-name -> cell map per row.
+pub fn csv_rows(path: &Path) -> Vec<HashMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    lines
+        .map(|l| {
+            header
+                .iter()
+                .zip(l.split(','))
+                .map(|(h, c)| (h.to_string(), c.to_string()))
+                .collect()
+        })
+        .collect()
+}
