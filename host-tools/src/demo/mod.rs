@@ -140,5 +140,20 @@ pub fn run(args: &Args) -> Result<()> {
     if let Some(why) = &outcome.aborted {
         bail!("the session ended early: {why}");
     }
+    // A demo that did not show what it should is a failure a script can see, not just a line.
+    let c = &summary.checks;
+    let failed: Vec<&str> = [
+        (c.speeds_tracked, "speeds tracked"),
+        (c.fault_stopped_both_motors, "fault stopped both motors"),
+        (c.residence_split_agrees, "residence split agrees"),
+        (c.link_clean, "link clean"),
+        (summary.ended_at_rest, "ended at rest"),
+    ]
+    .into_iter()
+    .filter_map(|(ok, name)| (!ok).then_some(name))
+    .collect();
+    if !failed.is_empty() {
+        bail!("the demo's checks failed: {}", failed.join(", "));
+    }
     Ok(())
 }
