@@ -245,15 +245,9 @@ const QEMU_BUILD_ARGS: [&str; 11] = [
 /// Builds the emulated board's image; returns the ELF path or why it cannot be had.
 fn build_qemu_image() -> Result<PathBuf> {
     if !on_path("qemu-system-arm") {
-        bail!("qemu-system-arm is not installed (see DEVELOPERS.md)");
+        bail!("qemu-system-arm is not installed (`bash tests/run` installs it)");
     }
     let root = workspace_root();
-    let manifest = root.join("firmware").join("Cargo.toml");
-    let text = std::fs::read_to_string(&manifest)
-        .with_context(|| format!("no firmware crate at {}", manifest.display()))?;
-    if !text.contains(&format!("name = \"{QEMU_RIG_BIN}\"")) {
-        bail!("the firmware crate has no `{QEMU_RIG_BIN}` image yet");
-    }
     eprintln!(
         "building the emulated board's image ({QEMU_RIG_BIN}; the first build takes minutes)..."
     );
