@@ -13,7 +13,7 @@ mod replay;
 mod send;
 mod serial;
 mod sim;
-mod simulated_rig;
+mod simulated_backend;
 mod telemetry_csv;
 mod virtual_rig;
 

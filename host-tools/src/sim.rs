@@ -13,7 +13,7 @@
 use anyhow::{Result, bail};
 use model_core::control::{Controller, ControllerConfig, Fault};
 use model_core::sim::experiments::{self, STEP_RUN_S, family_plant, rig_with_pulses};
-use model_core::sim::{ClosedLoop, Rig, RigParams, StepReport};
+use model_core::sim::{ClosedLoop, Plant, PlantParams, StepReport};
 use serde::Serialize;
 
 #[derive(clap::Subcommand)]
@@ -203,7 +203,7 @@ pub struct StepOutcome {
 
 /// Commissions, then steps both axes (see `model_core::sim::experiments::commissioned_step`).
 pub fn step_run_with(
-    rig: RigParams,
+    rig: PlantParams,
     cfg: ControllerConfig,
     seed: u32,
     target: f32,
@@ -233,7 +233,7 @@ fn outcome_json(o: experiments::StepOutcome) -> StepOutcome {
     }
 }
 
-fn step_run(rig: RigParams, seed: u32, target: f32, feedback: bool) -> StepOutcome {
+fn step_run(rig: PlantParams, seed: u32, target: f32, feedback: bool) -> StepOutcome {
     step_run_with(
         rig,
         ControllerConfig::nominal(),
@@ -359,9 +359,9 @@ pub struct CommissionJson {
 }
 
 fn commission_report(seed: u32) -> CommissionJson {
-    let rig = RigParams::nominal();
+    let rig = PlantParams::nominal();
     let ctrl = Controller::new(ControllerConfig::nominal()).expect("valid");
-    let mut cl = ClosedLoop::new(Rig::new(rig, seed), ctrl);
+    let mut cl = ClosedLoop::new(Plant::new(rig, seed), ctrl);
     let state = cl.commission(300.0);
     let ids = cl.ctrl.identified();
     let axes = (0..2)
@@ -432,10 +432,10 @@ fn trace(seed: u32, plant: Option<u32>) {
             let (rig, load) = family_plant(seed, i);
             (rig, seed.wrapping_add(i), load)
         }
-        None => (RigParams::nominal(), seed, [0.0; 2]),
+        None => (PlantParams::nominal(), seed, [0.0; 2]),
     };
     let ctrl = Controller::new(ControllerConfig::nominal()).expect("valid");
-    let mut cl = ClosedLoop::new(Rig::new(rig, rig_seed), ctrl);
+    let mut cl = ClosedLoop::new(Plant::new(rig, rig_seed), ctrl);
     let state = cl.commission(300.0);
     eprintln!(
         "commissioning: {state:?}, identified {:?}",

@@ -1,7 +1,7 @@
 //! The virtual rig's transport: `bowl sim --pty` (a pseudo-terminal speaking the protocol in real
 //! time) and `bowl sim --capture FILE --seconds S` (the same rig faster than real time, writing
 //! exactly the bytes it would send). The protocol side is `model_core::wire::device`, the same
-//! code the firmware runs; the rig behind it is [`crate::simulated_rig`].
+//! code the firmware runs; the rig behind it is [`crate::simulated_backend`].
 
 use std::fs::File;
 use std::io::{BufWriter, Read, Write};
@@ -17,7 +17,7 @@ use nix::pty::{PtyMaster, grantpt, posix_openpt, ptsname_r, unlockpt};
 use nix::sys::termios::{FlushArg, tcflush};
 
 use crate::send::command_line;
-use crate::simulated_rig::SimulatedRig;
+use crate::simulated_backend::SimulatedBackend;
 
 /// Flags of the virtual rig (`bowl sim --pty` / `bowl sim --capture`).
 #[derive(clap::Args)]
@@ -110,7 +110,7 @@ fn parse_commands(specs: &[String]) -> Result<Vec<Scheduled>> {
 
 /// The rig plus the protocol, advanced one millisecond at a time by either transport.
 pub(crate) struct VirtualRig {
-    rig: SimulatedRig,
+    rig: SimulatedBackend,
     device: Device,
     pub(crate) now_ms: u32,
 }
@@ -118,7 +118,7 @@ pub(crate) struct VirtualRig {
 impl VirtualRig {
     pub(crate) fn new(seed: u32) -> Result<Self> {
         Ok(Self {
-            rig: SimulatedRig::new(seed)?,
+            rig: SimulatedBackend::new(seed)?,
             device: Device::new(),
             now_ms: 0,
         })

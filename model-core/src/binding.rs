@@ -1,5 +1,5 @@
 //! The one binding of the controller ([`crate::control`]) and the particle model
-//! ([`crate::particle`]) to the serial protocol's rig interface ([`crate::wire::device::Rig`]).
+//! ([`crate::particle`]) to the serial protocol's rig interface ([`crate::wire::device::Backend`]).
 //! No heap, no hardware: the Black Pill firmware, the emulated board under QEMU and the host's
 //! virtual rig (`bowl sim --pty/--capture`) all run this code; each supplies only what is its
 //! own (the motors and sensors or a simulated plant, and an [`Injector`] for INJECT).
@@ -24,7 +24,7 @@ use crate::control::{
     Rejection, State,
 };
 use crate::particle::{self, InverseError, Model, Outcome, Scene};
-use crate::wire::device::{DEFAULT_TELEMETRY_HZ, Rig};
+use crate::wire::device::{Backend, DEFAULT_TELEMETRY_HZ};
 use crate::wire::{
     AxisModel, DeviceState, FaultCode, Hello, Injection, MODEL_FIELD_MAX, MotorTelemetry,
     PARAM_COUNT, ParamId, ParamValues, Reason, Residence, ResidenceModel, Telemetry,
@@ -271,9 +271,9 @@ fn mrad(x: f32) -> i16 {
     round(x * 1000.0) as i16
 }
 
-/// The controller and the particle scene behind the wire protocol's [`Rig`] trait.
+/// The controller and the particle scene behind the wire protocol's [`Backend`] trait.
 #[derive(Clone)]
-pub struct ControlledRig<I: Injector> {
+pub struct ControllerBackend<I: Injector> {
     ctrl: Controller,
     base: ControllerConfig,
     scene: Scene<f32>,
@@ -285,7 +285,7 @@ pub struct ControlledRig<I: Injector> {
     injector: I,
 }
 
-impl<I: Injector> ControlledRig<I> {
+impl<I: Injector> ControllerBackend<I> {
     /// A controller for a persisted record (checked: parameters or motor models that fail
     /// validation give the defaults, and `Err` says why, so the board still boots and reports
     /// it). `base` supplies what the wire does not carry (tick rate, timer, supervisor limits).
@@ -388,7 +388,7 @@ impl<I: Injector> ControlledRig<I> {
     }
 }
 
-impl<I: Injector> Rig for ControlledRig<I> {
+impl<I: Injector> Backend for ControllerBackend<I> {
     fn telemetry(&self) -> Telemetry {
         let s = self.ctrl.status();
         let motor = |i: usize| {
@@ -549,36 +549,36 @@ mod tests {
     use crate::wire::{Frame, ResetCause, decode_frame};
 
     /// The protocol device and the rig, as the firmware and the virtual rig pair them.
-    struct Station {
+    struct TestDevice {
         device: Device,
-        rig: ControlledRig<NoInjection>,
+        rig: ControllerBackend<NoInjection>,
     }
 
-    impl Station {
+    impl TestDevice {
         fn params_to_persist(&self) -> Persisted {
             self.rig.to_persist(self.device.telemetry_hz())
         }
     }
 
-    fn station() -> Station {
+    fn station() -> TestDevice {
         let hello = Hello {
             reset_cause: ResetCause::PowerOn,
             reset_count: 0,
         };
-        let (rig, ok) = ControlledRig::new(
+        let (rig, ok) = ControllerBackend::new(
             ControllerConfig::nominal(),
             default_persisted(),
             hello,
             NoInjection,
         );
         assert_eq!(ok, Ok(()), "the defaults must pass their own checks");
-        Station {
+        TestDevice {
             device: Device::new(),
             rig,
         }
     }
 
-    fn command(s: &mut Station, line: &str) -> Frame {
+    fn command(s: &mut TestDevice, line: &str) -> Frame {
         let payload = line.trim_start_matches('$');
         let crc = crate::wire::crc::crc32(payload.as_bytes());
         let bytes = std::format!("${payload}*{crc:08X}\n");
@@ -645,7 +645,7 @@ mod tests {
         let mut bad = default_persisted();
         bad[ParamId::RimUm.index()] = 10_000;
         bad[ParamId::StartUm.index()] = 20_000;
-        let (rig, outcome) = ControlledRig::new(
+        let (rig, outcome) = ControllerBackend::new(
             ControllerConfig::nominal(),
             bad,
             Hello {
@@ -666,7 +666,7 @@ mod tests {
         };
         let (params, mut models) = split_persisted(&default_persisted());
         models[0].time_constant_s = 0.11;
-        let (rig, ok) = ControlledRig::new(
+        let (rig, ok) = ControllerBackend::new(
             ControllerConfig::nominal(),
             persisted(&params, &models),
             hello,
@@ -678,7 +678,7 @@ mod tests {
             0.11
         );
         models[1].volts_per_rad_s = f32::NAN;
-        let (rig, ok) = ControlledRig::new(
+        let (rig, ok) = ControllerBackend::new(
             ControllerConfig::nominal(),
             persisted(&params, &models),
             hello,

@@ -2,19 +2,19 @@
 
 use model_core::control::{Controller, ControllerConfig, Fault, IdentifyError, State};
 use model_core::sim::experiments::{family_plant, rig_with_pulses};
-use model_core::sim::{ClosedLoop, Rig, RigParams};
+use model_core::sim::{ClosedLoop, Plant, PlantParams};
 
-fn commission(rig: RigParams, seed: u32) -> ClosedLoop {
+fn commission(rig: PlantParams, seed: u32) -> ClosedLoop {
     let mut cfg = ControllerConfig::nominal();
     for i in 0..2 {
         cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
     }
-    let mut cl = ClosedLoop::new(Rig::new(rig, seed), Controller::new(cfg).unwrap());
+    let mut cl = ClosedLoop::new(Plant::new(rig, seed), Controller::new(cfg).unwrap());
     cl.commission(300.0);
     cl
 }
 
-fn check_identified(rig: &RigParams, cl: &ClosedLoop, what: &str) {
+fn check_identified(rig: &PlantParams, cl: &ClosedLoop, what: &str) {
     assert_eq!(
         cl.ctrl.state(),
         State::Idle,

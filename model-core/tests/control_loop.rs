@@ -7,12 +7,12 @@ use model_core::control::{AxisConfig, ControllerConfig, State};
 use model_core::sim::experiments::{
     commissioned_step, family_step, low_speed_hold, rig_with_pulses, true_model_config,
 };
-use model_core::sim::{ClosedLoop, Rig, RigParams, StepMetrics};
+use model_core::sim::{ClosedLoop, Plant, PlantParams, StepMetrics};
 
-fn true_model_loop(rig: RigParams) -> ClosedLoop {
+fn true_model_loop(rig: PlantParams) -> ClosedLoop {
     let cfg = true_model_config(&rig);
     ClosedLoop::new(
-        Rig::new(rig, 3),
+        Plant::new(rig, 3),
         model_core::control::Controller::new(cfg).unwrap(),
     )
 }

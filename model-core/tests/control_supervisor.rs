@@ -2,20 +2,20 @@
 
 use model_core::control::{ConfigError, Controller, ControllerConfig, Fault, Rejection, State};
 use model_core::sim::experiments::{rig_with_pulses, true_model_config};
-use model_core::sim::{ClosedLoop, Rig, RigParams};
+use model_core::sim::{ClosedLoop, Plant, PlantParams};
 
 /// A controller given the nominal rig's true model (no commissioning: faster tests).
-fn running_loop(rig: RigParams, cfg_edit: impl FnOnce(&mut ControllerConfig)) -> ClosedLoop {
+fn running_loop(rig: PlantParams, cfg_edit: impl FnOnce(&mut ControllerConfig)) -> ClosedLoop {
     let mut cfg = true_model_config(&rig);
     cfg_edit(&mut cfg);
-    ClosedLoop::new(Rig::new(rig, 7), Controller::new(cfg).unwrap())
+    ClosedLoop::new(Plant::new(rig, 7), Controller::new(cfg).unwrap())
 }
 
 /// Runs to steady 3 rad/s, injects with `inject` at t = 3 s, returns (time of the fault after
 /// injection, fault) and checks both duties are zero from the fault tick on.
 fn fault_after(
-    rig: RigParams,
-    inject: impl Fn(&mut RigParams, f32),
+    rig: PlantParams,
+    inject: impl Fn(&mut PlantParams, f32),
     speed: f32,
 ) -> (f32, Option<Fault>) {
     let mut cl = running_loop(rig, |_| {});

@@ -3,7 +3,7 @@
 
 mod wire_support;
 
-use model_core::wire::device::{Device, Rig};
+use model_core::wire::device::{Backend, Device};
 use model_core::wire::*;
 use proptest::prelude::*;
 
@@ -15,7 +15,7 @@ struct Recorder {
     now_ms: u32,
 }
 
-impl Rig for Recorder {
+impl Backend for Recorder {
     fn telemetry(&self) -> Telemetry {
         Telemetry {
             time_ms: self.now_ms,

@@ -1,42 +1,42 @@
-//! The tasks' [`RigCore`]: the protocol device and the controlled rig together. The binding
+//! The tasks' [`TaskCore`]: the protocol device and the controller backend together. The binding
 //! of the controller and the particle model to the protocol is `model_core::binding` (the host's
 //! virtual rig runs the same one); it is re-exported here.
 
 pub use model_core::binding::{
-    AXES as BOUND_AXES, ControlledRig, Injector, NoInjection, OVERSPEED_PER_MAX, PERSISTED_COUNT,
-    Persisted, default_params, default_persisted, persisted, split_persisted,
+    AXES as BOUND_AXES, ControllerBackend, Injector, NoInjection, OVERSPEED_PER_MAX,
+    PERSISTED_COUNT, Persisted, default_params, default_persisted, persisted, split_persisted,
 };
 use model_core::control::State;
 use model_core::wire::device::Device;
 use model_core::wire::{Command, MAX_FRAME_LEN, ParamId};
 
 use super::motors::AXES;
-use super::tasks::{FRAME_BYTES, RigCore};
+use super::tasks::{FRAME_BYTES, TaskCore};
 
 const _: () = assert!(FRAME_BYTES == MAX_FRAME_LEN);
 const _: () = assert!(AXES == BOUND_AXES);
 
-/// The protocol device and the controlled rig together: what the tasks run.
-pub struct Station<I: Injector> {
+/// The protocol device and the controller backend together: what the tasks run.
+pub struct DeviceCore<I: Injector> {
     /// The protocol state (decoder, telemetry pacing).
     pub device: Device,
     /// The controller behind the protocol.
-    pub rig: ControlledRig<I>,
+    pub backend: ControllerBackend<I>,
     dropped_edges: [u32; AXES],
 }
 
-impl<I: Injector> Station<I> {
-    /// A station; the telemetry rate comes from `rig`'s parameters.
-    pub fn new(rig: ControlledRig<I>) -> Self {
+impl<I: Injector> DeviceCore<I> {
+    /// The device core; the telemetry rate comes from `backend`'s parameters.
+    pub fn new(backend: ControllerBackend<I>) -> Self {
         let mut s = Self {
             device: Device::new(),
-            rig,
+            backend,
             dropped_edges: [0; AXES],
         };
-        let hz = s.rig.params()[ParamId::TelemetryHz.index()];
+        let hz = s.backend.params()[ParamId::TelemetryHz.index()];
         // Inside the wire range by construction (checked params); a refusal keeps the default.
         let _ = s.device.execute(
-            &mut s.rig,
+            &mut s.backend,
             0,
             Command::SetParam {
                 id: ParamId::TelemetryHz,
@@ -48,7 +48,7 @@ impl<I: Injector> Station<I> {
 
     /// Every parameter including the telemetry rate, and the motor models, for persisting.
     pub fn params_to_persist(&self) -> Persisted {
-        self.rig.to_persist(self.device.telemetry_hz())
+        self.backend.to_persist(self.device.telemetry_hz())
     }
 
     /// Edges lost in capture so far, per axis.
@@ -57,26 +57,26 @@ impl<I: Injector> Station<I> {
     }
 }
 
-impl<I: Injector> RigCore for Station<I> {
+impl<I: Injector> TaskCore for DeviceCore<I> {
     fn control_tick(&mut self, now_ticks: u32, edges: [&[u32]; AXES]) -> [f32; AXES] {
-        self.rig.controller_mut().tick(now_ticks, edges)
+        self.backend.controller_mut().tick(now_ticks, edges)
     }
 
     fn faulted(&self) -> bool {
-        self.rig.controller().state() == State::Fault
+        self.backend.controller().state() == State::Fault
     }
 
     fn hello(&mut self, out: &mut [u8; FRAME_BYTES]) -> Option<usize> {
-        self.device.hello(&self.rig, out)
+        self.device.hello(&self.backend, out)
     }
 
     fn receive(&mut self, bytes: &[u8], send: &mut dyn FnMut(&[u8])) {
-        self.device.receive(&mut self.rig, bytes, send);
+        self.device.receive(&mut self.backend, bytes, send);
     }
 
     fn poll_telemetry(&mut self, now_ms: u32, out: &mut [u8; FRAME_BYTES]) -> Option<usize> {
-        self.rig.set_now_ms(now_ms);
-        self.device.poll_telemetry(&self.rig, now_ms, out)
+        self.backend.set_now_ms(now_ms);
+        self.device.poll_telemetry(&self.backend, now_ms, out)
     }
 
     fn set_dropped_edges(&mut self, dropped: [u32; AXES]) {

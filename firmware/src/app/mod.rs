@@ -4,7 +4,7 @@
 //!
 //! - [`hal`]: the traits a board implements (motor output, capture clock, watchdog, flash
 //!   region); the byte stream is `embedded_io_async`.
-//! - [`binding`]: the controller + particle model behind the wire protocol (`RigCore`).
+//! - [`binding`]: the controller + particle model behind the wire protocol (`TaskCore`).
 //! - [`edges`]: the queue from the pulse-capture interrupt/task to the control tick.
 //! - [`params`]: parameters persisted in flash (version + CRC-32, append-only records).
 //! - [`reset`]: reset cause and a reset counter that survives resets in uninitialised RAM.

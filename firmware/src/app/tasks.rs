@@ -1,4 +1,4 @@
-//! The async loops of the rig, generic over the board's peripherals and over the [`RigCore`]
+//! The async loops of the rig, generic over the board's peripherals and over the [`TaskCore`]
 //! (controller + protocol). A board wraps each in an `#[embassy_executor::task]` (tasks cannot
 //! be generic) and spawns them.
 //!
@@ -34,7 +34,7 @@ pub const SUPERVISOR_PERIOD: Duration = Duration::from_millis(20);
 
 /// What the tasks need from the controller and the protocol. The binding to
 /// `model_core::control` and `model_core::wire` implements it.
-pub trait RigCore {
+pub trait TaskCore {
     /// One control tick: the edges since the previous tick (oldest first) and the capture
     /// clock read after draining them. Returns the duties (-1..=1, 0 = off).
     fn control_tick(&mut self, now_ticks: u32, edges: [&[u32]; AXES]) -> [f32; AXES];
@@ -82,7 +82,7 @@ impl Heartbeat {
 }
 
 /// The fixed-rate control loop, forever.
-pub async fn control<RM: RawMutex, C: RigCore, M: MotorOutput, K: CaptureClock>(
+pub async fn control<RM: RawMutex, C: TaskCore, M: MotorOutput, K: CaptureClock>(
     core: &SharedCore<RM, C>,
     queues: &[EdgeQueue; AXES],
     clock: &K,
@@ -121,7 +121,7 @@ pub fn now_ms() -> u32 {
 
 /// Commands in, answers and telemetry out, forever. A write error (a broken link) drops that
 /// frame: telemetry's sequence numbers show the host what it missed.
-pub async fn link<RM: RawMutex, C: RigCore, R: Read, W: Write>(
+pub async fn link<RM: RawMutex, C: TaskCore, R: Read, W: Write>(
     core: &SharedCore<RM, C>,
     mut rx: R,
     mut tx: W,

@@ -27,7 +27,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
 use embassy_time::{Duration, Ticker};
 use firmware::app::binding::{
-    ControlledRig, NoInjection, PERSISTED_COUNT, Station, default_persisted,
+    ControllerBackend, DeviceCore, NoInjection, PERSISTED_COUNT, default_persisted,
 };
 use firmware::app::hal::Watchdog;
 use firmware::app::motors::Motors;
@@ -49,7 +49,7 @@ bind_interrupts!(struct Irqs {
     DMA1_STREAM6 => dma::InterruptHandler<DMA1_CH6>;
 });
 
-type Core = SharedCore<ThreadModeRawMutex, Station<NoInjection>>;
+type Core = SharedCore<ThreadModeRawMutex, DeviceCore<NoInjection>>;
 
 /// Watchdog timeout: 25 control periods of slack over the supervisor's 20 ms feeding period.
 const WATCHDOG_TIMEOUT_US: u32 = 250_000;
@@ -130,12 +130,12 @@ async fn main(spawner: Spawner) {
         reset_count: resets as u16,
     };
     let (rig, outcome) =
-        ControlledRig::new(ControllerConfig::nominal(), stored, hello, NoInjection);
+        ControllerBackend::new(ControllerConfig::nominal(), stored, hello, NoInjection);
     if let Err(r) = outcome {
         warn!("params: stored values rejected ({}), using defaults", r);
     }
     let core = CORE
-        .put(Mutex::new(RefCell::new(Station::new(rig))))
+        .put(Mutex::new(RefCell::new(DeviceCore::new(rig))))
         .unwrap_or_else(|| halt("core slot"));
 
     // Host link: USART2 115200 8N1, TX by DMA, RX into a circular DMA ring.
@@ -212,7 +212,7 @@ async fn supervisor_task(
             let (values, lost) = core.lock(|c| {
                 let mut c = c.borrow_mut();
                 let lost = c.dropped_edges();
-                if c.rig.take_params_to_save() {
+                if c.backend.take_params_to_save() {
                     (Some(c.params_to_persist()), lost)
                 } else {
                     (None, lost)

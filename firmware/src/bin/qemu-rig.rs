@@ -19,7 +19,7 @@ use cortex_m_semihosting::hprintln;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
 use embassy_time::{Duration, Timer};
-use firmware::app::binding::{ControlledRig, Station, default_persisted};
+use firmware::app::binding::{ControllerBackend, DeviceCore, default_persisted};
 use firmware::app::motors::Motors;
 use firmware::app::reset;
 use firmware::app::slot::Slot;
@@ -28,10 +28,10 @@ use firmware::qemu::plant::{self, PlantClock, PlantInjector, SimMotor};
 use firmware::qemu::watchdog::SoftWatchdog;
 use firmware::qemu::{self, executor, time_driver, usart};
 use model_core::control::ControllerConfig;
-use model_core::sim::RigParams;
+use model_core::sim::PlantParams;
 use model_core::wire::{Hello, ResetCause};
 
-type Core = SharedCore<ThreadModeRawMutex, Station<PlantInjector>>;
+type Core = SharedCore<ThreadModeRawMutex, DeviceCore<PlantInjector>>;
 
 static CORE: Slot<Core> = Slot::new();
 static HEARTBEAT: Heartbeat = Heartbeat::new();
@@ -60,7 +60,7 @@ async fn supervisor_task() {
 #[embassy_executor::task]
 async fn plant_task() {
     let mut next_log_ms = 0u32;
-    plant::run(RigParams::nominal(), 1, |rig| {
+    plant::run(PlantParams::nominal(), 1, |rig| {
         let t_ms = (rig.time_s() * 1000.0) as u32;
         if t_ms >= next_log_ms {
             next_log_ms = t_ms + TRUTH_EVERY_MS;
@@ -114,14 +114,14 @@ fn main() -> ! {
         reset_count: resets as u16,
     };
     // The emulated board has no parameter flash: it boots with the defaults every time.
-    let (rig, _) = ControlledRig::new(
+    let (rig, _) = ControllerBackend::new(
         ControllerConfig::nominal(),
         default_persisted(),
         hello,
         PlantInjector,
     );
     let core = CORE
-        .put(Mutex::new(RefCell::new(Station::new(rig))))
+        .put(Mutex::new(RefCell::new(DeviceCore::new(rig))))
         .unwrap_or_else(|| qemu::exit(false));
     let seconds = run_seconds();
     hprintln!("qemu-rig: up, run for {:?} s of virtual time", seconds);

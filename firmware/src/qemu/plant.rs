@@ -1,4 +1,4 @@
-//! The simulated rig (`model_core::sim::Rig`) standing in for the motors and the proximity
+//! The simulated rig (`model_core::sim::Plant`) standing in for the motors and the proximity
 //! sensors of the emulated board.
 //!
 //! The plant task advances the simulation by the embassy time that really passed (1 kHz),
@@ -12,7 +12,7 @@
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use embassy_time::{Duration, Instant, Ticker};
-use model_core::sim::{Rig, RigParams};
+use model_core::sim::{Plant, PlantParams};
 use model_core::wire::{Injection, Reason};
 
 use crate::app::binding::Injector;
@@ -84,8 +84,8 @@ impl Injector for PlantInjector {
 }
 
 /// Runs the plant forever; `observe` sees the rig after every step (for the truth log).
-pub async fn run(params: RigParams, seed: u32, mut observe: impl FnMut(&Rig)) -> ! {
-    let mut rig = Rig::new(params, seed);
+pub async fn run(params: PlantParams, seed: u32, mut observe: impl FnMut(&Plant)) -> ! {
+    let mut rig = Plant::new(params, seed);
     let mut ticker = Ticker::every(PLANT_PERIOD);
     let mut last = Instant::now();
     loop {

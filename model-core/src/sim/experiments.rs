@@ -3,8 +3,8 @@
 //! the low-speed hold.
 
 use super::harness::{ClosedLoop, StepMetrics, StepReport};
+use super::plant::{Plant, PlantParams};
 use super::prng::Prng;
-use super::rig::{Rig, RigParams};
 use crate::control::{Controller, ControllerConfig, Fault, State};
 
 /// Length of a step run after the step, s.
@@ -24,8 +24,8 @@ pub struct StepOutcome {
 }
 
 /// The nominal rig with `n` pulses per revolution on both axes.
-pub fn rig_with_pulses(n: u16) -> RigParams {
-    let mut rig = RigParams::nominal();
+pub fn rig_with_pulses(n: u16) -> PlantParams {
+    let mut rig = PlantParams::nominal();
     for a in &mut rig.axes {
         a.sensor.pulses_per_rev = n;
     }
@@ -34,7 +34,7 @@ pub fn rig_with_pulses(n: u16) -> RigParams {
 
 /// The nominal controller configuration given `rig`'s true motor models and pulse counts, as if
 /// commissioning had identified them exactly (tests that are not about commissioning start here).
-pub fn true_model_config(rig: &RigParams) -> ControllerConfig {
+pub fn true_model_config(rig: &PlantParams) -> ControllerConfig {
     let mut cfg = ControllerConfig::nominal();
     for (ax, rig_ax) in cfg.axes.iter_mut().zip(&rig.axes) {
         let (a, fd, tau) = rig_ax.motor.ideal_model(rig.supply_v);
@@ -51,7 +51,7 @@ pub fn true_model_config(rig: &RigParams) -> ControllerConfig {
 /// model does not know), then steps both axes from 0 to `target_rad_s` and measures the true
 /// speed for [`STEP_RUN_S`].
 pub fn commissioned_step(
-    rig: RigParams,
+    rig: PlantParams,
     mut cfg: ControllerConfig,
     seed: u32,
     target_rad_s: f32,
@@ -62,7 +62,7 @@ pub fn commissioned_step(
         cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
     }
     let ctrl = Controller::new_or_faulted(cfg);
-    let mut cl = ClosedLoop::new(Rig::new(rig, seed), ctrl);
+    let mut cl = ClosedLoop::new(Plant::new(rig, seed), ctrl);
     let commissioned = cl.commission(300.0) == State::Idle;
     cl.ctrl.set_feedback_enabled(feedback);
     let now = cl.rig.time_s() as f32;
@@ -106,9 +106,9 @@ pub fn commissioned_step(
 /// Plant `index` of the seeded family, and the material drag `[precession, spin]` (N m) added
 /// after commissioning. Inertia +/-30 %, torque constant +/-15 %, friction x0.5..x2 (log-uniform),
 /// 1 % tooth-spacing error, 200 us jitter, load ripple x0.5..x2, coupling +/-20 %.
-pub fn family_plant(seed: u32, index: u32) -> (RigParams, [f32; 2]) {
+pub fn family_plant(seed: u32, index: u32) -> (PlantParams, [f32; 2]) {
     let mut rng = Prng::new(seed.wrapping_mul(0x9e37_79b9) ^ index);
-    let mut rig = RigParams::nominal();
+    let mut rig = PlantParams::nominal();
     for a in &mut rig.axes {
         let m = &mut a.motor;
         m.inertia_kg_m2 *= rng.range(0.7, 1.3);
@@ -197,7 +197,7 @@ pub fn low_speed_hold_at_rate(
         }
         ax.min_speed_rad_s = ax.min_speed_rad_s.min(0.5 * speed_rad_s);
     }
-    let mut cl = ClosedLoop::new(Rig::new(rig, seed), Controller::new_or_faulted(cfg));
+    let mut cl = ClosedLoop::new(Plant::new(rig, seed), Controller::new_or_faulted(cfg));
     let _ = cl.ctrl.set_motor_speeds(speed_rad_s, speed_rad_s);
     let _ = cl.ctrl.start();
     cl.run(settle_s, |_| {});

@@ -1,14 +1,14 @@
 //! The closed loop: the controller ticking against the simulated rig, and the step-response
 //! measures computed on the rig's *true* speed, online (no storage).
 
-use super::rig::Rig;
+use super::plant::Plant;
 use crate::control::{Controller, State};
 
 /// The controller and the rig, stepped together one control period at a time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClosedLoop {
     /// The simulated rig.
-    pub rig: Rig,
+    pub rig: Plant,
     /// The controller under test.
     pub ctrl: Controller,
     dt_s: f32,
@@ -17,7 +17,7 @@ pub struct ClosedLoop {
 
 impl ClosedLoop {
     /// Couples a controller to a rig; the control period is the controller's tick.
-    pub fn new(rig: Rig, ctrl: Controller) -> Self {
+    pub fn new(rig: Plant, ctrl: Controller) -> Self {
         let dt_s = 1.0 / ctrl.config().tick_hz as f32;
         Self {
             rig,

@@ -2,7 +2,7 @@
 //! `bowl sim` on the host and on the emulated Cortex-M4F: two brushed 12 V gearmotors with
 //! their loads ([`motor`]), the spin motor's reaction torque on the precession axis, proximity
 //! sensors with tooth-spacing error and jitter, once-per-revolution load ripple and injectable
-//! faults ([`rig`]), a seeded generator ([`prng`]), and the closed loop with step-response
+//! faults ([`plant`]), a seeded generator ([`prng`]), and the closed loop with step-response
 //! measures ([`harness`]). Nominal parameters and why they are plausible: docs/control.md.
 //!
 //! Left out on purpose: PWM ripple (20 kHz, averaged), gyroscopic torques between the axes
@@ -11,9 +11,9 @@
 pub mod experiments;
 pub mod harness;
 pub mod motor;
+pub mod plant;
 pub mod prng;
-pub mod rig;
 
 pub use harness::{ClosedLoop, StepMetrics, StepReport};
 pub use motor::{MotorParams, MotorState};
-pub use rig::{AxisFaults, AxisParams, Rig, RigParams, SensorParams};
+pub use plant::{AxisFaults, AxisParams, Plant, PlantParams, SensorParams};

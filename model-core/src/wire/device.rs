@@ -1,5 +1,6 @@
 //! The rig's side of the protocol: answer every command, pace the telemetry. No heap, no
-//! hardware: the firmware and the virtual rig both drive a [`Device`] over their own [`Rig`].
+//! hardware: the firmware and the virtual rig both drive a [`Device`] over their own [`Backend`]
+//! (what the protocol needs from the controller).
 
 use super::decode::{Decoder, FrameError};
 use super::encode::{EncodeError, encode};
@@ -11,7 +12,7 @@ use super::{MAX_FRAME_LEN, max_telemetry_hz};
 
 /// What the protocol needs from the controller, in wire units. Every setter either applies the
 /// whole change and returns `Ok`, or changes nothing and returns the reason.
-pub trait Rig {
+pub trait Backend {
     /// The current values for a telemetry frame (the `seq` field is overwritten by [`Device`]).
     fn telemetry(&self) -> Telemetry;
     /// Why and how often the device has reset.
@@ -87,7 +88,7 @@ impl Device {
         self.telemetry_hz
     }
 
-    /// Frames that could not be encoded (a rig value outside the wire range). A telemetry frame
+    /// Frames that could not be encoded (a controller value outside the wire range). A telemetry frame
     /// lost this way still uses up its sequence number, so the PC counts it as missing.
     pub fn encode_failures(&self) -> u32 {
         self.encode_failures
@@ -99,16 +100,25 @@ impl Device {
     }
 
     /// The boot announcement, to send once after reset.
-    pub fn hello<R: Rig>(&mut self, rig: &R, out: &mut [u8; MAX_FRAME_LEN]) -> Option<usize> {
-        self.encoded(&Frame::Hello(rig.reset_info()), out)
+    pub fn hello<B: Backend>(
+        &mut self,
+        backend: &B,
+        out: &mut [u8; MAX_FRAME_LEN],
+    ) -> Option<usize> {
+        self.encoded(&Frame::Hello(backend.reset_info()), out)
     }
 
     /// Feeds received bytes; `send` gets every answer as one complete frame.
-    pub fn receive<R: Rig>(&mut self, rig: &mut R, bytes: &[u8], mut send: impl FnMut(&[u8])) {
+    pub fn receive<B: Backend>(
+        &mut self,
+        backend: &mut B,
+        bytes: &[u8],
+        mut send: impl FnMut(&[u8]),
+    ) {
         let mut out = [0u8; MAX_FRAME_LEN];
         for &b in bytes {
             let answer = match self.decoder.push_command(b) {
-                Some(Ok(Frame::Command { id, command })) => self.execute(rig, id, command),
+                Some(Ok(Frame::Command { id, command })) => self.execute(backend, id, command),
                 Some(Err(FrameError::BadCommand { id, reason })) => Frame::Reject { id, reason },
                 // Not a command, or damaged beyond reading an id: the PC times out and retries.
                 _ => continue,
@@ -132,36 +142,37 @@ impl Device {
     }
 
     /// Carries out one command and returns the answer frame.
-    pub fn execute<R: Rig>(&mut self, rig: &mut R, id: u16, command: Command) -> Frame {
+    pub fn execute<B: Backend>(&mut self, backend: &mut B, id: u16, command: Command) -> Frame {
         let done = match command {
             Command::SetSpeeds {
                 precession_mrad_s,
                 spin_mrad_s,
             } => {
-                let ok = |v: i16, limit: ParamId| (0..=rig.param(limit)).contains(&i32::from(v));
+                let ok =
+                    |v: i16, limit: ParamId| (0..=backend.param(limit)).contains(&i32::from(v));
                 if ok(precession_mrad_s, ParamId::SpeedMax1MradS)
                     && ok(spin_mrad_s, ParamId::SpeedMax2MradS)
                 {
-                    rig.set_speeds(precession_mrad_s, spin_mrad_s)
+                    backend.set_speeds(precession_mrad_s, spin_mrad_s)
                 } else {
                     Err(Reason::Range)
                 }
             }
-            Command::SetResidence { model, time_ms } => rig.set_residence(model, time_ms),
-            Command::Start => rig.start(),
+            Command::SetResidence { model, time_ms } => backend.set_residence(model, time_ms),
+            Command::Start => backend.start(),
             Command::Stop => {
-                rig.stop();
+                backend.stop();
                 Ok(())
             }
-            Command::ClearFault => rig.clear_fault(),
+            Command::ClearFault => backend.clear_fault(),
             Command::SetParam {
                 id: ParamId::TelemetryHz,
                 value,
             } => self.set_telemetry_hz(value),
-            Command::SetParam { id: param, value } => rig.set_param(param, value),
+            Command::SetParam { id: param, value } => backend.set_param(param, value),
             Command::GetStatus => {
-                let t = rig.telemetry();
-                let reset = rig.reset_info();
+                let t = backend.telemetry();
+                let reset = backend.reset_info();
                 return Frame::Status {
                     id,
                     status: Status {
@@ -177,16 +188,16 @@ impl Device {
             Command::GetParams => {
                 return Frame::Params {
                     id,
-                    values: self.params(rig),
+                    values: self.params(backend),
                 };
             }
-            Command::Inject(what) => rig.inject(what),
+            Command::Inject(what) => backend.inject(what),
             Command::Ping => {
-                rig.heartbeat();
+                backend.heartbeat();
                 Ok(())
             }
-            Command::Commission => rig.commission(),
-            Command::GetModels => match rig.models() {
+            Command::Commission => backend.commission(),
+            Command::GetModels => match backend.models() {
                 Ok(axes) => return Frame::Models { id, axes },
                 Err(reason) => Err(reason),
             },
@@ -198,12 +209,12 @@ impl Device {
     }
 
     /// Every parameter value, in wire order.
-    pub fn params<R: Rig>(&self, rig: &R) -> ParamValues {
+    pub fn params<B: Backend>(&self, backend: &B) -> ParamValues {
         let mut values = [0i32; PARAM_COUNT];
         for (slot, &p) in values.iter_mut().zip(ParamId::ALL.iter()) {
             *slot = match p {
                 ParamId::TelemetryHz => i32::from(self.telemetry_hz),
-                _ => rig.param(p),
+                _ => backend.param(p),
             };
         }
         values
@@ -222,9 +233,9 @@ impl Device {
     }
 
     /// Builds the telemetry frame if one is due at `now_ms` (call at least once per period).
-    pub fn poll_telemetry<R: Rig>(
+    pub fn poll_telemetry<B: Backend>(
         &mut self,
-        rig: &R,
+        backend: &B,
         now_ms: u32,
         out: &mut [u8; MAX_FRAME_LEN],
     ) -> Option<usize> {
@@ -246,7 +257,7 @@ impl Device {
             self.schedule_start_ms = Some(start.wrapping_add(1_000_000));
             self.frames_scheduled -= (hz * 1000) as u32;
         }
-        let mut t = rig.telemetry();
+        let mut t = backend.telemetry();
         t.seq = self.seq;
         self.seq = self.seq.wrapping_add(1);
         self.encoded(&Frame::Telemetry(t), out)

@@ -13,7 +13,7 @@
 //!
 //! - [`types`]: the plain data (telemetry, commands, answers);
 //! - [`encode()`] and [`decode`]: the codec and the streaming [`Decoder`];
-//! - [`device`]: the rig's side (command dispatch, telemetry pacing) over the [`device::Rig`] trait.
+//! - [`device`]: the rig's side (command dispatch, telemetry pacing) over the [`device::Backend`] trait.
 
 pub mod crc;
 pub mod decode;

@@ -8,7 +8,7 @@ use core::cell::UnsafeCell;
 use model_core::control::estimator::PulseSpeedEstimator;
 use model_core::control::{Controller, ControllerConfig, Fault, Rejection, State};
 use model_core::sim::experiments::{rig_with_pulses, true_model_config};
-use model_core::sim::{ClosedLoop, Rig, RigParams, StepMetrics};
+use model_core::sim::{ClosedLoop, Plant, PlantParams, StepMetrics};
 
 /// Cases of this module.
 pub static CASES: &[Case] = &[
@@ -102,10 +102,10 @@ fn rejected_commands_change_nothing() -> Result<(), Failure> {
     )
 }
 
-fn true_model_loop(rig: RigParams) -> Result<ClosedLoop, Failure> {
+fn true_model_loop(rig: PlantParams) -> Result<ClosedLoop, Failure> {
     let cfg = true_model_config(&rig);
     let ctrl = Controller::new(cfg).map_err(|_| fail("config"))?;
-    Ok(ClosedLoop::new(Rig::new(rig, 2), ctrl))
+    Ok(ClosedLoop::new(Plant::new(rig, 2), ctrl))
 }
 
 /// 0 -> 3 rad/s on the nominal rig (the true model given, no commissioning, to keep the
@@ -166,7 +166,7 @@ fn dead_sensor_stops_both_motors() -> Result<(), Failure> {
 fn commissioning_identifies_the_rig() -> Result<(), Failure> {
     let rig = rig_with_pulses(12);
     let mut cl = ClosedLoop::new(
-        Rig::new(rig, 4),
+        Plant::new(rig, 4),
         Controller::new(ControllerConfig::nominal()).map_err(|_| fail("config"))?,
     );
     ensure(

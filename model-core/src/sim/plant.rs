@@ -68,7 +68,7 @@ pub struct AxisParams {
 
 /// The whole rig.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RigParams {
+pub struct PlantParams {
     /// `[precession, spin]`.
     pub axes: [AxisParams; 2],
     /// Supply voltage, V.
@@ -86,7 +86,7 @@ pub struct RigParams {
     pub substeps: u32,
 }
 
-impl RigParams {
+impl PlantParams {
     /// The nominal rig: nominal motors, 12 pulses per revolution, ideal sensors, a small load
     /// ripple (2 mN m: a 0.2 kg load 1 mm off-centre), rigid coupling at 60 degrees.
     pub const fn nominal() -> Self {
@@ -134,8 +134,8 @@ struct AxisSim {
 
 /// The simulated rig.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Rig {
-    p: RigParams,
+pub struct Plant {
+    p: PlantParams,
     axes: [AxisSim; 2],
     time_s: f64,
     rng: Prng,
@@ -143,9 +143,9 @@ pub struct Rig {
     mask: u32,
 }
 
-impl Rig {
+impl Plant {
     /// A rig at rest at time 0; `seed` fixes tooth errors, jitter and fault draws.
-    pub fn new(p: RigParams, seed: u32) -> Self {
+    pub fn new(p: PlantParams, seed: u32) -> Self {
         let a = AxisSim {
             motor: MotorState::default(),
             angle_rad: 0.0,
@@ -179,11 +179,11 @@ impl Rig {
     }
 
     /// Parameters.
-    pub fn params(&self) -> &RigParams {
+    pub fn params(&self) -> &PlantParams {
         &self.p
     }
     /// Parameters, to inject a fault or a load change mid-run.
-    pub fn params_mut(&mut self) -> &mut RigParams {
+    pub fn params_mut(&mut self) -> &mut PlantParams {
         &mut self.p
     }
     /// Simulation time, s.
@@ -202,7 +202,7 @@ impl Rig {
     pub fn now_ticks(&self) -> u32 {
         ticks_of(self.time_s, self.p.timer_hz) & self.mask
     }
-    /// Edges captured on `axis` during the last [`Rig::advance`].
+    /// Edges captured on `axis` during the last [`Plant::advance`].
     pub fn edges(&self, axis: usize) -> &[u32] {
         &self.axes[axis].buf[..self.axes[axis].len]
     }

@@ -1,16 +1,16 @@
 //! The virtual rig behind `bowl sim --pty` / `--capture`: the simulated plant
-//! (`model_core::sim::Rig`) in place of the motors and sensors, and in front of it the same
+//! (`model_core::sim::Plant`) in place of the motors and sensors, and in front of it the same
 //! binding of the controller and the particle model to the protocol that the firmware runs
-//! (`model_core::binding::ControlledRig`).
+//! (`model_core::binding::ControllerBackend`).
 //!
 //! Only the fault injection (INJECT) is particular to the simulation. It sits between the
 //! plant and the controller: a lost sensor withholds the plant's edges from the controller, a
 //! stalled motor gets no drive (its duty never reaches the plant).
 
 use anyhow::{Result, anyhow};
-use model_core::binding::{ControlledRig, Injector, default_params, persisted};
+use model_core::binding::{ControllerBackend, Injector, default_params, persisted};
 use model_core::control::{ControllerConfig, State};
-use model_core::sim::RigParams;
+use model_core::sim::PlantParams;
 use model_core::wire::{Hello, Injection, ParamId, Reason, ResetCause};
 
 /// Simulated seconds of the identification run at boot (it ends much sooner).
@@ -45,20 +45,20 @@ impl SimFaults {
 
 /// The plant, and the controller bound to the protocol.
 #[derive(Clone)]
-pub struct SimulatedRig {
-    plant: model_core::sim::Rig,
-    rig: ControlledRig<SimFaults>,
+pub struct SimulatedBackend {
+    plant: model_core::sim::Plant,
+    rig: ControllerBackend<SimFaults>,
     ticks: u64,
     total_ms: u64,
     now_ms: u32,
 }
 
-impl SimulatedRig {
+impl SimulatedBackend {
     /// The nominal plant (seeded noise) and the nominal controller (told the plant's teeth),
     /// commissioned on the plant as the real rig is once after assembly (through the same
     /// COMMISSION path the wire uses), then at rest at device time 0.
     pub fn new(seed: u32) -> Result<Self> {
-        let plant_params = RigParams::nominal();
+        let plant_params = PlantParams::nominal();
         let base = ControllerConfig::nominal();
         let mut params = default_params();
         for (id, axis) in [(ParamId::Teeth1, 0), (ParamId::Teeth2, 1)] {
@@ -69,7 +69,7 @@ impl SimulatedRig {
             reset_count: 0,
         };
         let models = [base.axes[0].model, base.axes[1].model];
-        let (rig, checked) = ControlledRig::new(
+        let (rig, checked) = ControllerBackend::new(
             base,
             persisted(&params, &models),
             hello,
@@ -77,13 +77,13 @@ impl SimulatedRig {
         );
         checked.map_err(|r| anyhow!("rig parameters refused: {}", r.token()))?;
         let mut sim = Self {
-            plant: model_core::sim::Rig::new(plant_params, seed),
+            plant: model_core::sim::Plant::new(plant_params, seed),
             rig,
             ticks: 0,
             total_ms: 0,
             now_ms: 0,
         };
-        use model_core::wire::device::Rig as _;
+        use model_core::wire::device::Backend as _;
         sim.rig
             .commission()
             .map_err(|r| anyhow!("commissioning refused: {}", r.token()))?;
@@ -108,12 +108,12 @@ impl SimulatedRig {
     }
 
     /// The controller and particle model behind the protocol.
-    pub fn bound(&self) -> &ControlledRig<SimFaults> {
+    pub fn bound(&self) -> &ControllerBackend<SimFaults> {
         &self.rig
     }
 
     /// The same, to hand to the protocol device.
-    pub fn bound_mut(&mut self) -> &mut ControlledRig<SimFaults> {
+    pub fn bound_mut(&mut self) -> &mut ControllerBackend<SimFaults> {
         &mut self.rig
     }
 
@@ -162,12 +162,12 @@ impl SimulatedRig {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use model_core::wire::device::Rig as _;
+    use model_core::wire::device::Backend as _;
 
     /// The nominal parameters are all inside their wire ranges (else PARAMS would fail).
     #[test]
     fn nominal_parameters_fit_the_wire() {
-        let rig = SimulatedRig::new(1).unwrap();
+        let rig = SimulatedBackend::new(1).unwrap();
         for id in ParamId::ALL {
             if id == ParamId::TelemetryHz {
                 continue;
@@ -182,7 +182,7 @@ mod tests {
     /// controller's float configuration).
     #[test]
     fn parameters_round_trip() {
-        let mut rig = SimulatedRig::new(1).unwrap();
+        let mut rig = SimulatedBackend::new(1).unwrap();
         for (id, v) in [
             (ParamId::RimUm, 150_000),
             (ParamId::StartUm, 40_000),
@@ -209,12 +209,12 @@ mod tests {
     use proptest::prelude::*;
 
     /// Commissioning at boot dominates a debug-build test: do it once.
-    fn commissioned() -> &'static SimulatedRig {
-        static RIG: std::sync::OnceLock<SimulatedRig> = std::sync::OnceLock::new();
-        RIG.get_or_init(|| SimulatedRig::new(3).unwrap())
+    fn commissioned() -> &'static SimulatedBackend {
+        static RIG: std::sync::OnceLock<SimulatedBackend> = std::sync::OnceLock::new();
+        RIG.get_or_init(|| SimulatedBackend::new(3).unwrap())
     }
 
-    fn all_params(rig: &SimulatedRig) -> Vec<i32> {
+    fn all_params(rig: &SimulatedBackend) -> Vec<i32> {
         ParamId::ALL
             .iter()
             .map(|&id| rig.bound().param(id))
