@@ -9,7 +9,9 @@
 //!
 //! Slot layout (little-endian words): magic `BOWL`, version (u16) + value count (u16),
 //! sequence (u32), reserved (u32, 0), `MAX_VALUES` values (i32, unused ones 0), CRC-32 (IEEE)
-//! of all the preceding bytes of the slot.
+//! of all the preceding bytes of the slot: the protocol's CRC, `model_core::wire::crc`.
+
+use model_core::wire::crc::crc32;
 
 use super::hal::{FlashError, FlashRegion};
 
@@ -49,20 +51,6 @@ pub enum SaveError {
     Flash(FlashError),
     /// The record read back differs from what was written.
     Verify,
-}
-
-/// CRC-32 (IEEE 802.3, reflected, init and final xor all ones), bitwise: small, and only run
-/// on load and save.
-pub fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = u32::MAX;
-    for &b in bytes {
-        crc ^= u32::from(b);
-        for _ in 0..8 {
-            let mask = (crc & 1).wrapping_neg();
-            crc = (crc >> 1) ^ (0xEDB8_8320 & mask);
-        }
-    }
-    !crc
 }
 
 /// The parameter log over one flash region.
@@ -251,10 +239,34 @@ mod tests {
         }
     }
 
+    /// CRC-32 (IEEE 802.3: reflected polynomial 0xEDB88320, init and final xor all ones) bit by
+    /// bit, straight from its definition: the reference the records written before the log
+    /// shared the protocol's CRC were checked against.
+    fn crc32_by_definition(bytes: &[u8]) -> u32 {
+        let mut crc = u32::MAX;
+        for &b in bytes {
+            crc ^= u32::from(b);
+            for _ in 0..8 {
+                crc = if crc & 1 != 0 {
+                    (crc >> 1) ^ 0xEDB8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        !crc
+    }
+
     #[test]
-    fn crc32_matches_the_standard_check_value() {
+    fn record_crc_is_the_ieee_crc32_so_stored_records_still_load() {
         // The CRC-32/ISO-HDLC check value of "123456789" (Greg Cook's CRC catalogue).
-        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+        assert_eq!(crc32_by_definition(b"123456789"), 0xCBF4_3926);
+        let mut log = ParamLog::new(RamFlash::<{ 2 * SLOT_BYTES }>::new());
+        log.save(&[42, -7, 1_000_000]).unwrap();
+        let flash = log.into_inner();
+        let slot = &flash.bytes[..SLOT_BYTES];
+        let stored = u32::from_le_bytes(slot[SLOT_BYTES - 4..].try_into().unwrap());
+        assert_eq!(stored, crc32_by_definition(&slot[..SLOT_BYTES - 4]));
     }
 
     #[test]
