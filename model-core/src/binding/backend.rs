@@ -1,61 +1,24 @@
-//! The one binding of the controller ([`crate::control`]) and the particle model
-//! ([`crate::particle`]) to the serial protocol's rig interface ([`crate::wire::device::Backend`]).
-//! No heap, no hardware: the Black Pill firmware, the emulated board under QEMU and the host's
-//! virtual rig (`bowl sim --pty/--capture`) all run this code; each supplies only what is its
-//! own (the motors and sensors or a simulated plant, and an [`Injector`] for INJECT).
-//!
-//! The parameters in force are kept in wire units (what SET sent is what PARAMS reports,
-//! exactly), and the controller's configuration is derived from them:
-//! - `RIM_UM`, `START_UM`, `MU_PPM`, `K2_PPM`: the particle scene for `RTIME` and the predicted
-//!   residence times (paper Eq. 6/7 flat, Eq. 10/11 with the MODEL-NOTES coefficients) at the
-//!   controller's combined bowl speed (paper Eq. 2); gravity 9.81 m/s^2.
-//! - `AXES_MDEG`: `axes_angle_rad` (paper Eq. 2); `RATIO_PPM`: `spin_per_precession`.
-//! - per axis n: `BWn_MRAD_S` `bandwidth_rad_s`, `PER_PULSEn_MILLI` `per_pulse_bandwidth`
-//!   (both changeable while running, bumpless), `SPEED_MAXn_MRAD_S` `max_speed_rad_s` (the
-//!   over-speed fault limit follows at [`OVERSPEED_PER_MAX`] times it), `ACCELn_MRAD_S2`
-//!   `accel_limit_rad_s2`, `DUTY_MAXn_BP` `duty_limit`, `TEETHn` `pulses_per_rev` (these only
-//!   while idle or faulted).
-//!
-//! A value the scene check or the controller's validation refuses is rejected with `RANGE`
-//! (or `STATE` when the controller is busy) and changes nothing.
+//! [`ControllerBackend`]: the controller and the particle scene behind the protocol's
+//! [`Backend`] trait. It keeps the parameters in wire units and the motor models to persist,
+//! and turns the controller's states, faults and refusals into the wire's codes.
 
+use super::configure::{AxisSetting, ParamRole, derive, with_models};
+use super::record::{Persisted, persisted, split_persisted};
+use super::{AXES, Injector, default_params};
 use crate::control::{
     BowlSpeedForResidence, Controller, ControllerConfig, Fault, InverseFailure, MotorModel,
     Rejection, State,
 };
 use crate::particle::{self, InverseError, Model, Outcome, Scene};
-use crate::wire::device::{Backend, DEFAULT_TELEMETRY_HZ};
+use crate::wire::device::Backend;
 use crate::wire::{
-    AxisModel, DeviceState, FaultCode, Hello, Injection, MODEL_FIELD_MAX, MotorTelemetry,
-    PARAM_COUNT, ParamId, ParamValues, Reason, Residence, ResidenceModel, Telemetry,
+    AxisModel, DeviceState, FaultCode, Hello, Injection, MODEL_FIELD_MAX, MotorTelemetry, ParamId,
+    ParamValues, Reason, Residence, ResidenceModel, Telemetry,
 };
-
-/// Motor axes: precession (0) and spin (1).
-pub const AXES: usize = 2;
-
-/// Over-speed fault limit as a multiple of `SPEED_MAX` (the nominal 5.5 / 4.0 rad/s).
-pub const OVERSPEED_PER_MAX: f32 = 1.375;
-const GRAVITY_M_S2: f32 = 9.81;
 
 /// Nearest integer as f32 (ties away from zero); a cast after it saturates and maps NaN to 0.
 fn round(x: f32) -> f32 {
     libm::roundf(x)
-}
-
-/// Where fault injections go: the emulated board's plant, or nowhere on real hardware.
-pub trait Injector {
-    /// Applies `what` or says why not.
-    fn inject(&mut self, what: Injection) -> Result<(), Reason>;
-}
-
-/// Real hardware: nothing can be injected.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct NoInjection;
-
-impl Injector for NoInjection {
-    fn inject(&mut self, _what: Injection) -> Result<(), Reason> {
-        Err(Reason::Unsupported)
-    }
 }
 
 /// The particle scene as the controller's model traits.
@@ -94,142 +57,6 @@ impl SceneModel {
             Err(_) => Residence::Unavailable,
         }
     }
-}
-
-/// The parameter values a new board starts with (wire units, wire order): the controller's
-/// nominal configuration and the particle model's default scene.
-pub fn default_params() -> ParamValues {
-    let cfg = ControllerConfig::nominal();
-    let scene = Scene::<f32>::default();
-    let milli = |x: f32| round(x * 1000.0) as i32;
-    let micro = |x: f32| round(x * 1e6) as i32;
-    let mut v = [0i32; PARAM_COUNT];
-    for id in ParamId::ALL {
-        let (a, b) = (&cfg.axes[0], &cfg.axes[1]);
-        v[id.index()] = match id {
-            ParamId::RimUm => micro(scene.rim_radius_m),
-            ParamId::StartUm => micro(scene.ri_m),
-            ParamId::MuPpm => micro(scene.mu),
-            ParamId::K2Ppm => micro(scene.k2),
-            ParamId::AxesMdeg => milli(cfg.axes_angle_rad.to_degrees()),
-            ParamId::Bandwidth1MradS => milli(a.bandwidth_rad_s),
-            ParamId::Bandwidth2MradS => milli(b.bandwidth_rad_s),
-            ParamId::PerPulse1Milli => milli(a.per_pulse_bandwidth),
-            ParamId::PerPulse2Milli => milli(b.per_pulse_bandwidth),
-            ParamId::SpeedMax1MradS => milli(a.max_speed_rad_s),
-            ParamId::SpeedMax2MradS => milli(b.max_speed_rad_s),
-            ParamId::Accel1MradS2 => milli(a.accel_limit_rad_s2),
-            ParamId::Accel2MradS2 => milli(b.accel_limit_rad_s2),
-            ParamId::DutyMax1Bp => round(a.duty_limit * 10_000.0) as i32,
-            ParamId::DutyMax2Bp => round(b.duty_limit * 10_000.0) as i32,
-            ParamId::Teeth1 => i32::from(a.pulses_per_rev),
-            ParamId::Teeth2 => i32::from(b.pulses_per_rev),
-            ParamId::RatioPpm => micro(cfg.spin_per_precession),
-            ParamId::TelemetryHz => i32::from(DEFAULT_TELEMETRY_HZ),
-        };
-    }
-    v
-}
-
-/// Values persisted in flash: the wire parameters (wire order), then per axis the motor model
-/// in force (identified by commissioning, or nominal): back-EMF constant, friction duty, time
-/// constant, as f32 bit patterns.
-pub const PERSISTED_COUNT: usize = PARAM_COUNT + 3 * AXES;
-/// One persisted record's values.
-pub type Persisted = [i32; PERSISTED_COUNT];
-
-/// Joins parameters and motor models into a record.
-pub fn persisted(params: &ParamValues, models: &[MotorModel; AXES]) -> Persisted {
-    let mut v = [0i32; PERSISTED_COUNT];
-    v[..PARAM_COUNT].copy_from_slice(params);
-    for (i, m) in models.iter().enumerate() {
-        let at = PARAM_COUNT + 3 * i;
-        v[at] = m.volts_per_rad_s.to_bits() as i32;
-        v[at + 1] = m.friction_duty.to_bits() as i32;
-        v[at + 2] = m.time_constant_s.to_bits() as i32;
-    }
-    v
-}
-
-/// Splits a record into parameters and motor models.
-pub fn split_persisted(v: &Persisted) -> (ParamValues, [MotorModel; AXES]) {
-    let mut params = [0i32; PARAM_COUNT];
-    params.copy_from_slice(&v[..PARAM_COUNT]);
-    let f = |k: usize| f32::from_bits(v[k] as u32);
-    let model = |i: usize| {
-        let at = PARAM_COUNT + 3 * i;
-        MotorModel {
-            volts_per_rad_s: f(at),
-            friction_duty: f(at + 1),
-            time_constant_s: f(at + 2),
-        }
-    };
-    (params, [model(0), model(1)])
-}
-
-/// The record a new board starts with: [`default_params`] and the nominal motor models.
-pub fn default_persisted() -> Persisted {
-    let cfg = ControllerConfig::nominal();
-    persisted(&default_params(), &[cfg.axes[0].model, cfg.axes[1].model])
-}
-
-fn with_models(base: &ControllerConfig, models: &[MotorModel; AXES]) -> ControllerConfig {
-    let mut cfg = *base;
-    for (a, m) in cfg.axes.iter_mut().zip(models) {
-        a.model = *m;
-    }
-    cfg
-}
-
-/// Controller configuration and scene for a set of wire parameters, or why they do not fit.
-fn derive(
-    base: &ControllerConfig,
-    v: &ParamValues,
-) -> Result<(ControllerConfig, Scene<f32>), Reason> {
-    let p = |id: ParamId| v[id.index()] as f32;
-    let scene = Scene {
-        omega_rad_s: 0.0,
-        mu: p(ParamId::MuPpm) * 1e-6,
-        g_m_s2: GRAVITY_M_S2,
-        k2: p(ParamId::K2Ppm) * 1e-6,
-        ri_m: p(ParamId::StartUm) * 1e-6,
-        rim_radius_m: p(ParamId::RimUm) * 1e-6,
-    };
-    if scene.validate_except_omega().is_err() || scene.ri_m >= scene.rim_radius_m {
-        return Err(Reason::Range);
-    }
-    let mut cfg = *base;
-    cfg.axes_angle_rad = (p(ParamId::AxesMdeg) * 1e-3).to_radians();
-    cfg.spin_per_precession = p(ParamId::RatioPpm) * 1e-6;
-    let per_axis = [
-        [
-            ParamId::Bandwidth1MradS,
-            ParamId::PerPulse1Milli,
-            ParamId::SpeedMax1MradS,
-            ParamId::Accel1MradS2,
-            ParamId::DutyMax1Bp,
-            ParamId::Teeth1,
-        ],
-        [
-            ParamId::Bandwidth2MradS,
-            ParamId::PerPulse2Milli,
-            ParamId::SpeedMax2MradS,
-            ParamId::Accel2MradS2,
-            ParamId::DutyMax2Bp,
-            ParamId::Teeth2,
-        ],
-    ];
-    for (a, [bw, per_pulse, max, accel, duty, teeth]) in cfg.axes.iter_mut().zip(per_axis) {
-        a.bandwidth_rad_s = p(bw) * 1e-3;
-        a.per_pulse_bandwidth = p(per_pulse) * 1e-3;
-        a.max_speed_rad_s = p(max) * 1e-3;
-        a.overspeed_rad_s = a.max_speed_rad_s * OVERSPEED_PER_MAX;
-        a.accel_limit_rad_s2 = p(accel) * 1e-3;
-        a.duty_limit = p(duty) * 1e-4;
-        a.pulses_per_rev = u16::try_from(v[teeth.index()]).map_err(|_| Reason::Range)?;
-    }
-    cfg.validate().map_err(|_| Reason::Range)?;
-    Ok((cfg, scene))
 }
 
 fn reason(r: Rejection) -> Reason {
@@ -461,27 +288,22 @@ impl<I: Injector> Backend for ControllerBackend<I> {
         next[id.index()] = value;
         // The motor models in force (perhaps from commissioning) stay as they are.
         let (cfg, scene) = derive(&with_models(&self.base, &self.models()), &next)?;
-        match id {
+        match ParamRole::of(id) {
             // Owned by the protocol device, never passed here.
-            ParamId::TelemetryHz => return Err(Reason::Internal),
+            ParamRole::TelemetryRate => return Err(Reason::Internal),
             // The scene only feeds RTIME and the predictions: any time.
-            ParamId::RimUm | ParamId::StartUm | ParamId::MuPpm | ParamId::K2Ppm => {}
+            ParamRole::Scene => {}
             // Loop tuning: also while running, bumpless.
-            ParamId::Bandwidth1MradS
-            | ParamId::Bandwidth2MradS
-            | ParamId::PerPulse1Milli
-            | ParamId::PerPulse2Milli => {
-                let axis = usize::from(matches!(
-                    id,
-                    ParamId::Bandwidth2MradS | ParamId::PerPulse2Milli
-                ));
-                let a = &cfg.axes[axis];
+            ParamRole::Axis(axis, AxisSetting::Bandwidth | AxisSetting::PerPulseBandwidth) => {
+                let a = cfg.axes.get(axis).ok_or(Reason::Internal)?;
                 self.ctrl
                     .set_loop_tuning(axis, a.bandwidth_rad_s, a.per_pulse_bandwidth)
                     .map_err(reason)?;
             }
             // Everything else rebuilds the controller: idle or faulted only.
-            _ => self.ctrl.set_parameters(cfg).map_err(reason)?,
+            ParamRole::AxesAngle | ParamRole::SplitRatio | ParamRole::Axis(..) => {
+                self.ctrl.set_parameters(cfg).map_err(reason)?
+            }
         }
         self.scene = scene;
         self.params = next;
@@ -545,6 +367,7 @@ mod tests {
     extern crate std;
 
     use super::*;
+    use crate::binding::{NoInjection, default_persisted};
     use crate::wire::device::Device;
     use crate::wire::{Frame, ResetCause, decode_frame};
 
