@@ -191,53 +191,7 @@ fn put_word(slot: &mut [u8], at: usize, value: u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// NOR flash in RAM: programming can only clear bits, erase sets them all.
-    struct RamFlash<const S: usize> {
-        bytes: [u8; S],
-        erases: u32,
-        /// Bytes of the next write that actually land (simulates a reset mid-write).
-        cut_next_write_at: Option<usize>,
-    }
-
-    impl<const S: usize> RamFlash<S> {
-        fn new() -> Self {
-            Self {
-                bytes: [0xFF; S],
-                erases: 0,
-                cut_next_write_at: None,
-            }
-        }
-    }
-
-    impl<const S: usize> FlashRegion for RamFlash<S> {
-        const SIZE: u32 = S as u32;
-        fn read(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
-            let o = offset as usize;
-            let src = self
-                .bytes
-                .get(o..o + buf.len())
-                .ok_or(FlashError::OutOfBounds)?;
-            buf.copy_from_slice(src);
-            Ok(())
-        }
-        fn write(&mut self, offset: u32, data: &[u8]) -> Result<(), FlashError> {
-            let o = offset as usize;
-            if !o.is_multiple_of(4) || !data.len().is_multiple_of(4) || o + data.len() > S {
-                return Err(FlashError::OutOfBounds);
-            }
-            let n = self.cut_next_write_at.take().unwrap_or(data.len());
-            for (dst, &b) in self.bytes[o..o + n].iter_mut().zip(data) {
-                *dst &= b;
-            }
-            Ok(())
-        }
-        fn erase(&mut self) -> Result<(), FlashError> {
-            self.bytes = [0xFF; S];
-            self.erases += 1;
-            Ok(())
-        }
-    }
+    use crate::app::test_flash::RamFlash;
 
     /// CRC-32 (IEEE 802.3: reflected polynomial 0xEDB88320, init and final xor all ones) bit by
     /// bit, straight from its definition: the reference the records written before the log

@@ -27,11 +27,12 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
 use embassy_time::{Duration, Ticker};
 use firmware::app::binding::{
-    ControllerBackend, DeviceCore, NoInjection, PERSISTED_COUNT, default_persisted,
+    ControllerBackend, DeviceCore, NoInjection, PERSISTED_COUNT, default_persisted, split_persisted,
 };
 use firmware::app::hal::Watchdog;
 use firmware::app::motors::Motors;
 use firmware::app::params::ParamLog;
+use firmware::app::persist::{PersistEvent, Persistence};
 use firmware::app::reset;
 use firmware::app::slot::Slot;
 use firmware::app::tasks::{self, Heartbeat, SharedCore};
@@ -204,39 +205,18 @@ async fn supervisor_task(
     log: &'static mut ParamLog<ParamSector>,
 ) {
     let feed = tasks::supervisor(watchdog, &HEARTBEAT);
-    let persist = async {
-        let mut ticker = Ticker::every(Duration::from_millis(500));
-        let mut reported_lost = [0u32; 2];
-        loop {
-            ticker.next().await;
-            let (values, lost) = core.lock(|c| {
-                let mut c = c.borrow_mut();
-                let lost = c.dropped_edges();
-                if c.backend.take_params_to_save() {
-                    (Some(c.params_to_persist()), lost)
-                } else {
-                    (None, lost)
-                }
-            });
-            // The wire has no field for capture losses: say so in the log, never silently.
-            if lost != reported_lost {
-                warn!(
-                    "capture: edges lost so far: precession {}, spin {}",
-                    lost[0], lost[1]
-                );
-                reported_lost = lost;
-            }
-            if let Some(v) = values {
-                match log.save(&v) {
-                    Ok(()) => {
-                        let (_, models) = firmware::app::binding::split_persisted(&v);
-                        info!("params: saved; motor models {} / {}", models[0], models[1]);
-                    }
-                    Err(e) => error!("params: save failed: {}", e),
-                }
-            }
+    let persist = Persistence::new(log).run(core, |event| match event {
+        // The wire has no field for capture losses: say so in the log, never silently.
+        PersistEvent::EdgesLost(lost) => warn!(
+            "capture: edges lost so far: precession {}, spin {}",
+            lost[0], lost[1]
+        ),
+        PersistEvent::Saved(record) => {
+            let (_, models) = split_persisted(&record);
+            info!("params: saved; motor models {} / {}", models[0], models[1]);
         }
-    };
+        PersistEvent::SaveFailed(e) => error!("params: save failed: {}", e),
+    });
     embassy_futures::join::join(feed, persist).await;
 }
 
