@@ -12,9 +12,9 @@ use commands::HostWatch;
 
 use super::commission::{Commissioning, Identified, IdentifyError, Phase};
 use super::config::{ConfigError, ControllerConfig};
-use super::pi::{LoopInput, SpeedLoop};
+use super::pi::LoopInput;
 use super::planner::{InverseFailure, ResidenceForBowlSpeed, SetpointPlanner};
-use super::supervisor::{Fault, SensorWatch, State, fault_code};
+use super::supervisor::{Fault, State, fault_code};
 use crate::bowl::{MotorSpeeds, combined_speed_from_trig};
 
 /// Why a command was refused. A refused command changes nothing.
@@ -418,8 +418,7 @@ impl Controller {
         self.state = State::Fault;
         for a in &mut self.axes {
             a.duty = 0.0;
-            a.speed_loop = SpeedLoop::REST;
-            a.watch = SensorWatch::CLEAR;
+            a.rest_loop();
         }
         self.planner.reset();
         self.commissioning = None;

@@ -41,4 +41,10 @@ impl AxisState {
             direction: 1.0,
         }
     }
+
+    /// Loop and sensor watch back to rest (a fresh start).
+    pub(super) const fn rest_loop(&mut self) {
+        self.speed_loop = SpeedLoop::REST;
+        self.watch = SensorWatch::CLEAR;
+    }
 }

@@ -1,11 +1,12 @@
 //! The host's commands. Each one, accepted or refused, is word from the host: it resets the
-//! host-silence timer in one place, [`Controller::command`].
+//! host-silence timer, in one place, [`Controller::command`] (the two `const` commands, which
+//! cannot take its closure, do the same first thing by hand).
 
 use super::Controller;
 use super::Rejection;
 use crate::control::commission::Commissioning;
 use crate::control::config::{ControllerConfig, in_range};
-use crate::control::pi::{LoopConstants, SpeedLoop};
+use crate::control::pi::LoopConstants;
 use crate::control::planner::{BowlSpeedForResidence, split_combined};
 use crate::control::supervisor::{Fault, SensorWatch, State};
 
@@ -86,18 +87,25 @@ impl Controller {
     /// Sets both motor speeds, rad/s (signed; sign = direction). Zero, or a magnitude within
     /// `[min_speed_rad_s, max_speed_rad_s]` of the axis. Allowed in Idle (taken at `start`),
     /// SpinningUp and Running; the planner ramps to it.
-    pub fn set_motor_speeds(
+    pub const fn set_motor_speeds(
         &mut self,
         precession_rad_s: f32,
         spin_rad_s: f32,
     ) -> Result<(), Rejection> {
-        self.command(|c| {
-            c.check_state_for_setpoint()?;
-            c.check_speed(0, precession_rad_s)?;
-            c.check_speed(1, spin_rad_s)?;
-            c.planner.set_targets([precession_rad_s, spin_rad_s]);
-            Ok(())
-        })
+        // What `command` does; a `const fn` (the benchmark builds its controller at compile
+        // time) cannot take a closure or use `?`.
+        self.host.heard();
+        if let Err(e) = self.check_state_for_setpoint() {
+            return Err(e);
+        }
+        if let Err(e) = self.check_speed(0, precession_rad_s) {
+            return Err(e);
+        }
+        if let Err(e) = self.check_speed(1, spin_rad_s) {
+            return Err(e);
+        }
+        self.planner.set_targets([precession_rad_s, spin_rad_s]);
+        Ok(())
     }
 
     /// Sets the motor speeds from a target residence time, s: the particle model's inverse
@@ -124,19 +132,19 @@ impl Controller {
     }
 
     /// Starts the closed loop (Idle -> SpinningUp) toward the current targets.
-    pub fn start(&mut self) -> Result<(), Rejection> {
-        self.command(|c| match c.state {
+    pub const fn start(&mut self) -> Result<(), Rejection> {
+        // What `command` does, in a `const fn` (see `set_motor_speeds`).
+        self.host.heard();
+        match self.state {
             State::Idle => {
-                for a in &mut c.axes {
-                    a.speed_loop = SpeedLoop::REST;
-                    a.watch = SensorWatch::CLEAR;
-                }
-                c.state = State::SpinningUp;
+                self.axes[0].rest_loop();
+                self.axes[1].rest_loop();
+                self.state = State::SpinningUp;
                 Ok(())
             }
-            State::Fault => Err(Rejection::Faulted(c.latched())),
+            State::Fault => Err(Rejection::Faulted(self.latched())),
             s => Err(Rejection::WrongState(s)),
-        })
+        }
     }
 
     /// Stops: ramps both axes to zero (Stopping, then Idle once both read zero). Aborts
@@ -231,9 +239,8 @@ impl Controller {
                     c.cfg.timer_hz as f32,
                 ));
                 c.identify_error = None;
-                for a in &mut c.axes {
-                    a.watch = SensorWatch::CLEAR;
-                }
+                c.axes[0].watch = SensorWatch::CLEAR;
+                c.axes[1].watch = SensorWatch::CLEAR;
                 c.state = State::Commissioning;
                 Ok(())
             }
