@@ -4,7 +4,7 @@
 //! how an event is logged.
 
 use embassy_sync::blocking_mutex::raw::RawMutex;
-use embassy_time::{Duration, Ticker};
+use embassy_time::Duration;
 
 use super::binding::{DeviceCore, Injector, Persisted};
 use super::hal::FlashRegion;
@@ -37,17 +37,18 @@ impl<I: Injector> PersistSource for DeviceCore<I> {
 }
 
 /// What one step of the loop did, for the board's log.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum PersistEvent {
-    /// The capture queues have lost more edges: the totals so far, per axis.
-    EdgesLost([u32; AXES]),
-    /// This record was saved (or was already the newest one in flash).
-    Saved(Persisted),
-    /// The save failed; the previous record stays in force.
-    SaveFailed(SaveError),
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PersistReport {
+    /// The capture queues have lost more edges since the last report: the totals so far, per
+    /// axis.
+    pub edges_lost: Option<[u32; AXES]>,
+    /// A record was due: saved (or already the newest one in flash), or why not (the previous
+    /// record then stays in force).
+    pub saved: Option<Result<Persisted, SaveError>>,
 }
 
-/// The persistence state between steps: the flash log and the losses already reported.
+/// The persistence state between steps: the flash log and the losses already reported. The
+/// board calls [`Persistence::step`] every [`PERSIST_PERIOD`] and logs the report.
 pub struct Persistence<'a, F: FlashRegion> {
     log: &'a mut ParamLog<F>,
     reported_lost: [u32; AXES],
@@ -63,38 +64,20 @@ impl<'a, F: FlashRegion> Persistence<'a, F> {
     }
 
     /// One step: takes what is due from the core (a brief lock), then writes flash outside
-    /// the lock and tells `report` what happened.
+    /// the lock.
     pub fn step<RM: RawMutex, C: PersistSource>(
         &mut self,
         core: &SharedCore<RM, C>,
-        report: &mut impl FnMut(PersistEvent),
-    ) {
+    ) -> PersistReport {
         let (record, lost) = core.lock(|c| {
             let mut c = c.borrow_mut();
             (c.take_record_to_save(), c.dropped_edges())
         });
-        if lost != self.reported_lost {
-            report(PersistEvent::EdgesLost(lost));
-            self.reported_lost = lost;
-        }
-        if let Some(record) = record {
-            report(match self.log.save(&record) {
-                Ok(()) => PersistEvent::Saved(record),
-                Err(e) => PersistEvent::SaveFailed(e),
-            });
-        }
-    }
-
-    /// [`Persistence::step`] every [`PERSIST_PERIOD`], forever.
-    pub async fn run<RM: RawMutex, C: PersistSource>(
-        mut self,
-        core: &SharedCore<RM, C>,
-        mut report: impl FnMut(PersistEvent),
-    ) -> ! {
-        let mut ticker = Ticker::every(PERSIST_PERIOD);
-        loop {
-            ticker.next().await;
-            self.step(core, &mut report);
+        let edges_lost = (lost != self.reported_lost).then_some(lost);
+        self.reported_lost = lost;
+        PersistReport {
+            edges_lost,
+            saved: record.map(|r| self.log.save(&r).map(|()| r)),
         }
     }
 }
@@ -104,7 +87,6 @@ mod tests {
     extern crate std;
 
     use core::cell::RefCell;
-    use std::vec::Vec;
 
     use embassy_sync::blocking_mutex::Mutex;
     use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
@@ -149,32 +131,29 @@ mod tests {
         answer.expect("every command is answered")
     }
 
-    fn step(
-        p: &mut Persistence<'_, RamFlash<{ 4 * SLOT_BYTES }>>,
-        core: &Core,
-    ) -> Vec<PersistEvent> {
-        let mut events = Vec::new();
-        p.step(core, &mut |e| events.push(e));
-        events
-    }
+    const NOTHING: PersistReport = PersistReport {
+        edges_lost: None,
+        saved: None,
+    };
 
     #[test]
     fn a_changed_parameter_is_saved_once_and_loads_back() {
         let core = core();
         let mut log = ParamLog::new(RamFlash::<{ 4 * SLOT_BYTES }>::new());
         let mut p = Persistence::new(&mut log);
-        assert_eq!(step(&mut p, &core), [], "nothing changed yet");
+        assert_eq!(p.step(&core), NOTHING, "nothing changed yet");
         let set = Command::SetParam {
             id: ParamId::Teeth2,
             value: 60,
         };
         assert_eq!(send(&core, 1, set), Frame::Ack { id: 1 });
-        let events = step(&mut p, &core);
-        let [PersistEvent::Saved(record)] = events[..] else {
-            panic!("one save expected, got {events:?}");
+        let report = p.step(&core);
+        let Some(Ok(record)) = report.saved else {
+            panic!("one save expected, got {report:?}");
         };
+        assert_eq!(report.edges_lost, None);
         assert_eq!(record[ParamId::Teeth2.index()], 60);
-        assert_eq!(step(&mut p, &core), [], "saved once");
+        assert_eq!(p.step(&core), NOTHING, "saved once");
         let loaded = log.load::<PERSISTED_COUNT>().expect("the record loads");
         assert_eq!(loaded, record);
         let (params, _) = split_persisted(&loaded);
@@ -199,7 +178,7 @@ mod tests {
             value: 4000,
         };
         assert_eq!(send(&core, 3, tuning), Frame::Ack { id: 3 });
-        assert_eq!(step(&mut p, &core), []);
+        assert_eq!(p.step(&core), NOTHING);
         assert_eq!(log.load::<PERSISTED_COUNT>(), Err(LoadError::Empty));
     }
 
@@ -209,10 +188,14 @@ mod tests {
         let mut log = ParamLog::new(RamFlash::<{ 4 * SLOT_BYTES }>::new());
         let mut p = Persistence::new(&mut log);
         core.lock(|c| c.borrow_mut().set_dropped_edges([3, 0]));
-        assert_eq!(step(&mut p, &core), [PersistEvent::EdgesLost([3, 0])]);
-        assert_eq!(step(&mut p, &core), []);
+        let lost = |edges_lost| PersistReport {
+            edges_lost,
+            saved: None,
+        };
+        assert_eq!(p.step(&core), lost(Some([3, 0])));
+        assert_eq!(p.step(&core), NOTHING);
         core.lock(|c| c.borrow_mut().set_dropped_edges([3, 1]));
-        assert_eq!(step(&mut p, &core), [PersistEvent::EdgesLost([3, 1])]);
+        assert_eq!(p.step(&core), lost(Some([3, 1])));
     }
 
     #[test]
@@ -226,11 +209,7 @@ mod tests {
             value: 24,
         };
         assert_eq!(send(&core, 1, set), Frame::Ack { id: 1 });
-        let mut events = Vec::new();
-        p.step(&core, &mut |e| events.push(e));
-        assert!(
-            matches!(events[..], [PersistEvent::SaveFailed(_)]),
-            "{events:?}"
-        );
+        let report = p.step(&core);
+        assert!(matches!(report.saved, Some(Err(_))), "{report:?}");
     }
 }

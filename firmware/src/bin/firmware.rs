@@ -32,7 +32,7 @@ use firmware::app::binding::{
 use firmware::app::hal::Watchdog;
 use firmware::app::motors::Motors;
 use firmware::app::params::ParamLog;
-use firmware::app::persist::{PersistEvent, Persistence};
+use firmware::app::persist::{PERSIST_PERIOD, Persistence};
 use firmware::app::reset;
 use firmware::app::slot::Slot;
 use firmware::app::tasks::{self, Heartbeat, SharedCore};
@@ -205,18 +205,29 @@ async fn supervisor_task(
     log: &'static mut ParamLog<ParamSector>,
 ) {
     let feed = tasks::supervisor(watchdog, &HEARTBEAT);
-    let persist = Persistence::new(log).run(core, |event| match event {
-        // The wire has no field for capture losses: say so in the log, never silently.
-        PersistEvent::EdgesLost(lost) => warn!(
-            "capture: edges lost so far: precession {}, spin {}",
-            lost[0], lost[1]
-        ),
-        PersistEvent::Saved(record) => {
-            let (_, models) = split_persisted(&record);
-            info!("params: saved; motor models {} / {}", models[0], models[1]);
+    let persist = async {
+        let mut persistence = Persistence::new(log);
+        let mut ticker = Ticker::every(PERSIST_PERIOD);
+        loop {
+            ticker.next().await;
+            let report = persistence.step(core);
+            // The wire has no field for capture losses: say so in the log, never silently.
+            if let Some(lost) = report.edges_lost {
+                warn!(
+                    "capture: edges lost so far: precession {}, spin {}",
+                    lost[0], lost[1]
+                );
+            }
+            match report.saved {
+                Some(Ok(record)) => {
+                    let (_, models) = split_persisted(&record);
+                    info!("params: saved; motor models {} / {}", models[0], models[1]);
+                }
+                Some(Err(e)) => error!("params: save failed: {}", e),
+                None => {}
+            }
         }
-        PersistEvent::SaveFailed(e) => error!("params: save failed: {}", e),
-    });
+    };
     embassy_futures::join::join(feed, persist).await;
 }
 
