@@ -103,7 +103,7 @@ impl<F: FlashRegion> ParamLog<F> {
             }
             let (body, crc) = slot.split_at(SLOT_BYTES - 4);
             if word(&slot, 0) != MAGIC
-                || u32::from_le_bytes(crc.try_into().unwrap_or([0; 4])) != record_crc(body)
+                || u32::from_le_bytes(crc.try_into().unwrap_or([0; 4])) != crc32(body)
             {
                 scan.corrupt += 1;
                 continue;
@@ -168,7 +168,7 @@ impl<F: FlashRegion> ParamLog<F> {
         for (i, &v) in values.iter().enumerate() {
             put_word(&mut slot, 16 + 4 * i, v as u32);
         }
-        let crc = record_crc(&slot[..SLOT_BYTES - 4]);
+        let crc = crc32(&slot[..SLOT_BYTES - 4]);
         put_word(&mut slot, SLOT_BYTES - 4, crc);
         self.flash.write(offset, &slot).map_err(SaveError::Flash)?;
         if self.read_slot(offset).map_err(SaveError::Flash)? != slot {
@@ -176,13 +176,6 @@ impl<F: FlashRegion> ParamLog<F> {
         }
         Ok(())
     }
-}
-
-/// The CRC of a slot's bytes before its CRC word: the protocol's CRC-32, in one out-of-line
-/// copy for load and save (inlined into each it would cost flash).
-#[inline(never)]
-fn record_crc(body: &[u8]) -> u32 {
-    crc32(body)
 }
 
 fn word(slot: &[u8], at: usize) -> u32 {
