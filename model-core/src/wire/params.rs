@@ -22,7 +22,15 @@ macro_rules! parameter_table {
         #[derive(Debug, Clone, Copy, PartialEq, Eq)]
         #[cfg_attr(feature = "defmt", derive(defmt::Format))]
         pub enum ParamId {
-            $($(#[doc = $doc])* $id,)*
+            $(
+                $(#[doc = $doc])*
+                #[doc = ""]
+                #[doc = concat!(
+                    "Token `", $token, "`, unit ", $unit, ", range ", stringify!($min), "..=",
+                    stringify!($max), ", default ", stringify!($default), "."
+                )]
+                $id,
+            )*
         }
 
         /// Number of parameters; a PARAMS answer carries this many values in [`ParamId::ALL`]
