@@ -1,7 +1,7 @@
 //! The one binding of the controller ([`crate::control`]) and the particle model
 //! ([`crate::particle`]) to the serial protocol's rig interface ([`crate::wire::device::Backend`]).
 //! No heap, no hardware: the Black Pill firmware, the emulated board under QEMU and the host's
-//! virtual rig (`bowl sim --pty/--capture`) all run this code; each supplies only what is its
+//! virtual rig (`bowl serve --pty/--capture`) all run this code; each supplies only what is its
 //! own (the motors and sensors or a simulated plant, and an [`Injector`] for INJECT).
 //!
 //! The parameters in force are kept in wire units (what SET sent is what PARAMS reports,

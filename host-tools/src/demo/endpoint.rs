@@ -1,15 +1,14 @@
 //! Where the demo's rig runs. Either way the demo reaches it only through a serial device path
 //! (a pseudo-terminal) speaking `model_core::wire`, exactly as it would reach a real board:
 //!
-//! - [`RigChoice::Host`]: the virtual rig of `bowl sim --pty` (the controller and the simulated
+//! - [`RigChoice::Host`]: the virtual rig of `bowl serve --pty` (the controller and the simulated
 //!   plant behind `model_core::wire::device`), served on a pseudo-terminal from a thread of this
 //!   process. Always available.
 //! - [`RigChoice::Qemu`]: the firmware's emulated-board image (`qemu-rig`: the firmware's tasks and
 //!   controller binding on an emulated Cortex-M4F with the plant in place of the motors), its
 //!   USART1 on a pseudo-terminal. Needs `qemu-system-arm` and the thumb target.
 
-use std::fs::File;
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::Arc;
@@ -19,9 +18,9 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
-use nix::pty::PtyMaster;
 
-use crate::virtual_rig::{VirtualRig, open_pty};
+use crate::serve::{Backlog, LineNoise, Pacing, Pty, ServeStats, serve_on_pty};
+use crate::virtual_rig::VirtualRig;
 
 /// Which rig the demo drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -58,7 +57,7 @@ pub struct Endpoint {
 enum Running {
     Host {
         stop: Arc<AtomicBool>,
-        thread: Option<JoinHandle<Result<HostStats>>>,
+        thread: Option<JoinHandle<Result<ServeStats>>>,
     },
     Qemu {
         child: Child,
@@ -66,20 +65,11 @@ enum Running {
     },
 }
 
-/// What the host rig's server saw.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct HostStats {
-    /// Device time reached, ms.
-    pub device_ms: u32,
-    /// Bytes that could not be delivered because nobody read them (a stuck client).
-    pub bytes_dropped: u64,
-}
-
 /// What the endpoint reported when it was shut down.
 #[derive(Debug, Default)]
 pub struct Shutdown {
     /// Host rig counters.
-    pub host: Option<HostStats>,
+    pub host: Option<ServeStats>,
     /// The emulated board's semihosting console (its last lines).
     pub console: Vec<String>,
 }
@@ -105,7 +95,7 @@ impl Endpoint {
                 let stats = match thread.take().map(|t| t.join()) {
                     Some(Ok(r)) => r?,
                     Some(Err(_)) => bail!("the host rig's thread panicked"),
-                    None => HostStats::default(),
+                    None => ServeStats::default(),
                 };
                 Ok(Shutdown {
                     host: Some(stats),
@@ -133,14 +123,24 @@ impl Endpoint {
 
 fn start_host(fast: bool, seed: u32, qemu_note: Option<String>) -> Result<Endpoint> {
     let rig = VirtualRig::new(seed)?;
-    let (master, path, slave) = open_pty()?;
+    let pty = Pty::open()?;
+    let path = pty.path.clone();
     let stop = Arc::new(AtomicBool::new(false));
     let speed = if fast { FAST_FACTOR } else { 1.0 };
     let thread = {
         let stop = Arc::clone(&stop);
         std::thread::Builder::new()
             .name("host-rig".into())
-            .spawn(move || serve(master, slave, rig, speed, &stop))
+            .spawn(move || {
+                let pacing = Pacing {
+                    device_ms_per_wall_ms: speed,
+                    stop: &stop,
+                    stop_after: None,
+                    // The demo's client is always there: keep what it has not read yet.
+                    backlog: Backlog::KeepUpTo(1 << 20),
+                };
+                serve_on_pty(pty, rig, pacing, Vec::new(), LineNoise::none())
+            })
             .context("cannot start the host rig's thread")?
     };
     let pace = if fast {
@@ -161,57 +161,6 @@ fn start_host(fast: bool, seed: u32, qemu_note: Option<String>) -> Result<Endpoi
             thread: Some(thread),
         },
     })
-}
-
-/// Serves the virtual rig on the pseudo-terminal's master side, `speed` device milliseconds
-/// per wall millisecond, until `stop`. Unlike `bowl sim --pty` it keeps undelivered bytes
-/// queued (up to a bound) instead of dropping them, because the demo's client is always there.
-fn serve(
-    mut master: PtyMaster,
-    _slave: File,
-    mut rig: VirtualRig,
-    speed: f64,
-    stop: &AtomicBool,
-) -> Result<HostStats> {
-    const MAX_QUEUE: usize = 1 << 20;
-    let mut out = Vec::with_capacity(8192);
-    let mut stats = HostStats::default();
-    rig.boot(&mut out);
-    let started = Instant::now();
-    let mut inbuf = [0u8; 1024];
-    while !stop.load(Ordering::Relaxed) {
-        let wall_ms = started.elapsed().as_secs_f64() * 1000.0 * speed;
-        let due_ms = u32::try_from(wall_ms as u64).unwrap_or(u32::MAX);
-        // At most 50 device ms per pass, so reading and writing keep interleaving.
-        let mut steps = 0;
-        while rig.now_ms < due_ms && steps < 50 {
-            // An error is WouldBlock (nothing sent) or EIO (no client right now).
-            let received: &[u8] = match master.read(&mut inbuf) {
-                Ok(n) => &inbuf[..n],
-                Err(_) => &[],
-            };
-            rig.step_1ms(received, &mut out);
-            steps += 1;
-        }
-        while !out.is_empty() {
-            match master.write(&out) {
-                Ok(0) => break,
-                Ok(n) => {
-                    out.drain(..n);
-                }
-                Err(_) => break,
-            }
-        }
-        if out.len() > MAX_QUEUE {
-            stats.bytes_dropped += out.len() as u64;
-            out.clear();
-        }
-        if steps < 50 {
-            std::thread::sleep(Duration::from_millis(1));
-        }
-    }
-    stats.device_ms = rig.now_ms;
-    Ok(stats)
 }
 
 /// The workspace root (host-tools' parent), where the firmware crate lives.
