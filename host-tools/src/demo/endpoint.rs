@@ -8,16 +8,13 @@
 //!   controller binding on an emulated Cortex-M4F with the plant in place of the motors), its
 //!   USART1 on a pseudo-terminal. Needs `qemu-system-arm` and the thumb target.
 
-use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
+use bowl_emulator::image;
+use bowl_emulator::qemu::{self, Profile, PtyBoard};
 
 use crate::serve::{Backlog, LineNoise, Pacing, Pty, ServeStats, serve_on_pty};
 use crate::virtual_rig::VirtualRig;
@@ -32,9 +29,6 @@ pub enum RigChoice {
     /// The firmware image on the emulated board (fails if it cannot be built or started).
     Qemu,
 }
-
-/// The firmware binary that runs the rig on the emulated board.
-pub const QEMU_RIG_BIN: &str = "qemu-rig";
 
 /// Device milliseconds per wall millisecond of the host rig in `--fast` mode. High enough that
 /// a 40 s session takes a few seconds, low enough that 50 telemetry frames per device second
@@ -59,10 +53,7 @@ enum Running {
         stop: Arc<AtomicBool>,
         thread: Option<JoinHandle<Result<ServeStats>>>,
     },
-    Qemu {
-        child: Child,
-        console: Option<JoinHandle<Vec<String>>>,
-    },
+    Qemu(PtyBoard),
 }
 
 /// What the endpoint reported when it was shut down.
@@ -102,21 +93,10 @@ impl Endpoint {
                     console: Vec::new(),
                 })
             }
-            Running::Qemu {
-                mut child,
-                mut console,
-            } => {
-                let _ = child.kill();
-                let _ = child.wait();
-                let console = console
-                    .take()
-                    .and_then(|t| t.join().ok())
-                    .unwrap_or_default();
-                Ok(Shutdown {
-                    host: None,
-                    console,
-                })
-            }
+            Running::Qemu(board) => Ok(Shutdown {
+                host: None,
+                console: board.stop(),
+            }),
         }
     }
 }
@@ -163,197 +143,36 @@ fn start_host(fast: bool, seed: u32, qemu_note: Option<String>) -> Result<Endpoi
     })
 }
 
-/// The workspace root (host-tools' parent), where the firmware crate lives.
-fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from("."))
-}
-
-fn on_path(program: &str) -> bool {
-    std::env::var_os("PATH")
-        .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
-}
-
-/// The cargo arguments that build the emulated board's image.
-const QEMU_BUILD_ARGS: [&str; 11] = [
-    "build",
-    "--release",
-    "-p",
-    "firmware",
-    "--no-default-features",
-    "--features",
-    "qemu",
-    "--target",
-    "thumbv7em-none-eabihf",
-    "--bin",
-    QEMU_RIG_BIN,
-];
-
-/// Builds the emulated board's image; returns the ELF path or why it cannot be had.
-fn build_qemu_image() -> Result<PathBuf> {
-    if !on_path("qemu-system-arm") {
-        bail!("qemu-system-arm is not installed (`bash tests/run` installs it)");
-    }
-    let root = workspace_root();
-    eprintln!(
-        "building the emulated board's image ({QEMU_RIG_BIN}; the first build takes minutes)..."
-    );
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let mut child = Command::new(cargo)
-        .current_dir(&root)
-        .args(QEMU_BUILD_ARGS)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .context("cannot run cargo to build the emulated board's image")?;
-    // Cargo's progress lines are shown as they come (a first build takes minutes); the first
-    // error is kept as the reason.
-    let mut first_error = None;
-    if let Some(stderr) = child.stderr.take() {
-        for line in BufReader::new(stderr).lines().map_while(|l| l.ok()) {
-            let trimmed = line.trim_start();
-            if trimmed.starts_with("Compiling") || trimmed.starts_with("Finished") {
-                eprintln!("  {trimmed}");
-            } else if first_error.is_none() && trimmed.starts_with("error") {
-                first_error = Some(trimmed.to_string());
-            }
-        }
-    }
-    let status = child.wait().context("waiting for cargo")?;
-    if !status.success() {
+fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
+    if !qemu::installed() {
         bail!(
-            "the emulated board's image did not build ({}; to see why: cargo {})",
-            first_error.as_deref().unwrap_or("unknown error"),
-            QEMU_BUILD_ARGS.join(" ")
+            "{} is not installed (`bash tests/run` installs it)",
+            qemu::PROGRAM
         );
     }
-    let target_dir = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root.join("target"));
-    let elf = target_dir
-        .join("thumbv7em-none-eabihf")
-        .join("release")
-        .join(QEMU_RIG_BIN);
-    if !elf.is_file() {
-        bail!("built, but no image at {}", elf.display());
-    }
-    Ok(elf)
-}
-
-fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
-    let elf = build_qemu_image()?;
+    let elf = image::build(image::RIG_IMAGE)?;
     // The board ends its run by itself a little after the session (a safety net: we kill it).
     let run_s = (seconds * 1.5 + 60.0).ceil() as u64;
-    // -icount: virtual time counts instructions (1 ns each, as in firmware/qemu-rig-run and the
-    // QEMU tests). sleep=off lets an idle board's clock jump ahead (about 4x real time here);
-    // sleep=on waits for the wall clock when idle (about 0.6x real time here: the busy parts
-    // take longer than their 1 ns per instruction). shift=auto would track the wall clock, but
-    // its varying instruction time trips the board's emulated watchdog.
-    let icount = if fast {
-        "shift=0,sleep=off"
+    let profile = if fast {
+        Profile::VirtualTime
     } else {
-        "shift=0,sleep=on"
+        Profile::RealTime
     };
-    let mut child = Command::new("qemu-system-arm")
-        .args([
-            "-machine",
-            "netduinoplus2",
-            "-cpu",
-            "cortex-m4",
-            "-display",
-            "none",
-            "-monitor",
-            "none",
-            "-serial",
-            "pty",
-            "-semihosting-config",
-            "enable=on,target=native",
-            "-icount",
-            icount,
-            "-kernel",
-        ])
-        .arg(&elf)
-        .args(["-append", &format!("seconds={run_s}")])
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .context("cannot start qemu-system-arm")?;
-    // QEMU names the pseudo-terminal ("char device redirected to /dev/pts/N (label serial0)")
-    // on stdout, among the board's semihosting lines; older versions on stderr.
-    let (tx, rx) = mpsc::channel();
-    let stderr = child.stderr.take().ok_or_else(|| anyhow!("no stderr"))?;
-    let tx_err = tx.clone();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stderr).lines().map_while(|l| l.ok()) {
-            let _ = tx_err.send(line);
-        }
-    });
-    let stdout = child.stdout.take().ok_or_else(|| anyhow!("no stdout"))?;
-    let console = std::thread::spawn(move || {
-        let mut keep = Vec::new();
-        let mut reported = false;
-        for line in BufReader::new(stdout).lines().map_while(|l| l.ok()) {
-            if !reported && line.contains("redirected to ") {
-                reported = true;
-                let _ = tx.send(line);
-                continue;
-            }
-            if keep.len() == 200 {
-                keep.remove(0);
-            }
-            keep.push(line);
-        }
-        keep
-    });
-    let pty_of = |line: &str| {
-        line.split("redirected to ")
-            .nth(1)
-            .and_then(|rest| rest.split_whitespace().next())
-            .map(str::to_string)
-    };
-    let deadline = Instant::now() + Duration::from_secs(10);
-    let mut qemu_said = Vec::new();
-    let mut found = None;
-    while found.is_none() {
-        let left = deadline.saturating_duration_since(Instant::now());
-        match rx.recv_timeout(left) {
-            Ok(line) => match pty_of(&line) {
-                Some(p) => found = Some(p),
-                None => qemu_said.push(line),
-            },
-            Err(_) => break,
-        }
-    }
-    let Some(port) = found else {
-        let _ = child.kill();
-        let _ = child.wait();
-        bail!(
-            "qemu-system-arm did not report its serial pseudo-terminal{}",
-            qemu_said
-                .last()
-                .map_or(String::new(), |l| format!(" (it said: {l})"))
-        );
-    };
+    let board = PtyBoard::boot(&elf, profile, &["-append", &format!("seconds={run_s}")])?;
     Ok(Endpoint {
         description: format!(
-            "emulated board: firmware image {} on QEMU netduinoplus2 (Cortex-M4F), USART1 on {port}{}",
+            "emulated board: firmware image {} on QEMU netduinoplus2 (Cortex-M4F), USART1 on {}{}",
             elf.display(),
+            board.port,
             if fast {
                 " (virtual time, runs ahead when idle)"
             } else {
                 ""
             }
         ),
-        port,
+        port: board.port.clone(),
         kind: "qemu",
         qemu_note: None,
-        running: Running::Qemu {
-            child,
-            console: Some(console),
-        },
+        running: Running::Qemu(board),
     })
 }
