@@ -4,7 +4,7 @@
 //! not share their code or their tricks. Here everything is computed with 256-bit binary floats
 //! (astro-float, pure Rust), from the plain textbook forms:
 //! - flat model (paper Eq. 6, 7): `T = acosh(1 + x) / (k omega)`, `r'(T) = (ri - a) k omega sinh(k omega T)`;
-//! - Coriolis model (paper Eq. 10, 11 with the corrected A and B of MODEL-NOTES):
+//! - Coriolis model (paper Eq. 10, 11 with the corrected A and B of docs/model.md section 3):
 //!   the root of `A (e^{l1 T} - 1) + B (e^{l2 T} - 1) = x` found by plain bisection (no Newton,
 //!   no clever bracket: 300 halvings of `[0, ln(1 + (x + B)/A)/l1]`), and
 //!   `r'(T) = (ri - a) (k omega / (2 s)) (e^{l1 T} - e^{l2 T})`.

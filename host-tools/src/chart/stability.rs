@@ -3,7 +3,7 @@
 //! Coriolis term makes the fast mode fastest) and a frictionless one.
 //!
 //! The bounds are computed here from the linear stability of the fast mode
-//! `l2 = -k omega (s + k mu)` (MODEL-NOTES, "Numerical behaviour"; `s + k mu = 1` without friction):
+//! `l2 = -k omega (s + k mu)` (docs/model.md, "Stability"; `s + k mu = 1` without friction):
 //! explicit Euler is stable for `h |l2| <= 2`, RK4 for `h |l2| <= 2.785` (its real-axis limit);
 //! semi-implicit Euler (friction implicit) has no bound. Beyond a bound the model refuses the
 //! step (`OdeError::BeyondStabilityLimit`): the chart marks those steps with crosses, and the

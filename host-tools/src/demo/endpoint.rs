@@ -131,7 +131,7 @@ fn start_host(fast: bool, seed: u32, qemu_note: Option<String>) -> Result<Endpoi
     Ok(Endpoint {
         port: path.clone(),
         description: format!(
-            "host rig: model_core::wire::device + the controller against the simulated plant, \
+            "host rig: the protocol device and the controller against the simulated plant, \
              on pseudo-terminal {path} ({pace})"
         ),
         kind: "host",
