@@ -59,7 +59,7 @@ pub fn build(image: &str) -> Result<PathBuf> {
     let status = child.wait().context("waiting for cargo")?;
     if !status.success() {
         bail!(
-            "the emulated board's image {image} did not build ({}; to see why: cargo {})",
+            "the emulated board's image did not build ({image}: {}; to see why: cargo {})",
             first_error.as_deref().unwrap_or("unknown error"),
             args.join(" ")
         );
