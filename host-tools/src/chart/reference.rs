@@ -36,6 +36,20 @@ pub struct RefScene {
     pub rim_radius_m: f64,
 }
 
+/// The same scene as the model's.
+impl From<&model_core::particle::Scene<f64>> for RefScene {
+    fn from(s: &model_core::particle::Scene<f64>) -> Self {
+        Self {
+            omega_rad_s: s.omega_rad_s,
+            mu: s.mu,
+            g_m_s2: s.g_m_s2,
+            k2: s.k2,
+            start_radius_m: s.ri_m,
+            rim_radius_m: s.rim_radius_m,
+        }
+    }
+}
+
 /// Which equation of motion.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RefModel {
@@ -43,6 +57,16 @@ pub enum RefModel {
     Flat,
     /// Paper Eq. 9: with the Coriolis friction term.
     Coriolis,
+}
+
+/// The same equation as the model's.
+impl From<model_core::particle::Model> for RefModel {
+    fn from(m: model_core::particle::Model) -> Self {
+        match m {
+            model_core::particle::Model::Flat => Self::Flat,
+            model_core::particle::Model::Coriolis => Self::Coriolis,
+        }
+    }
 }
 
 /// What the reference says happens.

@@ -112,18 +112,8 @@ pub fn chart() -> anyhow::Result<(Figure, Table)> {
     ];
     for (si, sc) in scenes().iter().enumerate() {
         let s = &sc.scene;
-        let rs = RefScene {
-            omega_rad_s: s.omega_rad_s,
-            mu: s.mu,
-            g_m_s2: s.g_m_s2,
-            k2: s.k2,
-            start_radius_m: s.ri_m,
-            rim_radius_m: s.rim_radius_m,
-        };
-        let rm = match sc.model {
-            Model::Flat => RefModel::Flat,
-            Model::Coriolis => RefModel::Coriolis,
-        };
+        let rs = RefScene::from(s);
+        let rm = RefModel::from(sc.model);
         let RefOutcome::Leaves { time_s: t_ref, .. } = reference::outcome(&rs, rm) else {
             anyhow::bail!("stability scene {} should leave", sc.name);
         };
