@@ -341,3 +341,37 @@ fn write_pending(pty: &mut Pty, out: &mut Vec<u8>, backlog: Backlog, stats: &mut
         out.clear();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_noise_changes_the_asked_fraction_of_bytes_and_a_clean_line_none() {
+        let clean = vec![0x55u8; 100_000];
+        let mut bytes = clean.clone();
+        LineNoise::none().apply(&mut bytes);
+        assert_eq!(bytes, clean);
+        LineNoise::new(10.0, 7).unwrap().apply(&mut bytes);
+        let changed = bytes.iter().zip(&clean).filter(|(a, b)| a != b).count();
+        // Binomial(100 000, 0.1): standard deviation 95 bytes; 1 000 is over ten of them.
+        assert!((9_000..=11_000).contains(&changed), "{changed} changed");
+        for bad in [-1.0, 100.5, f64::NAN] {
+            let err = LineNoise::new(bad, 1).err().expect("refused").to_string();
+            assert!(err.contains("between 0 and 100"), "{err}");
+        }
+    }
+
+    #[test]
+    fn scheduled_commands_run_in_time_order_and_bad_ones_are_named() {
+        let specs = ["5000:start".to_string(), "0:speed,1800,2100".to_string()];
+        let cmds = parse_commands(&specs).unwrap();
+        assert_eq!(cmds.iter().map(|c| c.at_ms).collect::<Vec<_>>(), [0, 5000]);
+        let first = String::from_utf8(cmds[0].line.clone()).unwrap();
+        assert!(first.contains("SPEED"), "{first}");
+        for bad in ["start", "soon:start"] {
+            let err = parse_commands(&[bad.to_string()]).err().expect("refused");
+            assert!(format!("{err:#}").contains(bad), "{err:#}");
+        }
+    }
+}
