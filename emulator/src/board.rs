@@ -20,8 +20,8 @@ pub struct Board {
 }
 
 impl Board {
-    /// Boots `elf` in virtual time ([`Profile::VirtualTime`]); QEMU waits (`server=on,wait=on`) until we have connected to its USART1, so
-    /// no byte the board sends is lost.
+    /// Boots `elf` in virtual time ([`Profile::VirtualTime`]); QEMU waits (`server=on,wait=on`)
+    /// until we have connected to its USART1, so no byte the board sends is lost.
     pub fn boot(elf: &Path) -> Board {
         Self::boot_with(elf, &[])
     }
