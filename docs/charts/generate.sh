@@ -25,6 +25,6 @@ bowl=target/release/bowl
 for c in radial velocity residence stability; do
   "$bowl" chart "$c" --out "docs/charts/$c.svg"
 done
-# The control loop's figures on the simulated rig (issue 4).
+# The control loop's figures on the simulated rig (docs/control.md).
 "$bowl" chart settling --out docs/charts/control-settling.svg
 "$bowl" chart control-stability --out docs/charts/control-stability.svg

@@ -5,7 +5,9 @@
 //!   parameter store), so the same code runs on the STM32F411 and on the emulated board.
 //! - `blackpill` (feature `blackpill`): the STM32F411CE Black Pill's peripherals via embassy-stm32.
 //! - `qemu` (feature `qemu`): QEMU netduinoplus2: SysTick time driver, WFI executor, raw USART.
-//! - `host` (Unix hosts): boots the emulated board under QEMU and shares its link (the QEMU tests).
+//!
+//! The PC side of the emulated board (building its images, QEMU, sharing its link) is the
+//! `bowl-emulator` crate (`emulator/`).
 #![cfg_attr(not(test), no_std)]
 #![warn(missing_docs)]
 
@@ -15,6 +17,3 @@ pub mod app;
 pub mod blackpill;
 #[cfg(feature = "qemu")]
 pub mod qemu;
-
-#[cfg(all(unix, not(target_os = "none")))]
-pub mod host;

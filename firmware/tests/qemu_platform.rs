@@ -6,8 +6,8 @@ use std::io::Write;
 
 #[test]
 fn platform_checks_pass_under_qemu() {
-    let elf = firmware::host::build_image("qemu-fw-platform");
-    let mut board = firmware::host::Board::boot(&elf);
+    let elf = bowl_emulator::image::build("qemu-fw-platform").expect("the image builds");
+    let mut board = bowl_emulator::board::Board::boot(&elf);
 
     assert_eq!(board.read_usart_line(), "ready");
     board.usart.write_all(b"bowl rig 0123\n").unwrap();

@@ -2,11 +2,12 @@
 //! the parameter log (version + CRC-32 records) gives back what was saved before each reset.
 //! Run: `cargo test -p firmware --no-default-features --test qemu_reset`.
 
-use firmware::host::{self, Board};
+use bowl_emulator::board::Board;
+use bowl_emulator::image;
 
 #[test]
 fn reset_counter_and_parameters_survive_resets_under_qemu() {
-    let elf = host::build_image("qemu-fw-reset");
+    let elf = image::build("qemu-fw-reset").expect("the image builds");
     let (ok, console) = Board::boot(&elf).finish();
     let text = console.join("\n");
     println!("{text}");

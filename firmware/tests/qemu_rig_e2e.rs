@@ -2,18 +2,21 @@
 //! with the simulated plant, driven over its emulated USART by `bowl send`, its telemetry read
 //! with the shared host decoder, checked against the plant's true speeds (semihosting log).
 //!
-//! Time is the board's (`-icount shift=0,sleep=off`): every bound below is in device time,
+//! Time is the board's (`bowl_emulator::qemu::Profile::VirtualTime`): every bound below is in device time,
 //! taken from the telemetry frames, never from the host clock.
 //!
 //! Run: `cargo test -p firmware --no-default-features --test qemu_rig_e2e`.
 
-use firmware::host::{self, Board, Splitter, plant_truth};
+use bowl_emulator::board::Board;
+use bowl_emulator::image;
+use bowl_emulator::plant_log::plant_truth;
+use bowl_emulator::splitter::Splitter;
 use model_core::wire::{DeviceState, FaultCode, Residence};
 
 #[test]
 fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
-    let bowl = host::build_bowl();
-    let elf = host::build_image("qemu-rig");
+    let bowl = image::build_bowl().expect("bowl builds");
+    let elf = image::build(image::RIG_IMAGE).expect("the image builds");
     let board = Board::boot_with(&elf, &["-append", "seconds=40"]);
     let usart = board.usart.try_clone().unwrap();
     let split = Splitter::start(usart, false);

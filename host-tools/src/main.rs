@@ -12,6 +12,7 @@ mod predict;
 mod replay;
 mod send;
 mod serial;
+mod serve;
 mod sim;
 mod simulated_backend;
 mod telemetry_csv;
@@ -41,21 +42,15 @@ enum Command {
     Commission(commission::Args),
     /// Decode a raw capture of the rig's output; print statistics as JSON.
     Replay(replay::Args),
-    /// The simulated rig: serve it on a pseudo-terminal (--pty) or capture its bytes (--capture),
-    /// or report on the controller against it (step, family, commission, sweep, stability, trace).
-    Sim(SimCommand),
+    /// A virtual rig (no hardware): serve it on a pseudo-terminal (--pty) or write its bytes to a
+    /// file (--capture).
+    Serve(serve::Args),
+    /// Reports on the controller against the simulated plant (step, family, commission, sweep,
+    /// stability, trace).
+    #[command(subcommand)]
+    Sim(sim::What),
     /// The rig without hardware: a simulated rig, a scripted session, the live view, a summary.
     Demo(demo::Args),
-}
-
-/// `bowl sim`: either a report subcommand or the virtual rig's flags.
-#[derive(clap::Args)]
-#[command(args_conflicts_with_subcommands = true)]
-struct SimCommand {
-    #[command(subcommand)]
-    report: Option<sim::What>,
-    #[command(flatten)]
-    rig: virtual_rig::Args,
 }
 
 fn main() -> Result<()> {
@@ -69,9 +64,7 @@ fn main() -> Result<()> {
         Command::Commission(args) => commission::run(&args).map(|code| std::process::exit(code)),
         Command::Replay(args) => replay::run(&args),
         Command::Demo(args) => demo::run(&args),
-        Command::Sim(args) => match &args.report {
-            Some(report) => sim::run(report),
-            None => virtual_rig::run(&args.rig),
-        },
+        Command::Serve(args) => serve::run(&args),
+        Command::Sim(report) => sim::run(&report),
     }
 }

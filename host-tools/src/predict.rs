@@ -1,5 +1,5 @@
 //! `bowl predict`: residence time and exit velocities of a particle (paper Eq. 5 to 12, corrected
-//! per MODEL-NOTES), for one scene from flags or for every row of a CSV file.
+//! per docs/model.md), for one scene from flags or for every row of a CSV file.
 //!
 //! Batch format: a header row naming at least `model,w_rad_s,mu,ri_m,R_m` (any order; `g` and
 //! `k2` default to 9.81 and 5/7 when their columns are absent), any extra columns carried

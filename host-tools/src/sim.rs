@@ -9,6 +9,9 @@
 //! - `bowl sim sweep`: CSV of settling time against pulses per revolution.
 //! - `bowl sim stability`: CSV map of the limit-cycle amplitude at low speed against loop gain
 //!   (per-pulse bandwidth) and pulse rate, with and without the pulse-rate schedule.
+//! - `bowl sim trace`: CSV trace of the step on one family plant (or the nominal rig).
+//!
+//! The virtual rig on a link (pseudo-terminal or capture file) is `bowl serve` (`crate::serve`).
 
 use anyhow::{Result, bail};
 use model_core::control::{Controller, ControllerConfig, Fault};
@@ -145,7 +148,10 @@ pub(crate) fn run(what: &What) -> Result<()> {
         }
         What::Family(a) => {
             if a.plants < 50 && !a.allow_small {
-                bail!("--plants must be at least 50 (the issue's family size)");
+                bail!(
+                    "--plants must be at least 50, the family size the control targets are stated for (got {}); docs/control.md",
+                    a.plants
+                );
             }
             let out = family(a.common.seed, a.plants, !a.no_feedback);
             println!("{}", serde_json::to_string_pretty(&out)?);

@@ -1,4 +1,4 @@
-//! The virtual rig behind `bowl sim --pty` / `--capture`: the simulated plant
+//! The virtual rig behind `bowl serve --pty` / `--capture`: the simulated plant
 //! (`model_core::sim::Plant`) in place of the motors and sensors, and in front of it the same
 //! binding of the controller and the particle model to the protocol that the firmware runs
 //! (`model_core::binding::ControllerBackend`).

@@ -1,5 +1,5 @@
-//! `bowl chart settling` and `bowl chart control-stability` (issue 4's control figures), in quick
-//! mode: the CSV behind each chart must say what the issue requires, and the SVG and PNG must be
+//! `bowl chart settling` and `bowl chart control-stability` (the control figures of docs/control.md), in quick
+//! mode: the CSV behind each chart must show the targets docs/control.md states, and the SVG and PNG must be
 //! written beside it.
 
 use std::collections::HashMap;

@@ -156,7 +156,7 @@ fn coriolis_is_slower_by_a_few_percent_at_the_default_resistance() {
         };
         let (tf, tc): (f64, f64) = (f[c_t].parse().unwrap(), c[c_t].parse().unwrap());
         if tf.is_finite() && tf > 0.0 {
-            // MODEL-NOTES: the Coriolis effect is 0.3 to 2 % near mu = 0.03, always slower.
+            // docs/model.md section 5: the Coriolis effect is 0.3 to 2 % near mu = 0.03, always slower.
             assert!(tc > tf && tc / tf < 1.03, "{f:?} {c:?}");
             checked += 1;
         }

@@ -1,4 +1,4 @@
-//! `bowl chart work-precision --csv-only --quick`: the measured errors meet the issue's accuracy
+//! `bowl chart work-precision --csv-only --quick`: the measured errors meet the accuracy
 //! targets against the independent 256-bit reference, and the CSV joins QEMU counts by name.
 
 mod common;
@@ -44,7 +44,7 @@ fn closed_forms_meet_the_accuracy_targets() {
     for r in rows.iter().filter(|r| r["family"] == "closed") {
         let err: f64 = r["rel_error"].parse().unwrap();
         let c = cond(r);
-        // Issue 3: f64 within about 1e-12 x cond; f32 on the target within 2e-6 x cond.
+        // docs/model.md: f64 within about 1e-12 x cond; f32 on the target within 2e-6 x cond.
         let bound = match r["precision"].as_str() {
             "f64" => 1e-12 * c,
             "f32-libm" => 2e-6 * c,

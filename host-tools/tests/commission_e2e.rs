@@ -1,4 +1,4 @@
-//! End to end: `bowl commission` against `bowl sim --pty` (the virtual rig runs the same
+//! End to end: `bowl commission` against `bowl serve --pty` (the virtual rig runs the same
 //! controller and protocol binding as the firmware, on the simulated plant, in real time).
 
 mod common;

@@ -1,4 +1,4 @@
-//! `bowl sim family`: the family targets, and the same family failing without feedback.
+//! `bowl sim family`: the family targets of docs/control.md, and the same family failing without feedback.
 
 mod common;
 

@@ -1,4 +1,4 @@
-//! `bowl sim step`: the nominal figures, read from the command's JSON.
+//! `bowl sim step`: the nominal figures of docs/control.md, read from the command's JSON.
 
 mod common;
 

@@ -1,5 +1,5 @@
-//! End to end: `bowl monitor` and `bowl send` against `bowl sim --pty`, and `bowl replay` on
-//! `bowl sim --capture`.
+//! End to end: `bowl monitor` and `bowl send` against `bowl serve --pty`, and `bowl replay` on
+//! `bowl serve --capture`.
 
 mod common;
 
@@ -26,11 +26,11 @@ fn csv_keys(path: &Path) -> Vec<(u64, u64)> {
         .collect()
 }
 
-/// Runs `bowl sim --capture DIR/cap.bin ARGS...` (the virtual rig writing its bytes to a file)
+/// Runs `bowl serve --capture DIR/cap.bin ARGS...` (the virtual rig writing its bytes to a file)
 /// and returns the capture's path.
 fn sim_capture(dir: &Path, args: &[&str]) -> PathBuf {
     let capture = dir.join("cap.bin");
-    let mut all = vec!["sim", "--capture", capture.to_str().unwrap()];
+    let mut all = vec!["serve", "--capture", capture.to_str().unwrap()];
     all.extend_from_slice(args);
     let made = bowl(&all);
     assert!(made.status.success(), "{}", stdout(&made));

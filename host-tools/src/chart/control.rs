@@ -1,4 +1,4 @@
-//! The control loop's charts (issue 4), from the simulated-rig experiments that `bowl sim sweep`
+//! The control loop's charts (docs/control.md), from the simulated-rig experiments that `bowl sim sweep`
 //! and `bowl sim stability` print:
 //!
 //! - `bowl chart settling`: 2 % settling time of the commissioned 0 -> 3 rad/s step against pulses
@@ -20,9 +20,9 @@ use super::table::Table;
 
 /// Step target of the settling chart, rad/s (as `bowl sim step`).
 pub const STEP_TARGET_RAD_S: f32 = 3.0;
-/// Speed of the low-speed hold of the stability chart, rad/s (the issue's 0.5 rad/s).
+/// Speed of the low-speed hold of the stability chart, rad/s (the 0.5 rad/s of docs/control.md's stability target).
 pub const HOLD_SPEED_RAD_S: f32 = 0.5;
-/// Limit-cycle bound of the issue at 0.5 rad/s, percent of the speed.
+/// Limit-cycle bound at 0.5 rad/s (docs/control.md), percent of the speed.
 pub const LIMIT_CYCLE_BOUND_PCT: f64 = 5.0;
 /// Settling target of the nominal rig (12 pulses/rev), s.
 pub const NOMINAL_SETTLING_TARGET_S: f64 = 2.5;
@@ -403,7 +403,7 @@ pub fn stability_chart(points: &[HoldPoint]) -> (Figure, Table) {
         .fold(f64::NEG_INFINITY, f64::max);
     if g_min.is_finite() {
         series.push(Series {
-            name: format!("{LIMIT_CYCLE_BOUND_PCT} % bound (issue 4)"),
+            name: format!("{LIMIT_CYCLE_BOUND_PCT} % bound"),
             points: vec![
                 (g_min, LIMIT_CYCLE_BOUND_PCT),
                 (g_max, LIMIT_CYCLE_BOUND_PCT),

@@ -1,4 +1,4 @@
-//! `bowl chart`: the speed-against-accuracy chart and the paper-style figures (issue 3).
+//! `bowl chart`: the speed-against-accuracy chart and the paper-style figures (docs/model.md section 6).
 //!
 //! Every chart is written three ways from one `--out FILE.svg`: `FILE.svg`, `FILE.png` (same
 //! drawing, text rendered with the embedded DejaVu font) and `FILE.csv` (the numbers behind it).

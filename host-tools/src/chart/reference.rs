@@ -4,7 +4,7 @@
 //! not share their code or their tricks. Here everything is computed with 256-bit binary floats
 //! (astro-float, pure Rust), from the plain textbook forms:
 //! - flat model (paper Eq. 6, 7): `T = acosh(1 + x) / (k omega)`, `r'(T) = (ri - a) k omega sinh(k omega T)`;
-//! - Coriolis model (paper Eq. 10, 11 with the corrected A and B of MODEL-NOTES):
+//! - Coriolis model (paper Eq. 10, 11 with the corrected A and B of docs/model.md section 3):
 //!   the root of `A (e^{l1 T} - 1) + B (e^{l2 T} - 1) = x` found by plain bisection (no Newton,
 //!   no clever bracket: 300 halvings of `[0, ln(1 + (x + B)/A)/l1]`), and
 //!   `r'(T) = (ri - a) (k omega / (2 s)) (e^{l1 T} - e^{l2 T})`.
@@ -36,6 +36,20 @@ pub struct RefScene {
     pub rim_radius_m: f64,
 }
 
+/// The same scene as the model's.
+impl From<&model_core::particle::Scene<f64>> for RefScene {
+    fn from(s: &model_core::particle::Scene<f64>) -> Self {
+        Self {
+            omega_rad_s: s.omega_rad_s,
+            mu: s.mu,
+            g_m_s2: s.g_m_s2,
+            k2: s.k2,
+            start_radius_m: s.ri_m,
+            rim_radius_m: s.rim_radius_m,
+        }
+    }
+}
+
 /// Which equation of motion.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RefModel {
@@ -43,6 +57,16 @@ pub enum RefModel {
     Flat,
     /// Paper Eq. 9: with the Coriolis friction term.
     Coriolis,
+}
+
+/// The same equation as the model's.
+impl From<model_core::particle::Model> for RefModel {
+    fn from(m: model_core::particle::Model) -> Self {
+        match m {
+            model_core::particle::Model::Flat => Self::Flat,
+            model_core::particle::Model::Coriolis => Self::Coriolis,
+        }
+    }
 }
 
 /// What the reference says happens.

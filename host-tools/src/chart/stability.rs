@@ -3,7 +3,7 @@
 //! Coriolis term makes the fast mode fastest) and a frictionless one.
 //!
 //! The bounds are computed here from the linear stability of the fast mode
-//! `l2 = -k omega (s + k mu)` (MODEL-NOTES, "Numerical behaviour"; `s + k mu = 1` without friction):
+//! `l2 = -k omega (s + k mu)` (docs/model.md, "Stability"; `s + k mu = 1` without friction):
 //! explicit Euler is stable for `h |l2| <= 2`, RK4 for `h |l2| <= 2.785` (its real-axis limit);
 //! semi-implicit Euler (friction implicit) has no bound. Beyond a bound the model refuses the
 //! step (`OdeError::BeyondStabilityLimit`): the chart marks those steps with crosses, and the
@@ -112,18 +112,8 @@ pub fn chart() -> anyhow::Result<(Figure, Table)> {
     ];
     for (si, sc) in scenes().iter().enumerate() {
         let s = &sc.scene;
-        let rs = RefScene {
-            omega_rad_s: s.omega_rad_s,
-            mu: s.mu,
-            g_m_s2: s.g_m_s2,
-            k2: s.k2,
-            start_radius_m: s.ri_m,
-            rim_radius_m: s.rim_radius_m,
-        };
-        let rm = match sc.model {
-            Model::Flat => RefModel::Flat,
-            Model::Coriolis => RefModel::Coriolis,
-        };
+        let rs = RefScene::from(s);
+        let rm = RefModel::from(sc.model);
         let RefOutcome::Leaves { time_s: t_ref, .. } = reference::outcome(&rs, rm) else {
             anyhow::bail!("stability scene {} should leave", sc.name);
         };

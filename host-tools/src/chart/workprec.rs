@@ -352,18 +352,8 @@ pub fn time(method: &Method, s: &Scene<f64>, model: Model, budget: Budget) -> Ti
 }
 
 fn ref_time(s: &Scene<f64>, model: Model) -> Option<f64> {
-    let rs = RefScene {
-        omega_rad_s: s.omega_rad_s,
-        mu: s.mu,
-        g_m_s2: s.g_m_s2,
-        k2: s.k2,
-        start_radius_m: s.ri_m,
-        rim_radius_m: s.rim_radius_m,
-    };
-    let m = match model {
-        Model::Flat => RefModel::Flat,
-        Model::Coriolis => RefModel::Coriolis,
-    };
+    let rs = RefScene::from(s);
+    let m = RefModel::from(model);
     match reference::outcome(&rs, m) {
         RefOutcome::Leaves { time_s, .. } => Some(time_s),
         RefOutcome::AtRim => Some(0.0),

@@ -1,27 +1,23 @@
 //! Where the demo's rig runs. Either way the demo reaches it only through a serial device path
 //! (a pseudo-terminal) speaking `model_core::wire`, exactly as it would reach a real board:
 //!
-//! - [`RigChoice::Host`]: the virtual rig of `bowl sim --pty` (the controller and the simulated
+//! - [`RigChoice::Host`]: the virtual rig of `bowl serve --pty` (the controller and the simulated
 //!   plant behind `model_core::wire::device`), served on a pseudo-terminal from a thread of this
 //!   process. Always available.
 //! - [`RigChoice::Qemu`]: the firmware's emulated-board image (`qemu-rig`: the firmware's tasks and
 //!   controller binding on an emulated Cortex-M4F with the plant in place of the motors), its
 //!   USART1 on a pseudo-terminal. Needs `qemu-system-arm` and the thumb target.
 
-use std::fs::File;
-use std::io::{BufRead, BufReader, Read, Write};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
 use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, anyhow, bail};
-use nix::pty::PtyMaster;
+use anyhow::{Context, Result, bail};
+use bowl_emulator::image;
+use bowl_emulator::qemu::{self, Profile, PtyBoard};
 
-use crate::virtual_rig::{VirtualRig, open_pty};
+use crate::serve::{Backlog, LineNoise, Pacing, Pty, ServeStats, serve_on_pty};
+use crate::virtual_rig::VirtualRig;
 
 /// Which rig the demo drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -33,9 +29,6 @@ pub enum RigChoice {
     /// The firmware image on the emulated board (fails if it cannot be built or started).
     Qemu,
 }
-
-/// The firmware binary that runs the rig on the emulated board.
-pub const QEMU_RIG_BIN: &str = "qemu-rig";
 
 /// Device milliseconds per wall millisecond of the host rig in `--fast` mode. High enough that
 /// a 40 s session takes a few seconds, low enough that 50 telemetry frames per device second
@@ -58,28 +51,16 @@ pub struct Endpoint {
 enum Running {
     Host {
         stop: Arc<AtomicBool>,
-        thread: Option<JoinHandle<Result<HostStats>>>,
+        thread: Option<JoinHandle<Result<ServeStats>>>,
     },
-    Qemu {
-        child: Child,
-        console: Option<JoinHandle<Vec<String>>>,
-    },
-}
-
-/// What the host rig's server saw.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct HostStats {
-    /// Device time reached, ms.
-    pub device_ms: u32,
-    /// Bytes that could not be delivered because nobody read them (a stuck client).
-    pub bytes_dropped: u64,
+    Qemu(PtyBoard),
 }
 
 /// What the endpoint reported when it was shut down.
 #[derive(Debug, Default)]
 pub struct Shutdown {
     /// Host rig counters.
-    pub host: Option<HostStats>,
+    pub host: Option<ServeStats>,
     /// The emulated board's semihosting console (its last lines).
     pub console: Vec<String>,
 }
@@ -105,42 +86,41 @@ impl Endpoint {
                 let stats = match thread.take().map(|t| t.join()) {
                     Some(Ok(r)) => r?,
                     Some(Err(_)) => bail!("the host rig's thread panicked"),
-                    None => HostStats::default(),
+                    None => ServeStats::default(),
                 };
                 Ok(Shutdown {
                     host: Some(stats),
                     console: Vec::new(),
                 })
             }
-            Running::Qemu {
-                mut child,
-                mut console,
-            } => {
-                let _ = child.kill();
-                let _ = child.wait();
-                let console = console
-                    .take()
-                    .and_then(|t| t.join().ok())
-                    .unwrap_or_default();
-                Ok(Shutdown {
-                    host: None,
-                    console,
-                })
-            }
+            Running::Qemu(board) => Ok(Shutdown {
+                host: None,
+                console: board.stop(),
+            }),
         }
     }
 }
 
 fn start_host(fast: bool, seed: u32, qemu_note: Option<String>) -> Result<Endpoint> {
     let rig = VirtualRig::new(seed)?;
-    let (master, path, slave) = open_pty()?;
+    let pty = Pty::open()?;
+    let path = pty.path.clone();
     let stop = Arc::new(AtomicBool::new(false));
     let speed = if fast { FAST_FACTOR } else { 1.0 };
     let thread = {
         let stop = Arc::clone(&stop);
         std::thread::Builder::new()
             .name("host-rig".into())
-            .spawn(move || serve(master, slave, rig, speed, &stop))
+            .spawn(move || {
+                let pacing = Pacing {
+                    device_ms_per_wall_ms: speed,
+                    stop: &stop,
+                    stop_after: None,
+                    // The demo's client is always there: keep what it has not read yet.
+                    backlog: Backlog::KeepUpTo(1 << 20),
+                };
+                serve_on_pty(pty, rig, pacing, Vec::new(), LineNoise::none())
+            })
             .context("cannot start the host rig's thread")?
     };
     let pace = if fast {
@@ -151,7 +131,7 @@ fn start_host(fast: bool, seed: u32, qemu_note: Option<String>) -> Result<Endpoi
     Ok(Endpoint {
         port: path.clone(),
         description: format!(
-            "host rig: model_core::wire::device + the controller against the simulated plant, \
+            "host rig: the protocol device and the controller against the simulated plant, \
              on pseudo-terminal {path} ({pace})"
         ),
         kind: "host",
@@ -163,248 +143,36 @@ fn start_host(fast: bool, seed: u32, qemu_note: Option<String>) -> Result<Endpoi
     })
 }
 
-/// Serves the virtual rig on the pseudo-terminal's master side, `speed` device milliseconds
-/// per wall millisecond, until `stop`. Unlike `bowl sim --pty` it keeps undelivered bytes
-/// queued (up to a bound) instead of dropping them, because the demo's client is always there.
-fn serve(
-    mut master: PtyMaster,
-    _slave: File,
-    mut rig: VirtualRig,
-    speed: f64,
-    stop: &AtomicBool,
-) -> Result<HostStats> {
-    const MAX_QUEUE: usize = 1 << 20;
-    let mut out = Vec::with_capacity(8192);
-    let mut stats = HostStats::default();
-    rig.boot(&mut out);
-    let started = Instant::now();
-    let mut inbuf = [0u8; 1024];
-    while !stop.load(Ordering::Relaxed) {
-        let wall_ms = started.elapsed().as_secs_f64() * 1000.0 * speed;
-        let due_ms = u32::try_from(wall_ms as u64).unwrap_or(u32::MAX);
-        // At most 50 device ms per pass, so reading and writing keep interleaving.
-        let mut steps = 0;
-        while rig.now_ms < due_ms && steps < 50 {
-            // An error is WouldBlock (nothing sent) or EIO (no client right now).
-            let received: &[u8] = match master.read(&mut inbuf) {
-                Ok(n) => &inbuf[..n],
-                Err(_) => &[],
-            };
-            rig.step_1ms(received, &mut out);
-            steps += 1;
-        }
-        while !out.is_empty() {
-            match master.write(&out) {
-                Ok(0) => break,
-                Ok(n) => {
-                    out.drain(..n);
-                }
-                Err(_) => break,
-            }
-        }
-        if out.len() > MAX_QUEUE {
-            stats.bytes_dropped += out.len() as u64;
-            out.clear();
-        }
-        if steps < 50 {
-            std::thread::sleep(Duration::from_millis(1));
-        }
-    }
-    stats.device_ms = rig.now_ms;
-    Ok(stats)
-}
-
-/// The workspace root (host-tools' parent), where the firmware crate lives.
-fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from("."))
-}
-
-fn on_path(program: &str) -> bool {
-    std::env::var_os("PATH")
-        .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
-}
-
-/// The cargo arguments that build the emulated board's image.
-const QEMU_BUILD_ARGS: [&str; 11] = [
-    "build",
-    "--release",
-    "-p",
-    "firmware",
-    "--no-default-features",
-    "--features",
-    "qemu",
-    "--target",
-    "thumbv7em-none-eabihf",
-    "--bin",
-    QEMU_RIG_BIN,
-];
-
-/// Builds the emulated board's image; returns the ELF path or why it cannot be had.
-fn build_qemu_image() -> Result<PathBuf> {
-    if !on_path("qemu-system-arm") {
-        bail!("qemu-system-arm is not installed (`bash tests/run` installs it)");
-    }
-    let root = workspace_root();
-    eprintln!(
-        "building the emulated board's image ({QEMU_RIG_BIN}; the first build takes minutes)..."
-    );
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let mut child = Command::new(cargo)
-        .current_dir(&root)
-        .args(QEMU_BUILD_ARGS)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .context("cannot run cargo to build the emulated board's image")?;
-    // Cargo's progress lines are shown as they come (a first build takes minutes); the first
-    // error is kept as the reason.
-    let mut first_error = None;
-    if let Some(stderr) = child.stderr.take() {
-        for line in BufReader::new(stderr).lines().map_while(|l| l.ok()) {
-            let trimmed = line.trim_start();
-            if trimmed.starts_with("Compiling") || trimmed.starts_with("Finished") {
-                eprintln!("  {trimmed}");
-            } else if first_error.is_none() && trimmed.starts_with("error") {
-                first_error = Some(trimmed.to_string());
-            }
-        }
-    }
-    let status = child.wait().context("waiting for cargo")?;
-    if !status.success() {
+fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
+    if !qemu::installed() {
         bail!(
-            "the emulated board's image did not build ({}; to see why: cargo {})",
-            first_error.as_deref().unwrap_or("unknown error"),
-            QEMU_BUILD_ARGS.join(" ")
+            "{} is not installed (`bash tests/run` installs it)",
+            qemu::PROGRAM
         );
     }
-    let target_dir = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root.join("target"));
-    let elf = target_dir
-        .join("thumbv7em-none-eabihf")
-        .join("release")
-        .join(QEMU_RIG_BIN);
-    if !elf.is_file() {
-        bail!("built, but no image at {}", elf.display());
-    }
-    Ok(elf)
-}
-
-fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
-    let elf = build_qemu_image()?;
+    let elf = image::build(image::RIG_IMAGE)?;
     // The board ends its run by itself a little after the session (a safety net: we kill it).
     let run_s = (seconds * 1.5 + 60.0).ceil() as u64;
-    // -icount: virtual time counts instructions (1 ns each, as in firmware/qemu-rig-run and the
-    // QEMU tests). sleep=off lets an idle board's clock jump ahead (about 4x real time here);
-    // sleep=on waits for the wall clock when idle (about 0.6x real time here: the busy parts
-    // take longer than their 1 ns per instruction). shift=auto would track the wall clock, but
-    // its varying instruction time trips the board's emulated watchdog.
-    let icount = if fast {
-        "shift=0,sleep=off"
+    let profile = if fast {
+        Profile::VirtualTime
     } else {
-        "shift=0,sleep=on"
+        Profile::RealTime
     };
-    let mut child = Command::new("qemu-system-arm")
-        .args([
-            "-machine",
-            "netduinoplus2",
-            "-cpu",
-            "cortex-m4",
-            "-display",
-            "none",
-            "-monitor",
-            "none",
-            "-serial",
-            "pty",
-            "-semihosting-config",
-            "enable=on,target=native",
-            "-icount",
-            icount,
-            "-kernel",
-        ])
-        .arg(&elf)
-        .args(["-append", &format!("seconds={run_s}")])
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .context("cannot start qemu-system-arm")?;
-    // QEMU names the pseudo-terminal ("char device redirected to /dev/pts/N (label serial0)")
-    // on stdout, among the board's semihosting lines; older versions on stderr.
-    let (tx, rx) = mpsc::channel();
-    let stderr = child.stderr.take().ok_or_else(|| anyhow!("no stderr"))?;
-    let tx_err = tx.clone();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stderr).lines().map_while(|l| l.ok()) {
-            let _ = tx_err.send(line);
-        }
-    });
-    let stdout = child.stdout.take().ok_or_else(|| anyhow!("no stdout"))?;
-    let console = std::thread::spawn(move || {
-        let mut keep = Vec::new();
-        let mut reported = false;
-        for line in BufReader::new(stdout).lines().map_while(|l| l.ok()) {
-            if !reported && line.contains("redirected to ") {
-                reported = true;
-                let _ = tx.send(line);
-                continue;
-            }
-            if keep.len() == 200 {
-                keep.remove(0);
-            }
-            keep.push(line);
-        }
-        keep
-    });
-    let pty_of = |line: &str| {
-        line.split("redirected to ")
-            .nth(1)
-            .and_then(|rest| rest.split_whitespace().next())
-            .map(str::to_string)
-    };
-    let deadline = Instant::now() + Duration::from_secs(10);
-    let mut qemu_said = Vec::new();
-    let mut found = None;
-    while found.is_none() {
-        let left = deadline.saturating_duration_since(Instant::now());
-        match rx.recv_timeout(left) {
-            Ok(line) => match pty_of(&line) {
-                Some(p) => found = Some(p),
-                None => qemu_said.push(line),
-            },
-            Err(_) => break,
-        }
-    }
-    let Some(port) = found else {
-        let _ = child.kill();
-        let _ = child.wait();
-        bail!(
-            "qemu-system-arm did not report its serial pseudo-terminal{}",
-            qemu_said
-                .last()
-                .map_or(String::new(), |l| format!(" (it said: {l})"))
-        );
-    };
+    let board = PtyBoard::boot(&elf, profile, &["-append", &format!("seconds={run_s}")])?;
     Ok(Endpoint {
         description: format!(
-            "emulated board: firmware image {} on QEMU netduinoplus2 (Cortex-M4F), USART1 on {port}{}",
+            "emulated board: firmware image {} on QEMU netduinoplus2 (Cortex-M4F), USART1 on {}{}",
             elf.display(),
+            board.port,
             if fast {
                 " (virtual time, runs ahead when idle)"
             } else {
                 ""
             }
         ),
-        port,
+        port: board.port.clone(),
         kind: "qemu",
         qemu_note: None,
-        running: Running::Qemu {
-            child,
-            console: Some(console),
-        },
+        running: Running::Qemu(board),
     })
 }

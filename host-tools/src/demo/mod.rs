@@ -6,8 +6,13 @@
 mod analysis;
 mod charts;
 mod endpoint;
+mod frames;
+mod physics_check;
+mod render;
+mod report;
 mod script;
 mod session;
+mod step_response;
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -103,7 +108,7 @@ pub fn run(args: &Args) -> Result<()> {
         }
     }
     let summary = analysis::summarise(
-        analysis::RunInfo {
+        report::RunInfo {
             rig: kind,
             description,
             qemu_note,
@@ -119,7 +124,7 @@ pub fn run(args: &Args) -> Result<()> {
         &stats,
         record.commands.clone(),
     );
-    print!("{}", analysis::text(&summary));
+    print!("{}", render::text(&summary));
     let json_path = args.out.join("summary.json");
     std::fs::write(&json_path, serde_json::to_string_pretty(&summary)?)
         .with_context(|| format!("cannot write {}", json_path.display()))?;

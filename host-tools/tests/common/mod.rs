@@ -1,4 +1,4 @@
-//! Helpers shared by the end-to-end tests that run the built `bowl` binary: a `bowl sim --pty`
+//! Helpers shared by the end-to-end tests that run the built `bowl` binary: a `bowl serve --pty`
 //! virtual rig, one-shot `bowl` runs, scratch directories, and a pseudo-terminal standing in for
 //! the user's screen.
 //!
@@ -18,27 +18,27 @@ use nix::pty::{PtyMaster, grantpt, posix_openpt, ptsname_r, unlockpt};
 /// The `bowl` binary under test.
 pub const BOWL: &str = env!("CARGO_BIN_EXE_bowl");
 
-/// A `bowl sim --pty` process (the virtual rig on a pseudo-terminal), killed when dropped.
+/// A `bowl serve --pty` process (the virtual rig on a pseudo-terminal), killed when dropped.
 pub struct Sim {
     child: Child,
-    /// The pty's device path, as `bowl sim` printed it.
+    /// The pty's device path, as `bowl serve` printed it.
     pub path: String,
 }
 
 impl Sim {
-    /// Starts `bowl sim --pty EXTRA...` and waits for the pty path it prints first.
+    /// Starts `bowl serve --pty EXTRA...` and waits for the pty path it prints first.
     pub fn start(extra: &[&str]) -> Sim {
         let mut child = Command::new(BOWL)
-            .args(["sim", "--pty"])
+            .args(["serve", "--pty"])
             .args(extra)
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
             .spawn()
-            .expect("bowl sim starts");
+            .expect("bowl serve starts");
         let mut line = String::new();
         BufReader::new(child.stdout.take().unwrap())
             .read_line(&mut line)
-            .expect("bowl sim prints its pty");
+            .expect("bowl serve prints its pty");
         let path = line.trim().to_string();
         assert!(path.starts_with("/dev/"), "pty path, got {path:?}");
         Sim { child, path }

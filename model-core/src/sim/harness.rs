@@ -73,15 +73,24 @@ impl ClosedLoop {
     }
 }
 
-/// Step-response measures of one signal against a constant setpoint, accumulated online.
+/// The settling band of the simulated experiments: +/-2 % of the setpoint.
+pub const SETTLING_BAND: f32 = 0.02;
+
+/// Step-response measures of one signal stepping from one level to a constant setpoint,
+/// accumulated online. The one definition of rise, overshoot, settling and steady error: the
+/// simulated experiments and the demo's telemetry analysis both use it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepMetrics {
+    from: f32,
     setpoint: f32,
+    band: f32,
     steady_from_s: f32,
     t10: Option<f32>,
     t90: Option<f32>,
-    peak: f32,
+    /// Largest excursion past the setpoint, in the step's direction.
+    excess: f32,
     last_outside_s: f32,
+    last_sample_outside: bool,
     n: f32,
     sum: f64,
     sum_sq: f64,
@@ -94,10 +103,13 @@ pub struct StepMetrics {
 pub struct StepReport {
     /// 10 % to 90 % rise time, s (infinite if never reached).
     pub rise_time_s: f32,
-    /// Peak above the setpoint, fraction of the setpoint (0 if none).
+    /// Peak past the setpoint, fraction of the change (of the setpoint for a step from rest;
+    /// 0 if none).
     pub overshoot: f32,
-    /// Last time outside the +/-2 % band, s (the 2 % settling time).
+    /// Last time outside the settling band, s (the settling time; 0 if never outside).
     pub settling_time_s: f32,
+    /// The newest sample was inside the band (a run that ends outside never settled).
+    pub settled: bool,
     /// |mean over the steady window - setpoint|, fraction of the setpoint.
     pub steady_state_error: f32,
     /// RMS of the deviation from the steady window's mean, fraction of the setpoint.
@@ -107,15 +119,26 @@ pub struct StepReport {
 }
 
 impl StepMetrics {
-    /// Measures a step to `setpoint`; the steady window starts `steady_from_s` after the step.
+    /// Measures a step from rest to `setpoint` with the +/-2 % band ([`SETTLING_BAND`]); the
+    /// steady window starts `steady_from_s` after the step.
     pub fn new(setpoint: f32, steady_from_s: f32) -> Self {
+        Self::between(0.0, setpoint, SETTLING_BAND, steady_from_s)
+    }
+
+    /// Measures a step from `from` to `setpoint`: rise from 10 % to 90 % of the change,
+    /// overshoot as a fraction of the change, settled inside +/-`band` x |setpoint|; the steady
+    /// window starts `steady_from_s` after the step.
+    pub fn between(from: f32, setpoint: f32, band: f32, steady_from_s: f32) -> Self {
         Self {
+            from,
             setpoint,
+            band,
             steady_from_s,
             t10: None,
             t90: None,
-            peak: f32::MIN,
+            excess: f32::MIN,
             last_outside_s: 0.0,
+            last_sample_outside: false,
             n: 0.0,
             sum: 0.0,
             sum_sq: 0.0,
@@ -127,16 +150,18 @@ impl StepMetrics {
     /// Adds the sample `y` at `t_s` after the step.
     pub fn add(&mut self, t_s: f32, y: f32) {
         let sp = self.setpoint;
-        if self.t10.is_none() && y >= 0.1 * sp {
+        let change = sp - self.from;
+        let direction = if change < 0.0 { -1.0 } else { 1.0 };
+        let progress = (y - self.from) * direction;
+        if self.t10.is_none() && progress >= 0.1 * change.abs() {
             self.t10 = Some(t_s);
         }
-        if self.t90.is_none() && y >= 0.9 * sp {
+        if self.t90.is_none() && progress >= 0.9 * change.abs() {
             self.t90 = Some(t_s);
         }
-        if y > self.peak {
-            self.peak = y;
-        }
-        if (y - sp).abs() > 0.02 * sp.abs() {
+        self.excess = self.excess.max((y - sp) * direction);
+        self.last_sample_outside = (y - sp).abs() > self.band * sp.abs();
+        if self.last_sample_outside {
             self.last_outside_s = t_s;
         }
         if t_s >= self.steady_from_s {
@@ -151,6 +176,7 @@ impl StepMetrics {
     /// The measures so far.
     pub fn report(&self) -> StepReport {
         let sp = self.setpoint.abs().max(f32::MIN_POSITIVE);
+        let change = (self.setpoint - self.from).abs().max(f32::MIN_POSITIVE);
         let rise = match (self.t10, self.t90) {
             (Some(a), Some(b)) => b - a,
             _ => f32::INFINITY,
@@ -163,8 +189,9 @@ impl StepMetrics {
         };
         StepReport {
             rise_time_s: rise,
-            overshoot: ((self.peak - self.setpoint) / sp).max(0.0),
+            overshoot: (self.excess / change).max(0.0),
             settling_time_s: self.last_outside_s,
+            settled: !self.last_sample_outside,
             steady_state_error: ((mean as f32) - self.setpoint).abs() / sp,
             rms_ripple: libm::sqrt(var) as f32 / sp,
             half_peak_to_peak: 0.5 * (self.max_steady - self.min_steady) / sp,

@@ -14,6 +14,6 @@ pub mod motor;
 pub mod plant;
 pub mod prng;
 
-pub use harness::{ClosedLoop, StepMetrics, StepReport};
+pub use harness::{ClosedLoop, SETTLING_BAND, StepMetrics, StepReport};
 pub use motor::{MotorParams, MotorState};
 pub use plant::{AxisFaults, AxisParams, Plant, PlantParams, SensorParams};

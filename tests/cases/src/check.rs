@@ -32,7 +32,7 @@ pub struct Bench {
     pub inputs: usize,
     /// Evaluates grid point `i`; returns a value so the call is not optimised away.
     pub run: fn(usize) -> f32,
-    /// Instruction budget from the issues, if one is set (the runner flags a breach).
+    /// Instruction budget, if one is set (the runner flags a breach).
     pub budget_instructions: Option<u32>,
 }
 

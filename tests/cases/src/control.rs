@@ -109,7 +109,7 @@ fn true_model_loop(rig: PlantParams) -> Result<ClosedLoop, Failure> {
 }
 
 /// 0 -> 3 rad/s on the nominal rig (the true model given, no commissioning, to keep the
-/// emulated run short): the nominal figures on the true speed.
+/// emulated run short): the nominal figures of docs/control.md on the true speed.
 fn step_on_simulated_rig() -> Result<(), Failure> {
     let mut cl = true_model_loop(rig_with_pulses(12))?;
     cl.ctrl

@@ -2,7 +2,7 @@
 //! method executes on the Cortex-M4F for each of the chart's named scenes.
 //!
 //! The model's own benchmarks (`particle.rs`) report the worst case over a grid against the
-//! issue's budgets; the chart needs one point per (scene, model, method, setting) instead. The
+//! instruction budgets; the chart needs one point per (scene, model, method, setting) instead. The
 //! names are `cost::SCENE::MODEL::METHOD`; `bowl chart work-precision --qemu-log FILE` reads them
 //! back by that name from the QEMU run's output. The scenes are defined here once and used by the
 //! chart too, so the host and the target measure the same inputs.

@@ -1,6 +1,6 @@
-//! Cases for the particle model (paper Eq. 5 to 12, corrected per MODEL-NOTES) in `f32`, each
+//! Cases for the particle model (paper Eq. 5 to 12, corrected per docs/model.md) in `f32`, each
 //! against an `f64` reference computed here from an independent formula, and the benchmarks of
-//! the target path (residence time flat / Coriolis, the inverse) with the issue's budgets.
+//! the target path (residence time flat / Coriolis, the inverse) with their instruction budgets.
 
 use crate::check::{Bench, Case, Failure, close, ensure};
 use model_core::Real;
@@ -33,7 +33,7 @@ pub static CASES: &[Case] = &[
     },
 ];
 
-/// Benchmarks of this module (the issue's budgets: worst case over the grid).
+/// Benchmarks of this module (instruction budgets: worst case over the grid).
 pub static BENCHES: &[Bench] = &[
     Bench {
         name: "particle::residence_flat_f32",
@@ -192,7 +192,7 @@ fn flat_ref(s: &Scene<f64>) -> f64 {
     libm::acosh((s.rim_radius_m - a) / (s.ri_m - a)) / (libm::sqrt(s.k2) * s.omega_rad_s)
 }
 
-/// Reference Coriolis time: bisection on MODEL-NOTES' printed solution
+/// Reference Coriolis time: bisection on the corrected solution of docs/model.md section 3
 /// `a + (ri - a)(A e^{l1 t} + B e^{l2 t}) = R`, coefficients straight from the notes.
 fn coriolis_ref(s: &Scene<f64>) -> f64 {
     let k = libm::sqrt(s.k2);
@@ -218,7 +218,7 @@ fn coriolis_ref(s: &Scene<f64>) -> f64 {
     0.5 * (lo + hi)
 }
 
-/// f32 target: within 2e-6 times the condition number (MODEL-NOTES / issue 3).
+/// f32 target: within 2e-6 times the condition number (docs/model.md, "Speed against accuracy").
 const F32_TOL: f64 = 2e-6;
 
 fn flat_time_vs_acosh() -> Result<(), Failure> {

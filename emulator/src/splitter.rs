@@ -1,159 +1,22 @@
-//! Host side of the emulated board (Unix hosts only, never on the MCU): build a `qemu-*` image,
-//! boot it under QEMU netduinoplus2 with USART1 on a Unix socket, and share that link between
-//! the telemetry decoder and `bowl` commands. Used by the QEMU tests. (The demo,
-//! `bowl demo`, starts the same image with USART1 on a pseudo-terminal instead.)
+//! Shares a board's link between the telemetry decoder and `bowl` commands.
 //!
 //! Why a splitter: a serial port (or pseudo-terminal) has one input queue, so two readers
 //! (`bowl monitor` and `bowl send`) would steal each other's bytes. The splitter reads the board
 //! once, decodes every frame for itself, and copies the bytes to one pseudo-terminal per
-//! client: the monitor's always, the command terminal's while a `bowl send` runs.
-extern crate std;
+//! client: the monitor's always, the command terminal's while a `bowl send` runs. A test
+//! harness: it panics, with the reason, when a pseudo-terminal cannot be had or the board stops
+//! sending.
 
-use std::format;
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::os::fd::{AsRawFd, OwnedFd};
 use std::os::unix::net::UnixStream;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::string::String;
+use std::process::Command;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-use std::vec::Vec;
-use std::{println, vec};
 
 use model_core::wire::{Decoder, Frame, Telemetry};
-
-/// The workspace root (parent of this crate).
-pub fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// Builds `bin` for the emulated board (release profile) and returns the ELF path.
-pub fn build_image(bin: &str) -> PathBuf {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .current_dir(workspace_root())
-        .args([
-            "build",
-            "--release",
-            "-p",
-            "firmware",
-            "--no-default-features",
-            "--features",
-            "qemu",
-            "--target",
-            "thumbv7em-none-eabihf",
-            "--bin",
-            bin,
-        ])
-        .status()
-        .expect("cargo runs");
-    assert!(status.success(), "building {bin} for QEMU failed");
-    target_dir().join("thumbv7em-none-eabihf/release").join(bin)
-}
-
-/// A running emulated board: QEMU's stdout carries the semihosting console.
-pub struct Board {
-    /// The QEMU process (stdout: the semihosting console).
-    pub child: Child,
-    /// The board's USART1.
-    pub usart: UnixStream,
-    socket_path: PathBuf,
-}
-
-impl Board {
-    /// Boots `elf`; QEMU waits (`server=on,wait=on`) until we have connected to its USART1, so
-    /// no byte the board sends is lost.
-    pub fn boot(elf: &Path) -> Board {
-        Self::boot_with(elf, &[])
-    }
-
-    /// Boots `elf` with extra QEMU arguments (e.g. `-append seconds=30`).
-    pub fn boot_with(elf: &Path, extra: &[&str]) -> Board {
-        let socket_path = std::env::temp_dir().join(format!(
-            "bowl-qemu-{}-{}.sock",
-            std::process::id(),
-            elf.file_name().unwrap().to_string_lossy()
-        ));
-        let _ = std::fs::remove_file(&socket_path);
-        let child = Command::new("qemu-system-arm")
-            .args([
-                "-machine",
-                "netduinoplus2",
-                "-cpu",
-                "cortex-m4",
-                "-nographic",
-            ])
-            .args(["-monitor", "none"])
-            .args(["-semihosting-config", "enable=on,target=native"])
-            .args(["-icount", "shift=0,sleep=off"])
-            .arg("-chardev")
-            .arg(format!(
-                "socket,id=usart1,path={},server=on,wait=on",
-                socket_path.display()
-            ))
-            .args(["-serial", "chardev:usart1"])
-            .arg("-kernel")
-            .arg(elf)
-            .args(extra)
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .expect("qemu-system-arm is installed");
-        let deadline = Instant::now() + Duration::from_secs(20);
-        let usart = loop {
-            match UnixStream::connect(&socket_path) {
-                Ok(s) => break s,
-                Err(_) if Instant::now() < deadline => {
-                    std::thread::sleep(Duration::from_millis(20))
-                }
-                Err(e) => panic!("QEMU's USART socket never appeared: {e}"),
-            }
-        };
-        usart
-            .set_read_timeout(Some(Duration::from_secs(30)))
-            .unwrap();
-        Board {
-            child,
-            usart,
-            socket_path,
-        }
-    }
-
-    /// Reads one `\n`-terminated line from the USART (without the newline).
-    pub fn read_usart_line(&mut self) -> String {
-        let mut line = Vec::new();
-        let mut byte = [0u8; 1];
-        loop {
-            let n = self.usart.read(&mut byte).expect("USART read");
-            assert!(n == 1, "USART closed before a full line: {line:?}");
-            if byte[0] == b'\n' {
-                return String::from_utf8_lossy(&line).into_owned();
-            }
-            line.push(byte[0]);
-        }
-    }
-
-    /// Waits for QEMU to exit and returns (exit success, console lines).
-    pub fn finish(mut self) -> (bool, Vec<String>) {
-        let stdout = self.child.stdout.take().unwrap();
-        let lines: Vec<String> = BufReader::new(stdout)
-            .lines()
-            .map_while(Result::ok)
-            .collect();
-        let status = self.child.wait().expect("QEMU exits");
-        (status.success(), lines)
-    }
-}
-
-impl Drop for Board {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = std::fs::remove_file(&self.socket_path);
-    }
-}
 
 /// What the splitter decoded from the board.
 #[derive(Default)]
@@ -321,52 +184,4 @@ impl Splitter {
             std::thread::sleep(Duration::from_millis(5));
         }
     }
-}
-
-/// Builds the `bowl` command (host-tools, debug profile) and returns its path.
-pub fn build_bowl() -> PathBuf {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .current_dir(workspace_root())
-        .args(["build", "-p", "host-tools", "--bin", "bowl"])
-        .status()
-        .expect("cargo runs");
-    assert!(status.success(), "building bowl failed");
-    target_dir().join("debug/bowl")
-}
-
-fn target_dir() -> PathBuf {
-    std::env::var("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| workspace_root().join("target"))
-}
-
-/// One line of the plant's semihosting log: the simulation's truth.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PlantSample {
-    /// Simulation time, ms.
-    pub t_ms: u32,
-    /// True speeds `[precession, spin]`, rad/s.
-    pub speed_rad_s: [f32; 2],
-    /// Duties the plant was driven with.
-    pub duty: [f32; 2],
-}
-
-/// The `plant t_ms=.. w1=.. w2=.. d1=.. d2=..` lines of the semihosting console.
-pub fn plant_truth(console: &[String]) -> Vec<PlantSample> {
-    console
-        .iter()
-        .filter_map(|l| l.strip_prefix("plant "))
-        .filter_map(|l| {
-            let v: Vec<f32> = l
-                .split_whitespace()
-                .filter_map(|kv| kv.split_once('=').and_then(|(_, v)| v.parse().ok()))
-                .collect();
-            (v.len() == 5).then(|| PlantSample {
-                t_ms: v[0] as u32,
-                speed_rad_s: [v[1], v[2]],
-                duty: [v[3], v[4]],
-            })
-        })
-        .collect()
 }

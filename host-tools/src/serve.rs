@@ -1,0 +1,377 @@
+//! `bowl serve`: the virtual rig ([`crate::virtual_rig`]) on a transport. Either a
+//! pseudo-terminal speaking the protocol in real time (`--pty`), or a capture file written
+//! faster than real time with exactly the bytes the rig would send (`--capture FILE --seconds S`).
+//! The demo serves its host rig with the same loop ([`serve_on_pty`]).
+
+use std::fs::File;
+use std::io::{BufWriter, Read, Write};
+use std::os::fd::AsFd;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use nix::fcntl::OFlag;
+use nix::pty::{PtyMaster, grantpt, posix_openpt, ptsname_r, unlockpt};
+use nix::sys::termios::{FlushArg, tcflush};
+
+use crate::send::command_line;
+use crate::virtual_rig::VirtualRig;
+
+/// Flags of `bowl serve`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Serve the virtual rig on a new pseudo-terminal; its path is printed on the first line.
+    #[arg(long, conflicts_with = "capture")]
+    pty: bool,
+    /// Also make this symlink point at the pseudo-terminal (replaced if it exists).
+    #[arg(long, requires = "pty")]
+    link: Option<PathBuf>,
+    /// Run faster than real time and write the rig's output bytes to this file.
+    #[arg(long, requires = "seconds")]
+    capture: Option<PathBuf>,
+    /// Simulated seconds to run (with --pty: stop after this many real seconds).
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// Commands fed to the rig as if from the PC, `AT_MS:WORDS`, e.g. `0:speed,1800,2100`
+    /// `0:start` `5000:inject,sensor2` (repeatable; the answers appear in the output).
+    #[arg(long = "command", value_name = "AT_MS:WORDS")]
+    commands: Vec<String>,
+    /// Seed of the simulated plant's noise (and of the line noise).
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// A noisy line: this percentage of the bytes sent is replaced by a different random byte
+    /// (what the PC receives, to try the decoder and the counters; default 0).
+    #[arg(long, default_value_t = 0.0)]
+    line_noise_percent: f64,
+}
+
+/// Corrupts a fraction of the bytes on their way out (xorshift PRNG, seeded: reproducible).
+pub(crate) struct LineNoise {
+    state: u64,
+    threshold: u64,
+}
+
+impl LineNoise {
+    /// A clean line.
+    pub(crate) fn none() -> Self {
+        Self {
+            state: 1,
+            threshold: 0,
+        }
+    }
+
+    fn new(percent: f64, seed: u32) -> Result<Self> {
+        if !(percent.is_finite() && (0.0..=100.0).contains(&percent)) {
+            bail!("--line-noise-percent must be between 0 and 100 (got {percent})");
+        }
+        Ok(Self {
+            state: 0x9E37_79B9_7F4A_7C15 ^ u64::from(seed),
+            threshold: (percent / 100.0 * u64::MAX as f64) as u64,
+        })
+    }
+
+    fn next(&mut self) -> u64 {
+        self.state ^= self.state << 13;
+        self.state ^= self.state >> 7;
+        self.state ^= self.state << 17;
+        self.state
+    }
+
+    fn apply(&mut self, bytes: &mut [u8]) {
+        if self.threshold == 0 {
+            return;
+        }
+        for b in bytes {
+            if self.next() < self.threshold {
+                // A non-zero mask: the byte always changes.
+                *b ^= (self.next() % 255 + 1) as u8;
+            }
+        }
+    }
+}
+
+/// A scheduled command: device time and the command line bytes.
+pub(crate) struct Scheduled {
+    at_ms: u32,
+    line: Vec<u8>,
+}
+
+fn parse_commands(specs: &[String]) -> Result<Vec<Scheduled>> {
+    let mut out = Vec::new();
+    for (i, spec) in specs.iter().enumerate() {
+        let (at, words) = spec
+            .split_once(':')
+            .with_context(|| format!("--command {spec}: expected AT_MS:WORDS"))?;
+        let at_ms: u32 = at
+            .parse()
+            .with_context(|| format!("--command {spec}: bad time"))?;
+        let id = u16::try_from(i + 1).unwrap_or(u16::MAX);
+        let line = command_line(id, &[words.to_string()])
+            .map_err(|r| anyhow::anyhow!("--command {spec}: rejected locally ({})", r.token()))?;
+        out.push(Scheduled { at_ms, line });
+    }
+    out.sort_by_key(|s| s.at_ms);
+    Ok(out)
+}
+
+/// Runs `bowl serve`.
+pub fn run(args: &Args) -> Result<()> {
+    let commands = parse_commands(&args.commands)?;
+    let noise = LineNoise::new(args.line_noise_percent, args.seed)?;
+    if let Some(path) = &args.capture {
+        let seconds = args.seconds.unwrap_or(0.0);
+        return capture(path, seconds, commands, args.seed, noise);
+    }
+    if args.pty {
+        let pty = Pty::open()?;
+        if let Some(link) = &args.link {
+            let _ = std::fs::remove_file(link);
+            std::os::unix::fs::symlink(&pty.path, link)
+                .with_context(|| format!("cannot link {} to {}", link.display(), pty.path))?;
+        }
+        println!("{}", pty.path);
+        std::io::stdout().flush()?;
+        let never = AtomicBool::new(false);
+        let served = serve_on_pty(
+            pty,
+            VirtualRig::new(args.seed)?,
+            Pacing {
+                device_ms_per_wall_ms: 1.0,
+                stop: &never,
+                stop_after: args.seconds.map(Duration::from_secs_f64),
+                backlog: Backlog::DropWhenUnread,
+            },
+            commands,
+            noise,
+        );
+        if let Some(link) = &args.link {
+            let _ = std::fs::remove_file(link);
+        }
+        return served.map(|_| ());
+    }
+    bail!("say --pty (serve on a pseudo-terminal) or --capture FILE --seconds S (write to a file)")
+}
+
+fn capture(
+    path: &PathBuf,
+    seconds: f64,
+    commands: Vec<Scheduled>,
+    seed: u32,
+    mut noise: LineNoise,
+) -> Result<()> {
+    if !(seconds.is_finite() && (0.0..=4_000_000.0).contains(&seconds)) {
+        bail!("--seconds must be between 0 and 4e6 (got {seconds})");
+    }
+    let mut file = BufWriter::new(
+        File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
+    );
+    let mut rig = VirtualRig::new(seed)?;
+    let mut out = Vec::with_capacity(4096);
+    rig.boot(&mut out);
+    let total_ms = (seconds * 1000.0).round() as u64;
+    let mut pending = commands.into_iter().peekable();
+    let mut written = 0u64;
+    for _ in 0..total_ms {
+        let mut received = Vec::new();
+        while let Some(c) = pending.next_if(|c| c.at_ms <= rig.now_ms) {
+            received.extend(c.line);
+        }
+        rig.step_1ms(&received, &mut out);
+        if out.len() >= 4096 {
+            noise.apply(&mut out);
+            file.write_all(&out)?;
+            written += out.len() as u64;
+            out.clear();
+        }
+    }
+    noise.apply(&mut out);
+    file.write_all(&out)?;
+    written += out.len() as u64;
+    file.flush()?;
+    eprintln!(
+        "wrote {written} bytes ({seconds} s of rig output) to {}",
+        path.display()
+    );
+    Ok(())
+}
+
+/// A pseudo-terminal pair: the master side the rig is served on, and the slave's path.
+pub(crate) struct Pty {
+    master: PtyMaster,
+    /// Held open so the master never sees a hang-up between clients.
+    slave: File,
+    /// The slave's device path, for the client.
+    pub(crate) path: String,
+}
+
+impl Pty {
+    /// Opens a pair. The slave is put in raw mode so nothing is echoed or line-buffered before a
+    /// client configures it.
+    pub(crate) fn open() -> Result<Pty> {
+        let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY | OFlag::O_NONBLOCK)
+            .context("posix_openpt")?;
+        grantpt(&master).context("grantpt")?;
+        unlockpt(&master).context("unlockpt")?;
+        let path = ptsname_r(&master).context("ptsname")?;
+        let slave = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(&path)
+            .with_context(|| format!("open {path}"))?;
+        crate::serial::make_raw(&slave, model_core::wire::DEFAULT_BAUD)?;
+        Ok(Pty {
+            master,
+            slave,
+            path,
+        })
+    }
+}
+
+/// What happens to output bytes nobody reads.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Backlog {
+    /// Drop them, like a UART with no listener, so a client that connects later starts with
+    /// fresh frames (`bowl serve`).
+    DropWhenUnread,
+    /// Keep up to this many bytes queued, then drop them all (the demo: its client is always
+    /// there, only slower at times).
+    KeepUpTo(usize),
+}
+
+/// How the served rig keeps time and when it stops.
+pub(crate) struct Pacing<'a> {
+    /// Device milliseconds per wall millisecond (1 = real time).
+    pub(crate) device_ms_per_wall_ms: f64,
+    /// Stops the loop when set.
+    pub(crate) stop: &'a AtomicBool,
+    /// Stops the loop after this much wall time.
+    pub(crate) stop_after: Option<Duration>,
+    /// Unread output.
+    pub(crate) backlog: Backlog,
+}
+
+/// What the server saw.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct ServeStats {
+    /// Device time reached, ms.
+    pub device_ms: u32,
+    /// Bytes that could not be delivered because nobody read them.
+    pub bytes_dropped: u64,
+}
+
+/// Serves `rig` on `pty` until `pacing` says stop: the rig catches up with the (scaled) wall
+/// clock one millisecond at a time, reading what the client sent before each millisecond and
+/// writing what the rig answered after each pass.
+pub(crate) fn serve_on_pty(
+    mut pty: Pty,
+    mut rig: VirtualRig,
+    pacing: Pacing<'_>,
+    commands: Vec<Scheduled>,
+    mut noise: LineNoise,
+) -> Result<ServeStats> {
+    // At most this many device ms per pass, so reading and writing keep interleaving.
+    const MAX_STEPS_PER_PASS: u32 = 50;
+    let mut out = Vec::with_capacity(8192);
+    let mut stats = ServeStats::default();
+    rig.boot(&mut out);
+    let mut noisy_from = 0;
+    let started = Instant::now();
+    let mut pending = commands.into_iter().peekable();
+    let mut inbuf = [0u8; 1024];
+    while !pacing.stop.load(Ordering::Relaxed) {
+        let elapsed = started.elapsed();
+        if pacing.stop_after.is_some_and(|s| elapsed >= s) {
+            break;
+        }
+        let wall_ms = elapsed.as_secs_f64() * 1000.0 * pacing.device_ms_per_wall_ms;
+        let due_ms = u32::try_from(wall_ms as u64).unwrap_or(u32::MAX);
+        let mut steps = 0;
+        while rig.now_ms < due_ms && steps < MAX_STEPS_PER_PASS {
+            let mut received = Vec::new();
+            // An error is WouldBlock (nothing sent) or EIO (no client right now).
+            if let Ok(n) = pty.master.read(&mut inbuf) {
+                received.extend_from_slice(&inbuf[..n]);
+            }
+            while let Some(c) = pending.next_if(|c| c.at_ms <= rig.now_ms) {
+                received.extend(c.line);
+            }
+            rig.step_1ms(&received, &mut out);
+            steps += 1;
+        }
+        // Bytes not yet sent were already corrupted once; only the new ones get noise.
+        if let Some(fresh) = out.get_mut(noisy_from..) {
+            noise.apply(fresh);
+        }
+        write_pending(&mut pty, &mut out, pacing.backlog, &mut stats);
+        noisy_from = out.len();
+        if steps < MAX_STEPS_PER_PASS {
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+    stats.device_ms = rig.now_ms;
+    Ok(stats)
+}
+
+/// Writes what the pty takes of `out`; what it does not take is kept or dropped per `backlog`.
+fn write_pending(pty: &mut Pty, out: &mut Vec<u8>, backlog: Backlog, stats: &mut ServeStats) {
+    while !out.is_empty() {
+        match pty.master.write(out) {
+            Ok(0) => break,
+            Ok(n) => {
+                out.drain(..n);
+            }
+            Err(e) => {
+                if let Backlog::DropWhenUnread = backlog {
+                    if e.kind() == std::io::ErrorKind::WouldBlock {
+                        // Nobody reads: what the slave holds is stale too.
+                        let _ = tcflush(pty.slave.as_fd(), FlushArg::TCIFLUSH);
+                    }
+                    stats.bytes_dropped += out.len() as u64;
+                    out.clear();
+                }
+                break;
+            }
+        }
+    }
+    if let Backlog::KeepUpTo(max) = backlog
+        && out.len() > max
+    {
+        stats.bytes_dropped += out.len() as u64;
+        out.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_noise_changes_the_asked_fraction_of_bytes_and_a_clean_line_none() {
+        let clean = vec![0x55u8; 100_000];
+        let mut bytes = clean.clone();
+        LineNoise::none().apply(&mut bytes);
+        assert_eq!(bytes, clean);
+        LineNoise::new(10.0, 7).unwrap().apply(&mut bytes);
+        let changed = bytes.iter().zip(&clean).filter(|(a, b)| a != b).count();
+        // Binomial(100 000, 0.1): standard deviation 95 bytes; 1 000 is over ten of them.
+        assert!((9_000..=11_000).contains(&changed), "{changed} changed");
+        for bad in [-1.0, 100.5, f64::NAN] {
+            let err = LineNoise::new(bad, 1).err().expect("refused").to_string();
+            assert!(err.contains("between 0 and 100"), "{err}");
+        }
+    }
+
+    #[test]
+    fn scheduled_commands_run_in_time_order_and_bad_ones_are_named() {
+        let specs = ["5000:start".to_string(), "0:speed,1800,2100".to_string()];
+        let cmds = parse_commands(&specs).unwrap();
+        assert_eq!(cmds.iter().map(|c| c.at_ms).collect::<Vec<_>>(), [0, 5000]);
+        let first = String::from_utf8(cmds[0].line.clone()).unwrap();
+        assert!(first.contains("SPEED"), "{first}");
+        for bad in ["start", "soon:start"] {
+            let err = parse_commands(&[bad.to_string()]).err().expect("refused");
+            assert!(format!("{err:#}").contains(bad), "{err:#}");
+        }
+    }
+}
