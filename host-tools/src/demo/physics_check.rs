@@ -70,19 +70,18 @@ pub(super) fn residence_check(
         .unwrap_or([f64::NAN; 2]);
     let target_s = f64::from(RESIDENCE_TARGET_MS) / 1000.0;
     let (mut bowl, mut split, mut flat) = (None, None, None);
-    if let Some(p) = params {
-        if let Some(scene) = scene_of(p)
-            && let Ok(w) = particle::omega_for_residence_time(&scene, Model::Coriolis, target_s)
+    if let Some(p) = params
+        && let Some(scene) = scene_of(p)
+        && let Ok(w) = particle::omega_for_residence_time(&scene, Model::Coriolis, target_s)
+    {
+        bowl = Some(w);
+        flat = host_residence_ms(&scene, w, Model::Flat);
+        let angle = f64::from(p[ParamId::AxesMdeg.index()]) / 1000.0;
+        let ratio = f64::from(p[ParamId::RatioPpm.index()]) / 1e6;
+        if let Ok(g) = BowlGeometry::new(angle.to_radians())
+            && let Ok(m) = g.split(w, ratio)
         {
-            bowl = Some(w);
-            flat = host_residence_ms(&scene, w, Model::Flat);
-            let angle = f64::from(p[ParamId::AxesMdeg.index()]) / 1000.0;
-            let ratio = f64::from(p[ParamId::RatioPpm.index()]) / 1e6;
-            if let Ok(g) = BowlGeometry::new(angle.to_radians())
-                && let Ok(m) = g.split(w, ratio)
-            {
-                split = Some([m.precession_rad_s, m.spin_rad_s]);
-            }
+            split = Some([m.precession_rad_s, m.spin_rad_s]);
         }
     }
     let split_agrees = accepted
