@@ -16,6 +16,8 @@ use model_core::sim::experiments::{self, STEP_RUN_S, family_plant, rig_with_puls
 use model_core::sim::{ClosedLoop, Plant, PlantParams, StepReport};
 use serde::Serialize;
 
+use crate::{family_file, rig_file, sim_reports};
+
 #[derive(clap::Subcommand)]
 pub(crate) enum What {
     /// Step 0 -> 3 rad/s on the nominal rig; JSON.
@@ -30,6 +32,33 @@ pub(crate) enum What {
     Stability(StabilityArgs),
     /// CSV trace (every 10 ms) of the 0 -> 3 rad/s step on one family plant (or the nominal rig).
     Trace(TraceArgs),
+    /// The fault matrix on every plant of a rig file; JSON.
+    Faults(FaultsArgs),
+    /// Writes a seeded family file of plants spread the way lab rigs differ (TOML, stdout).
+    MakeFamily(MakeFamilyArgs),
+}
+
+#[derive(clap::Args)]
+pub(crate) struct FaultsArgs {
+    /// Rig file or family file (TOML, see docs/rigs/nominal.toml).
+    #[arg(long)]
+    rig_file: std::path::PathBuf,
+    /// Speed both axes run at when each fault is injected, rad/s.
+    #[arg(long, default_value_t = 3.0)]
+    speed_rad_s: f32,
+    /// JSON output (the only format; accepted for symmetry with the other reports).
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct MakeFamilyArgs {
+    /// Seed of the spread.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Number of plants.
+    #[arg(long, default_value_t = 60)]
+    plants: u32,
 }
 
 #[derive(clap::Args)]
@@ -73,6 +102,10 @@ pub(crate) struct StepArgs {
     /// Override the setpoint ramp, rad/s^2.
     #[arg(long)]
     accel_rad_s2: Option<f32>,
+    /// A rig file (one rig) instead of the nominal rig; its pulses per revolution and load
+    /// step apply (`--pulses-per-rev` and `--ripple-nm` are then ignored).
+    #[arg(long)]
+    rig_file: Option<std::path::PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -88,6 +121,15 @@ pub(crate) struct FamilyArgs {
     /// Allow fewer than 50 plants (for quick tests).
     #[arg(long, hide = true)]
     allow_small: bool,
+    /// Run the plants of this rig or family file instead of the built-in family.
+    #[arg(long)]
+    rig_file: Option<std::path::PathBuf>,
+    /// Step target with --rig-file, rad/s.
+    #[arg(long, default_value_t = 3.0)]
+    target_rad_s: f32,
+    /// JSON output (the only format; accepted for symmetry).
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(clap::Args)]
@@ -108,6 +150,55 @@ pub(crate) struct StabilityArgs {
 /// Runs `bowl sim`.
 pub(crate) fn run(what: &What) -> Result<()> {
     match what {
+        What::Step(a) if a.rig_file.is_some() => {
+            let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
+            let rigs = rig_file::load(path)?;
+            if rigs.len() != 1 {
+                bail!(
+                    "{} holds {} plants; `bowl sim step` runs one rig (use `bowl sim family --rig-file` for a family)",
+                    path.display(),
+                    rigs.len()
+                );
+            }
+            let rig = &rigs[0];
+            let cfg = sim_reports::config_for(rig);
+            let load = [
+                rig.params.axes[0].load_step_nm,
+                rig.params.axes[1].load_step_nm,
+            ];
+            let out = StepJson {
+                scenario: "rig file, both axes 0 -> target, commissioned first, true speed",
+                pulses_per_rev: rig.params.axes[1].sensor.pulses_per_rev,
+                target_rad_s: a.target_rad_s,
+                feedback: !a.no_feedback,
+                outcome: step_run_with(
+                    rig.params,
+                    cfg,
+                    rig.seed,
+                    a.target_rad_s,
+                    !a.no_feedback,
+                    load,
+                ),
+            };
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::Family(a) if a.rig_file.is_some() => {
+            let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
+            check_speed(a.target_rad_s, "--target-rad-s")?;
+            let rigs = rig_file::load(path)?;
+            let plants = parallel(&rigs, |r| sim_reports::family_plant(r, a.target_rad_s));
+            let summary = sim_reports::summary(&plants);
+            let out = serde_json::json!({ "plants": plants, "summary": summary });
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::Faults(a) => {
+            check_speed(a.speed_rad_s, "--speed-rad-s")?;
+            let rigs = rig_file::load(&a.rig_file)?;
+            let plants = parallel(&rigs, |r| sim_reports::fault_plant(r, a.speed_rad_s));
+            let out = serde_json::json!({ "plants": plants });
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::MakeFamily(a) => print!("{}", family_file::family_toml(a.seed, a.plants)),
         What::Step(a) => {
             let mut rig = rig_with_pulses(a.pulses_per_rev);
             if let Some(r) = a.ripple_nm {
@@ -159,6 +250,30 @@ pub(crate) fn run(what: &What) -> Result<()> {
         What::Trace(a) => trace(a.common.seed, a.plant),
     }
     Ok(())
+}
+
+fn check_speed(x: f32, flag: &str) -> Result<()> {
+    let max = ControllerConfig::nominal().axes[0].max_speed_rad_s;
+    if !(x.is_finite() && x > 0.0 && x <= max) {
+        bail!("{flag} {x} is outside 0 to {max} rad/s (the controller's speed range)");
+    }
+    Ok(())
+}
+
+/// `f` over `items` on all cores, results in order.
+fn parallel<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let chunk = items.len().div_ceil(threads).max(1);
+    std::thread::scope(|s| {
+        let handles: Vec<_> = items
+            .chunks(chunk)
+            .map(|c| s.spawn(|| c.iter().map(&f).collect::<Vec<R>>()))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("a report thread panicked"))
+            .collect()
+    })
 }
 
 /// The step-response figures of one axis.

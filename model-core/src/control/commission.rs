@@ -95,6 +95,24 @@ pub enum IdentifyError {
     Timeout,
 }
 
+impl IdentifyError {
+    /// The reason in plain words, for a refusal message.
+    pub fn reason(self) -> &'static str {
+        match self {
+            IdentifyError::TooFewEdges => {
+                "too few sensor edges to fit a speed: check the sensor, or free the shaft"
+            }
+            IdentifyError::NoSpeedIncrease => {
+                "the shaft did not turn faster at the higher duty: check the motor and its load"
+            }
+            IdentifyError::Implausible => {
+                "the identified motor model is outside the plausible range"
+            }
+            IdentifyError::Timeout => "identification took longer than its timeout",
+        }
+    }
+}
+
 /// One axis's identification result, with the raw fit for reports.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
