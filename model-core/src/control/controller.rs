@@ -382,6 +382,7 @@ impl Controller {
                         self.cfg.axes[i].min_speed_rad_s,
                         self.est[i].rad_per_pulse(),
                     ) {
+                        self.identify_error = Some(IdentifyError::TooFewEdges);
                         self.latch(Fault::SensorLostOrStall(i as u8));
                         return;
                     }
@@ -597,6 +598,10 @@ impl Controller {
                     self.cfg.commissioning,
                     self.cfg.supply_v,
                     self.cfg.timer_hz as f32,
+                    [
+                        self.cfg.axes[0].pulses_per_rev,
+                        self.cfg.axes[1].pulses_per_rev,
+                    ],
                 ));
                 self.identify_error = None;
                 self.watch = [SensorWatch::CLEAR; 2];

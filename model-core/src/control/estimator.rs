@@ -191,8 +191,17 @@ impl PulseSpeedEstimator {
         }
         let dt = at.wrapping_sub(self.last_edge);
         // `lockout_now` = max(absolute lockout, 40 % of the filtered period), kept up to date
-        // when the period changes, so the common path is integer compares only.
-        if dt < self.lockout_now {
+        // when the period changes, so the common path is integer compares only. The relative
+        // part only holds at steady speed: while the speed changes (a ramp, a commissioning
+        // step) the period can more than halve between two edges, and a real edge must never
+        // be dropped; the absolute lockout (half the period at the over-speed limit) still
+        // rejects contact bounce.
+        let lockout = if steady {
+            self.lockout_now
+        } else {
+            self.lockout_ticks
+        };
+        if dt < lockout {
             self.rejected = self.rejected.wrapping_add(1);
             return None;
         }
