@@ -68,6 +68,15 @@ pub(crate) struct TraceArgs {
     /// Family plant index; without it, the nominal rig.
     #[arg(long)]
     plant: Option<u32>,
+    /// A rig file instead (the plant named by --name, or its first).
+    #[arg(long)]
+    rig_file: Option<std::path::PathBuf>,
+    /// The plant's name in --rig-file.
+    #[arg(long)]
+    name: Option<String>,
+    /// Step target, rad/s.
+    #[arg(long, default_value_t = 3.0)]
+    target_rad_s: f32,
 }
 
 #[derive(clap::Args, Clone)]
@@ -247,7 +256,20 @@ pub(crate) fn run(what: &What) -> Result<()> {
         }
         What::Sweep(a) => sweep(a.seed),
         What::Stability(a) => stability(a.common.seed, a.speed_rad_s, a.pulses_per_rev, a.tick_hz),
-        What::Trace(a) => trace(a.common.seed, a.plant),
+        What::Trace(a) => {
+            let rig = match &a.rig_file {
+                Some(path) => {
+                    let rigs = rig_file::load(path)?;
+                    let found = match &a.name {
+                        Some(n) => rigs.into_iter().find(|r| &r.name == n),
+                        None => rigs.into_iter().next(),
+                    };
+                    Some(found.ok_or_else(|| anyhow::anyhow!("no plant of that name in the file"))?)
+                }
+                None => None,
+            };
+            trace(a.common.seed, a.plant, rig, a.target_rad_s)
+        }
     }
     Ok(())
 }
@@ -541,15 +563,22 @@ fn stability(seed: u32, speed: f32, only: Option<u16>, tick_hz: u32) {
     }
 }
 
-fn trace(seed: u32, plant: Option<u32>) {
+fn trace(seed: u32, plant: Option<u32>, from_file: Option<rig_file::Rig>, target: f32) {
+    let mut cfg = ControllerConfig::nominal();
     let (rig, rig_seed, load) = match plant {
+        _ if from_file.is_some() => {
+            let r = from_file.unwrap_or_else(|| unreachable!());
+            cfg = sim_reports::config_for(&r);
+            let load = [r.params.axes[0].load_step_nm, r.params.axes[1].load_step_nm];
+            (r.params, r.seed, load)
+        }
         Some(i) => {
             let (rig, load) = family_plant(seed, i);
             (rig, seed.wrapping_add(i), load)
         }
         None => (PlantParams::nominal(), seed, [0.0; 2]),
     };
-    let ctrl = Controller::new(ControllerConfig::nominal()).expect("valid");
+    let ctrl = Controller::new(cfg).expect("valid");
     let mut cl = ClosedLoop::new(Plant::new(rig, rig_seed), ctrl);
     let state = cl.commission(300.0);
     eprintln!(
@@ -561,14 +590,14 @@ fn trace(seed: u32, plant: Option<u32>) {
         a.faults.load_step_from_s = now;
         a.faults.load_step_nm = l;
     }
-    let _ = cl.ctrl.set_motor_speeds(3.0, 3.0);
+    let _ = cl.ctrl.set_motor_speeds(target, target);
     let _ = cl.ctrl.start();
     println!(
         "t_s,true_prec,true_spin,meas_prec,meas_spin,ref_prec,ref_spin,duty_prec,duty_spin,state,fault"
     );
     let dt = cl.dt_s();
     let mut k = 0u32;
-    cl.run(STEP_RUN_S, |c| {
+    cl.run(sim_reports::step_run_s(target).max(STEP_RUN_S), |c| {
         k += 1;
         if k.is_multiple_of(10) {
             let s = c.ctrl.status();

@@ -310,13 +310,16 @@ impl Controller {
             events: self.est[i].window_events(),
             feedback: self.feedback,
             extra_duty,
+            at_rest: self.est[i].at_rest(),
         };
         let duty = self.loops[i].step(&self.k[i], input);
         self.duties[i] = duty;
+        // Expected edges are watched whatever the duty: at low speed the duty that holds the
+        // shaft can be below any fixed threshold.
         if self.watch[i].step(
             dt,
             duty.abs(),
-            self.cfg.stall_duty,
+            0.0,
             seen,
             self.cfg.sensor_timeout_floor_s,
             self.loops[i].model_rad_s(),

@@ -309,6 +309,10 @@ impl PulseSpeedEstimator {
     pub fn updated(&self) -> bool {
         self.closed_at.is_some()
     }
+    /// True when no edge has come since the shaft last stopped (or ever).
+    pub fn at_rest(&self) -> bool {
+        !self.has_edge
+    }
     /// True when the estimate is exactly zero (stopped or never moved).
     pub fn is_stopped(&self) -> bool {
         self.speed == 0.0
