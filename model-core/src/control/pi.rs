@@ -46,6 +46,8 @@ pub const BREAKAWAY_PUSH_PER_S: f32 = 0.25;
 /// The shaft counts as stuck once the plant model has turned this many pitches since the last
 /// edge without a new one (a shaft following the model would have given one).
 pub const STUCK_PITCHES: f32 = 1.5;
+/// Share of the breakaway push the integral keeps once the shaft moves.
+pub const PUSH_KEPT: f32 = 0.5;
 
 /// State of one axis's loop.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -226,6 +228,10 @@ impl SpeedLoop {
             e = 0.0;
         }
         if !input.at_rest {
+            // The shaft moved. The push held stiction and whatever load the model does not
+            // know; half of it stays in the integral (the loop corrects the rest either way),
+            // so a loaded shaft at low speed does not stick again at once.
+            self.integral += PUSH_KEPT * self.push;
             self.push = 0.0;
         } else if input.feedback
             && self.model_angle_rad.abs() > k.stuck_angle_rad
