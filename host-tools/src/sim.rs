@@ -264,7 +264,10 @@ pub(crate) fn run(what: &What) -> Result<()> {
                         Some(n) => rigs.into_iter().find(|r| &r.name == n),
                         None => rigs.into_iter().next(),
                     };
-                    Some(found.ok_or_else(|| anyhow::anyhow!("no plant of that name in the file"))?)
+                    Some(
+                        found
+                            .ok_or_else(|| anyhow::anyhow!("no plant of that name in the file"))?,
+                    )
                 }
                 None => None,
             };

@@ -2,7 +2,7 @@
 
 use super::commission::{Commissioning, Identified, IdentifyError, Phase};
 use super::config::{ConfigError, ControllerConfig, in_range};
-use super::estimator::PulseSpeedEstimator;
+use super::estimator::{PulseSpeedEstimator, lowest_speed_rad_s};
 use super::pi::{LoopConstants, LoopInput, SpeedLoop};
 use super::planner::{
     BowlSpeedForResidence, InverseFailure, ResidenceForBowlSpeed, SetpointPlanner, split_combined,
@@ -105,7 +105,14 @@ pub struct Controller {
     cos_axes: f32,
     sin_axes: f32,
     host_watch: bool,
+    reached: bool,
 }
+
+/// An edge interval faster than this many times the plant model's speed (plus the margin) is a
+/// runaway: tooth offsets (up to 10 % on one interval) and a 10 % overshoot stay well inside.
+const RUNAWAY_RATIO: f32 = 1.3;
+/// See [`RUNAWAY_RATIO`], rad/s.
+const RUNAWAY_MARGIN_RAD_S: f32 = 0.2;
 
 impl Controller {
     /// A controller in [`State::Idle`] for a configuration that passes validation.
@@ -167,6 +174,7 @@ impl Controller {
             cos_axes: cos_const(cfg.axes_angle_rad),
             sin_axes: sin_const(cfg.axes_angle_rad),
             host_watch: cfg.host_timeout_s > 0.0,
+            reached: false,
         }
     }
 
@@ -187,7 +195,14 @@ impl Controller {
             let speed = self.est[i].tick(now_ticks, edges[i], steady[i] > 0.5, |_, _| {});
             seen[i] = self.est[i].accepted_edges() != before;
             self.measured[i] = self.direction[i] * speed;
-            if speed > self.cfg.axes[i].overspeed_rad_s {
+            // Runaway (a bridge stuck on): once both axes have reached their references, an
+            // edge that came far sooner than the plant model expects faults at once, without
+            // waiting for the filtered speed to reach the absolute limit.
+            let runaway = self.reached
+                && seen[i]
+                && self.est[i].edge_speed_rad_s()
+                    > RUNAWAY_RATIO * self.loops[i].model_rad_s().abs() + RUNAWAY_MARGIN_RAD_S;
+            if speed > self.cfg.axes[i].overspeed_rad_s || runaway {
                 self.latch(Fault::Overspeed(i as u8));
             }
         }
@@ -286,6 +301,7 @@ impl Controller {
                         && (self.measured[i] - ramped[i]).abs() <= 0.05 * ramped[i].abs() + 0.05
                 });
                 self.state = if reached {
+                    self.reached = true;
                     State::Running
                 } else {
                     State::SpinningUp
@@ -429,7 +445,7 @@ impl Controller {
         if m > a.max_speed_rad_s {
             return Err(Rejection::AboveMaxSpeed(axis as u8));
         }
-        if m != 0.0 && m < a.min_speed_rad_s {
+        if m != 0.0 && m < lowest_speed_rad_s(a) {
             return Err(Rejection::BelowMinSpeed(axis as u8));
         }
         Ok(())
@@ -469,6 +485,9 @@ impl Controller {
             return Err(e);
         }
         self.planner.set_targets([precession_rad_s, spin_rad_s]);
+        // A new setpoint: the runaway check waits until it is reached (a heavy shaft may
+        // coast down slower than the ramp).
+        self.reached = false;
         Ok(())
     }
 
@@ -496,6 +515,7 @@ impl Controller {
         self.check_speed(0, speeds[0])?;
         self.check_speed(1, speeds[1])?;
         self.planner.set_targets(speeds);
+        self.reached = false;
         Ok(speeds)
     }
 
@@ -506,6 +526,7 @@ impl Controller {
             State::Idle => {
                 self.loops = [SpeedLoop::REST; 2];
                 self.watch = [SensorWatch::CLEAR; 2];
+                self.reached = false;
                 self.state = State::SpinningUp;
                 Ok(())
             }
@@ -521,6 +542,7 @@ impl Controller {
         match self.state {
             State::SpinningUp | State::Running => {
                 self.planner.set_targets([0.0; 2]);
+                self.reached = false;
                 self.state = State::Stopping;
             }
             State::Commissioning => {

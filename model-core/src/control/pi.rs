@@ -35,8 +35,10 @@
 //! [`STUCK_PITCHES`] gets a breakaway push on top of the feedforward that rises at
 //! [`BREAKAWAY_PUSH_PER_S`] until the first edge comes, then drops to zero: the feedforward holds Coulomb friction once the shaft slides,
 //! but only stiction's larger torque starts it. The push does not depend on the loop's gain,
-//! which the pulse-rate schedule makes small at low speed. A blocked shaft or a dead sensor
-//! pushes up to the duty limit and the supervisor's expected-edge watch faults it.
+//! which the pulse-rate schedule makes small at low speed. The push only starts a shaft from
+//! rest: once the loop has seen it move, a shaft that goes quiet is not pushed (a dead sensor on
+//! a turning shaft would otherwise run it away before the supervisor's expected-edge watch
+//! faults it); the integral keeps what the push found.
 
 use super::config::AxisConfig;
 use super::estimator::WindowEvents;
@@ -61,6 +63,7 @@ pub struct SpeedLoop {
     error: f32,
     kp_prev: f32,
     push: f32,
+    moved: bool,
 }
 
 /// Inputs of one loop step.
@@ -178,6 +181,7 @@ impl SpeedLoop {
         error: 0.0,
         kp_prev: 0.0,
         push: 0.0,
+        moved: false,
     };
 
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
@@ -228,12 +232,14 @@ impl SpeedLoop {
             e = 0.0;
         }
         if !input.at_rest {
+            self.moved = true;
             // The shaft moved. The push held stiction and whatever load the model does not
             // know; half of it stays in the integral (the loop corrects the rest either way),
             // so a loaded shaft at low speed does not stick again at once.
             self.integral += PUSH_KEPT * self.push;
             self.push = 0.0;
         } else if input.feedback
+            && !self.moved
             && self.model_angle_rad.abs() > k.stuck_angle_rad
             && self.push < 1.0
         {
