@@ -231,15 +231,26 @@ impl SpeedLoop {
             self.error = 0.0;
             e = 0.0;
         }
-        if !input.at_rest {
-            self.moved = true;
-            // The shaft moved. The push held stiction and whatever load the model does not
-            // know; half of it stays in the integral (the loop corrects the rest either way),
-            // so a loaded shaft at low speed does not stick again at once.
+        // The first edge from rest, or the first measurement after a crawl: the push held
+        // stiction and whatever load the model does not know; half of it stays in the integral
+        // (the loop corrects the rest either way), so a loaded shaft at low speed does not
+        // stick again at once.
+        let first_edge = !input.at_rest && !self.moved;
+        if first_edge || (input.measurement_valid && self.push != 0.0) {
             self.integral += PUSH_KEPT * self.push;
             self.push = 0.0;
-        } else if input.feedback
-            && !self.moved
+        }
+        if !input.at_rest {
+            self.moved = true;
+        }
+        // Push a shaft that should have given an edge by now: from rest before it first moved,
+        // or crawling between its first and second edge (no measurement yet). Never a shaft
+        // that went quiet after moving (the estimator reset it to rest): that is the
+        // supervisor's to judge, and pushing it would run away a shaft with a dead sensor.
+        let starting = input.at_rest && !self.moved;
+        let crawling = !input.at_rest && !input.measurement_valid;
+        if (starting || crawling)
+            && input.feedback
             && self.model_angle_rad.abs() > k.stuck_angle_rad
             && self.push < 1.0
         {
