@@ -363,7 +363,13 @@ impl Controller {
             Err(e) => {
                 self.identify_error = Some(e);
                 self.commissioning = None;
-                self.latch(Fault::InvalidConfiguration);
+                // No edge at any duty: a dead sensor or a blocked shaft, the same fault as
+                // in closed loop; anything else leaves the configuration unidentified.
+                self.latch(if e == IdentifyError::NoBreakaway {
+                    Fault::SensorLostOrStall(axis as u8)
+                } else {
+                    Fault::InvalidConfiguration
+                });
             }
             Ok(duties) => {
                 self.duties = duties;
