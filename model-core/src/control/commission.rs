@@ -1,7 +1,8 @@
 //! Commissioning: open-loop identification of each axis from duty steps and edge times.
 //!
 //! # Routine (spin first, then precession; one at a time, the other at zero duty)
-//! 0. *Breakaway search*: from rest the duty rises at [`BREAKAWAY_RATE_PER_S`] until the sensor
+//! 0. *Breakaway search*: from rest the duty rises at [`BREAKAWAY_RATE_PER_S`] (slower with
+//!    fewer than 12 pulses per revolution, in proportion) until the sensor
 //!    gives an edge; that duty breaks stiction (a fixed low duty never breaks away a stiff
 //!    shaft). No edge by [`BREAKAWAY_MAX_DUTY`] refuses: the shaft is blocked or the sensor dead.
 //! 1. *Low step*: duty `max(low_duty, breakaway + 0.1)`, held at least `step_time_s` and until
@@ -270,7 +271,10 @@ impl Commissioning {
         let mut duty = 0.0;
         match self.phase {
             Phase::Breakaway => {
-                self.duty = BREAKAWAY_START_DUTY + BREAKAWAY_RATE_PER_S * t_s;
+                // With sparse pulses the first edge comes up to a pitch after the shaft starts:
+                // the duty rises slower so that it overshoots the breakaway duty as little.
+                let sparse = if n < 12 { n as f32 / 12.0 } else { 1.0 };
+                self.duty = BREAKAWAY_START_DUTY + BREAKAWAY_RATE_PER_S * sparse * t_s;
                 if self.duty > BREAKAWAY_MAX_DUTY {
                     return Err(IdentifyError::NoBreakaway);
                 }
