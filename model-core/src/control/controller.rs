@@ -110,9 +110,9 @@ pub struct Controller {
 
 /// An edge interval faster than this many times the plant model's speed (plus the margin) is a
 /// runaway: tooth offsets (up to 10 % on one interval) and a 10 % overshoot stay well inside.
-const RUNAWAY_RATIO: f32 = 1.3;
+const RUNAWAY_RATIO: f32 = 1.2;
 /// See [`RUNAWAY_RATIO`], rad/s.
-const RUNAWAY_MARGIN_RAD_S: f32 = 0.2;
+const RUNAWAY_MARGIN_RAD_S: f32 = 0.15;
 
 impl Controller {
     /// A controller in [`State::Idle`] for a configuration that passes validation.
