@@ -109,10 +109,11 @@ pub struct Controller {
 }
 
 /// An edge interval faster than this many times the plant model's speed (plus the margin) is a
-/// runaway: tooth offsets (up to 10 % on one interval) and a 10 % overshoot stay well inside.
+/// runaway: tooth offsets (up to 10 % on one interval), a 10 % overshoot and the breakaway of a
+/// stiff shaft at the lowest speed stay inside.
 const RUNAWAY_RATIO: f32 = 1.2;
 /// See [`RUNAWAY_RATIO`], rad/s.
-const RUNAWAY_MARGIN_RAD_S: f32 = 0.15;
+const RUNAWAY_MARGIN_RAD_S: f32 = 0.3;
 
 impl Controller {
     /// A controller in [`State::Idle`] for a configuration that passes validation.
