@@ -44,7 +44,7 @@ use super::config::AxisConfig;
 use super::estimator::WindowEvents;
 
 /// Rise of the breakaway push on a shaft at rest, duty per second.
-pub const BREAKAWAY_PUSH_PER_S: f32 = 0.25;
+pub const BREAKAWAY_PUSH_PER_S: f32 = 0.15;
 /// The shaft counts as stuck once the plant model has turned this many pitches since the last
 /// edge without a new one (a shaft following the model would have given one).
 pub const STUCK_PITCHES: f32 = 1.5;
