@@ -195,6 +195,7 @@ pub(crate) fn run(what: &What) -> Result<()> {
             let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
             check_speed(a.target_rad_s, "--target-rad-s")?;
             let rigs = rig_file::load(path)?;
+            check_lowest(&rigs, a.target_rad_s, "--target-rad-s")?;
             let plants = parallel(&rigs, |r| sim_reports::family_plant(r, a.target_rad_s));
             let summary = sim_reports::summary(&plants);
             let out = serde_json::json!({ "plants": plants, "summary": summary });
@@ -203,6 +204,7 @@ pub(crate) fn run(what: &What) -> Result<()> {
         What::Faults(a) => {
             check_speed(a.speed_rad_s, "--speed-rad-s")?;
             let rigs = rig_file::load(&a.rig_file)?;
+            check_lowest(&rigs, a.speed_rad_s, "--speed-rad-s")?;
             let plants = parallel(&rigs, |r| sim_reports::fault_plant(r, a.speed_rad_s));
             let out = serde_json::json!({ "plants": plants });
             println!("{}", serde_json::to_string_pretty(&out)?);
@@ -281,6 +283,24 @@ fn check_speed(x: f32, flag: &str) -> Result<()> {
     let max = ControllerConfig::nominal().axes[0].max_speed_rad_s;
     if !(x.is_finite() && x > 0.0 && x <= max) {
         bail!("{flag} {x} is outside 0 to {max} rad/s (the controller's speed range)");
+    }
+    Ok(())
+}
+
+/// Refuses a speed below the lowest one a plant's sensors can measure (one pulse per 4 s).
+fn check_lowest(rigs: &[rig_file::Rig], x: f32, flag: &str) -> Result<()> {
+    for r in rigs {
+        let cfg = sim_reports::config_for(r);
+        for (axis, name) in cfg.axes.iter().zip(["precession", "spin"]) {
+            let lowest = model_core::control::estimator::lowest_speed_rad_s(axis);
+            if x < lowest {
+                bail!(
+                    "{flag} {x} is below the lowest speed of plant {}'s {name} axis, {lowest:.3} rad/s ({} pulses per revolution); ask for at least that",
+                    r.name,
+                    axis.pulses_per_rev
+                );
+            }
+        }
     }
     Ok(())
 }
