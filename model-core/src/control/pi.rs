@@ -47,7 +47,7 @@ use super::estimator::WindowEvents;
 pub const BREAKAWAY_PUSH_PER_S: f32 = 0.15;
 /// The shaft counts as stuck once the plant model has turned this many pitches since the last
 /// edge without a new one (a shaft following the model would have given one).
-pub const STUCK_PITCHES: f32 = 1.5;
+pub const STUCK_PITCHES: f32 = 1.2;
 /// Share of the breakaway push the integral keeps once the shaft moves.
 pub const PUSH_KEPT: f32 = 0.5;
 
