@@ -27,11 +27,12 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
 use embassy_time::{Duration, Ticker};
 use firmware::app::binding::{
-    ControllerBackend, DeviceCore, NoInjection, PERSISTED_COUNT, default_persisted,
+    ControllerBackend, DeviceCore, NoInjection, PERSISTED_COUNT, default_persisted, split_persisted,
 };
 use firmware::app::hal::Watchdog;
 use firmware::app::motors::Motors;
 use firmware::app::params::ParamLog;
+use firmware::app::persist::{PERSIST_PERIOD, Persistence};
 use firmware::app::reset;
 use firmware::app::slot::Slot;
 use firmware::app::tasks::{self, Heartbeat, SharedCore};
@@ -205,35 +206,25 @@ async fn supervisor_task(
 ) {
     let feed = tasks::supervisor(watchdog, &HEARTBEAT);
     let persist = async {
-        let mut ticker = Ticker::every(Duration::from_millis(500));
-        let mut reported_lost = [0u32; 2];
+        let mut persistence = Persistence::new(log);
+        let mut ticker = Ticker::every(PERSIST_PERIOD);
         loop {
             ticker.next().await;
-            let (values, lost) = core.lock(|c| {
-                let mut c = c.borrow_mut();
-                let lost = c.dropped_edges();
-                if c.backend.take_params_to_save() {
-                    (Some(c.params_to_persist()), lost)
-                } else {
-                    (None, lost)
-                }
-            });
+            let report = persistence.step(core);
             // The wire has no field for capture losses: say so in the log, never silently.
-            if lost != reported_lost {
+            if let Some(lost) = report.edges_lost {
                 warn!(
                     "capture: edges lost so far: precession {}, spin {}",
                     lost[0], lost[1]
                 );
-                reported_lost = lost;
             }
-            if let Some(v) = values {
-                match log.save(&v) {
-                    Ok(()) => {
-                        let (_, models) = firmware::app::binding::split_persisted(&v);
-                        info!("params: saved; motor models {} / {}", models[0], models[1]);
-                    }
-                    Err(e) => error!("params: save failed: {}", e),
+            match report.saved {
+                Some(Ok(record)) => {
+                    let (_, models) = split_persisted(&record);
+                    info!("params: saved; motor models {} / {}", models[0], models[1]);
                 }
+                Some(Err(e)) => error!("params: save failed: {}", e),
+                None => {}
             }
         }
     };
