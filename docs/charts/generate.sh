@@ -28,3 +28,5 @@ done
 # The control loop's figures on the simulated rig (docs/control.md).
 "$bowl" chart settling --out docs/charts/control-settling.svg
 "$bowl" chart control-stability --out docs/charts/control-stability.svg
+"$bowl" chart family --rig-file tests/rigs/family-60.toml --out docs/charts/control-family.svg
+"$bowl" chart family --rig-file tests/rigs/family-60.toml --target-rad-s 0.5 --out docs/charts/control-family-low.svg

@@ -19,6 +19,8 @@ use model_core::sim::experiments::{self, STEP_RUN_S, family_plant, rig_with_puls
 use model_core::sim::{ClosedLoop, Plant, PlantParams, StepReport};
 use serde::Serialize;
 
+use crate::{family_file, rig_file, sim_reports};
+
 #[derive(clap::Subcommand)]
 pub(crate) enum What {
     /// Step 0 -> 3 rad/s on the nominal rig; JSON.
@@ -33,6 +35,33 @@ pub(crate) enum What {
     Stability(StabilityArgs),
     /// CSV trace (every 10 ms) of the 0 -> 3 rad/s step on one family plant (or the nominal rig).
     Trace(TraceArgs),
+    /// The fault matrix on every plant of a rig file; JSON.
+    Faults(FaultsArgs),
+    /// Writes a seeded family file of plants spread the way lab rigs differ (TOML, stdout).
+    MakeFamily(MakeFamilyArgs),
+}
+
+#[derive(clap::Args)]
+pub(crate) struct FaultsArgs {
+    /// Rig file or family file (TOML, see docs/rigs/nominal.toml).
+    #[arg(long)]
+    rig_file: std::path::PathBuf,
+    /// Speed both axes run at when each fault is injected, rad/s.
+    #[arg(long, default_value_t = 3.0)]
+    speed_rad_s: f32,
+    /// JSON output (the only format; accepted for symmetry with the other reports).
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct MakeFamilyArgs {
+    /// Seed of the spread.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Number of plants.
+    #[arg(long, default_value_t = 60)]
+    plants: u32,
 }
 
 #[derive(clap::Args)]
@@ -42,6 +71,15 @@ pub(crate) struct TraceArgs {
     /// Family plant index; without it, the nominal rig.
     #[arg(long)]
     plant: Option<u32>,
+    /// A rig file instead (the plant named by --name, or its first).
+    #[arg(long)]
+    rig_file: Option<std::path::PathBuf>,
+    /// The plant's name in --rig-file.
+    #[arg(long)]
+    name: Option<String>,
+    /// Step target, rad/s.
+    #[arg(long, default_value_t = 3.0)]
+    target_rad_s: f32,
 }
 
 #[derive(clap::Args, Clone)]
@@ -76,6 +114,10 @@ pub(crate) struct StepArgs {
     /// Override the setpoint ramp, rad/s^2.
     #[arg(long)]
     accel_rad_s2: Option<f32>,
+    /// A rig file (one rig) instead of the nominal rig; its pulses per revolution and load
+    /// step apply (`--pulses-per-rev` and `--ripple-nm` are then ignored).
+    #[arg(long)]
+    rig_file: Option<std::path::PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -91,6 +133,15 @@ pub(crate) struct FamilyArgs {
     /// Allow fewer than 50 plants (for quick tests).
     #[arg(long, hide = true)]
     allow_small: bool,
+    /// Run the plants of this rig or family file instead of the built-in family.
+    #[arg(long)]
+    rig_file: Option<std::path::PathBuf>,
+    /// Step target with --rig-file, rad/s.
+    #[arg(long, default_value_t = 3.0)]
+    target_rad_s: f32,
+    /// JSON output (the only format; accepted for symmetry).
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(clap::Args)]
@@ -111,6 +162,57 @@ pub(crate) struct StabilityArgs {
 /// Runs `bowl sim`.
 pub(crate) fn run(what: &What) -> Result<()> {
     match what {
+        What::Step(a) if a.rig_file.is_some() => {
+            let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
+            let rigs = rig_file::load(path)?;
+            if rigs.len() != 1 {
+                bail!(
+                    "{} holds {} plants; `bowl sim step` runs one rig (use `bowl sim family --rig-file` for a family)",
+                    path.display(),
+                    rigs.len()
+                );
+            }
+            let rig = &rigs[0];
+            let cfg = sim_reports::config_for(rig);
+            let load = [
+                rig.params.axes[0].load_step_nm,
+                rig.params.axes[1].load_step_nm,
+            ];
+            let out = StepJson {
+                scenario: "rig file, both axes 0 -> target, commissioned first, true speed",
+                pulses_per_rev: rig.params.axes[1].sensor.pulses_per_rev,
+                target_rad_s: a.target_rad_s,
+                feedback: !a.no_feedback,
+                outcome: step_run_with(
+                    rig.params,
+                    cfg,
+                    rig.seed,
+                    a.target_rad_s,
+                    !a.no_feedback,
+                    load,
+                ),
+            };
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::Family(a) if a.rig_file.is_some() => {
+            let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
+            check_speed(a.target_rad_s, "--target-rad-s")?;
+            let rigs = rig_file::load(path)?;
+            check_lowest(&rigs, a.target_rad_s, "--target-rad-s")?;
+            let plants = parallel(&rigs, |r| sim_reports::family_plant(r, a.target_rad_s));
+            let summary = sim_reports::summary(&plants);
+            let out = serde_json::json!({ "plants": plants, "summary": summary });
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::Faults(a) => {
+            check_speed(a.speed_rad_s, "--speed-rad-s")?;
+            let rigs = rig_file::load(&a.rig_file)?;
+            check_lowest(&rigs, a.speed_rad_s, "--speed-rad-s")?;
+            let plants = parallel(&rigs, |r| sim_reports::fault_plant(r, a.speed_rad_s));
+            let out = serde_json::json!({ "plants": plants });
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::MakeFamily(a) => print!("{}", family_file::family_toml(a.seed, a.plants)),
         What::Step(a) => {
             let mut rig = rig_with_pulses(a.pulses_per_rev);
             if let Some(r) = a.ripple_nm {
@@ -162,9 +264,67 @@ pub(crate) fn run(what: &What) -> Result<()> {
         }
         What::Sweep(a) => sweep(a.seed),
         What::Stability(a) => stability(a.common.seed, a.speed_rad_s, a.pulses_per_rev, a.tick_hz),
-        What::Trace(a) => trace(a.common.seed, a.plant),
+        What::Trace(a) => {
+            let rig = match &a.rig_file {
+                Some(path) => {
+                    let rigs = rig_file::load(path)?;
+                    let found = match &a.name {
+                        Some(n) => rigs.into_iter().find(|r| &r.name == n),
+                        None => rigs.into_iter().next(),
+                    };
+                    Some(
+                        found
+                            .ok_or_else(|| anyhow::anyhow!("no plant of that name in the file"))?,
+                    )
+                }
+                None => None,
+            };
+            trace(a.common.seed, a.plant, rig, a.target_rad_s)
+        }
     }
     Ok(())
+}
+
+fn check_speed(x: f32, flag: &str) -> Result<()> {
+    let max = ControllerConfig::nominal().axes[0].max_speed_rad_s;
+    if !(x.is_finite() && x > 0.0 && x <= max) {
+        bail!("{flag} {x} is outside 0 to {max} rad/s (the controller's speed range)");
+    }
+    Ok(())
+}
+
+/// Refuses a speed below the lowest one a plant's sensors can measure (one pulse per 4 s).
+fn check_lowest(rigs: &[rig_file::Rig], x: f32, flag: &str) -> Result<()> {
+    for r in rigs {
+        let cfg = sim_reports::config_for(r);
+        for (axis, name) in cfg.axes.iter().zip(["precession", "spin"]) {
+            let lowest = model_core::control::estimator::lowest_speed_rad_s(axis);
+            if x < lowest {
+                bail!(
+                    "{flag} {x} is below the lowest speed of plant {}'s {name} axis, {lowest:.3} rad/s ({} pulses per revolution); ask for at least that",
+                    r.name,
+                    axis.pulses_per_rev
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `f` over `items` on all cores, results in order.
+pub(crate) fn parallel<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let chunk = items.len().div_ceil(threads).max(1);
+    std::thread::scope(|s| {
+        let handles: Vec<_> = items
+            .chunks(chunk)
+            .map(|c| s.spawn(|| c.iter().map(&f).collect::<Vec<R>>()))
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("a report thread panicked"))
+            .collect()
+    })
 }
 
 /// The step-response figures of one axis.
@@ -432,15 +592,22 @@ fn stability(seed: u32, speed: f32, only: Option<u16>, tick_hz: u32) {
     }
 }
 
-fn trace(seed: u32, plant: Option<u32>) {
+fn trace(seed: u32, plant: Option<u32>, from_file: Option<rig_file::Rig>, target: f32) {
+    let mut cfg = ControllerConfig::nominal();
     let (rig, rig_seed, load) = match plant {
+        _ if from_file.is_some() => {
+            let r = from_file.unwrap_or_else(|| unreachable!());
+            cfg = sim_reports::config_for(&r);
+            let load = [r.params.axes[0].load_step_nm, r.params.axes[1].load_step_nm];
+            (r.params, r.seed, load)
+        }
         Some(i) => {
             let (rig, load) = family_plant(seed, i);
             (rig, seed.wrapping_add(i), load)
         }
         None => (PlantParams::nominal(), seed, [0.0; 2]),
     };
-    let ctrl = Controller::new(ControllerConfig::nominal()).expect("valid");
+    let ctrl = Controller::new(cfg).expect("valid");
     let mut cl = ClosedLoop::new(Plant::new(rig, rig_seed), ctrl);
     let state = cl.commission(300.0);
     eprintln!(
@@ -452,14 +619,14 @@ fn trace(seed: u32, plant: Option<u32>) {
         a.faults.load_step_from_s = now;
         a.faults.load_step_nm = l;
     }
-    let _ = cl.ctrl.set_motor_speeds(3.0, 3.0);
+    let _ = cl.ctrl.set_motor_speeds(target, target);
     let _ = cl.ctrl.start();
     println!(
         "t_s,true_prec,true_spin,meas_prec,meas_spin,ref_prec,ref_spin,duty_prec,duty_spin,state,fault"
     );
     let dt = cl.dt_s();
     let mut k = 0u32;
-    cl.run(STEP_RUN_S, |c| {
+    cl.run(sim_reports::step_run_s(target).max(STEP_RUN_S), |c| {
         k += 1;
         if k.is_multiple_of(10) {
             let s = c.ctrl.status();

@@ -70,6 +70,38 @@ fn dead_sensor_during_commissioning_faults_with_motors_off() {
     let cl = commission(rig, 1);
     assert_eq!(cl.ctrl.fault(), Some(Fault::SensorLostOrStall(1)));
     assert_eq!(cl.duties(), [0.0, 0.0]);
+    // Refused with the reason in plain words.
+    let reason = cl.ctrl.identify_error().map(|e| e.reason()).unwrap_or("");
+    assert!(reason.contains("sensor"), "{reason}");
+}
+
+#[test]
+fn a_stiff_shaft_is_broken_away_and_identified() {
+    // Stiction far above what the old fixed 0.25 low duty gave (2.4 N m stall torque at 12 V):
+    // the breakaway search finds the duty that starts it.
+    let mut rig = rig_with_pulses(12);
+    for a in &mut rig.axes {
+        a.motor.coulomb_nm = 0.6;
+        a.motor.stiction_nm = 0.8;
+    }
+    let cl = commission(rig, 3);
+    assert_eq!(
+        cl.ctrl.state(),
+        State::Idle,
+        "{:?}",
+        cl.ctrl.identify_error()
+    );
+    for (i, id) in cl.ctrl.identified().iter().enumerate() {
+        let id = id.expect("identified");
+        let (a, fd, _) = rig.axes[i].motor.ideal_model(rig.supply_v);
+        assert!(
+            (id.model.volts_per_rad_s - a).abs() < 0.05 * a,
+            "{id:?} vs {a}"
+        );
+        assert!((id.model.friction_duty - fd).abs() < 0.02, "{id:?} vs {fd}");
+        // Breakaway needs the stiction torque: duty above 0.8 * R / (k V) = 0.333.
+        assert!(id.breakaway_duty > 0.33, "{id:?}");
+    }
 }
 
 #[test]

@@ -1,6 +1,6 @@
 //! Pulse speed estimator against synthetic edge trains whose true speed is known exactly.
 
-use model_core::control::estimator::PulseSpeedEstimator;
+use model_core::control::estimator::{PulseSpeedEstimator, STALL_PITCHES, lowest_speed_rad_s};
 use model_core::control::{AxisConfig, ControllerConfig};
 use proptest::prelude::*;
 
@@ -11,6 +11,7 @@ struct Feed {
     tick_s: f64,
     t_s: f64,
     steady: bool,
+    lowest: f32,
 }
 
 impl Feed {
@@ -32,6 +33,7 @@ impl Feed {
             tick_s: 1.0 / cfg.tick_hz as f64,
             t_s: 0.0,
             steady: true,
+            lowest: lowest_speed_rad_s(&axis),
         }
     }
     fn ticks(&self, t: f64) -> u32 {
@@ -73,6 +75,11 @@ fn edges_at(speed: f64, pulses: u16, until: f64) -> Vec<f64> {
 fn constant_speed_is_exact_for_1_12_and_60_pulses() {
     for &n in &[1u16, 12, 60] {
         for &w in &[0.5f64, 1.8, 3.6] {
+            let f = Feed::new(n, 32);
+            if (w as f32) < f.lowest {
+                // Below the lowest speed for this N (one pulse per 4 s): commands are refused.
+                continue;
+            }
             let until = 8.0 + 3.0 * std::f64::consts::TAU / (n as f64 * w);
             let e = edges_at(w, n, until);
             let mut f = Feed::new(n, 32);
@@ -107,7 +114,7 @@ fn a_stopped_shaft_decays_then_reads_exactly_zero() {
         let v_running = f.run(3.0, &e);
         assert!((v_running - 2.0).abs() < 0.05);
         // No more edges: bounded by pitches * pitch / time since the last edge, then zero after
-        // the stall time (one pitch at the minimum speed 0.1 rad/s: 5.2 s).
+        // the stall time (two pitches at the lowest speed, 0.13 rad/s at 12 pulses/rev: 8 s).
         let mut prev = v_running;
         let last_edge = *e.last().unwrap();
         let pitch = std::f64::consts::TAU / 12.0;
@@ -125,7 +132,10 @@ fn a_stopped_shaft_decays_then_reads_exactly_zero() {
             (prev as f64) < pitches * pitch / 5.0,
             "still reads {prev} five seconds after the last edge"
         );
-        let v = f.run(0.5, &[]);
+        let stall_s = STALL_PITCHES as f64 * pitch / f.lowest as f64;
+        let v = f.run(stall_s - (f.t_s - last_edge) - 0.05, &[]);
+        assert!(v > 0.0, "zero before the stall time {stall_s} s");
+        let v = f.run(0.1, &[]);
         assert_eq!(v, 0.0);
         assert!(f.est.is_stopped());
     }

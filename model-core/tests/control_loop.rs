@@ -132,6 +132,7 @@ fn anti_windup_holds_the_integral_when_the_output_saturates() {
         events: ev,
         feedback: true,
         extra_duty: 0.0,
+        at_rest: false,
     };
     l.step(&k, input(sample(0.0, 4.0)));
     for i in 0..30_000 {

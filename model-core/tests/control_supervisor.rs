@@ -311,3 +311,47 @@ fn sixteen_bit_capture_timer_runs_the_same_loop() {
         s.axes[0]
     );
 }
+
+#[test]
+fn a_dead_sensor_at_low_speed_is_detected_whatever_the_duty() {
+    // At 0.5 and 0.2 rad/s the duty that holds the nominal shaft (about 0.13 and 0.09) is below
+    // the old fixed stall threshold of 0.15: the watch runs on expected edge times alone.
+    for speed in [0.5f32, 0.2] {
+        let rig = rig_with_pulses(12);
+        let (t, fault) = fault_after(rig, |p, t0| p.axes[1].faults.dead_sensor_from_s = t0, speed);
+        let bound = (3.0 * std::f32::consts::TAU / (12.0 * speed)).max(0.2);
+        assert_eq!(fault, Some(Fault::SensorLostOrStall(1)), "{speed} rad/s");
+        assert!(
+            t <= bound,
+            "{speed} rad/s: detected after {t} s, bound {bound} s"
+        );
+    }
+}
+
+#[test]
+fn a_bridge_stuck_on_is_caught_by_the_first_early_edge() {
+    // Full duty from 1 rad/s: the shaft runs towards 7 rad/s; the first edge interval faster
+    // than 1.2 x the model speed + 0.3 rad/s latches the over-speed fault long before the
+    // filtered speed reaches the 5.5 rad/s limit.
+    let rig = rig_with_pulses(12);
+    let (t, fault) = fault_after(rig, |p, t0| p.axes[1].faults.bridge_stuck_from_s = t0, 1.0);
+    assert_eq!(fault, Some(Fault::Overspeed(1)));
+    // Within two pulse periods at the setpoint (the second edge after injection at the latest).
+    assert!(
+        t <= 2.0 * std::f32::consts::TAU / 12.0,
+        "detected after {t} s"
+    );
+}
+
+#[test]
+fn speeds_below_what_the_pulses_can_measure_are_refused() {
+    // One pulse per revolution: the lowest speed is 2 pi / 4 s = 1.57 rad/s, above the
+    // configured 0.2 rad/s.
+    let rig = rig_with_pulses(1);
+    let mut cl = running_loop(rig, |_| {});
+    assert_eq!(
+        cl.ctrl.set_motor_speeds(1.0, 1.0),
+        Err(Rejection::BelowMinSpeed(0))
+    );
+    assert!(cl.ctrl.set_motor_speeds(1.6, 1.6).is_ok());
+}

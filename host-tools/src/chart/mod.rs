@@ -9,6 +9,7 @@ use anyhow::{Context, Result};
 use clap::Subcommand;
 
 pub mod control;
+pub mod family;
 pub mod figures;
 pub mod plot;
 pub mod qemu_log;
@@ -46,6 +47,21 @@ enum Which {
     Settling(ControlArgs),
     /// Limit cycle of the 0.5 rad/s hold against the per-pulse gain, with and without the schedule.
     ControlStability(ControlArgs),
+    /// Overshoot against settling of every axis of a rig or family file (0 -> target step).
+    Family(FamilyArgs),
+}
+
+/// Options of `bowl chart family`.
+#[derive(clap::Args)]
+struct FamilyArgs {
+    #[command(flatten)]
+    out: Out,
+    /// Rig or family file (TOML).
+    #[arg(long)]
+    rig_file: PathBuf,
+    /// Step target, rad/s.
+    #[arg(long, default_value_t = 3.0)]
+    target_rad_s: f32,
 }
 
 /// Options of the control charts (`settling`, `control-stability`).
@@ -282,6 +298,15 @@ pub fn run(args: &Args) -> Result<()> {
         Which::Stability(out) => {
             let (f, t) = stability::chart()?;
             write_all(out, &f, &t)
+        }
+        Which::Family(a) => {
+            let rigs = crate::rig_file::load(&a.rig_file)?;
+            let name = a
+                .rig_file
+                .file_name()
+                .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+            let (f, t) = family::chart(&rigs, a.target_rad_s, &name);
+            write_all(&a.out, &f, &t)
         }
     }
 }

@@ -42,14 +42,16 @@ fn fault_reaction(
             .iter()
             .find(|t| t.time_ms >= o.time_ms && measured(t, 0).abs() < tol.stopped_rad_s)
     });
-    // The supervisor's timeout: max(floor, 3 expected pulse periods) at the spin speed.
+    // The supervisor's timeout: max(floor, WATCH_PITCHES expected pulse periods) at the spin
+    // speed, counted from the last edge before the injection.
     let expected = before.zip(params).map(|(b, p)| {
         let teeth = f64::from(p[ParamId::Teeth2.index()]);
         let w = set(b, 1).abs().max(1e-3);
         let period = std::f64::consts::TAU / (teeth * w);
         let floor =
             f64::from(model_core::control::ControllerConfig::nominal().sensor_timeout_floor_s);
-        let timeout = (3.0 * period).max(floor);
+        let pitches = f64::from(model_core::control::supervisor::WATCH_PITCHES);
+        let timeout = (pitches * period).max(floor);
         let frame = 1.0 / f64::from(p[ParamId::TelemetryHz.index()].max(1));
         [(timeout - period - frame).max(0.0), timeout + frame + 0.005]
     });

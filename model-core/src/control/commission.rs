@@ -1,10 +1,17 @@
 //! Commissioning: open-loop identification of each axis from duty steps and edge times.
 //!
 //! # Routine (spin first, then precession; one at a time, the other at zero duty)
-//! 1. *Low step*: duty `low_duty` from rest, held at least `step_time_s` and until
-//!    `min_fit_edges` edges fell in the step's second half. A straight line fitted to
-//!    (edge time, edge angle) over the second half gives the steady speed `w_L` (its slope).
-//! 2. *High step*: duty `high_duty`, same rule, gives `w_H` and the line's intercept.
+//! 0. *Breakaway search*: from rest the duty rises at [`BREAKAWAY_RATE_PER_S`] (slower with
+//!    fewer than 12 pulses per revolution, in proportion) until the sensor
+//!    gives an edge; that duty breaks stiction (a fixed low duty never breaks away a stiff
+//!    shaft). No edge by [`BREAKAWAY_MAX_DUTY`] refuses: the shaft is blocked or the sensor dead.
+//! 1. *Low step*: duty `max(low_duty, breakaway + 0.1)`, held at least `step_time_s` and until
+//!    the edges in the step's second half span whole revolutions (a multiple of the pulses per
+//!    revolution, at least `min_fit_edges` and one revolution): each tooth enters the fit equally
+//!    often, so tooth offsets and a once-per-revolution load average out instead of biasing
+//!    the slope. A straight line fitted to (edge time, edge angle) gives the steady speed `w_L`.
+//! 2. *High step*: duty `max(high_duty, low + 0.2)` (at most 0.95), same rule, gives `w_H` and
+//!    the line's intercept.
 //! 3. *Coast*: zero duty until the estimator reads zero, then the next axis.
 //!
 //! # What is estimated
@@ -22,6 +29,15 @@
 //! The feedforward and the PI gains follow from the model (see `pi`).
 
 use super::config::{CommissioningConfig, MotorModel};
+
+/// Duty rise of the breakaway search, per second.
+pub const BREAKAWAY_RATE_PER_S: f32 = 0.2;
+/// The breakaway search starts at this duty.
+pub const BREAKAWAY_START_DUTY: f32 = 0.05;
+/// The breakaway search gives up at this duty.
+pub const BREAKAWAY_MAX_DUTY: f32 = 0.9;
+/// Largest duty of the high step.
+const TOP_DUTY: f32 = 0.95;
 
 /// Least-squares straight line `y = b + m x`, accumulated without storage.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -71,6 +87,8 @@ impl LineFit {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Phase {
+    /// Rising duty until the shaft breaks away.
+    Breakaway,
     /// Low duty step on the axis.
     Low,
     /// High duty step on the axis.
@@ -93,6 +111,29 @@ pub enum IdentifyError {
     Implausible,
     /// The routine exceeded its timeout.
     Timeout,
+    /// No edge even at the breakaway search's highest duty.
+    NoBreakaway,
+}
+
+impl IdentifyError {
+    /// The reason in plain words, for a refusal message.
+    pub fn reason(self) -> &'static str {
+        match self {
+            IdentifyError::TooFewEdges => {
+                "too few sensor edges to fit a speed: check the sensor, or free the shaft"
+            }
+            IdentifyError::NoSpeedIncrease => {
+                "the shaft did not turn faster at the higher duty: check the motor and its load"
+            }
+            IdentifyError::Implausible => {
+                "the identified motor model is outside the plausible range"
+            }
+            IdentifyError::Timeout => "identification took longer than its timeout",
+            IdentifyError::NoBreakaway => {
+                "the shaft gave no sensor edge even at 90 % duty: it is blocked or the sensor is dead"
+            }
+        }
+    }
 }
 
 /// One axis's identification result, with the raw fit for reports.
@@ -105,6 +146,8 @@ pub struct Identified {
     pub low_speed_rad_s: f32,
     /// Steady speed at the high duty, rad/s.
     pub high_speed_rad_s: f32,
+    /// Duty at which the shaft broke away from rest.
+    pub breakaway_duty: f32,
 }
 
 /// The identification routine's state (driven by the controller's tick).
@@ -122,18 +165,29 @@ pub struct Commissioning {
     angle_pulses: u32,
     low_fit: LineFit,
     high_fit: LineFit,
+    pulses_per_rev: [u32; 2],
+    duty: f32,
+    breakaway_duty: f32,
+    low_duty: f32,
+    high_duty: f32,
     results: [Option<Identified>; 2],
 }
 
 impl Commissioning {
     /// A routine starting with the spin axis (its reaction torque may drag the coasting
     /// precession axis; the precession axis is identified afterwards, with the spin at rest).
-    pub fn new(cfg: CommissioningConfig, supply_v: f32, ticks_per_s: f32) -> Self {
+    /// `pulses_per_rev`: of each axis, `[precession, spin]`.
+    pub fn new(
+        cfg: CommissioningConfig,
+        supply_v: f32,
+        ticks_per_s: f32,
+        pulses_per_rev: [u16; 2],
+    ) -> Self {
         Self {
             cfg,
             supply_v,
             axis: 1,
-            phase: Phase::Low,
+            phase: Phase::Breakaway,
             t0_ticks: None,
             ticks_per_s,
             coast_s: 0.0,
@@ -142,6 +196,11 @@ impl Commissioning {
             angle_pulses: 0,
             low_fit: LineFit::default(),
             high_fit: LineFit::default(),
+            pulses_per_rev: [pulses_per_rev[0] as u32, pulses_per_rev[1] as u32],
+            duty: BREAKAWAY_START_DUTY,
+            breakaway_duty: 0.0,
+            low_duty: cfg.low_duty,
+            high_duty: cfg.high_duty,
             results: [None, None],
         }
     }
@@ -163,6 +222,16 @@ impl Commissioning {
             return;
         }
         let Some(t0) = self.t0_ticks else { return };
+        if self.phase == Phase::Breakaway {
+            // Moving: the low step starts now, from this edge's angle.
+            self.breakaway_duty = self.duty;
+            self.low_duty = self.cfg.low_duty.max(self.duty + 0.1).min(TOP_DUTY - 0.2);
+            self.high_duty = self.cfg.high_duty.max(self.low_duty + 0.2).min(TOP_DUTY);
+            self.phase = Phase::Low;
+            self.t0_ticks = Some(at_ticks);
+            self.angle_pulses = 0;
+            return;
+        }
         let t_s = at_ticks.wrapping_sub(t0) as f32 / self.ticks_per_s;
         self.angle_pulses += pulses;
         let angle = self.angle_pulses as f32 * rad_per_pulse;
@@ -195,22 +264,33 @@ impl Commissioning {
         }
         let t0 = *self.t0_ticks.get_or_insert(clock_ticks);
         let t_s = clock_ticks.wrapping_sub(t0) as f32 / self.ticks_per_s;
-        let min_edges = self.cfg.min_fit_edges as u32;
+        let n = self.pulses_per_rev[self.axis].max(1);
+        // Whole revolutions: each tooth equally often in the fit.
+        let min_edges = (self.cfg.min_fit_edges as u32).max(n);
+        let whole = |count: u32| count >= min_edges && count.is_multiple_of(n);
         let mut duty = 0.0;
         match self.phase {
+            Phase::Breakaway => {
+                // With sparse pulses the first edge comes up to a pitch after the shaft starts:
+                // the duty rises slower so that it overshoots the breakaway duty as little.
+                let sparse = if n < 12 { n as f32 / 12.0 } else { 1.0 };
+                self.duty = BREAKAWAY_START_DUTY + BREAKAWAY_RATE_PER_S * sparse * t_s;
+                if self.duty > BREAKAWAY_MAX_DUTY {
+                    return Err(IdentifyError::NoBreakaway);
+                }
+                duty = self.duty;
+            }
             Phase::Low => {
-                duty = self.cfg.low_duty;
-                if t_s >= self.cfg.step_time_s && self.low_fit.count() >= min_edges {
+                duty = self.low_duty;
+                if t_s >= self.cfg.step_time_s && whole(self.low_fit.count()) {
                     self.step_at_s = t_s;
                     self.phase = Phase::High;
-                    duty = self.cfg.high_duty;
+                    duty = self.high_duty;
                 }
             }
             Phase::High => {
-                duty = self.cfg.high_duty;
-                if t_s - self.step_at_s >= self.cfg.step_time_s
-                    && self.high_fit.count() >= min_edges
-                {
+                duty = self.high_duty;
+                if t_s - self.step_at_s >= self.cfg.step_time_s && whole(self.high_fit.count()) {
                     self.results[self.axis] = Some(self.identify()?);
                     self.phase = Phase::Coast;
                     self.coast_s = 0.0;
@@ -222,7 +302,8 @@ impl Commissioning {
                 if stopped && self.coast_s > 0.05 {
                     if self.axis == 1 {
                         self.axis = 0;
-                        self.phase = Phase::Low;
+                        self.phase = Phase::Breakaway;
+                        self.duty = BREAKAWAY_START_DUTY;
                         self.t0_ticks = None;
                         self.total_s = 0.0;
                         self.angle_pulses = 0;
@@ -248,7 +329,7 @@ impl Commissioning {
             return Err(IdentifyError::NoSpeedIncrease);
         }
         let v = self.supply_v;
-        let (d_l, d_h) = (self.cfg.low_duty, self.cfg.high_duty);
+        let (d_l, d_h) = (self.low_duty, self.high_duty);
         let a = v * (d_h - d_l) / (w_h - w_l);
         let mut friction_duty = d_l - a * w_l / v;
         // A slightly negative offset is fit noise around zero friction.
@@ -273,6 +354,7 @@ impl Commissioning {
             model,
             low_speed_rad_s: w_l,
             high_speed_rad_s: w_h,
+            breakaway_duty: self.breakaway_duty,
         })
     }
 }

@@ -107,7 +107,16 @@ pub struct Controller {
     /// cos and sin of the axes angle (paper Eq. 2), computed once per configuration.
     cos_axes: f32,
     sin_axes: f32,
+    /// Both references were reached since the last start or setpoint (arms the runaway check).
+    reached: bool,
 }
+
+/// An edge interval faster than this many times the plant model's speed (plus the margin) is a
+/// runaway: tooth offsets (up to 10 % on one interval), a 10 % overshoot and the breakaway of a
+/// stiff shaft at the lowest speed stay inside.
+const RUNAWAY_RATIO: f32 = 1.2;
+/// See [`RUNAWAY_RATIO`], rad/s.
+const RUNAWAY_MARGIN_RAD_S: f32 = 0.3;
 
 impl Controller {
     /// A controller in [`State::Idle`] for a configuration that passes validation.
@@ -158,6 +167,7 @@ impl Controller {
             feedback: true,
             cos_axes: cos_const(cfg.axes_angle_rad),
             sin_axes: sin_const(cfg.axes_angle_rad),
+            reached: false,
         }
     }
 
@@ -179,7 +189,14 @@ impl Controller {
             let speed = a.est.tick(now_ticks, edges[i], steady[i] > 0.5, |_, _| {});
             seen[i] = a.est.accepted_edges() != before;
             a.measured = a.direction * speed;
-            if speed > self.cfg.axes[i].overspeed_rad_s {
+            // Runaway (a bridge stuck on): once both axes have reached their references, an
+            // edge that came far sooner than the plant model expects faults at once, without
+            // waiting for the filtered speed to reach the absolute limit.
+            let runaway = self.reached
+                && seen[i]
+                && a.est.edge_speed_rad_s()
+                    > RUNAWAY_RATIO * a.speed_loop.model_rad_s().abs() + RUNAWAY_MARGIN_RAD_S;
+            if speed > self.cfg.axes[i].overspeed_rad_s || runaway {
                 self.latch(Fault::Overspeed(i as u8));
             }
         }
@@ -289,6 +306,7 @@ impl Controller {
                             <= 0.05 * ramped[i].abs() + 0.05
                 });
                 self.state = if reached {
+                    self.reached = true;
                     State::Running
                 } else {
                     State::SpinningUp
@@ -314,13 +332,16 @@ impl Controller {
             events: a.est.window_events(),
             feedback: self.feedback,
             extra_duty,
+            at_rest: a.est.at_rest(),
         };
         let duty = a.speed_loop.step(&a.k, input);
         a.duty = duty;
+        // Expected edges are watched whatever the duty: at low speed the duty that holds the
+        // shaft can be below any fixed threshold.
         if a.watch.step(
             dt,
             duty.abs(),
-            self.cfg.stall_duty,
+            0.0,
             seen,
             self.cfg.sensor_timeout_floor_s,
             a.speed_loop.model_rad_s(),
@@ -348,7 +369,13 @@ impl Controller {
             Err(e) => {
                 self.identify_error = Some(e);
                 self.commissioning = None;
-                self.latch(Fault::InvalidConfiguration);
+                // No edge at any duty: a dead sensor or a blocked shaft, the same fault as
+                // in closed loop; anything else leaves the configuration unidentified.
+                self.latch(if e == IdentifyError::NoBreakaway {
+                    Fault::SensorLostOrStall(axis as u8)
+                } else {
+                    Fault::InvalidConfiguration
+                });
             }
             Ok(duties) => {
                 self.axes[0].duty = duties[0];
@@ -388,6 +415,7 @@ impl Controller {
                         self.cfg.axes[i].min_speed_rad_s,
                         a.est.rad_per_pulse(),
                     ) {
+                        self.identify_error = Some(IdentifyError::TooFewEdges);
                         self.latch(Fault::SensorLostOrStall(i as u8));
                         return;
                     }

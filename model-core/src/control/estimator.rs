@@ -20,8 +20,9 @@
 //! Between edges the shaft has turned less than one pitch since the last edge, so the speed is at
 //! most `pitch / time since the last edge`. Once that bound is below the filtered value, it is
 //! the estimate (at steady speed the bound allows two pitches, so that one missing pulse does not
-//! halve the reading): a stopping shaft reads a falling speed, and after one pitch at the configured
-//! minimum speed without an edge it reads exactly zero and the estimator starts afresh.
+//! halve the reading): a stopping shaft reads a falling speed, and after [`STALL_PITCHES`]
+//! pitches at the lowest speed ([`lowest_speed_rad_s`]) without an edge it reads exactly zero
+//! and the estimator starts afresh.
 //!
 //! # Bounce and missing pulses
 //! An edge closer to the previous accepted edge than half the pulse period at the over-speed
@@ -39,6 +40,26 @@ use super::config::{AxisConfig, ControllerConfig};
 
 /// Shortest counting window, s: at high pulse rates a raw sample averages over at least this.
 pub const WINDOW_S: f32 = 0.025;
+
+/// Longest pulse period the controller works with, s: below the speed that gives it, a shaft
+/// cannot be measured often enough to be held (one sample per 4 s).
+pub const MAX_PULSE_PERIOD_S: f32 = 4.0;
+
+/// Pitches without an edge at the lowest speed after which the estimate reads zero: two, so
+/// that tooth offsets and jitter at the lowest speed never read a turning shaft as stopped.
+pub const STALL_PITCHES: f32 = 2.0;
+
+/// The lowest speed an axis may be commanded to, rad/s: the configured minimum, raised to the
+/// speed whose pulse period is [`MAX_PULSE_PERIOD_S`] (`2 pi / (N * 4 s)`: 1.57 rad/s at one
+/// pulse per revolution, 0.13 rad/s at 12).
+pub const fn lowest_speed_rad_s(axis: &AxisConfig) -> f32 {
+    let by_pulses = core::f32::consts::TAU / (axis.pulses_per_rev as f32 * MAX_PULSE_PERIOD_S);
+    if by_pulses > axis.min_speed_rad_s {
+        by_pulses
+    } else {
+        axis.min_speed_rad_s
+    }
+}
 
 /// A closed counting window: the raw speed over a known interval.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -105,7 +126,7 @@ impl PulseSpeedEstimator {
         let ticks_per_s = cfg.timer_hz as f32;
         let rad_per_pulse = core::f32::consts::TAU / axis.pulses_per_rev as f32;
         let min_period_s = rad_per_pulse / axis.overspeed_rad_s;
-        let stall_s = rad_per_pulse / axis.min_speed_rad_s;
+        let stall_s = STALL_PITCHES * rad_per_pulse / lowest_speed_rad_s(axis);
         Self {
             mask: cfg.timer_mask(),
             rad_per_pulse,
@@ -186,13 +207,23 @@ impl PulseSpeedEstimator {
             self.win_start = at;
             self.win_pulses = 0;
             self.restart_at = Some(at);
+            self.last_interval = 0;
             self.accepted = self.accepted.wrapping_add(1);
             return Some(1);
         }
         let dt = at.wrapping_sub(self.last_edge);
         // `lockout_now` = max(absolute lockout, 40 % of the filtered period), kept up to date
-        // when the period changes, so the common path is integer compares only.
-        if dt < self.lockout_now {
+        // when the period changes, so the common path is integer compares only. The relative
+        // part only holds at steady speed: while the speed changes (a ramp, a commissioning
+        // step) the period can more than halve between two edges, and a real edge must never
+        // be dropped; the absolute lockout (half the period at the over-speed limit) still
+        // rejects contact bounce.
+        let lockout = if steady {
+            self.lockout_now
+        } else {
+            self.lockout_ticks
+        };
+        if dt < lockout {
             self.rejected = self.rejected.wrapping_add(1);
             return None;
         }
@@ -299,6 +330,19 @@ impl PulseSpeedEstimator {
     /// True if the last tick produced a new raw sample.
     pub fn updated(&self) -> bool {
         self.closed_at.is_some()
+    }
+    /// Speed over the last pulse interval alone, rad/s (0 before a first interval since rest):
+    /// the newest evidence of the speed, unfiltered, for the runaway check.
+    pub fn edge_speed_rad_s(&self) -> f32 {
+        if self.has_edge && self.last_interval > 0 {
+            self.rad_ticks_per_pulse_s / self.last_interval as f32
+        } else {
+            0.0
+        }
+    }
+    /// True when no edge has come since the shaft last stopped (or ever).
+    pub fn at_rest(&self) -> bool {
+        !self.has_edge
     }
     /// True when the estimate is exactly zero (stopped or never moved).
     pub fn is_stopped(&self) -> bool {

@@ -27,12 +27,29 @@
 //! changes the integral absorbs `(Kp_old - Kp_new) e`, so neither does that. Integration stops
 //! (conditional integration) while the output is clamped or slew-limited in the direction the
 //! error pushes, which holds a blocked motor's integral instead of letting it run away, and while
-//! the estimator has no valid measurement (no pulse interval yet), until the plant model has
-//! turned 2.5 pitches without one: then the shaft is stuck and the loop pushes (see `step`). At a zero reference the output
+//! the estimator has no valid measurement (no pulse interval yet). At a zero reference the output
 //! is exactly zero and the integral is cleared: no hum, no creep.
+//!
+//! # Breaking stiction
+//! A shaft at rest (no edge since it last stopped) whose plant model has turned
+//! [`STUCK_PITCHES`] gets a breakaway push on top of the feedforward that rises at
+//! [`BREAKAWAY_PUSH_PER_S`] until the first edge comes, then drops to zero: the feedforward holds Coulomb friction once the shaft slides,
+//! but only stiction's larger torque starts it. The push does not depend on the loop's gain,
+//! which the pulse-rate schedule makes small at low speed. The push only starts a shaft from
+//! rest: once the loop has seen it move, a shaft that goes quiet is not pushed (a dead sensor on
+//! a turning shaft would otherwise run it away before the supervisor's expected-edge watch
+//! faults it); the integral keeps what the push found.
 
 use super::config::AxisConfig;
 use super::estimator::WindowEvents;
+
+/// Rise of the breakaway push on a shaft at rest, duty per second.
+pub const BREAKAWAY_PUSH_PER_S: f32 = 0.15;
+/// The shaft counts as stuck once the plant model has turned this many pitches since the last
+/// edge without a new one (a shaft following the model would have given one).
+pub const STUCK_PITCHES: f32 = 1.2;
+/// Share of the breakaway push the integral keeps once the shaft moves.
+pub const PUSH_KEPT: f32 = 0.5;
 
 /// State of one axis's loop.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -45,6 +62,8 @@ pub struct SpeedLoop {
     have_error: bool,
     error: f32,
     kp_prev: f32,
+    push: f32,
+    moved: bool,
 }
 
 /// Inputs of one loop step.
@@ -64,6 +83,8 @@ pub struct LoopInput {
     pub feedback: bool,
     /// Extra feedforward duty (the precession axis's decoupling of the spin reaction).
     pub extra_duty: f32,
+    /// No edge since the shaft last stopped (the estimator's view).
+    pub at_rest: bool,
 }
 
 /// Per-axis constants of the loop, precomputed from the configuration.
@@ -78,6 +99,7 @@ pub struct LoopConstants {
     bandwidth_rad_s: f32,
     per_pulse_bw_times_pulses_per_rad: f32,
     filter_weight: f32,
+    push_per_tick: f32,
     stuck_angle_rad: f32,
     duty_limit: f32,
     slew_per_tick: f32,
@@ -99,7 +121,8 @@ impl LoopConstants {
             bandwidth_rad_s: axis.bandwidth_rad_s,
             per_pulse_bw_times_pulses_per_rad: axis.per_pulse_bandwidth * pulses_per_rad,
             filter_weight: w,
-            stuck_angle_rad: 2.5 / pulses_per_rad,
+            push_per_tick: BREAKAWAY_PUSH_PER_S * dt_s,
+            stuck_angle_rad: STUCK_PITCHES / pulses_per_rad,
             duty_limit: axis.duty_limit,
             slew_per_tick: axis.duty_slew_per_s * dt_s,
         }
@@ -157,6 +180,8 @@ impl SpeedLoop {
         have_error: false,
         error: 0.0,
         kp_prev: 0.0,
+        push: 0.0,
+        moved: false,
     };
 
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
@@ -204,16 +229,32 @@ impl SpeedLoop {
         if !input.measurement_valid {
             self.have_error = false;
             self.error = 0.0;
-            // No measurement although the model has turned 2.5 pitches since the last window
-            // event: a shaft following the model would have given two edges by now, so it is
-            // stuck (stiction, a blocked shaft, a dead sensor). Push with the full model speed
-            // so that it breaks away, or the duty crosses the stall threshold and the
-            // supervisor's sensor watch latches the fault; never sit silently at a low duty.
-            e = if input.feedback && self.model_angle_rad.abs() > k.stuck_angle_rad {
-                rp
-            } else {
-                0.0
-            };
+            e = 0.0;
+        }
+        // The first edge from rest, or the first measurement after a crawl: the push held
+        // stiction and whatever load the model does not know; half of it stays in the integral
+        // (the loop corrects the rest either way), so a loaded shaft at low speed does not
+        // stick again at once.
+        let first_edge = !input.at_rest && !self.moved;
+        if first_edge || (input.measurement_valid && self.push != 0.0) {
+            self.integral += PUSH_KEPT * self.push;
+            self.push = 0.0;
+        }
+        if !input.at_rest {
+            self.moved = true;
+        }
+        // Push a shaft that should have given an edge by now: from rest before it first moved,
+        // or crawling between its first and second edge (no measurement yet). Never a shaft
+        // that went quiet after moving (the estimator reset it to rest): that is the
+        // supervisor's to judge, and pushing it would run away a shaft with a dead sensor.
+        let starting = input.at_rest && !self.moved;
+        let crawling = !input.at_rest && !input.measurement_valid;
+        if (starting || crawling)
+            && input.feedback
+            && self.model_angle_rad.abs() > k.stuck_angle_rad
+            && self.push < 1.0
+        {
+            self.push += k.push_per_tick;
         }
         // The stall bound is only active with a valid measurement.
         if ev.bound_active && input.feedback {
@@ -233,7 +274,9 @@ impl SpeedLoop {
         self.kp_prev = kp;
 
         // r != 0 here, so its sign is the commanded direction.
-        let ff = k.friction_duty * input.direction + r * k.duty_per_rad_s + input.extra_duty;
+        let ff = (k.friction_duty + self.push) * input.direction
+            + r * k.duty_per_rad_s
+            + input.extra_duty;
         let candidate_i = self.integral + ki_dt * e;
         let unlimited = ff + kp * e + candidate_i;
         let lim = k.duty_limit;

@@ -65,6 +65,11 @@ pub fn fault_code(f: Option<Fault>) -> u8 {
     f.map_or(0, Fault::code)
 }
 
+/// Pitches the plant model turns without an edge before the watch faults: below three, so a
+/// fault comes within three expected pulse periods from the last edge; above two, so one
+/// tooth's offset (a tenth of a pitch at most) or one missing pulse never faults a healthy shaft.
+pub const WATCH_PITCHES: f32 = 2.6;
+
 /// The sensor-lost watch of one axis: time spent driving above the stall duty without an edge,
 /// and how far the shaft should have turned meanwhile.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -105,7 +110,7 @@ impl SensorWatch {
         }
         self.blind_s += dt_s;
         self.expected_rad += expected_rad_s.abs() * dt_s;
-        self.blind_s > floor_s && self.expected_rad > 3.0 * rad_per_pulse
+        self.blind_s > floor_s && self.expected_rad > WATCH_PITCHES * rad_per_pulse
     }
 
     /// Clears the watch.

@@ -38,6 +38,10 @@ pub struct AxisFaults {
     pub load_step_from_s: f32,
     /// The load step's size, N m (added to the Coulomb and stiction torques).
     pub load_step_nm: f32,
+    /// From this time on, the bridge is stuck on: any nonzero commanded duty drives the motor
+    /// at full duty in the commanded direction (a shorted driver input); a zero duty still
+    /// coasts (the driver's enable follows the controller's stop).
+    pub bridge_stuck_from_s: f32,
 }
 
 impl AxisFaults {
@@ -50,6 +54,7 @@ impl AxisFaults {
         blocked_from_s: f32::INFINITY,
         load_step_from_s: f32::INFINITY,
         load_step_nm: 0.0,
+        bridge_stuck_from_s: f32::INFINITY,
     };
 }
 
@@ -62,6 +67,9 @@ pub struct AxisParams {
     pub sensor: SensorParams,
     /// Once-per-revolution load ripple amplitude, N m (an off-centre load).
     pub ripple_nm: f32,
+    /// Material poured in after commissioning, N m of friction-like drag: the experiments add
+    /// it through [`AxisFaults::load_step_nm`] once the controller has identified its model.
+    pub load_step_nm: f32,
     /// Injected faults.
     pub faults: AxisFaults,
 }
@@ -101,12 +109,14 @@ impl PlantParams {
                     motor: MotorParams::nominal_precession(),
                     sensor,
                     ripple_nm: 0.002,
+                    load_step_nm: 0.0,
                     faults: AxisFaults::NONE,
                 },
                 AxisParams {
                     motor: MotorParams::nominal_spin(),
                     sensor,
                     ripple_nm: 0.002,
+                    load_step_nm: 0.0,
                     faults: AxisFaults::NONE,
                 },
             ],
@@ -194,6 +204,10 @@ impl Plant {
     pub fn speed_rad_s(&self, axis: usize) -> f32 {
         self.axes[axis].motor.speed_rad_s
     }
+    /// True shaft angle of an axis since the start, rad.
+    pub fn angle_rad(&self, axis: usize) -> f64 {
+        self.axes[axis].angle_rad
+    }
     /// Armature current of an axis, A.
     pub fn current_a(&self, axis: usize) -> f32 {
         self.axes[axis].motor.current_a
@@ -237,11 +251,14 @@ impl Plant {
             let f = ap.faults;
             let ax = &mut self.axes[i];
             // A NaN duty drives nothing (coast), never full reverse.
-            let d = if duties[i].is_nan() {
+            let mut d = if duties[i].is_nan() {
                 0.0
             } else {
                 duties[i].clamp(-1.0, 1.0)
             };
+            if d != 0.0 && t0 as f32 >= f.bridge_stuck_from_s {
+                d = d.signum();
+            }
             let volts = if d == 0.0 {
                 None
             } else {

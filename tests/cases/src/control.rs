@@ -39,7 +39,7 @@ pub static BENCHES: &[Bench] = &[Bench {
     name: "control::tick_both_axes_f32",
     inputs: 420,
     run: bench_tick,
-    budget_instructions: Some(800),
+    budget_instructions: Some(1200),
 }];
 
 fn fail(what: &'static str) -> Failure {

@@ -6,6 +6,7 @@ use super::Controller;
 use super::Rejection;
 use crate::control::commission::Commissioning;
 use crate::control::config::{ControllerConfig, in_range};
+use crate::control::estimator::lowest_speed_rad_s;
 use crate::control::pi::LoopConstants;
 use crate::control::planner::{BowlSpeedForResidence, split_combined};
 use crate::control::supervisor::{Fault, SensorWatch, State};
@@ -63,7 +64,7 @@ impl Controller {
         if m > a.max_speed_rad_s {
             return Err(Rejection::AboveMaxSpeed(axis as u8));
         }
-        if m != 0.0 && m < a.min_speed_rad_s {
+        if m != 0.0 && m < lowest_speed_rad_s(a) {
             return Err(Rejection::BelowMinSpeed(axis as u8));
         }
         Ok(())
@@ -105,6 +106,9 @@ impl Controller {
             return Err(e);
         }
         self.planner.set_targets([precession_rad_s, spin_rad_s]);
+        // A new setpoint: the runaway check waits until it is reached (a heavy shaft may coast
+        // down slower than the ramp).
+        self.reached = false;
         Ok(())
     }
 
@@ -127,6 +131,7 @@ impl Controller {
             c.check_speed(0, speeds[0])?;
             c.check_speed(1, speeds[1])?;
             c.planner.set_targets(speeds);
+            c.reached = false;
             Ok(speeds)
         })
     }
@@ -139,6 +144,7 @@ impl Controller {
             State::Idle => {
                 self.axes[0].rest_loop();
                 self.axes[1].rest_loop();
+                self.reached = false;
                 self.state = State::SpinningUp;
                 Ok(())
             }
@@ -154,6 +160,7 @@ impl Controller {
             match c.state {
                 State::SpinningUp | State::Running => {
                     c.planner.set_targets([0.0; 2]);
+                    c.reached = false;
                     c.state = State::Stopping;
                 }
                 State::Commissioning => {
@@ -237,6 +244,7 @@ impl Controller {
                     c.cfg.commissioning,
                     c.cfg.supply_v,
                     c.cfg.timer_hz as f32,
+                    [c.cfg.axes[0].pulses_per_rev, c.cfg.axes[1].pulses_per_rev],
                 ));
                 c.identify_error = None;
                 c.axes[0].watch = SensorWatch::CLEAR;

@@ -1,0 +1,430 @@
+//! The closed-loop reports on rig files: `bowl sim family --rig-file` (commissioning, then the
+//! step from rest on both axes) and `bowl sim faults --rig-file` (the fault matrix), with the
+//! fixed JSON shapes docs/control.md describes. Every figure is taken on the plant's *true*
+//! speed, never on the controller's estimate.
+
+use crate::rig_file::Rig;
+use model_core::control::{Controller, ControllerConfig, Fault, State};
+use model_core::sim::{ClosedLoop, Plant};
+use serde::Serialize;
+use std::f64::consts::TAU;
+
+/// Host-silence timeout the fault matrix configures, s (the link-loss row).
+pub const LINK_TIMEOUT_S: f32 = 1.0;
+/// Longest commissioning run allowed in a report, s.
+const COMMISSION_MAX_S: f32 = 300.0;
+
+/// The controller configuration a lab engineer gives for `rig`: the nominal one with the rig's
+/// pulses per revolution and capture timer (everything else is identified).
+pub fn config_for(rig: &Rig) -> ControllerConfig {
+    let mut cfg = ControllerConfig::nominal();
+    cfg.timer_hz = rig.params.timer_hz;
+    cfg.timer_bits = rig.params.timer_bits;
+    for (a, p) in cfg.axes.iter_mut().zip(&rig.params.axes) {
+        a.pulses_per_rev = p.sensor.pulses_per_rev;
+    }
+    cfg
+}
+
+/// Commissions `rig`; returns the closed loop (Idle, identified) or the plain reason.
+pub fn commissioned(rig: &Rig, cfg: ControllerConfig) -> Result<ClosedLoop, String> {
+    let ctrl = Controller::new(cfg).map_err(|e| format!("configuration rejected: {e:?}"))?;
+    let mut cl = ClosedLoop::new(Plant::new(rig.params, rig.seed), ctrl);
+    match cl.commission(COMMISSION_MAX_S) {
+        State::Idle => Ok(cl),
+        _ => Err(match cl.ctrl.identify_error() {
+            Some(e) => e.reason().to_string(),
+            None => match cl.ctrl.fault() {
+                Some(f) => format!("fault {} during identification", f.code()),
+                None => "did not finish".to_string(),
+            },
+        }),
+    }
+}
+
+/// Adds each axis's `load_step_nm` (material poured in after commissioning) from now on.
+pub fn pour_material(cl: &mut ClosedLoop) {
+    let now = cl.rig.time_s() as f32;
+    for a in &mut cl.rig.params_mut().axes {
+        a.faults.load_step_from_s = now;
+        a.faults.load_step_nm = a.load_step_nm;
+    }
+}
+
+/// Step figures of one axis.
+#[derive(Serialize, Debug, Clone, Copy)]
+pub struct AxisStep {
+    /// Peak of the true speed above the setpoint, % of the setpoint.
+    pub overshoot_pct: f64,
+    /// Time after which the revolution-averaged true speed stays in the band, s; None = never.
+    pub settling_s: Option<f64>,
+    /// RMS of the true speed about its mean over whole revolutions at steady state, %.
+    pub ripple_pct: f64,
+}
+
+/// Both axes.
+#[derive(Serialize, Debug, Clone, Copy)]
+pub struct Axes<T> {
+    /// Precession axis.
+    pub precession: T,
+    /// Spin axis.
+    pub spin: T,
+}
+
+/// One plant of `bowl sim family`.
+#[derive(Serialize, Debug, Clone)]
+pub struct PlantStep {
+    /// The plant's name.
+    pub name: String,
+    /// "ok" or "refused: <reason>".
+    pub commissioning: String,
+    /// A fault latched on this healthy plant.
+    pub false_fault: bool,
+    /// None when commissioning refused.
+    pub axes: Option<Axes<AxisStep>>,
+}
+
+/// The true-speed record of a step run, sampled every control tick.
+struct Record {
+    dt_s: f64,
+    speed: Vec<[f32; 2]>,
+    angle: Vec<[f64; 2]>,
+}
+
+/// Figures of axis `i` of `rec` for a step to `sp` with a `band` (fraction) settling band.
+fn figures(rec: &Record, i: usize, sp: f64, band: f64) -> AxisStep {
+    let n = rec.speed.len();
+    let peak = rec
+        .speed
+        .iter()
+        .map(|w| w[i] as f64)
+        .fold(f64::MIN, f64::max);
+    let overshoot_pct = (100.0 * (peak - sp) / sp).max(0.0);
+    let run_s = n as f64 * rec.dt_s;
+    let rev_s = TAU / sp;
+    // Settling on the speed averaged over the revolution centred on each instant (the true
+    // speed itself when a revolution is longer than the run).
+    let half = if rev_s < run_s {
+        ((0.5 * rev_s / rec.dt_s) as usize).max(1)
+    } else {
+        0
+    };
+    let avg = |k: usize| {
+        if half == 0 {
+            rec.speed[k][i] as f64
+        } else {
+            (rec.angle[k + half][i] - rec.angle[k - half][i]) / (2 * half) as f64 / rec.dt_s
+        }
+    };
+    let mut last_out = None;
+    let mut judged = false;
+    for k in half..n.saturating_sub(half) {
+        judged = true;
+        if (avg(k) - sp).abs() > band * sp {
+            last_out = Some(k);
+        }
+    }
+    let last_judged = n.saturating_sub(half).saturating_sub(1);
+    let settling_s = match last_out {
+        _ if !judged => None,
+        Some(k) if k >= last_judged => None,
+        Some(k) => Some((k + 1) as f64 * rec.dt_s),
+        None => Some(half as f64 * rec.dt_s),
+    };
+    // Ripple over the whole revolutions at the end of the run that follow settling (at least one).
+    let rev_ticks = ((rev_s / rec.dt_s) as usize).clamp(1, n);
+    let settled_k = settling_s.map_or(n, |s| (s / rec.dt_s) as usize);
+    let revs = ((n.saturating_sub(settled_k)) / rev_ticks).max(1);
+    let from = n - (revs * rev_ticks).min(n);
+    let w: Vec<f64> = rec.speed[from..].iter().map(|w| w[i] as f64).collect();
+    let mean = w.iter().sum::<f64>() / w.len() as f64;
+    let var = w.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / w.len() as f64;
+    AxisStep {
+        overshoot_pct,
+        settling_s,
+        ripple_pct: 100.0 * var.sqrt() / sp,
+    }
+}
+
+/// How long a step to `sp` runs: 8 s, or long enough for the settling window plus three
+/// revolutions of steady state.
+pub fn step_run_s(sp: f32) -> f32 {
+    let rev = std::f32::consts::TAU / sp;
+    (8.0f32).max(6.0 + 3.0 * rev).min(120.0)
+}
+
+/// Steps a commissioned loop from rest to `target` on both axes; records the true speed.
+fn step(mut cl: ClosedLoop, target: f32, band: f64) -> (Axes<AxisStep>, bool) {
+    pour_material(&mut cl);
+    let mut fault = cl.ctrl.set_motor_speeds(target, target).is_err() || cl.ctrl.start().is_err();
+    let mut rec = Record {
+        dt_s: cl.dt_s() as f64,
+        speed: Vec::new(),
+        angle: Vec::new(),
+    };
+    cl.run(step_run_s(target), |c| {
+        rec.speed.push([c.rig.speed_rad_s(0), c.rig.speed_rad_s(1)]);
+        rec.angle.push([c.rig.angle_rad(0), c.rig.angle_rad(1)]);
+        fault |= c.ctrl.fault().is_some();
+    });
+    let sp = target as f64;
+    (
+        Axes {
+            precession: figures(&rec, 0, sp, band),
+            spin: figures(&rec, 1, sp, band),
+        },
+        fault,
+    )
+}
+
+/// Settling band for a step to `target`: 2 %, and 5 % at low speed (below 1 rad/s, where the
+/// targets ask for 5 %).
+pub fn band_for(target: f32) -> f64 {
+    if target < 1.0 { 0.05 } else { 0.02 }
+}
+
+/// `bowl sim family` for one plant.
+pub fn family_plant(rig: &Rig, target: f32) -> PlantStep {
+    match commissioned(rig, config_for(rig)) {
+        Err(reason) => PlantStep {
+            name: rig.name.clone(),
+            commissioning: format!("refused: {reason}"),
+            false_fault: false,
+            axes: None,
+        },
+        Ok(cl) => {
+            let (axes, fault) = step(cl, target, band_for(target));
+            PlantStep {
+                name: rig.name.clone(),
+                commissioning: "ok".into(),
+                false_fault: fault,
+                axes: Some(axes),
+            }
+        }
+    }
+}
+
+/// Summary over the family.
+#[derive(Serialize, Debug)]
+pub struct FamilySummary {
+    /// Plants in the file.
+    pub plants: usize,
+    /// Commissioned.
+    pub commissioned: usize,
+    /// Healthy plants that faulted.
+    pub false_faults: usize,
+    /// Axes measured (2 per commissioned plant).
+    pub axes: usize,
+    /// Axes with overshoot <= 5 %, in %.
+    pub overshoot_within_5_pct_share: f64,
+    /// Worst overshoot, %.
+    pub overshoot_worst_pct: f64,
+    /// Axes that settled within 3 s, in %.
+    pub settled_within_3_s_share: f64,
+    /// Axes that never settled.
+    pub never_settled: usize,
+    /// Worst settling, s (None if any axis never settled).
+    pub settling_worst_s: Option<f64>,
+    /// Median ripple, %.
+    pub ripple_median_pct: f64,
+    /// Worst ripple, %.
+    pub ripple_worst_pct: f64,
+}
+
+/// The summary of `plants`.
+pub fn summary(plants: &[PlantStep]) -> FamilySummary {
+    let axes: Vec<AxisStep> = plants
+        .iter()
+        .filter_map(|p| p.axes)
+        .flat_map(|a| [a.precession, a.spin])
+        .collect();
+    let n = axes.len().max(1) as f64;
+    let share =
+        |f: &dyn Fn(&AxisStep) -> bool| 100.0 * axes.iter().filter(|a| f(a)).count() as f64 / n;
+    let mut ripple: Vec<f64> = axes.iter().map(|a| a.ripple_pct).collect();
+    ripple.sort_by(f64::total_cmp);
+    let never = axes.iter().filter(|a| a.settling_s.is_none()).count();
+    FamilySummary {
+        plants: plants.len(),
+        commissioned: plants.iter().filter(|p| p.axes.is_some()).count(),
+        false_faults: plants.iter().filter(|p| p.false_fault).count(),
+        axes: axes.len(),
+        overshoot_within_5_pct_share: share(&|a| a.overshoot_pct <= 5.0),
+        overshoot_worst_pct: axes.iter().map(|a| a.overshoot_pct).fold(0.0, f64::max),
+        settled_within_3_s_share: share(&|a| a.settling_s.is_some_and(|s| s <= 3.0)),
+        never_settled: never,
+        settling_worst_s: if never > 0 {
+            None
+        } else {
+            Some(axes.iter().filter_map(|a| a.settling_s).fold(0.0, f64::max))
+        },
+        ripple_median_pct: ripple.get(ripple.len() / 2).copied().unwrap_or(0.0),
+        ripple_worst_pct: ripple.last().copied().unwrap_or(0.0),
+    }
+}
+
+/// One injected fault's outcome (the worse of the two axes it was injected on, one at a time).
+#[derive(Serialize, Debug, Clone, Copy)]
+pub struct FaultOutcome {
+    /// From injection to the latched fault, s; None = not detected.
+    pub detected_s: Option<f64>,
+    /// What the targets allow, s.
+    pub bound_s: f64,
+    /// Highest true speed of the faulted axis between injection and detection, rad/s.
+    pub peak_speed_rad_s: f64,
+    /// Both duties were zero in the tick the fault latched.
+    pub pwm_zero: bool,
+    /// Still latched, duties zero, one second later.
+    pub latched: bool,
+}
+
+/// The four faults.
+#[derive(Serialize, Debug, Clone, Copy)]
+pub struct FaultSet {
+    /// Dead sensor.
+    pub sensor_lost: FaultOutcome,
+    /// Blocked shaft.
+    pub stall: FaultOutcome,
+    /// Bridge stuck on (full duty in the commanded direction).
+    pub overspeed: FaultOutcome,
+    /// No command or heartbeat from the host.
+    pub link_lost: FaultOutcome,
+}
+
+/// One plant of `bowl sim faults`.
+#[derive(Serialize, Debug, Clone)]
+pub struct PlantFaults {
+    /// The plant's name.
+    pub name: String,
+    /// "ok" or "refused: <reason>".
+    pub commissioning: String,
+    /// A fault latched before any injection (a false fault).
+    pub false_fault: bool,
+    /// None when commissioning refused.
+    pub faults: Option<FaultSet>,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Injected {
+    SensorLost,
+    Stall,
+    Overspeed,
+    LinkLost,
+}
+
+/// Runs `rig` at `speed` and injects each fault in turn on each axis.
+pub fn fault_plant(rig: &Rig, speed: f32) -> PlantFaults {
+    let cl = match commissioned(rig, config_for(rig)) {
+        Err(reason) => {
+            return PlantFaults {
+                name: rig.name.clone(),
+                commissioning: format!("refused: {reason}"),
+                false_fault: false,
+                faults: None,
+            };
+        }
+        Ok(cl) => cl,
+    };
+    // Settle at `speed` once, then copy the loop for every injection.
+    let mut running = cl;
+    let mut cfg = *running.ctrl.config();
+    cfg.host_timeout_s = LINK_TIMEOUT_S;
+    let mut false_fault = running.ctrl.set_parameters(cfg).is_err();
+    pour_material(&mut running);
+    false_fault |=
+        running.ctrl.set_motor_speeds(speed, speed).is_err() || running.ctrl.start().is_err();
+    let settle = (3.0 + 2.0 * std::f32::consts::TAU / speed).min(40.0);
+    for _ in 0..(settle / running.dt_s()) as u32 {
+        running.ctrl.host_heartbeat();
+        running.tick();
+        false_fault |= running.ctrl.fault().is_some();
+    }
+    let rate_bound = |axis: usize| {
+        let n = rig.params.axes[axis].sensor.pulses_per_rev as f64;
+        (3.0 * TAU / (n * speed as f64)).max(0.2)
+    };
+    let one = |what: Injected| {
+        let mut worst: Option<FaultOutcome> = None;
+        for axis in 0..2 {
+            let bound = match what {
+                Injected::LinkLost => LINK_TIMEOUT_S as f64 + 0.1,
+                _ => rate_bound(axis),
+            };
+            let o = inject(running, what, axis, bound);
+            let worse = match (&worst, o.detected_s) {
+                (None, _) => true,
+                (Some(w), None) => {
+                    w.detected_s.is_some() || o.peak_speed_rad_s > w.peak_speed_rad_s
+                }
+                (Some(w), Some(d)) => w.detected_s.is_some_and(|wd| d > wd),
+            };
+            if worse {
+                worst = Some(o);
+            }
+            if what == Injected::LinkLost {
+                break;
+            }
+        }
+        worst.expect("two axes ran")
+    };
+    PlantFaults {
+        name: rig.name.clone(),
+        commissioning: "ok".into(),
+        false_fault,
+        faults: Some(FaultSet {
+            sensor_lost: one(Injected::SensorLost),
+            stall: one(Injected::Stall),
+            overspeed: one(Injected::Overspeed),
+            link_lost: one(Injected::LinkLost),
+        }),
+    }
+}
+
+fn inject(mut cl: ClosedLoop, what: Injected, axis: usize, bound_s: f64) -> FaultOutcome {
+    let t0 = cl.rig.time_s();
+    {
+        let f = &mut cl.rig.params_mut().axes[axis].faults;
+        let now = t0 as f32;
+        match what {
+            Injected::SensorLost => f.dead_sensor_from_s = now,
+            Injected::Stall => f.blocked_from_s = now,
+            Injected::Overspeed => f.bridge_stuck_from_s = now,
+            Injected::LinkLost => {}
+        }
+    }
+    let heartbeat = what != Injected::LinkLost;
+    let mut detected = None;
+    let mut pwm_zero = false;
+    let mut peak: f64 = 0.0;
+    let limit = (3.0 * bound_s + 2.0) as f32;
+    let ticks = (limit / cl.dt_s()) as u32;
+    for _ in 0..ticks {
+        if heartbeat {
+            cl.ctrl.host_heartbeat();
+        }
+        let duties = cl.tick();
+        if detected.is_none() {
+            peak = peak.max(cl.rig.speed_rad_s(axis).abs() as f64);
+        }
+        if detected.is_none() && cl.ctrl.fault().is_some() {
+            detected = Some(cl.rig.time_s() - t0);
+            pwm_zero = duties == [0.0; 2];
+            break;
+        }
+    }
+    let mut latched = false;
+    if detected.is_some() {
+        let fault: Option<Fault> = cl.ctrl.fault();
+        latched = true;
+        cl.run(1.0, |c| {
+            latched &= c.ctrl.fault() == fault && c.duties() == [0.0; 2];
+        });
+    }
+    FaultOutcome {
+        detected_s: detected,
+        bound_s,
+        peak_speed_rad_s: peak,
+        pwm_zero,
+        latched,
+    }
+}
