@@ -16,8 +16,17 @@ class ClockTree:
 
     def __init__(self, rcc):
         self.rcc = rcc
+        self._key = None
+        self._sysclk = HSI_HZ
 
     def sysclk_hz(self) -> float:
+        key = (self.rcc.instance.CFGR & 0xC, self.rcc.instance.PLLCFGR)
+        if key != self._key:
+            self._sysclk = self._compute_sysclk()
+            self._key = key
+        return self._sysclk
+
+    def _compute_sysclk(self) -> float:
         cfgr = self.rcc.instance.CFGR
         sws = (cfgr >> 2) & 3
         if sws == 0:

@@ -76,7 +76,6 @@ class Dma(QlPeripheral):
                 s.index = 0
             else:
                 s.cr &= ~EN
-        self.machine.reschedule()
 
     def read(self, offset: int, size: int) -> int:
         if offset in (0, 4):
@@ -115,7 +114,6 @@ class Dma(QlPeripheral):
             else:
                 s.fcr = value
             self.machine.service_dma()
-        self.machine.reschedule()
 
     @property
     def region(self):

@@ -54,7 +54,6 @@ class Iwdg(QlPeripheral):
             self.pr = value & 7
         elif offset == 8 and self.unlocked:
             self.rlr = value & 0xFFF
-        self.machine.reschedule()
 
     @property
     def region(self):

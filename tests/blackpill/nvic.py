@@ -47,6 +47,17 @@ class Nvic(QlPeripheral):
             irq += 1
         return best
 
+    def get_priority(self, irq: int) -> int:
+        return self.priority[irq] if irq >= 0 else 0
+
+    def set_pending(self, irq: int):
+        """Qiling reports CPU faults here (negative numbers): the image crashed."""
+        if irq < 0:
+            self.machine.cpu_fault = irq
+            self.ql.emu_stop()
+        else:
+            self.soft_pending |= 1 << irq
+
     def taken(self, irq: int):
         self.soft_pending &= ~(1 << irq)
 
@@ -80,8 +91,6 @@ class Nvic(QlPeripheral):
             self.soft_pending |= bits
         elif offset < 0x200:
             self.soft_pending &= ~bits
-        # An unmask or pend may make an interrupt takeable at once.
-        self.machine.reschedule()
 
     @property
     def region(self):

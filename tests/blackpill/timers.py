@@ -59,9 +59,10 @@ class Timer(QlPeripheral):
     def sync(self, now_ns=None):
         """Advances the counter to `now_ns`, raising compare and update flags on the way."""
         now = self.machine.now_ns if now_ns is None else now_ns
-        if not self.running() or now <= self.anchor_ns:
-            if not self.running():
-                self.anchor_ns = max(self.anchor_ns, now)
+        if now <= self.anchor_ns:
+            return
+        if not self.running():
+            self.anchor_ns = now
             return
         ticks = self._ticks_between(self.anchor_ns, now)
         if ticks <= 0:
@@ -211,7 +212,6 @@ class Timer(QlPeripheral):
                 self.anchor_ns = self.machine.now_ns
         elif offset in self.regs:
             self.regs[offset] = value
-        self.machine.reschedule()
 
     @property
     def region(self):

@@ -143,7 +143,6 @@ class Usart(QlPeripheral):
         elif offset in self.regs:
             self.regs[offset] = value
         self.machine.service_dma()
-        self.machine.reschedule()
 
     @property
     def region(self):
