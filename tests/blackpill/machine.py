@@ -226,6 +226,7 @@ class Machine:
         self.sev_sites = _find_opcodes(elf, THUMB_SEV)
         self.reset_request = None
         self.power_cut = False
+        self.in_dma = False
         self.resets = []
         self.interrupts = 0
         self.slices = 0
@@ -244,9 +245,18 @@ class Machine:
         return self.board.clocks
 
     def service_dma(self):
+        """Serves active DMA requests (not re-entered: a transfer's own register access
+        must not start the next transfer before the stream has counted this one)."""
         b = getattr(self, "board", None)
-        if b is None:
+        if b is None or self.in_dma:
             return
+        self.in_dma = True
+        try:
+            self._serve_dma_requests(b)
+        finally:
+            self.in_dma = False
+
+    def _serve_dma_requests(self, b):
         for (stream, channel), (label, kind) in DMA1_ROUTES.items():
             s = b.dma1.streams[stream]
             periph = b.ql.hw.entity[label]
