@@ -9,6 +9,12 @@ pub trait MotorOutput {
     fn set_duty(&mut self, duty: f32);
     /// PWM compare to 0 at once: the bridge input goes low (coast on a PWM/DIR bridge).
     fn off(&mut self);
+    /// A fault: the output stage itself is disabled (on the STM32 the timer's main output
+    /// enable), not only the compare value, so no later compare write can drive the bridge
+    /// until a non-zero duty is set again after the fault is cleared.
+    fn disable(&mut self) {
+        self.off();
+    }
 }
 
 /// The free-running timer the edge timestamps come from.

@@ -18,6 +18,7 @@ use embassy_stm32::flash::Flash;
 use embassy_stm32::gpio::{Level, Output, Speed};
 use embassy_stm32::peripherals::{DMA1_CH5, DMA1_CH6, USART2};
 use embassy_stm32::time::Hertz;
+use embassy_stm32::timer::Channel;
 use embassy_stm32::timer::low_level::CountingMode;
 use embassy_stm32::timer::simple_pwm::{PwmPin, SimplePwm};
 use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
@@ -98,8 +99,16 @@ async fn main(spawner: Spawner) {
     );
     let ch = pwm.split();
     let mut motors = Motors::new([
-        PwmMotor::new(ch.ch1, Output::new(p.PB12, Level::Low, Speed::Low)),
-        PwmMotor::new(ch.ch2, Output::new(p.PB13, Level::Low, Speed::Low)),
+        PwmMotor::new(
+            ch.ch1,
+            Channel::Ch1,
+            Output::new(p.PB12, Level::Low, Speed::Low),
+        ),
+        PwmMotor::new(
+            ch.ch2,
+            Channel::Ch2,
+            Output::new(p.PB13, Level::Low, Speed::Low),
+        ),
     ]);
     motors.all_off();
     let capture = capture::start(p.TIM2, p.PA15, p.PB3);

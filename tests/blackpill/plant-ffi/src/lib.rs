@@ -113,7 +113,12 @@ pub unsafe extern "C" fn plant_free(plant: *mut Plant) {
 /// # Safety
 /// `plant` is null or came from [`plant_new`].
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn plant_advance(plant: *mut Plant, duty0: f32, duty1: f32, dt_s: f32) -> i32 {
+pub unsafe extern "C" fn plant_advance(
+    plant: *mut Plant,
+    duty0: f32,
+    duty1: f32,
+    dt_s: f32,
+) -> i32 {
     // SAFETY: the caller passes null or a live plant.
     let Some(p) = (unsafe { plant.as_mut() }) else {
         return -1;
@@ -131,7 +136,12 @@ pub unsafe extern "C" fn plant_advance(plant: *mut Plant, duty0: f32, duty1: f32
 /// # Safety
 /// `plant` is null or came from [`plant_new`]; `out` points to `cap` writable `u32`s.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn plant_edges(plant: *const Plant, axis: u32, out: *mut u32, cap: u32) -> i32 {
+pub unsafe extern "C" fn plant_edges(
+    plant: *const Plant,
+    axis: u32,
+    out: *mut u32,
+    cap: u32,
+) -> i32 {
     // SAFETY: the caller passes null or a live plant.
     let Some(p) = (unsafe { plant.as_ref() }) else {
         return -1;
