@@ -68,7 +68,11 @@ class FlashInterface(QlPeripheral):
             self.cr = value & ~STRT
             if value & STRT and value & SER:
                 sector = (value >> 3) & 0xF
-                self.store.erase(sector, self.machine)
+                try:
+                    self.store.erase(sector, self.machine)
+                except PowerCut:
+                    self.machine.cut_power()
+                    return
                 self.sr |= EOP
 
     def program(self, address: int, size: int, value: int):
@@ -76,7 +80,11 @@ class FlashInterface(QlPeripheral):
         if self.cr & LOCK or not self.cr & PG:
             self.sr |= PGSERR
             return
-        self.store.program(address - BACKED_BASE, size, value, self.machine)
+        try:
+            self.store.program(address - BACKED_BASE, size, value, self.machine)
+        except PowerCut:
+            self.machine.cut_power()
+            return
         self.sr |= EOP
 
     @property

@@ -21,7 +21,7 @@ from unicorn.arm_const import UC_ARM_REG_FPSCR, UC_ARM_REG_S0
 
 from clock_tree import ClockTree
 from dma import Dma
-from flash import BACKED_BASE, BACKED_SIZE, FlashInterface, FlashStore, PowerCut
+from flash import BACKED_BASE, BACKED_SIZE, FlashInterface, FlashStore
 from iwdg import Iwdg
 from nvic import Nvic
 from plant import STEP_NS
@@ -145,11 +145,7 @@ class Board:
         return self.m.store.read(offset, size)
 
     def _flash_write(self, ql, offset, size, value):
-        try:
-            self.flash.program(BACKED_BASE + offset, size, value)
-        except PowerCut:
-            self.m.power_cut = True
-            self.uc.emu_stop()
+        self.flash.program(BACKED_BASE + offset, size, value)
 
     def _scb_write(self, scb, access, offset, size, value):
         # AIRCR with VECTKEY and SYSRESETREQ: a software reset (the panic path).
@@ -272,6 +268,13 @@ class Machine:
 
     def request_reset(self, kind: str):
         self.reset_request = kind
+        b = getattr(self, "board", None)
+        if b is not None:
+            b.uc.emu_stop()
+
+    def cut_power(self):
+        """The supply is gone: the CPU stops here; the next step powers the board up again."""
+        self.power_cut = True
         b = getattr(self, "board", None)
         if b is not None:
             b.uc.emu_stop()
