@@ -26,7 +26,7 @@ use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::{bind_interrupts, dma, gpio::OutputType};
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
-use embassy_time::{Duration, Ticker};
+use embassy_time::{Duration, Instant, Ticker};
 use firmware::app::binding::{
     ControllerBackend, DeviceCore, NoInjection, PERSISTED_COUNT, default_persisted,
 };
@@ -54,6 +54,9 @@ type Core = SharedCore<ThreadModeRawMutex, DeviceCore<NoInjection>>;
 
 /// Watchdog timeout: 25 control periods of slack over the supervisor's 20 ms feeding period.
 const WATCHDOG_TIMEOUT_US: u32 = 250_000;
+/// Shortest time between two parameter saves: a host sending SET in a loop cannot wear the
+/// flash out (each sector takes 10 000 erases; a save erases at most one sector per 600).
+const MIN_SAVE_INTERVAL: Duration = Duration::from_secs(2);
 
 static CORE: Slot<Core> = Slot::new();
 static HEARTBEAT: Heartbeat = Heartbeat::new();
@@ -216,12 +219,16 @@ async fn supervisor_task(
     let persist = async {
         let mut ticker = Ticker::every(Duration::from_millis(500));
         let mut reported_lost = [0u32; 2];
+        let mut next_save = Instant::now();
         loop {
             ticker.next().await;
+            // Saves wait until the motors are off (`take_params_to_save`: a sector erase stalls
+            // the CPU) and until MIN_SAVE_INTERVAL after the previous one.
+            let may_save = Instant::now() >= next_save;
             let (values, lost) = core.lock(|c| {
                 let mut c = c.borrow_mut();
                 let lost = c.dropped_edges();
-                if c.backend.take_params_to_save() {
+                if may_save && c.backend.take_params_to_save() {
                     (Some(c.params_to_persist()), lost)
                 } else {
                     (None, lost)
@@ -236,6 +243,7 @@ async fn supervisor_task(
                 reported_lost = lost;
             }
             if let Some(v) = values {
+                next_save = Instant::now() + MIN_SAVE_INTERVAL;
                 match log.save(&v) {
                     Ok(()) => {
                         let (_, models) = firmware::app::binding::split_persisted(&v);

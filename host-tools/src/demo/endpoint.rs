@@ -7,6 +7,8 @@
 //! - [`RigChoice::Qemu`]: the firmware's emulated-board image (`qemu-rig`: the firmware's tasks and
 //!   controller binding on an emulated Cortex-M4F with the plant in place of the motors), its
 //!   USART1 on a pseudo-terminal. Needs `qemu-system-arm` and the thumb target.
+//! - [`RigChoice::Blackpill`]: the exact Black Pill image on the emulated STM32F411
+//!   (tests/blackpill, [`super::blackpill`]), USART2 on a pseudo-terminal.
 
 use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Write};
@@ -32,6 +34,8 @@ pub enum RigChoice {
     Host,
     /// The firmware image on the emulated board (fails if it cannot be built or started).
     Qemu,
+    /// The Black Pill image (`cargo fw`) on the emulated STM32F411 against the project's plant.
+    Blackpill,
 }
 
 /// The firmware binary that runs the rig on the emulated board.
@@ -48,19 +52,19 @@ pub struct Endpoint {
     pub port: String,
     /// One line saying which rig this is.
     pub description: String,
-    /// Short name for the summary: `host` or `qemu`.
+    /// Short name for the summary: `host`, `qemu` or `blackpill`.
     pub kind: &'static str,
     /// Why the emulated board is not used, when it is not.
     pub qemu_note: Option<String>,
-    running: Running,
+    pub(super) running: Running,
 }
 
-enum Running {
+pub(super) enum Running {
     Host {
         stop: Arc<AtomicBool>,
         thread: Option<JoinHandle<Result<HostStats>>>,
     },
-    Qemu {
+    Emulator {
         child: Child,
         console: Option<JoinHandle<Vec<String>>>,
     },
@@ -90,6 +94,7 @@ impl Endpoint {
         match choice {
             RigChoice::Host => start_host(fast, seed, None),
             RigChoice::Qemu => start_qemu(fast, seconds),
+            RigChoice::Blackpill => super::blackpill::start(seconds),
             RigChoice::Auto => match start_qemu(fast, seconds) {
                 Ok(e) => Ok(e),
                 Err(why) => start_host(fast, seed, Some(format!("{why:#}"))),
@@ -112,7 +117,7 @@ impl Endpoint {
                     console: Vec::new(),
                 })
             }
-            Running::Qemu {
+            Running::Emulator {
                 mut child,
                 mut console,
             } => {
@@ -215,7 +220,7 @@ fn serve(
 }
 
 /// The workspace root (host-tools' parent), where the firmware crate lives.
-fn workspace_root() -> PathBuf {
+pub(super) fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .map(Path::to_path_buf)
@@ -402,7 +407,7 @@ fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
         port,
         kind: "qemu",
         qemu_note: None,
-        running: Running::Qemu {
+        running: Running::Emulator {
             child,
             console: Some(console),
         },

@@ -4,6 +4,7 @@
 //! at the end a summary (JSON and text), the telemetry CSV and charts go to `--out`.
 
 mod analysis;
+mod blackpill;
 mod charts;
 mod endpoint;
 mod script;
@@ -72,7 +73,7 @@ pub fn run(args: &Args) -> Result<()> {
         }
     };
     let timing = script::Timing::for_seconds(args.seconds);
-    let boot_limit = std::time::Duration::from_secs(if rig.kind == "qemu" { 60 } else { 10 });
+    let boot_limit = std::time::Duration::from_secs(if rig.kind == "host" { 10 } else { 60 });
     let outcome = match session.wait_first_telemetry(boot_limit) {
         Ok(()) => script::run(&mut session, timing),
         Err(e) => script::Outcome {
