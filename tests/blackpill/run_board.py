@@ -6,12 +6,17 @@ Prints `pty: /dev/pts/N` once the board is up; `bowl send PTY status` then talks
 emulation keeps to real time so the host tools' timeouts mean what they mean on a board. defmt
 logs go to target/test-logs/blackpill-defmt.log. Ends after --seconds of emulated time, or on
 Ctrl-C, or when a file named by --stop-file appears. --reset-file PATH: when PATH appears the
-board gets a pin reset (and PATH is removed)."""
+board gets a pin reset (and PATH is removed). --control-stdin: lines on standard input inject
+faults into the emulated plant (the firmware itself refuses INJECT, as a real board does):
+`inject sensor1|sensor2` silences a sensor, `inject stall1|stall2` blocks a shaft, `inject none`
+repairs both."""
 
 import argparse
 import os
+import queue
 import signal
 import sys
+import threading
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -33,6 +38,29 @@ def default_paths():
     }
 
 
+def inject(plant, line: str):
+    """Applies one `inject WHAT` control line to the plant, from the plant's present time."""
+    words = line.split()
+    if len(words) != 2 or words[0] != "inject":
+        print(f"control: ignored {line!r} (expected `inject sensor1|sensor2|stall1|stall2|none`)",
+              file=sys.stderr)
+        return
+    now_s = plant.time_ns / 1e9
+    what = words[1]
+    if what == "none":
+        for axis in (0, 1):
+            plant.kill_sensor(axis, float("inf"))
+            plant.block_shaft(axis, float("inf"))
+    elif what in ("sensor1", "sensor2"):
+        plant.kill_sensor(int(what[-1]) - 1, now_s)
+    elif what in ("stall1", "stall2"):
+        plant.block_shaft(int(what[-1]) - 1, now_s)
+    else:
+        print(f"control: unknown fault {what!r}", file=sys.stderr)
+        return
+    print(f"control: inject {what} at plant time {now_s:.3f} s", flush=True)
+
+
 def main():
     d = default_paths()
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -45,8 +73,8 @@ def main():
     ap.add_argument("--pty-link", default=None, help="also make this symlink to the pty")
     ap.add_argument("--stop-file", default=None)
     ap.add_argument("--reset-file", default=None)
-    ap.add_argument("--fault-file", default=None,
-                    help="when this file appears, block the spin shaft (it holds the axis, 0 or 1)")
+    ap.add_argument("--control-stdin", action="store_true",
+                    help="take `inject WHAT` lines on standard input")
     args = ap.parse_args()
     for what, path in (("image", args.elf), ("plant library", args.plant_lib)):
         if not os.path.exists(path):
@@ -61,6 +89,12 @@ def main():
     stop = []
     signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
     signal.signal(signal.SIGINT, lambda *_: stop.append(1))
+    control = queue.Queue()
+    if args.control_stdin:
+        def read_control():
+            for line in sys.stdin:
+                control.put(line.strip())
+        threading.Thread(target=read_control, daemon=True).start()
     wall0 = time.monotonic()
     status = 0
     try:
@@ -72,11 +106,8 @@ def main():
             if args.reset_file and os.path.exists(args.reset_file):
                 os.unlink(args.reset_file)
                 m.reset("pin")
-            if args.fault_file and os.path.exists(args.fault_file):
-                with open(args.fault_file) as f:
-                    axis = int(f.read().strip() or "1")
-                os.unlink(args.fault_file)
-                plant.block_shaft(axis, plant.time_ns / 1e9)
+            while not control.empty():
+                inject(plant, control.get())
     except EmulationError as e:
         print(f"error: {e}", file=sys.stderr)
         status = 1

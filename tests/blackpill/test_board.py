@@ -233,16 +233,19 @@ def test_power_cut_during_the_erase_of_a_full_region_keeps_the_last_record():
     # erase: the image wrote the first slot; the copies are byte for byte the same.
     with open(base, "r+b") as f:
         data = bytearray(f.read())
+        first = SECTOR_BASES[6] - BACKED_BASE
+        used = data[first:first + SECTOR_SIZE]
+        end = len(used.rstrip(b"\xff"))
+        check(end > 0, "the first save left sector 6 blank")
+        record = bytes(used[:(end + 3) // 4 * 4])
         for sector in (6, 7):
             start = SECTOR_BASES[sector] - BACKED_BASE
-            used = data[start:start + SECTOR_SIZE]
-            end = len(used.rstrip(b"\xff"))
-            if end:
-                record = used[:(end + 3) // 4 * 4]
-                n = SECTOR_SIZE // len(record)
-                data[start:start + n * len(record)] = record * n
+            n = SECTOR_SIZE // len(record)
+            data[start:start + n * len(record)] = record * n
         f.seek(0)
         f.write(data)
+    steps = save_and_count_steps(shutil.copy(base, base + ".probe"), "36")
+    check(any(s.startswith("erase") for s in steps), f"the save did not erase: {steps[:3]}...")
     n = power_cut_sweep(base, "36", 24)
     print(f"   power cut swept over {n} program/erase steps")
 

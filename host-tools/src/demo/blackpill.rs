@@ -72,11 +72,13 @@ pub fn start(seconds: f64) -> Result<Endpoint> {
         .arg("tests/blackpill/run_board.py")
         .args(["--seconds", &run_s.to_string()])
         .args(["--defmt-print", &defmt_print(&root)])
-        .stdin(Stdio::null())
+        .arg("--control-stdin")
+        .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
         .spawn()
         .context("cannot start the Black Pill emulator")?;
+    let control = child.stdin.take();
     let stdout = child.stdout.take().ok_or_else(|| anyhow!("no stdout"))?;
     let (tx, rx) = mpsc::channel();
     let console = std::thread::spawn(move || {
@@ -107,6 +109,7 @@ pub fn start(seconds: f64) -> Result<Endpoint> {
         running: Running::Emulator {
             child,
             console: Some(console),
+            control,
         },
     })
 }

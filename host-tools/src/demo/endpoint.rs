@@ -67,6 +67,8 @@ pub(super) enum Running {
     Emulator {
         child: Child,
         console: Option<JoinHandle<Vec<String>>>,
+        /// Lines to the emulator (`inject WHAT`), when it takes them.
+        control: Option<std::process::ChildStdin>,
     },
 }
 
@@ -102,6 +104,22 @@ impl Endpoint {
         }
     }
 
+    /// Fault injection into the emulated world, for a rig whose firmware refuses `INJECT`
+    /// (the Black Pill image): each call sends `inject WHAT` to the emulator.
+    pub fn injector(&mut self) -> Option<impl FnMut(&str) -> Result<()> + '_> {
+        match &mut self.running {
+            Running::Emulator {
+                control: Some(stdin),
+                ..
+            } => Some(move |what: &str| {
+                writeln!(stdin, "inject {what}")
+                    .and_then(|()| stdin.flush())
+                    .context("the emulator's control input is closed")
+            }),
+            _ => None,
+        }
+    }
+
     /// Stops the rig and collects what it reported.
     pub fn shutdown(self) -> Result<Shutdown> {
         match self.running {
@@ -120,6 +138,7 @@ impl Endpoint {
             Running::Emulator {
                 mut child,
                 mut console,
+                ..
             } => {
                 let _ = child.kill();
                 let _ = child.wait();
@@ -410,6 +429,7 @@ fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
         running: Running::Emulator {
             child,
             console: Some(console),
+            control: None,
         },
     })
 }
