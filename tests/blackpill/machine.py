@@ -14,7 +14,7 @@ import os
 import time
 
 from qiling import Qiling
-from qiling.const import QL_ARCH, QL_OS, QL_VERBOSE
+from qiling.const import QL_ARCH, QL_INTERCEPT, QL_OS, QL_VERBOSE
 from qiling.extensions.mcu.stm32f4 import stm32f411
 from unicorn import UC_HOOK_CODE, UcError
 from unicorn.arm_const import UC_ARM_REG_FPSCR, UC_ARM_REG_S0
@@ -24,7 +24,7 @@ from dma import Dma
 from flash import BACKED_BASE, BACKED_SIZE, FlashInterface, FlashStore
 from iwdg import Iwdg
 from nvic import Nvic
-from plant import STEP_NS
+from plant import DIR_PINS
 from rtt import RttReader
 from timers import Timer
 from usart import Usart
@@ -40,6 +40,7 @@ IRQ_DMA1_STREAM = {5: 16, 6: 17}
 DMA1_ROUTES = {(5, 4): ("usart2", "rx"), (6, 4): ("usart2", "tx")}
 
 THUMB_WFE, THUMB_SEV = b"\x20\xbf", b"\x40\xbf"
+DIR_MASK = sum(1 << pin for pin in DIR_PINS)
 
 # RCC_CSR reset flags (RM0383 6.3.21).
 CSR_FLAGS = {
@@ -125,6 +126,8 @@ class Board:
                         info="[param flash]")
         scb = ql.hw.scb
         scb.hook_write(self._scb_write)
+        self.dir_pins = self.gpiob.instance.ODR & DIR_MASK
+        self.gpiob.hook_write(self._gpiob_written, intercept=QL_INTERCEPT.EXIT)
 
         for addr in m.wfe_sites:
             self.uc.hook_add(UC_HOOK_CODE, self._on_wfe, begin=addr, end=addr)
@@ -151,6 +154,18 @@ class Board:
         # AIRCR with VECTKEY and SYSRESETREQ: a software reset (the panic path).
         if offset == 0x0C and (value >> 16) == 0x05FA and value & 4:
             self.m.request_reset("software")
+
+    def _gpiob_written(self, gpio, access, offset, size, value):
+        # A DIR pin that turns while its PWM channel still drives the bridge drives the new
+        # direction with the old duty: the harness records every such moment.
+        pins = gpio.instance.ODR & DIR_MASK
+        changed = pins ^ self.dir_pins
+        self.dir_pins = pins
+        for axis, pin in enumerate(DIR_PINS):
+            if changed & (1 << pin):
+                self.m.dir_changes += 1
+            if changed & (1 << pin) and self.tim1.pwm_fraction(axis) > 0.0:
+                self.m.dir_violations.append((self.m.now_ns, axis, self.tim1.pwm_fraction(axis)))
 
     def _on_wfe(self, uc, address, size, user_data):
         # Stop before the instruction (unicorn 2.0.1 would fault on it); `resume_after_wfe`
@@ -223,6 +238,8 @@ class Machine:
         self.reset_request = None
         self.power_cut = False
         self.in_dma = False
+        self.dir_violations = []
+        self.dir_changes = 0
         self.resets = []
         self.interrupts = 0
         self.slices = 0

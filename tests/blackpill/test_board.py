@@ -100,6 +100,14 @@ def test_closed_loop_step_reaches_the_setpoints():
         for axis, target in ((0, 1.0), (1, 2.0)):
             err = abs(w[axis] - target) / target
             check(err < 0.03, f"axis {axis}: true speed {w[axis]:.3f} rad/s, setpoint {target}")
+        # Down to a lower speed and to a stop: braking may reverse the drive.
+        check(s.bowl("speed", "200", "300").startswith("ok"), "SPEED down refused")
+        s.wait_emulated(1.0)
+        check(s.bowl("stop").startswith("ok"), "STOP refused")
+        s.wait_emulated(1.0)
+        bad, turns = s.call(lambda m: (list(m.dir_violations), m.dir_changes))
+        print(f"   direction changes: {turns}")
+        check(not bad, f"DIR turned while the PWM still drove (time ns, axis, duty): {bad[:5]}")
     finally:
         s.close()
 
