@@ -54,6 +54,9 @@ type Core = SharedCore<ThreadModeRawMutex, DeviceCore<NoInjection>>;
 
 /// Watchdog timeout: 25 control periods of slack over the supervisor's 20 ms feeding period.
 const WATCHDOG_TIMEOUT_US: u32 = 250_000;
+/// A control tick's work ends before the next tick is due (the motors are the only thing the
+/// executor serves at this rate); later, and the watchdog goes unfed for a period.
+const CONTROL_DEADLINE: Duration = Duration::from_hz(tasks::CONTROL_HZ);
 /// Shortest time between two parameter saves: a host sending SET in a loop cannot wear the
 /// flash out (each sector takes 10 000 erases; a save erases at most one sector per 600).
 const MIN_SAVE_INTERVAL: Duration = Duration::from_secs(2);
@@ -195,7 +198,15 @@ async fn control_task(
     mut motors: Motors<PwmMotor>,
     _capture: capture::Capture,
 ) {
-    tasks::control(core, &capture::EDGES, &Tim2Clock, &mut motors, &HEARTBEAT).await
+    tasks::control(
+        core,
+        &capture::EDGES,
+        &Tim2Clock,
+        &mut motors,
+        &HEARTBEAT,
+        CONTROL_DEADLINE,
+    )
+    .await
 }
 
 #[embassy_executor::task]
