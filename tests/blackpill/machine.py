@@ -238,6 +238,7 @@ class Machine:
         self.reset_request = None
         self.power_cut = False
         self.in_dma = False
+        self.held = None  # (every_ns, hold_ns, next_ns): the CPU held periodically
         self.dir_violations = []
         self.dir_changes = 0
         self.resets = []
@@ -295,6 +296,11 @@ class Machine:
         b = getattr(self, "board", None)
         if b is not None:
             b.uc.emu_stop()
+
+    def hold_cpu_periodically(self, every_s: float, hold_s: float):
+        """From now on, stop the CPU for `hold_s` every `every_s` (as an interrupt storm or a
+        runaway flash operation would): control ticks end late while they still advance."""
+        self.held = (int(every_s * 1e9), int(hold_s * 1e9), self.now_ns)
 
     def stall(self, ns: int):
         """The CPU is stopped for `ns` (a flash operation) while the peripherals run on."""
@@ -366,6 +372,11 @@ class Machine:
         if self.now_ns >= self.next_poll_ns:
             self._poll_host()
             self.next_poll_ns = self.now_ns + 1_000_000
+        if self.held is not None and self.now_ns >= self.held[2]:
+            every, hold, at = self.held
+            self.held = (every, hold, at + every)
+            self.stall(hold)
+            return
         if b.take_interrupt():
             return
         nxt = self._next_event_ns()

@@ -20,6 +20,8 @@ from session import LOGS, Session  # noqa: E402
 from timers import BDTR, MOE  # noqa: E402
 
 WORK = tempfile.mkdtemp(prefix="blackpill-")
+# The control task's tick counter in the image (`HEARTBEAT` static).
+HEARTBEAT = None
 
 
 def fresh_flash(name: str) -> str:
@@ -180,6 +182,29 @@ def test_wedged_cpu_is_reset_by_the_watchdog():
         s.close()
 
 
+def test_late_control_ticks_starve_the_watchdog():
+    s = Session(fresh_flash("deadline"))
+    try:
+        s.wait_until_s(0.3)
+        ticks = s.call(lambda m: bytes(m.board.ql.mem.read(HEARTBEAT, 8)))
+        # 3 ms held every 10 ms: the control task still ticks (its count advances) but ticks
+        # end more than one period late.
+        t0 = s.call(lambda m: (m.hold_cpu_periodically(0.010, 0.003), m.now_ns)[1])
+        s.wait_emulated(0.15)
+        later = s.call(lambda m: bytes(m.board.ql.mem.read(HEARTBEAT, 8)))
+        check(later != ticks, "the control task stopped ticking: this test wants late ticks")
+        s.wait_emulated(0.5)
+        resets = s.call(lambda m: list(m.resets))
+        check(resets and resets[0][1] == "watchdog",
+              f"no watchdog reset while ticks missed their deadline: {resets}")
+        after_ms = (resets[0][0] - t0) / 1e6
+        check(after_ms <= 300, f"watchdog reset {after_ms:.0f} ms after ticks began to be late")
+        st = s.status()
+        check(st.get("reset_cause") == "IndependentWatchdog", f"status: {st}")
+    finally:
+        s.close()
+
+
 def save_and_count_steps(path: str, value: str):
     """Boots on `path`, sets TEETH2, waits for the save; returns the flash steps it took."""
     s = Session(path, realtime=False)
@@ -258,10 +283,23 @@ def test_power_cut_during_the_erase_of_a_full_region_keeps_the_last_record():
     print(f"   power cut swept over {n} program/erase steps")
 
 
+def heartbeat_address(elf: str) -> int:
+    """The address of the image's HEARTBEAT static (a mangled Rust name)."""
+    from elftools.elf.elffile import ELFFile
+    with open(elf, "rb") as f:
+        for sym in ELFFile(f).get_section_by_name(".symtab").iter_symbols():
+            if "9HEARTBEAT" in sym.name:
+                return sym["st_value"]
+    raise RuntimeError(f"{elf}: no HEARTBEAT symbol")
+
+
 TESTS = [v for k, v in sorted(globals().items()) if k.startswith("test_")]
 
 
 def main(names):
+    global HEARTBEAT
+    from session import ELF
+    HEARTBEAT = heartbeat_address(ELF)
     passed = failed = 0
     t_all = time.monotonic()
     for t in TESTS:
