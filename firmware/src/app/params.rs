@@ -110,6 +110,10 @@ impl<F: FlashRegion> ParamLog<F> {
         Ok(bytes)
     }
 
+    fn is_blank(&mut self, slot: u32) -> Result<bool, FlashError> {
+        Ok(self.read_slot(slot)?.iter().all(|&b| b == 0xFF))
+    }
+
     fn scan(&mut self) -> Result<Scan, FlashError> {
         let mut scan = Scan {
             first_free: None,
@@ -117,15 +121,22 @@ impl<F: FlashRegion> ParamLog<F> {
             corrupt: 0,
         };
         for i in 0..Self::SLOTS {
-            let slot = self.read_slot(i)?;
-            if slot.iter().all(|&b| b == 0xFF) {
+            // The first word tells an unwritten slot (programs start there) and a foreign one
+            // without reading the whole slot; `next_slot` checks a slot in full before use.
+            let mut head = [0u8; 4];
+            self.flash.read(Self::offset_of(i), &mut head)?;
+            let head = u32::from_le_bytes(head);
+            if head == ERASED_WORD {
                 scan.first_free.get_or_insert(i);
                 continue;
             }
+            if head != MAGIC {
+                scan.corrupt += 1;
+                continue;
+            }
+            let slot = self.read_slot(i)?;
             let (body, crc) = slot.split_at(SLOT_BYTES - 4);
-            if word(&slot, 0) != MAGIC
-                || u32::from_le_bytes(crc.try_into().unwrap_or([0; 4])) != crc32(body)
-            {
+            if u32::from_le_bytes(crc.try_into().unwrap_or([0; 4])) != crc32(body) {
                 scan.corrupt += 1;
                 continue;
             }
@@ -137,28 +148,26 @@ impl<F: FlashRegion> ParamLog<F> {
         Ok(scan)
     }
 
-    /// Where the next record goes, and which sector to erase first (if any). Never the sector
-    /// of the newest record.
+    /// Where the next record goes, and which sector to erase first (if any): the slot after
+    /// the newest record (or the first unwritten one) if it is blank; else the start of its
+    /// sector, erased, unless that sector holds the newest record, in which case the start of
+    /// the following sector, erased. Never the sector of the newest record.
     fn next_slot(&mut self, scan: &Scan) -> Result<(u32, Option<u32>), FlashError> {
-        let Some((_, newest)) = scan.newest else {
-            // No record to keep: the first blank slot, or a freshly erased first sector.
-            return Ok(match scan.first_free {
-                Some(i) => (i, None),
-                None => (0, Some(0)),
-            });
+        let candidate = match scan.newest {
+            Some((_, newest)) => (newest + 1) % Self::SLOTS,
+            None => scan.first_free.unwrap_or(0),
         };
-        let next = (newest + 1) % Self::SLOTS;
-        if self.read_slot(next)?.iter().all(|&b| b == 0xFF) {
-            return Ok((next, None));
+        if self.is_blank(candidate)? {
+            return Ok((candidate, None));
         }
-        let sector = Self::sector_of(next);
-        if sector != Self::sector_of(newest) {
-            return Ok((next, Some(sector)));
-        }
-        // The slot after the newest record is dirty (a torn write or a torn erase): start the
-        // following sector instead, which holds only older records.
-        let following = (sector + 1) % F::SECTORS;
-        Ok((following * Self::SLOTS_PER_SECTOR, Some(following)))
+        let sector = Self::sector_of(candidate);
+        let erase = if scan.newest.map(|(_, n)| Self::sector_of(n)) == Some(sector) {
+            // Dirty after the newest record (a torn write or erase) in the same sector.
+            (sector + 1) % F::SECTORS
+        } else {
+            sector
+        };
+        Ok((erase * Self::SLOTS_PER_SECTOR, Some(erase)))
     }
 
     /// The values of the newest valid record, if it has this version and `N` values.
