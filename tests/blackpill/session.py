@@ -7,6 +7,7 @@ import queue
 import re
 import subprocess
 import threading
+import time
 
 from machine import Machine
 from plant import RigPlant
@@ -32,6 +33,7 @@ class Session:
         self.actions = queue.Queue()
         self.stopping = False
         self.error = None
+        self.wall0 = time.monotonic()
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.thread.start()
 
@@ -59,7 +61,6 @@ class Session:
 
     def wait_until_s(self, t_s: float):
         """Blocks until the emulated clock has reached `t_s`."""
-        import time
         while self.now_s() < t_s:
             if self.error:
                 raise self.error
@@ -87,8 +88,14 @@ class Session:
         out = self.bowl("params")
         return {k: int(v) for k, v in re.findall(r"(\w+)=(-?\d+)", out)}
 
+    def speed(self) -> str:
+        wall = time.monotonic() - self.wall0
+        emu = self.now_s()
+        return f"emulated {emu:.2f} s in {wall:.2f} s wall: {emu / wall:.2f}x real time"
+
     def close(self):
         self.stopping = True
         self.thread.join(timeout=60)
+        print(f"   {self.speed()}", flush=True)
         self.machine.close()
         self.link.close()

@@ -211,7 +211,8 @@ def save_and_count_steps(path: str, value: str):
     try:
         s.wait_until_s(0.3)
         check(s.bowl("set", "TEETH2", value).startswith("ok"), "SET refused")
-        s.wait_emulated(1.2)
+        # The save starts within one persistence period (0.5 s); an erase first takes 1 s.
+        s.wait_emulated(2.0)
         return s.call(lambda m: list(m.store.log))
     finally:
         s.close()
@@ -225,8 +226,9 @@ def boot_with_cut(path: str, cut_at: int, value: str):
         s.call(lambda m: setattr(m.store, "cut_at", cut_at))
         s.wait_until_s(0.3)
         s.bowl("set", "TEETH2", value)
-        # The save starts within one persistence period (0.5 s); the board then boots again.
-        deadline = s.now_s() + 1.5
+        # The save starts within one persistence period (0.5 s), after an erase (1 s) if it
+        # needs one; the board then boots again.
+        deadline = s.now_s() + 2.0
         cut_at_s = None
         while cut_at_s is None and s.now_s() < deadline:
             s.wait_emulated(0.05)
