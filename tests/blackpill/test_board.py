@@ -114,27 +114,63 @@ def test_closed_loop_step_reaches_the_setpoints():
         s.close()
 
 
-def test_blocked_shaft_faults_and_the_bridge_goes_off():
-    s = Session(fresh_flash("fault"))
+def fault_stops_the_bridge(name: str, inject):
+    s = Session(fresh_flash(name))
     try:
         s.wait_until_s(0.3)
         s.bowl("speed", "1000", "2000")
         s.bowl("start")
         s.wait_emulated(1.5)
-        t_block = s.call(lambda m: (m.plant.block_shaft(1, m.plant.time_ns / 1e9), m.now_ns / 1e9)[1])
-        deadline = t_block + 4.0
+        t_fault = s.call(lambda m: (inject(m.plant, m.plant.time_ns / 1e9), m.now_ns / 1e9)[1])
+        deadline = t_fault + 4.0
         st = {}
         while s.now_s() < deadline:
             s.wait_emulated(0.25)
             st = s.status()
             if st.get("fault", "None") != "None":
                 break
-        check(st.get("fault", "None") != "None", f"no fault within 4 s of a blocked shaft: {st}")
+        check(st.get("fault", "None") != "None", f"no fault within 4 s of the {name}: {st}")
         s.wait_emulated(0.01)
         duty, moe = s.call(lambda m: ((m.board.tim1.pwm_fraction(0), m.board.tim1.pwm_fraction(1)),
                                       bool(m.board.tim1.regs[BDTR] & MOE)))
         check(duty == (0.0, 0.0), f"PWM still active after the fault: {duty}")
         check(not moe, "TIM1 main output (MOE) still enabled after the fault")
+        print(f"   fault {st.get('fault')} reported within {s.now_s() - t_fault:.2f} s")
+    finally:
+        s.close()
+
+
+def test_blocked_shaft_faults_and_the_bridge_goes_off():
+    fault_stops_the_bridge("blocked spin shaft", lambda plant, t: plant.block_shaft(1, t))
+
+
+def test_dead_sensor_faults_and_the_bridge_goes_off():
+    fault_stops_the_bridge("dead spin sensor", lambda plant, t: plant.kill_sensor(1, t))
+
+
+def test_no_flash_operation_while_a_motor_is_driven():
+    s = Session(fresh_flash("deferred"))
+    try:
+        s.wait_until_s(0.3)
+        s.bowl("speed", "1000", "1000")
+        s.bowl("start")
+        s.wait_emulated(0.5)
+        # A parameter change while driving is refused (so no save can stall the loop) ...
+        out = s.bowl("set", "TEETH2", "24")
+        check(out.startswith("rejected") and "STATE" in out, f"SET while running: {out}")
+        s.wait_emulated(1.0)
+        steps = s.call(lambda m: list(m.store.log))
+        check(not steps, f"flash written while the motors ran: {steps[:3]}")
+        # ... and accepted and saved once the rig is idle again.
+        s.bowl("stop")
+        deadline = s.now_s() + 8.0
+        while s.status().get("state") != "Idle" and s.now_s() < deadline:
+            s.wait_emulated(0.25)
+        out = s.bowl("set", "TEETH2", "24")
+        check(out.startswith("ok"), f"SET after STOP: {out}; status {s.status()}")
+        s.wait_emulated(1.0)
+        steps = s.call(lambda m: list(m.store.log))
+        check(steps, "no save after the SET in Idle")
     finally:
         s.close()
 
