@@ -180,19 +180,27 @@ fn steps(
     s.wait_ms(d.dwell_ms)?;
 
     // 4. Fault: the spin sensor goes dead. The rig must stop both motors.
-    let ok = match injector.as_mut() {
+    let injected = match injector.as_mut() {
         Some(inject) => {
             inject(INJECTION)?;
             s.event(format!(
                 "inject a sensor fault: {INJECTION} in the emulated plant (the firmware answers \
                  INJECT with UNSUPPORTED, as on a real board)"
             ));
-            true
+            // No command carries the time: the mark is now.
+            Mark {
+                name: "fault injected".into(),
+                kind: MarkKind::Inject,
+                at_ms: s.now_ms().unwrap_or(0),
+                accepted: true,
+            }
         }
-        None => s.command("inject a sensor fault", &["inject", INJECTION])?,
+        None => {
+            let ok = s.command("inject a sensor fault", &["inject", INJECTION])?;
+            mark(s, "fault injected", MarkKind::Inject, ok)
+        }
     };
-    out.marks
-        .push(mark(s, "fault injected", MarkKind::Inject, ok));
+    out.marks.push(injected);
     let detected = s.wait_for(d.wait_limit_ms, |t| t.fault != FaultCode::None)?;
     match detected {
         Some(at) => {
