@@ -7,7 +7,8 @@
 //!   edge timestamps into one [`EdgeQueue`] per axis;
 //! - control: a fixed-rate tick ([`CONTROL_HZ`]): drain edges, run the controller, set duties;
 //! - link: commands in, answers and telemetry out over the byte stream;
-//! - supervisor: feeds the watchdog only while the control tick keeps running.
+//! - supervisor: feeds the watchdog only while the control tick keeps running and meeting its
+//!   deadlines.
 
 use core::cell::RefCell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
