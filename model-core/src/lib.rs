@@ -1,7 +1,7 @@
 //! Pure logic of the bowl granulation rig: `no_std`, no heap, no panics on any finite input.
 //!
 //! The physics follows the paper "The Coriolis Effect on Spherical Particles Inside the Bowl"
-//! with the corrections of `shared/MODEL-NOTES.md`; every formula cites the paper's equation.
+//! with the corrections of `docs/model.md`; every formula cites the paper's equation.
 //! SI units throughout; names carry the unit (`omega_rad_s`, `radius_m`).
 //!
 //! The same code runs on the host (f64 for analysis, f32 to reproduce the target) and on the

@@ -3,7 +3,7 @@
 //! and tiny omega; and the stability failures our code avoids (naive acosh near the rim, Newton
 //! started at T = 0, f32 just above the threshold).
 //!
-//! Targets (issue 3): f64 within 1e-12 x condition number, f32 within 2e-6 x condition number.
+//! Targets: f64 within 1e-12 x condition number, f32 within 2e-6 x condition number.
 //! Run with `--nocapture` to see the worst error/condition ratios.
 
 use astro_float::{BigFloat, Consts, RoundingMode};
@@ -45,9 +45,9 @@ impl Hp {
         x.exp(P, RM, &mut self.cc)
     }
 
-    /// Paper Eq. 6/7 and 10/11 (MODEL-NOTES' A, B, l1, l2), solved in 320-bit arithmetic.
+    /// Paper Eq. 6/7 and 10/11 (the corrected A, B, l1, l2 of docs/model.md), solved in 320-bit arithmetic.
     /// Flat: `T = ln(1 + x + sqrt(x (x + 2))) / (k omega)`. Coriolis: Newton on
-    /// `A (e^{l1 T} - 1) + B (e^{l2 T} - 1) = x` from MODEL-NOTES' upper bracket (monotone).
+    /// `A (e^{l1 T} - 1) + B (e^{l2 T} - 1) = x` from the upper bracket of docs/model.md (monotone).
     fn solve(&mut self, s: &Scene<f64>, model: Model) -> Want {
         let (w, mu, g, k2, ri, rim) = (
             bf(s.omega_rad_s),

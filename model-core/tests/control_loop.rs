@@ -18,7 +18,7 @@ fn true_model_loop(rig: PlantParams) -> ClosedLoop {
 }
 
 #[test]
-fn nominal_step_meets_the_issue_figures() {
+fn nominal_step_meets_the_control_targets() {
     let o = commissioned_step(
         rig_with_pulses(12),
         ControllerConfig::nominal(),

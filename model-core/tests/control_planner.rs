@@ -4,7 +4,7 @@ use model_core::control::{
     BowlSpeedForResidence, Controller, ControllerConfig, InverseFailure, Rejection,
 };
 
-/// Flat model (paper Eq. 6/7, MODEL-NOTES form): `T = acosh(1 + (R - ri)/(ri - a)) / (k omega)`,
+/// Flat model (paper Eq. 6/7, docs/model.md form): `T = acosh(1 + (R - ri)/(ri - a)) / (k omega)`,
 /// `a = mu g / omega^2`, inverted by bisection in f64 here, independently of model-core.
 struct FlatInverse {
     rim_m: f64,

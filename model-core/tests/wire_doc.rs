@@ -100,3 +100,30 @@ fn link_budget_figures_in_the_doc_hold() {
     assert!(doc.contains(&format!("50 x {MAX_TELEMETRY_LEN} = {bytes_per_s} bytes/s")));
     assert_eq!(max_telemetry_hz(DEFAULT_BAUD), 52);
 }
+
+/// The parameter table of docs/protocol.md lists the code's table (`wire::params`) in wire
+/// order with the same ranges.
+#[test]
+fn parameter_table_matches_the_code() {
+    let doc = doc();
+    let rows: Vec<(String, String)> = doc
+        .lines()
+        .filter(|l| l.starts_with("| ") && l.contains("| `"))
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            // | # | name | unit | range |
+            let name = cells.get(2)?.trim_matches('`').to_string();
+            let range = cells.get(4)?.replace(' ', "");
+            Some((name, range))
+        })
+        .filter(|(name, _)| ParamId::from_token(name.as_bytes()).is_some())
+        .collect();
+    let expected: Vec<(String, String)> = ParamId::ALL
+        .iter()
+        .map(|id| {
+            let (lo, hi) = id.range();
+            (id.token().to_string(), format!("{lo}..={hi}"))
+        })
+        .collect();
+    assert_eq!(rows, expected);
+}

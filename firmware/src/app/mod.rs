@@ -7,6 +7,7 @@
 //! - [`binding`]: the controller + particle model behind the wire protocol (`TaskCore`).
 //! - [`edges`]: the queue from the pulse-capture interrupt/task to the control tick.
 //! - [`params`]: parameters persisted in flash (version + CRC-32, append-only records).
+//! - [`persist`]: the loop that saves changed parameters and reports lost capture edges.
 //! - [`reset`]: reset cause and a reset counter that survives resets in uninitialised RAM.
 //! - [`motors`]: the pair of motor outputs and the all-off path used by faults and panics.
 //! - [`tasks`]: capture, control tick, link (telemetry + commands), supervisor.
@@ -16,6 +17,10 @@ pub mod edges;
 pub mod hal;
 pub mod motors;
 pub mod params;
+pub mod persist;
 pub mod reset;
 pub mod slot;
 pub mod tasks;
+
+#[cfg(test)]
+mod test_flash;

@@ -26,13 +26,14 @@ use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::{bind_interrupts, dma, gpio::OutputType};
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
-use embassy_time::{Duration, Instant, Ticker};
+use embassy_time::{Duration, Ticker};
 use firmware::app::binding::{
-    ControllerBackend, DeviceCore, NoInjection, PERSISTED_COUNT, default_persisted,
+    ControllerBackend, DeviceCore, NoInjection, PERSISTED_COUNT, default_persisted, split_persisted,
 };
 use firmware::app::hal::Watchdog;
 use firmware::app::motors::Motors;
 use firmware::app::params::ParamLog;
+use firmware::app::persist::{PERSIST_PERIOD, Persistence};
 use firmware::app::reset;
 use firmware::app::slot::Slot;
 use firmware::app::tasks::{self, Heartbeat, SharedCore};
@@ -57,9 +58,6 @@ const WATCHDOG_TIMEOUT_US: u32 = 250_000;
 /// A control tick's work ends before the next tick is due (the motors are the only thing the
 /// executor serves at this rate); later, and the watchdog goes unfed for a period.
 const CONTROL_DEADLINE: Duration = Duration::from_hz(tasks::CONTROL_HZ);
-/// Shortest time between two parameter saves: a host sending SET in a loop cannot wear the
-/// flash out (each sector takes 10 000 erases; a save erases at most one sector per 600).
-const MIN_SAVE_INTERVAL: Duration = Duration::from_secs(2);
 
 static CORE: Slot<Core> = Slot::new();
 static HEARTBEAT: Heartbeat = Heartbeat::new();
@@ -228,40 +226,25 @@ async fn supervisor_task(
 ) {
     let feed = tasks::supervisor(watchdog, &HEARTBEAT);
     let persist = async {
-        let mut ticker = Ticker::every(Duration::from_millis(500));
-        let mut reported_lost = [0u32; 2];
-        let mut next_save = Instant::now();
+        let mut persistence = Persistence::new(log);
+        let mut ticker = Ticker::every(PERSIST_PERIOD);
         loop {
             ticker.next().await;
-            // Saves wait until the motors are off (`take_params_to_save`: a sector erase stalls
-            // the CPU) and until MIN_SAVE_INTERVAL after the previous one.
-            let may_save = Instant::now() >= next_save;
-            let (values, lost) = core.lock(|c| {
-                let mut c = c.borrow_mut();
-                let lost = c.dropped_edges();
-                if may_save && c.backend.take_params_to_save() {
-                    (Some(c.params_to_persist()), lost)
-                } else {
-                    (None, lost)
-                }
-            });
+            let report = persistence.step(core);
             // The wire has no field for capture losses: say so in the log, never silently.
-            if lost != reported_lost {
+            if let Some(lost) = report.edges_lost {
                 warn!(
                     "capture: edges lost so far: precession {}, spin {}",
                     lost[0], lost[1]
                 );
-                reported_lost = lost;
             }
-            if let Some(v) = values {
-                next_save = Instant::now() + MIN_SAVE_INTERVAL;
-                match log.save(&v) {
-                    Ok(()) => {
-                        let (_, models) = firmware::app::binding::split_persisted(&v);
-                        info!("params: saved; motor models {} / {}", models[0], models[1]);
-                    }
-                    Err(e) => error!("params: save failed: {}", e),
+            match report.saved {
+                Some(Ok(record)) => {
+                    let (_, models) = split_persisted(&record);
+                    info!("params: saved; motor models {} / {}", models[0], models[1]);
                 }
+                Some(Err(e)) => error!("params: save failed: {}", e),
+                None => {}
             }
         }
     };

@@ -60,12 +60,10 @@ fn main() -> ! {
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
-    hprintln!("PANIC: {}", info);
-    qemu::exit(false)
+    qemu::fail_on_panic(info)
 }
 
 #[exception]
 unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
-    hprintln!("HARD FAULT at pc {:#010x}", frame.pc());
-    qemu::exit(false)
+    qemu::fail_on_hard_fault(frame)
 }

@@ -37,3 +37,15 @@ pub fn exit(success: bool) -> ! {
         cortex_m::asm::wfi();
     }
 }
+
+/// What a test image's panic handler does: says where, and fails the run.
+pub fn fail_on_panic(info: &core::panic::PanicInfo) -> ! {
+    cortex_m_semihosting::hprintln!("PANIC: {}", info);
+    exit(false)
+}
+
+/// What a test image's hard-fault handler does: says where, and fails the run.
+pub fn fail_on_hard_fault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
+    cortex_m_semihosting::hprintln!("HARD FAULT at pc {:#010x}", frame.pc());
+    exit(false)
+}

@@ -1,13 +1,20 @@
 //! The top-level controller: both axes, the supervisor, the planner and commissioning.
+//!
+//! - this file: the state, its construction, the control tick and the telemetry snapshot;
+//! - [`axis`]: one motor axis's runtime state (estimator, loop, sensor watch, outputs);
+//! - [`commands`]: the host's commands, each of which also counts as hearing from the host.
+
+mod axis;
+mod commands;
+
+use axis::AxisState;
+use commands::HostWatch;
 
 use super::commission::{Commissioning, Identified, IdentifyError, Phase};
-use super::config::{ConfigError, ControllerConfig, in_range};
-use super::estimator::PulseSpeedEstimator;
-use super::pi::{LoopConstants, LoopInput, SpeedLoop};
-use super::planner::{
-    BowlSpeedForResidence, InverseFailure, ResidenceForBowlSpeed, SetpointPlanner, split_combined,
-};
-use super::supervisor::{Fault, SensorWatch, State, fault_code};
+use super::config::{ConfigError, ControllerConfig};
+use super::pi::LoopInput;
+use super::planner::{InverseFailure, ResidenceForBowlSpeed, SetpointPlanner};
+use super::supervisor::{Fault, State, fault_code};
 use crate::bowl::{MotorSpeeds, combined_speed_from_trig};
 
 /// Why a command was refused. A refused command changes nothing.
@@ -85,26 +92,21 @@ pub struct Status {
 pub struct Controller {
     cfg: ControllerConfig,
     dt_s: f32,
-    est: [PulseSpeedEstimator; 2],
-    k: [LoopConstants; 2],
-    loops: [SpeedLoop; 2],
-    watch: [SensorWatch; 2],
+    /// Precession, spin.
+    axes: [AxisState; 2],
     planner: SetpointPlanner,
-    max_step: [f32; 2],
     state: State,
     fault: Option<Fault>,
+    /// Why the configuration was refused (blocks clearing the fault until replaced).
     config_error: Option<ConfigError>,
-    host_silence_s: f32,
-    duties: [f32; 2],
-    measured: [f32; 2],
-    direction: [f32; 2],
+    host: HostWatch,
     commissioning: Option<Commissioning>,
     identified: [Option<Identified>; 2],
     identify_error: Option<IdentifyError>,
     feedback: bool,
+    /// cos and sin of the axes angle (paper Eq. 2), computed once per configuration.
     cos_axes: f32,
     sin_axes: f32,
-    host_watch: bool,
 }
 
 impl Controller {
@@ -141,32 +143,21 @@ impl Controller {
         Self {
             cfg,
             dt_s,
-            est: [
-                PulseSpeedEstimator::new(&cfg, &a0),
-                PulseSpeedEstimator::new(&cfg, &a1),
+            axes: [
+                AxisState::new(&cfg, &a0, dt_s),
+                AxisState::new(&cfg, &a1, dt_s),
             ],
-            k: [
-                LoopConstants::new(&a0, dt_s, cfg.supply_v),
-                LoopConstants::new(&a1, dt_s, cfg.supply_v),
-            ],
-            loops: [SpeedLoop::REST; 2],
-            watch: [SensorWatch::CLEAR; 2],
             planner: SetpointPlanner::REST,
-            max_step: [a0.accel_limit_rad_s2 * dt_s, a1.accel_limit_rad_s2 * dt_s],
             state: State::Idle,
             fault: None,
             config_error: None,
-            host_silence_s: 0.0,
-            duties: [0.0; 2],
-            measured: [0.0; 2],
-            direction: [1.0; 2],
+            host: HostWatch::new(cfg.host_timeout_s),
             commissioning: None,
             identified: [None; 2],
             identify_error: None,
             feedback: true,
             cos_axes: cos_const(cfg.axes_angle_rad),
             sin_axes: sin_const(cfg.axes_angle_rad),
-            host_watch: cfg.host_timeout_s > 0.0,
         }
     }
 
@@ -183,10 +174,11 @@ impl Controller {
         let steady = self.planner.steady_s();
         let mut seen = [false; 2];
         for i in 0..2 {
-            let before = self.est[i].accepted_edges();
-            let speed = self.est[i].tick(now_ticks, edges[i], steady[i] > 0.5, |_, _| {});
-            seen[i] = self.est[i].accepted_edges() != before;
-            self.measured[i] = self.direction[i] * speed;
+            let a = &mut self.axes[i];
+            let before = a.est.accepted_edges();
+            let speed = a.est.tick(now_ticks, edges[i], steady[i] > 0.5, |_, _| {});
+            seen[i] = a.est.accepted_edges() != before;
+            a.measured = a.direction * speed;
             if speed > self.cfg.axes[i].overspeed_rad_s {
                 self.latch(Fault::Overspeed(i as u8));
             }
@@ -195,7 +187,7 @@ impl Controller {
             State::SpinningUp | State::Running | State::Stopping => {
                 self.closed_loop_step(dt, &seen)
             }
-            _ => self.duties = [0.0; 2],
+            _ => self.set_duties_zero(),
         }
         self.after_tick(dt)
     }
@@ -210,20 +202,21 @@ impl Controller {
             None => 2,
         };
         for i in 0..2 {
-            let rad_per_pulse = self.est[i].rad_per_pulse();
+            let a = &mut self.axes[i];
+            let rad_per_pulse = a.est.rad_per_pulse();
             let mut comm = if i == comm_axis {
                 self.commissioning.as_mut()
             } else {
                 None
             };
             let seen_i = &mut seen[i];
-            let speed = self.est[i].tick(now_ticks, edges[i], false, |at, pulses| {
+            let speed = a.est.tick(now_ticks, edges[i], false, |at, pulses| {
                 *seen_i = true;
                 if let Some(c) = comm.as_deref_mut() {
                     c.on_edge(at, pulses, rad_per_pulse);
                 }
             });
-            self.measured[i] = self.direction[i] * speed;
+            a.measured = a.direction * speed;
             if speed > self.cfg.axes[i].overspeed_rad_s {
                 self.latch(Fault::Overspeed(i as u8));
             }
@@ -237,29 +230,37 @@ impl Controller {
     /// Host-silence watch and the final say of a latched fault, common to both ticks.
     #[inline(always)]
     fn after_tick(&mut self, dt: f32) -> [f32; 2] {
-        if self.host_watch && !matches!(self.state, State::Idle | State::Fault) {
-            self.host_silence_s += dt;
-            if self.host_silence_s > self.cfg.host_timeout_s {
-                self.latch(Fault::HostSilent);
-            }
+        if !matches!(self.state, State::Idle | State::Fault)
+            && self.host.silent_after(dt, self.cfg.host_timeout_s)
+        {
+            self.latch(Fault::HostSilent);
         }
         if self.fault.is_some() {
-            self.duties = [0.0; 2];
+            self.set_duties_zero();
         }
-        self.duties
+        [self.axes[0].duty, self.axes[1].duty]
+    }
+
+    /// Both duties 0 (coast).
+    #[inline(always)]
+    fn set_duties_zero(&mut self) {
+        self.axes[0].duty = 0.0;
+        self.axes[1].duty = 0.0;
     }
 
     #[inline(never)]
     fn closed_loop_step(&mut self, dt: f32, seen: &[bool; 2]) {
-        let stopped = [self.est[0].is_stopped(), self.est[1].is_stopped()];
+        let [p, s] = &self.axes;
+        let stopped = [p.est.is_stopped(), s.est.is_stopped()];
+        let max_step = [p.max_step, s.max_step];
         let r0 = self.planner.ramped()[0];
         // Precession established: measured at half its reference or more, or (sparse pulses:
         // N = 1 needs two pulse periods for a first measurement) its ramp done for a second.
         let established = !self.planner.spin_released()
             && r0 != 0.0
-            && ((self.est[0].is_valid() && self.measured[0].abs() >= 0.5 * r0.abs())
+            && ((p.est.is_valid() && p.measured.abs() >= 0.5 * r0.abs())
                 || self.planner.steady_s()[0] > 1.0);
-        let ramped = self.planner.step(dt, self.max_step, stopped, established);
+        let ramped = self.planner.step(dt, max_step, stopped, established);
         // Spin first: its model's acceleration feeds the precession axis's decoupling.
         if self.axis_loop(1, ramped[1], 0.0, seen[1], dt) {
             return;
@@ -268,8 +269,9 @@ impl Controller {
         // With J2 a2 = tau2 k2 a2 dr_p/dt / R2 and the same motor type on both axes, the
         // precession duty that cancels it is cos(angle) * (r - r_p) * duty_per_rad_s of the spin
         // model.
+        let s = &self.axes[1];
         let decouple =
-            self.cos_axes * (ramped[1] - self.loops[1].model_rad_s()) * self.k[1].duty_per_rad_s();
+            self.cos_axes * (ramped[1] - s.speed_loop.model_rad_s()) * s.k.duty_per_rad_s();
         if self.axis_loop(0, ramped[0], decouple, seen[0], dt) {
             return;
         }
@@ -283,7 +285,8 @@ impl Controller {
             _ => {
                 let reached = (0..2).all(|i| {
                     ramped[i] == target[i]
-                        && (self.measured[i] - ramped[i]).abs() <= 0.05 * ramped[i].abs() + 0.05
+                        && (self.axes[i].measured - ramped[i]).abs()
+                            <= 0.05 * ramped[i].abs() + 0.05
                 });
                 self.state = if reached {
                     State::Running
@@ -297,30 +300,31 @@ impl Controller {
     /// One axis's loop and sensor watch; true if it latched a fault.
     #[inline(always)]
     fn axis_loop(&mut self, i: usize, r: f32, extra_duty: f32, seen: bool, dt: f32) -> bool {
+        let a = &mut self.axes[i];
         if r > 0.0 {
-            self.direction[i] = 1.0;
+            a.direction = 1.0;
         } else if r < 0.0 {
-            self.direction[i] = -1.0;
+            a.direction = -1.0;
         }
         let input = LoopInput {
             reference_rad_s: r,
-            measured_rad_s: self.measured[i],
-            direction: self.direction[i],
-            measurement_valid: self.est[i].is_valid(),
-            events: self.est[i].window_events(),
+            measured_rad_s: a.measured,
+            direction: a.direction,
+            measurement_valid: a.est.is_valid(),
+            events: a.est.window_events(),
             feedback: self.feedback,
             extra_duty,
         };
-        let duty = self.loops[i].step(&self.k[i], input);
-        self.duties[i] = duty;
-        if self.watch[i].step(
+        let duty = a.speed_loop.step(&a.k, input);
+        a.duty = duty;
+        if a.watch.step(
             dt,
             duty.abs(),
             self.cfg.stall_duty,
             seen,
             self.cfg.sensor_timeout_floor_s,
-            self.loops[i].model_rad_s(),
-            self.est[i].rad_per_pulse(),
+            a.speed_loop.model_rad_s(),
+            a.est.rad_per_pulse(),
         ) {
             self.latch(Fault::SensorLostOrStall(i as u8));
             return true;
@@ -335,11 +339,11 @@ impl Controller {
             return;
         };
         let axis = c.progress().0;
-        let clock = self.est[axis].clock_ticks();
+        let clock = self.axes[axis].est.clock_ticks();
         match c.step(
             dt,
             clock,
-            self.est[0].is_stopped() && self.est[1].is_stopped(),
+            self.axes[0].est.is_stopped() && self.axes[1].est.is_stopped(),
         ) {
             Err(e) => {
                 self.identify_error = Some(e);
@@ -347,7 +351,8 @@ impl Controller {
                 self.latch(Fault::InvalidConfiguration);
             }
             Ok(duties) => {
-                self.duties = duties;
+                self.axes[0].duty = duties[0];
+                self.axes[1].duty = duties[1];
                 if c.progress().1 == Phase::Done {
                     let results = c.results();
                     self.commissioning = None;
@@ -373,14 +378,15 @@ impl Controller {
                 // Blocked shaft or dead sensor during identification: the expected period is
                 // unknown, so allow 3 periods at the lowest speed.
                 for (i, &seen_i) in seen.iter().enumerate() {
-                    if self.watch[i].step(
+                    let a = &mut self.axes[i];
+                    if a.watch.step(
                         dt,
-                        self.duties[i].abs(),
+                        a.duty.abs(),
                         self.cfg.stall_duty,
                         seen_i,
                         self.cfg.sensor_timeout_floor_s,
                         self.cfg.axes[i].min_speed_rad_s,
-                        self.est[i].rad_per_pulse(),
+                        a.est.rad_per_pulse(),
                     ) {
                         self.latch(Fault::SensorLostOrStall(i as u8));
                         return;
@@ -393,11 +399,12 @@ impl Controller {
     /// Replaces the configuration, keeping the estimators' clocks.
     #[inline(never)]
     fn rebuild_keep_state(&mut self, cfg: ControllerConfig) {
-        let est = self.est;
+        let est = [self.axes[0].est, self.axes[1].est];
         let identified = self.identified;
         let feedback = self.feedback;
         *self = Self::build(cfg);
-        self.est = est;
+        self.axes[0].est = est[0];
+        self.axes[1].est = est[1];
         self.identified = identified;
         self.feedback = feedback;
     }
@@ -409,208 +416,12 @@ impl Controller {
             self.fault = Some(fault);
         }
         self.state = State::Fault;
-        self.duties = [0.0; 2];
-        self.loops = [SpeedLoop::REST; 2];
-        self.watch = [SensorWatch::CLEAR; 2];
+        for a in &mut self.axes {
+            a.duty = 0.0;
+            a.rest_loop();
+        }
         self.planner.reset();
         self.commissioning = None;
-    }
-
-    const fn check_speed(&self, axis: usize, w: f32) -> Result<(), Rejection> {
-        if !w.is_finite() {
-            return Err(Rejection::NotFinite);
-        }
-        let a = &self.cfg.axes[axis];
-        let m = w.abs();
-        if m > a.max_speed_rad_s {
-            return Err(Rejection::AboveMaxSpeed(axis as u8));
-        }
-        if m != 0.0 && m < a.min_speed_rad_s {
-            return Err(Rejection::BelowMinSpeed(axis as u8));
-        }
-        Ok(())
-    }
-
-    const fn latched(&self) -> Fault {
-        match self.fault {
-            Some(f) => f,
-            None => Fault::InvalidConfiguration,
-        }
-    }
-
-    const fn check_state_for_setpoint(&self) -> Result<(), Rejection> {
-        match self.state {
-            State::Fault => Err(Rejection::Faulted(self.latched())),
-            State::Commissioning | State::Stopping => Err(Rejection::WrongState(self.state)),
-            _ => Ok(()),
-        }
-    }
-
-    /// Sets both motor speeds, rad/s (signed; sign = direction). Zero, or a magnitude within
-    /// `[min_speed_rad_s, max_speed_rad_s]` of the axis. Allowed in Idle (taken at `start`),
-    /// SpinningUp and Running; the planner ramps to it.
-    pub const fn set_motor_speeds(
-        &mut self,
-        precession_rad_s: f32,
-        spin_rad_s: f32,
-    ) -> Result<(), Rejection> {
-        self.host_silence_s = 0.0;
-        if let Err(e) = self.check_state_for_setpoint() {
-            return Err(e);
-        }
-        if let Err(e) = self.check_speed(0, precession_rad_s) {
-            return Err(e);
-        }
-        if let Err(e) = self.check_speed(1, spin_rad_s) {
-            return Err(e);
-        }
-        self.planner.set_targets([precession_rad_s, spin_rad_s]);
-        Ok(())
-    }
-
-    /// Sets the motor speeds from a target residence time, s: the particle model's inverse
-    /// gives the combined bowl speed, Eq. 2 splits it at `spin_per_precession`, and the result
-    /// must pass the same checks as [`Controller::set_motor_speeds`]. Returns the speeds set.
-    pub fn set_target_residence_time(
-        &mut self,
-        target_s: f32,
-        model: &dyn BowlSpeedForResidence,
-    ) -> Result<[f32; 2], Rejection> {
-        self.host_silence_s = 0.0;
-        self.check_state_for_setpoint()?;
-        if !in_range(target_s, 1e-6, 1e6) {
-            return Err(Rejection::InvalidResidenceTime);
-        }
-        let omega = model.omega_rad_s(target_s).map_err(Rejection::Inverse)?;
-        let speeds = split_combined(
-            omega,
-            self.cos_axes,
-            self.sin_axes,
-            self.cfg.spin_per_precession,
-        )
-        .ok_or(Rejection::SplitFailed)?;
-        self.check_speed(0, speeds[0])?;
-        self.check_speed(1, speeds[1])?;
-        self.planner.set_targets(speeds);
-        Ok(speeds)
-    }
-
-    /// Starts the closed loop (Idle -> SpinningUp) toward the current targets.
-    pub const fn start(&mut self) -> Result<(), Rejection> {
-        self.host_silence_s = 0.0;
-        match self.state {
-            State::Idle => {
-                self.loops = [SpeedLoop::REST; 2];
-                self.watch = [SensorWatch::CLEAR; 2];
-                self.state = State::SpinningUp;
-                Ok(())
-            }
-            State::Fault => Err(Rejection::Faulted(self.latched())),
-            s => Err(Rejection::WrongState(s)),
-        }
-    }
-
-    /// Stops: ramps both axes to zero (Stopping, then Idle once both read zero). Aborts
-    /// commissioning at once (zero duty). In Idle or Fault it does nothing and succeeds.
-    pub fn stop(&mut self) -> Result<(), Rejection> {
-        self.host_silence_s = 0.0;
-        match self.state {
-            State::SpinningUp | State::Running => {
-                self.planner.set_targets([0.0; 2]);
-                self.state = State::Stopping;
-            }
-            State::Commissioning => {
-                self.commissioning = None;
-                self.duties = [0.0; 2];
-                self.state = State::Idle;
-            }
-            State::Idle | State::Stopping | State::Fault => {}
-        }
-        Ok(())
-    }
-
-    /// Clears a latched fault (Fault -> Idle, targets zero). Refused while the configuration
-    /// is invalid.
-    pub fn clear_fault(&mut self) -> Result<(), Rejection> {
-        self.host_silence_s = 0.0;
-        if self.state != State::Fault {
-            return Err(Rejection::NotFaulted);
-        }
-        if let Some(e) = self.config_error {
-            return Err(Rejection::InvalidConfig(e));
-        }
-        self.fault = None;
-        self.state = State::Idle;
-        self.planner.reset();
-        Ok(())
-    }
-
-    /// Replaces all parameters (Idle or Fault only). A valid configuration also lifts the
-    /// block on clearing an invalid-configuration fault (the fault stays latched until cleared).
-    pub fn set_parameters(&mut self, cfg: ControllerConfig) -> Result<(), Rejection> {
-        self.host_silence_s = 0.0;
-        if !matches!(self.state, State::Idle | State::Fault) {
-            return Err(Rejection::WrongState(self.state));
-        }
-        cfg.validate().map_err(Rejection::InvalidConfig)?;
-        let (state, fault) = (self.state, self.fault);
-        self.rebuild_keep_state(cfg);
-        self.state = state;
-        self.fault = fault;
-        Ok(())
-    }
-
-    /// Changes one axis's loop bandwidth and per-pulse bandwidth while running (bumpless: the
-    /// integral absorbs the proportional change). Refused during commissioning.
-    pub fn set_loop_tuning(
-        &mut self,
-        axis: usize,
-        bandwidth_rad_s: f32,
-        per_pulse_bandwidth: f32,
-    ) -> Result<(), Rejection> {
-        self.host_silence_s = 0.0;
-        if self.state == State::Commissioning {
-            return Err(Rejection::WrongState(self.state));
-        }
-        if axis > 1
-            || !in_range(bandwidth_rad_s, 0.01, 1000.0)
-            || !in_range(per_pulse_bandwidth, 0.01, 10.0)
-        {
-            return Err(Rejection::InvalidTuning);
-        }
-        let mut a = self.cfg.axes[axis];
-        a.bandwidth_rad_s = bandwidth_rad_s;
-        a.per_pulse_bandwidth = per_pulse_bandwidth;
-        self.cfg.axes[axis] = a;
-        self.k[axis] = LoopConstants::new(&a, self.dt_s, self.cfg.supply_v);
-        Ok(())
-    }
-
-    /// Starts the identification routine (Idle only); at the end the identified models
-    /// replace the configured ones and the state returns to Idle, or an implausible result
-    /// latches [`Fault::InvalidConfiguration`].
-    pub fn start_commissioning(&mut self) -> Result<(), Rejection> {
-        self.host_silence_s = 0.0;
-        match self.state {
-            State::Idle => {
-                self.commissioning = Some(Commissioning::new(
-                    self.cfg.commissioning,
-                    self.cfg.supply_v,
-                    self.cfg.timer_hz as f32,
-                ));
-                self.identify_error = None;
-                self.watch = [SensorWatch::CLEAR; 2];
-                self.state = State::Commissioning;
-                Ok(())
-            }
-            State::Fault => Err(Rejection::Faulted(self.latched())),
-            s => Err(Rejection::WrongState(s)),
-        }
-    }
-
-    /// Resets the host-silence timer (any command does too).
-    pub fn host_heartbeat(&mut self) {
-        self.host_silence_s = 0.0;
     }
 
     /// Feedback on or off (diagnostics and the test that shows the feedforward alone is not
@@ -637,7 +448,7 @@ impl Controller {
     /// The speed loop's gains on `axis` at its full bandwidth (the schedule lowers both in
     /// proportion at sparse pulses): `(kp, ki)` in duty per rad/s and duty per rad.
     pub fn loop_gains(&self, axis: usize) -> Option<(f32, f32)> {
-        let k = self.k.get(axis)?;
+        let k = &self.axes.get(axis)?.k;
         let wc = self.cfg.axes.get(axis)?.bandwidth_rad_s;
         Some((k.kp(wc), k.ki_per_s(wc)))
     }
@@ -657,16 +468,16 @@ impl Controller {
         let targets = self.planner.targets();
         let ramped = self.planner.ramped();
         let mut axes = [AxisStatus::default(); 2];
-        for (i, a) in axes.iter_mut().enumerate() {
-            *a = AxisStatus {
+        for (i, (out, a)) in axes.iter_mut().zip(&self.axes).enumerate() {
+            *out = AxisStatus {
                 target_rad_s: targets[i],
                 reference_rad_s: ramped[i],
-                measured_rad_s: self.measured[i],
-                duty: self.duties[i],
-                pulses: self.est[i].accepted_edges(),
-                rejected_edges: self.est[i].rejected_edges(),
-                inferred_missing: self.est[i].inferred_missing(),
-                measurement_valid: self.est[i].is_valid(),
+                measured_rad_s: a.measured,
+                duty: a.duty,
+                pulses: a.est.accepted_edges(),
+                rejected_edges: a.est.rejected_edges(),
+                inferred_missing: a.est.inferred_missing(),
+                measurement_valid: a.est.is_valid(),
             };
         }
         let combined = |w: [f32; 2]| {
@@ -686,7 +497,7 @@ impl Controller {
             fault_code: fault_code(self.fault),
             axes,
             combined_target_rad_s: combined(targets),
-            combined_measured_rad_s: combined(self.measured),
+            combined_measured_rad_s: combined([self.axes[0].measured, self.axes[1].measured]),
         }
     }
 

@@ -2,8 +2,8 @@
 //! speeds through the particle model's inverse and paper Eq. 2; then ramps.
 //!
 //! The residence-time inverse is behind [`BowlSpeedForResidence`] so the controller does not
-//! depend on which particle model (flat Eq. 6/7 or Coriolis Eq. 10/11, with the MODEL-NOTES
-//! corrections) or which scene (bowl radius, start radius, resistance coefficient) is in use:
+//! depend on which particle model (flat Eq. 6/7 or Coriolis Eq. 10/11, with the corrections of
+//! docs/model.md) or which scene (bowl radius, start radius, resistance coefficient) is in use:
 //! the caller passes the model in with the command.
 
 use crate::bowl::split_from_trig;

@@ -2,7 +2,7 @@
 //! finds lines in a byte stream, resynchronises after garbage and keeps the statistics.
 
 use super::crc::crc32;
-use super::types::{
+use super::{
     AxisModel, Command, DeviceState, FaultCode, Frame, Hello, Injection, MODEL_FIELD_MAX,
     MotorTelemetry, PARAM_COUNT, ParamId, ParamValues, Reason, ResetCause, Residence,
     ResidenceModel, Status, Telemetry,

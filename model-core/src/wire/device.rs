@@ -4,9 +4,9 @@
 
 use super::decode::{Decoder, FrameError};
 use super::encode::{EncodeError, encode};
+use super::params::{PARAM_COUNT, ParamId, ParamValues};
 use super::types::{
-    AxisModel, Command, Frame, Hello, Injection, PARAM_COUNT, ParamId, ParamValues, Reason,
-    ResidenceModel, Status, Telemetry,
+    AxisModel, Command, Frame, Hello, Injection, Reason, ResidenceModel, Status, Telemetry,
 };
 use super::{MAX_FRAME_LEN, max_telemetry_hz};
 
@@ -62,7 +62,7 @@ pub struct Device {
 }
 
 /// The default telemetry rate, frames per second.
-pub const DEFAULT_TELEMETRY_HZ: u8 = 50;
+pub const DEFAULT_TELEMETRY_HZ: u8 = ParamId::TelemetryHz.default_value() as u8;
 
 impl Default for Device {
     fn default() -> Self {

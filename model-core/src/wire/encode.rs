@@ -1,7 +1,7 @@
 //! The encoder: a [`Frame`] to its text line `$K1,field,...*CRC32\n`, into a caller's buffer.
 
 use super::crc::crc32;
-use super::types::{
+use super::{
     AxisModel, Command, DUTY_MAX_BP, Frame, MODEL_FIELD_MAX, MotorTelemetry, PARAM_COUNT, ParamId,
     RESIDENCE_MAX_MS, Residence, Telemetry,
 };

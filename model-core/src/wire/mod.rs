@@ -12,6 +12,7 @@
 //! [`MAX_TELEMETRY_LEN`] bytes: 50 frames/s use 48 % of a 115 200 baud link.
 //!
 //! - [`types`]: the plain data (telemetry, commands, answers);
+//! - [`params`]: the settable parameters, one table (token, unit, range, default);
 //! - [`encode()`] and [`decode`]: the codec and the streaming [`Decoder`];
 //! - [`device`]: the rig's side (command dispatch, telemetry pacing) over the [`device::Backend`] trait.
 
@@ -19,10 +20,12 @@ pub mod crc;
 pub mod decode;
 pub mod device;
 pub mod encode;
+pub mod params;
 pub mod types;
 
 pub use decode::{DecodeStats, Decoder, FrameError, decode_frame, parse_command_line, parse_line};
 pub use encode::{EncodeError, encode};
+pub use params::*;
 pub use types::*;
 
 /// The protocol version in every frame header (`$T1`): one decimal digit.

@@ -2,7 +2,10 @@
 //!
 //! Every number is a scaled integer with its unit in its name (`_mrad_s` = milliradians per
 //! second, `_ms` = milliseconds, `_bp` = basis points, 1/10 000). Each enum has a fixed numeric or
-//! token form, listed in `docs/protocol.md`.
+//! token form, listed in `docs/protocol.md`. The settable parameters are one table of their
+//! own: [`super::params`].
+
+use super::params::{ParamId, ParamValues};
 
 /// Pulse-count, sequence-number and request-id fields wrap modulo 2^16.
 pub type Wrapping16 = u16;
@@ -175,144 +178,6 @@ pub enum Injection {
     StallPrecession,
     /// The spin motor is blocked. Token `STALL2`.
     StallSpin,
-}
-
-/// The settable parameters, each with a token, a unit and a wire range (inclusive).
-///
-/// Every range stays below 2^23 steps, so a value survives the controller's f32 configuration
-/// exactly (relative f32 rounding 2^-24 is then under half a step): what PARAMS reports back is
-/// what SET sent, never a silently rounded neighbour.
-/// The rig may reject a value inside the wire range that conflicts with another parameter
-/// (for instance a start radius beyond the rim) with [`Reason::Range`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum ParamId {
-    /// Bowl rim radius R, micrometres.
-    RimUm,
-    /// Particle start radius ri, micrometres.
-    StartUm,
-    /// Effective rolling-resistance coefficient mu, parts per million.
-    MuPpm,
-    /// Inertia factor k2 = m rp^2 / (I + m rp^2), parts per million (solid sphere 714 286).
-    K2Ppm,
-    /// Angle between the spin and precession axes (paper Eq. 2), millidegrees.
-    AxesMdeg,
-    /// Precession speed-loop bandwidth (the PI gains follow from it and the motor model), mrad/s.
-    Bandwidth1MradS,
-    /// Spin speed-loop bandwidth, mrad/s.
-    Bandwidth2MradS,
-    /// Precession loop bandwidth per pulse rate (caps the bandwidth at low speed), 1/1000.
-    PerPulse1Milli,
-    /// Spin loop bandwidth per pulse rate, 1/1000.
-    PerPulse2Milli,
-    /// Precession speed limit (setpoints above it are rejected), mrad/s.
-    SpeedMax1MradS,
-    /// Spin speed limit, mrad/s.
-    SpeedMax2MradS,
-    /// Precession setpoint ramp rate, mrad/s^2.
-    Accel1MradS2,
-    /// Spin setpoint ramp rate, mrad/s^2.
-    Accel2MradS2,
-    /// Precession PWM duty limit, basis points.
-    DutyMax1Bp,
-    /// Spin PWM duty limit, basis points.
-    DutyMax2Bp,
-    /// Target-wheel teeth (pulses per revolution) on the precession sensor.
-    Teeth1,
-    /// Target-wheel teeth on the spin sensor.
-    Teeth2,
-    /// Spin speed per precession speed used to split a combined bowl speed (Eq. 2), ppm.
-    RatioPpm,
-    /// Telemetry rate, frames per second, 0 = off (50 fills under half of 115 200 baud).
-    TelemetryHz,
-}
-
-/// Number of parameters; a PARAMS answer carries this many values in [`ParamId::ALL`] order.
-pub const PARAM_COUNT: usize = 19;
-
-/// The values of all parameters, indexed by [`ParamId::index`].
-pub type ParamValues = [i32; PARAM_COUNT];
-
-impl ParamId {
-    /// Every parameter, in wire order.
-    pub const ALL: [ParamId; PARAM_COUNT] = [
-        ParamId::RimUm,
-        ParamId::StartUm,
-        ParamId::MuPpm,
-        ParamId::K2Ppm,
-        ParamId::AxesMdeg,
-        ParamId::Bandwidth1MradS,
-        ParamId::Bandwidth2MradS,
-        ParamId::PerPulse1Milli,
-        ParamId::PerPulse2Milli,
-        ParamId::SpeedMax1MradS,
-        ParamId::SpeedMax2MradS,
-        ParamId::Accel1MradS2,
-        ParamId::Accel2MradS2,
-        ParamId::DutyMax1Bp,
-        ParamId::DutyMax2Bp,
-        ParamId::Teeth1,
-        ParamId::Teeth2,
-        ParamId::RatioPpm,
-        ParamId::TelemetryHz,
-    ];
-
-    /// Position in [`ParamId::ALL`] and in a PARAMS answer.
-    pub fn index(self) -> usize {
-        self as usize
-    }
-
-    /// The token used in `SET` commands.
-    pub fn token(self) -> &'static str {
-        match self {
-            ParamId::RimUm => "RIM_UM",
-            ParamId::StartUm => "START_UM",
-            ParamId::MuPpm => "MU_PPM",
-            ParamId::K2Ppm => "K2_PPM",
-            ParamId::AxesMdeg => "AXES_MDEG",
-            ParamId::Bandwidth1MradS => "BW1_MRAD_S",
-            ParamId::Bandwidth2MradS => "BW2_MRAD_S",
-            ParamId::PerPulse1Milli => "PER_PULSE1_MILLI",
-            ParamId::PerPulse2Milli => "PER_PULSE2_MILLI",
-            ParamId::SpeedMax1MradS => "SPEED_MAX1_MRAD_S",
-            ParamId::SpeedMax2MradS => "SPEED_MAX2_MRAD_S",
-            ParamId::Accel1MradS2 => "ACCEL1_MRAD_S2",
-            ParamId::Accel2MradS2 => "ACCEL2_MRAD_S2",
-            ParamId::DutyMax1Bp => "DUTY_MAX1_BP",
-            ParamId::DutyMax2Bp => "DUTY_MAX2_BP",
-            ParamId::Teeth1 => "TEETH1",
-            ParamId::Teeth2 => "TEETH2",
-            ParamId::RatioPpm => "RATIO_PPM",
-            ParamId::TelemetryHz => "TELEM_HZ",
-        }
-    }
-
-    /// The wire range (inclusive); values outside it are rejected with [`Reason::Range`].
-    pub fn range(self) -> (i32, i32) {
-        match self {
-            ParamId::RimUm => (10_000, 1_000_000),
-            ParamId::StartUm => (0, 1_000_000),
-            ParamId::MuPpm => (0, 1_000_000),
-            ParamId::K2Ppm => (1, 1_000_000),
-            ParamId::AxesMdeg => (0, 179_999),
-            ParamId::Bandwidth1MradS | ParamId::Bandwidth2MradS => (10, 1_000_000),
-            ParamId::PerPulse1Milli | ParamId::PerPulse2Milli => (10, 10_000),
-            ParamId::SpeedMax1MradS | ParamId::SpeedMax2MradS => (0, i16::MAX as i32),
-            ParamId::Accel1MradS2 | ParamId::Accel2MradS2 => (1, 1_000_000),
-            ParamId::DutyMax1Bp | ParamId::DutyMax2Bp => (0, DUTY_MAX_BP as i32),
-            ParamId::Teeth1 | ParamId::Teeth2 => (1, 255),
-            ParamId::RatioPpm => (1_000, 8_000_000),
-            ParamId::TelemetryHz => (0, 50),
-        }
-    }
-
-    /// The parameter with this token.
-    pub fn from_token(token: &[u8]) -> Option<ParamId> {
-        ParamId::ALL
-            .iter()
-            .copied()
-            .find(|p| p.token().as_bytes() == token)
-    }
 }
 
 /// A command from the PC.

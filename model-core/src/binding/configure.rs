@@ -1,0 +1,236 @@
+//! Wire parameters to the controller's configuration and the particle scene.
+//!
+//! Each parameter's row in [`crate::wire::params`] gives its token, unit, range and default;
+//! [`ParamRole::of`] says what it configures:
+//! - `RIM_UM`, `START_UM`, `MU_PPM`, `K2_PPM`: the particle scene ([`scene_from_params`]) for
+//!   `RTIME` and the predicted residence times (paper Eq. 6/7 flat, Eq. 10/11 with the
+//!   corrected coefficients of docs/model.md) at the controller's combined bowl speed (paper
+//!   Eq. 2);
+//! - `AXES_MDEG`: `axes_angle_rad` (paper Eq. 2); `RATIO_PPM`: `spin_per_precession`;
+//! - per axis n: `BWn_MRAD_S` `bandwidth_rad_s`, `PER_PULSEn_MILLI` `per_pulse_bandwidth`
+//!   (both changeable while running, bumpless), `SPEED_MAXn_MRAD_S` `max_speed_rad_s` (the
+//!   over-speed fault limit follows at [`OVERSPEED_PER_MAX`] times it), `ACCELn_MRAD_S2`
+//!   `accel_limit_rad_s2`, `DUTY_MAXn_BP` `duty_limit`, `TEETHn` `pulses_per_rev` (these only
+//!   while idle or faulted);
+//! - `TELEM_HZ`: the protocol device's telemetry rate (the device owns it).
+
+use super::AXES;
+use crate::Real;
+use crate::control::{AxisConfig, ControllerConfig, MotorModel};
+use crate::particle::Scene;
+use crate::wire::{ParamId, ParamValues, Reason};
+
+/// Over-speed fault limit as a multiple of `SPEED_MAX` (the nominal 5.5 / 4.0 rad/s).
+pub const OVERSPEED_PER_MAX: f32 = 1.375;
+
+/// The parameter values a new board starts with (wire units, wire order): the table's
+/// defaults.
+pub fn default_params() -> ParamValues {
+    ParamId::defaults()
+}
+
+/// One setting of a motor axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AxisSetting {
+    /// `bandwidth_rad_s`, from mrad/s.
+    Bandwidth,
+    /// `per_pulse_bandwidth`, from 1/1000.
+    PerPulseBandwidth,
+    /// `max_speed_rad_s` (and the over-speed limit), from mrad/s.
+    MaxSpeed,
+    /// `accel_limit_rad_s2`, from mrad/s^2.
+    AccelLimit,
+    /// `duty_limit`, from basis points.
+    DutyLimit,
+    /// `pulses_per_rev`, from teeth.
+    PulsesPerRev,
+}
+
+/// What a parameter configures, and so when it may change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ParamRole {
+    /// The particle scene: feeds RTIME and the predictions only, so any time.
+    Scene,
+    /// The angle between the axes (paper Eq. 2): rebuilds the controller (idle or faulted).
+    AxesAngle,
+    /// The spin per precession split ratio: rebuilds the controller (idle or faulted).
+    SplitRatio,
+    /// A motor axis's setting: loop tuning changes while running (bumpless), the rest
+    /// rebuilds the controller (idle or faulted).
+    Axis(usize, AxisSetting),
+    /// The telemetry rate: the protocol device's, never the controller's.
+    TelemetryRate,
+}
+
+impl ParamRole {
+    /// The role of `id`. A new parameter needs its line here (the match is exhaustive).
+    pub const fn of(id: ParamId) -> Self {
+        use AxisSetting as S;
+        use ParamId as P;
+        match id {
+            P::RimUm | P::StartUm | P::MuPpm | P::K2Ppm => ParamRole::Scene,
+            P::AxesMdeg => ParamRole::AxesAngle,
+            P::RatioPpm => ParamRole::SplitRatio,
+            P::Bandwidth1MradS => ParamRole::Axis(0, S::Bandwidth),
+            P::Bandwidth2MradS => ParamRole::Axis(1, S::Bandwidth),
+            P::PerPulse1Milli => ParamRole::Axis(0, S::PerPulseBandwidth),
+            P::PerPulse2Milli => ParamRole::Axis(1, S::PerPulseBandwidth),
+            P::SpeedMax1MradS => ParamRole::Axis(0, S::MaxSpeed),
+            P::SpeedMax2MradS => ParamRole::Axis(1, S::MaxSpeed),
+            P::Accel1MradS2 => ParamRole::Axis(0, S::AccelLimit),
+            P::Accel2MradS2 => ParamRole::Axis(1, S::AccelLimit),
+            P::DutyMax1Bp => ParamRole::Axis(0, S::DutyLimit),
+            P::DutyMax2Bp => ParamRole::Axis(1, S::DutyLimit),
+            P::Teeth1 => ParamRole::Axis(0, S::PulsesPerRev),
+            P::Teeth2 => ParamRole::Axis(1, S::PulsesPerRev),
+            P::TelemetryHz => ParamRole::TelemetryRate,
+        }
+    }
+}
+
+/// The particle scene of a set of wire parameters (`omega_rad_s` 0: the bowl speed is the
+/// controller's), or [`Reason::Range`] if the scene is invalid or the start radius is not
+/// inside the rim. Gravity is the particle model's default scene's. The one mapping from wire
+/// parameters to a scene: the rig's predictions and the host's re-checks both use it.
+pub fn scene_from_params<R: Real>(params: &ParamValues) -> Result<Scene<R>, Reason> {
+    let p = |id: ParamId| R::from_f64(f64::from(params[id.index()]));
+    let micro = R::from_f64(1e-6);
+    let scene = Scene {
+        omega_rad_s: R::ZERO,
+        mu: p(ParamId::MuPpm) * micro,
+        g_m_s2: Scene::<R>::default().g_m_s2,
+        k2: p(ParamId::K2Ppm) * micro,
+        ri_m: p(ParamId::StartUm) * micro,
+        rim_radius_m: p(ParamId::RimUm) * micro,
+    };
+    if scene.validate_except_omega().is_err() || scene.ri_m >= scene.rim_radius_m {
+        return Err(Reason::Range);
+    }
+    Ok(scene)
+}
+
+fn apply_axis(a: &mut AxisConfig, setting: AxisSetting, value: i32) -> Result<(), Reason> {
+    let x = value as f32;
+    match setting {
+        AxisSetting::Bandwidth => a.bandwidth_rad_s = x * 1e-3,
+        AxisSetting::PerPulseBandwidth => a.per_pulse_bandwidth = x * 1e-3,
+        AxisSetting::MaxSpeed => {
+            a.max_speed_rad_s = x * 1e-3;
+            a.overspeed_rad_s = a.max_speed_rad_s * OVERSPEED_PER_MAX;
+        }
+        AxisSetting::AccelLimit => a.accel_limit_rad_s2 = x * 1e-3,
+        AxisSetting::DutyLimit => a.duty_limit = x * 1e-4,
+        AxisSetting::PulsesPerRev => {
+            a.pulses_per_rev = u16::try_from(value).map_err(|_| Reason::Range)?
+        }
+    }
+    Ok(())
+}
+
+/// The controller configuration for a set of wire parameters: `base` supplies what the wire
+/// does not carry (tick rate, timer, supervisor limits, motor models), or why they do not fit.
+pub fn config_from_params(
+    base: &ControllerConfig,
+    params: &ParamValues,
+) -> Result<ControllerConfig, Reason> {
+    let mut cfg = *base;
+    for id in ParamId::ALL {
+        let value = params[id.index()];
+        match ParamRole::of(id) {
+            ParamRole::Scene | ParamRole::TelemetryRate => {}
+            ParamRole::AxesAngle => cfg.axes_angle_rad = (value as f32 * 1e-3).to_radians(),
+            ParamRole::SplitRatio => cfg.spin_per_precession = value as f32 * 1e-6,
+            ParamRole::Axis(axis, setting) => {
+                let a = cfg.axes.get_mut(axis).ok_or(Reason::Internal)?;
+                apply_axis(a, setting, value)?;
+            }
+        }
+    }
+    cfg.validate().map_err(|_| Reason::Range)?;
+    Ok(cfg)
+}
+
+/// `base` with these motor models.
+pub(crate) fn with_models(
+    base: &ControllerConfig,
+    models: &[MotorModel; AXES],
+) -> ControllerConfig {
+    let mut cfg = *base;
+    for (a, m) in cfg.axes.iter_mut().zip(models) {
+        a.model = *m;
+    }
+    cfg
+}
+
+/// Controller configuration and scene for a set of wire parameters, or why they do not fit.
+pub(crate) fn derive(
+    base: &ControllerConfig,
+    params: &ParamValues,
+) -> Result<(ControllerConfig, Scene<f32>), Reason> {
+    let scene = scene_from_params(params)?;
+    Ok((config_from_params(base, params)?, scene))
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+
+    use super::*;
+    use crate::wire::device::DEFAULT_TELEMETRY_HZ;
+
+    /// The table's defaults are the controller's nominal configuration and the particle
+    /// model's default scene in wire units (computed here from those, independently).
+    #[test]
+    fn table_defaults_are_the_nominal_configuration_and_default_scene() {
+        let cfg = ControllerConfig::nominal();
+        let scene = Scene::<f32>::default();
+        let milli = |x: f32| libm::roundf(x * 1000.0) as i32;
+        let micro = |x: f32| libm::roundf(x * 1e6) as i32;
+        let (a, b) = (&cfg.axes[0], &cfg.axes[1]);
+        let expected = [
+            micro(scene.rim_radius_m),
+            micro(scene.ri_m),
+            micro(scene.mu),
+            micro(scene.k2),
+            milli(cfg.axes_angle_rad.to_degrees()),
+            milli(a.bandwidth_rad_s),
+            milli(b.bandwidth_rad_s),
+            milli(a.per_pulse_bandwidth),
+            milli(b.per_pulse_bandwidth),
+            milli(a.max_speed_rad_s),
+            milli(b.max_speed_rad_s),
+            milli(a.accel_limit_rad_s2),
+            milli(b.accel_limit_rad_s2),
+            libm::roundf(a.duty_limit * 10_000.0) as i32,
+            libm::roundf(b.duty_limit * 10_000.0) as i32,
+            i32::from(a.pulses_per_rev),
+            i32::from(b.pulses_per_rev),
+            micro(cfg.spin_per_precession),
+            i32::from(DEFAULT_TELEMETRY_HZ),
+        ];
+        assert_eq!(default_params(), expected);
+        let derived = config_from_params(&cfg, &default_params()).expect("defaults pass");
+        assert_eq!(derived.axes[0].overspeed_rad_s, cfg.axes[0].overspeed_rad_s);
+        assert_eq!(derived.axes[1].pulses_per_rev, cfg.axes[1].pulses_per_rev);
+    }
+
+    /// One scene mapping for f32 (the rig) and f64 (the host's re-check): the same scene to
+    /// f32 precision, gravity the default scene's.
+    #[test]
+    fn scene_from_params_agrees_in_f32_and_f64_and_refuses_a_start_beyond_the_rim() {
+        let mut p = default_params();
+        let s32: Scene<f32> = scene_from_params(&p).unwrap();
+        let s64: Scene<f64> = scene_from_params(&p).unwrap();
+        assert_eq!(s64.g_m_s2, 9.81);
+        assert_eq!(s32.g_m_s2, 9.81f32);
+        assert!((f64::from(s32.mu) - s64.mu).abs() <= 1e-7 * s64.mu);
+        assert!((s64.rim_radius_m - 0.1).abs() < 1e-15);
+        assert!((s64.ri_m - 0.05).abs() < 1e-15);
+        assert!((s64.k2 - 0.714_286).abs() < 1e-15);
+        p[ParamId::StartUm.index()] = p[ParamId::RimUm.index()];
+        assert_eq!(scene_from_params::<f64>(&p), Err(Reason::Range));
+        p[ParamId::StartUm.index()] = 0;
+        p[ParamId::K2Ppm.index()] = 0;
+        assert_eq!(scene_from_params::<f32>(&p), Err(Reason::Range));
+    }
+}

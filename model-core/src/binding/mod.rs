@@ -1,0 +1,46 @@
+//! The one binding of the controller ([`crate::control`]) and the particle model
+//! ([`crate::particle`]) to the serial protocol's device interface
+//! ([`crate::wire::device::Backend`]). No heap, no hardware: the Black Pill firmware, the
+//! emulated board under QEMU and the host's virtual rig all run this code; each supplies only
+//! what is its own (the motors and sensors or a simulated plant, and an [`Injector`] for INJECT).
+//!
+//! - [`configure`]: wire parameters (the table in [`crate::wire::params`]) to the controller's
+//!   configuration and the particle scene, and when each may change;
+//! - [`record`]: the layout of the record persisted in flash (parameters and motor models);
+//! - [`backend`]: [`ControllerBackend`], the controller and the scene behind the protocol.
+//!
+//! The parameters in force are kept in wire units (what SET sent is what PARAMS reports,
+//! exactly), and the controller's configuration is derived from them. A value the scene check
+//! or the controller's validation refuses is rejected with `RANGE` (or `STATE` when the
+//! controller is busy) and changes nothing.
+
+pub mod backend;
+pub mod configure;
+pub mod record;
+
+pub use backend::ControllerBackend;
+pub use configure::{
+    OVERSPEED_PER_MAX, ParamRole, config_from_params, default_params, scene_from_params,
+};
+pub use record::{PERSISTED_COUNT, Persisted, default_persisted, persisted, split_persisted};
+
+use crate::wire::{Injection, Reason};
+
+/// Motor axes: precession (0) and spin (1).
+pub const AXES: usize = 2;
+
+/// Where fault injections go: the emulated board's plant, or nowhere on real hardware.
+pub trait Injector {
+    /// Applies `what` or says why not.
+    fn inject(&mut self, what: Injection) -> Result<(), Reason>;
+}
+
+/// Real hardware: nothing can be injected.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoInjection;
+
+impl Injector for NoInjection {
+    fn inject(&mut self, _what: Injection) -> Result<(), Reason> {
+        Err(Reason::Unsupported)
+    }
+}

@@ -1,0 +1,50 @@
+//! One motor axis's runtime state inside the controller.
+
+use crate::control::config::{AxisConfig, ControllerConfig};
+use crate::control::estimator::PulseSpeedEstimator;
+use crate::control::pi::{LoopConstants, SpeedLoop};
+use crate::control::supervisor::SensorWatch;
+
+/// What the controller keeps per axis between ticks: the speed estimator, the loop and its
+/// constants, the sensor watch, and the last outputs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct AxisState {
+    /// Speed from the edge timestamps.
+    pub(super) est: PulseSpeedEstimator,
+    /// The loop's constants for this axis's motor model and bandwidth.
+    pub(super) k: LoopConstants,
+    /// Feedforward + PI state.
+    pub(super) speed_loop: SpeedLoop,
+    /// Stall / lost-sensor detection.
+    pub(super) watch: SensorWatch,
+    /// Largest setpoint change per tick (the acceleration limit times the tick), rad/s.
+    pub(super) max_step: f32,
+    /// Duty applied, -1..=1.
+    pub(super) duty: f32,
+    /// Measured speed with the commanded sign, rad/s.
+    pub(super) measured: f32,
+    /// The commanded direction (+1 or -1): one sensor per shaft cannot tell.
+    pub(super) direction: f32,
+}
+
+impl AxisState {
+    /// At rest, for axis configuration `a` of `cfg`, ticking every `dt_s`.
+    pub(super) const fn new(cfg: &ControllerConfig, a: &AxisConfig, dt_s: f32) -> Self {
+        Self {
+            est: PulseSpeedEstimator::new(cfg, a),
+            k: LoopConstants::new(a, dt_s, cfg.supply_v),
+            speed_loop: SpeedLoop::REST,
+            watch: SensorWatch::CLEAR,
+            max_step: a.accel_limit_rad_s2 * dt_s,
+            duty: 0.0,
+            measured: 0.0,
+            direction: 1.0,
+        }
+    }
+
+    /// Loop and sensor watch back to rest (a fresh start).
+    pub(super) const fn rest_loop(&mut self) {
+        self.speed_loop = SpeedLoop::REST;
+        self.watch = SensorWatch::CLEAR;
+    }
+}
