@@ -6,9 +6,10 @@
 //! (`firmware/tests/`) and the benchmark runner (`tests/qemu-run`, through the `bowl-emulator`
 //! command) all start emulators through this crate.
 //!
-//! One module per emulator: [`qemu`] runs the `qemu-*` images on QEMU's netduinoplus2. A second
-//! emulator (the exact Black Pill image) gets its own module and its own [`Emulator`] variant.
+//! One module per emulator: [`qemu`] runs the `qemu-*` images on QEMU's netduinoplus2;
+//! [`blackpill`] runs the exact Black Pill image on an emulated STM32F411.
 
+pub mod blackpill;
 pub mod board;
 pub mod image;
 pub mod plant_log;
@@ -22,4 +23,6 @@ pub enum Emulator {
     /// QEMU netduinoplus2 (an STM32F405: the F411's Cortex-M4F and memory map, more of both),
     /// running the firmware's `qemu-*` images ([`qemu`]).
     Qemu,
+    /// The exact Black Pill image on an emulated STM32F411 (qiling, [`blackpill`]).
+    Blackpill,
 }

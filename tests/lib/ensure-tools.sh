@@ -37,3 +37,28 @@ ensure_qemu() {
   rm -f "$list"
   return $status
 }
+
+# The emulated Black Pill (tests/blackpill): a venv under target/ with the pinned qiling and
+# unicorn (tests/blackpill/requirements.txt), and defmt-print to decode the image's logs.
+# Sets BLACKPILL_PYTHON and DEFMT_PRINT for the caller.
+ensure_blackpill_emulator() {
+  local venv=target/venv-blackpill
+  local req=tests/blackpill/requirements.txt
+  if ! [ -x "$venv/bin/python" ] || ! cmp -s "$req" "$venv/requirements.txt"; then
+    echo "== installing the Black Pill emulator (qiling, pinned unicorn) into $venv"
+    python3 -m venv "$venv" &&
+      "$venv/bin/pip" install --quiet --disable-pip-version-check -r "$req" &&
+      cp "$req" "$venv/requirements.txt" || return 1
+  fi
+  BLACKPILL_PYTHON=$venv/bin/python
+  if command -v defmt-print >/dev/null; then
+    DEFMT_PRINT=$(command -v defmt-print)
+  else
+    if ! [ -x target/defmt-tools/bin/defmt-print ]; then
+      echo "== installing defmt-print"
+      cargo install defmt-print --locked --quiet --root target/defmt-tools || return 1
+    fi
+    DEFMT_PRINT=$PWD/target/defmt-tools/bin/defmt-print
+  fi
+  export BLACKPILL_PYTHON DEFMT_PRINT
+}

@@ -4,6 +4,7 @@
 //!   bowl-emulator build qemu-rig
 //!   bowl-emulator run --profile instruction-count ELF            (what tests/qemu-run does)
 //!   bowl-emulator run --image qemu-rig --serial pty -- -append seconds=30
+//!   bowl-emulator run --emulator blackpill --timeout-s 60       (the Black Pill image, USART2 on a pty)
 
 use std::path::PathBuf;
 use std::process::{ExitCode, Stdio};
@@ -11,7 +12,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use bowl_emulator::qemu::{self, Profile, Serial};
-use bowl_emulator::{Emulator, image};
+use bowl_emulator::{Emulator, blackpill, image};
 use clap::{Parser, Subcommand, ValueEnum};
 
 /// Builds the firmware's emulator images and runs them on an emulator.
@@ -35,8 +36,8 @@ enum Cmd {
 
 #[derive(clap::Args)]
 struct RunArgs {
-    /// The ELF to run.
-    #[arg(required_unless_present = "image", conflicts_with = "image")]
+    /// The ELF to run (QEMU; the Black Pill emulator always runs the board image it builds).
+    #[arg(conflicts_with = "image")]
     elf: Option<PathBuf>,
     /// Build this firmware emulator image first and run it (e.g. qemu-rig).
     #[arg(long)]
@@ -82,16 +83,17 @@ fn run(cli: Cli) -> Result<ExitCode> {
             println!("{}", image::build(&image)?.display());
             Ok(ExitCode::SUCCESS)
         }
-        Cmd::Run(args) => {
-            let elf = match (&args.elf, &args.image) {
-                (Some(elf), _) => elf.clone(),
-                (None, Some(image)) => image::build(image)?,
-                (None, None) => bail!("name an ELF or an --image to build"),
-            };
-            match args.emulator {
-                Emulator::Qemu => run_qemu(&elf, &args),
+        Cmd::Run(args) => match args.emulator {
+            Emulator::Qemu => {
+                let elf = match (&args.elf, &args.image) {
+                    (Some(elf), _) => elf.clone(),
+                    (None, Some(image)) => image::build(image)?,
+                    (None, None) => bail!("name an ELF or an --image to build"),
+                };
+                run_qemu(&elf, &args)
             }
-        }
+            Emulator::Blackpill => run_blackpill(&args),
+        },
     }
 }
 
@@ -130,4 +132,24 @@ fn run_qemu(elf: &std::path::Path, args: &RunArgs) -> Result<ExitCode> {
         }
         std::thread::sleep(Duration::from_millis(20));
     }
+}
+
+fn run_blackpill(args: &RunArgs) -> Result<ExitCode> {
+    if args.elf.is_some() || args.image.is_some() {
+        bail!(
+            "the Black Pill emulator runs the board image it builds itself \
+             (target/thumbv7em-none-eabihf/release/firmware): drop the ELF / --image"
+        );
+    }
+    let seconds = if args.timeout_s > 0 {
+        args.timeout_s as f64
+    } else {
+        3600.0
+    };
+    let mut board = blackpill::PtyBoard::boot(seconds)?;
+    println!("pty: {}", board.port);
+    let status = board.wait()?;
+    Ok(ExitCode::from(
+        u8::try_from(status.code().unwrap_or(1)).unwrap_or(1),
+    ))
 }

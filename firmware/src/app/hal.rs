@@ -9,6 +9,12 @@ pub trait MotorOutput {
     fn set_duty(&mut self, duty: f32);
     /// PWM compare to 0 at once: the bridge input goes low (coast on a PWM/DIR bridge).
     fn off(&mut self);
+    /// A fault: the output stage itself is disabled (on the STM32 the timer's main output
+    /// enable), not only the compare value, so no later compare write can drive the bridge
+    /// until a non-zero duty is set again after the fault is cleared.
+    fn disable(&mut self) {
+        self.off();
+    }
 }
 
 /// The free-running timer the edge timestamps come from.
@@ -23,16 +29,21 @@ pub trait Watchdog {
     fn feed(&mut self);
 }
 
-/// One erasable flash region reserved for parameter records.
+/// A flash region reserved for parameter records: `SECTORS` sectors of `SECTOR_SIZE` bytes,
+/// each erased on its own.
 pub trait FlashRegion {
-    /// Size of the region in bytes (a multiple of 4).
-    const SIZE: u32;
+    /// Bytes per erasable sector (a multiple of 4).
+    const SECTOR_SIZE: u32;
+    /// Sectors in the region (at least 2, so one always holds the last record while the other
+    /// is erased).
+    const SECTORS: u32;
     /// Reads `buf.len()` bytes at `offset`.
     fn read(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError>;
     /// Programs `data` (a multiple of 4 bytes, into erased words) at `offset` (4-aligned).
     fn write(&mut self, offset: u32, data: &[u8]) -> Result<(), FlashError>;
-    /// Erases the whole region (all bytes 0xFF). Slow: the caller keeps the motors off.
-    fn erase(&mut self) -> Result<(), FlashError>;
+    /// Erases sector `sector` (0-based; all its bytes 0xFF). Slow: the caller keeps the motors
+    /// off.
+    fn erase(&mut self, sector: u32) -> Result<(), FlashError>;
 }
 
 /// A flash operation that failed.

@@ -49,6 +49,14 @@ impl<M: MotorOutput> Motors<M> {
         self.duties = [0.0; AXES];
     }
 
+    /// A fault: both output stages disabled (see [`MotorOutput::disable`]).
+    pub fn fault_stop(&mut self) {
+        for out in &mut self.outputs {
+            out.disable();
+        }
+        self.duties = [0.0; AXES];
+    }
+
     /// The duties last applied.
     pub fn duties(&self) -> [f32; AXES] {
         self.duties

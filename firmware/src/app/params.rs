@@ -1,11 +1,14 @@
-//! Parameters persisted in flash: append-only records with a version and a CRC-32.
+//! Parameters persisted in flash: append-only records with a sequence number, a version and a
+//! CRC-32.
 //!
-//! The region (one flash sector on the STM32) is a row of fixed-size slots. Saving programs the
-//! next erased slot; only when every slot is used is the region erased (motors must be off: the
-//! CPU stalls during a sector erase). Loading takes the valid record with the highest sequence
-//! number. A record cut short by a reset fails its CRC and is skipped; the next save goes after
-//! it. A record of another layout version is never read as this one: defaults are used and
-//! the caller reports why.
+//! The region is two (or more) erasable sectors, each a row of fixed-size slots; the slots of
+//! all sectors form one ring. Saving programs the slot after the newest record. A sector is
+//! erased only to write into it, and never the sector holding the newest record, so at every
+//! moment of a save (power may fail at any program or erase step) the last complete record is
+//! still in flash: a torn record or a half-erased sector fails its CRC and is skipped. Loading
+//! takes the valid record with the highest sequence number. A record of another layout version
+//! is never read as this one: defaults are used and the caller reports why. Erasing stalls the
+//! CPU (1 to 4 s for a 128 KiB sector): call [`ParamLog::save`] with the motors off.
 //!
 //! Slot layout (little-endian words): magic `BOWL`, version (u16) + value count (u16),
 //! sequence (u32), reserved (u32, 0), `MAX_VALUES` values (i32, unused ones 0), CRC-32 (IEEE)
@@ -59,16 +62,17 @@ pub struct ParamLog<F: FlashRegion> {
 }
 
 struct Scan {
-    /// Offset of the first never-written slot, if any.
+    /// The first slot (ring index) never written, if any.
     first_free: Option<u32>,
-    /// The newest slot that passed its CRC: (sequence, offset).
+    /// The newest slot that passed its CRC: (sequence, ring index).
     newest: Option<(u32, u32)>,
     /// Slots written but failing the check.
     corrupt: u32,
 }
 
 impl<F: FlashRegion> ParamLog<F> {
-    const SLOTS: u32 = F::SIZE / SLOT_BYTES as u32;
+    const SLOTS_PER_SECTOR: u32 = F::SECTOR_SIZE / SLOT_BYTES as u32;
+    const SLOTS: u32 = Self::SLOTS_PER_SECTOR * F::SECTORS;
 
     /// Wraps a flash region.
     pub fn new(flash: F) -> Self {
@@ -80,10 +84,25 @@ impl<F: FlashRegion> ParamLog<F> {
         self.flash
     }
 
-    fn read_slot(&mut self, offset: u32) -> Result<[u8; SLOT_BYTES], FlashError> {
-        let mut slot = [0u8; SLOT_BYTES];
-        self.flash.read(offset, &mut slot)?;
-        Ok(slot)
+    // A region too small for one slot has no slots; these then give offset 0, whose read
+    // fails with `OutOfBounds` (never a division by zero).
+    fn sector_of(slot: u32) -> u32 {
+        slot.checked_div(Self::SLOTS_PER_SECTOR).unwrap_or(0)
+    }
+
+    fn offset_of(slot: u32) -> u32 {
+        Self::sector_of(slot) * F::SECTOR_SIZE
+            + slot.checked_rem(Self::SLOTS_PER_SECTOR).unwrap_or(0) * SLOT_BYTES as u32
+    }
+
+    fn read_slot(&mut self, slot: u32) -> Result<[u8; SLOT_BYTES], FlashError> {
+        let mut bytes = [0u8; SLOT_BYTES];
+        self.flash.read(Self::offset_of(slot), &mut bytes)?;
+        Ok(bytes)
+    }
+
+    fn is_blank(&mut self, slot: u32) -> Result<bool, FlashError> {
+        Ok(self.read_slot(slot)?.iter().all(|&b| b == 0xFF))
     }
 
     // One copy, shared by load and save (inlined into both it would cost flash).
@@ -95,38 +114,66 @@ impl<F: FlashRegion> ParamLog<F> {
             corrupt: 0,
         };
         for i in 0..Self::SLOTS {
-            let offset = i * SLOT_BYTES as u32;
-            let slot = self.read_slot(offset)?;
-            if slot.iter().all(|&b| b == 0xFF) {
-                scan.first_free = Some(offset);
-                break; // slots are used in order: nothing was written after a free one
+            // The first word tells an unwritten slot (programs start there) and a foreign one
+            // without reading the whole slot; `next_slot` checks a slot in full before use.
+            let mut head = [0u8; 4];
+            self.flash.read(Self::offset_of(i), &mut head)?;
+            let head = u32::from_le_bytes(head);
+            if head == ERASED_WORD {
+                scan.first_free.get_or_insert(i);
+                continue;
             }
+            if head != MAGIC {
+                scan.corrupt += 1;
+                continue;
+            }
+            let slot = self.read_slot(i)?;
             let (body, crc) = slot.split_at(SLOT_BYTES - 4);
-            if word(&slot, 0) != MAGIC
-                || u32::from_le_bytes(crc.try_into().unwrap_or([0; 4])) != crc32(body)
-            {
+            if u32::from_le_bytes(crc.try_into().unwrap_or([0; 4])) != crc32(body) {
                 scan.corrupt += 1;
                 continue;
             }
             let seq = word(&slot, 8);
             if scan.newest.is_none_or(|(s, _)| seq >= s) {
-                scan.newest = Some((seq, offset));
+                scan.newest = Some((seq, i));
             }
         }
         Ok(scan)
     }
 
+    /// Where the next record goes, and which sector to erase first (if any): the slot after
+    /// the newest record (or the first unwritten one) if it is blank; else the start of its
+    /// sector, erased, unless that sector holds the newest record, in which case the start of
+    /// the following sector, erased. Never the sector of the newest record.
+    fn next_slot(&mut self, scan: &Scan) -> Result<(u32, Option<u32>), FlashError> {
+        let candidate = match scan.newest {
+            Some((_, newest)) => (newest + 1).checked_rem(Self::SLOTS).unwrap_or(0),
+            None => scan.first_free.unwrap_or(0),
+        };
+        if self.is_blank(candidate)? {
+            return Ok((candidate, None));
+        }
+        let sector = Self::sector_of(candidate);
+        let erase = if scan.newest.map(|(_, n)| Self::sector_of(n)) == Some(sector) {
+            // Dirty after the newest record (a torn write or erase) in the same sector.
+            (sector + 1).checked_rem(F::SECTORS).unwrap_or(0)
+        } else {
+            sector
+        };
+        Ok((erase * Self::SLOTS_PER_SECTOR, Some(erase)))
+    }
+
     /// The values of the newest valid record, if it has this version and `N` values.
     pub fn load<const N: usize>(&mut self) -> Result<[i32; N], LoadError> {
         let scan = self.scan().map_err(LoadError::Flash)?;
-        let Some((_, offset)) = scan.newest else {
+        let Some((_, newest)) = scan.newest else {
             return Err(if scan.corrupt > 0 {
                 LoadError::Corrupt
             } else {
                 LoadError::Empty
             });
         };
-        let slot = self.read_slot(offset).map_err(LoadError::Flash)?;
+        let slot = self.read_slot(newest).map_err(LoadError::Flash)?;
         let header = word(&slot, 4);
         let version = header as u16;
         let count = (header >> 16) as u16;
@@ -144,7 +191,7 @@ impl<F: FlashRegion> ParamLog<F> {
     }
 
     /// Appends a record with `values` (nothing is written if they equal the newest record's).
-    /// Erases the region first when it is full: call only with the motors off.
+    /// May erase a sector first: call only with the motors off.
     pub fn save<const N: usize>(&mut self, values: &[i32; N]) -> Result<(), SaveError> {
         if N > MAX_VALUES {
             return Err(SaveError::TooManyValues);
@@ -154,13 +201,10 @@ impl<F: FlashRegion> ParamLog<F> {
         }
         let scan = self.scan().map_err(SaveError::Flash)?;
         let seq = scan.newest.map_or(0, |(s, _)| s.wrapping_add(1));
-        let offset = match scan.first_free {
-            Some(offset) => offset,
-            None => {
-                self.flash.erase().map_err(SaveError::Flash)?;
-                0
-            }
-        };
+        let (target, erase) = self.next_slot(&scan).map_err(SaveError::Flash)?;
+        if let Some(sector) = erase {
+            self.flash.erase(sector).map_err(SaveError::Flash)?;
+        }
         let mut slot = [0u8; SLOT_BYTES];
         put_word(&mut slot, 0, MAGIC);
         put_word(&mut slot, 4, u32::from(RECORD_VERSION) | ((N as u32) << 16));
@@ -170,8 +214,10 @@ impl<F: FlashRegion> ParamLog<F> {
         }
         let crc = crc32(&slot[..SLOT_BYTES - 4]);
         put_word(&mut slot, SLOT_BYTES - 4, crc);
-        self.flash.write(offset, &slot).map_err(SaveError::Flash)?;
-        if self.read_slot(offset).map_err(SaveError::Flash)? != slot {
+        self.flash
+            .write(Self::offset_of(target), &slot)
+            .map_err(SaveError::Flash)?;
+        if self.read_slot(target).map_err(SaveError::Flash)? != slot {
             return Err(SaveError::Verify);
         }
         Ok(())
@@ -234,14 +280,102 @@ mod tests {
     }
 
     #[test]
-    fn newest_record_wins_and_a_full_region_is_erased_once() {
-        let mut log = ParamLog::new(RamFlash::<{ 3 * SLOT_BYTES }>::new());
-        for k in 0..7 {
+    fn newest_record_wins_and_sectors_are_erased_in_turn() {
+        // Two sectors of 2 slots each.
+        let mut log = ParamLog::new(RamFlash::<{ 4 * SLOT_BYTES }>::new());
+        for k in 0..9 {
             log.save(&[k, k * 10]).unwrap();
             assert_eq!(log.load::<2>(), Ok([k, k * 10]));
         }
-        // 3 slots, 7 distinct saves: erased before the 4th and the 7th.
-        assert_eq!(log.into_inner().erases, 2);
+        // 9 distinct saves into a ring of 4 slots: a sector erased before the 5th, 7th and 9th.
+        assert_eq!(log.into_inner().erases, 3);
+    }
+
+    /// Flash whose every program or erase step can be the last before a power cut: the step
+    /// is left half done (a program lands only its first half, an erase clears only the first
+    /// half of the sector) and nothing after it happens.
+    struct CutFlash<const S: usize> {
+        flash: RamFlash<S>,
+        steps: u32,
+        cut_at: u32,
+    }
+
+    impl<const S: usize> CutFlash<S> {
+        fn step(&mut self) -> Result<bool, FlashError> {
+            self.steps += 1;
+            match self.steps.cmp(&self.cut_at) {
+                core::cmp::Ordering::Less => Ok(false),
+                core::cmp::Ordering::Equal => Ok(true),
+                core::cmp::Ordering::Greater => Err(FlashError::Hardware),
+            }
+        }
+    }
+
+    impl<const S: usize> FlashRegion for CutFlash<S> {
+        const SECTOR_SIZE: u32 = (S / 2) as u32;
+        const SECTORS: u32 = 2;
+        fn read(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
+            self.flash.read(offset, buf)
+        }
+        fn write(&mut self, offset: u32, data: &[u8]) -> Result<(), FlashError> {
+            for (k, chunk) in data.chunks(4).enumerate() {
+                let at = offset + 4 * k as u32;
+                if self.step()? {
+                    self.flash.write(at, &[chunk[0], chunk[1], 0xFF, 0xFF])?;
+                    return Err(FlashError::Hardware);
+                }
+                self.flash.write(at, chunk)?;
+            }
+            Ok(())
+        }
+        fn erase(&mut self, sector: u32) -> Result<(), FlashError> {
+            if self.step()? {
+                let half = S / 2;
+                let start = sector as usize * half;
+                self.flash.bytes[start..start + half / 2].fill(0xFF);
+                return Err(FlashError::Hardware);
+            }
+            self.flash.erase(sector)
+        }
+    }
+
+    #[test]
+    fn a_power_cut_at_any_step_of_any_save_keeps_the_last_complete_record() {
+        // Two sectors of 3 slots: saves 4 and 7 each begin with an erase.
+        const S: usize = 6 * SLOT_BYTES;
+        for saves in 1..9 {
+            // Flash after `saves - 1` complete saves, then every cut point of the next one.
+            let mut log = ParamLog::new(RamFlash::<S>::new());
+            for k in 0..saves - 1 {
+                log.save(&[k, -k]).unwrap();
+            }
+            let before = log.into_inner().bytes;
+            let k = saves - 1;
+            let steps = (SLOT_BYTES / 4) as u32 + 1;
+            for cut_at in 1..=steps {
+                let mut flash = RamFlash::<S>::new();
+                flash.bytes = before;
+                let mut log = ParamLog::new(CutFlash {
+                    flash,
+                    steps: 0,
+                    cut_at,
+                });
+                let _ = log.save(&[k, -k]);
+                let mut after = ParamLog::new(log.into_inner().flash);
+                let loaded = after.load::<2>();
+                // The first save has no earlier record to fall back on.
+                let fine = loaded == Ok([k, -k])
+                    || (k > 0 && loaded == Ok([k - 1, 1 - k]))
+                    || (k == 0 && loaded.is_err());
+                assert!(
+                    fine,
+                    "save {saves}, cut at step {cut_at}: loaded {loaded:?}"
+                );
+                // And the log goes on: the next save lands and loads.
+                after.save(&[100 + k, 0]).unwrap();
+                assert_eq!(after.load::<2>(), Ok([100 + k, 0]));
+            }
+        }
     }
 
     #[test]

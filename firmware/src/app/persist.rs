@@ -4,7 +4,7 @@
 //! how an event is logged.
 
 use embassy_sync::blocking_mutex::raw::RawMutex;
-use embassy_time::Duration;
+use embassy_time::{Duration, Instant};
 
 use super::binding::{DeviceCore, Injector, Persisted};
 use super::hal::FlashRegion;
@@ -14,6 +14,9 @@ use super::tasks::SharedCore;
 
 /// How often the loop looks for something to save or report.
 pub const PERSIST_PERIOD: Duration = Duration::from_millis(500);
+/// Shortest time between two saves: a host sending SET in a loop cannot wear the flash out
+/// (a sector takes 10 000 erases; a save erases at most one sector per several hundred).
+pub const MIN_SAVE_INTERVAL: Duration = Duration::from_secs(2);
 
 /// What the persistence loop needs from the core.
 pub trait PersistSource {
@@ -52,6 +55,8 @@ pub struct PersistReport {
 pub struct Persistence<'a, F: FlashRegion> {
     log: &'a mut ParamLog<F>,
     reported_lost: [u32; AXES],
+    /// No save before this time (rate limit).
+    next_save: Instant,
 }
 
 impl<'a, F: FlashRegion> Persistence<'a, F> {
@@ -60,6 +65,7 @@ impl<'a, F: FlashRegion> Persistence<'a, F> {
         Self {
             log,
             reported_lost: [0; AXES],
+            next_save: Instant::now(),
         }
     }
 
@@ -69,10 +75,21 @@ impl<'a, F: FlashRegion> Persistence<'a, F> {
         &mut self,
         core: &SharedCore<RM, C>,
     ) -> PersistReport {
+        // A change that comes within MIN_SAVE_INTERVAL of the last save stays pending (the
+        // core keeps it dirty) until the interval is over.
+        let may_save = Instant::now() >= self.next_save;
         let (record, lost) = core.lock(|c| {
             let mut c = c.borrow_mut();
-            (c.take_record_to_save(), c.dropped_edges())
+            let record = if may_save {
+                c.take_record_to_save()
+            } else {
+                None
+            };
+            (record, c.dropped_edges())
         });
+        if record.is_some() {
+            self.next_save = Instant::now() + MIN_SAVE_INTERVAL;
+        }
         let edges_lost = (lost != self.reported_lost).then_some(lost);
         self.reported_lost = lost;
         PersistReport {

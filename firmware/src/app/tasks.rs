@@ -7,10 +7,11 @@
 //!   edge timestamps into one [`EdgeQueue`] per axis;
 //! - control: a fixed-rate tick ([`CONTROL_HZ`]): drain edges, run the controller, set duties;
 //! - link: commands in, answers and telemetry out over the byte stream;
-//! - supervisor: feeds the watchdog only while the control tick keeps running.
+//! - supervisor: feeds the watchdog only while the control tick keeps running and meeting its
+//!   deadlines.
 
 use core::cell::RefCell;
-use core::sync::atomic::{AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use embassy_futures::select::{Either, select};
 use embassy_sync::blocking_mutex::Mutex;
@@ -58,8 +59,12 @@ pub trait TaskCore {
 /// computes the residence-time prediction).
 pub type SharedCore<M, C> = Mutex<M, RefCell<C>>;
 
-/// Counts control ticks: the supervisor feeds the watchdog only while this advances.
-pub struct Heartbeat(AtomicU32);
+/// Counts control ticks and remembers a missed deadline: the supervisor feeds the watchdog
+/// only while the count advances and no tick has missed its deadline since the last feed.
+pub struct Heartbeat {
+    ticks: AtomicU32,
+    missed: AtomicBool,
+}
 
 impl Default for Heartbeat {
     fn default() -> Self {
@@ -70,27 +75,42 @@ impl Default for Heartbeat {
 impl Heartbeat {
     /// A heartbeat at zero.
     pub const fn new() -> Self {
-        Self(AtomicU32::new(0))
+        Self {
+            ticks: AtomicU32::new(0),
+            missed: AtomicBool::new(false),
+        }
     }
     fn beat(&self) {
-        self.0.fetch_add(1, Ordering::Relaxed);
+        self.ticks.fetch_add(1, Ordering::Relaxed);
+    }
+    /// A control tick missed its deadline.
+    pub fn miss(&self) {
+        self.missed.store(true, Ordering::Relaxed);
+    }
+    /// Whether a tick missed its deadline since the last call (and forgets it).
+    pub fn take_missed(&self) -> bool {
+        self.missed.swap(false, Ordering::Relaxed)
     }
     /// Ticks so far, modulo 2^32.
     pub fn count(&self) -> u32 {
-        self.0.load(Ordering::Relaxed)
+        self.ticks.load(Ordering::Relaxed)
     }
 }
 
-/// The fixed-rate control loop, forever.
+/// The fixed-rate control loop, forever. A tick whose work ends more than `deadline` after
+/// the tick was due has missed its deadline (see [`Heartbeat`]).
 pub async fn control<RM: RawMutex, C: TaskCore, M: MotorOutput, K: CaptureClock>(
     core: &SharedCore<RM, C>,
     queues: &[EdgeQueue; AXES],
     clock: &K,
     motors: &mut Motors<M>,
     heartbeat: &Heartbeat,
+    deadline: Duration,
 ) -> ! {
     let mut buffers: [Vec<u32, EDGES_PER_TICK>; AXES] = [Vec::new(), Vec::new()];
-    let mut ticker = Ticker::every(Duration::from_hz(CONTROL_HZ));
+    let period = Duration::from_hz(CONTROL_HZ);
+    let mut ticker = Ticker::every(period);
+    let mut due = Instant::now() + period;
     loop {
         ticker.next().await;
         for (q, b) in queues.iter().zip(&mut buffers) {
@@ -106,10 +126,16 @@ pub async fn control<RM: RawMutex, C: TaskCore, M: MotorOutput, K: CaptureClock>
             (d, c.faulted())
         });
         if faulted {
-            motors.all_off();
+            motors.fault_stop();
         } else {
             motors.apply(duties);
         }
+        // A tick that starts late (the ticker catching up) counts from when it was due.
+        let done = Instant::now();
+        if done > due + deadline {
+            heartbeat.miss();
+        }
+        due += period;
         heartbeat.beat();
     }
 }
@@ -163,15 +189,17 @@ pub async fn link<RM: RawMutex, C: TaskCore, R: Read, W: Write>(
     }
 }
 
-/// Feeds the watchdog while the control tick runs; stops feeding (so the watchdog resets the
-/// MCU, and the bridge pull-downs hold the motors off) when it has not ticked for a period.
+/// Feeds the watchdog while the control tick runs and meets its deadlines; stops feeding (so
+/// the watchdog resets the MCU, and the bridge pull-downs hold the motors off) when it has not
+/// ticked for a period or a tick missed its deadline since the last feed.
 pub async fn supervisor<W: Watchdog>(mut watchdog: W, heartbeat: &Heartbeat) -> ! {
     let mut ticker = Ticker::every(SUPERVISOR_PERIOD);
     let mut last = heartbeat.count();
     loop {
         ticker.next().await;
         let now = heartbeat.count();
-        if now != last {
+        let missed = heartbeat.take_missed();
+        if now != last && !missed {
             watchdog.feed();
         }
         last = now;

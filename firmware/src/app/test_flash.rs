@@ -2,7 +2,8 @@
 
 use super::hal::{FlashError, FlashRegion};
 
-/// NOR flash in RAM: programming can only clear bits, erase sets them all.
+/// NOR flash in RAM, two sectors of `S / 2` bytes: programming can only clear bits, erase sets
+/// a sector's bits.
 pub(crate) struct RamFlash<const S: usize> {
     pub(crate) bytes: [u8; S],
     pub(crate) erases: u32,
@@ -21,7 +22,8 @@ impl<const S: usize> RamFlash<S> {
 }
 
 impl<const S: usize> FlashRegion for RamFlash<S> {
-    const SIZE: u32 = S as u32;
+    const SECTOR_SIZE: u32 = (S / 2) as u32;
+    const SECTORS: u32 = 2;
     fn read(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
         let o = offset as usize;
         let src = self
@@ -42,8 +44,13 @@ impl<const S: usize> FlashRegion for RamFlash<S> {
         }
         Ok(())
     }
-    fn erase(&mut self) -> Result<(), FlashError> {
-        self.bytes = [0xFF; S];
+    fn erase(&mut self, sector: u32) -> Result<(), FlashError> {
+        let half = S / 2;
+        let start = sector as usize * half;
+        self.bytes
+            .get_mut(start..start + half)
+            .ok_or(FlashError::OutOfBounds)?
+            .fill(0xFF);
         self.erases += 1;
         Ok(())
     }

@@ -18,6 +18,7 @@ use embassy_stm32::flash::Flash;
 use embassy_stm32::gpio::{Level, Output, Speed};
 use embassy_stm32::peripherals::{DMA1_CH5, DMA1_CH6, USART2};
 use embassy_stm32::time::Hertz;
+use embassy_stm32::timer::Channel;
 use embassy_stm32::timer::low_level::CountingMode;
 use embassy_stm32::timer::simple_pwm::{PwmPin, SimplePwm};
 use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
@@ -54,6 +55,9 @@ type Core = SharedCore<ThreadModeRawMutex, DeviceCore<NoInjection>>;
 
 /// Watchdog timeout: 25 control periods of slack over the supervisor's 20 ms feeding period.
 const WATCHDOG_TIMEOUT_US: u32 = 250_000;
+/// A control tick's work ends before the next tick is due (the motors are the only thing the
+/// executor serves at this rate); later, and the watchdog goes unfed for a period.
+const CONTROL_DEADLINE: Duration = Duration::from_hz(tasks::CONTROL_HZ);
 
 static CORE: Slot<Core> = Slot::new();
 static HEARTBEAT: Heartbeat = Heartbeat::new();
@@ -99,8 +103,16 @@ async fn main(spawner: Spawner) {
     );
     let ch = pwm.split();
     let mut motors = Motors::new([
-        PwmMotor::new(ch.ch1, Output::new(p.PB12, Level::Low, Speed::Low)),
-        PwmMotor::new(ch.ch2, Output::new(p.PB13, Level::Low, Speed::Low)),
+        PwmMotor::new(
+            ch.ch1,
+            Channel::Ch1,
+            Output::new(p.PB12, Level::Low, Speed::Low),
+        ),
+        PwmMotor::new(
+            ch.ch2,
+            Channel::Ch2,
+            Output::new(p.PB13, Level::Low, Speed::Low),
+        ),
     ]);
     motors.all_off();
     let capture = capture::start(p.TIM2, p.PA15, p.PB3);
@@ -184,7 +196,15 @@ async fn control_task(
     mut motors: Motors<PwmMotor>,
     _capture: capture::Capture,
 ) {
-    tasks::control(core, &capture::EDGES, &Tim2Clock, &mut motors, &HEARTBEAT).await
+    tasks::control(
+        core,
+        &capture::EDGES,
+        &Tim2Clock,
+        &mut motors,
+        &HEARTBEAT,
+        CONTROL_DEADLINE,
+    )
+    .await
 }
 
 #[embassy_executor::task]

@@ -38,13 +38,24 @@ static HEARTBEAT: Heartbeat = Heartbeat::new();
 
 /// Same slack as the Black Pill's IWDG.
 const WATCHDOG_TIMEOUT_US: u64 = 250_000;
+/// How late a control tick's work may end: the plant task shares this executor (the Black
+/// Pill's image has no plant), and a plant step can hold the CPU past the next tick.
+const CONTROL_DEADLINE: Duration = Duration::from_millis(20);
 /// Truth log period.
 const TRUTH_EVERY_MS: u32 = 500;
 
 #[embassy_executor::task]
 async fn control_task(core: &'static Core) {
     let mut motors = Motors::new([SimMotor(0), SimMotor(1)]);
-    tasks::control(core, &plant::EDGES, &PlantClock, &mut motors, &HEARTBEAT).await
+    tasks::control(
+        core,
+        &plant::EDGES,
+        &PlantClock,
+        &mut motors,
+        &HEARTBEAT,
+        CONTROL_DEADLINE,
+    )
+    .await
 }
 
 #[embassy_executor::task]

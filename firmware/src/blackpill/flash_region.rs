@@ -1,14 +1,15 @@
-//! Flash sector 7 of the STM32F411CE (0x0806_0000, 128 KiB) as the parameter region.
-//! The image (under 64 KiB) never reaches it; docs/wiring.md notes the reservation.
+//! Flash sectors 6 and 7 of the STM32F411CE (0x0804_0000..0x0808_0000, 128 KiB each) as the
+//! parameter region. `memory.x` ends the image's flash before sector 6, so code never lands
+//! there; docs/wiring.md notes the reservation.
 
 use embassy_stm32::flash::{Blocking, Flash};
 
 use crate::app::hal::{FlashError, FlashRegion};
 
-/// Offset of sector 7 from the start of flash.
-const SECTOR7_OFFSET: u32 = 0x6_0000;
+/// Offset of sector 6 from the start of flash.
+const REGION_OFFSET: u32 = 0x4_0000;
 
-/// The parameter sector.
+/// The parameter sectors.
 pub struct ParamSector {
     flash: Flash<'static, Blocking>,
 }
@@ -22,7 +23,7 @@ impl ParamSector {
 
 fn check(offset: u32, len: usize) -> Result<(), FlashError> {
     let end = offset as u64 + len as u64;
-    if end > u64::from(ParamSector::SIZE) {
+    if end > u64::from(ParamSector::SECTOR_SIZE * ParamSector::SECTORS) {
         Err(FlashError::OutOfBounds)
     } else {
         Ok(())
@@ -30,30 +31,35 @@ fn check(offset: u32, len: usize) -> Result<(), FlashError> {
 }
 
 impl FlashRegion for ParamSector {
-    const SIZE: u32 = 0x2_0000;
+    const SECTOR_SIZE: u32 = 0x2_0000;
+    const SECTORS: u32 = 2;
 
     fn read(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
         check(offset, buf.len())?;
         self.flash
-            .blocking_read(SECTOR7_OFFSET + offset, buf)
+            .blocking_read(REGION_OFFSET + offset, buf)
             .map_err(|_| FlashError::Hardware)
     }
 
     fn write(&mut self, offset: u32, data: &[u8]) -> Result<(), FlashError> {
         check(offset, data.len())?;
         self.flash
-            .blocking_write(SECTOR7_OFFSET + offset, data)
+            .blocking_write(REGION_OFFSET + offset, data)
             .map_err(|_| FlashError::Hardware)
     }
 
-    fn erase(&mut self) -> Result<(), FlashError> {
+    fn erase(&mut self, sector: u32) -> Result<(), FlashError> {
+        if sector >= Self::SECTORS {
+            return Err(FlashError::OutOfBounds);
+        }
+        let start = REGION_OFFSET + sector * Self::SECTOR_SIZE;
         // A 128 KiB sector erase takes 1 to 4 s (RM0383: t_ERASE128KB), with the CPU stalled
         // on flash reads. The watchdog (250 ms) would reset the MCU half way: stretch it to its
         // maximum for the erase, then put it back. Only called with the motors off.
         let saved = stretch_watchdog();
         let result = self
             .flash
-            .blocking_erase(SECTOR7_OFFSET, SECTOR7_OFFSET + Self::SIZE)
+            .blocking_erase(start, start + Self::SECTOR_SIZE)
             .map_err(|_| FlashError::Hardware);
         restore_watchdog(saved);
         result

@@ -5,6 +5,7 @@
 
 use embassy_stm32::gpio::{Level, Output};
 use embassy_stm32::peripherals::TIM1;
+use embassy_stm32::timer::Channel;
 use embassy_stm32::timer::simple_pwm::SimplePwmChannel;
 
 use crate::app::hal::MotorOutput;
@@ -15,15 +16,37 @@ pub const PWM_HZ: u32 = 20_000;
 /// One motor: a TIM1 channel and its direction pin.
 pub struct PwmMotor {
     channel: SimplePwmChannel<'static, TIM1>,
+    /// The channel's index on TIM1 (0 = CH1).
+    index: usize,
     direction: Output<'static>,
 }
 
 impl PwmMotor {
-    /// Takes an enabled PWM channel (compare 0) and a direction pin (low = forward).
-    pub fn new(mut channel: SimplePwmChannel<'static, TIM1>, direction: Output<'static>) -> Self {
+    /// Takes an enabled PWM channel (compare 0), its TIM1 channel (`Channel::Ch1` or `Ch2`)
+    /// and a direction pin (low = forward).
+    pub fn new(
+        mut channel: SimplePwmChannel<'static, TIM1>,
+        which: Channel,
+        direction: Output<'static>,
+    ) -> Self {
         channel.set_duty_cycle_fully_off();
         channel.enable();
-        Self { channel, direction }
+        Self {
+            channel,
+            index: which.index(),
+            direction,
+        }
+    }
+
+    /// Compare 0 now, not at the next update event: with compare preload on (embassy's PWM
+    /// sets OCxPE) a compare write waits for the end of the period, so the old duty would
+    /// still drive the bridge after the direction pin has changed.
+    fn compare_zero_now(&mut self) {
+        let tim1 = embassy_stm32::pac::TIM1;
+        let (reg, slot) = (self.index / 2, self.index % 2);
+        tim1.ccmr_output(reg).modify(|w| w.set_ocpe(slot, false));
+        self.channel.set_duty_cycle_fully_off();
+        tim1.ccmr_output(reg).modify(|w| w.set_ocpe(slot, true));
     }
 }
 
@@ -37,9 +60,15 @@ impl MotorOutput for PwmMotor {
         let reverse = duty < 0.0;
         let level = if reverse { Level::High } else { Level::Low };
         if self.direction.get_output_level() != level {
-            // Never drive the old direction with the new duty: off, turn, then drive.
-            self.channel.set_duty_cycle_fully_off();
+            // Never drive the new direction with the old duty: off at once, turn, then drive
+            // (the new compare takes effect at the next update event).
+            self.compare_zero_now();
             self.direction.set_level(level);
+        }
+        // After a fault the main output stays off until the controller drives again.
+        let tim1 = embassy_stm32::pac::TIM1;
+        if !tim1.bdtr().read().moe() {
+            tim1.bdtr().modify(|w| w.set_moe(true));
         }
         let max = self.channel.max_duty_cycle();
         // |duty| <= 1, so the product fits; rounding to the nearest compare step.
@@ -49,6 +78,12 @@ impl MotorOutput for PwmMotor {
 
     fn off(&mut self) {
         self.channel.set_duty_cycle_fully_off();
+    }
+
+    fn disable(&mut self) {
+        // TIM1's main output enable serves both channels: a fault stops both motors, which
+        // is what the supervisor asks for anyway.
+        emergency_off();
     }
 }
 

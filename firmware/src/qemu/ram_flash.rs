@@ -40,7 +40,8 @@ fn span(offset: u32, len: usize) -> Result<core::ops::Range<usize>, FlashError> 
 }
 
 impl FlashRegion for RamFlash {
-    const SIZE: u32 = SIZE as u32;
+    const SECTOR_SIZE: u32 = (SIZE / 2) as u32;
+    const SECTORS: u32 = 2;
 
     fn read(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), FlashError> {
         let r = span(offset, buf.len())?;
@@ -59,8 +60,9 @@ impl FlashRegion for RamFlash {
         Ok(())
     }
 
-    fn erase(&mut self) -> Result<(), FlashError> {
-        self.bytes().fill(0xFF);
+    fn erase(&mut self, sector: u32) -> Result<(), FlashError> {
+        let r = span(sector * Self::SECTOR_SIZE, Self::SECTOR_SIZE as usize)?;
+        self.bytes()[r].fill(0xFF);
         Ok(())
     }
 }

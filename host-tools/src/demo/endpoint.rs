@@ -7,14 +7,16 @@
 //! - [`RigChoice::Qemu`]: the firmware's emulated-board image (`qemu-rig`: the firmware's tasks and
 //!   controller binding on an emulated Cortex-M4F with the plant in place of the motors), its
 //!   USART1 on a pseudo-terminal. Needs `qemu-system-arm` and the thumb target.
+//! - [`RigChoice::Blackpill`]: the exact Black Pill image on the emulated STM32F411
+//!   (tests/blackpill, [`bowl_emulator::blackpill`]), USART2 on a pseudo-terminal.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::JoinHandle;
 
 use anyhow::{Context, Result, bail};
-use bowl_emulator::image;
 use bowl_emulator::qemu::{self, Profile, PtyBoard};
+use bowl_emulator::{blackpill, image};
 
 use crate::serve::{Backlog, LineNoise, Pacing, Pty, ServeStats, serve_on_pty};
 use crate::virtual_rig::VirtualRig;
@@ -28,6 +30,8 @@ pub enum RigChoice {
     Host,
     /// The firmware image on the emulated board (fails if it cannot be built or started).
     Qemu,
+    /// The Black Pill image (`cargo fw`) on the emulated STM32F411 against the project's plant.
+    Blackpill,
 }
 
 /// Device milliseconds per wall millisecond of the host rig in `--fast` mode. High enough that
@@ -41,7 +45,7 @@ pub struct Endpoint {
     pub port: String,
     /// One line saying which rig this is.
     pub description: String,
-    /// Short name for the summary: `host` or `qemu`.
+    /// Short name for the summary: `host`, `qemu` or `blackpill`.
     pub kind: &'static str,
     /// Why the emulated board is not used, when it is not.
     pub qemu_note: Option<String>,
@@ -54,6 +58,7 @@ enum Running {
         thread: Option<JoinHandle<Result<ServeStats>>>,
     },
     Qemu(PtyBoard),
+    Blackpill(blackpill::PtyBoard),
 }
 
 /// What the endpoint reported when it was shut down.
@@ -71,10 +76,20 @@ impl Endpoint {
         match choice {
             RigChoice::Host => start_host(fast, seed, None),
             RigChoice::Qemu => start_qemu(fast, seconds),
+            RigChoice::Blackpill => start_blackpill(seconds),
             RigChoice::Auto => match start_qemu(fast, seconds) {
                 Ok(e) => Ok(e),
                 Err(why) => start_host(fast, seed, Some(format!("{why:#}"))),
             },
+        }
+    }
+
+    /// Fault injection into the emulated world, for a rig whose firmware refuses `INJECT`
+    /// (the Black Pill image): each call sends `inject WHAT` to the emulator.
+    pub fn injector(&mut self) -> Option<impl FnMut(&str) -> Result<()> + '_> {
+        match &mut self.running {
+            Running::Blackpill(board) => Some(move |what: &str| board.inject(what)),
+            _ => None,
         }
     }
 
@@ -94,6 +109,10 @@ impl Endpoint {
                 })
             }
             Running::Qemu(board) => Ok(Shutdown {
+                host: None,
+                console: board.stop(),
+            }),
+            Running::Blackpill(board) => Ok(Shutdown {
                 host: None,
                 console: board.stop(),
             }),
@@ -174,5 +193,22 @@ fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
         kind: "qemu",
         qemu_note: None,
         running: Running::Qemu(board),
+    })
+}
+
+fn start_blackpill(seconds: f64) -> Result<Endpoint> {
+    // The board ends its run by itself a little after the session (a safety net: we stop it).
+    let board = blackpill::PtyBoard::boot(seconds * 1.5 + 60.0)?;
+    Ok(Endpoint {
+        description: format!(
+            "emulated Black Pill: image {} on an emulated STM32F411 (tests/blackpill), USART2 on \
+             {}; defmt log in target/test-logs/blackpill-defmt.log",
+            blackpill::image_path().display(),
+            board.port
+        ),
+        port: board.port.clone(),
+        kind: "blackpill",
+        qemu_note: None,
+        running: Running::Blackpill(board),
     })
 }

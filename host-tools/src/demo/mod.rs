@@ -77,9 +77,13 @@ pub fn run(args: &Args) -> Result<()> {
         }
     };
     let timing = script::Timing::for_seconds(args.seconds);
-    let boot_limit = std::time::Duration::from_secs(if rig.kind == "qemu" { 60 } else { 10 });
+    let boot_limit = std::time::Duration::from_secs(if rig.kind == "host" { 10 } else { 60 });
+    let mut rig = rig;
     let outcome = match session.wait_first_telemetry(boot_limit) {
-        Ok(()) => script::run(&mut session, timing),
+        Ok(()) => match rig.injector() {
+            Some(mut inject) => script::run(&mut session, timing, Some(&mut inject)),
+            None => script::run(&mut session, timing, None),
+        },
         Err(e) => script::Outcome {
             marks: Vec::new(),
             params: None,

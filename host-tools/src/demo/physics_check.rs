@@ -45,6 +45,9 @@ pub(super) fn predicted(
     scene: Option<&Scene<f64>>,
     tol: &Tolerances,
 ) -> Option<Predicted> {
+    if frames.is_empty() {
+        return None;
+    }
     let from = frames.len()
         - ((frames.len() as f64 * tol.steady_fraction).ceil() as usize).clamp(1, frames.len());
     let steady = frames.get(from..)?;

@@ -115,15 +115,19 @@ fn motors_off(t: &Telemetry) -> bool {
     t.state == DeviceState::Faulted && t.precession.duty_bp == 0 && t.spin.duty_bp == 0
 }
 
+/// Injects a fault into the rig's simulated world (`sensor2`, `none`, ...) when the rig's
+/// firmware does not take `INJECT` over the wire (real firmware on an emulated board).
+pub type Injector<'a> = &'a mut dyn FnMut(&str) -> Result<()>;
+
 /// Runs the session. An error of the link (no answer, port gone) ends it early; the record so
 /// far is still summarised.
-pub fn run(s: &mut Session, timing: Timing) -> Outcome {
+pub fn run(s: &mut Session, timing: Timing, injector: Option<Injector>) -> Outcome {
     let mut out = Outcome {
         marks: Vec::new(),
         params: None,
         aborted: None,
     };
-    if let Err(e) = steps(s, timing, &mut out) {
+    if let Err(e) = steps(s, timing, &mut out, injector) {
         s.event(format!("session aborted: {e:#}"));
         out.aborted = Some(format!("{e:#}"));
     }
@@ -137,7 +141,12 @@ pub fn run(s: &mut Session, timing: Timing) -> Outcome {
     out
 }
 
-fn steps(s: &mut Session, timing: Timing, out: &mut Outcome) -> Result<()> {
+fn steps(
+    s: &mut Session,
+    timing: Timing,
+    out: &mut Outcome,
+    mut injector: Option<Injector>,
+) -> Result<()> {
     let d = timing;
     s.command("ask the rig's state", &["status"])?;
     let (_, params) = s.command_answer("read the parameters", &["params"])?;
@@ -171,9 +180,27 @@ fn steps(s: &mut Session, timing: Timing, out: &mut Outcome) -> Result<()> {
     s.wait_ms(d.dwell_ms)?;
 
     // 4. Fault: the spin sensor goes dead. The rig must stop both motors.
-    let ok = s.command("inject a sensor fault", &["inject", INJECTION])?;
-    out.marks
-        .push(mark(s, "fault injected", MarkKind::Inject, ok));
+    let injected = match injector.as_mut() {
+        Some(inject) => {
+            inject(INJECTION)?;
+            s.event(format!(
+                "inject a sensor fault: {INJECTION} in the emulated plant (the firmware answers \
+                 INJECT with UNSUPPORTED, as on a real board)"
+            ));
+            // No command carries the time: the mark is now.
+            Mark {
+                name: "fault injected".into(),
+                kind: MarkKind::Inject,
+                at_ms: s.now_ms().unwrap_or(0),
+                accepted: true,
+            }
+        }
+        None => {
+            let ok = s.command("inject a sensor fault", &["inject", INJECTION])?;
+            mark(s, "fault injected", MarkKind::Inject, ok)
+        }
+    };
+    out.marks.push(injected);
     let detected = s.wait_for(d.wait_limit_ms, |t| t.fault != FaultCode::None)?;
     match detected {
         Some(at) => {
@@ -222,7 +249,15 @@ fn steps(s: &mut Session, timing: Timing, out: &mut Outcome) -> Result<()> {
     s.wait_ms(d.faulted_ms.saturating_sub(watched).max(d.pause_ms))?;
 
     // 5. Repair and clear.
-    s.command("sensor repaired", &["inject", "none"])?;
+    match injector.as_mut() {
+        Some(inject) => {
+            inject("none")?;
+            s.event("sensor repaired in the emulated plant".into());
+        }
+        None => {
+            s.command("sensor repaired", &["inject", "none"])?;
+        }
+    }
     let ok = s.command("clear the fault", &["clear"])?;
     out.marks
         .push(mark(s, "fault cleared", MarkKind::Clear, ok));

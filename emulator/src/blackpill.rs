@@ -1,0 +1,167 @@
+//! The second emulator: the exact Black Pill image (`cargo build --release -p firmware`) on an
+//! emulated STM32F411, run by `tests/blackpill/run_board.py` (qiling with the project's
+//! peripheral models, the simulated plant through `tests/blackpill/plant-ffi`). USART2 is served
+//! on a pseudo-terminal. The emulator's Python environment is made by `bash tests/run`
+//! (`ensure_blackpill_emulator` in tests/lib/ensure-tools.sh).
+
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc;
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use anyhow::{Context, Result, anyhow, bail};
+
+use crate::workspace;
+
+/// The Black Pill image: the release build of the firmware's board binary.
+pub fn image_path() -> PathBuf {
+    workspace::target_dir().join("thumbv7em-none-eabihf/release/firmware")
+}
+
+/// The emulator's Python interpreter (its virtual environment under the target directory).
+pub fn python() -> PathBuf {
+    workspace::root().join("target/venv-blackpill/bin/python")
+}
+
+/// Builds what the emulated board needs: the image and the plant library.
+pub fn build() -> Result<()> {
+    for args in [
+        &[
+            "build",
+            "--release",
+            "-p",
+            "firmware",
+            "--target",
+            "thumbv7em-none-eabihf",
+        ][..],
+        &["build", "-p", "plant-ffi"][..],
+    ] {
+        eprintln!("building: cargo {}", args.join(" "));
+        let status = Command::new(workspace::cargo())
+            .current_dir(workspace::root())
+            .args(args)
+            .stdin(Stdio::null())
+            .status()
+            .context("cannot run cargo")?;
+        if !status.success() {
+            bail!("`cargo {}` failed", args.join(" "));
+        }
+    }
+    Ok(())
+}
+
+/// `defmt-print`: `DEFMT_PRINT`, else the copy `bash tests/run` installs, else the path's.
+fn defmt_print(root: &Path) -> String {
+    if let Some(p) = std::env::var_os("DEFMT_PRINT") {
+        return p.to_string_lossy().into_owned();
+    }
+    let local = root.join("target/defmt-tools/bin/defmt-print");
+    if local.is_file() {
+        local.to_string_lossy().into_owned()
+    } else {
+        "defmt-print".into()
+    }
+}
+
+/// A running emulated Black Pill with its USART2 on a pseudo-terminal.
+pub struct PtyBoard {
+    /// The serial device to open.
+    pub port: String,
+    child: Child,
+    console: Option<JoinHandle<Vec<String>>>,
+    control: Option<ChildStdin>,
+}
+
+impl PtyBoard {
+    /// Builds the image and boots it for `seconds` of device time at most (a safety net: the
+    /// caller stops it sooner). Waits 60 s at most for the pseudo-terminal.
+    pub fn boot(seconds: f64) -> Result<PtyBoard> {
+        let root = workspace::root();
+        let python = python();
+        if !python.is_file() {
+            bail!(
+                "the Black Pill emulator is not installed ({} is missing): run `bash tests/run` \
+                 once, which installs it",
+                python.display()
+            );
+        }
+        build()?;
+        let mut child = Command::new(&python)
+            .current_dir(&root)
+            .arg("tests/blackpill/run_board.py")
+            .args(["--seconds", &seconds.ceil().to_string()])
+            .args(["--defmt-print", &defmt_print(&root)])
+            .arg("--control-stdin")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .context("cannot start the Black Pill emulator")?;
+        let control = child.stdin.take();
+        let stdout = child.stdout.take().ok_or_else(|| anyhow!("no stdout"))?;
+        let (tx, rx) = mpsc::channel();
+        let console = std::thread::spawn(move || {
+            let mut keep = Vec::new();
+            for line in BufReader::new(stdout).lines().map_while(|l| l.ok()) {
+                if let Some(pty) = line.strip_prefix("pty: ") {
+                    let _ = tx.send(pty.to_string());
+                } else {
+                    if keep.len() == 200 {
+                        keep.remove(0);
+                    }
+                    keep.push(line);
+                }
+            }
+            keep
+        });
+        let Ok(port) = rx.recv_timeout(Duration::from_secs(60)) else {
+            let _ = child.kill();
+            let _ = child.wait();
+            bail!("the Black Pill emulator did not report its pseudo-terminal within 60 s");
+        };
+        Ok(PtyBoard {
+            port,
+            child,
+            console: Some(console),
+            control,
+        })
+    }
+
+    /// Injects a fault into the emulated world (`WHAT` as `run_board.py` takes it): the Black
+    /// Pill image refuses the protocol's INJECT, so faults come from outside, as on a real rig.
+    pub fn inject(&mut self, what: &str) -> Result<()> {
+        let stdin = self
+            .control
+            .as_mut()
+            .ok_or_else(|| anyhow!("the emulator's control input is closed"))?;
+        writeln!(stdin, "inject {what}")
+            .and_then(|()| stdin.flush())
+            .context("the emulator's control input is closed")
+    }
+
+    /// Waits for the board to end its run by itself; its exit status.
+    pub fn wait(&mut self) -> Result<std::process::ExitStatus> {
+        self.child
+            .wait()
+            .context("waiting for the Black Pill emulator")
+    }
+
+    /// Stops the board; returns the last lines of its console.
+    pub fn stop(mut self) -> Vec<String> {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        self.console
+            .take()
+            .and_then(|t| t.join().ok())
+            .unwrap_or_default()
+    }
+}
+
+impl Drop for PtyBoard {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}

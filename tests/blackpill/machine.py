@@ -1,0 +1,412 @@
+"""The emulated STM32F411 Black Pill: the exact release ELF on qiling's Cortex-M4 (unicorn)
+with the peripheral models of this directory, one virtual clock, and resets (pin, software,
+watchdog, power cut) that keep what survives on a real board (flash always; RAM, and so the
+`.uninit` reset counter, except on a power cut).
+
+Time: the CPU runs in slices of at most SLICE_NS (as many instructions as SYSCLK gives, one
+per cycle); register accesses see the slice's start time, and interrupts raised during a slice
+are taken at its end, so an interrupt's latency is at most one slice. A slice cut short (WFE,
+a reset) is charged in full: unicorn cannot say how many instructions ran. At the executor's WFE (unicorn 2.0.1 rejects the instruction: it is hooked
+and skipped) with nothing pending, the clock jumps to the next peripheral or plant event."""
+
+import copy
+import os
+import time
+
+from qiling import Qiling
+from qiling.const import QL_ARCH, QL_INTERCEPT, QL_OS, QL_VERBOSE
+from qiling.extensions.mcu.stm32f4 import stm32f411
+from unicorn import UC_HOOK_CODE, UcError
+from unicorn.arm_const import UC_ARM_REG_FPSCR, UC_ARM_REG_S0
+
+from clock_tree import ClockTree
+from dma import Dma
+from flash import BACKED_BASE, BACKED_SIZE, FlashInterface, FlashStore
+from iwdg import Iwdg
+from nvic import Nvic
+from plant import DIR_PINS
+from rtt import RttReader
+from timers import Timer
+from usart import Usart
+
+SLICE_NS = 20_000
+# The image sits in sectors 0..4 (memory.x); 5..7 are the flash model's.
+CODE_FLASH_SIZE = BACKED_BASE - 0x0800_0000
+
+IRQ_TIM1_UP, IRQ_TIM1_CC, IRQ_TIM2, IRQ_TIM5 = 25, 27, 28, 50
+IRQ_USART2 = 38
+IRQ_DMA1_STREAM = {5: 16, 6: 17}
+# DMA1 requests (RM0383 table 27): (stream, channel) -> (peripheral label, direction).
+DMA1_ROUTES = {(5, 4): ("usart2", "rx"), (6, 4): ("usart2", "tx")}
+
+THUMB_WFE, THUMB_SEV = b"\x20\xbf", b"\x40\xbf"
+DIR_MASK = sum(1 << pin for pin in DIR_PINS)
+
+# RCC_CSR reset flags (RM0383 6.3.21).
+CSR_FLAGS = {
+    "power": (1 << 27) | (1 << 26) | (1 << 25),  # POR, PIN, BOR
+    "pin": 1 << 26,
+    "software": (1 << 28) | (1 << 26),
+    "watchdog": (1 << 29) | (1 << 26),
+}
+
+
+class EmulationError(RuntimeError):
+    pass
+
+
+def _board_env():
+    env = copy.deepcopy(stm32f411)
+    env["FLASH"]["size"] = CODE_FLASH_SIZE
+    env["REMAP"]["kwargs"]["size"] = CODE_FLASH_SIZE
+    env["REMAP REGION"]["size"] = CODE_FLASH_SIZE
+    del env["NVIC"]
+    return env
+
+
+def _find_opcodes(elf_path: str, opcode: bytes):
+    """Addresses of a 16-bit Thumb opcode in the image's executable sections."""
+    from elftools.elf.elffile import ELFFile
+    found = []
+    with open(elf_path, "rb") as f:
+        elf = ELFFile(f)
+        for sec in elf.iter_sections():
+            if sec["sh_flags"] & 0x4 and sec["sh_type"] == "SHT_PROGBITS":
+                data = sec.data()
+                base = sec["sh_addr"]
+                for off in range(0, len(data) - 1, 2):
+                    if data[off:off + 2] == opcode:
+                        found.append(base + off)
+    return found
+
+
+class Board:
+    """One boot of the MCU: a fresh core and peripherals on the machine's clock."""
+
+    def __init__(self, machine, reset_kind: str, ram: bytes = None):
+        m = machine
+        self.m = m
+        ql = Qiling([m.elf], archtype=QL_ARCH.CORTEX_M, ostype=QL_OS.MCU, env=_board_env(),
+                    verbose=QL_VERBOSE.DISABLED)
+        self.ql = ql
+        self.uc = ql.uc
+        for label in ("rcc", "pwr", "gpioa", "gpiob", "gpioc", "syscfg", "exti", "dbgmcu"):
+            ql.hw.create(label)
+        self.rcc = ql.hw.rcc
+        self.clocks = ClockTree(self.rcc)
+        self.rcc.instance.CSR = (self.rcc.instance.CSR & 0x00FF_FFFF) | CSR_FLAGS[reset_kind]
+        self.gpiob = ql.hw.gpiob
+
+        def add(label, entity, base):
+            ql.hw.entity[label] = entity
+            ql.hw.region[label] = [(lo + base, hi + base) for lo, hi in entity.region]
+            return entity
+
+        self.nvic = add("nvic", Nvic(ql, "nvic", m), 0xE000E100)
+        self.tim1 = add("tim1", Timer(ql, "tim1", m, apb=2, bits=16, advanced=True), 0x4001_0000)
+        self.tim2 = add("tim2", Timer(ql, "tim2", m, apb=1, bits=32), 0x4000_0000)
+        self.tim5 = add("tim5", Timer(ql, "tim5", m, apb=1, bits=32), 0x4000_0C00)
+        self.usart2 = add("usart2", Usart(ql, "usart2", m, apb=1, transmit=m.link_out), 0x4000_4400)
+        self.dma1 = add("dma1", Dma(ql, "dma1", m), 0x4002_6000)
+        self.iwdg = add("iwdg", Iwdg(ql, "iwdg", m), 0x4000_3000)
+        self.flash = add("flash", FlashInterface(ql, "flash", m, m.store), 0x4002_3C00)
+        self.timers = (self.tim1, self.tim2, self.tim5)
+        self.clocked = (self.tim1, self.tim2, self.tim5, self.usart2, self.iwdg)
+        self.stepping = [e for k, e in ql.hw.stepable.items() if k in ("rcc", "pwr")]
+
+        self.nvic.connect(IRQ_TIM1_UP, lambda: self.tim1.irq_level(0x01))
+        self.nvic.connect(IRQ_TIM1_CC, lambda: self.tim1.irq_level(0x1E))
+        self.nvic.connect(IRQ_TIM2, lambda: self.tim2.irq_level(0x1F))
+        self.nvic.connect(IRQ_TIM5, lambda: self.tim5.irq_level(0x1F))
+        self.nvic.connect(IRQ_USART2, self.usart2.irq_level)
+        for stream, irq in IRQ_DMA1_STREAM.items():
+            self.nvic.connect(irq, lambda s=stream: self.dma1.irq_level(s))
+
+        ql.mem.map_mmio(BACKED_BASE, BACKED_SIZE, self._flash_read, self._flash_write,
+                        info="[param flash]")
+        scb = ql.hw.scb
+        scb.hook_write(self._scb_write)
+        self.dir_pins = self.gpiob.instance.ODR & DIR_MASK
+        self.gpiob.hook_write(self._gpiob_written, intercept=QL_INTERCEPT.EXIT)
+
+        for addr in m.wfe_sites:
+            self.uc.hook_add(UC_HOOK_CODE, self._on_wfe, begin=addr, end=addr)
+        for addr in m.sev_sites:
+            self.uc.hook_add(UC_HOOK_CODE, self._on_sev, begin=addr, end=addr)
+        if ram is not None:
+            ql.mem.write(0x2000_0000, ram)
+        # Vector table at the start of flash.
+        ql.arch.regs.msp = ql.mem.read_ptr(0x0800_0000)
+        ql.arch.regs.pc = ql.mem.read_ptr(0x0800_0004)
+        self.event = False
+        self.sleeping = False
+        self.at_wfe = None
+        self.in_isr = False
+
+    # --- hooks -------------------------------------------------------------------------
+    def _flash_read(self, ql, offset, size):
+        return self.m.store.read(offset, size)
+
+    def _flash_write(self, ql, offset, size, value):
+        self.flash.program(BACKED_BASE + offset, size, value)
+
+    def _scb_write(self, scb, access, offset, size, value):
+        # AIRCR with VECTKEY and SYSRESETREQ: a software reset (the panic path).
+        if offset == 0x0C and (value >> 16) == 0x05FA and value & 4:
+            self.m.request_reset("software")
+
+    def _gpiob_written(self, gpio, access, offset, size, value):
+        # A DIR pin that turns while its PWM channel still drives the bridge drives the new
+        # direction with the old duty: the harness records every such moment.
+        pins = gpio.instance.ODR & DIR_MASK
+        changed = pins ^ self.dir_pins
+        self.dir_pins = pins
+        for axis, pin in enumerate(DIR_PINS):
+            if changed & (1 << pin):
+                self.m.dir_changes += 1
+            if changed & (1 << pin) and self.tim1.pwm_fraction(axis) > 0.0:
+                self.m.dir_violations.append((self.m.now_ns, axis, self.tim1.pwm_fraction(axis)))
+
+    def _on_wfe(self, uc, address, size, user_data):
+        # Stop before the instruction (unicorn 2.0.1 would fault on it); `resume_after_wfe`
+        # steps over it.
+        self.at_wfe = address
+        uc.emu_stop()
+
+    def resume_after_wfe(self):
+        """At a WFE: skip it; sleep unless an event (SEV, an interrupt) is latched."""
+        self.ql.arch.regs.pc = self.at_wfe + 2
+        self.at_wfe = None
+        if self.event:
+            self.event = False
+        else:
+            self.sleeping = True
+
+    def _on_sev(self, uc, address, size, user_data):
+        self.event = True
+
+    # --- interrupts --------------------------------------------------------------------
+    def take_interrupt(self) -> bool:
+        regs = self.ql.arch.regs
+        if regs.primask & 1 or regs.ipsr > 1:
+            return False
+        irq = self.nvic.next_irq()
+        if irq is None:
+            return False
+        basepri = regs.basepri & 0xF0
+        if basepri and basepri <= self.nvic.priority[irq]:
+            return False
+        self.nvic.taken(irq)
+        # The exception frame qiling pushes holds the integer registers only; keep the
+        # caller-saved FPU registers as the hardware's lazy stacking would.
+        fpu = [self.uc.reg_read(UC_ARM_REG_S0 + i) for i in range(16)]
+        fpscr = self.uc.reg_read(UC_ARM_REG_FPSCR)
+        self.in_isr = True
+        try:
+            self.ql.arch.interrupt_handler(self.ql, irq)
+        finally:
+            self.in_isr = False
+        for i, v in enumerate(fpu):
+            self.uc.reg_write(UC_ARM_REG_S0 + i, v)
+        self.uc.reg_write(UC_ARM_REG_FPSCR, fpscr)
+        self.event = True
+        self.m.interrupts += 1
+        return True
+
+    def sync_peripherals(self):
+        for p in self.clocked:
+            p.sync()
+        for p in self.stepping:
+            p.step()
+
+    def next_event_ns(self):
+        times = [t for t in (p.next_event_ns() for p in self.clocked) if t is not None]
+        return min(times) if times else None
+
+
+class Machine:
+    def __init__(self, elf: str, flash_path: str, plant=None, link=None, defmt_print=None,
+                 log_dir=None, realtime=False):
+        self.elf = elf
+        self.store = FlashStore(flash_path)
+        self.plant = plant
+        self.link = link
+        self.realtime = realtime
+        self.now_ns = 0
+        self.wfe_sites = _find_opcodes(elf, THUMB_WFE)
+        self.sev_sites = _find_opcodes(elf, THUMB_SEV)
+        self.reset_request = None
+        self.power_cut = False
+        self.in_dma = False
+        self.held = None  # (every_ns, hold_ns, next_ns): the CPU held periodically
+        self.dir_violations = []
+        self.dir_changes = 0
+        self.resets = []
+        self.interrupts = 0
+        self.slices = 0
+        self.tx_bytes = bytearray()
+        self.rtt = None
+        if defmt_print and log_dir:
+            os.makedirs(log_dir, exist_ok=True)
+            self.rtt = RttReader(elf, defmt_print, os.path.join(log_dir, "blackpill-defmt.log"))
+        self.board = Board(self, "power")
+        self.wall0 = time.monotonic()
+        self.next_poll_ns = 0
+
+    # --- called by peripherals ----------------------------------------------------------
+    @property
+    def clocks(self):
+        return self.board.clocks
+
+    def service_dma(self):
+        """Serves active DMA requests (not re-entered: a transfer's own register access
+        must not start the next transfer before the stream has counted this one)."""
+        b = getattr(self, "board", None)
+        if b is None or self.in_dma:
+            return
+        self.in_dma = True
+        try:
+            self._serve_dma_requests(b)
+        finally:
+            self.in_dma = False
+
+    def _serve_dma_requests(self, b):
+        for (stream, channel), (label, kind) in DMA1_ROUTES.items():
+            s = b.dma1.streams[stream]
+            periph = b.ql.hw.entity[label]
+            guard = 0
+            while s.enabled and s.chsel == channel and periph.dma_request(kind) and guard < 4:
+                b.dma1.transfer_one(stream, periph)
+                guard += 1
+
+    def link_out(self, byte: int):
+        self.tx_bytes.append(byte)
+        if self.link is not None:
+            self.link.send(bytes([byte]))
+
+    def request_reset(self, kind: str):
+        self.reset_request = kind
+        b = getattr(self, "board", None)
+        if b is not None:
+            b.uc.emu_stop()
+
+    def cut_power(self):
+        """The supply is gone: the CPU stops here; the next step powers the board up again."""
+        self.power_cut = True
+        b = getattr(self, "board", None)
+        if b is not None:
+            b.uc.emu_stop()
+
+    def hold_cpu_periodically(self, every_s: float, hold_s: float):
+        """From now on, stop the CPU for `hold_s` every `every_s` (as an interrupt storm or a
+        runaway flash operation would): control ticks end late while they still advance."""
+        self.held = (int(every_s * 1e9), int(hold_s * 1e9), self.now_ns)
+
+    def stall(self, ns: int):
+        """The CPU is stopped for `ns` (a flash operation) while the peripherals run on."""
+        end = self.now_ns + ns
+        while self.now_ns < end and self.reset_request is None:
+            nxt = self._next_event_ns()
+            self.now_ns = end if nxt is None else max(self.now_ns, min(nxt, end))
+            self._process_events()
+
+    # --- host side -----------------------------------------------------------------------
+    def send(self, data: bytes):
+        self.board.usart2.receive(data)
+
+    def reset(self, kind: str):
+        """Resets the MCU; a power cut also loses RAM."""
+        self.store.flush()
+        ram = None
+        if kind != "power":
+            ram = bytes(self.board.ql.mem.read(0x2000_0000, 0x2_0000))
+        self.resets.append((self.now_ns, kind))
+        self.board = Board(self, kind, ram)
+        self.reset_request = None
+        self.power_cut = False
+
+    # --- the loop ------------------------------------------------------------------------
+    def _next_event_ns(self):
+        t = self.board.next_event_ns()
+        if self.plant is not None:
+            p = self.plant.next_event_ns()
+            t = p if t is None else min(t, p)
+        return t
+
+    def _process_events(self):
+        b = self.board
+        if self.plant is not None:
+            while self.plant.edges and self.plant.edges[0][0] <= self.now_ns:
+                at, axis = self.plant.edges.popleft()
+                b.tim2.capture(axis, at)
+            while self.plant.time_ns <= self.now_ns:
+                self.plant.step(b.tim1, b.gpiob)
+        b.sync_peripherals()
+
+    def _poll_host(self):
+        if self.rtt is not None:
+            self.rtt.poll(self.board.ql.mem)
+        if self.link is not None:
+            data = self.link.receive()
+            if data:
+                self.send(data)
+        if self.realtime:
+            ahead = self.now_ns / 1e9 - (time.monotonic() - self.wall0)
+            if ahead > 0.002:
+                time.sleep(ahead)
+
+    def run_for(self, seconds: float, until=None):
+        """Runs `seconds` of emulated time (or until `until()` is true)."""
+        end = self.now_ns + int(seconds * 1e9)
+        while self.now_ns < end:
+            if until is not None and until():
+                return True
+            self.step(end)
+        return False
+
+    def step(self, horizon_ns: int):
+        b = self.board
+        if self.reset_request is not None or self.power_cut:
+            self.reset("power" if self.power_cut else self.reset_request)
+            return
+        if self.now_ns >= self.next_poll_ns:
+            self._poll_host()
+            self.next_poll_ns = self.now_ns + 1_000_000
+        if self.held is not None and self.now_ns >= self.held[2]:
+            every, hold, at = self.held
+            self.held = (every, hold, at + every)
+            self.stall(hold)
+            return
+        if b.take_interrupt():
+            return
+        nxt = self._next_event_ns()
+        if b.sleeping:
+            b.sleeping = False
+            target = horizon_ns if nxt is None else min(nxt, horizon_ns)
+            if self.realtime:
+                target = min(target, self.next_poll_ns)
+            self.now_ns = max(self.now_ns, target)
+            self._process_events()
+            return
+        limit = self.now_ns + SLICE_NS
+        if nxt is not None:
+            limit = min(limit, max(nxt, self.now_ns + 100))
+        count = max(1, int((limit - self.now_ns) * self.clocks.sysclk_hz() / 1e9))
+        pc = b.ql.arch.regs.pc
+        try:
+            b.uc.emu_start(pc | 1, 0, 0, count)
+        except UcError as e:
+            raise EmulationError(f"CPU fault at pc {b.ql.arch.regs.pc:#010x}: {e}") from e
+        self.slices += 1
+        if b.at_wfe is not None:
+            b.resume_after_wfe()
+        self.now_ns = limit
+        self._process_events()
+
+    def close(self):
+        self.store.flush()
+        if self.rtt is not None:
+            self.rtt.poll(self.board.ql.mem)
+            self.rtt.close()
+        if self.plant is not None:
+            self.plant.close()

@@ -1,0 +1,235 @@
+//! The project's one simulated plant, [`model_core::sim::Plant`], behind a C ABI so the
+//! emulated Black Pill harness (Python, tests/blackpill) drives the same plant as every other
+//! simulated rig instead of a copy. The harness reads the PWM duty and direction pins from the
+//! emulated timer and GPIO, calls [`plant_advance`], and feeds the returned edge timestamps to
+//! the emulated capture timer.
+//!
+//! Why a C ABI and not a Rust harness on the unicorn engine: the peripheral models need
+//! qiling's STM32F411 RCC/GPIO/EXTI models and its ELF loader, which are Python.
+//!
+//! Every function takes a pointer returned by [`plant_new`]; a null pointer or an axis other
+//! than 0 or 1 is refused (a negative or zero result), never a crash.
+
+use model_core::sim::{Plant, PlantParams};
+
+/// The rig parameters the harness may set, flat and `repr(C)`. [`plant_params_nominal`] fills
+/// it with the nominal rig; a rig file loader fills the same struct.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct RigParams {
+    /// Supply voltage, V.
+    pub supply_v: f32,
+    /// cos of the angle between the axes (0 = no reaction torque).
+    pub coupling: f32,
+    /// Capture timer rate, Hz (timestamps returned by [`plant_edges`] count at this rate).
+    pub timer_hz: u32,
+    /// Per axis `[precession, spin]`: teeth per revolution.
+    pub pulses_per_rev: [u16; 2],
+    /// Per axis: tooth-spacing error, fraction of a pitch.
+    pub tooth_error: [f32; 2],
+    /// Per axis: edge jitter, s.
+    pub jitter_s: [f32; 2],
+    /// Per axis: once-per-revolution load ripple, N m.
+    pub ripple_nm: [f32; 2],
+}
+
+impl RigParams {
+    fn to_plant(self) -> PlantParams {
+        let mut p = PlantParams::nominal();
+        p.supply_v = self.supply_v;
+        p.coupling = self.coupling;
+        p.timer_hz = self.timer_hz;
+        p.timer_bits = 32;
+        // The harness advances in short steps (a quarter of a control period): one physics
+        // step each keeps the nominal rig's step length.
+        p.substeps = 1;
+        for (i, axis) in p.axes.iter_mut().enumerate() {
+            axis.sensor.pulses_per_rev = self.pulses_per_rev[i].max(1);
+            axis.sensor.tooth_error = self.tooth_error[i];
+            axis.sensor.jitter_s = self.jitter_s[i];
+            axis.ripple_nm = self.ripple_nm[i];
+        }
+        p
+    }
+}
+
+/// Writes the nominal rig's parameters to `out`. Returns 0, or -1 for a null pointer.
+///
+/// # Safety
+/// `out` is null or points to writable memory for one [`RigParams`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_params_nominal(out: *mut RigParams) -> i32 {
+    let n = PlantParams::nominal();
+    let p = RigParams {
+        supply_v: n.supply_v,
+        coupling: n.coupling,
+        timer_hz: n.timer_hz,
+        pulses_per_rev: [
+            n.axes[0].sensor.pulses_per_rev,
+            n.axes[1].sensor.pulses_per_rev,
+        ],
+        tooth_error: [n.axes[0].sensor.tooth_error, n.axes[1].sensor.tooth_error],
+        jitter_s: [n.axes[0].sensor.jitter_s, n.axes[1].sensor.jitter_s],
+        ripple_nm: [n.axes[0].ripple_nm, n.axes[1].ripple_nm],
+    };
+    // SAFETY: the caller passes null or a valid pointer.
+    match unsafe { out.as_mut() } {
+        Some(o) => {
+            *o = p;
+            0
+        }
+        None => -1,
+    }
+}
+
+/// A plant at rest at time 0, or null for a null `params`. Free it with [`plant_free`].
+///
+/// # Safety
+/// `params` is null or points to a valid [`RigParams`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_new(params: *const RigParams, seed: u32) -> *mut Plant {
+    // SAFETY: the caller passes null or a valid pointer.
+    match unsafe { params.as_ref() } {
+        Some(p) => Box::into_raw(Box::new(Plant::new(p.to_plant(), seed))),
+        None => core::ptr::null_mut(),
+    }
+}
+
+/// Frees a plant from [`plant_new`] (null is ignored).
+///
+/// # Safety
+/// `plant` is null or came from [`plant_new`] and is not used afterwards.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_free(plant: *mut Plant) {
+    if !plant.is_null() {
+        // SAFETY: the pointer came from `Box::into_raw` in `plant_new`.
+        drop(unsafe { Box::from_raw(plant) });
+    }
+}
+
+/// Advances by `dt_s` with the signed duties held (-1..=1; the sign is the direction).
+/// Returns 0, or -1 for a null plant or a `dt_s` that is not finite and positive.
+///
+/// # Safety
+/// `plant` is null or came from [`plant_new`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_advance(
+    plant: *mut Plant,
+    duty0: f32,
+    duty1: f32,
+    dt_s: f32,
+) -> i32 {
+    // SAFETY: the caller passes null or a live plant.
+    let Some(p) = (unsafe { plant.as_mut() }) else {
+        return -1;
+    };
+    if !(dt_s.is_finite() && dt_s > 0.0) {
+        return -1;
+    }
+    p.advance([duty0, duty1], dt_s);
+    0
+}
+
+/// Copies the edges of `axis` from the last [`plant_advance`] (timer ticks, oldest first) to
+/// `out` (room for `cap`). Returns how many were copied, or -1 for a bad pointer or axis.
+///
+/// # Safety
+/// `plant` is null or came from [`plant_new`]; `out` points to `cap` writable `u32`s.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_edges(
+    plant: *const Plant,
+    axis: u32,
+    out: *mut u32,
+    cap: u32,
+) -> i32 {
+    // SAFETY: the caller passes null or a live plant.
+    let Some(p) = (unsafe { plant.as_ref() }) else {
+        return -1;
+    };
+    if axis > 1 || out.is_null() {
+        return -1;
+    }
+    let edges = p.edges(axis as usize);
+    let n = edges.len().min(cap as usize);
+    // SAFETY: `out` has room for `cap >= n` values.
+    unsafe { core::ptr::copy_nonoverlapping(edges.as_ptr(), out, n) };
+    n as i32
+}
+
+/// True speed of `axis`, rad/s (NaN for a bad pointer or axis: the caller checks).
+///
+/// # Safety
+/// `plant` is null or came from [`plant_new`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_speed_rad_s(plant: *const Plant, axis: u32) -> f32 {
+    // SAFETY: the caller passes null or a live plant.
+    match unsafe { plant.as_ref() } {
+        Some(p) if axis <= 1 => p.speed_rad_s(axis as usize),
+        _ => f32::NAN,
+    }
+}
+
+/// Blocks the shaft of `axis` from plant time `from_s` on (an injected stall). Returns 0 or -1.
+///
+/// # Safety
+/// `plant` is null or came from [`plant_new`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_block_shaft(plant: *mut Plant, axis: u32, from_s: f32) -> i32 {
+    // SAFETY: the caller passes null or a live plant.
+    match unsafe { plant.as_mut() } {
+        Some(p) if axis <= 1 => {
+            p.params_mut().axes[axis as usize].faults.blocked_from_s = from_s;
+            0
+        }
+        _ => -1,
+    }
+}
+
+/// Silences the sensor of `axis` from plant time `from_s` on. Returns 0 or -1.
+///
+/// # Safety
+/// `plant` is null or came from [`plant_new`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_kill_sensor(plant: *mut Plant, axis: u32, from_s: f32) -> i32 {
+    // SAFETY: the caller passes null or a live plant.
+    match unsafe { plant.as_mut() } {
+        Some(p) if axis <= 1 => {
+            p.params_mut().axes[axis as usize].faults.dead_sensor_from_s = from_s;
+            0
+        }
+        _ => -1,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nominal_plant_spins_up_and_emits_edges_through_the_c_abi() {
+        let mut params = core::mem::MaybeUninit::<RigParams>::uninit();
+        // SAFETY: a valid out pointer.
+        assert_eq!(unsafe { plant_params_nominal(params.as_mut_ptr()) }, 0);
+        // SAFETY: initialised just above.
+        let params = unsafe { params.assume_init() };
+        // SAFETY: valid pointers throughout; the plant is freed at the end.
+        unsafe {
+            let p = plant_new(&params, 1);
+            assert!(!p.is_null());
+            let mut edges = 0;
+            let mut buf = [0u32; 64];
+            for _ in 0..8000 {
+                assert_eq!(plant_advance(p, 0.0, 0.8, 0.00025), 0);
+                edges += plant_edges(p, 1, buf.as_mut_ptr(), 64);
+            }
+            let w = plant_speed_rad_s(p, 1);
+            // Two seconds at 80 % of 12 V: the spin shaft runs and the sensor reports it.
+            assert!(w > 1.0, "spin speed {w}");
+            assert!(edges > 12, "edges {edges}");
+            assert_eq!(plant_advance(p, 0.0, 0.0, f32::NAN), -1);
+            assert_eq!(plant_edges(p, 2, buf.as_mut_ptr(), 64), -1);
+            plant_free(p);
+            assert_eq!(plant_advance(core::ptr::null_mut(), 0.0, 0.0, 0.001), -1);
+        }
+    }
+}

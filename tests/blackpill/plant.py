@@ -1,0 +1,102 @@
+"""The project's plant (`model_core::sim::Plant`, through the plant-ffi C ABI) wired to the
+emulated board: it reads TIM1's PWM outputs and the DIR pins (PB12, PB13), steps the physics,
+and delivers each sensor edge to TIM2's capture channels at its own time."""
+
+import ctypes
+from collections import deque
+
+# The plant runs this far ahead of the CPU: one physics step (a quarter control period).
+STEP_S = 0.00025
+STEP_NS = 250_000
+PLANT_TIMER_HZ = 1_000_000
+DIR_PINS = (12, 13)
+
+
+class RigParams(ctypes.Structure):
+    _fields_ = [
+        ("supply_v", ctypes.c_float),
+        ("coupling", ctypes.c_float),
+        ("timer_hz", ctypes.c_uint32),
+        ("pulses_per_rev", ctypes.c_uint16 * 2),
+        ("tooth_error", ctypes.c_float * 2),
+        ("jitter_s", ctypes.c_float * 2),
+        ("ripple_nm", ctypes.c_float * 2),
+    ]
+
+
+def load_library(path: str):
+    lib = ctypes.CDLL(path)
+    lib.plant_params_nominal.argtypes = [ctypes.POINTER(RigParams)]
+    lib.plant_new.argtypes = [ctypes.POINTER(RigParams), ctypes.c_uint32]
+    lib.plant_new.restype = ctypes.c_void_p
+    lib.plant_free.argtypes = [ctypes.c_void_p]
+    lib.plant_advance.argtypes = [ctypes.c_void_p, ctypes.c_float, ctypes.c_float, ctypes.c_float]
+    lib.plant_edges.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.POINTER(ctypes.c_uint32),
+                                ctypes.c_uint32]
+    lib.plant_speed_rad_s.argtypes = [ctypes.c_void_p, ctypes.c_uint32]
+    lib.plant_speed_rad_s.restype = ctypes.c_float
+    lib.plant_block_shaft.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.c_float]
+    lib.plant_kill_sensor.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.c_float]
+    return lib
+
+
+class RigPlant:
+    def __init__(self, library_path: str, seed: int = 1):
+        self.lib = load_library(library_path)
+        params = RigParams()
+        if self.lib.plant_params_nominal(ctypes.byref(params)) != 0:
+            raise RuntimeError("plant_params_nominal failed")
+        params.timer_hz = PLANT_TIMER_HZ
+        self.handle = self.lib.plant_new(ctypes.byref(params), seed)
+        if not self.handle:
+            raise RuntimeError("plant_new failed")
+        self.time_ns = 0
+        self.edges = deque()  # (time_ns, axis)
+        self.buf = (ctypes.c_uint32 * 64)()
+        self.duties = (0.0, 0.0)
+
+    def duties_from_board(self, tim1, gpiob):
+        duties = []
+        odr = gpiob.instance.ODR if gpiob is not None else 0
+        for axis in (0, 1):
+            frac = tim1.pwm_fraction(axis) if tim1 is not None else 0.0
+            reverse = (odr >> DIR_PINS[axis]) & 1
+            duties.append(-frac if reverse else frac)
+        return tuple(duties)
+
+    def step(self, tim1, gpiob):
+        """One physics step from `time_ns` with the board's present outputs held."""
+        self.duties = self.duties_from_board(tim1, gpiob)
+        start_us = self.time_ns // 1000
+        self.lib.plant_advance(self.handle, self.duties[0], self.duties[1], STEP_S)
+        for axis in (0, 1):
+            n = self.lib.plant_edges(self.handle, axis, self.buf, 64)
+            for k in range(max(n, 0)):
+                ticks = self.buf[k]
+                # Unwrap the 32-bit microsecond stamp against the step's start.
+                us = start_us + ((ticks - start_us) & 0xFFFF_FFFF)
+                if us - start_us > 0x8000_0000:
+                    us -= 1 << 32
+                self.edges.append((us * 1000, axis))
+        self.edges = deque(sorted(self.edges))
+        self.time_ns += STEP_NS
+
+    def speed_rad_s(self, axis: int) -> float:
+        return self.lib.plant_speed_rad_s(self.handle, axis)
+
+    def block_shaft(self, axis: int, from_s: float):
+        self.lib.plant_block_shaft(self.handle, axis, from_s)
+
+    def kill_sensor(self, axis: int, from_s: float):
+        self.lib.plant_kill_sensor(self.handle, axis, from_s)
+
+    def next_event_ns(self):
+        t = self.time_ns
+        if self.edges:
+            t = min(t, self.edges[0][0])
+        return t
+
+    def close(self):
+        if self.handle:
+            self.lib.plant_free(self.handle)
+            self.handle = None

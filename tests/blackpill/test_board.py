@@ -1,0 +1,361 @@
+"""End-to-end tests of the exact Black Pill image on the emulated STM32F411, over the pty with
+`bowl send`, against the project's plant. Run by tests/run:
+
+    target/venv-blackpill/bin/python tests/blackpill/test_board.py [NAME...]
+
+Ends with `blackpill: N passed, M failed` and exits non-zero on a failure. Each test states
+its reference: the plant's true speed, the timer's registers, the flash file, the wire."""
+
+import os
+import shutil
+import sys
+import tempfile
+import time
+import traceback
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from flash import SECTOR_BASES, BACKED_BASE, SECTOR_SIZE  # noqa: E402
+from session import LOGS, Session  # noqa: E402
+from timers import BDTR, MOE  # noqa: E402
+
+WORK = tempfile.mkdtemp(prefix="blackpill-")
+# The control task's tick counter in the image (`HEARTBEAT` static).
+HEARTBEAT = None
+
+
+def fresh_flash(name: str) -> str:
+    path = os.path.join(WORK, name + ".bin")
+    if os.path.exists(path):
+        os.unlink(path)
+    return path
+
+
+def check(cond, what):
+    if not cond:
+        raise AssertionError(what)
+
+
+def mean_speed(s: Session, axis: int, seconds: float, samples: int = 10) -> float:
+    total = 0.0
+    for _ in range(samples):
+        s.wait_emulated(seconds / samples)
+        total += s.call(lambda m: m.plant.speed_rad_s(axis))
+    return total / samples
+
+
+def test_boot_says_hello_and_reports_power_on():
+    s = Session(fresh_flash("boot"))
+    try:
+        s.wait_until_s(0.3)
+        first = s.call(lambda m: bytes(m.tx_bytes[:4]))
+        check(first == b"$H1,", f"first bytes on the link {first!r}, expected a Hello frame '$H1,'")
+        st = s.status()
+        check(st.get("state") == "Idle" and st.get("reset_cause") == "PowerOn"
+              and st.get("reset_count") == "0", f"status after power-on: {st}")
+        with open(os.path.join(LOGS, "blackpill-defmt.log"), errors="replace") as f:
+            log = f.read()
+        check("boot: reset cause PowerOn" in log, "defmt log lacks the boot line")
+    finally:
+        s.close()
+
+
+def test_every_command_and_its_refusals():
+    s = Session(fresh_flash("commands"))
+    try:
+        s.wait_until_s(0.3)
+        p = s.params()
+        check(len(p) == 19 and p["TEETH1"] == 12 and p["SPEED_MAX1_MRAD_S"] == 4000,
+              f"PARAMS: {p}")
+        check(s.bowl("set", "TEETH1", "24").startswith("ok"), "SET TEETH1 24 refused")
+        check(s.params()["TEETH1"] == 24, "PARAMS does not show TEETH1 24 after SET")
+        check("axes" in s.bowl("models"), "MODELS answer has no axes")
+        check(s.bowl("ping").startswith("ok"), "PING not acknowledged")
+        out = s.bowl("speed", "5000", "0")
+        check("RANGE" in out, f"SPEED above SPEED_MAX1 (4000): {out}")
+        out = s.bowl("set", "START_UM", "999999")
+        check("RANGE" in out, f"START_UM beyond RIM_UM: {out}")
+        out = s.bowl("inject", "stall1")
+        check("UNSUPPORTED" in out, f"INJECT on real hardware: {out}")
+        check(s.bowl("speed", "1000", "1000").startswith("ok"), "SPEED 1000 1000 refused")
+        check(s.bowl("start").startswith("ok"), "START refused")
+        s.wait_emulated(0.3)
+        st = s.status()
+        check(st.get("state") in ("SpinningUp", "Running"), f"not driving after START: {st}")
+        check(s.bowl("stop").startswith("ok"), "STOP refused")
+        out = s.bowl("clear")
+        check(out.startswith(("ok", "rejected")), f"CLEAR: {out}")
+    finally:
+        s.close()
+
+
+def test_closed_loop_step_reaches_the_setpoints():
+    s = Session(fresh_flash("step"))
+    try:
+        s.wait_until_s(0.3)
+        check(s.bowl("speed", "1000", "2000").startswith("ok"), "SPEED refused")
+        check(s.bowl("start").startswith("ok"), "START refused")
+        t0 = s.now_s()
+        s.wait_until_s(t0 + 2.5)
+        w = [mean_speed(s, axis, 0.5) for axis in (0, 1)]
+        # The plant's true speed, averaged over half a second: within 3 % of the setpoint.
+        for axis, target in ((0, 1.0), (1, 2.0)):
+            err = abs(w[axis] - target) / target
+            check(err < 0.03, f"axis {axis}: true speed {w[axis]:.3f} rad/s, setpoint {target}")
+        # Down to a lower speed and to a stop: braking may reverse the drive.
+        check(s.bowl("speed", "200", "300").startswith("ok"), "SPEED down refused")
+        s.wait_emulated(1.0)
+        check(s.bowl("stop").startswith("ok"), "STOP refused")
+        s.wait_emulated(1.0)
+        bad, turns = s.call(lambda m: (list(m.dir_violations), m.dir_changes))
+        print(f"   direction changes: {turns}")
+        check(not bad, f"DIR turned while the PWM still drove (time ns, axis, duty): {bad[:5]}")
+    finally:
+        s.close()
+
+
+def fault_stops_the_bridge(name: str, inject):
+    s = Session(fresh_flash(name))
+    try:
+        s.wait_until_s(0.3)
+        s.bowl("speed", "1000", "2000")
+        s.bowl("start")
+        s.wait_emulated(1.5)
+        t_fault = s.call(lambda m: (inject(m.plant, m.plant.time_ns / 1e9), m.now_ns / 1e9)[1])
+        deadline = t_fault + 4.0
+        st = {}
+        while s.now_s() < deadline:
+            s.wait_emulated(0.25)
+            st = s.status()
+            if st.get("fault", "None") != "None":
+                break
+        check(st.get("fault", "None") != "None", f"no fault within 4 s of the {name}: {st}")
+        s.wait_emulated(0.01)
+        duty, moe = s.call(lambda m: ((m.board.tim1.pwm_fraction(0), m.board.tim1.pwm_fraction(1)),
+                                      bool(m.board.tim1.regs[BDTR] & MOE)))
+        check(duty == (0.0, 0.0), f"PWM still active after the fault: {duty}")
+        check(not moe, "TIM1 main output (MOE) still enabled after the fault")
+        print(f"   fault {st.get('fault')} reported within {s.now_s() - t_fault:.2f} s")
+    finally:
+        s.close()
+
+
+def test_blocked_shaft_faults_and_the_bridge_goes_off():
+    fault_stops_the_bridge("blocked spin shaft", lambda plant, t: plant.block_shaft(1, t))
+
+
+def test_dead_sensor_faults_and_the_bridge_goes_off():
+    fault_stops_the_bridge("dead spin sensor", lambda plant, t: plant.kill_sensor(1, t))
+
+
+def test_no_flash_operation_while_a_motor_is_driven():
+    s = Session(fresh_flash("deferred"))
+    try:
+        s.wait_until_s(0.3)
+        s.bowl("speed", "1000", "1000")
+        s.bowl("start")
+        s.wait_emulated(0.5)
+        # A parameter change while driving is refused (so no save can stall the loop) ...
+        out = s.bowl("set", "TEETH2", "24")
+        check(out.startswith("rejected") and "STATE" in out, f"SET while running: {out}")
+        s.wait_emulated(1.0)
+        steps = s.call(lambda m: list(m.store.log))
+        check(not steps, f"flash written while the motors ran: {steps[:3]}")
+        # ... and accepted and saved once the rig is idle again.
+        s.bowl("stop")
+        deadline = s.now_s() + 8.0
+        while s.status().get("state") != "Idle" and s.now_s() < deadline:
+            s.wait_emulated(0.25)
+        out = s.bowl("set", "TEETH2", "24")
+        check(out.startswith("ok"), f"SET after STOP: {out}; status {s.status()}")
+        s.wait_emulated(1.0)
+        steps = s.call(lambda m: list(m.store.log))
+        check(steps, "no save after the SET in Idle")
+    finally:
+        s.close()
+
+
+def test_parameters_survive_a_reset():
+    path = fresh_flash("persist")
+    s = Session(path)
+    try:
+        s.wait_until_s(0.3)
+        check(s.bowl("set", "TEETH2", "24").startswith("ok"), "SET refused")
+        s.wait_emulated(1.2)  # the save runs at the next persistence tick
+        s.call(lambda m: m.reset("pin"))
+        s.wait_emulated(0.3)
+        st = s.status()
+        check(st.get("reset_cause") == "Pin" and st.get("reset_count") == "1", f"status: {st}")
+        check(s.params()["TEETH2"] == 24, "TEETH2 not restored from flash after the reset")
+    finally:
+        s.close()
+
+
+def wedge_cpu(m):
+    """The control task never returns: interrupts off, the CPU spinning on `b .`."""
+    spin = 0x2000_0100
+    m.board.ql.mem.write(spin, b"\xfe\xe7")
+    m.board.ql.arch.regs.write("primask", 1)
+    m.board.ql.arch.regs.pc = spin
+    return m.now_ns
+
+
+def test_wedged_cpu_is_reset_by_the_watchdog():
+    s = Session(fresh_flash("watchdog"))
+    try:
+        s.wait_until_s(0.3)
+        t_wedge = s.call(wedge_cpu)
+        s.wait_emulated(0.6)
+        resets = s.call(lambda m: list(m.resets))
+        check(resets and resets[0][1] == "watchdog", f"resets after the wedge: {resets}")
+        after_ms = (resets[0][0] - t_wedge) / 1e6
+        # IWDG timeout 250 ms (firmware); LSI 32 kHz as modelled.
+        check(after_ms <= 260, f"watchdog reset {after_ms:.0f} ms after the wedge (limit 260)")
+        st = s.status()
+        check(st.get("reset_cause") == "IndependentWatchdog" and st.get("reset_count") == "1",
+              f"status after the watchdog reset: {st}")
+    finally:
+        s.close()
+
+
+def test_late_control_ticks_starve_the_watchdog():
+    s = Session(fresh_flash("deadline"))
+    try:
+        s.wait_until_s(0.3)
+        ticks = s.call(lambda m: bytes(m.board.ql.mem.read(HEARTBEAT, 8)))
+        # 3 ms held every 10 ms: the control task still ticks (its count advances) but ticks
+        # end more than one period late.
+        t0 = s.call(lambda m: (m.hold_cpu_periodically(0.010, 0.003), m.now_ns)[1])
+        s.wait_emulated(0.15)
+        later = s.call(lambda m: bytes(m.board.ql.mem.read(HEARTBEAT, 8)))
+        check(later != ticks, "the control task stopped ticking: this test wants late ticks")
+        s.wait_emulated(0.5)
+        resets = s.call(lambda m: list(m.resets))
+        check(resets and resets[0][1] == "watchdog",
+              f"no watchdog reset while ticks missed their deadline: {resets}")
+        after_ms = (resets[0][0] - t0) / 1e6
+        check(after_ms <= 300, f"watchdog reset {after_ms:.0f} ms after ticks began to be late")
+        st = s.status()
+        check(st.get("reset_cause") == "IndependentWatchdog", f"status: {st}")
+    finally:
+        s.close()
+
+
+def save_and_count_steps(path: str, value: str):
+    """Boots on `path`, sets TEETH2, waits for the save; returns the flash steps it took."""
+    s = Session(path, realtime=False)
+    try:
+        s.wait_until_s(0.3)
+        check(s.bowl("set", "TEETH2", value).startswith("ok"), "SET refused")
+        # The save starts within one persistence period (0.5 s); an erase first takes 1 s.
+        s.wait_emulated(2.0)
+        return s.call(lambda m: list(m.store.log))
+    finally:
+        s.close()
+
+
+def boot_with_cut(path: str, cut_at: int, value: str):
+    """Like save_and_count_steps, with the power cut at step `cut_at`; returns TEETH2 after the
+    reboot and whether the cut happened."""
+    s = Session(path, realtime=False)
+    try:
+        s.call(lambda m: setattr(m.store, "cut_at", cut_at))
+        s.wait_until_s(0.3)
+        s.bowl("set", "TEETH2", value)
+        # The save starts within one persistence period (0.5 s), after an erase (1 s) if it
+        # needs one; the board then boots again.
+        deadline = s.now_s() + 2.0
+        cut_at_s = None
+        while cut_at_s is None and s.now_s() < deadline:
+            s.wait_emulated(0.05)
+            cut_at_s = s.call(lambda m: next((t / 1e9 for t, k in m.resets if k == "power"), None))
+        if cut_at_s is not None:
+            s.wait_until_s(cut_at_s + 0.3)
+        return s.params().get("TEETH2"), cut_at_s is not None
+    finally:
+        s.close()
+
+
+def power_cut_sweep(base: str, value: str, previous: int):
+    steps = save_and_count_steps(shutil.copy(base, base + ".probe"), value)
+    check(steps, "the save programmed nothing")
+    bad = []
+    for k in range(1, len(steps) + 1):
+        path = shutil.copy(base, base + f".cut{k}")
+        teeth, cut = boot_with_cut(path, k, value)
+        if not cut or teeth not in (previous, int(value)):
+            bad.append((k, steps[k - 1], teeth, cut))
+    check(not bad, f"after a power cut at (step, what, TEETH2 found, cut happened): {bad}; "
+          f"expected {previous} or {value}")
+    return len(steps)
+
+
+def test_power_cut_at_every_step_of_a_save_keeps_the_last_record():
+    base = fresh_flash("powercut")
+    save_and_count_steps(base, "24")  # the last good record: TEETH2 24
+    n = power_cut_sweep(base, "36", 24)
+    print(f"   power cut swept over {n} program/erase steps")
+
+
+def test_power_cut_during_the_erase_of_a_full_region_keeps_the_last_record():
+    base = fresh_flash("powercut-full")
+    save_and_count_steps(base, "24")
+    # Fill every slot of the region with the firmware's own record, so the next save must
+    # erase: the image wrote the first slot; the copies are byte for byte the same.
+    with open(base, "r+b") as f:
+        data = bytearray(f.read())
+        first = SECTOR_BASES[6] - BACKED_BASE
+        used = data[first:first + SECTOR_SIZE]
+        end = len(used.rstrip(b"\xff"))
+        check(end > 0, "the first save left sector 6 blank")
+        record = bytes(used[:(end + 3) // 4 * 4])
+        for sector in (6, 7):
+            start = SECTOR_BASES[sector] - BACKED_BASE
+            n = SECTOR_SIZE // len(record)
+            data[start:start + n * len(record)] = record * n
+        f.seek(0)
+        f.write(data)
+    steps = save_and_count_steps(shutil.copy(base, base + ".probe"), "36")
+    check(any(s.startswith("erase") for s in steps), f"the save did not erase: {steps[:3]}...")
+    n = power_cut_sweep(base, "36", 24)
+    print(f"   power cut swept over {n} program/erase steps")
+
+
+def heartbeat_address(elf: str) -> int:
+    """The address of the image's HEARTBEAT static (a mangled Rust name)."""
+    from elftools.elf.elffile import ELFFile
+    with open(elf, "rb") as f:
+        for sym in ELFFile(f).get_section_by_name(".symtab").iter_symbols():
+            if "9HEARTBEAT" in sym.name:
+                return sym["st_value"]
+    raise RuntimeError(f"{elf}: no HEARTBEAT symbol")
+
+
+TESTS = [v for k, v in sorted(globals().items()) if k.startswith("test_")]
+
+
+def main(names):
+    global HEARTBEAT
+    from session import ELF
+    HEARTBEAT = heartbeat_address(ELF)
+    passed = failed = 0
+    t_all = time.monotonic()
+    for t in TESTS:
+        if names and t.__name__ not in names:
+            continue
+        t0 = time.monotonic()
+        try:
+            t()
+            passed += 1
+            print(f"ok   {t.__name__} ({time.monotonic() - t0:.1f} s)", flush=True)
+        except Exception:
+            failed += 1
+            print(f"FAIL {t.__name__} ({time.monotonic() - t0:.1f} s)", flush=True)
+            traceback.print_exc()
+    print(f"blackpill: {passed} passed, {failed} failed ({time.monotonic() - t_all:.0f} s)")
+    shutil.rmtree(WORK, ignore_errors=True)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
