@@ -6,6 +6,8 @@ use clap::{Parser, Subcommand};
 mod chart;
 mod commission;
 mod demo;
+mod experiment;
+mod fit;
 mod kinematics;
 mod monitor;
 mod predict;
@@ -46,6 +48,11 @@ enum Command {
     Sim(SimCommand),
     /// The rig without hardware: a simulated rig, a scripted session, the live view, a summary.
     Demo(demo::Args),
+    /// Run a plan of particle releases on a simulated rig and record residence times, or
+    /// suggest a plan (--suggest).
+    Experiment(experiment::Args),
+    /// Fit the rolling resistance of each particle model to measured residence times.
+    Fit(fit::Args),
 }
 
 /// `bowl sim`: either a report subcommand or the virtual rig's flags.
@@ -69,6 +76,8 @@ fn main() -> Result<()> {
         Command::Commission(args) => commission::run(&args).map(|code| std::process::exit(code)),
         Command::Replay(args) => replay::run(&args),
         Command::Demo(args) => demo::run(&args),
+        Command::Experiment(args) => experiment::run(&args),
+        Command::Fit(args) => fit::run(&args),
         Command::Sim(args) => match &args.report {
             Some(report) => sim::run(report),
             None => virtual_rig::run(&args.rig),
