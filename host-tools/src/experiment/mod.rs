@@ -2,6 +2,7 @@
 //! simulated rig and writes one row per release (see [`results`]); `--suggest` prints a plan.
 //! Method and limits: docs/experiment.md.
 
+pub mod benchmark;
 pub mod particle_table;
 pub mod plan;
 pub mod results;
@@ -41,6 +42,10 @@ pub struct Args {
     /// With --suggest: releases per condition.
     #[arg(long, default_value_t = 10)]
     pub repeats: usize,
+    /// Run the plan on this many simulated rigs (seeds 1..=N), fit each, and report the
+    /// statistics of the fits against the rig file's truth (results under --out's folder).
+    #[arg(long)]
+    pub benchmark_seeds: Option<u32>,
     /// Seed of the simulated rig (overrides the rig file's `seed`).
     #[arg(long)]
     pub seed: Option<u32>,
@@ -107,9 +112,27 @@ pub fn run(args: &Args) -> Result<()> {
     let text = std::fs::read_to_string(plan_path)
         .with_context(|| format!("cannot read the plan {}", plan_path.display()))?;
     let plan = plan::parse(&text, &plan_path.display().to_string())?;
-    let total = plan::releases(&plan);
+    if let Some(seeds) = args.benchmark_seeds {
+        return benchmark::run(&plan, &particle, seeds, out);
+    }
     let mut writer = Writer::create(out)?;
     let progress = std::io::stderr().is_terminal();
+    let run_no = run_plan(&mut rig, &plan, &mut writer, progress)?;
+    rig.stop();
+    println!("{run_no} releases written to {}", out.display());
+    Ok(())
+}
+
+/// Runs every release of `plan` on `rig`, writing each row as it is measured; returns the
+/// number of releases. A progress bar on standard error when `progress`.
+pub fn run_plan(
+    rig: &mut SimulatedRig,
+    plan: &plan::Plan,
+    writer: &mut Writer,
+    progress: bool,
+) -> Result<usize> {
+    let particle = *rig.particle();
+    let total = plan::releases(plan);
     let mut run_no = 0;
     for (ci, c) in plan.condition.iter().enumerate() {
         let targets = match (c.bowl_rad_s, c.precession_rad_s, c.spin_rad_s) {
@@ -183,6 +206,5 @@ pub fn run(args: &Args) -> Result<()> {
     if progress {
         eprintln!();
     }
-    println!("{run_no} releases written to {}", out.display());
-    Ok(())
+    Ok(run_no)
 }

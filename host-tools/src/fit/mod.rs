@@ -54,8 +54,6 @@ pub struct ModelFit {
     pub rms_error_pct: f64,
     /// Akaike information criterion.
     pub aic: f64,
-    /// Sum of squared errors, s^2.
-    pub sse_s2: f64,
     /// Relative error of each run, % (prediction minus measurement, over the measurement).
     pub errors_pct: Vec<f64>,
 }
@@ -119,7 +117,6 @@ pub fn load(path: &Path) -> Result<(Vec<Run>, Vec<Excluded>)> {
             Method::Integrated
         };
         runs.push(Run {
-            line,
             condition: row.condition,
             residence_s: t,
             mean_rad_s: mean,
@@ -176,7 +173,6 @@ pub fn fit_model(runs: &[Run], candidate: Candidate) -> ModelFit {
         mu_ci95: (lo, hi),
         rms_error_pct: rms,
         aic: aic(s_min, n, 2),
-        sse_s2: s_min,
         errors_pct,
     }
 }
@@ -327,3 +323,6 @@ pub fn run(args: &Args) -> Result<()> {
     print!("{}", condition_table(&fit).to_csv());
     Ok(())
 }
+
+#[cfg(test)]
+mod tests;

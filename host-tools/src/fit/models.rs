@@ -50,8 +50,6 @@ pub enum Method {
 /// One usable run.
 #[derive(Debug, Clone)]
 pub struct Run {
-    /// Line of the results file.
-    pub line: usize,
     /// Plan condition.
     pub condition: usize,
     /// Measured residence time, s.

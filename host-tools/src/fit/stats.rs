@@ -123,11 +123,12 @@ mod tests {
     fn minimise_and_crossing_find_a_parabola() {
         let f = |x: f64| (x - 0.0312).powi(2) + 1.0;
         let x = minimise(&f, 0.0, 0.1);
-        assert!((x - 0.0312).abs() < 1e-8, "{x}");
+        // A smooth minimum is located to about sqrt(epsilon) relative: f changes by x^2 there.
+        assert!((x - 0.0312).abs() < 1e-7, "{x}");
         let c = crossing(&f, 1.0 + 1e-4, 0.0312, 0.1);
         assert!((c - 0.0412).abs() < 1e-9, "{c}");
         // An infinite wall at the top of the range does not disturb it.
         let g = |x: f64| if x > 0.05 { f64::INFINITY } else { f(x) };
-        assert!((minimise(&g, 0.0, 0.06) - 0.0312).abs() < 1e-8);
+        assert!((minimise(&g, 0.0, 0.06) - 0.0312).abs() < 1e-7);
     }
 }

@@ -244,7 +244,7 @@ impl Granule {
         if let Some(t) = self.exit_s {
             return Some(t);
         }
-        if trace.is_empty() || !(max_step_s > 0.0) {
+        if trace.is_empty() || max_step_s.is_nan() || max_step_s <= 0.0 {
             return None;
         }
         let speed_at = |t: f64, from: &mut usize| -> f64 {
