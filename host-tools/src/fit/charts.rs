@@ -59,7 +59,7 @@ fn speed_range(fit: &Fit) -> (f64, f64) {
     let speeds = fit.runs.iter().map(|r| r.mean_rad_s);
     let lo = speeds.clone().fold(f64::INFINITY, f64::min);
     let hi = speeds.fold(0.0, f64::max);
-    (0.8 * lo, 1.1 * hi)
+    (0.95 * lo, 1.05 * hi)
 }
 
 fn model_curves(
@@ -97,7 +97,7 @@ fn figure(title: &str, x: &str, y: &str, series: Vec<Series>, notes: Vec<String>
     }
 }
 
-/// Writes `fig5_radial_fit.svg`, `fig6_exit_speed_fit.svg`, `fig7_residence_fit.svg` and
+/// Writes `fig5_radial_fit`, `fig6_exit_speed_fit`, `fig7_residence_fit` (SVG and PNG) and
 /// `table.csv` (mean error per model and condition) into `dir`.
 pub fn write(fit: &Fit, dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -129,7 +129,10 @@ pub fn write(fit: &Fit, dir: &Path) -> Result<()> {
     let draw = |f: Figure, name: &str| -> Result<()> {
         let path = dir.join(name);
         f.write_svg(&path)
-            .map_err(|e| anyhow::anyhow!("cannot draw {}: {e:?}", path.display()))
+            .map_err(|e| anyhow::anyhow!("cannot draw {}: {e:?}", path.display()))?;
+        let png = path.with_extension("png");
+        f.write_png(&png)
+            .map_err(|e| anyhow::anyhow!("cannot draw {}: {e:?}", png.display()))
     };
     draw(
         figure(
