@@ -320,6 +320,16 @@ pub fn run(args: &Args) -> Result<()> {
         "preferred: {} (a model is preferred when its AIC is lower by more than {AIC_DECISIVE})",
         fit.preferred
     );
+    if let Some(m) = fit
+        .models
+        .iter()
+        .find(|m| m.candidate.name == fit.preferred)
+    {
+        println!(
+            "apply to the rig: bowl send PORT set MU_PPM {:.0}",
+            (m.mu * 1e6).round()
+        );
+    }
     print!("{}", condition_table(&fit).to_csv());
     Ok(())
 }

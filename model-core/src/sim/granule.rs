@@ -367,4 +367,29 @@ mod tests {
         assert!(mean.abs() < 0.03, "{mean}");
         assert!((var - 1.0).abs() < 0.05, "{var}");
     }
+
+    proptest::proptest! {
+        /// Any finite inputs: no panic, the radius stays finite and never moves inward, an exit
+        /// time lies within the elapsed time.
+        #[test]
+        fn any_finite_input_is_safe(
+            flat in proptest::bool::ANY,
+            mu in -1e3f64..1e3, k2 in -2.0f64..2.0, r0 in -1.0f64..1.0, rim in -1.0f64..1.0,
+            w in -1e3f64..1e3, dt in -1.0f64..1.0,
+        ) {
+            let model = if flat { Model::Flat } else { Model::Coriolis };
+            let mut g = Granule::new(model, mu, k2, r0, rim);
+            let start = g.radius_m();
+            for _ in 0..50 {
+                let before = g.radius_m();
+                if let Some(t) = g.step(w, dt) {
+                    proptest::prop_assert!(t >= 0.0 && t <= g.time_s());
+                }
+                proptest::prop_assert!(g.radius_m().is_finite() || g.exit_s().is_some());
+                proptest::prop_assert!(g.radius_m() >= before && !g.radius_m().is_nan());
+            }
+            proptest::prop_assert!(start >= 0.0);
+            let _ = Granule::new(model, mu, k2, r0, rim).residence_over_trace(&[(0.0, w), (1.0, -w)], dt.abs(), 2.0);
+        }
+    }
 }
