@@ -7,6 +7,7 @@
 use anyhow::{Result, anyhow};
 use model_core::bowl::{MotorSpeeds, combined_speed_from_trig};
 use model_core::control::State;
+use model_core::control::supervisor::Fault;
 use model_core::sim::granule::ParticleParams;
 use model_core::sim::prng::Prng;
 
@@ -35,6 +36,17 @@ pub enum Release {
     NotSettled,
     /// The controller faulted (its fault named).
     MotorFault(String),
+}
+
+/// A fault in plain words for the results file.
+fn fault_words(fault: Option<Fault>) -> String {
+    let axis = |a: u8| if a == 0 { "precession" } else { "spin" };
+    match fault {
+        Some(Fault::SensorLostOrStall(a)) => format!("{} sensor lost or shaft stalled", axis(a)),
+        Some(Fault::Overspeed(a)) => format!("{} over speed", axis(a)),
+        Some(Fault::HostSilent) => "host silent".into(),
+        Some(Fault::InvalidConfiguration) | None => "invalid configuration".into(),
+    }
 }
 
 /// The simulated rig with its granules.
@@ -106,7 +118,7 @@ impl SimulatedRig {
 
     fn fault(&self) -> Option<String> {
         let c = self.backend.bound().controller();
-        (c.state() == State::Fault).then(|| format!("{:?}", c.fault()))
+        (c.state() == State::Fault).then(|| fault_words(c.fault()))
     }
 
     fn clear_fault(&mut self) {
@@ -118,7 +130,10 @@ impl SimulatedRig {
     pub fn settle(&mut self, targets: [f64; 2], settle_s: f64) -> Result<(), Release> {
         let ctrl = self.backend.bound_mut().controller_mut();
         if let Err(e) = ctrl.set_motor_speeds(targets[0] as f32, targets[1] as f32) {
-            return Err(Release::MotorFault(format!("speeds refused: {e:?}")));
+            return Err(Release::MotorFault(format!(
+                "speeds {:.3}, {:.3} rad/s refused by the controller ({e:?})",
+                targets[0], targets[1]
+            )));
         }
         if ctrl.state() == State::Idle {
             let _ = ctrl.start();
@@ -181,6 +196,15 @@ impl SimulatedRig {
             }
         }
         Release::NeverLeft(trace)
+    }
+
+    /// Injects a fault into the simulated rig (as INJECT does on the wire).
+    pub fn inject(&mut self, what: model_core::wire::Injection) -> Result<()> {
+        use model_core::wire::device::Backend as _;
+        self.backend
+            .bound_mut()
+            .inject(what)
+            .map_err(|r| anyhow!("injection refused: {}", r.token()))
     }
 
     /// Stops the motors (ramping down).

@@ -169,3 +169,32 @@ fn small_plan_on_the_simulated_rig() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A stalled spin motor: the release is not made, the row says why, and the fit excludes it
+/// with the reason in plain words.
+#[test]
+fn stalled_motor_is_excluded_with_its_reason() {
+    let particle = ParticleParams::default();
+    let plan = plan::parse(
+        "settle_s = 0.5\n[[condition]]\nbowl_rad_s = 4.0\nrepeats = 1\n",
+        "p.toml",
+    )
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("bowl-fit-stall-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("results.csv");
+    let mut rig = SimulatedRig::new(particle, 2).unwrap();
+    rig.inject(model_core::wire::Injection::StallSpin).unwrap();
+    let mut writer = Writer::create(&out).unwrap();
+    run_plan(&mut rig, &plan, &mut writer, false).unwrap();
+    let (runs, excluded) = load(&out).unwrap();
+    assert!(runs.is_empty());
+    assert_eq!(excluded.len(), 1);
+    let reason = &excluded[0].reason;
+    assert!(
+        reason == "the controller stopped the motors on a fault: spin sensor lost or shaft stalled"
+            || reason.starts_with("the speeds never settled"),
+        "{reason}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
