@@ -199,6 +199,7 @@ impl SimulatedRig {
     }
 
     /// Injects a fault into the simulated rig (as INJECT does on the wire).
+    #[cfg(test)]
     pub fn inject(&mut self, what: model_core::wire::Injection) -> Result<()> {
         use model_core::wire::device::Backend as _;
         self.backend
