@@ -198,3 +198,83 @@ fn stalled_motor_is_excluded_with_its_reason() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Runs whose speed drifts (a 10 % ramp during the residence) are predicted by integrating
+/// over the trace, and the fit recovers the truth from them; the closed form at the mean speed
+/// would be off by more than the noise.
+#[test]
+fn drifting_speed_uses_the_integrator() {
+    let mut rng = Prng::new(11);
+    let mut runs = Vec::new();
+    for (c, &w) in SPEEDS.iter().enumerate() {
+        for _ in 0..4 {
+            let trace: Vec<(f64, f64)> = (0..=300)
+                .map(|k| (k as f64 * 0.01, w * (1.0 + 0.1 * k as f64 / 300.0)))
+                .collect();
+            let truth = model_core::sim::granule::Granule::new(
+                Model::Coriolis,
+                0.03,
+                5.0 / 7.0,
+                0.05,
+                0.15,
+            )
+            .residence_over_trace(&trace, 1e-4, 100.0)
+            .unwrap();
+            let kept: Vec<(f64, f64)> = trace.into_iter().filter(|p| p.0 <= truth).collect();
+            runs.push(Run {
+                condition: c + 1,
+                residence_s: truth + 0.002 * gaussian(&mut rng),
+                mean_rad_s: kept.iter().map(|p| p.1).sum::<f64>() / kept.len() as f64,
+                release_radius_m: 0.05,
+                rim_radius_m: 0.15,
+                k2: 5.0 / 7.0,
+                trace: kept,
+                method: Method::Integrated,
+            });
+        }
+    }
+    let f = fit(runs.clone(), Vec::new()).unwrap();
+    let c = fitted(&f, "coriolis");
+    assert!(
+        c.mu_ci95.0 <= 0.03 && 0.03 <= c.mu_ci95.1,
+        "{:?}",
+        c.mu_ci95
+    );
+    for r in &mut runs {
+        r.method = Method::ClosedForm;
+    }
+    let wrong = fitted(&fit(runs, Vec::new()).unwrap(), "coriolis");
+    assert!(
+        !(wrong.mu_ci95.0 <= 0.03 && 0.03 <= wrong.mu_ci95.1),
+        "{:?}",
+        wrong.mu_ci95
+    );
+}
+
+/// The suggested plan has conditions where the granule leaves under both models, and its
+/// printed separation is the one [`crate::experiment::suggest::separation`] computes.
+#[test]
+fn suggested_plan_leaves_and_separates() {
+    let p = ParticleParams {
+        mu: 0.03,
+        gate_jitter_s: 0.002,
+        ..ParticleParams::default()
+    };
+    let text = crate::experiment::suggest::plan_text(&p, 0.03, 6.5, 4, 10);
+    let plan = plan::parse(&text, "suggested").unwrap();
+    assert_eq!(plan.condition.len(), 4);
+    let speeds: Vec<f64> = plan
+        .condition
+        .iter()
+        .map(|c| c.bowl_rad_s.unwrap())
+        .collect();
+    for &w in &speeds {
+        let r = &synthetic(Model::Flat, 0.03, 0.0, 1, 0)[0];
+        for m in [Model::Flat, Model::Coriolis] {
+            assert!(closed_form(r, m, 0.03, w).is_finite(), "{w} rad/s");
+        }
+    }
+    let d = crate::experiment::suggest::separation(&p, 0.03, &speeds, 10, 0.002);
+    assert!(text.contains(&format!("D = {d:.1}")), "{text}");
+    assert!(d > 6.0, "{d}");
+}
