@@ -6,7 +6,9 @@ use clap::{Parser, Subcommand};
 mod chart;
 mod commission;
 mod demo;
+mod experiment;
 mod family_file;
+mod fit;
 mod kinematics;
 mod monitor;
 mod predict;
@@ -54,6 +56,11 @@ enum Command {
     Sim(sim::What),
     /// The rig without hardware: a simulated rig, a scripted session, the live view, a summary.
     Demo(demo::Args),
+    /// Run a plan of particle releases on a simulated rig and record residence times, or
+    /// suggest a plan (--suggest).
+    Experiment(experiment::Args),
+    /// Fit the rolling resistance of each particle model to measured residence times.
+    Fit(fit::Args),
 }
 
 fn main() -> Result<()> {
@@ -69,5 +76,7 @@ fn main() -> Result<()> {
         Command::Demo(args) => demo::run(&args),
         Command::Serve(args) => serve::run(&args),
         Command::Sim(report) => sim::run(&report),
+        Command::Experiment(args) => experiment::run(&args),
+        Command::Fit(args) => fit::run(&args),
     }
 }

@@ -112,6 +112,11 @@ impl SimulatedBackend {
         &self.rig
     }
 
+    /// The simulated plant (its true shaft speeds, for a simulated granule).
+    pub fn plant(&self) -> &model_core::sim::Plant {
+        &self.plant
+    }
+
     /// The same, to hand to the protocol device.
     pub fn bound_mut(&mut self) -> &mut ControllerBackend<SimFaults> {
         &mut self.rig

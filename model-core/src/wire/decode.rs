@@ -3,9 +3,9 @@
 
 use super::crc::crc32;
 use super::{
-    AxisModel, Command, DeviceState, FaultCode, Frame, Hello, Injection, MODEL_FIELD_MAX,
-    MotorTelemetry, PARAM_COUNT, ParamId, ParamValues, Reason, ResetCause, Residence,
-    ResidenceModel, Status, Telemetry,
+    AxisModel, Command, DeviceState, FaultCode, Frame, GateEvent, GateKind, Hello, Injection,
+    MODEL_FIELD_MAX, MotorTelemetry, PARAM_COUNT, ParamId, ParamValues, Reason, ResetCause,
+    Residence, ResidenceModel, Status, Telemetry,
 };
 use super::{FRAME_END, FRAME_START, MAX_FRAME_LEN, PROTOCOL_VERSION};
 
@@ -17,7 +17,7 @@ pub enum FrameError {
     BadTrailer,
     /// The CRC did not match: the line was damaged on the way.
     BadCrc,
-    /// The CRC matched but the kind letter is not one of `T H C A R S P M`.
+    /// The CRC matched but the kind letter is not one of `T H E C A R S P M`.
     UnknownKind,
     /// The CRC matched but the protocol version is not the one spoken here.
     UnsupportedVersion,
@@ -348,6 +348,11 @@ fn parse_payload(payload: &[u8]) -> Result<Frame, FrameError> {
         b'H' => Frame::Hello(Hello {
             reset_cause: coded(&mut f, ResetCause::from_code)?,
             reset_count: u16_field(&mut f)?,
+        }),
+        b'E' => Frame::Event(GateEvent {
+            kind: coded(&mut f, GateKind::from_code)?,
+            time_us: u32_field(&mut f)?,
+            boot: u16_field(&mut f)?,
         }),
         b'C' => return command_frame(&mut f),
         b'A' => Frame::Ack {

@@ -156,6 +156,11 @@ fn body(out: &mut Out<'_>, frame: &Frame) {
             out.int(h.reset_cause.code().into());
             out.int(h.reset_count.into());
         }
+        Frame::Event(e) => {
+            out.int(e.kind.code().into());
+            out.int(e.time_us.into());
+            out.int(e.boot.into());
+        }
         Frame::Command { id, command } => {
             out.int((*id).into());
             command_body(out, command);
@@ -229,6 +234,7 @@ pub fn kind_letter(frame: &Frame) -> u8 {
     match frame {
         Frame::Telemetry(_) => b'T',
         Frame::Hello(_) => b'H',
+        Frame::Event(_) => b'E',
         Frame::Command { .. } => b'C',
         Frame::Ack { .. } => b'A',
         Frame::Reject { .. } => b'R',

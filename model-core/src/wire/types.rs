@@ -145,6 +145,32 @@ pub struct Hello {
     pub reset_count: Wrapping16,
 }
 
+/// Which gate fired (`$E1` field 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
+pub enum GateKind {
+    /// The release trigger: a granule was dropped at the start radius.
+    Release = 0,
+    /// The exit light gate at the rim: a granule left the bowl.
+    Exit = 1,
+}
+
+/// A gate event (`$E1,...`), sent by the device when a gate input fires, outside the telemetry
+/// rate: the residence time is the difference of an exit and the release before it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GateEvent {
+    /// Which gate.
+    pub kind: GateKind,
+    /// Device time of the captured edge, microseconds since reset (the proximity sensors' time
+    /// base), modulo 2^32.
+    pub time_us: u32,
+    /// The reset counter of the boot that measured it ([`Hello::reset_count`]): events of
+    /// different boots have unrelated times.
+    pub boot: Wrapping16,
+}
+
 /// The answer to STATUS (`$S1,...`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -345,6 +371,8 @@ pub enum Frame {
         /// The values.
         values: ParamValues,
     },
+    /// `$E1`: a gate event (device to PC).
+    Event(GateEvent),
     /// `$M1`: the answer to MODELS, precession then spin.
     Models {
         /// Request id.
@@ -401,6 +429,7 @@ code_enum!(FaultCode {
     HostSilent,
     InvalidConfiguration,
 });
+code_enum!(GateKind { Release, Exit });
 code_enum!(ResetCause {
     PowerOn,
     Pin,

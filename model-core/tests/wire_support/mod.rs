@@ -115,6 +115,13 @@ pub fn frame() -> impl Strategy<Value = Frame> {
             reset_cause,
             reset_count
         })),
+        1 => (any::<bool>(), any::<u32>(), any::<u16>()).prop_map(|(exit, time_us, boot)| {
+            Frame::Event(GateEvent {
+                kind: if exit { GateKind::Exit } else { GateKind::Release },
+                time_us,
+                boot,
+            })
+        }),
         1 => (any::<u16>(), command()).prop_map(|(id, command)| Frame::Command { id, command }),
         1 => any::<u16>().prop_map(|id| Frame::Ack { id }),
         1 => (any::<u16>(), 0..Reason::ALL.len()).prop_map(|(id, r)| Frame::Reject {

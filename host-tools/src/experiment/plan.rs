@@ -1,0 +1,100 @@
+//! The experiment plan (TOML): a settle time and a list of conditions, each a combined bowl
+//! speed (split into motor speeds by the rig's rule) or the two motor speeds, repeated.
+
+use anyhow::{Context, Result, bail};
+use serde::Deserialize;
+
+/// One condition as written.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Condition {
+    /// Combined bowl speed (paper Eq. 2), rad/s.
+    pub bowl_rad_s: Option<f64>,
+    /// Precession speed, rad/s (with `spin_rad_s`, instead of `bowl_rad_s`).
+    pub precession_rad_s: Option<f64>,
+    /// Spin speed, rad/s.
+    pub spin_rad_s: Option<f64>,
+    /// Releases at this condition.
+    pub repeats: usize,
+}
+
+/// A plan.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Plan {
+    /// Wait after the speeds have settled, before each release, s.
+    #[serde(default = "default_settle")]
+    pub settle_s: f64,
+    /// The conditions, run in order.
+    pub condition: Vec<Condition>,
+}
+
+fn default_settle() -> f64 {
+    3.0
+}
+
+/// Reads and checks a plan.
+pub fn parse(text: &str, file: &str) -> Result<Plan> {
+    let plan: Plan = toml::from_str(text).with_context(|| format!("{file}: not a valid plan"))?;
+    if !(plan.settle_s.is_finite() && (0.0..=600.0).contains(&plan.settle_s)) {
+        bail!(
+            "{file}: settle_s = {} must lie in 0 ..= 600 s",
+            plan.settle_s
+        );
+    }
+    if plan.condition.is_empty() {
+        bail!("{file}: the plan has no [[condition]]");
+    }
+    for (i, c) in plan.condition.iter().enumerate() {
+        let n = i + 1;
+        match (c.bowl_rad_s, c.precession_rad_s, c.spin_rad_s) {
+            (Some(w), None, None) if w.is_finite() && w > 0.0 => {}
+            (None, Some(p), Some(s)) if p.is_finite() && s.is_finite() => {}
+            _ => bail!(
+                "{file}: condition {n} needs either bowl_rad_s (> 0) or both precession_rad_s \
+                 and spin_rad_s, finite"
+            ),
+        }
+        if !(1..=10_000).contains(&c.repeats) {
+            bail!(
+                "{file}: condition {n} repeats = {} must lie in 1 ..= 10000",
+                c.repeats
+            );
+        }
+    }
+    Ok(plan)
+}
+
+/// Total releases of a plan.
+pub fn releases(plan: &Plan) -> usize {
+    plan.condition.iter().map(|c| c.repeats).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_both_forms_and_names_errors() {
+        let p = parse(
+            "settle_s = 1.5\n[[condition]]\nbowl_rad_s = 6.5\nrepeats = 5\n\
+             [[condition]]\nprecession_rad_s = 2.0\nspin_rad_s = 3.0\nrepeats = 2\n",
+            "p.toml",
+        )
+        .unwrap();
+        assert_eq!(p.settle_s, 1.5);
+        assert_eq!(releases(&p), 7);
+        let e = parse(
+            "[[condition]]\nbowl_rad_s = 6.5\nspin_rad_s = 1\nrepeats = 5\n",
+            "p.toml",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("condition 1 needs either"), "{e}");
+        let e = parse("[[condition]]\nbowl_rad_s = 6.5\nrepeats = 0\n", "p.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("repeats = 0"), "{e}");
+        assert!(parse("settle_s = 1\n", "p.toml").is_err());
+    }
+}

@@ -1,0 +1,135 @@
+//! The results file of `bowl experiment`: one row per release, written and flushed as soon as
+//! the release is over (so an interrupted experiment keeps every row measured so far), read back
+//! by `bowl fit`. Each row names its speed trace file (`t_s,bowl_rad_s`: time since the release
+//! and the measured combined bowl speed), relative to the results file.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+
+/// How a release ended.
+pub const STATUS_OK: &str = "ok";
+/// The granule was still in the bowl when the run gave up.
+pub const STATUS_NEVER_LEFT: &str = "never_left";
+/// The speeds did not settle (a stalled or too weak motor).
+pub const STATUS_NOT_SETTLED: &str = "not_settled";
+/// The controller stopped the motors on a fault during the run.
+pub const STATUS_MOTOR_FAULT: &str = "motor_fault";
+
+/// One release.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    /// Release number, from 1.
+    pub run: usize,
+    /// The plan's condition, from 1.
+    pub condition: usize,
+    /// Target combined bowl speed (paper Eq. 2), rad/s.
+    pub bowl_rad_s: f64,
+    /// Target precession speed, rad/s.
+    pub precession_rad_s: f64,
+    /// Target spin speed, rad/s.
+    pub spin_rad_s: f64,
+    /// Nominal start radius, m.
+    pub release_radius_m: f64,
+    /// Rim radius (exit gate), m.
+    pub rim_radius_m: f64,
+    /// Assumed `k2` of the granules.
+    pub k2: f64,
+    /// `ok`, `never_left`, `not_settled`, `motor_fault` (with detail after a colon).
+    pub status: String,
+    /// Release to exit gate, s; empty unless `ok`.
+    pub residence_s: Option<f64>,
+    /// Mean of the measured combined speed from release to exit, rad/s.
+    pub trace_mean_rad_s: Option<f64>,
+    /// Its standard deviation, rad/s.
+    pub trace_sd_rad_s: Option<f64>,
+    /// The trace file, relative to the results file.
+    pub trace_path: String,
+}
+
+/// Appends rows to a results file, flushing each.
+pub struct Writer {
+    csv: csv::Writer<std::fs::File>,
+    dir: PathBuf,
+    trace_dir: PathBuf,
+}
+
+impl Writer {
+    /// Creates `path` and the trace folder `<stem>_traces` beside it.
+    pub fn create(path: &Path) -> Result<Self> {
+        let dir = path.parent().map_or_else(PathBuf::new, Path::to_path_buf);
+        let stem = path
+            .file_stem()
+            .map_or("results".into(), |s| s.to_string_lossy());
+        let trace_dir = PathBuf::from(format!("{stem}_traces"));
+        std::fs::create_dir_all(dir.join(&trace_dir))
+            .with_context(|| format!("cannot create {}", dir.join(&trace_dir).display()))?;
+        let file = std::fs::File::create(path)
+            .with_context(|| format!("cannot create {}", path.display()))?;
+        Ok(Self {
+            csv: csv::Writer::from_writer(file),
+            dir,
+            trace_dir,
+        })
+    }
+
+    /// Writes the trace of run `run`, returns its path relative to the results file.
+    pub fn write_trace(&self, run: usize, trace: &[(f64, f64)]) -> Result<String> {
+        let rel = self.trace_dir.join(format!("run_{run:04}.csv"));
+        let mut text = String::from("t_s,bowl_rad_s\n");
+        for (t, w) in trace {
+            text.push_str(&format!("{t:.4},{w:.6}\n"));
+        }
+        let full = self.dir.join(&rel);
+        std::fs::write(&full, text).with_context(|| format!("cannot write {}", full.display()))?;
+        Ok(rel.to_string_lossy().into_owned())
+    }
+
+    /// Appends one row and flushes it to disk.
+    pub fn push(&mut self, row: &Row) -> Result<()> {
+        self.csv.serialize(row)?;
+        self.csv.flush()?;
+        Ok(())
+    }
+}
+
+/// Reads a results file: the rows with their line numbers (header = line 1).
+pub fn read(path: &Path) -> Result<Vec<(usize, Row)>> {
+    let mut reader = csv::Reader::from_path(path)
+        .with_context(|| format!("cannot read the results file {}", path.display()))?;
+    let mut rows = Vec::new();
+    for (i, rec) in reader.deserialize::<Row>().enumerate() {
+        let line = i + 2;
+        let row = rec.with_context(|| {
+            format!(
+                "{} line {line}: not a results row of bowl experiment (columns run, condition, \
+                 bowl_rad_s, ..., trace_path)",
+                path.display()
+            )
+        })?;
+        rows.push((line, row));
+    }
+    Ok(rows)
+}
+
+/// Reads a trace file (`t_s,bowl_rad_s`).
+pub fn read_trace(path: &Path) -> Result<Vec<(f64, f64)>> {
+    let mut reader = csv::Reader::from_path(path)?;
+    let mut out = Vec::new();
+    for rec in reader.deserialize::<(f64, f64)>() {
+        out.push(rec?);
+    }
+    Ok(out)
+}
+
+/// Mean and standard deviation of the speeds of a trace.
+pub fn mean_sd(trace: &[(f64, f64)]) -> Option<(f64, f64)> {
+    if trace.is_empty() {
+        return None;
+    }
+    let n = trace.len() as f64;
+    let mean = trace.iter().map(|p| p.1).sum::<f64>() / n;
+    let var = trace.iter().map(|p| (p.1 - mean).powi(2)).sum::<f64>() / n;
+    Some((mean, var.sqrt()))
+}

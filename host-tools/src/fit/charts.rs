@@ -1,0 +1,211 @@
+//! The paper's Figures 5 to 7 redrawn from a fit: residence time against bowl speed with the
+//! measured points (mean per condition, 95 % error bars) beside both fitted models (Figure 7);
+//! the exit speed (Figure 6) and the path r(t) (Figure 5) that the fitted models imply. The gates
+//! measure only residence times, so Figures 5 and 6 carry the measured times where they apply
+//! (Figure 5: the exit at the rim) and otherwise the models alone.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use model_core::particle::{Scene, position_m, residence};
+use model_core::sim::granule::G_M_S2;
+
+use super::stats::t_quantile_975;
+use super::{Fit, condition_table};
+use crate::chart::plot::{Figure, Mark, Scale, Series};
+
+/// Points along each model curve.
+const CURVE_POINTS: usize = 120;
+
+fn scene(fit: &Fit, mu: f64, omega: f64) -> Scene<f64> {
+    let r = &fit.runs[0];
+    Scene {
+        omega_rad_s: omega,
+        mu,
+        g_m_s2: G_M_S2,
+        k2: r.k2,
+        ri_m: r.release_radius_m,
+        rim_radius_m: r.rim_radius_m,
+    }
+}
+
+/// Per condition: (mean speed, mean time, half-width of the 95 % interval of the mean).
+fn measured_points(fit: &Fit) -> Vec<(f64, f64, f64)> {
+    let mut out = Vec::new();
+    let mut conditions: Vec<usize> = fit.runs.iter().map(|r| r.condition).collect();
+    conditions.sort_unstable();
+    conditions.dedup();
+    for c in conditions {
+        let runs: Vec<_> = fit.runs.iter().filter(|r| r.condition == c).collect();
+        let n = runs.len() as f64;
+        let w = runs.iter().map(|r| r.mean_rad_s).sum::<f64>() / n;
+        let t = runs.iter().map(|r| r.residence_s).sum::<f64>() / n;
+        let half = if runs.len() > 1 {
+            let var = runs
+                .iter()
+                .map(|r| (r.residence_s - t).powi(2))
+                .sum::<f64>()
+                / (n - 1.0);
+            t_quantile_975(runs.len() - 1) * (var / n).sqrt()
+        } else {
+            0.0
+        };
+        out.push((w, t, half));
+    }
+    out
+}
+
+fn speed_range(fit: &Fit) -> (f64, f64) {
+    let speeds = fit.runs.iter().map(|r| r.mean_rad_s);
+    let lo = speeds.clone().fold(f64::INFINITY, f64::min);
+    let hi = speeds.fold(0.0, f64::max);
+    (0.95 * lo, 1.05 * hi)
+}
+
+fn model_curves(
+    fit: &Fit,
+    value: &dyn Fn(&Scene<f64>, model_core::particle::Model) -> f64,
+) -> Vec<Series> {
+    let (lo, hi) = speed_range(fit);
+    fit.models
+        .iter()
+        .enumerate()
+        .map(|(i, m)| Series {
+            name: format!("{} model, fitted mu {:.4}", m.candidate.name, m.mu),
+            points: (0..=CURVE_POINTS)
+                .map(|k| {
+                    let w = lo + (hi - lo) * k as f64 / CURVE_POINTS as f64;
+                    (w, value(&scene(fit, m.mu, w), m.candidate.model))
+                })
+                .collect(),
+            mark: if i == 0 { Mark::Dashed } else { Mark::Line },
+            color: i + 1,
+        })
+        .collect()
+}
+
+fn figure(title: &str, x: &str, y: &str, series: Vec<Series>, notes: Vec<String>) -> Figure {
+    Figure {
+        title: title.into(),
+        x_label: x.into(),
+        y_label: y.into(),
+        x_scale: Scale::Linear,
+        y_scale: Scale::Linear,
+        series,
+        vlines: Vec::new(),
+        notes,
+    }
+}
+
+/// Writes `fig5_radial_fit`, `fig6_exit_speed_fit`, `fig7_residence_fit` (SVG and PNG) and
+/// `table.csv` (mean error per model and condition) into `dir`.
+pub fn write(fit: &Fit, dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let points = measured_points(fit);
+    let mut bars = Vec::new();
+    for &(w, t, half) in &points {
+        bars.extend([(w, t - half), (w, t + half), (f64::NAN, f64::NAN)]);
+    }
+    let mut fig7 = model_curves(fit, &|s, m| {
+        residence(s, m).map_or(f64::NAN, |o| o.residence_time_s())
+    });
+    fig7.push(Series {
+        name: "measured, mean per condition".into(),
+        points: points.iter().map(|p| (p.0, p.1)).collect(),
+        mark: Mark::Points,
+        color: 0,
+    });
+    fig7.push(Series {
+        name: "95 % interval of the mean".into(),
+        points: bars,
+        mark: Mark::Line,
+        color: 0,
+    });
+    let notes = vec![format!(
+        "{} runs; preferred by AIC: {}",
+        fit.runs.len(),
+        fit.preferred
+    )];
+    let draw = |f: Figure, name: &str| -> Result<()> {
+        let path = dir.join(name);
+        f.write_svg(&path)
+            .map_err(|e| anyhow::anyhow!("cannot draw {}: {e:?}", path.display()))?;
+        let png = path.with_extension("png");
+        f.write_png(&png)
+            .map_err(|e| anyhow::anyhow!("cannot draw {}: {e:?}", png.display()))
+    };
+    draw(
+        figure(
+            "Residence time against bowl speed (paper Fig. 7), measured and fitted",
+            "combined bowl speed, rad/s",
+            "residence time, s",
+            fig7,
+            notes.clone(),
+        ),
+        "fig7_residence_fit.svg",
+    )?;
+    let fig6 = model_curves(fit, &|s, m| {
+        residence(s, m)
+            .ok()
+            .and_then(|o| o.exit_velocities_m_s())
+            .map_or(f64::NAN, |v| v.1)
+    });
+    draw(
+        figure(
+            "Total exit speed against bowl speed (paper Fig. 6) of the fitted models",
+            "combined bowl speed, rad/s",
+            "exit speed, m/s",
+            fig6,
+            vec!["the gates measure times only: models alone".into()],
+        ),
+        "fig6_exit_speed_fit.svg",
+    )?;
+    // Figure 5 at the speed of the condition with the most runs.
+    let (w5, t5, _) = points
+        .iter()
+        .copied()
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .unwrap_or((1.0, 1.0, 0.0));
+    let mut fig5: Vec<Series> = fit
+        .models
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let s = scene(fit, m.mu, w5);
+            let t_end = 1.5 * t5;
+            Series {
+                name: format!("{} model, mu {:.4}", m.candidate.name, m.mu),
+                points: (0..=CURVE_POINTS)
+                    .map(|k| {
+                        let t = t_end * k as f64 / CURVE_POINTS as f64;
+                        let r = position_m(&s, m.candidate.model, t).unwrap_or(f64::NAN);
+                        (t, if r <= s.rim_radius_m { r } else { f64::NAN })
+                    })
+                    .collect(),
+                mark: if i == 0 { Mark::Dashed } else { Mark::Line },
+                color: i + 1,
+            }
+        })
+        .collect();
+    fig5.push(Series {
+        name: "measured exit (mean time at the rim)".into(),
+        points: vec![(t5, fit.runs[0].rim_radius_m)],
+        mark: Mark::Points,
+        color: 0,
+    });
+    draw(
+        figure(
+            &format!("Radial position at {w5:.2} rad/s (paper Fig. 5), fitted models"),
+            "time, s",
+            "radius, m",
+            fig5,
+            Vec::new(),
+        ),
+        "fig5_radial_fit.svg",
+    )?;
+    let table = condition_table(fit);
+    table
+        .write(&dir.join("table.csv"))
+        .with_context(|| format!("cannot write {}", dir.join("table.csv").display()))?;
+    Ok(())
+}

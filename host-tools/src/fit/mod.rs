@@ -1,0 +1,338 @@
+//! `bowl fit results.csv [--json]`: the effective rolling resistance `mu` of each candidate model
+//! from measured residence times, its 95 % interval, the residuals per condition, and which model
+//! the data supports (AIC). Method and limits: docs/experiment.md.
+
+pub mod charts;
+pub mod models;
+pub mod stats;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, bail};
+use serde::Serialize;
+use serde_json::json;
+
+use crate::experiment::results::{self, STATUS_OK};
+use models::{CANDIDATES, Candidate, Method, Run, STEADY_REL_SD, mu_ceiling, predict};
+use stats::{AIC_DECISIVE, aic, crossing, minimise, t_quantile_975};
+
+/// Arguments of `bowl fit`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The results file written by `bowl experiment`.
+    pub results: PathBuf,
+    /// Print the fit as JSON instead of tables.
+    #[arg(long)]
+    pub json: bool,
+    /// Folder for the charts and the table (default: `<results stem>_fit` beside the file).
+    #[arg(long)]
+    pub charts: Option<PathBuf>,
+    /// Do not draw charts.
+    #[arg(long)]
+    pub no_charts: bool,
+}
+
+/// A run left out, and why.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Excluded {
+    /// Line of the results file (header = 1).
+    pub row: usize,
+    /// Plain words.
+    pub reason: String,
+}
+
+/// The fit of one model.
+#[derive(Debug, Clone)]
+pub struct ModelFit {
+    /// The candidate.
+    pub candidate: Candidate,
+    /// Estimate.
+    pub mu: f64,
+    /// 95 % interval.
+    pub mu_ci95: (f64, f64),
+    /// Root mean square of the relative errors, %.
+    pub rms_error_pct: f64,
+    /// Akaike information criterion.
+    pub aic: f64,
+    /// Relative error of each run, % (prediction minus measurement, over the measurement).
+    pub errors_pct: Vec<f64>,
+}
+
+/// The whole fit.
+#[derive(Debug, Clone)]
+pub struct Fit {
+    /// Usable runs.
+    pub runs: Vec<Run>,
+    /// Runs left out.
+    pub excluded: Vec<Excluded>,
+    /// One per candidate, in [`CANDIDATES`] order.
+    pub models: Vec<ModelFit>,
+    /// `flat`, `coriolis` or `undecided`.
+    pub preferred: &'static str,
+}
+
+/// Loads the usable runs of a results file; every other row is excluded with its reason.
+pub fn load(path: &Path) -> Result<(Vec<Run>, Vec<Excluded>)> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut runs = Vec::new();
+    let mut excluded = Vec::new();
+    for (line, row) in results::read(path)? {
+        let mut exclude = |reason: String| excluded.push(Excluded { row: line, reason });
+        if row.status != STATUS_OK {
+            exclude(match row.status.split_once(':') {
+                Some((kind, detail)) => format!("{}: {}", words(kind), detail.trim()),
+                None => words(&row.status).to_string(),
+            });
+            continue;
+        }
+        let Some(t) = row.residence_s.filter(|t| t.is_finite() && *t > 0.0) else {
+            exclude("no exit gate event (residence time missing)".into());
+            continue;
+        };
+        let geometry_ok = row.release_radius_m >= 0.0
+            && row.rim_radius_m > row.release_radius_m
+            && row.k2 > 0.0
+            && row.k2 <= 1.0;
+        if !geometry_ok {
+            exclude(format!(
+                "release radius {} m, rim {} m, k2 {}: need 0 <= release < rim and 0 < k2 <= 1",
+                row.release_radius_m, row.rim_radius_m, row.k2
+            ));
+            continue;
+        }
+        let trace = match results::read_trace(&dir.join(&row.trace_path)) {
+            Ok(t) if !t.is_empty() => t,
+            _ => {
+                exclude(format!("speed trace {} missing or empty", row.trace_path));
+                continue;
+            }
+        };
+        let Some((mean, sd)) = results::mean_sd(&trace).filter(|(m, _)| *m > 0.0) else {
+            exclude("the bowl was not turning during the run".into());
+            continue;
+        };
+        let method = if sd <= STEADY_REL_SD * mean {
+            Method::ClosedForm
+        } else {
+            Method::Integrated
+        };
+        runs.push(Run {
+            condition: row.condition,
+            residence_s: t,
+            mean_rad_s: mean,
+            release_radius_m: row.release_radius_m,
+            rim_radius_m: row.rim_radius_m,
+            k2: row.k2,
+            trace,
+            method,
+        });
+    }
+    Ok((runs, excluded))
+}
+
+fn words(status: &str) -> &str {
+    match status {
+        results::STATUS_NEVER_LEFT => "the granule never left the bowl",
+        results::STATUS_NOT_SETTLED => "the speeds never settled (stalled or weak motor)",
+        results::STATUS_MOTOR_FAULT => "the controller stopped the motors on a fault",
+        other => other,
+    }
+}
+
+/// Sum of squared errors of `runs` under `model` at `mu`, s^2.
+pub fn sse(runs: &[Run], model: model_core::particle::Model, mu: f64) -> f64 {
+    runs.iter()
+        .map(|r| (predict(r, model, mu) - r.residence_s).powi(2))
+        .sum()
+}
+
+/// Fits one model (needs at least 3 runs).
+pub fn fit_model(runs: &[Run], candidate: Candidate) -> ModelFit {
+    let n = runs.len();
+    let model = candidate.model;
+    let ceiling = runs.iter().map(mu_ceiling).fold(f64::INFINITY, f64::min);
+    let s = |mu: f64| sse(runs, model, mu);
+    let mu = minimise(&s, 0.0, ceiling);
+    let s_min = s(mu);
+    let t = t_quantile_975(n - 1);
+    let level = s_min * (1.0 + t * t / (n - 1) as f64);
+    let lo = if s(0.0) <= level {
+        0.0
+    } else {
+        crossing(&s, level, mu, 0.0)
+    };
+    let hi = crossing(&s, level, mu, ceiling);
+    let errors_pct: Vec<f64> = runs
+        .iter()
+        .map(|r| 100.0 * (predict(r, model, mu) - r.residence_s) / r.residence_s)
+        .collect();
+    let rms = (errors_pct.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
+    ModelFit {
+        candidate,
+        mu,
+        mu_ci95: (lo, hi),
+        rms_error_pct: rms,
+        aic: aic(s_min, n, 2),
+        errors_pct,
+    }
+}
+
+/// Fits every candidate and decides between flat and Coriolis.
+pub fn fit(runs: Vec<Run>, excluded: Vec<Excluded>) -> Result<Fit> {
+    if runs.len() < 3 {
+        bail!(
+            "{} usable runs ({} excluded): the fit needs at least 3 (two parameters, mu and the \
+             timing noise, and one degree of freedom for the interval)",
+            runs.len(),
+            excluded.len()
+        );
+    }
+    let models: Vec<ModelFit> = CANDIDATES.iter().map(|&c| fit_model(&runs, c)).collect();
+    let by_name = |n: &str| models.iter().find(|m| m.candidate.name == n).map(|m| m.aic);
+    let preferred = match (by_name("flat"), by_name("coriolis")) {
+        (Some(f), Some(c)) if f - c > AIC_DECISIVE => "coriolis",
+        (Some(f), Some(c)) if c - f > AIC_DECISIVE => "flat",
+        _ => "undecided",
+    };
+    Ok(Fit {
+        runs,
+        excluded,
+        models,
+        preferred,
+    })
+}
+
+/// The JSON of the fit (the shape docs/experiment.md gives).
+pub fn to_json(fit: &Fit) -> serde_json::Value {
+    let mut models = serde_json::Map::new();
+    for m in &fit.models {
+        models.insert(
+            m.candidate.name.into(),
+            json!({
+                "mu": m.mu,
+                "mu_ci95": [m.mu_ci95.0, m.mu_ci95.1],
+                "rms_error_pct": m.rms_error_pct,
+                "aic": m.aic,
+            }),
+        );
+    }
+    json!({
+        "models": models,
+        "preferred": fit.preferred,
+        "runs": fit.runs.len(),
+        "excluded": fit.excluded,
+    })
+}
+
+/// Per condition: mean measured speed, mean and standard error of the measured time, and the
+/// mean error of each model, %.
+pub fn condition_table(fit: &Fit) -> crate::chart::table::Table {
+    let mut header = vec!["condition", "runs", "bowl_rad_s", "t_mean_s", "t_se_s"];
+    let names: Vec<String> = fit
+        .models
+        .iter()
+        .map(|m| format!("{}_mean_error_pct", m.candidate.name))
+        .collect();
+    header.extend(names.iter().map(String::as_str));
+    let mut table = crate::chart::table::Table::new(&header);
+    let mut conditions: Vec<usize> = fit.runs.iter().map(|r| r.condition).collect();
+    conditions.sort_unstable();
+    conditions.dedup();
+    for c in conditions {
+        let idx: Vec<usize> = (0..fit.runs.len())
+            .filter(|&i| fit.runs[i].condition == c)
+            .collect();
+        let n = idx.len() as f64;
+        let mean = |f: &dyn Fn(usize) -> f64| idx.iter().map(|&i| f(i)).sum::<f64>() / n;
+        let t_mean = mean(&|i| fit.runs[i].residence_s);
+        let t_se = if idx.len() > 1 {
+            (idx.iter()
+                .map(|&i| (fit.runs[i].residence_s - t_mean).powi(2))
+                .sum::<f64>()
+                / (n - 1.0)
+                / n)
+                .sqrt()
+        } else {
+            f64::NAN
+        };
+        let mut row = vec![
+            c.to_string(),
+            idx.len().to_string(),
+            format!("{:.4}", mean(&|i| fit.runs[i].mean_rad_s)),
+            format!("{t_mean:.4}"),
+            format!("{t_se:.4}"),
+        ];
+        for m in &fit.models {
+            row.push(format!("{:+.2}", mean(&|i| m.errors_pct[i])));
+        }
+        table.row(row);
+    }
+    table
+}
+
+/// `bowl fit`.
+pub fn run(args: &Args) -> Result<()> {
+    let (runs, excluded) = load(&args.results)?;
+    let fit = fit(runs, excluded)?;
+    if !args.no_charts {
+        let dir = args.charts.clone().unwrap_or_else(|| {
+            let stem = args
+                .results
+                .file_stem()
+                .map_or("results".into(), |s| s.to_string_lossy());
+            args.results
+                .parent()
+                .unwrap_or(Path::new("."))
+                .join(format!("{stem}_fit"))
+        });
+        charts::write(&fit, &dir)?;
+        if !args.json {
+            println!("charts and table: {}", dir.display());
+        }
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&to_json(&fit))?);
+        return Ok(());
+    }
+    let integrated = fit
+        .runs
+        .iter()
+        .filter(|r| r.method == Method::Integrated)
+        .count();
+    println!(
+        "{} runs ({} by the closed form at the mean speed, {} integrated over the speed trace), {} excluded",
+        fit.runs.len(),
+        fit.runs.len() - integrated,
+        integrated,
+        fit.excluded.len()
+    );
+    for e in &fit.excluded {
+        println!("  excluded line {}: {}", e.row, e.reason);
+    }
+    println!("model      mu        95 % interval          rms error %   AIC");
+    for m in &fit.models {
+        println!(
+            "{:<10} {:.5}  [{:.5}, {:.5}]   {:>8.2}   {:>10.2}",
+            m.candidate.name, m.mu, m.mu_ci95.0, m.mu_ci95.1, m.rms_error_pct, m.aic
+        );
+    }
+    println!(
+        "preferred: {} (a model is preferred when its AIC is lower by more than {AIC_DECISIVE})",
+        fit.preferred
+    );
+    if let Some(m) = fit
+        .models
+        .iter()
+        .find(|m| m.candidate.name == fit.preferred)
+    {
+        println!(
+            "apply to the rig: bowl send PORT set MU_PPM {:.0}",
+            (m.mu * 1e6).round()
+        );
+    }
+    print!("{}", condition_table(&fit).to_csv());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;

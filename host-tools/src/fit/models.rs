@@ -1,0 +1,101 @@
+//! The candidate equations of motion and a run's predicted residence time under each.
+//!
+//! A run is predicted from its own measured speed trace: at the trace's mean speed by the closed
+//! form (paper Eq. 6 / 10, corrected, `model_core::particle::residence`) when the speed held
+//! steady, otherwise by integrating the equation over the trace
+//! (`model_core::sim::granule::Granule`, the same integrator the simulated rig's granules use).
+
+use model_core::particle::{Model, Scene, residence};
+use model_core::sim::granule::{G_M_S2, Granule};
+
+/// Relative standard deviation of the speed trace below which the closed form at the mean
+/// speed is used. `T` moves by about 1 to 3 times a relative speed change (more only near the
+/// threshold), so 0.2 % keeps the closed form's error under about 0.5 % of `T` - below the
+/// scatter of any real gate - and spares the integrator for runs that need it.
+pub const STEADY_REL_SD: f64 = 0.002;
+
+/// Integration step over a trace, s (the rig's control period).
+pub const TRACE_STEP_S: f64 = 1e-3;
+
+/// A model the fit can try. Adding one (a rolling model) means a name and a prediction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    /// Name in the JSON and the tables.
+    pub name: &'static str,
+    /// The equation of motion.
+    pub model: Model,
+}
+
+/// The models compared, in output order.
+pub const CANDIDATES: [Candidate; 2] = [
+    Candidate {
+        name: "flat",
+        model: Model::Flat,
+    },
+    Candidate {
+        name: "coriolis",
+        model: Model::Coriolis,
+    },
+];
+
+/// How a run's prediction is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// Closed form at the trace's mean speed.
+    ClosedForm,
+    /// The equation integrated over the trace.
+    Integrated,
+}
+
+/// One usable run.
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// Plan condition.
+    pub condition: usize,
+    /// Measured residence time, s.
+    pub residence_s: f64,
+    /// Mean measured combined speed, rad/s.
+    pub mean_rad_s: f64,
+    /// Start radius, m.
+    pub release_radius_m: f64,
+    /// Rim radius, m.
+    pub rim_radius_m: f64,
+    /// `k2`.
+    pub k2: f64,
+    /// Speed trace (time since release, rad/s).
+    pub trace: Vec<(f64, f64)>,
+    /// Closed form or integrator.
+    pub method: Method,
+}
+
+/// Predicted residence time at `mu`, s; infinite when the granule would never leave.
+pub fn predict(run: &Run, model: Model, mu: f64) -> f64 {
+    match run.method {
+        Method::ClosedForm => closed_form(run, model, mu, run.mean_rad_s),
+        Method::Integrated => {
+            let give_up = 20.0 * run.residence_s + 10.0;
+            Granule::new(model, mu, run.k2, run.release_radius_m, run.rim_radius_m)
+                .residence_over_trace(&run.trace, TRACE_STEP_S, give_up)
+                .unwrap_or(f64::INFINITY)
+        }
+    }
+}
+
+/// Closed-form residence time at a constant speed, s (infinite: never leaves or invalid).
+pub fn closed_form(run: &Run, model: Model, mu: f64, omega_rad_s: f64) -> f64 {
+    let scene = Scene {
+        omega_rad_s,
+        mu,
+        g_m_s2: G_M_S2,
+        k2: run.k2,
+        ri_m: run.release_radius_m,
+        rim_radius_m: run.rim_radius_m,
+    };
+    residence(&scene, model).map_or(f64::INFINITY, |o| o.residence_time_s())
+}
+
+/// The largest `mu` at which the run can leave: `ri omega^2 / g` at its fastest speed.
+pub fn mu_ceiling(run: &Run) -> f64 {
+    let fastest = run.trace.iter().map(|p| p.1).fold(run.mean_rad_s, f64::max);
+    run.release_radius_m * fastest * fastest / G_M_S2
+}

@@ -1,0 +1,280 @@
+//! The fit's statistics against known truths: synthetic residence times (closed form plus
+//! Gaussian gate noise, no plant) for the statistics, and a small plan on the simulated rig for
+//! the whole loop.
+
+use model_core::particle::Model;
+use model_core::sim::granule::{ParticleParams, gaussian};
+use model_core::sim::prng::Prng;
+
+use super::models::{Method, Run, closed_form};
+use super::*;
+use crate::experiment::results::Writer;
+use crate::experiment::simulated::SimulatedRig;
+use crate::experiment::{plan, run_plan};
+
+const SPEEDS: [f64; 3] = [2.9, 3.5, 4.2];
+
+/// `per_speed` releases at each of [`SPEEDS`] for the given truth, noise `sigma_s`.
+fn synthetic(model: Model, mu: f64, sigma_s: f64, per_speed: usize, seed: u32) -> Vec<Run> {
+    let mut rng = Prng::new(seed);
+    let mut runs = Vec::new();
+    for (c, &w) in SPEEDS.iter().enumerate() {
+        for _ in 0..per_speed {
+            let mut run = Run {
+                condition: c + 1,
+                residence_s: 0.0,
+                mean_rad_s: w,
+                release_radius_m: 0.05,
+                rim_radius_m: 0.15,
+                k2: 5.0 / 7.0,
+                trace: vec![(0.0, w)],
+                method: Method::ClosedForm,
+            };
+            run.residence_s = closed_form(&run, model, mu, w) + sigma_s * gaussian(&mut rng);
+            runs.push(run);
+        }
+    }
+    runs
+}
+
+fn fitted(fit: &Fit, name: &str) -> ModelFit {
+    fit.models
+        .iter()
+        .find(|m| m.candidate.name == name)
+        .unwrap()
+        .clone()
+}
+
+/// Over 200 synthetic data sets of 12 runs the 95 % interval covers the truth at least 181
+/// times (the binomial(200, 0.95) range holding 99.7 %), and the mean estimate lies within
+/// 3 standard errors of the mean of the truth (so the bias is well under one standard error
+/// of a single fit).
+#[test]
+fn interval_covers_and_estimate_is_unbiased() {
+    for (model, name) in [(Model::Flat, "flat"), (Model::Coriolis, "coriolis")] {
+        let mut covered = 0;
+        let mut estimates = Vec::new();
+        for seed in 0..200 {
+            let runs = synthetic(model, 0.03, 0.01, 4, seed);
+            let f = fit(runs, Vec::new()).unwrap();
+            let m = fitted(&f, name);
+            if m.mu_ci95.0 <= 0.03 && 0.03 <= m.mu_ci95.1 {
+                covered += 1;
+            }
+            estimates.push(m.mu);
+        }
+        let n = estimates.len() as f64;
+        let mean = estimates.iter().sum::<f64>() / n;
+        let sd = (estimates.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        assert!(covered >= 181, "{name}: covered {covered} of 200");
+        assert!(
+            (mean - 0.03).abs() < 3.0 * sd / n.sqrt(),
+            "{name}: mean {mean}, sd {sd}"
+        );
+    }
+}
+
+/// Where the models differ by several times the noise (2 ms against 8..18 ms at mu 0.03) the
+/// fit names the true model; with the truth flat it never prefers Coriolis, at any noise.
+#[test]
+fn preference_follows_the_truth() {
+    for seed in 0..10 {
+        let f = fit(synthetic(Model::Coriolis, 0.03, 0.002, 4, seed), Vec::new()).unwrap();
+        assert_eq!(f.preferred, "coriolis", "seed {seed}");
+        let f = fit(synthetic(Model::Flat, 0.03, 0.002, 4, seed), Vec::new()).unwrap();
+        assert_eq!(f.preferred, "flat", "seed {seed}");
+        let f = fit(synthetic(Model::Flat, 0.03, 0.02, 4, seed), Vec::new()).unwrap();
+        assert_ne!(f.preferred, "coriolis", "seed {seed}");
+    }
+}
+
+/// Too few runs is a plain error, not a panic.
+#[test]
+fn too_few_runs_is_an_error() {
+    let runs = synthetic(Model::Flat, 0.03, 0.01, 1, 1)[..2].to_vec();
+    let e = fit(runs, Vec::new()).unwrap_err().to_string();
+    assert!(e.contains("needs at least 3"), "{e}");
+}
+
+/// The whole loop on the simulated rig: a small plan with one condition too slow for the
+/// granule to leave; those releases are excluded with their reason, a row whose trace file is
+/// gone is excluded too, the rest recover the truth within the interval, and the JSON has the
+/// documented shape.
+#[test]
+fn small_plan_on_the_simulated_rig() {
+    let particle = ParticleParams {
+        mu: 0.03,
+        gate_jitter_s: 0.002,
+        ..ParticleParams::default()
+    };
+    let plan = plan::parse(
+        "settle_s = 3.0\n[[condition]]\nbowl_rad_s = 3.0\nrepeats = 3\n\
+         [[condition]]\nbowl_rad_s = 4.2\nrepeats = 3\n\
+         [[condition]]\nbowl_rad_s = 2.0\nrepeats = 1\n",
+        "plan.toml",
+    )
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("bowl-fit-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("results.csv");
+    let mut rig = SimulatedRig::new(particle, 5).unwrap();
+    let mut writer = Writer::create(&out).unwrap();
+    assert_eq!(run_plan(&mut rig, &plan, &mut writer, false).unwrap(), 7);
+    std::fs::remove_file(dir.join("results_traces/run_0002.csv")).unwrap();
+    let (runs, excluded) = load(&out).unwrap();
+    assert_eq!(runs.len(), 5);
+    assert_eq!(
+        excluded,
+        vec![
+            Excluded {
+                row: 3,
+                reason: "speed trace results_traces/run_0002.csv missing or empty".into()
+            },
+            Excluded {
+                row: 8,
+                reason: "the granule never left the bowl".into()
+            },
+        ]
+    );
+    let f = fit(runs, excluded).unwrap();
+    let c = fitted(&f, "coriolis");
+    assert!(
+        c.mu_ci95.0 <= 0.03 && 0.03 <= c.mu_ci95.1,
+        "{:?}",
+        c.mu_ci95
+    );
+    assert!(c.rms_error_pct < 1.0, "{}", c.rms_error_pct);
+    let j = to_json(&f);
+    assert_eq!(j["runs"], 5);
+    assert_eq!(j["excluded"][1]["row"], 8);
+    for name in ["flat", "coriolis"] {
+        let m = &j["models"][name];
+        for key in ["mu", "rms_error_pct", "aic"] {
+            assert!(m[key].is_f64(), "{name}.{key}");
+        }
+        assert_eq!(m["mu_ci95"].as_array().unwrap().len(), 2);
+    }
+    assert!(["flat", "coriolis", "undecided"].contains(&j["preferred"].as_str().unwrap()));
+    charts::write(&f, &dir.join("fit")).unwrap();
+    for name in [
+        "fig5_radial_fit.svg",
+        "fig6_exit_speed_fit.svg",
+        "fig7_residence_fit.svg",
+        "table.csv",
+    ] {
+        assert!(
+            dir.join("fit").join(name).metadata().unwrap().len() > 100,
+            "{name}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A stalled spin motor: the release is not made, the row says why, and the fit excludes it
+/// with the reason in plain words.
+#[test]
+fn stalled_motor_is_excluded_with_its_reason() {
+    let particle = ParticleParams::default();
+    let plan = plan::parse(
+        "settle_s = 0.5\n[[condition]]\nbowl_rad_s = 4.0\nrepeats = 1\n",
+        "p.toml",
+    )
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("bowl-fit-stall-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("results.csv");
+    let mut rig = SimulatedRig::new(particle, 2).unwrap();
+    rig.inject(model_core::wire::Injection::StallSpin).unwrap();
+    let mut writer = Writer::create(&out).unwrap();
+    run_plan(&mut rig, &plan, &mut writer, false).unwrap();
+    let (runs, excluded) = load(&out).unwrap();
+    assert!(runs.is_empty());
+    assert_eq!(excluded.len(), 1);
+    let reason = &excluded[0].reason;
+    assert!(
+        reason == "the controller stopped the motors on a fault: spin sensor lost or shaft stalled"
+            || reason.starts_with("the speeds never settled"),
+        "{reason}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Runs whose speed drifts (a 10 % ramp during the residence) are predicted by integrating
+/// over the trace, and the fit recovers the truth from them; the closed form at the mean speed
+/// would be off by more than the noise.
+#[test]
+fn drifting_speed_uses_the_integrator() {
+    let mut rng = Prng::new(11);
+    let mut runs = Vec::new();
+    for (c, &w) in SPEEDS.iter().enumerate() {
+        for _ in 0..4 {
+            let trace: Vec<(f64, f64)> = (0..=300)
+                .map(|k| (k as f64 * 0.01, w * (1.0 + 0.1 * k as f64 / 300.0)))
+                .collect();
+            let truth = model_core::sim::granule::Granule::new(
+                Model::Coriolis,
+                0.03,
+                5.0 / 7.0,
+                0.05,
+                0.15,
+            )
+            .residence_over_trace(&trace, 1e-4, 100.0)
+            .unwrap();
+            let kept: Vec<(f64, f64)> = trace.into_iter().filter(|p| p.0 <= truth).collect();
+            runs.push(Run {
+                condition: c + 1,
+                residence_s: truth + 0.002 * gaussian(&mut rng),
+                mean_rad_s: kept.iter().map(|p| p.1).sum::<f64>() / kept.len() as f64,
+                release_radius_m: 0.05,
+                rim_radius_m: 0.15,
+                k2: 5.0 / 7.0,
+                trace: kept,
+                method: Method::Integrated,
+            });
+        }
+    }
+    let f = fit(runs.clone(), Vec::new()).unwrap();
+    let c = fitted(&f, "coriolis");
+    assert!(
+        c.mu_ci95.0 <= 0.03 && 0.03 <= c.mu_ci95.1,
+        "{:?}",
+        c.mu_ci95
+    );
+    for r in &mut runs {
+        r.method = Method::ClosedForm;
+    }
+    let wrong = fitted(&fit(runs, Vec::new()).unwrap(), "coriolis");
+    assert!(
+        !(wrong.mu_ci95.0 <= 0.03 && 0.03 <= wrong.mu_ci95.1),
+        "{:?}",
+        wrong.mu_ci95
+    );
+}
+
+/// The suggested plan has conditions where the granule leaves under both models, and its
+/// printed separation is the one [`crate::experiment::suggest::separation`] computes.
+#[test]
+fn suggested_plan_leaves_and_separates() {
+    let p = ParticleParams {
+        mu: 0.03,
+        gate_jitter_s: 0.002,
+        ..ParticleParams::default()
+    };
+    let text = crate::experiment::suggest::plan_text(&p, 0.03, 6.5, 4, 10);
+    let plan = plan::parse(&text, "suggested").unwrap();
+    assert_eq!(plan.condition.len(), 4);
+    let speeds: Vec<f64> = plan
+        .condition
+        .iter()
+        .map(|c| c.bowl_rad_s.unwrap())
+        .collect();
+    for &w in &speeds {
+        let r = &synthetic(Model::Flat, 0.03, 0.0, 1, 0)[0];
+        for m in [Model::Flat, Model::Coriolis] {
+            assert!(closed_form(r, m, 0.03, w).is_finite(), "{w} rad/s");
+        }
+    }
+    let d = crate::experiment::suggest::separation(&p, 0.03, &speeds, 10, 0.002);
+    assert!(text.contains(&format!("D = {d:.1}")), "{text}");
+    assert!(d > 6.0, "{d}");
+}
