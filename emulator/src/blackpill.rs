@@ -4,15 +4,15 @@
 //! on a pseudo-terminal. The emulator's Python environment is made by `bash tests/run`
 //! (`ensure_blackpill_emulator` in tests/lib/ensure-tools.sh).
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdin, Command, Stdio};
+use std::process::{ChildStdin, Command, Stdio};
 use std::sync::mpsc;
-use std::thread::JoinHandle;
 use std::time::Duration;
 
 use anyhow::{Context, Result, anyhow, bail};
 
+use crate::process::EmulatorProcess;
 use crate::workspace;
 
 /// The Black Pill image: the release build of the firmware's board binary.
@@ -69,10 +69,12 @@ fn defmt_print(root: &Path) -> String {
 pub struct PtyBoard {
     /// The serial device to open.
     pub port: String,
-    child: Child,
-    console: Option<JoinHandle<Vec<String>>>,
+    process: EmulatorProcess,
     control: Option<ChildStdin>,
 }
+
+/// How `run_board.py` names its pseudo-terminal on its first output line of that kind.
+const PTY_PREFIX: &str = "pty: ";
 
 impl PtyBoard {
     /// Builds the image and boots it for `seconds` of device time at most (a safety net: the
@@ -102,29 +104,14 @@ impl PtyBoard {
         let control = child.stdin.take();
         let stdout = child.stdout.take().ok_or_else(|| anyhow!("no stdout"))?;
         let (tx, rx) = mpsc::channel();
-        let console = std::thread::spawn(move || {
-            let mut keep = Vec::new();
-            for line in BufReader::new(stdout).lines().map_while(|l| l.ok()) {
-                if let Some(pty) = line.strip_prefix("pty: ") {
-                    let _ = tx.send(pty.to_string());
-                } else {
-                    if keep.len() == 200 {
-                        keep.remove(0);
-                    }
-                    keep.push(line);
-                }
-            }
-            keep
-        });
-        let Ok(port) = rx.recv_timeout(Duration::from_secs(60)) else {
-            let _ = child.kill();
-            let _ = child.wait();
+        let process = EmulatorProcess::watch(child, stdout, |l| l.starts_with(PTY_PREFIX), tx);
+        let Ok(line) = rx.recv_timeout(Duration::from_secs(60)) else {
+            drop(process);
             bail!("the Black Pill emulator did not report its pseudo-terminal within 60 s");
         };
         Ok(PtyBoard {
-            port,
-            child,
-            console: Some(console),
+            port: line[PTY_PREFIX.len()..].to_string(),
+            process,
             control,
         })
     }
@@ -143,25 +130,14 @@ impl PtyBoard {
 
     /// Waits for the board to end its run by itself; its exit status.
     pub fn wait(&mut self) -> Result<std::process::ExitStatus> {
-        self.child
+        self.process
+            .child
             .wait()
             .context("waiting for the Black Pill emulator")
     }
 
     /// Stops the board; returns the last lines of its console.
-    pub fn stop(mut self) -> Vec<String> {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-        self.console
-            .take()
-            .and_then(|t| t.join().ok())
-            .unwrap_or_default()
-    }
-}
-
-impl Drop for PtyBoard {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+    pub fn stop(self) -> Vec<String> {
+        self.process.stop()
     }
 }

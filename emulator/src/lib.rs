@@ -13,6 +13,7 @@ pub mod blackpill;
 pub mod board;
 pub mod image;
 pub mod plant_log;
+pub mod process;
 pub mod qemu;
 pub mod splitter;
 pub mod workspace;

@@ -5,13 +5,13 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::sync::mpsc;
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
 
+use crate::process::EmulatorProcess;
 use crate::workspace;
 
 /// The emulator's program.
@@ -95,8 +95,7 @@ pub fn command(elf: &Path, profile: Profile, serial: &Serial) -> Command {
 pub struct PtyBoard {
     /// The serial device to open.
     pub port: String,
-    child: Child,
-    console: Option<JoinHandle<Vec<String>>>,
+    process: EmulatorProcess,
 }
 
 impl PtyBoard {
@@ -124,22 +123,8 @@ impl PtyBoard {
             }
         });
         let stdout = child.stdout.take().ok_or_else(|| anyhow!("no stdout"))?;
-        let console = std::thread::spawn(move || {
-            let mut keep = Vec::new();
-            let mut reported = false;
-            for line in BufReader::new(stdout).lines().map_while(|l| l.ok()) {
-                if !reported && line.contains("redirected to ") {
-                    reported = true;
-                    let _ = tx.send(line);
-                    continue;
-                }
-                if keep.len() == 200 {
-                    keep.remove(0);
-                }
-                keep.push(line);
-            }
-            keep
-        });
+        let process =
+            EmulatorProcess::watch(child, stdout, |l| pty_named_in(l).is_some(), tx.clone());
         let deadline = Instant::now() + Duration::from_secs(10);
         let mut qemu_said = Vec::new();
         let mut found = None;
@@ -154,8 +139,7 @@ impl PtyBoard {
             }
         }
         let Some(port) = found else {
-            let _ = child.kill();
-            let _ = child.wait();
+            drop(process);
             bail!(
                 "{PROGRAM} did not report its serial pseudo-terminal{}",
                 qemu_said
@@ -163,28 +147,12 @@ impl PtyBoard {
                     .map_or(String::new(), |l| format!(" (it said: {l})"))
             );
         };
-        Ok(PtyBoard {
-            port,
-            child,
-            console: Some(console),
-        })
+        Ok(PtyBoard { port, process })
     }
 
     /// Stops the board; returns the last lines of its semihosting console.
-    pub fn stop(mut self) -> Vec<String> {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-        self.console
-            .take()
-            .and_then(|t| t.join().ok())
-            .unwrap_or_default()
-    }
-}
-
-impl Drop for PtyBoard {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+    pub fn stop(self) -> Vec<String> {
+        self.process.stop()
     }
 }
 

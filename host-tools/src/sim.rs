@@ -311,7 +311,7 @@ fn check_lowest(rigs: &[rig_file::Rig], x: f32, flag: &str) -> Result<()> {
     Ok(())
 }
 
-/// `f` over `items` on all cores, results in order.
+/// `f` over `items` on all cores, results in order; a panic in `f` is raised again here.
 pub(crate) fn parallel<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let chunk = items.len().div_ceil(threads).max(1);
@@ -322,7 +322,7 @@ pub(crate) fn parallel<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync
             .collect();
         handles
             .into_iter()
-            .flat_map(|h| h.join().expect("a report thread panicked"))
+            .flat_map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
             .collect()
     })
 }

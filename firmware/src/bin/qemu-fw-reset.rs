@@ -7,7 +7,7 @@
 #![no_std]
 #![no_main]
 
-use cortex_m_rt::{ExceptionFrame, entry, exception};
+use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
 use firmware::app::binding::{PERSISTED_COUNT, default_persisted};
 use firmware::app::params::{LoadError, ParamLog};
@@ -58,12 +58,4 @@ fn main() -> ! {
     cortex_m::peripheral::SCB::sys_reset()
 }
 
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    qemu::fail_on_panic(info)
-}
-
-#[exception]
-unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
-    qemu::fail_on_hard_fault(frame)
-}
+firmware::test_image_handlers!();

@@ -49,3 +49,19 @@ pub fn fail_on_hard_fault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
     cortex_m_semihosting::hprintln!("HARD FAULT at pc {:#010x}", frame.pc());
     exit(false)
 }
+
+/// A test image's panic and hard-fault handlers: both say where and fail the run.
+#[macro_export]
+macro_rules! test_image_handlers {
+    () => {
+        #[panic_handler]
+        fn panic(info: &core::panic::PanicInfo) -> ! {
+            $crate::qemu::fail_on_panic(info)
+        }
+
+        #[cortex_m_rt::exception]
+        unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
+            $crate::qemu::fail_on_hard_fault(frame)
+        }
+    };
+}

@@ -48,24 +48,6 @@ pub enum Extent {
     Quick,
 }
 
-/// Maps `f` over `items` on up to `available_parallelism` threads, keeping the order.
-fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
-    let workers = std::thread::available_parallelism()
-        .map_or(1, usize::from)
-        .clamp(1, items.len().max(1));
-    let chunk = items.len().div_ceil(workers).max(1);
-    std::thread::scope(|s| {
-        let handles: Vec<_> = items
-            .chunks(chunk)
-            .map(|c| s.spawn(|| c.iter().map(&f).collect::<Vec<R>>()))
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-            .collect()
-    })
-}
-
 /// One commissioned step of the settling sweep.
 #[derive(Clone, Copy, Debug)]
 pub struct SettlingPoint {
@@ -93,7 +75,7 @@ pub fn settling_pulse_counts(extent: Extent) -> &'static [u16] {
 
 /// Runs the commissioned step (nominal rig and controller, seed `seed`) for every pulse count.
 pub fn settling_points(extent: Extent, seed: u32) -> Vec<SettlingPoint> {
-    par_map(settling_pulse_counts(extent), |&n| {
+    crate::sim::parallel(settling_pulse_counts(extent), |&n| {
         let o = experiments::commissioned_step(
             rig_with_pulses(n),
             ControllerConfig::nominal(),
@@ -303,7 +285,7 @@ pub fn hold_points(extent: Extent, seed: u32) -> Vec<HoldPoint> {
             }
         }
     }
-    par_map(&jobs, |&(setup, g, scheduled)| {
+    crate::sim::parallel(&jobs, |&(setup, g, scheduled)| {
         let (r, fault) = experiments::low_speed_hold_at_rate(
             setup.tick_hz,
             seed,

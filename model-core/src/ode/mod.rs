@@ -12,7 +12,7 @@
 //! output). Every run reports the right-hand-side evaluations and steps, refuses a step beyond
 //! the method's stability limit instead of returning a wrong number, and stops at a step cap.
 //!
-//! Stability on this ODE: the fast mode is `l2 = -k omega (s + k mu)` (MODEL-NOTES; `s + k mu = 1`
+//! Stability on this ODE: the fast mode is `l2 = -k omega (s + k mu)` (docs/model.md, Stability; `s + k mu = 1`
 //! for the flat model). Explicit Euler is stable for `h |l2| <= 2`, RK4 for `h |l2| <= 2.785`
 //! (its real-axis limit); our semi-implicit Euler takes the friction term implicitly and is
 //! stable for every step (accuracy, not stability, limits it).

@@ -138,7 +138,7 @@ fn euler_beyond_its_limit_would_have_oscillated() {
 
 #[test]
 fn errors_at_h_omega_1_match_the_notes_table() {
-    // MODEL-NOTES: error in T at h omega = 1 is 29-41 % (Euler), 12-17 % (semi-implicit),
+    // docs/model.md (Stability): error in T at h omega = 1 is 29-41 % (Euler), 12-17 % (semi-implicit),
     // 0.08-0.27 % (RK4). Our semi-implicit Euler takes the friction implicitly, so its figure
     // may differ; the ordering and the magnitudes must hold.
     extern crate std;

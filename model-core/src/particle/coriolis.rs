@@ -1,4 +1,4 @@
-//! Residence time of the Coriolis model (paper Eq. 10, 11 with MODEL-NOTES' corrected A, B).
+//! Residence time of the Coriolis model (paper Eq. 10, 11 with the corrected A, B of docs/model.md §3).
 
 use super::flat::acosh_1p_ratio;
 use super::{Exit, Model, Scene, SceneError, Shape, condition};
@@ -15,8 +15,8 @@ const MAX_NEWTON: u32 = 40;
 /// flat model's closed form scaled to the same curvature at 0,
 /// `u0 = acosh(1 + x / (A (1 + q)))` (exact at `mu = 0`, within about `k mu` otherwise). If
 /// `F(u0) < x`, `u0` becomes the lower bracket and one step takes us above the root; from there
-/// Newton is monotone. Every iterate is clamped to the bracket, whose upper end is MODEL-NOTES'
-/// `sqrt(2 x / A)` (`F >= A u^2 / 2`); the notes' tighter `ln((1 + x)/A)` costs a logarithm and
+/// Newton is monotone. Every iterate is clamped to the bracket, whose upper end is
+/// `sqrt(2 x / A)` (`F >= A u^2 / 2`, docs/model.md §4); the tighter `ln((1 + x)/A)` costs a logarithm and
 /// the start makes it unnecessary.
 /// Stop test: after a step `d` the remaining error is about `F''/(2 F') d^2`; we stop when that
 /// is below a quarter of an ulp of `u`, which saves the customary extra iteration.

@@ -1,5 +1,5 @@
 //! A sphere rolling outward in the spinning bowl: paper Eq. 5 to 12, corrected as in
-//! `shared/MODEL-NOTES.md`.
+//! docs/model.md.
 //!
 //! The particle starts at rest at radius `ri_m` on a bowl turning at `omega_rad_s`; the
 //! centrifugal term pushes it out, an *effective rolling resistance* `mu` (times `g`) holds it
@@ -16,7 +16,7 @@
 //! The paper uses a *sliding* friction coefficient 0.4 in a *rolling* model; with it the
 //! equilibrium radius `a = mu g / omega^2` exceeds every bowl and nothing ever leaves. We name the
 //! coefficient for what the model needs, an effective rolling resistance, and default it to the
-//! paper's own "correction factor" 0.029 (see MODEL-NOTES, "The parameter problem"); 0.4 stays
+//! paper's own "correction factor" 0.029 (docs/model.md §5, "The parameter problem"); 0.4 stays
 //! reachable and then gives [`Outcome::NeverLeaves`].
 
 mod coriolis;
@@ -201,7 +201,7 @@ impl<T: Real> Scene<T> {
         Ok(())
     }
 
-    /// The equilibrium radius `a = mu g / omega^2`, m (MODEL-NOTES): infinite at `omega = 0`.
+    /// The equilibrium radius `a = mu g / omega^2`, m (docs/model.md §4): infinite at `omega = 0`.
     /// Divides twice by omega rather than once by `omega^2` so a large omega cannot overflow.
     pub fn equilibrium_radius_m(&self) -> T {
         if self.omega_rad_s > T::ZERO {
@@ -283,7 +283,7 @@ impl<T: Real> Shape<T> {
     }
 }
 
-/// Residence time `T` and exit velocities (paper Eq. 7, 11, 12; MODEL-NOTES "Residence time").
+/// Residence time `T` and exit velocities (paper Eq. 7, 11, 12; docs/model.md §4, "Residence time T").
 ///
 /// `ri >= R` gives [`Outcome::AlreadyAtRim`], `ri <= a` (or `omega = 0`)
 /// [`Outcome::NeverLeaves`]. Flat: `T = log1p(x + sqrt(x (x + 2))) / (k omega)` with

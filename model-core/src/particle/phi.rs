@@ -1,6 +1,6 @@
 //! `e^z - 1 - z` and `e^z - 1` together, without cancellation.
 //!
-//! The Coriolis solution (paper Eq. 10, corrected in MODEL-NOTES) is
+//! The Coriolis solution (paper Eq. 10, corrected as in docs/model.md §3) is
 //! `F(u) = A (e^u - 1) + B (e^{-q u} - 1)`; since `A - B q = 0` this equals
 //! `A phi(u) + B phi(-q u)` with `phi(z) = e^z - 1 - z`. For small `z`, `phi(z)` is about `z^2 / 2`
 //! and `expm1(z) - z` would cancel all but a few digits, so we sum its Taylor series there.

@@ -29,7 +29,7 @@ fn leaves(o: Outcome<f64>) -> (f64, f64, f64) {
 }
 
 /// Independent reference for the Coriolis time: bisection on the printed form
-/// `a + (ri - a)(A e^{l1 t} + B e^{l2 t}) = R` with MODEL-NOTES' A, B, l1, l2 computed directly.
+/// `a + (ri - a)(A e^{l1 t} + B e^{l2 t}) = R` with the corrected A, B, l1, l2 of docs/model.md §3 computed directly.
 fn coriolis_time_bisection(s: &Scene<f64>) -> f64 {
     let k = s.k2.sqrt();
     let root = (1.0 + s.k2 * s.mu * s.mu).sqrt();
@@ -59,7 +59,7 @@ fn coriolis_time_bisection(s: &Scene<f64>) -> f64 {
 
 #[test]
 fn corrected_coefficients_are_exact_at_mu_0_2() {
-    // MODEL-NOTES check value: mu = 0.2, k2 = 5/7 -> l1 = 5 omega/7, l2 = -omega, A = 7/12.
+    // docs/model.md §3 check value: mu = 0.2, k2 = 5/7 -> l1 = 5 omega/7, l2 = -omega, A = 7/12.
     let s = scene(2.0, 0.2, 0.05, 0.1);
     let sh = Shape::new(&s, Model::Coriolis).unwrap();
     assert!((sh.c1 - 5.0 / 7.0).abs() < 1e-15);
@@ -115,7 +115,7 @@ fn coriolis_time_matches_bisection_and_is_slower() {
 
 #[test]
 fn coriolis_effect_is_small_at_mu_0_029() {
-    // MODEL-NOTES: 0.3 to 2 % at a coefficient near 0.03 for omega >= 1.8.
+    // docs/model.md §6: 0.3 to 2 % at a coefficient near 0.03 for omega >= 1.8.
     for &w in &[1.8, 2.5, 3.6] {
         let s = scene(w, 0.029, 0.09, 0.1);
         let tf = residence(&s, Model::Flat).unwrap().residence_time_s();
