@@ -2,9 +2,10 @@
 //! hardware: the firmware and the virtual rig both drive a [`Device`] over their own [`Backend`]
 //! (what the protocol needs from the controller).
 
-use super::decode::{Decoder, FrameError};
+use super::decode::FrameError;
 use super::encode::{EncodeError, encode};
 use super::params::{PARAM_COUNT, ParamId, ParamValues};
+use super::stream::Decoder;
 use super::types::{
     AxisModel, Command, Frame, Hello, Injection, Reason, ResidenceModel, Status, Telemetry,
 };

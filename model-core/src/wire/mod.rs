@@ -21,11 +21,13 @@ pub mod decode;
 pub mod device;
 pub mod encode;
 pub mod params;
+pub mod stream;
 pub mod types;
 
-pub use decode::{DecodeStats, Decoder, FrameError, decode_frame, parse_command_line, parse_line};
+pub use decode::{FrameError, decode_frame, parse_command_line, parse_line};
 pub use encode::{EncodeError, encode};
 pub use params::*;
+pub use stream::{DecodeStats, Decoder};
 pub use types::*;
 
 /// The protocol version in every frame header (`$T1`): one decimal digit.

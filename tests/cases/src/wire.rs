@@ -5,7 +5,7 @@
 use crate::check::{Bench, Case, Failure, ensure};
 use model_core::wire::crc::crc32;
 use model_core::wire::{
-    DeviceState, FaultCode, Frame, MAX_FRAME_LEN, MotorTelemetry, Residence, Telemetry, decode,
+    Decoder, DeviceState, FaultCode, Frame, MAX_FRAME_LEN, MotorTelemetry, Residence, Telemetry,
     encode,
 };
 
@@ -96,7 +96,7 @@ fn doc_example() -> Result<(), Failure> {
 }
 
 fn resync() -> Result<(), Failure> {
-    let mut d = decode::Decoder::new();
+    let mut d = Decoder::new();
     let mut ok = 0u32;
     // Noise, the example with its `\n` lost, then the example intact.
     let first = EXAMPLE.get(..EXAMPLE.len() - 1).unwrap_or(&[]);
@@ -121,7 +121,7 @@ fn bench_encode(i: usize) -> f32 {
 }
 
 fn bench_decode(_i: usize) -> f32 {
-    let mut d = decode::Decoder::new();
+    let mut d = Decoder::new();
     let mut n = 0u32;
     d.push_slice(core::hint::black_box(EXAMPLE), |r, _| {
         n += u32::from(r.is_ok())
