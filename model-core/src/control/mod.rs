@@ -61,6 +61,7 @@
 
 pub mod commission;
 pub mod config;
+mod const_trig;
 mod controller;
 pub mod estimator;
 pub mod pi;
