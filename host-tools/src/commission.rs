@@ -16,11 +16,9 @@ use model_core::wire::{
 };
 use serde::Serialize;
 
-use crate::send::{EXIT_REJECTED, EXIT_TIMEOUT, command_line, explain, transact};
+use crate::exit_code;
+use crate::send::{command_line, explain, transact};
 use crate::serial::{Port, ReadOutcome};
-
-/// Exit status when commissioning ended in a fault.
-pub const EXIT_FAULT: i32 = 4;
 
 /// How long one command waits for its answer.
 const ANSWER_TIMEOUT: Duration = Duration::from_millis(1000);
@@ -235,12 +233,12 @@ pub fn run(args: &Args) -> Result<i32> {
             report.result = "rejected";
             report.reason = Some(reason.token());
             print(&report, args.json)?;
-            return Ok(EXIT_REJECTED);
+            return Ok(exit_code::REFUSED);
         }
         _ => {
             report.result = "timeout";
             print(&report, args.json)?;
-            return Ok(EXIT_TIMEOUT);
+            return Ok(exit_code::TIMEOUT);
         }
     }
     if !args.json {
@@ -259,7 +257,7 @@ pub fn run(args: &Args) -> Result<i32> {
         End::Fault(fault) => {
             report.result = "fault";
             report.fault = Some(format!("{fault:?} (code {})", fault.code()));
-            EXIT_FAULT
+            exit_code::FAULT
         }
         End::OtherState(state) => {
             bail!("commissioning ended in state {state:?} (another PC may have sent a command)")
@@ -268,7 +266,7 @@ pub fn run(args: &Args) -> Result<i32> {
             report.result = "timeout";
             // Leave the motors off rather than half-way through a duty step.
             let _ = ask(&mut port, &mut ids, &["STOP"]);
-            EXIT_TIMEOUT
+            exit_code::TIMEOUT
         }
     };
     if code == 0 {

@@ -1,11 +1,14 @@
 //! `bowl`: the PC side of the bowl granulation rig.
 
+use std::process::ExitCode;
+
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 mod chart;
 mod commission;
 mod demo;
+mod exit_code;
 mod experiment;
 mod family_file;
 mod fit;
@@ -63,20 +66,59 @@ enum Command {
     Fit(fit::Args),
 }
 
-fn main() -> Result<()> {
-    let cli = Cli::parse();
+fn main() -> ExitCode {
+    restore_default_sigpipe();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            // --help and --version end here too, on standard output and with success.
+            let _ = e.print();
+            return ExitCode::from(if e.use_stderr() {
+                exit_code::USAGE as u8
+            } else {
+                exit_code::OK as u8
+            });
+        }
+    };
+    let code = match run(cli) {
+        Ok(code) => code,
+        Err(e) if exit_code::is_closed_output(&e) => exit_code::OK,
+        Err(e) => {
+            eprintln!("bowl: {e:#}");
+            exit_code::for_error(&e)
+        }
+    };
+    ExitCode::from(u8::try_from(code).unwrap_or(1))
+}
+
+/// `bowl ... | head`: when the reader goes away, end quietly the way Unix tools do (the default
+/// action of SIGPIPE), instead of failing on the next write to standard output. Logs are flushed
+/// as they are written, so nothing already received is lost.
+fn restore_default_sigpipe() {
+    #[cfg(unix)]
+    {
+        use nix::sys::signal::{SigHandler, Signal, signal};
+        // SAFETY: SIG_DFL installs no handler of ours; nothing else in the process relies on
+        // SIGPIPE being ignored (writes to a closed pipe end the process, as for `cat`).
+        let _ = unsafe { signal(Signal::SIGPIPE, SigHandler::SigDfl) };
+    }
+}
+
+/// Runs the command; its exit code (see [`exit_code`]) or the error that ended it.
+fn run(cli: Cli) -> Result<i32> {
+    let done = |r: Result<()>| r.map(|()| exit_code::OK);
     match cli.command {
-        Command::Kinematics(args) => kinematics::run(&args),
-        Command::Chart(args) => chart::run(&args),
-        Command::Predict(args) => predict::run(&args),
-        Command::Monitor(args) => monitor::run(&args),
-        Command::Send(args) => send::run(&args).map(|code| std::process::exit(code)),
-        Command::Commission(args) => commission::run(&args).map(|code| std::process::exit(code)),
-        Command::Replay(args) => replay::run(&args),
-        Command::Demo(args) => demo::run(&args),
-        Command::Serve(args) => serve::run(&args),
-        Command::Sim(report) => sim::run(&report),
-        Command::Experiment(args) => experiment::run(&args),
-        Command::Fit(args) => fit::run(&args),
+        Command::Kinematics(args) => done(kinematics::run(&args)),
+        Command::Chart(args) => done(chart::run(&args)),
+        Command::Predict(args) => done(predict::run(&args)),
+        Command::Monitor(args) => done(monitor::run(&args)),
+        Command::Send(args) => send::run(&args),
+        Command::Commission(args) => commission::run(&args),
+        Command::Replay(args) => done(replay::run(&args)),
+        Command::Demo(args) => done(demo::run(&args)),
+        Command::Serve(args) => done(serve::run(&args)),
+        Command::Sim(report) => done(sim::run(&report)),
+        Command::Experiment(args) => done(experiment::run(&args)),
+        Command::Fit(args) => done(fit::run(&args)),
     }
 }

@@ -278,6 +278,8 @@ fn open_log(path: &PathBuf) -> Result<BufWriter<File>> {
 
 /// Runs `bowl monitor`.
 pub fn run(args: &Args) -> Result<()> {
+    crate::serial::baud_rate(args.baud)?;
+    crate::serial::check_path(&args.port)?;
     let plain = args.plain || !std::io::stdout().is_terminal();
     let mut log = args.log.as_ref().map(open_log).transpose()?;
     let started = Instant::now();
@@ -366,5 +368,13 @@ pub fn run(args: &Args) -> Result<()> {
     summary["reconnects"] = json!(view.reconnects);
     summary["logged_rows"] = json!(view.logged_rows);
     println!("{summary}");
+    if !ever_connected {
+        return Err(crate::exit_code::LinkError(format!(
+            "no telemetry: {} never appeared or could not be opened in {:.0} s",
+            args.port,
+            started.elapsed().as_secs_f64()
+        ))
+        .into());
+    }
     Ok(())
 }

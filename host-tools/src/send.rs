@@ -9,12 +9,8 @@ use model_core::wire::{
     Decoder, Frame, FrameError, PROTOCOL_VERSION, ParamId, Reason, decode_frame,
 };
 
+use crate::exit_code;
 use crate::serial::{Port, ReadOutcome};
-
-/// Exit status of a rejected command.
-pub const EXIT_REJECTED: i32 = 2;
-/// Exit status when no answer came.
-pub const EXIT_TIMEOUT: i32 = 3;
 
 /// Flags of `bowl send`.
 #[derive(clap::Args)]
@@ -139,7 +135,7 @@ pub fn run(args: &Args) -> Result<i32> {
                 reason.token(),
                 explain(reason)
             );
-            return Ok(EXIT_REJECTED);
+            return Ok(exit_code::ERROR);
         }
     };
     let mut port = Port::open(&args.port, args.baud)?;
@@ -147,9 +143,9 @@ pub fn run(args: &Args) -> Result<i32> {
         Some(frame) => {
             println!("{}", describe(&frame));
             Ok(if matches!(frame, Frame::Reject { .. }) {
-                EXIT_REJECTED
+                exit_code::REFUSED
             } else {
-                0
+                exit_code::OK
             })
         }
         None => {
@@ -157,7 +153,7 @@ pub fn run(args: &Args) -> Result<i32> {
                 "timeout: no answer to id {id} within {} ms",
                 args.timeout_ms
             );
-            Ok(EXIT_TIMEOUT)
+            Ok(exit_code::TIMEOUT)
         }
     }
 }

@@ -93,9 +93,12 @@ pub fn omega_for_residence_time<T: Real>(
     }
     let tol = T::from_f64(4.0) * T::EPSILON;
     let settle = |omega: T| {
-        // Forward would find ri within rounding of a: T is not determined by this omega.
+        // Forward would find ri within rounding of a, or F overflows at the target time (a
+        // target so long that only a speed within rounding of the threshold gives it): T is
+        // not determined by this omega.
         let a = mu_g / omega / omega;
-        if a >= ri * (T::ONE - T::from_f64(8.0) * T::EPSILON) {
+        let (f, _, _) = shape.eval(l * omega);
+        if a >= ri * (T::ONE - T::from_f64(8.0) * T::EPSILON) || !f.is_finite() {
             Err(InverseError::BeyondPrecision)
         } else {
             Ok(omega)

@@ -99,6 +99,9 @@ pub enum SceneError {
     /// The inputs are valid but a result (or an intermediate of it) overflows the number type,
     /// e.g. `cosh(k omega t)` for a long time in `f32`, or absurd magnitudes. Rescale the units.
     OutOfRange,
+    /// The root finder for the residence time did not converge: no result rather than a wrong
+    /// one (not seen on any tested input; it would be a defect).
+    NoConvergence,
 }
 
 /// The result of [`residence`]. Never NaN; the three physical cases are explicit.
