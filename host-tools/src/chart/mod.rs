@@ -14,6 +14,8 @@ pub mod figures;
 pub mod plot;
 pub mod qemu_log;
 pub mod reference;
+#[cfg(test)]
+mod reference_check;
 pub mod scipy;
 pub mod stability;
 pub mod table;

@@ -96,6 +96,17 @@ impl Ctx {
             cc: Consts::new().expect("astro-float constants cache"),
         }
     }
+    fn inputs(&self, s: &RefScene) -> [BigFloat; 6] {
+        [
+            s.omega_rad_s,
+            s.mu,
+            s.g_m_s2,
+            s.k2,
+            s.start_radius_m,
+            s.rim_radius_m,
+        ]
+        .map(|v| self.f(v))
+    }
     fn f(&self, v: f64) -> BigFloat {
         BigFloat::from_f64(v, P)
     }
@@ -117,20 +128,52 @@ pub fn outcome(scene: &RefScene, model: RefModel) -> RefOutcome {
         return RefOutcome::AtRim;
     }
     let mut c = Ctx::new();
-    let w = c.f(scene.omega_rad_s);
-    let mu = c.f(scene.mu);
-    let g = c.f(scene.g_m_s2);
-    let k2 = c.f(scene.k2);
-    let ri = c.f(scene.start_radius_m);
-    let rr = c.f(scene.rim_radius_m);
-    let a = mu.mul(&g, P, RM).div(&w.mul(&w, P, RM), P, RM);
+    let inputs = c.inputs(scene);
+    match solve(&mut c, &inputs, model) {
+        None => RefOutcome::NeverLeaves,
+        Some((t, v)) => RefOutcome::Leaves {
+            time_s: c.round_to_f64(&t),
+            radial_velocity_m_s: c.round_to_f64(&v),
+        },
+    }
+}
+
+/// The relative condition number of `T`, computed here and not by the model: the sum over the
+/// six inputs of `|d ln T / d ln p|`, each by a relative perturbation of 2^-120 (far below f64
+/// rounding, far above this precision's). A relative error `e` in every input moves `T` by at
+/// most `cond e`. `None` when the particle does not leave.
+#[cfg(test)]
+pub fn condition(scene: &RefScene, model: RefModel) -> Option<f64> {
+    if scene.start_radius_m >= scene.rim_radius_m {
+        return None;
+    }
+    let mut c = Ctx::new();
+    let inputs = c.inputs(scene);
+    let (t, _) = solve(&mut c, &inputs, model)?;
+    let h = BigFloat::from_f64(2f64.powi(-120), P);
+    let one = c.f(1.0);
+    let mut cond = 0.0;
+    for i in 0..inputs.len() {
+        let mut moved = inputs.clone();
+        moved[i] = moved[i].mul(&one.add(&h, P, RM), P, RM);
+        let (tp, _) = solve(&mut c, &moved, model)?;
+        let rel = tp.sub(&t, P, RM).div(&t, P, RM).div(&h, P, RM);
+        cond += c.round_to_f64(&rel).abs();
+    }
+    Some(cond)
+}
+
+/// `T` and `r'(T)` from the inputs `[omega, mu, g, k2, ri, R]`; `None` when `ri <= a`.
+fn solve(c: &mut Ctx, inputs: &[BigFloat; 6], model: RefModel) -> Option<(BigFloat, BigFloat)> {
+    let [w, mu, g, k2, ri, rr] = inputs;
+    let a = mu.mul(g, P, RM).div(&w.mul(w, P, RM), P, RM);
     let d = ri.sub(&a, P, RM);
     if !d.is_positive() || d.is_zero() {
-        return RefOutcome::NeverLeaves;
+        return None;
     }
-    let x = rr.sub(&ri, P, RM).div(&d, P, RM);
+    let x = rr.sub(ri, P, RM).div(&d, P, RM);
     let k = k2.sqrt(P, RM);
-    let kw = k.mul(&w, P, RM);
+    let kw = k.mul(w, P, RM);
     let one = c.f(1.0);
     let (t, v) = match model {
         RefModel::Flat => {
@@ -140,9 +183,9 @@ pub fn outcome(scene: &RefScene, model: RefModel) -> RefOutcome {
             (t, d.mul(&kw, P, RM).mul(&sinh, P, RM))
         }
         RefModel::Coriolis => {
-            let kmu = k.mul(&mu, P, RM);
+            let kmu = k.mul(mu, P, RM);
             let s = one
-                .add(&k2.mul(&mu, P, RM).mul(&mu, P, RM), P, RM)
+                .add(&k2.mul(mu, P, RM).mul(mu, P, RM), P, RM)
                 .sqrt(P, RM);
             let spk = s.add(&kmu, P, RM);
             let l1 = kw.div(&spk, P, RM);
@@ -183,10 +226,7 @@ pub fn outcome(scene: &RefScene, model: RefModel) -> RefOutcome {
             (t, v)
         }
     };
-    RefOutcome::Leaves {
-        time_s: c.round_to_f64(&t),
-        radial_velocity_m_s: c.round_to_f64(&v),
-    }
+    Some((t, v))
 }
 
 #[cfg(test)]

@@ -319,7 +319,7 @@ pub fn residence<T: Real>(scene: &Scene<T>, model: Model) -> Result<Outcome<T>, 
         Model::Flat => flat::residence(scene, a),
         Model::Coriolis => coriolis::residence(scene, a)?,
     };
-    let total = (exit.radial * exit.radial + (omega * rim) * (omega * rim)).sqrt();
+    let total = hypot(exit.radial, omega * rim);
     let cond = exit.condition;
     if !(exit.time.is_finite() && exit.radial.is_finite() && total.is_finite() && cond.is_finite())
     {
@@ -332,6 +332,23 @@ pub fn residence<T: Real>(scene: &Scene<T>, model: Model) -> Result<Outcome<T>, 
         condition_number: cond,
         ill_conditioned: cond * cond * T::EPSILON > T::ONE,
     })
+}
+
+/// `sqrt(x^2 + y^2)` (paper Eq. 12's total exit speed) that cannot overflow where the result is
+/// representable: the plain form first (cheap on the MCU), scaled by the larger magnitude only
+/// when a square overflowed.
+fn hypot<T: Real>(x: T, y: T) -> T {
+    let plain = (x * x + y * y).sqrt();
+    if plain.is_finite() {
+        return plain;
+    }
+    let (x, y) = (x.abs(), y.abs());
+    let (big, small) = if x >= y { (x, y) } else { (y, x) };
+    if big == T::ZERO || !big.is_finite() {
+        return big;
+    }
+    let r = small / big;
+    big * (T::ONE + r * r).sqrt()
 }
 
 /// What the per-model solvers return (the caller adds the total speed and checks ranges).

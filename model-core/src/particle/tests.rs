@@ -340,3 +340,70 @@ proptest! {
         }
     }
 }
+
+/// Paper Eq. 12 at magnitudes where `r'^2` overflows f32 but the total speed does not: the
+/// total must come out, not an out-of-range error.
+#[test]
+fn total_exit_speed_does_not_overflow_in_its_squares() {
+    let s = Scene::<f32> {
+        omega_rad_s: 1e19,
+        mu: 0.0,
+        g_m_s2: 9.81,
+        k2: 5.0 / 7.0,
+        ri_m: 1.0,
+        rim_radius_m: 2.0,
+    };
+    // r' = (ri - a) k omega sinh(k omega T) = k omega sqrt(3) ~ 1.46e19, omega R = 2e19: each
+    // square is ~1e38..4e38, their sum overflows f32 (3.4e38); the total is ~2.5e19.
+    match residence(&s, Model::Flat) {
+        Ok(Outcome::Leaves {
+            exit_radial_velocity_m_s: v,
+            exit_total_velocity_m_s: total,
+            ..
+        }) => {
+            let expected = (f64::from(v).powi(2) + 4e38).sqrt();
+            assert!(
+                ((f64::from(total) - expected) / expected).abs() < 1e-6,
+                "{total} vs {expected}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// A target so long that only a speed within rounding of the threshold gives it (the largest
+/// finite target is the extreme case) is refused in both precisions; it used to return
+/// 3.37 rad/s, at which the forward model gives 0.62 s.
+#[test]
+fn inverse_refuses_targets_beyond_the_precision() {
+    let s64 = Scene::<f64>::default();
+    let s32 = Scene::<f32>::default();
+    for model in [Model::Flat, Model::Coriolis] {
+        for t in [f64::MAX, 1e300, 1e6, 100.0] {
+            assert_eq!(
+                omega_for_residence_time(&s64, model, t),
+                Err(InverseError::BeyondPrecision),
+                "f64 {model:?} {t}"
+            );
+        }
+        for t in [f32::MAX, 1e30, 1e4] {
+            assert_eq!(
+                omega_for_residence_time(&s32, model, t),
+                Err(InverseError::BeyondPrecision),
+                "f32 {model:?} {t}"
+            );
+        }
+        // Within the precision, the forward model at the answer gives the target back.
+        let w = omega_for_residence_time(&s64, model, 5.0).unwrap();
+        let back = residence(
+            &Scene {
+                omega_rad_s: w,
+                ..s64
+            },
+            model,
+        )
+        .unwrap()
+        .residence_time_s();
+        assert!((back - 5.0).abs() < 1e-9, "{model:?}: {back}");
+    }
+}
