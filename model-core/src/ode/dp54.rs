@@ -7,17 +7,17 @@ use super::{Limits, OdeError, OdeOutcome, OmegaProfile, Report, Rhs, leaves};
 use crate::Real;
 use crate::particle::Scene;
 
-const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
-const A2: [f64; 1] = [1.0 / 5.0];
-const A3: [f64; 2] = [3.0 / 40.0, 9.0 / 40.0];
-const A4: [f64; 3] = [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0];
-const A5: [f64; 4] = [
+pub(super) const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
+pub(super) const A2: [f64; 1] = [1.0 / 5.0];
+pub(super) const A3: [f64; 2] = [3.0 / 40.0, 9.0 / 40.0];
+pub(super) const A4: [f64; 3] = [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0];
+pub(super) const A5: [f64; 4] = [
     19372.0 / 6561.0,
     -25360.0 / 2187.0,
     64448.0 / 6561.0,
     -212.0 / 729.0,
 ];
-const A6: [f64; 5] = [
+pub(super) const A6: [f64; 5] = [
     9017.0 / 3168.0,
     -355.0 / 33.0,
     46732.0 / 5247.0,
@@ -25,7 +25,7 @@ const A6: [f64; 5] = [
     -5103.0 / 18656.0,
 ];
 /// 5th-order weights (also the 7th stage's row: FSAL).
-const B: [f64; 7] = [
+pub(super) const B: [f64; 7] = [
     35.0 / 384.0,
     0.0,
     500.0 / 1113.0,
@@ -35,7 +35,7 @@ const B: [f64; 7] = [
     0.0,
 ];
 /// 5th minus 4th order weights: the local error estimate.
-const E: [f64; 7] = [
+pub(super) const E: [f64; 7] = [
     71.0 / 57600.0,
     0.0,
     -71.0 / 16695.0,
@@ -45,7 +45,7 @@ const E: [f64; 7] = [
     -1.0 / 40.0,
 ];
 /// Dense output (continuous extension of order 4).
-const D: [f64; 7] = [
+pub(super) const D: [f64; 7] = [
     -12715105075.0 / 11282082432.0,
     0.0,
     87487479700.0 / 32700410799.0,
@@ -55,19 +55,19 @@ const D: [f64; 7] = [
     69997945.0 / 29380423.0,
 ];
 
-fn t_of<T: Real>(x: f64) -> T {
+pub(super) fn t_of<T: Real>(x: f64) -> T {
     T::from_f64(x)
 }
 
 /// The dense-output polynomial of one component on `[0, 1]`:
 /// `y(theta) = c1 + theta (c2 + (1 - theta)(c3 + theta (c4 + (1 - theta) c5)))`.
 #[derive(Clone, Copy)]
-struct Dense<T> {
+pub(super) struct Dense<T> {
     c: [T; 5],
 }
 
 impl<T: Real> Dense<T> {
-    fn new(y0: T, y1: T, hk: &[T; 7]) -> Self {
+    pub(super) fn new(y0: T, y1: T, hk: &[T; 7]) -> Self {
         let diff = y1 - y0;
         let bspl = hk[0] - diff;
         let mut c5 = T::ZERO;
@@ -80,7 +80,7 @@ impl<T: Real> Dense<T> {
     }
 
     /// Value and derivative with respect to theta.
-    fn at(&self, th: T) -> (T, T) {
+    pub(super) fn at(&self, th: T) -> (T, T) {
         let [c1, c2, c3, c4, c5] = self.c;
         let one_m = T::ONE - th;
         let q = c4 + one_m * c5;
@@ -201,7 +201,7 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
 }
 
 /// `exp(p * x)` for the controller's powers, on the `ln` already taken.
-trait ExpScaled {
+pub(super) trait ExpScaled {
     fn exp_scaled(self, p: f64) -> Self;
 }
 

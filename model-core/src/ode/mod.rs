@@ -20,6 +20,7 @@
 mod dp54;
 mod event;
 mod fixed;
+pub mod system;
 
 use crate::Real;
 use crate::particle::{Model, Scene, SceneError};

@@ -23,6 +23,7 @@ mod coriolis;
 mod flat;
 mod inverse;
 mod phi;
+pub mod rolling;
 
 pub use inverse::{InverseError, omega_for_residence_time};
 

@@ -1,0 +1,302 @@
+//! The project's integrators for a system of `N` first-order equations `y' = f(t, y)` (the
+//! rolling granule of [`crate::particle::rolling`]): adaptive Dormand-Prince 5(4) with its dense
+//! output (the same tableau and step control as the radial model's, [`super::dp54`]) and classical
+//! RK4 at a fixed step with cubic Hermite interpolation. Both stop at the first zero of an event
+//! function (the rim), located on the interpolant, so `T` keeps the method's order; a check
+//! after every accepted step can end the run early (lift-off, slip, a held granule).
+
+use core::ops::ControlFlow;
+
+use super::dp54::{A2, A3, A4, A5, A6, B, C, Dense, E, ExpScaled, t_of};
+use super::event::{hermite, locate};
+use crate::Real;
+
+/// How a system run ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Ended<T, const N: usize, S> {
+    /// The event function reached zero (from below) at `t`, with the state `y` there.
+    Event {
+        /// Time, s.
+        t: T,
+        /// State at `t`.
+        y: [T; N],
+    },
+    /// The check after a step stopped the run.
+    Stopped {
+        /// Time of that step's end, s.
+        t: T,
+        /// State there.
+        y: [T; N],
+        /// Why.
+        why: S,
+    },
+    /// The time horizon was reached first.
+    Horizon {
+        /// State at the horizon.
+        y: [T; N],
+    },
+}
+
+/// Why a system run gave no result.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SystemError {
+    /// The step cap was reached before an event or the horizon.
+    StepLimit,
+    /// A state or error estimate was not finite.
+    NotFinite,
+    /// A step size or tolerance was not positive and finite.
+    InvalidStep,
+}
+
+/// What a run did besides its ending: its cost.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Run<T, const N: usize, S> {
+    /// How it ended.
+    pub ended: Ended<T, N, S>,
+    /// Right-hand-side evaluations.
+    pub evaluations: u32,
+    /// Accepted steps.
+    pub steps: u32,
+}
+
+/// The event: `(g(y), g'(y) dy)` for a state `y` and a state increment `dy` (the directional
+/// derivative), so that its zero can be located on an interpolant.
+pub type EventFn<T, const N: usize> = fn(&[T; N], &[T; N]) -> (T, T);
+
+/// Limits of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SystemLimits<T> {
+    /// Stop at this time, s.
+    pub horizon_s: T,
+    /// Stop after this many steps (accepted and rejected).
+    pub max_steps: u32,
+}
+
+fn axpy<T: Real, const N: usize>(y: &[T; N], h: T, terms: &[(f64, &[T; N])]) -> [T; N] {
+    let mut out = *y;
+    for (a, k) in terms {
+        let ha = h * t_of::<T>(*a);
+        for i in 0..N {
+            out[i] += ha * k[i];
+        }
+    }
+    out
+}
+
+fn finite<T: Real, const N: usize>(y: &[T; N]) -> bool {
+    y.iter().all(|v| v.is_finite())
+}
+
+/// Adaptive Dormand-Prince 5(4) from `(t0, y0)` until `event` crosses zero from below, `check`
+/// breaks, or the horizon. `scale[i]` is the absolute tolerance of component `i` (a state's
+/// typical size times `rtol` where it may pass through zero); `h0` the first step.
+#[allow(clippy::too_many_arguments)]
+pub fn dp54<T: Real, const N: usize, S>(
+    mut f: impl FnMut(T, &[T; N]) -> [T; N],
+    t0: T,
+    y0: [T; N],
+    rtol: T,
+    atol: [T; N],
+    h0: T,
+    event: EventFn<T, N>,
+    mut check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
+    limits: SystemLimits<T>,
+) -> Result<Run<T, N, S>, SystemError> {
+    if !(rtol > T::ZERO && rtol.is_finite() && h0 > T::ZERO && h0.is_finite()) {
+        return Err(SystemError::InvalidStep);
+    }
+    let (mut t, mut y, mut h) = (t0, y0, h0.min(limits.horizon_s - t0));
+    let mut evaluations = 1u32;
+    let mut steps = 0u32;
+    let mut k1 = f(t, &y);
+    while steps < limits.max_steps {
+        if t >= limits.horizon_s {
+            return Ok(Run {
+                ended: Ended::Horizon { y },
+                evaluations,
+                steps,
+            });
+        }
+        if h <= T::EPSILON * t.abs() {
+            return Err(SystemError::StepLimit);
+        }
+        steps += 1;
+        let mut k = [[T::ZERO; N]; 7];
+        k[0] = k1;
+        let rows: [&[f64]; 5] = [&A2, &A3, &A4, &A5, &A6];
+        for (s, row) in rows.iter().enumerate() {
+            let mut yi = y;
+            for (j, &a) in row.iter().enumerate() {
+                let ha = h * t_of::<T>(a);
+                for i in 0..N {
+                    yi[i] += ha * k[j][i];
+                }
+            }
+            k[s + 1] = f(t + t_of::<T>(C[s + 1]) * h, &yi);
+        }
+        let mut y1 = y;
+        for (s, &b) in B.iter().enumerate().take(6) {
+            let hb = h * t_of::<T>(b);
+            for i in 0..N {
+                y1[i] += hb * k[s][i];
+            }
+        }
+        k[6] = f(t + h, &y1);
+        evaluations += 6;
+        let mut err2 = T::ZERO;
+        for i in 0..N {
+            let mut e = T::ZERO;
+            for s in 0..7 {
+                e += h * t_of::<T>(E[s]) * k[s][i];
+            }
+            let sc = atol[i] + rtol * y[i].abs().max(y1[i].abs());
+            err2 += (e / sc) * (e / sc);
+        }
+        if !(finite(&y1) && err2.is_finite()) {
+            return Err(SystemError::NotFinite);
+        }
+        let err = (err2 / T::from_f64(N as f64)).sqrt();
+        let factor = if err > T::ZERO {
+            (T::from_f64(0.9) * err.ln().exp_scaled(-0.2))
+                .max(T::from_f64(0.2))
+                .min(T::from_f64(5.0))
+        } else {
+            T::from_f64(5.0)
+        };
+        if err > T::ONE {
+            h *= factor.min(T::ONE);
+            continue;
+        }
+        let (g1, _) = event(&y1, &[T::ZERO; N]);
+        if g1 >= T::ZERO {
+            let dense: [Dense<T>; N] = core::array::from_fn(|i| {
+                let hk: [T; 7] = core::array::from_fn(|s| h * k[s][i]);
+                Dense::new(y[i], y1[i], &hk)
+            });
+            let at = |th: T| -> ([T; N], [T; N]) {
+                let mut v = [T::ZERO; N];
+                let mut d = [T::ZERO; N];
+                for i in 0..N {
+                    (v[i], d[i]) = dense[i].at(th);
+                }
+                (v, d)
+            };
+            let theta = locate(
+                |th| {
+                    let (v, d) = at(th);
+                    event(&v, &d)
+                },
+                T::ZERO,
+            );
+            let (ye, _) = at(theta);
+            return Ok(Run {
+                ended: Ended::Event {
+                    t: t + theta * h,
+                    y: ye,
+                },
+                evaluations,
+                steps,
+            });
+        }
+        t += h;
+        y = y1;
+        k1 = k[6];
+        if let ControlFlow::Break(why) = check(t, &y) {
+            return Ok(Run {
+                ended: Ended::Stopped { t, y, why },
+                evaluations,
+                steps,
+            });
+        }
+        h = (h * factor).min(limits.horizon_s - t).max(T::EPSILON * t);
+    }
+    Err(SystemError::StepLimit)
+}
+
+/// Classical RK4 at the fixed step `h` from `(t0, y0)`, the event located on the cubic Hermite
+/// interpolant of each component (its slopes are the right-hand sides at the step's ends).
+pub fn rk4<T: Real, const N: usize, S>(
+    mut f: impl FnMut(T, &[T; N]) -> [T; N],
+    t0: T,
+    y0: [T; N],
+    h: T,
+    event: EventFn<T, N>,
+    mut check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
+    limits: SystemLimits<T>,
+) -> Result<Run<T, N, S>, SystemError> {
+    if !(h > T::ZERO && h.is_finite()) {
+        return Err(SystemError::InvalidStep);
+    }
+    let (mut t, mut y) = (t0, y0);
+    let mut evaluations = 1u32;
+    let mut steps = 0u32;
+    let mut k1 = f(t, &y);
+    let half = T::HALF;
+    while steps < limits.max_steps {
+        if t >= limits.horizon_s {
+            return Ok(Run {
+                ended: Ended::Horizon { y },
+                evaluations,
+                steps,
+            });
+        }
+        steps += 1;
+        let k2 = f(t + half * h, &axpy(&y, h, &[(0.5, &k1)]));
+        let k3 = f(t + half * h, &axpy(&y, h, &[(0.5, &k2)]));
+        let k4 = f(t + h, &axpy(&y, h, &[(1.0, &k3)]));
+        let y1 = axpy(
+            &y,
+            h,
+            &[
+                (1.0 / 6.0, &k1),
+                (1.0 / 3.0, &k2),
+                (1.0 / 3.0, &k3),
+                (1.0 / 6.0, &k4),
+            ],
+        );
+        let k1_next = f(t + h, &y1);
+        evaluations += 4;
+        if !finite(&y1) {
+            return Err(SystemError::NotFinite);
+        }
+        let (g1, _) = event(&y1, &[T::ZERO; N]);
+        if g1 >= T::ZERO {
+            let at = |th: T| -> ([T; N], [T; N]) {
+                let mut v = [T::ZERO; N];
+                let mut d = [T::ZERO; N];
+                for i in 0..N {
+                    (v[i], d[i]) = hermite(y[i], h * k1[i], y1[i], h * k1_next[i], th);
+                }
+                (v, d)
+            };
+            let theta = locate(
+                |th| {
+                    let (v, d) = at(th);
+                    event(&v, &d)
+                },
+                T::ZERO,
+            );
+            let (ye, _) = at(theta);
+            return Ok(Run {
+                ended: Ended::Event {
+                    t: t + theta * h,
+                    y: ye,
+                },
+                evaluations,
+                steps,
+            });
+        }
+        t += h;
+        y = y1;
+        k1 = k1_next;
+        if let ControlFlow::Break(why) = check(t, &y) {
+            return Ok(Run {
+                ended: Ended::Stopped { t, y, why },
+                evaluations,
+                steps,
+            });
+        }
+    }
+    Err(SystemError::StepLimit)
+}

@@ -1,0 +1,139 @@
+//! The equations of motion of a sphere rolling without slip on the flat bottom of the tilted,
+//! precessing bowl, in the bowl's frame (docs/model.md §9). Why not the paper's Eq. 5: a rolling
+//! sphere's contact couples its radial and azimuthal motion (the gyroscopic term `(1 + k2) Oz`),
+//! resistance acts against the actual velocity, and on the tilted rig gravity has an in-plane
+//! part that is the largest force.
+//!
+//! Frame: origin at the centre of the bottom, `e1`, `e2` in its plane, `n = e3` the bowl's axis,
+//! which precesses about the vertical at `w1` at the angle `th`; the bowl spins about `n` at
+//! `w2`, `psi = w2 t`. State `[x, y, ux, uy, sig]`: the contact point, the centre's velocity
+//! relative to the bowl, and `sig = a s` with `s` the sphere's spin about `n` relative to the bowl.
+//!
+//! ```text
+//! Omega = (w1 sin th cos psi, -w1 sin th sin psi, w1 cos th + w2)
+//! alpha = w1 w2 sin th (-sin psi, -cos psi, 0)
+//! gB    = -g (sin th cos psi, -sin th sin psi, cos th)
+//! A_O   = w1^2 L (cos th cos psi, -cos th sin psi, -sin th)
+//! p = (x, y, a);  C = Omega (Omega . p) - |Omega|^2 p;  E = alpha x p
+//! N/m = g cos th + A_Oz + E_z + C_z + 2 (Ox uy - Oy ux)
+//! D   = (gB - A_O - E - C)_xy + ((1 - k2)/k2) [sig (Ox, Oy) - a (alpha_y, -alpha_x)]
+//! du/dt   = k2 [D - mu_r (N/m) u/|u|] - (1 + k2) Oz (-uy, ux)
+//! dsig/dt = -(Ox ux + Oy uy)
+//! f_t/m = (A_O + E + C + 2 Omega x u + du/dt - gB)_xy   (the friction that keeps it rolling)
+//! ```
+
+use super::RollingScene;
+use crate::Real;
+
+/// Below this speed relative to the bowl, m/s, the granule counts as at rest: the resistance's
+/// direction `u/|u|` is undefined there and the start from rest is stiff (eigenvalue about
+/// `-k2 mu_r (N/m)/|u|`), so the direction is held on `D/|D|` instead. `T` moves by less than
+/// 1e-10 s against a threshold 100 times smaller.
+pub const AT_REST_M_S: f64 = 1e-7;
+
+/// The state: `[x, y, ux, uy, sig]`, m and m/s.
+pub type State<T> = [T; 5];
+
+/// Everything the equations give at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Forces<T> {
+    /// The state's time derivative.
+    pub derivative: State<T>,
+    /// Normal force per unit mass, m/s^2 (the granule lifts off where it is <= 0).
+    pub normal_m_s2: T,
+    /// In-plane friction force per unit mass needed to roll, `|f_t|/m`, m/s^2.
+    pub friction_m_s2: T,
+    /// At rest and held by the resistance: `|D| <= mu_r N/m`.
+    pub held: bool,
+}
+
+/// Vectors of the bowl frame at time `t`.
+struct Frame<T> {
+    omega: [T; 3],
+    alpha: [T; 3],
+    gravity: [T; 3],
+    carrier: [T; 3],
+}
+
+fn frame<T: Real>(s: &RollingScene<T>, t: T) -> Frame<T> {
+    let psi = s.spin_rad_s * t;
+    let (sp, cp) = (psi.sin(), psi.cos());
+    let (st, ct) = (s.axes_angle_rad.sin(), s.axes_angle_rad.cos());
+    let w1 = s.precession_rad_s;
+    let w1l = w1 * w1 * s.rod_length_m;
+    let g = s.g_m_s2;
+    let aw = w1 * s.spin_rad_s * st;
+    Frame {
+        omega: [w1 * st * cp, -w1 * st * sp, w1 * ct + s.spin_rad_s],
+        alpha: [-aw * sp, -aw * cp, T::ZERO],
+        gravity: [-g * st * cp, g * st * sp, -g * ct],
+        carrier: [w1l * ct * cp, -w1l * ct * sp, -w1l * st],
+    }
+}
+
+fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The right-hand side and the contact forces at `(t, y)`.
+pub fn forces<T: Real>(s: &RollingScene<T>, t: T, y: &State<T>) -> Forces<T> {
+    let [x, yy, ux, uy, sig] = *y;
+    let f = frame(s, t);
+    let o = f.omega;
+    let a = s.particle_radius_m;
+    let p = [x, yy, a];
+    let o_dot_p = o[0] * p[0] + o[1] * p[1] + o[2] * p[2];
+    let o2 = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
+    let c = [
+        o[0] * o_dot_p - o2 * p[0],
+        o[1] * o_dot_p - o2 * p[1],
+        o[2] * o_dot_p - o2 * p[2],
+    ];
+    let e = cross(&f.alpha, &p);
+    let g_cos = -f.gravity[2];
+    let normal = g_cos + f.carrier[2] + e[2] + c[2] + T::TWO * (o[0] * uy - o[1] * ux);
+    let k2 = s.k2;
+    let spin_coupling = (T::ONE - k2) / k2;
+    let d = [
+        f.gravity[0] - f.carrier[0] - e[0] - c[0] + spin_coupling * (sig * o[0] - a * f.alpha[1]),
+        f.gravity[1] - f.carrier[1] - e[1] - c[1] + spin_coupling * (sig * o[1] + a * f.alpha[0]),
+    ];
+    let resistance = s.rolling_resistance * normal.max(T::ZERO);
+    let speed = (ux * ux + uy * uy).sqrt();
+    let gyro = (T::ONE + k2) * o[2];
+    let (dir, held) = if speed > T::from_f64(AT_REST_M_S) {
+        ([ux / speed, uy / speed], false)
+    } else {
+        let d_norm = (d[0] * d[0] + d[1] * d[1]).sqrt();
+        if d_norm <= resistance || d_norm == T::ZERO {
+            // Held: the resistance balances D; it cannot exceed it.
+            ([T::ZERO, T::ZERO], true)
+        } else {
+            ([d[0] / d_norm, d[1] / d_norm], false)
+        }
+    };
+    let (dux, duy) = if held && speed <= T::from_f64(AT_REST_M_S) {
+        (T::ZERO, T::ZERO)
+    } else {
+        (
+            k2 * (d[0] - resistance * dir[0]) + gyro * uy,
+            k2 * (d[1] - resistance * dir[1]) - gyro * ux,
+        )
+    };
+    let dsig = -(o[0] * ux + o[1] * uy);
+    let ou = cross(&o, &[ux, uy, T::ZERO]);
+    let ft = [
+        f.carrier[0] + e[0] + c[0] + T::TWO * ou[0] + dux - f.gravity[0],
+        f.carrier[1] + e[1] + c[1] + T::TWO * ou[1] + duy - f.gravity[1],
+    ];
+    Forces {
+        derivative: [ux, uy, dux, duy, dsig],
+        normal_m_s2: normal,
+        friction_m_s2: (ft[0] * ft[0] + ft[1] * ft[1]).sqrt(),
+        held,
+    }
+}

@@ -1,0 +1,444 @@
+//! The granule as it really rolls: a sphere rolling without slip on the flat bottom of the tilted
+//! bowl that spins at `w2` about its axis while the axis precesses at `w1` about the vertical
+//! (docs/model.md §9). The equations are in [`equations`]; here are the scene, the release, the
+//! outcomes, and the simpler members of the model hierarchy with closed forms:
+//!
+//! * [`residence`]: one release at azimuth `beta` (from the downhill direction at `t = 0`),
+//!   integrated by the project's integrators ([`crate::ode::system`]) with the rim located on
+//!   the interpolant; [`residence_over_azimuths`]: mean, min and max over `beta = 0, 30, ...,
+//!   330` degrees.
+//! * [`incline_residence_s`]: the straight roll down a fixed incline (no rotation).
+//! * [`disc_residence_s`]: the horizontal spinning disc without resistance, where the granule
+//!   runs on a circle at `(1 - k2) Omega` in the inertial frame.
+
+pub mod equations;
+
+use core::ops::ControlFlow;
+
+use crate::Real;
+use crate::ode::system::{self, Ended, SystemError, SystemLimits};
+use equations::{AT_REST_M_S, State, forces};
+
+/// A scene of the rolling model. SI units; angles in radians.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RollingScene<T> {
+    /// Precession speed `w1` of the bowl's axis about the vertical, rad/s.
+    pub precession_rad_s: T,
+    /// Spin speed `w2` of the bowl about its own axis, rad/s.
+    pub spin_rad_s: T,
+    /// Angle `th` between the bowl's axis and the vertical (paper Eq. 2's angle), rad.
+    pub axes_angle_rad: T,
+    /// Rolling resistance `mu_r`: a torque `mu_r a N`, i.e. a force `mu_r N` against the motion.
+    pub rolling_resistance: T,
+    /// The friction coefficient the contact can give before it slides (the paper's measured
+    /// 0.4): rolling needs `|f_t| <= mu_s N`.
+    pub sliding_friction: T,
+    /// Gravity, m/s^2.
+    pub g_m_s2: T,
+    /// `k2 = m a^2 / (I + m a^2)`: 5/7 for a uniform sphere.
+    pub k2: T,
+    /// Granule radius `a`, m.
+    pub particle_radius_m: T,
+    /// Distance `L` of the bowl's centre from the precession axis, m.
+    pub rod_length_m: T,
+    /// Release radius `ri`, m.
+    pub ri_m: T,
+    /// Rim radius `R`, m.
+    pub rim_radius_m: T,
+}
+
+impl<T: Real> RollingScene<T> {
+    /// The rig's usual scene at the combined speed `omega_rad_s`: `w1 = w2` with
+    /// `|w1 e_z + w2 n| = omega`, tilt `th`, `mu_r` 0.029, `mu_s` 0.4, g 9.81, k2 5/7, a 3 mm,
+    /// L 0, release at half the rim radius `rim_m`.
+    pub fn equal_speeds(omega_rad_s: T, axes_angle_rad: T, rim_m: T) -> Self {
+        let w = omega_rad_s / (T::TWO * (T::ONE + axes_angle_rad.cos())).sqrt();
+        Self {
+            precession_rad_s: w,
+            spin_rad_s: w,
+            axes_angle_rad,
+            rolling_resistance: T::from_f64(0.029),
+            sliding_friction: T::from_f64(0.4),
+            g_m_s2: T::from_f64(9.81),
+            k2: T::from_f64(5.0 / 7.0),
+            particle_radius_m: T::from_f64(0.003),
+            rod_length_m: T::ZERO,
+            ri_m: T::HALF * rim_m,
+            rim_radius_m: rim_m,
+        }
+    }
+
+    /// Checks every input; the first bad one is named.
+    pub fn validate(&self) -> Result<(), RollingError> {
+        let finite = |v: T| v.is_finite();
+        let nonneg = |v: T| v.is_nonneg_finite();
+        let checks = [
+            (
+                finite(self.precession_rad_s),
+                RollingError::InvalidPrecession,
+            ),
+            (finite(self.spin_rad_s), RollingError::InvalidSpin),
+            (
+                nonneg(self.axes_angle_rad)
+                    && self.axes_angle_rad < T::from_f64(core::f64::consts::FRAC_PI_2),
+                RollingError::InvalidAxesAngle,
+            ),
+            (
+                nonneg(self.rolling_resistance),
+                RollingError::InvalidResistance,
+            ),
+            (
+                nonneg(self.sliding_friction),
+                RollingError::InvalidSlidingFriction,
+            ),
+            (nonneg(self.g_m_s2), RollingError::InvalidGravity),
+            (
+                self.k2.is_finite() && self.k2 > T::ZERO && self.k2 < T::ONE,
+                RollingError::InvalidK2,
+            ),
+            (
+                nonneg(self.particle_radius_m),
+                RollingError::InvalidParticleRadius,
+            ),
+            (nonneg(self.rod_length_m), RollingError::InvalidRodLength),
+            (nonneg(self.ri_m), RollingError::InvalidStartRadius),
+            (
+                nonneg(self.rim_radius_m) && self.rim_radius_m > self.ri_m,
+                RollingError::InvalidRimRadius,
+            ),
+        ];
+        match checks.iter().find(|(ok, _)| !ok) {
+            Some((_, e)) => Err(*e),
+            None => Ok(()),
+        }
+    }
+
+    /// The combined rotation speed `|w1 e_z + w2 n|`, rad/s (paper Eq. 2).
+    pub fn combined_speed_rad_s(&self) -> T {
+        let (w1, w2) = (self.precession_rad_s, self.spin_rad_s);
+        let c = self.axes_angle_rad.cos();
+        (w1 * w1 + w2 * w2 + T::TWO * w1 * w2 * c)
+            .max(T::ZERO)
+            .sqrt()
+    }
+
+    /// Whether the forces in the bowl's frame are constant in time (no precession, or a
+    /// precession about the bowl's own axis with the bowl on it): then a held granule stays.
+    fn stationary(&self) -> bool {
+        self.precession_rad_s == T::ZERO
+            || (self.axes_angle_rad == T::ZERO && self.rod_length_m == T::ZERO)
+    }
+}
+
+/// Why the rolling model gave no answer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RollingError {
+    /// The precession speed was NaN or infinite.
+    InvalidPrecession,
+    /// The spin speed was NaN or infinite.
+    InvalidSpin,
+    /// The axes angle was not in [0, 90) degrees.
+    InvalidAxesAngle,
+    /// The rolling resistance was NaN, infinite or negative.
+    InvalidResistance,
+    /// The sliding friction coefficient was NaN, infinite or negative.
+    InvalidSlidingFriction,
+    /// Gravity was NaN, infinite or negative.
+    InvalidGravity,
+    /// k2 was not in (0, 1).
+    InvalidK2,
+    /// The granule radius was NaN, infinite or negative.
+    InvalidParticleRadius,
+    /// The rod length was NaN, infinite or negative.
+    InvalidRodLength,
+    /// The release radius was NaN, infinite or negative.
+    InvalidStartRadius,
+    /// The rim radius was not finite and larger than the release radius.
+    InvalidRimRadius,
+    /// The release azimuth was not finite.
+    InvalidAzimuth,
+    /// The integration failed (step cap, a non-finite state, an invalid step).
+    Integration(SystemError),
+}
+
+/// What happens to one granule.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RollingOutcome<T> {
+    /// It reaches the rim.
+    Leaves {
+        /// Residence time `T`, s.
+        residence_time_s: T,
+        /// Speed relative to the bowl at the rim, m/s.
+        exit_speed_m_s: T,
+        /// The largest friction the contact had to give to keep rolling, as a fraction of the
+        /// normal force: above the sliding coefficient the granule slid, and this `T` is the
+        /// rolling model's, not the rig's.
+        max_friction_ratio: T,
+        /// When rolling first needed more friction than the sliding coefficient gives, s.
+        first_slip_s: Option<T>,
+    },
+    /// Released at rest, the resistance holds it, and the forces never change.
+    Held,
+    /// The normal force fell to zero: the granule leaves the bottom at this time, s.
+    LiftsOff {
+        /// s.
+        time_s: T,
+    },
+    /// Still in the bowl at the horizon, s.
+    NotLeftBy {
+        /// s.
+        horizon_s: T,
+    },
+}
+
+/// How the rolling model is integrated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RollingMethod<T> {
+    /// Adaptive Dormand-Prince 5(4) at this relative tolerance.
+    Dp54 {
+        /// Relative tolerance.
+        rtol: T,
+    },
+    /// Classical RK4 at this step, s.
+    Rk4 {
+        /// s.
+        step_s: T,
+    },
+}
+
+/// One release's outcome and what it cost.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RollingReport<T> {
+    /// The outcome.
+    pub outcome: RollingOutcome<T>,
+    /// Right-hand-side evaluations.
+    pub evaluations: u32,
+    /// Accepted steps.
+    pub steps: u32,
+}
+
+/// The horizon of a release, s: a granule still in the bowl after this long is reported as such.
+pub const HORIZON_S: f64 = 60.0;
+
+/// Step cap of one release.
+pub const MAX_STEPS: u32 = 2_000_000;
+
+/// The rim in the state scaled by `1/R`: `|(x, y)|^2 - 1` and its derivative along `dy`.
+fn rim_event<T: Real>(y: &State<T>, dy: &State<T>) -> (T, T) {
+    (
+        y[0] * y[0] + y[1] * y[1] - T::ONE,
+        T::TWO * (y[0] * dy[0] + y[1] * dy[1]),
+    )
+}
+
+/// One release at azimuth `beta_rad` (measured from the downhill direction at `t = 0`, which is
+/// `-e1`, turning towards `-e2`): `(x, y) = ri (-cos beta, -sin beta)`, at rest in the bowl.
+pub fn residence<T: Real>(
+    scene: &RollingScene<T>,
+    beta_rad: T,
+    method: RollingMethod<T>,
+) -> Result<RollingReport<T>, RollingError> {
+    scene.validate()?;
+    if !beta_rad.is_finite() {
+        return Err(RollingError::InvalidAzimuth);
+    }
+    // Lengths in units of R: the event is then |r|^2 - 1 = 0 with a fixed target.
+    let rim = scene.rim_radius_m;
+    let y0: State<T> = [
+        -scene.ri_m * beta_rad.cos(),
+        -scene.ri_m * beta_rad.sin(),
+        T::ZERO,
+        T::ZERO,
+        T::ZERO,
+    ];
+    let start = forces(scene, T::ZERO, &y0);
+    if start.held && scene.stationary() {
+        return Ok(RollingReport {
+            outcome: RollingOutcome::Held,
+            evaluations: 1,
+            steps: 0,
+        });
+    }
+    let mut max_ratio = T::ZERO;
+    let mut first_slip = None;
+    let mut watch = |t: T, y: &State<T>| -> ControlFlow<T> {
+        let f = forces(scene, t, y);
+        if f.normal_m_s2 <= T::ZERO {
+            return ControlFlow::Break(t);
+        }
+        let ratio = f.friction_m_s2 / f.normal_m_s2;
+        max_ratio = max_ratio.max(ratio);
+        if first_slip.is_none() && ratio > scene.sliding_friction {
+            first_slip = Some(t);
+        }
+        ControlFlow::Continue(())
+    };
+    let rhs = |t: T, y: &State<T>| forces(scene, t, y).derivative;
+    let limits = SystemLimits {
+        horizon_s: T::from_f64(HORIZON_S),
+        max_steps: MAX_STEPS,
+    };
+    // The integrators' event is a plain function: lengths are integrated in units of R so the
+    // rim is the fixed |(x, y)| = 1.
+    let scale = T::ONE / rim;
+    let scaled = |y: &State<T>| -> State<T> { y.map(|v| v * scale) };
+    let rhs_scaled = |t: T, y: &State<T>| -> State<T> {
+        let unscaled = y.map(|v| v * rim);
+        scaled(&rhs(t, &unscaled))
+    };
+    let watch_scaled = |t: T, y: &State<T>| watch(t, &y.map(|v| v * rim));
+    let event: system::EventFn<T, 5> = rim_event;
+    let run = match method {
+        RollingMethod::Dp54 { rtol } => {
+            let speed_scale = scene.combined_speed_rad_s().max(T::ONE);
+            let atol = [
+                rtol,
+                rtol,
+                rtol * speed_scale,
+                rtol * speed_scale,
+                rtol * speed_scale,
+            ];
+            let h0 = T::from_f64(1e-3) / speed_scale;
+            system::dp54(
+                rhs_scaled,
+                T::ZERO,
+                scaled(&y0),
+                rtol,
+                atol,
+                h0,
+                event,
+                watch_scaled,
+                limits,
+            )
+        }
+        RollingMethod::Rk4 { step_s } => system::rk4(
+            rhs_scaled,
+            T::ZERO,
+            scaled(&y0),
+            step_s,
+            event,
+            watch_scaled,
+            limits,
+        ),
+    }
+    .map_err(RollingError::Integration)?;
+    let outcome = match run.ended {
+        Ended::Event { t, y } => RollingOutcome::Leaves {
+            residence_time_s: t,
+            exit_speed_m_s: (y[2] * y[2] + y[3] * y[3]).sqrt() * rim,
+            max_friction_ratio: max_ratio,
+            first_slip_s: first_slip,
+        },
+        Ended::Stopped { why, .. } => RollingOutcome::LiftsOff { time_s: why },
+        Ended::Horizon { .. } => RollingOutcome::NotLeftBy {
+            horizon_s: limits.horizon_s,
+        },
+    };
+    Ok(RollingReport {
+        outcome,
+        evaluations: run.evaluations,
+        steps: run.steps,
+    })
+}
+
+/// Residence times over the release azimuths `beta = 0, 30, ..., 330` degrees.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AzimuthSummary<T> {
+    /// Mean over the releases that leave, s (`None` if none does).
+    pub mean_s: Option<T>,
+    /// Shortest, s.
+    pub min_s: Option<T>,
+    /// Longest, s.
+    pub max_s: Option<T>,
+    /// How many of the 12 releases leave.
+    pub left: u32,
+    /// How many of those slid on the way (rolling needed more friction than there is).
+    pub slid: u32,
+    /// Right-hand-side evaluations of all 12.
+    pub evaluations: u32,
+}
+
+/// The release azimuths of [`residence_over_azimuths`], degrees.
+pub const AZIMUTHS_DEG: [f64; 12] = [
+    0.0, 30.0, 60.0, 90.0, 120.0, 150.0, 180.0, 210.0, 240.0, 270.0, 300.0, 330.0,
+];
+
+/// [`residence`] at every azimuth of [`AZIMUTHS_DEG`].
+pub fn residence_over_azimuths<T: Real>(
+    scene: &RollingScene<T>,
+    method: RollingMethod<T>,
+) -> Result<AzimuthSummary<T>, RollingError> {
+    let mut sum = T::ZERO;
+    let (mut min_s, mut max_s): (Option<T>, Option<T>) = (None, None);
+    let (mut left, mut slid, mut evaluations) = (0u32, 0u32, 0u32);
+    for deg in AZIMUTHS_DEG {
+        let beta = T::from_f64(deg.to_radians());
+        let report = residence(scene, beta, method)?;
+        evaluations = evaluations.saturating_add(report.evaluations);
+        if let RollingOutcome::Leaves {
+            residence_time_s: t,
+            first_slip_s,
+            ..
+        } = report.outcome
+        {
+            sum += t;
+            left += 1;
+            slid += u32::from(first_slip_s.is_some());
+            min_s = Some(min_s.map_or(t, |m| m.min(t)));
+            max_s = Some(max_s.map_or(t, |m| m.max(t)));
+        }
+    }
+    Ok(AzimuthSummary {
+        mean_s: (left > 0).then(|| sum / T::from_f64(f64::from(left))),
+        min_s,
+        max_s,
+        left,
+        slid,
+        evaluations,
+    })
+}
+
+/// The straight roll down a fixed incline at the bowl's tilt, no rotation (the simplest member
+/// with gravity): `T(beta) = sqrt(2 s / (k2 g (sin th - mu_r cos th)))` with the path to the rim
+/// `s = -ri cos beta + sqrt(R^2 - ri^2 sin^2 beta)`. `None` when the resistance holds it.
+pub fn incline_residence_s<T: Real>(scene: &RollingScene<T>, beta_rad: T) -> Option<T> {
+    let (st, ct) = (scene.axes_angle_rad.sin(), scene.axes_angle_rad.cos());
+    let drive = scene.k2 * scene.g_m_s2 * (st - scene.rolling_resistance * ct);
+    // Also catches a NaN drive.
+    if drive.is_nan() || drive <= T::ZERO {
+        return None;
+    }
+    let (ri, rim) = (scene.ri_m, scene.rim_radius_m);
+    let sb = beta_rad.sin();
+    let s = -ri * beta_rad.cos() + (rim * rim - ri * ri * sb * sb).max(T::ZERO).sqrt();
+    let t = (T::TWO * s / drive).sqrt();
+    t.is_finite().then_some(t)
+}
+
+/// The horizontal spinning disc, no resistance, granule released at rest in the disc at `ri`:
+/// in the inertial frame it runs on a circle at `nu = (1 - k2) Omega` through the release point,
+/// centred `k2 ri / (1 - k2)` on the far side of the axis, so
+/// `|r|^2 / ri^2 = ((1 + k2^2) - 2 k2 cos(nu t)) / (1 - k2)^2` (for k2 = 5/7:
+/// `37/2 - (35/2) cos(2 Omega t / 7)`, never beyond `6 ri`) and
+/// `T = acos(((1 + k2^2) - (1 - k2)^2 (R/ri)^2) / (2 k2)) / nu`. `None` when the circle stays
+/// inside the rim or the inputs give no time.
+pub fn disc_residence_s<T: Real>(omega_rad_s: T, k2: T, ri_m: T, rim_m: T) -> Option<T> {
+    let one_m = T::ONE - k2;
+    let nu = one_m * omega_rad_s.abs();
+    let ratio = rim_m / ri_m;
+    let c = ((T::ONE + k2 * k2) - one_m * one_m * ratio * ratio) / (T::TWO * k2);
+    if !(nu > T::ZERO && c.is_finite() && c >= -T::ONE) {
+        return None;
+    }
+    let t = c.min(T::ONE).acos() / nu;
+    t.is_finite().then_some(t)
+}
+
+/// At rest below this speed (see [`equations::AT_REST_M_S`]), m/s.
+pub fn at_rest_threshold_m_s<T: Real>() -> T {
+    T::from_f64(AT_REST_M_S)
+}
+
+#[cfg(test)]
+mod tests;
