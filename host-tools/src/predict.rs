@@ -13,6 +13,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use model_core::particle::{self, Model, Outcome, Scene};
 
 mod ode;
+mod rolling;
 
 /// Which model(s) to evaluate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -23,6 +24,9 @@ pub enum ModelChoice {
     Coriolis,
     /// Both, side by side.
     Both,
+    /// The granule rolling on the tilted, precessing bowl (docs/model.md §9): needs
+    /// --precession-rad-s, --spin-rad-s and --axes-angle-deg.
+    Rolling,
 }
 
 /// How to compute the residence time.
@@ -85,6 +89,9 @@ pub struct Args {
     /// Batch mode: write results to this CSV file.
     #[arg(long, requires = "batch")]
     out: Option<std::path::PathBuf>,
+    /// The rolling model's own flags.
+    #[command(flatten)]
+    rolling: rolling::RollingArgs,
 }
 
 /// One computed result, whatever the method.
@@ -139,6 +146,9 @@ pub fn predict(
 
 /// Runs `bowl predict`.
 pub fn run(args: &Args) -> Result<()> {
+    if args.model == ModelChoice::Rolling {
+        return rolling::run(args, &args.rolling);
+    }
     if let (Some(input), Some(output)) = (&args.batch, &args.out) {
         return run_batch(input, output, args);
     }
@@ -154,6 +164,7 @@ pub fn run(args: &Args) -> Result<()> {
         ModelChoice::Flat => &[Model::Flat],
         ModelChoice::Coriolis => &[Model::Coriolis],
         ModelChoice::Both => &[Model::Flat, Model::Coriolis],
+        ModelChoice::Rolling => return rolling::run(args, &args.rolling),
     };
     if let Some(target) = args.target_time_s {
         return run_inverse(&scene, models, target, args.json);

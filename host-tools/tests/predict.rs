@@ -250,3 +250,47 @@ fn a_step_beyond_stability_is_an_error_not_a_number() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("BeyondStabilityLimit"));
 }
+
+/// `--model rolling` on the tilted rig's reference scene (60 deg, R 150 mm, mu_r 0.029,
+/// |Omega| 3.6 with w1 = w2): mean 0.211 s over the twelve azimuths, in [0.153, 0.287]
+/// (docs/model.md §9); one azimuth gives `residence_time_s`.
+#[test]
+fn rolling_model_on_the_tilted_rig() {
+    let w = 3.6 / (2.0 * (1.0 + 60f64.to_radians().cos())).sqrt();
+    let w = format!("{w}");
+    let base = [
+        "predict",
+        "--model",
+        "rolling",
+        "--precession-rad-s",
+        &w,
+        "--spin-rad-s",
+        &w,
+        "--axes-angle-deg",
+        "60",
+        "--mu",
+        "0.029",
+        "--ri-m",
+        "0.075",
+        "--rim-radius-m",
+        "0.15",
+        "--json",
+    ];
+    let mut all = base.to_vec();
+    all.extend(["--release-azimuth-deg", "all"]);
+    let v = json(&all);
+    let get = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("{k} in {v}"));
+    assert!((get("residence_time_mean_s") - 0.211).abs() < 5e-4, "{v}");
+    assert!((get("residence_time_min_s") - 0.153).abs() < 5e-4, "{v}");
+    assert!((get("residence_time_max_s") - 0.287).abs() < 5e-4, "{v}");
+    let mut one = base.to_vec();
+    one.extend(["--release-azimuth-deg", "0"]);
+    let v = json(&one);
+    let t = v["residence_time_s"].as_f64().unwrap();
+    assert!(t > 0.15 && t < 0.29, "{v}");
+    // A missing speed is said plainly, exit code 1.
+    let out = bowl(&["predict", "--model", "rolling", "--axes-angle-deg", "30"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--precession-rad-s"), "{err}");
+}

@@ -1,0 +1,215 @@
+//! `bowl predict --model rolling`: the granule rolling on the tilted, precessing bowl
+//! (model-core `particle::rolling`, docs/model.md §9), for one release azimuth or the mean, min
+//! and max over the twelve azimuths 0, 30, ..., 330 degrees.
+
+use anyhow::{Result, bail};
+use model_core::particle::rolling::{
+    self, AZIMUTHS_DEG, RollingError, RollingMethod, RollingOutcome, RollingScene,
+};
+use serde_json::json;
+
+use super::{Args, MethodChoice};
+
+/// Flags of the rolling model (the shared ones: `--mu` is its rolling resistance, `--ri-m`,
+/// `--rim-radius-m`, `--g`, `--k2`, `--method`, `--tol`, `--step-s`, `--json`).
+#[derive(clap::Args, Debug, Clone)]
+pub struct RollingArgs {
+    /// Rolling model: precession speed w1 of the bowl's axis about the vertical, rad/s.
+    #[arg(long)]
+    precession_rad_s: Option<f64>,
+    /// Rolling model: spin speed w2 of the bowl about its own axis, rad/s.
+    #[arg(long)]
+    spin_rad_s: Option<f64>,
+    /// Rolling model: angle between the bowl's axis and the vertical, degrees (paper Eq. 2).
+    #[arg(long)]
+    axes_angle_deg: Option<f64>,
+    /// Rolling model: granule radius a, m.
+    #[arg(long, default_value_t = 0.003)]
+    particle_radius_m: f64,
+    /// Rolling model: distance L of the bowl's centre from the precession axis, m.
+    #[arg(long, default_value_t = 0.0)]
+    rod_length_m: f64,
+    /// Rolling model: release azimuth from the downhill direction, degrees, or `all` (mean, min
+    /// and max over 0, 30, ..., 330).
+    #[arg(long, default_value = "all")]
+    release_azimuth_deg: String,
+    /// Rolling model: the friction coefficient the contact can give (slip beyond it is reported).
+    #[arg(long, default_value_t = 0.4)]
+    sliding_mu: f64,
+}
+
+fn words(e: RollingError) -> String {
+    match e {
+        RollingError::InvalidPrecession => "--precession-rad-s must be a finite number".into(),
+        RollingError::InvalidSpin => "--spin-rad-s must be a finite number".into(),
+        RollingError::InvalidAxesAngle => {
+            "--axes-angle-deg must be at least 0 and below 90 degrees".into()
+        }
+        RollingError::InvalidResistance => "--mu must be 0 or more".into(),
+        RollingError::InvalidSlidingFriction => "--sliding-mu must be 0 or more".into(),
+        RollingError::InvalidGravity => "--g must be 0 or more".into(),
+        RollingError::InvalidK2 => {
+            "--k2 must lie between 0 and 1 (5/7 for a solid sphere, 3/5 for a hollow one)".into()
+        }
+        RollingError::InvalidParticleRadius => "--particle-radius-m must be 0 or more".into(),
+        RollingError::InvalidRodLength => "--rod-length-m must be 0 or more".into(),
+        RollingError::InvalidStartRadius => "--ri-m must be 0 or more".into(),
+        RollingError::InvalidRimRadius => {
+            "--rim-radius-m must be finite and larger than --ri-m (the granule starts inside the bowl)"
+                .into()
+        }
+        RollingError::InvalidAzimuth => "--release-azimuth-deg must be a finite number".into(),
+        RollingError::Integration(e) => format!(
+            "the integration did not finish ({e:?}); try --method dp54 with a looser --tol, or a \
+             larger --step-s"
+        ),
+    }
+}
+
+fn outcome_json(o: &RollingOutcome<f64>) -> serde_json::Value {
+    match *o {
+        RollingOutcome::Leaves {
+            residence_time_s,
+            exit_speed_m_s,
+            max_friction_ratio,
+            first_slip_s,
+        } => json!({
+            "outcome": "leaves", "residence_time_s": residence_time_s,
+            "exit_speed_relative_m_s": exit_speed_m_s,
+            "max_friction_ratio": max_friction_ratio, "first_slip_s": first_slip_s,
+        }),
+        RollingOutcome::Held => json!({"outcome": "held"}),
+        RollingOutcome::LiftsOff { time_s } => json!({"outcome": "lifts_off", "time_s": time_s}),
+        RollingOutcome::NotLeftBy { horizon_s } => {
+            json!({"outcome": "not_left", "horizon_s": horizon_s})
+        }
+    }
+}
+
+fn outcome_text(o: &RollingOutcome<f64>, sliding_mu: f64) -> String {
+    match *o {
+        RollingOutcome::Leaves {
+            residence_time_s,
+            exit_speed_m_s,
+            max_friction_ratio,
+            first_slip_s,
+        } => {
+            let slip = match first_slip_s {
+                Some(t) => format!(
+                    "; from t = {t:.4} s rolling needs friction up to {max_friction_ratio:.3} of \
+                     the normal force, more than the {sliding_mu} the contact gives: the granule \
+                     slides there, so this T is the rolling model's"
+                ),
+                None => format!(
+                    "; rolls throughout (friction needed at most {max_friction_ratio:.3} of the \
+                     normal force)"
+                ),
+            };
+            format!(
+                "leaves after T = {residence_time_s:.6} s at {exit_speed_m_s:.4} m/s relative to the bowl{slip}"
+            )
+        }
+        RollingOutcome::Held => "held: the resistance keeps it at rest".into(),
+        RollingOutcome::LiftsOff { time_s } => {
+            format!("lifts off the bottom at t = {time_s:.4} s (normal force reaches zero)")
+        }
+        RollingOutcome::NotLeftBy { horizon_s } => {
+            format!("still in the bowl after {horizon_s} s")
+        }
+    }
+}
+
+/// Runs `bowl predict --model rolling`.
+pub fn run(args: &Args, r: &RollingArgs) -> Result<()> {
+    let (Some(w1), Some(w2), Some(th_deg)) = (r.precession_rad_s, r.spin_rad_s, r.axes_angle_deg)
+    else {
+        bail!(
+            "the rolling model needs --precession-rad-s, --spin-rad-s and --axes-angle-deg \
+             (the two motor speeds and the tilt of the bowl's axis)"
+        );
+    };
+    if args.target_time_s.is_some() || args.batch.is_some() {
+        bail!("--target-time-s and --batch are for the flat and Coriolis models, not rolling");
+    }
+    let method = match args.method {
+        MethodChoice::Closed | MethodChoice::Dp54 => RollingMethod::Dp54 { rtol: args.tol },
+        MethodChoice::Rk4 => RollingMethod::Rk4 {
+            step_s: args.step_s.unwrap_or(1e-3),
+        },
+        other => bail!(
+            "--method {other:?} is not offered for the rolling model: use dp54 (default) or rk4",
+        ),
+    };
+    let scene = RollingScene {
+        precession_rad_s: w1,
+        spin_rad_s: w2,
+        axes_angle_rad: th_deg.to_radians(),
+        rolling_resistance: args.mu,
+        sliding_friction: r.sliding_mu,
+        g_m_s2: args.g,
+        k2: args.k2,
+        particle_radius_m: r.particle_radius_m,
+        rod_length_m: r.rod_length_m,
+        ri_m: args.ri_m,
+        rim_radius_m: args.rim_radius_m,
+    };
+    scene.validate().map_err(|e| anyhow::anyhow!(words(e)))?;
+    let head = format!(
+        "rolling model: w1 {w1} rad/s, w2 {w2} rad/s, tilt {th_deg} deg (combined {:.4} rad/s), \
+         mu_r {}, a {} m, L {} m, ri {} m, R {} m",
+        scene.combined_speed_rad_s(),
+        args.mu,
+        r.particle_radius_m,
+        r.rod_length_m,
+        args.ri_m,
+        args.rim_radius_m
+    );
+    if r.release_azimuth_deg.trim() == "all" {
+        let sum = rolling::residence_over_azimuths(&scene, method)
+            .map_err(|e| anyhow::anyhow!(words(e)))?;
+        if args.json {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&json!({
+                    "model": "rolling", "release_azimuths_deg": AZIMUTHS_DEG,
+                    "residence_time_mean_s": sum.mean_s, "residence_time_min_s": sum.min_s,
+                    "residence_time_max_s": sum.max_s, "releases_leaving": sum.left,
+                    "releases_sliding": sum.slid, "rhs_evaluations": sum.evaluations,
+                }))?
+            );
+        } else {
+            println!("{head}");
+            match (sum.mean_s, sum.min_s, sum.max_s) {
+                (Some(m), Some(lo), Some(hi)) => println!(
+                    "over 12 release azimuths: T mean {m:.6} s, min {lo:.6} s, max {hi:.6} s; \
+                     {} of 12 leave, {} of those slide on the way",
+                    sum.left, sum.slid
+                ),
+                _ => println!("none of the 12 releases leaves the bowl"),
+            }
+        }
+        return Ok(());
+    }
+    let beta_deg: f64 = r.release_azimuth_deg.trim().parse().map_err(|_| {
+        anyhow::anyhow!(
+            "--release-azimuth-deg {:?} is neither a number of degrees nor `all`",
+            r.release_azimuth_deg
+        )
+    })?;
+    let report = rolling::residence(&scene, beta_deg.to_radians(), method)
+        .map_err(|e| anyhow::anyhow!(words(e)))?;
+    if args.json {
+        let mut v = outcome_json(&report.outcome);
+        v["model"] = json!("rolling");
+        v["release_azimuth_deg"] = json!(beta_deg);
+        v["rhs_evaluations"] = json!(report.evaluations);
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!("{head}");
+        println!(
+            "release at {beta_deg} deg: {}",
+            outcome_text(&report.outcome, r.sliding_mu)
+        );
+    }
+    Ok(())
+}
