@@ -30,3 +30,10 @@ done
 "$bowl" chart control-stability --out docs/charts/control-stability.svg
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --out docs/charts/control-family.svg
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --target-rad-s 0.5 --out docs/charts/control-family-low.svg
+# The rolling model of the tilted, precessing bowl (docs/model.md section 9).
+mkdir -p docs/charts/rolling
+"$bowl" chart rolling-residence --out docs/charts/rolling/residence-60.svg
+"$bowl" chart rolling-residence --axes-angle-deg 30 --out docs/charts/rolling/residence-30.svg
+"$bowl" chart rolling-paths --out docs/charts/rolling/paths.svg
+"$bowl" chart rolling-hierarchy --out docs/charts/rolling/hierarchy.svg
+"$bowl" chart rolling-work-precision --out docs/charts/rolling/work-precision.svg

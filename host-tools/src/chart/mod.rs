@@ -16,6 +16,7 @@ pub mod qemu_log;
 pub mod reference;
 #[cfg(test)]
 mod reference_check;
+pub mod rolling;
 pub mod scipy;
 pub mod stability;
 pub mod table;
@@ -51,6 +52,34 @@ enum Which {
     ControlStability(ControlArgs),
     /// Overshoot against settling of every axis of a rig or family file (0 -> target step).
     Family(FamilyArgs),
+    /// Rolling model: residence time against bowl speed beside the paper's (cf. paper Fig. 7).
+    RollingResidence(RollingResidenceArgs),
+    /// Rolling model: the twelve releases' paths on the bowl bottom.
+    RollingPaths(Out),
+    /// Rolling model: each simpler member's difference from the full model (the hierarchy map).
+    RollingHierarchy(RollingHierarchyArgs),
+    /// Rolling model: work-precision of DP5(4) and RK4, on the rig and near the stick threshold.
+    RollingWorkPrecision(Out),
+}
+
+/// Options of `bowl chart rolling-residence`.
+#[derive(clap::Args)]
+struct RollingResidenceArgs {
+    #[command(flatten)]
+    out: Out,
+    /// Tilt of the bowl's axis from the vertical, degrees.
+    #[arg(long, default_value_t = 60.0)]
+    axes_angle_deg: f64,
+}
+
+/// Options of `bowl chart rolling-hierarchy`.
+#[derive(clap::Args)]
+struct RollingHierarchyArgs {
+    #[command(flatten)]
+    out: Out,
+    /// Rolling resistance.
+    #[arg(long, default_value_t = 0.029)]
+    mu: f64,
 }
 
 /// Options of `bowl chart family`.
@@ -289,6 +318,22 @@ pub fn run(args: &Args) -> Result<()> {
             write_all(out, &f, &t)
         }
         Which::Scipy(a) => scipy_charts(a),
+        Which::RollingResidence(a) => {
+            let (f, t) = rolling::residence(a.axes_angle_deg)?;
+            write_all(&a.out, &f, &t)
+        }
+        Which::RollingPaths(out) => {
+            let (f, t) = rolling::trajectories()?;
+            write_all(out, &f, &t)
+        }
+        Which::RollingHierarchy(a) => {
+            let (f, t) = rolling::hierarchy_map(a.mu)?;
+            write_all(&a.out, &f, &t)
+        }
+        Which::RollingWorkPrecision(out) => {
+            let (f, t) = rolling::work_precision()?;
+            write_all(out, &f, &t)
+        }
         Which::Settling(a) => {
             let (f, t) = control::settling_chart(&control::settling_points(a.extent(), a.seed));
             write_all(&a.out, &f, &t)

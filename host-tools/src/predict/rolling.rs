@@ -36,6 +36,11 @@ pub struct RollingArgs {
     /// Rolling model: the friction coefficient the contact can give (slip beyond it is reported).
     #[arg(long, default_value_t = 0.4)]
     sliding_mu: f64,
+    /// Rolling model: every member of the model hierarchy on this scene, its mean residence
+    /// time and its difference from the full model, and the cheapest member within this
+    /// relative tolerance (e.g. 0.05).
+    #[arg(long)]
+    hierarchy_tolerance: Option<f64>,
 }
 
 fn words(e: RollingError) -> String {
@@ -164,6 +169,9 @@ pub fn run(args: &Args, r: &RollingArgs) -> Result<()> {
         args.ri_m,
         args.rim_radius_m
     );
+    if let Some(tol) = r.hierarchy_tolerance {
+        return hierarchy(&scene, method, tol, args.json, &head);
+    }
     if r.release_azimuth_deg.trim() == "all" {
         let sum = rolling::residence_over_azimuths(&scene, method)
             .map_err(|e| anyhow::anyhow!(words(e)))?;
@@ -211,5 +219,66 @@ pub fn run(args: &Args, r: &RollingArgs) -> Result<()> {
             outcome_text(&report.outcome, r.sliding_mu)
         );
     }
+    Ok(())
+}
+
+/// `--hierarchy-tolerance`: each member's mean residence time and difference from the full
+/// model, and the cheapest member within the tolerance.
+fn hierarchy(
+    scene: &RollingScene<f64>,
+    method: RollingMethod<f64>,
+    tol: f64,
+    json_out: bool,
+    head: &str,
+) -> Result<()> {
+    use model_core::particle::rolling::hierarchy::{MEMBERS, cheapest_within, mean_residence_s};
+    if !(tol.is_finite() && tol >= 0.0) {
+        bail!("--hierarchy-tolerance must be a relative difference of 0 or more, e.g. 0.05");
+    }
+    let full = mean_residence_s(MEMBERS[4], scene, method);
+    let rows: Vec<_> = MEMBERS
+        .iter()
+        .map(|&m| {
+            let t = mean_residence_s(m, scene, method);
+            let diff = t.zip(full).map(|(t, f)| ((t - f) / f).abs());
+            (m, t, diff)
+        })
+        .collect();
+    let (chosen, diff) = cheapest_within(scene, tol, method);
+    if json_out {
+        let members: Vec<_> = rows
+            .iter()
+            .map(|(m, t, d)| {
+                json!({"member": m.name(), "residence_time_mean_s": t, "difference_from_rolling": d})
+            })
+            .collect();
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&json!({
+                "model": "rolling", "tolerance": tol, "members": members,
+                "chosen": chosen.name(), "chosen_difference": diff,
+            }))?
+        );
+        return Ok(());
+    }
+    println!("{head}");
+    println!(
+        "{:<16} {:>12} {:>22}",
+        "member", "mean T, s", "difference from rolling"
+    );
+    for (m, t, d) in &rows {
+        let t = t.map_or_else(|| "never leaves".into(), |t| format!("{t:.6}"));
+        let d = d.map_or_else(|| "-".into(), |d| format!("{:.2} %", d * 100.0));
+        println!("{:<16} {t:>12} {d:>22}", m.name());
+    }
+    println!(
+        "cheapest within {:.2} %: {}{}",
+        tol * 100.0,
+        chosen.name(),
+        diff.map_or(String::new(), |d| format!(
+            " (differs by {:.3} %)",
+            d * 100.0
+        ))
+    );
     Ok(())
 }

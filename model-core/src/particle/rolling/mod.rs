@@ -12,6 +12,7 @@
 //!   runs on a circle at `(1 - k2) Omega` in the inertial frame.
 
 pub mod equations;
+pub mod hierarchy;
 
 use core::ops::ControlFlow;
 

@@ -293,3 +293,39 @@ mod no_panic {
         }
     }
 }
+
+mod hierarchy_members {
+    use super::super::hierarchy::{Member, cheapest_within, differences};
+    use super::*;
+
+    /// On the horizontal disc without resistance the disc member is exact and the paper's flat
+    /// model is 25 % short; on the 60-degree rig gravity dominates and only the full model (or
+    /// the incline, within its own difference) is close.
+    #[test]
+    fn the_map_says_which_member_stands_in() {
+        let disc = horizontal(3.6, 0.05, 0.1);
+        let d = differences(&disc, FINE);
+        assert!(d[2].unwrap() < 1e-9, "disc member on the disc: {:?}", d[2]);
+        assert!(
+            (d[0].unwrap() - 0.2508).abs() < 1e-3,
+            "paper flat: {:?}",
+            d[0]
+        );
+        assert_eq!(cheapest_within(&disc, 1e-6, FINE).0, Member::HorizontalDisc);
+
+        let rig = reference_scene(60.0, 0.15, 0.029, 3.6);
+        let d = differences(&rig, FINE);
+        // The paper's models are off by a factor (2x to 20x on the rig's grid).
+        let paper_flat = d[0].unwrap_or(f64::INFINITY);
+        assert!(
+            paper_flat > 0.5,
+            "paper flat vs rolling on the rig: {paper_flat}"
+        );
+        // A 1 % tolerance needs the full model here.
+        let (member, diff) = cheapest_within(&rig, 0.01, FINE);
+        assert!(
+            member == Member::Full || diff.is_some_and(|x| x <= 0.01),
+            "{member:?} {diff:?}"
+        );
+    }
+}

@@ -1,0 +1,133 @@
+//! The model hierarchy for the tilted, precessing bowl, from the cheapest idealisation to the
+//! full rolling model, and how far each member is from the full model on a scene: the measure
+//! by which a chooser takes the cheapest member good enough for a tolerance (docs/model.md §9).
+
+use super::{
+    AZIMUTHS_DEG, RollingMethod, RollingScene, disc_residence_s, incline_residence_s,
+    residence_over_azimuths,
+};
+use crate::Real;
+use crate::particle::{self, Model, Outcome, Scene};
+
+/// A member of the hierarchy, cheapest first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Member {
+    /// The paper's flat Eq. 6/7 at the combined speed: no tilt, no rolling coupling.
+    PaperFlat,
+    /// The paper's Eq. 10/11 (corrected) at the combined speed.
+    PaperCoriolis,
+    /// The horizontal spinning disc rolled exactly, no resistance, no tilt (closed form).
+    HorizontalDisc,
+    /// The straight roll down the tilted bottom, no rotation (closed form per azimuth).
+    FixedIncline,
+    /// The full rolling model (integrated per azimuth).
+    Full,
+}
+
+/// Every member, cheapest first.
+pub const MEMBERS: [Member; 5] = [
+    Member::PaperFlat,
+    Member::PaperCoriolis,
+    Member::HorizontalDisc,
+    Member::FixedIncline,
+    Member::Full,
+];
+
+impl Member {
+    /// Short name for tables and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Member::PaperFlat => "paper-flat",
+            Member::PaperCoriolis => "paper-coriolis",
+            Member::HorizontalDisc => "horizontal-disc",
+            Member::FixedIncline => "fixed-incline",
+            Member::Full => "rolling",
+        }
+    }
+}
+
+/// The mean residence time over the release azimuths under `member`, s; `None` when the member
+/// says the granule does not leave.
+pub fn mean_residence_s<T: Real>(
+    member: Member,
+    scene: &RollingScene<T>,
+    method: RollingMethod<T>,
+) -> Option<T> {
+    let paper = |model: Model| {
+        let s = Scene {
+            omega_rad_s: scene.combined_speed_rad_s(),
+            mu: scene.rolling_resistance,
+            g_m_s2: scene.g_m_s2,
+            k2: scene.k2,
+            ri_m: scene.ri_m,
+            rim_radius_m: scene.rim_radius_m,
+        };
+        match particle::residence(&s, model) {
+            Ok(Outcome::Leaves {
+                residence_time_s, ..
+            }) => Some(residence_time_s),
+            _ => None,
+        }
+    };
+    match member {
+        Member::PaperFlat => paper(Model::Flat),
+        Member::PaperCoriolis => paper(Model::Coriolis),
+        Member::HorizontalDisc => disc_residence_s(
+            scene.combined_speed_rad_s(),
+            scene.k2,
+            scene.ri_m,
+            scene.rim_radius_m,
+        ),
+        Member::FixedIncline => {
+            let mut sum = T::ZERO;
+            for deg in AZIMUTHS_DEG {
+                sum += incline_residence_s(scene, T::from_f64(deg.to_radians()))?;
+            }
+            Some(sum / T::from_f64(AZIMUTHS_DEG.len() as f64))
+        }
+        Member::Full => {
+            let s = residence_over_azimuths(scene, method).ok()?;
+            if s.left as usize == AZIMUTHS_DEG.len() {
+                s.mean_s
+            } else {
+                None
+            }
+        }
+    }
+}
+
+/// Each member's relative difference from the full model in the mean residence time, in the
+/// order of [`MEMBERS`]: `Some(|T_member - T_full| / T_full)`, `None` where the member or the full
+/// model has no time (then the member cannot stand in for the full model).
+pub fn differences<T: Real>(scene: &RollingScene<T>, method: RollingMethod<T>) -> [Option<T>; 5] {
+    let full = mean_residence_s(Member::Full, scene, method);
+    MEMBERS.map(|m| {
+        let full = full?;
+        let t = if m == Member::Full {
+            full
+        } else {
+            mean_residence_s(m, scene, method)?
+        };
+        Some(((t - full) / full).abs())
+    })
+}
+
+/// The cheapest member whose mean residence time is within `tolerance` (relative) of the full
+/// model's on this scene, and that difference. The full model when nothing cheaper is close
+/// enough.
+pub fn cheapest_within<T: Real>(
+    scene: &RollingScene<T>,
+    tolerance: T,
+    method: RollingMethod<T>,
+) -> (Member, Option<T>) {
+    let d = differences(scene, method);
+    for (m, diff) in MEMBERS.iter().zip(d) {
+        if let Some(x) = diff
+            && x <= tolerance
+        {
+            return (*m, Some(x));
+        }
+    }
+    (Member::Full, d[4])
+}
