@@ -10,6 +10,7 @@ use anyhow::{Context, Result};
 use model_core::particle::{Scene, position_m, residence};
 use model_core::sim::granule::G_M_S2;
 
+use super::models::Equation;
 use super::stats::t_quantile_975;
 use super::{Fit, condition_table};
 use crate::chart::plot::{Figure, Mark, Scale, Series};
@@ -67,15 +68,21 @@ fn model_curves(
     value: &dyn Fn(&Scene<f64>, model_core::particle::Model) -> f64,
 ) -> Vec<Series> {
     let (lo, hi) = speed_range(fit);
+    // The paper's radial models have these curves; the rolling model's residence time is in the
+    // fit's tables (its paths are two-dimensional).
     fit.models
         .iter()
         .enumerate()
-        .map(|(i, m)| Series {
+        .filter_map(|(i, m)| match m.candidate.equation {
+            Equation::Paper(model) => Some((i, m, model)),
+            Equation::Rolling => None,
+        })
+        .map(|(i, m, model)| Series {
             name: format!("{} model, fitted mu {:.4}", m.candidate.name, m.mu),
             points: (0..=CURVE_POINTS)
                 .map(|k| {
                     let w = lo + (hi - lo) * k as f64 / CURVE_POINTS as f64;
-                    (w, value(&scene(fit, m.mu, w), m.candidate.model))
+                    (w, value(&scene(fit, m.mu, w), model))
                 })
                 .collect(),
             mark: if i == 0 { Mark::Dashed } else { Mark::Line },
@@ -170,7 +177,11 @@ pub fn write(fit: &Fit, dir: &Path) -> Result<()> {
         .models
         .iter()
         .enumerate()
-        .map(|(i, m)| {
+        .filter_map(|(i, m)| match m.candidate.equation {
+            Equation::Paper(model) => Some((i, m, model)),
+            Equation::Rolling => None,
+        })
+        .map(|(i, m, model)| {
             let s = scene(fit, m.mu, w5);
             let t_end = 1.5 * t5;
             Series {
@@ -178,7 +189,7 @@ pub fn write(fit: &Fit, dir: &Path) -> Result<()> {
                 points: (0..=CURVE_POINTS)
                     .map(|k| {
                         let t = t_end * k as f64 / CURVE_POINTS as f64;
-                        let r = position_m(&s, m.candidate.model, t).unwrap_or(f64::NAN);
+                        let r = position_m(&s, model, t).unwrap_or(f64::NAN);
                         (t, if r <= s.rim_radius_m { r } else { f64::NAN })
                     })
                     .collect(),

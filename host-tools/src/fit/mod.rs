@@ -13,7 +13,9 @@ use serde::Serialize;
 use serde_json::json;
 
 use crate::experiment::results::{self, STATUS_OK};
-use models::{CANDIDATES, Candidate, Method, Run, STEADY_REL_SD, mu_ceiling, predict};
+use models::{
+    CANDIDATES, Candidate, Equation, Method, Run, STEADY_REL_SD, mu_ceiling_for, predict,
+};
 use stats::{AIC_DECISIVE, aic, crossing, minimise, t_quantile_975};
 
 /// Arguments of `bowl fit`.
@@ -30,7 +32,14 @@ pub struct Args {
     /// Do not draw charts.
     #[arg(long)]
     pub no_charts: bool,
+    /// Angle between the bowl's axis and the vertical during the runs, degrees (the rolling
+    /// model's tilt; the results file does not record it).
+    #[arg(long, default_value_t = DEFAULT_AXES_ANGLE_DEG)]
+    pub axes_angle_deg: f64,
 }
+
+/// The rig's axes angle unless told otherwise, degrees (the controller's default, paper Eq. 2).
+pub const DEFAULT_AXES_ANGLE_DEG: f64 = 60.0;
 
 /// A run left out, and why.
 #[derive(Debug, Clone, Serialize, PartialEq)]
@@ -125,6 +134,7 @@ pub fn load(path: &Path) -> Result<(Vec<Run>, Vec<Excluded>)> {
             k2: row.k2,
             trace,
             method,
+            axes_angle_rad: DEFAULT_AXES_ANGLE_DEG.to_radians(),
         });
     }
     Ok((runs, excluded))
@@ -139,18 +149,21 @@ fn words(status: &str) -> &str {
     }
 }
 
-/// Sum of squared errors of `runs` under `model` at `mu`, s^2.
-pub fn sse(runs: &[Run], model: model_core::particle::Model, mu: f64) -> f64 {
+/// Sum of squared errors of `runs` under `equation` at `mu`, s^2.
+pub fn sse(runs: &[Run], equation: Equation, mu: f64) -> f64 {
     runs.iter()
-        .map(|r| (predict(r, model, mu) - r.residence_s).powi(2))
+        .map(|r| (predict(r, equation, mu) - r.residence_s).powi(2))
         .sum()
 }
 
 /// Fits one model (needs at least 3 runs).
 pub fn fit_model(runs: &[Run], candidate: Candidate) -> ModelFit {
     let n = runs.len();
-    let model = candidate.model;
-    let ceiling = runs.iter().map(mu_ceiling).fold(f64::INFINITY, f64::min);
+    let model = candidate.equation;
+    let ceiling = runs
+        .iter()
+        .map(|r| mu_ceiling_for(r, model))
+        .fold(f64::INFINITY, f64::min);
     let s = |mu: f64| sse(runs, model, mu);
     let mu = minimise(&s, 0.0, ceiling);
     let s_min = s(mu);
@@ -177,8 +190,29 @@ pub fn fit_model(runs: &[Run], candidate: Candidate) -> ModelFit {
     }
 }
 
-/// Fits every candidate and decides between flat and Coriolis.
+/// The model whose AIC is lower than every other's by more than [`AIC_DECISIVE`], else
+/// "undecided".
+fn preferred_by_aic(models: &[ModelFit]) -> &'static str {
+    let mut by_aic: Vec<&ModelFit> = models.iter().filter(|m| m.aic.is_finite()).collect();
+    by_aic.sort_by(|a, b| a.aic.total_cmp(&b.aic));
+    match by_aic.as_slice() {
+        [best] => best.candidate.name,
+        [best, next, ..] if next.aic - best.aic > AIC_DECISIVE => best.candidate.name,
+        _ => "undecided",
+    }
+}
+
+/// Fits every candidate of [`CANDIDATES`] and decides between them by AIC.
 pub fn fit(runs: Vec<Run>, excluded: Vec<Excluded>) -> Result<Fit> {
+    fit_candidates(runs, excluded, &CANDIDATES)
+}
+
+/// Fits the given candidates and decides between them by AIC.
+pub fn fit_candidates(
+    runs: Vec<Run>,
+    excluded: Vec<Excluded>,
+    candidates: &[Candidate],
+) -> Result<Fit> {
     if runs.len() < 3 {
         bail!(
             "{} usable runs ({} excluded): the fit needs at least 3 (two parameters, mu and the \
@@ -187,13 +221,8 @@ pub fn fit(runs: Vec<Run>, excluded: Vec<Excluded>) -> Result<Fit> {
             excluded.len()
         );
     }
-    let models: Vec<ModelFit> = CANDIDATES.iter().map(|&c| fit_model(&runs, c)).collect();
-    let by_name = |n: &str| models.iter().find(|m| m.candidate.name == n).map(|m| m.aic);
-    let preferred = match (by_name("flat"), by_name("coriolis")) {
-        (Some(f), Some(c)) if f - c > AIC_DECISIVE => "coriolis",
-        (Some(f), Some(c)) if c - f > AIC_DECISIVE => "flat",
-        _ => "undecided",
-    };
+    let models: Vec<ModelFit> = candidates.iter().map(|&c| fit_model(&runs, c)).collect();
+    let preferred = preferred_by_aic(&models);
     Ok(Fit {
         runs,
         excluded,
@@ -272,7 +301,16 @@ pub fn condition_table(fit: &Fit) -> crate::chart::table::Table {
 
 /// `bowl fit`.
 pub fn run(args: &Args) -> Result<()> {
-    let (runs, excluded) = load(&args.results)?;
+    if !(args.axes_angle_deg.is_finite() && (0.0..90.0).contains(&args.axes_angle_deg)) {
+        anyhow::bail!(
+            "--axes-angle-deg {} is not a tilt the rig can have: give 0 to below 90 degrees",
+            args.axes_angle_deg
+        );
+    }
+    let (mut runs, excluded) = load(&args.results)?;
+    for r in &mut runs {
+        r.axes_angle_rad = args.axes_angle_deg.to_radians();
+    }
     let fit = fit(runs, excluded)?;
     if !args.no_charts {
         let dir = args.charts.clone().unwrap_or_else(|| {

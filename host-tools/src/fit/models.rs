@@ -5,6 +5,7 @@
 //! steady, otherwise by integrating the equation over the trace
 //! (`model_core::sim::granule::Granule`, the same integrator the simulated rig's granules use).
 
+use model_core::particle::rolling::{self, RollingMethod, RollingScene};
 use model_core::particle::{Model, Scene, residence};
 use model_core::sim::granule::{G_M_S2, Granule};
 
@@ -18,26 +19,50 @@ pub const STEADY_REL_SD: f64 = 0.0002;
 /// Integration step over a trace, s (the rig's control period).
 pub const TRACE_STEP_S: f64 = 1e-3;
 
-/// A model the fit can try. Adding one (a rolling model) means a name and a prediction.
+/// An equation of motion the fit can try.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Equation {
+    /// The paper's radial equation (flat or Coriolis, docs/model.md sections 2 to 4).
+    Paper(Model),
+    /// The granule rolling on the tilted, precessing bowl (docs/model.md section 9), the mean
+    /// over the twelve release azimuths at the run's mean speed split equally between the
+    /// motors, at the run's axes angle.
+    Rolling,
+}
+
+/// A model the fit can try: a name and an equation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Candidate {
     /// Name in the JSON and the tables.
     pub name: &'static str,
     /// The equation of motion.
-    pub model: Model,
+    pub equation: Equation,
 }
 
 /// The models compared, in output order.
-pub const CANDIDATES: [Candidate; 2] = [
+pub const CANDIDATES: [Candidate; 3] = [
     Candidate {
         name: "flat",
-        model: Model::Flat,
+        equation: Equation::Paper(Model::Flat),
     },
     Candidate {
         name: "coriolis",
-        model: Model::Coriolis,
+        equation: Equation::Paper(Model::Coriolis),
+    },
+    Candidate {
+        name: "rolling",
+        equation: Equation::Rolling,
     },
 ];
+
+/// The rolling model's integration in the fit: DP5(4) at rtol 1e-9, whose error in the mean
+/// residence time (2e-10 relative on the rig, docs/model.md §9) is far under any gate's
+/// scatter, and which copes near the stick threshold where looser tolerances chatter.
+const ROLLING_METHOD: RollingMethod<f64> = RollingMethod::Dp54 { rtol: 1e-9 };
+
+/// Steps allowed per release in the fit: a release that needs more is near the stick threshold,
+/// far slower than any measured run, and counts as not leaving.
+const ROLLING_MAX_STEPS: u32 = 5_000;
 
 /// How a run's prediction is computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,10 +92,17 @@ pub struct Run {
     pub trace: Vec<(f64, f64)>,
     /// Closed form or integrator.
     pub method: Method,
+    /// Angle between the bowl's axis and the vertical, rad (the rolling model's tilt).
+    pub axes_angle_rad: f64,
 }
 
-/// Predicted residence time at `mu`, s; infinite when the granule would never leave.
-pub fn predict(run: &Run, model: Model, mu: f64) -> f64 {
+/// Predicted residence time at `mu` (for the rolling model, its rolling resistance), s;
+/// infinite when the granule would never leave.
+pub fn predict(run: &Run, equation: Equation, mu: f64) -> f64 {
+    let model = match equation {
+        Equation::Paper(m) => m,
+        Equation::Rolling => return rolling_mean(run, mu),
+    };
     match run.method {
         Method::ClosedForm => closed_form(run, model, mu, run.mean_rad_s),
         Method::Integrated => {
@@ -93,6 +125,41 @@ pub fn closed_form(run: &Run, model: Model, mu: f64, omega_rad_s: f64) -> f64 {
         rim_radius_m: run.rim_radius_m,
     };
     residence(&scene, model).map_or(f64::INFINITY, |o| o.residence_time_s())
+}
+
+/// The rolling model's mean residence time over the azimuths at the run's mean speed, s
+/// (infinite when a release does not leave). The rolling model takes constant motor speeds: a
+/// drifting speed trace is represented by its mean.
+fn rolling_mean(run: &Run, mu: f64) -> f64 {
+    let scene = RollingScene {
+        rolling_resistance: mu,
+        k2: run.k2,
+        ri_m: run.release_radius_m,
+        rim_radius_m: run.rim_radius_m,
+        g_m_s2: G_M_S2,
+        ..RollingScene::equal_speeds(run.mean_rad_s, run.axes_angle_rad, run.rim_radius_m)
+    };
+    let limits = rolling::SystemLimits {
+        horizon_s: 20.0 * run.residence_s + 1.0,
+        max_steps: ROLLING_MAX_STEPS,
+    };
+    match rolling::over_azimuths_within(&scene, ROLLING_METHOD, limits) {
+        Ok(s) if s.left as usize == rolling::AZIMUTHS_DEG.len() => {
+            s.mean_s.unwrap_or(f64::INFINITY)
+        }
+        _ => f64::INFINITY,
+    }
+}
+
+/// The largest `mu` at which the run can leave under `equation`: for the paper's equation
+/// `ri omega^2 / g` at its fastest speed; for the rolling model on the tilted bottom, where
+/// gravity's in-plane part drives it, `tan th` (the fixed incline's hold) plus that centrifugal
+/// bound.
+pub fn mu_ceiling_for(run: &Run, equation: Equation) -> f64 {
+    match equation {
+        Equation::Paper(_) => mu_ceiling(run),
+        Equation::Rolling => run.axes_angle_rad.tan() + mu_ceiling(run),
+    }
 }
 
 /// The largest `mu` at which the run can leave: `ri omega^2 / g` at its fastest speed.

@@ -11,41 +11,26 @@ const MAX_NEWTON: u32 = 40;
 ///
 /// `F` is convex and increasing with `F'(0) = 0`, so Newton from 0 divides by zero; from any
 /// point above the root it decreases monotonically onto it, and from a point below it the first
-/// step lands above the root (the tangent of a convex function lies below it). The root lies in
-/// the bracket of docs/model.md §4: with `A + B = 1`,
-/// `ln(1 + x/A) <= u <= min(ln((1 + x)/A), sqrt(2 x / A))` (at the lower end `F = x - B (1 -
-/// e^{-q u}) <= x`, at `ln((1 + x)/A)` `F = x + B e^{-q u} >= x`, and `F >= A u^2 / 2`). The
-/// logarithmic ends matter when `x` is large: there the bracket is `B/(A + x)` wide, while
-/// `sqrt(2 x / A)` alone lets Newton start far up the exponential and crawl down one unit of
-/// `u` per step. We start at the flat model's closed form scaled to the same curvature at 0,
-/// `u0 = acosh(1 + x / (A (1 + q)))` (exact at `mu = 0`, within about `k mu` otherwise),
-/// clamped to the bracket. Every iterate is clamped to the bracket, which shrinks as Newton
-/// learns which side each point is on.
+/// step lands above the root (the tangent of a convex function lies below it). We start at the
+/// flat model's closed form scaled to the same curvature at 0,
+/// `u0 = acosh(1 + x / (A (1 + q)))` (exact at `mu = 0`, within about `k mu` otherwise), inside
+/// the bracket `[0, sqrt(2 x / A)]` (`F >= A u^2 / 2`, docs/model.md §4). Every iterate is
+/// clamped to the bracket, which shrinks as Newton learns which side each point is on.
+///
+/// Where `F` is a factor off `x` with `u > 1` (a large `k mu` with a start far from the rim:
+/// `u0` is then far from the root), `F` behaves like `A e^u` and a Newton step moves `u` by
+/// about one unit: there we step by `ln(x / F)` instead, which lands within a unit of the root
+/// (`F <= A e^u`, docs/model.md §4's `ln((1 + x)/A)` bound). Ordinary scenes never take it, so
+/// it costs no logarithm on the MCU where it is not needed.
 /// Stop test: after a step `d` the remaining error is about `F''/(2 F') d^2`; we stop when that
 /// is below a quarter of an ulp of `u`, which saves the customary extra iteration. An iteration
 /// that has not converged is an error, never a result.
 pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneError> {
     let ac = shape.a_coef;
-    let (mut lower, mut upper) = if x < T::ONE / T::EPSILON {
-        (
-            (x / ac).ln_1p(),
-            (T::TWO * x / ac).sqrt().min(x.ln_1p() - ac.ln()),
-        )
-    } else {
-        // 1 + x/A and 1 + x round to x/A and x: both ends are ln x - ln A, and x/A may overflow.
-        let end = x.ln() - ac.ln();
-        (end, end)
-    };
-    if !(lower.is_finite() && upper.is_finite()) {
-        return Err(SceneError::OutOfRange);
-    }
-    if upper < lower {
-        // Both ends agree to rounding.
-        upper = lower;
-    }
-    let mut u = acosh_1p_ratio(x, ac * (T::ONE + shape.q))
-        .min(upper)
-        .max(lower);
+    let mut lower = T::ZERO;
+    let mut upper = (T::TWO * x / ac).sqrt();
+    let mut u = acosh_1p_ratio(x, ac * (T::ONE + shape.q)).min(upper);
+    let far = T::from_f64(4.0);
     for _ in 0..MAX_NEWTON {
         let (f, fp, fpp) = shape.eval(u);
         if !(f.is_finite() && fp.is_finite() && fpp.is_finite()) {
@@ -60,12 +45,15 @@ pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneEr
         } else {
             upper = u;
         }
+        if u > T::ONE && (f > far * x || x > far * f) {
+            u = (u - (f / x).ln()).max(lower).min(upper);
+            continue;
+        }
         let d = (f - x) / fp;
         let next = (u - d).max(lower).min(upper);
         // F' at the new point to first order, for the exit velocity.
         let fp_next = fp - fpp * (u - next);
-        let converged =
-            fpp * d * d <= T::HALF * T::EPSILON * fp * next || upper - lower <= T::EPSILON * upper;
+        let converged = fpp * d * d <= T::HALF * T::EPSILON * fp * next;
         u = next;
         if converged {
             return Ok((u, fp_next));

@@ -17,7 +17,8 @@ pub mod hierarchy;
 use core::ops::ControlFlow;
 
 use crate::Real;
-use crate::ode::system::{self, Ended, SystemError, SystemLimits};
+pub use crate::ode::system::SystemLimits;
+use crate::ode::system::{self, Ended, SystemError};
 use equations::{AT_REST_M_S, State, forces};
 
 /// A scene of the rolling model. SI units; angles in radians.
@@ -235,10 +236,27 @@ fn rim_event<T: Real>(y: &State<T>, dy: &State<T>) -> (T, T) {
 
 /// One release at azimuth `beta_rad` (measured from the downhill direction at `t = 0`, which is
 /// `-e1`, turning towards `-e2`): `(x, y) = ri (-cos beta, -sin beta)`, at rest in the bowl.
+/// Gives up after [`HORIZON_S`] and [`MAX_STEPS`].
 pub fn residence<T: Real>(
     scene: &RollingScene<T>,
     beta_rad: T,
     method: RollingMethod<T>,
+) -> Result<RollingReport<T>, RollingError> {
+    let limits = SystemLimits {
+        horizon_s: T::from_f64(HORIZON_S),
+        max_steps: MAX_STEPS,
+    };
+    residence_within(scene, beta_rad, method, limits)
+}
+
+/// [`residence`] within the caller's horizon and step cap (a fit that only needs to know that
+/// a granule takes far longer than measured stops early; near the stick threshold a granule
+/// that slows to rest and restarts can take many steps).
+pub fn residence_within<T: Real>(
+    scene: &RollingScene<T>,
+    beta_rad: T,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
 ) -> Result<RollingReport<T>, RollingError> {
     scene.validate()?;
     if !beta_rad.is_finite() {
@@ -276,10 +294,6 @@ pub fn residence<T: Real>(
         ControlFlow::Continue(())
     };
     let rhs = |t: T, y: &State<T>| forces(scene, t, y).derivative;
-    let limits = SystemLimits {
-        horizon_s: T::from_f64(HORIZON_S),
-        max_steps: MAX_STEPS,
-    };
     // The integrators' event is a plain function: lengths are integrated in units of R so the
     // rim is the fixed |(x, y)| = 1.
     let scale = T::ONE / rim;
@@ -370,12 +384,25 @@ pub fn residence_over_azimuths<T: Real>(
     scene: &RollingScene<T>,
     method: RollingMethod<T>,
 ) -> Result<AzimuthSummary<T>, RollingError> {
+    let limits = SystemLimits {
+        horizon_s: T::from_f64(HORIZON_S),
+        max_steps: MAX_STEPS,
+    };
+    over_azimuths_within(scene, method, limits)
+}
+
+/// [`residence_over_azimuths`] within the caller's horizon and step cap per release.
+pub fn over_azimuths_within<T: Real>(
+    scene: &RollingScene<T>,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+) -> Result<AzimuthSummary<T>, RollingError> {
     let mut sum = T::ZERO;
     let (mut min_s, mut max_s): (Option<T>, Option<T>) = (None, None);
     let (mut left, mut slid, mut evaluations) = (0u32, 0u32, 0u32);
     for deg in AZIMUTHS_DEG {
         let beta = T::from_f64(deg.to_radians());
-        let report = residence(scene, beta, method)?;
+        let report = residence_within(scene, beta, method, limits)?;
         evaluations = evaluations.saturating_add(report.evaluations);
         if let RollingOutcome::Leaves {
             residence_time_s: t,
