@@ -287,7 +287,8 @@ pub fn rk4<T: Real, const N: usize, S>(
                 steps,
             });
         }
-        t += h;
+        // The time as a multiple of the step, not a running sum: no rounding accumulates in it.
+        t = t0 + T::from_f64(f64::from(steps)) * h;
         y = y1;
         k1 = k1_next;
         if let ControlFlow::Break(why) = check(t, &y) {

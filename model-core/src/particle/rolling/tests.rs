@@ -329,3 +329,44 @@ mod hierarchy_members {
         );
     }
 }
+
+/// The same reference values in f32 (the MCU's precision): DP5(4) and RK4 within 1e-6 of the
+/// f64 reference.
+#[test]
+fn tilted_rig_reference_values_in_f32() {
+    let cases = [
+        reference_scene(60.0, 0.15, 0.029, 3.6),
+        reference_scene(30.0, 0.075, 0.001, 0.5),
+    ];
+    for s in cases {
+        let fine = residence_over_azimuths(&s, FINE).unwrap();
+        let s32 = RollingScene::<f32> {
+            precession_rad_s: s.precession_rad_s as f32,
+            spin_rad_s: s.spin_rad_s as f32,
+            axes_angle_rad: s.axes_angle_rad as f32,
+            rolling_resistance: s.rolling_resistance as f32,
+            sliding_friction: s.sliding_friction as f32,
+            g_m_s2: s.g_m_s2 as f32,
+            k2: s.k2 as f32,
+            particle_radius_m: s.particle_radius_m as f32,
+            rod_length_m: s.rod_length_m as f32,
+            ri_m: s.ri_m as f32,
+            rim_radius_m: s.rim_radius_m as f32,
+        };
+        for method in [
+            RollingMethod::Dp54 { rtol: 1e-6f32 },
+            RollingMethod::Rk4 { step_s: 1e-3f32 },
+        ] {
+            let got = residence_over_azimuths(&s32, method).unwrap();
+            assert_eq!(got.left, 12);
+            for (x, y) in [
+                (got.mean_s.unwrap(), fine.mean_s.unwrap()),
+                (got.min_s.unwrap(), fine.min_s.unwrap()),
+                (got.max_s.unwrap(), fine.max_s.unwrap()),
+            ] {
+                let e = ((f64::from(x) - y) / y).abs();
+                assert!(e <= 1e-6, "f32 {method:?}: {x} vs {y}: {e:e}");
+            }
+        }
+    }
+}
