@@ -163,14 +163,7 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
         let sv = atol + rtol * v.abs().max(v1.abs());
         let err = ((er / sr) * (er / sr) + (ev / sv) * (ev / sv)) * T::HALF;
         let err = err.sqrt();
-        // Classic controller: 0.9 err^(-1/5), the factor kept within [0.2, 5].
-        let factor = if err > T::ZERO {
-            (T::from_f64(0.9) * err.ln().exp_scaled(-0.2))
-                .max(T::from_f64(0.2))
-                .min(T::from_f64(5.0))
-        } else {
-            T::from_f64(5.0)
-        };
+        let factor = step_factor(err);
         if err <= T::ONE {
             if r1 >= rim {
                 let hkr = kr.map(|k| h * k);
@@ -198,6 +191,18 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
         }
     }
     Err(OdeError::StepLimit)
+}
+
+/// The step-size controller: the next step is `factor` times this one for a scaled error
+/// `err`, the classic `0.9 err^(-1/5)` kept within [0.2, 5].
+pub(super) fn step_factor<T: Real>(err: T) -> T {
+    if err > T::ZERO {
+        (T::from_f64(0.9) * err.ln().exp_scaled(-0.2))
+            .max(T::from_f64(0.2))
+            .min(T::from_f64(5.0))
+    } else {
+        T::from_f64(5.0)
+    }
 }
 
 /// `exp(p * x)` for the controller's powers, on the `ln` already taken.

@@ -7,7 +7,7 @@
 
 use core::ops::ControlFlow;
 
-use super::dp54::{A2, A3, A4, A5, A6, B, C, Dense, E, ExpScaled, t_of};
+use super::dp54::{A2, A3, A4, A5, A6, B, C, Dense, E, step_factor, t_of};
 use super::event::{hermite, locate};
 use crate::Real;
 
@@ -88,6 +88,33 @@ fn finite<T: Real, const N: usize>(y: &[T; N]) -> bool {
     y.iter().all(|v| v.is_finite())
 }
 
+/// Where in the step `[t, t + h]` the event reaches zero, located on the step's interpolant
+/// (`component(i, theta)`: component `i`'s value and derivative per unit theta), and the
+/// state there.
+fn event_in_step<T: Real, const N: usize>(
+    component: impl Fn(usize, T) -> (T, T),
+    event: EventFn<T, N>,
+    t: T,
+    h: T,
+) -> (T, [T; N]) {
+    let at = |th: T| -> ([T; N], [T; N]) {
+        let mut v = [T::ZERO; N];
+        let mut d = [T::ZERO; N];
+        for i in 0..N {
+            (v[i], d[i]) = component(i, th);
+        }
+        (v, d)
+    };
+    let theta = locate(
+        |th| {
+            let (v, d) = at(th);
+            event(&v, &d)
+        },
+        T::ZERO,
+    );
+    (t + theta * h, at(theta).0)
+}
+
 /// Adaptive Dormand-Prince 5(4) from `(t0, y0)` until `event` crosses zero from below, `check`
 /// breaks, or the horizon. `scale[i]` is the absolute tolerance of component `i` (a state's
 /// typical size times `rtol` where it may pass through zero); `h0` the first step.
@@ -157,13 +184,7 @@ pub fn dp54<T: Real, const N: usize, S>(
             return Err(SystemError::NotFinite);
         }
         let err = (err2 / T::from_f64(N as f64)).sqrt();
-        let factor = if err > T::ZERO {
-            (T::from_f64(0.9) * err.ln().exp_scaled(-0.2))
-                .max(T::from_f64(0.2))
-                .min(T::from_f64(5.0))
-        } else {
-            T::from_f64(5.0)
-        };
+        let factor = step_factor(err);
         if err > T::ONE {
             h *= factor.min(T::ONE);
             continue;
@@ -174,27 +195,9 @@ pub fn dp54<T: Real, const N: usize, S>(
                 let hk: [T; 7] = core::array::from_fn(|s| h * k[s][i]);
                 Dense::new(y[i], y1[i], &hk)
             });
-            let at = |th: T| -> ([T; N], [T; N]) {
-                let mut v = [T::ZERO; N];
-                let mut d = [T::ZERO; N];
-                for i in 0..N {
-                    (v[i], d[i]) = dense[i].at(th);
-                }
-                (v, d)
-            };
-            let theta = locate(
-                |th| {
-                    let (v, d) = at(th);
-                    event(&v, &d)
-                },
-                T::ZERO,
-            );
-            let (ye, _) = at(theta);
+            let (te, ye) = event_in_step(|i, th| dense[i].at(th), event, t, h);
             return Ok(Run {
-                ended: Ended::Event {
-                    t: t + theta * h,
-                    y: ye,
-                },
+                ended: Ended::Event { t: te, y: ye },
                 evaluations,
                 steps,
             });
@@ -262,27 +265,14 @@ pub fn rk4<T: Real, const N: usize, S>(
         }
         let (g1, _) = event(&y1, &[T::ZERO; N]);
         if g1 >= T::ZERO {
-            let at = |th: T| -> ([T; N], [T; N]) {
-                let mut v = [T::ZERO; N];
-                let mut d = [T::ZERO; N];
-                for i in 0..N {
-                    (v[i], d[i]) = hermite(y[i], h * k1[i], y1[i], h * k1_next[i], th);
-                }
-                (v, d)
-            };
-            let theta = locate(
-                |th| {
-                    let (v, d) = at(th);
-                    event(&v, &d)
-                },
-                T::ZERO,
+            let (te, ye) = event_in_step(
+                |i, th| hermite(y[i], h * k1[i], y1[i], h * k1_next[i], th),
+                event,
+                t,
+                h,
             );
-            let (ye, _) = at(theta);
             return Ok(Run {
-                ended: Ended::Event {
-                    t: t + theta * h,
-                    y: ye,
-                },
+                ended: Ended::Event { t: te, y: ye },
                 evaluations,
                 steps,
             });
