@@ -36,4 +36,6 @@ mkdir -p docs/charts/rolling
 "$bowl" chart rolling-residence --axes-angle-deg 30 --out docs/charts/rolling/residence-30.svg
 "$bowl" chart rolling-paths --out docs/charts/rolling/paths.svg
 "$bowl" chart rolling-hierarchy --out docs/charts/rolling/hierarchy.svg
+"$bowl" chart rolling-hierarchy --mu 0.001 --out docs/charts/rolling/hierarchy-mu0.001.svg
+"$bowl" chart rolling-hierarchy --mu 0.1 --out docs/charts/rolling/hierarchy-mu0.1.svg
 "$bowl" chart rolling-work-precision --out docs/charts/rolling/work-precision.svg

@@ -3,6 +3,7 @@
 //! and max over the twelve azimuths 0, 30, ..., 330 degrees.
 
 use anyhow::{Result, bail};
+use model_core::particle::rolling::hierarchy::{Wanted, tolerance_from_resistance_uncertainty};
 use model_core::particle::rolling::{
     self, AZIMUTHS_DEG, RollingError, RollingMethod, RollingOutcome, RollingScene,
 };
@@ -39,8 +40,16 @@ pub struct RollingArgs {
     /// Rolling model: every member of the model hierarchy on this scene, its mean residence
     /// time and its difference from the full model, and the cheapest member within this
     /// relative tolerance (e.g. 0.05).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "hierarchy_uncertainty_mu")]
     hierarchy_tolerance: Option<f64>,
+    /// Rolling model: as --hierarchy-tolerance, the tolerance set by this uncertainty in the
+    /// rolling resistance (the change of the full model's mean T when mu moves by it).
+    #[arg(long)]
+    hierarchy_uncertainty_mu: Option<f64>,
+    /// Rolling model: with the hierarchy, judge each single release (the worst azimuth), not
+    /// the mean over the releases.
+    #[arg(long)]
+    each_release: bool,
 }
 
 fn words(e: RollingError) -> String {
@@ -169,8 +178,32 @@ pub fn run(args: &Args, r: &RollingArgs) -> Result<()> {
         args.ri_m,
         args.rim_radius_m
     );
+    let wanted = if r.each_release {
+        Wanted::EachRelease
+    } else {
+        Wanted::AzimuthMean
+    };
     if let Some(tol) = r.hierarchy_tolerance {
-        return hierarchy(&scene, method, tol, args.json, &head);
+        return hierarchy(&scene, method, tol, wanted, args.json, &head);
+    }
+    if let Some(dmu) = r.hierarchy_uncertainty_mu {
+        if !(dmu.is_finite() && dmu >= 0.0) {
+            bail!("--hierarchy-uncertainty-mu must be 0 or more, e.g. 0.01");
+        }
+        let tol = tolerance_from_resistance_uncertainty(&scene, dmu, method).ok_or_else(|| {
+            anyhow::anyhow!(
+                "the rolling model gives no mean residence time here (a release does not leave), \
+                 so no tolerance follows from the uncertainty"
+            )
+        })?;
+        if !args.json {
+            println!(
+                "an uncertainty of {dmu} in mu_r moves the mean residence time by {:.3} %: that is \
+                 the tolerance",
+                tol * 100.0
+            );
+        }
+        return hierarchy(&scene, method, tol, wanted, args.json, &head);
     }
     if r.release_azimuth_deg.trim() == "all" {
         let sum = rolling::residence_over_azimuths(&scene, method)
@@ -228,23 +261,23 @@ fn hierarchy(
     scene: &RollingScene<f64>,
     method: RollingMethod<f64>,
     tol: f64,
+    wanted: Wanted,
     json_out: bool,
     head: &str,
 ) -> Result<()> {
-    use model_core::particle::rolling::hierarchy::{MEMBERS, cheapest_within, mean_residence_s};
+    use model_core::particle::rolling::hierarchy::{
+        MEMBERS, cheapest_within, differences, mean_residence_s,
+    };
     if !(tol.is_finite() && tol >= 0.0) {
         bail!("--hierarchy-tolerance must be a relative difference of 0 or more, e.g. 0.05");
     }
-    let full = mean_residence_s(MEMBERS[4], scene, method);
+    let diffs = differences(scene, method, wanted);
     let rows: Vec<_> = MEMBERS
         .iter()
-        .map(|&m| {
-            let t = mean_residence_s(m, scene, method);
-            let diff = t.zip(full).map(|(t, f)| ((t - f) / f).abs());
-            (m, t, diff)
-        })
+        .zip(diffs)
+        .map(|(&m, diff)| (m, mean_residence_s(m, scene, method), diff))
         .collect();
-    let (chosen, diff) = cheapest_within(scene, tol, method);
+    let (chosen, diff) = cheapest_within(scene, tol, method, wanted);
     if json_out {
         let members: Vec<_> = rows
             .iter()
@@ -256,6 +289,7 @@ fn hierarchy(
             "{}",
             serde_json::to_string_pretty(&json!({
                 "model": "rolling", "tolerance": tol, "members": members,
+                "judged_on": if wanted == Wanted::EachRelease { "each release" } else { "azimuth mean" },
                 "chosen": chosen.name(), "chosen_difference": diff,
             }))?
         );

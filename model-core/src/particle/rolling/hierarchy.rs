@@ -3,8 +3,8 @@
 //! by which a chooser takes the cheapest member good enough for a tolerance (docs/model.md §9).
 
 use super::{
-    AZIMUTHS_DEG, RollingMethod, RollingScene, disc_residence_s, incline_residence_s,
-    residence_over_azimuths,
+    AZIMUTHS_DEG, RollingMethod, RollingOutcome, RollingScene, disc_residence_s,
+    incline_residence_s, residence, residence_over_azimuths,
 };
 use crate::Real;
 use crate::particle::{self, Model, Outcome, Scene};
@@ -97,31 +97,112 @@ pub fn mean_residence_s<T: Real>(
     }
 }
 
-/// Each member's relative difference from the full model in the mean residence time, in the
-/// order of [`MEMBERS`]: `Some(|T_member - T_full| / T_full)`, `None` where the member or the full
-/// model has no time (then the member cannot stand in for the full model).
-pub fn differences<T: Real>(scene: &RollingScene<T>, method: RollingMethod<T>) -> [Option<T>; 5] {
-    let full = mean_residence_s(Member::Full, scene, method);
-    MEMBERS.map(|m| {
-        let full = full?;
-        let t = if m == Member::Full {
-            full
-        } else {
-            mean_residence_s(m, scene, method)?
-        };
-        Some(((t - full) / full).abs())
-    })
+/// What the scene needs the model for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Wanted {
+    /// The mean over the release azimuths (a batch of granules dropped anywhere).
+    AzimuthMean,
+    /// Every single release (one granule at a known azimuth): the worst azimuth counts.
+    EachRelease,
 }
 
-/// The cheapest member whose mean residence time is within `tolerance` (relative) of the full
-/// model's on this scene, and that difference. The full model when nothing cheaper is close
-/// enough.
+/// One release's residence time under `member`, s (the paper's forms and the disc do not
+/// depend on the azimuth).
+fn release_time_s<T: Real>(
+    member: Member,
+    scene: &RollingScene<T>,
+    beta_rad: T,
+    method: RollingMethod<T>,
+) -> Option<T> {
+    match member {
+        Member::FixedIncline => incline_residence_s(scene, beta_rad),
+        Member::Full => match residence(scene, beta_rad, method).ok()?.outcome {
+            RollingOutcome::Leaves {
+                residence_time_s, ..
+            } => Some(residence_time_s),
+            _ => None,
+        },
+        other => mean_residence_s(other, scene, method),
+    }
+}
+
+/// Each member's relative difference from the full model, in the order of [`MEMBERS`]: for the
+/// azimuth mean `|T_member - T_full| / T_full` of the means, for each release the largest such
+/// difference over the azimuths. `None` where the member or the full model has no time (then
+/// the member cannot stand in for the full model).
+pub fn differences<T: Real>(
+    scene: &RollingScene<T>,
+    method: RollingMethod<T>,
+    wanted: Wanted,
+) -> [Option<T>; 5] {
+    match wanted {
+        Wanted::AzimuthMean => {
+            let full = mean_residence_s(Member::Full, scene, method);
+            MEMBERS.map(|m| {
+                let full = full?;
+                let t = if m == Member::Full {
+                    full
+                } else {
+                    mean_residence_s(m, scene, method)?
+                };
+                Some(((t - full) / full).abs())
+            })
+        }
+        Wanted::EachRelease => {
+            let mut full = [T::ZERO; AZIMUTHS_DEG.len()];
+            for (slot, deg) in full.iter_mut().zip(AZIMUTHS_DEG) {
+                match release_time_s(Member::Full, scene, T::from_f64(deg.to_radians()), method) {
+                    Some(t) => *slot = t,
+                    None => return [None; 5],
+                }
+            }
+            MEMBERS.map(|m| {
+                let mut worst = T::ZERO;
+                for (f, deg) in full.iter().zip(AZIMUTHS_DEG) {
+                    let t = if m == Member::Full {
+                        *f
+                    } else {
+                        release_time_s(m, scene, T::from_f64(deg.to_radians()), method)?
+                    };
+                    worst = worst.max(((t - *f) / *f).abs());
+                }
+                Some(worst)
+            })
+        }
+    }
+}
+
+/// The tolerance a scene's uncertainty in the rolling resistance sets: the relative change of
+/// the full model's mean residence time when `mu_r` moves by `+- mu_uncertainty`. A simpler
+/// member within that is as good as the full model for this scene.
+pub fn tolerance_from_resistance_uncertainty<T: Real>(
+    scene: &RollingScene<T>,
+    mu_uncertainty: T,
+    method: RollingMethod<T>,
+) -> Option<T> {
+    let at = |mu: T| {
+        let s = RollingScene {
+            rolling_resistance: mu.max(T::ZERO),
+            ..*scene
+        };
+        mean_residence_s(Member::Full, &s, method)
+    };
+    let t = at(scene.rolling_resistance)?;
+    let up = at(scene.rolling_resistance + mu_uncertainty)?;
+    let down = at(scene.rolling_resistance - mu_uncertainty)?;
+    Some((up - down).abs() / (T::TWO * t))
+}
+
+/// The cheapest member within `tolerance` (relative) of the full model on this scene for what
+/// is `wanted`, and that difference; the full model when nothing cheaper is close enough.
 pub fn cheapest_within<T: Real>(
     scene: &RollingScene<T>,
     tolerance: T,
     method: RollingMethod<T>,
+    wanted: Wanted,
 ) -> (Member, Option<T>) {
-    let d = differences(scene, method);
+    let d = differences(scene, method, wanted);
     for (m, diff) in MEMBERS.iter().zip(d) {
         if let Some(x) = diff
             && x <= tolerance

@@ -295,7 +295,9 @@ mod no_panic {
 }
 
 mod hierarchy_members {
-    use super::super::hierarchy::{Member, cheapest_within, differences};
+    use super::super::hierarchy::{
+        Member, Wanted, cheapest_within, differences, tolerance_from_resistance_uncertainty,
+    };
     use super::*;
 
     /// On the horizontal disc without resistance the disc member is exact and the paper's flat
@@ -304,17 +306,20 @@ mod hierarchy_members {
     #[test]
     fn the_map_says_which_member_stands_in() {
         let disc = horizontal(3.6, 0.05, 0.1);
-        let d = differences(&disc, FINE);
+        let d = differences(&disc, FINE, Wanted::AzimuthMean);
         assert!(d[2].unwrap() < 1e-9, "disc member on the disc: {:?}", d[2]);
         assert!(
             (d[0].unwrap() - 0.2508).abs() < 1e-3,
             "paper flat: {:?}",
             d[0]
         );
-        assert_eq!(cheapest_within(&disc, 1e-6, FINE).0, Member::HorizontalDisc);
+        assert_eq!(
+            cheapest_within(&disc, 1e-6, FINE, Wanted::AzimuthMean).0,
+            Member::HorizontalDisc
+        );
 
         let rig = reference_scene(60.0, 0.15, 0.029, 3.6);
-        let d = differences(&rig, FINE);
+        let d = differences(&rig, FINE, Wanted::AzimuthMean);
         // The paper's models are off by a factor (2x to 20x on the rig's grid).
         let paper_flat = d[0].unwrap_or(f64::INFINITY);
         assert!(
@@ -322,10 +327,39 @@ mod hierarchy_members {
             "paper flat vs rolling on the rig: {paper_flat}"
         );
         // A 1 % tolerance needs the full model here.
-        let (member, diff) = cheapest_within(&rig, 0.01, FINE);
+        let (member, diff) = cheapest_within(&rig, 0.01, FINE, Wanted::AzimuthMean);
         assert!(
             member == Member::Full || diff.is_some_and(|x| x <= 0.01),
             "{member:?} {diff:?}"
+        );
+        // The incline's worst release differs more than its mean: a tolerance between the two
+        // takes the incline for the mean and the full model for single releases.
+        let mean = differences(&rig, FINE, Wanted::AzimuthMean)[3].unwrap();
+        let each = differences(&rig, FINE, Wanted::EachRelease)[3].unwrap();
+        assert!(each > mean, "{each} vs {mean}");
+        let tol = 0.5 * (mean + each);
+        assert_eq!(
+            cheapest_within(&rig, tol, FINE, Wanted::AzimuthMean).0,
+            Member::FixedIncline
+        );
+        assert_eq!(
+            cheapest_within(&rig, tol, FINE, Wanted::EachRelease).0,
+            Member::Full
+        );
+        // An uncertainty of 0.01 in mu_r moves the mean by 0.3 %, less than the incline's
+        // difference (0.8 %): the full model is needed. With 0.05 (a resistance known only to
+        // its size) the incline is good enough.
+        let tight = tolerance_from_resistance_uncertainty(&rig, 0.01, FINE).unwrap();
+        assert!(tight < mean, "{tight} vs {mean}");
+        assert_eq!(
+            cheapest_within(&rig, tight, FINE, Wanted::AzimuthMean).0,
+            Member::Full
+        );
+        let tol = tolerance_from_resistance_uncertainty(&rig, 0.05, FINE).unwrap();
+        assert!(tol > mean, "{tol} vs {mean}");
+        assert_eq!(
+            cheapest_within(&rig, tol, FINE, Wanted::AzimuthMean).0,
+            Member::FixedIncline
         );
     }
 }
