@@ -4,9 +4,9 @@
 //! the state leaves "commissioning", then asks MODELS and PARAMS and prints the identified motor
 //! models and the speed-loop gains that follow from them, as text or `--json`.
 //!
-//! Exit status: 0 done, 2 the rig refused COMMISSION (the reason is printed), 3 no answer or
-//! commissioning did not end within `--timeout-s`, 4 commissioning ended in a fault (the rig's
-//! fault code is printed; the motors are off).
+//! Exit status (`exit_code`): 0 done, 1 the rig refused COMMISSION (the reason is printed) or
+//! commissioning ended in a fault (the rig's fault code is printed; the motors are off), 3 the
+//! link failed, 4 no answer or commissioning did not end within `--timeout-s`.
 
 use std::time::{Duration, Instant};
 
@@ -16,11 +16,9 @@ use model_core::wire::{
 };
 use serde::Serialize;
 
-use crate::send::{EXIT_REJECTED, EXIT_TIMEOUT, command_line, explain, transact};
+use crate::exit_code;
+use crate::send::{command_line, explain, transact};
 use crate::serial::{Port, ReadOutcome};
-
-/// Exit status when commissioning ended in a fault.
-pub const EXIT_FAULT: i32 = 4;
 
 /// How long one command waits for its answer.
 const ANSWER_TIMEOUT: Duration = Duration::from_millis(1000);
@@ -235,12 +233,12 @@ pub fn run(args: &Args) -> Result<i32> {
             report.result = "rejected";
             report.reason = Some(reason.token());
             print(&report, args.json)?;
-            return Ok(EXIT_REJECTED);
+            return Ok(exit_code::REFUSED);
         }
         _ => {
             report.result = "timeout";
             print(&report, args.json)?;
-            return Ok(EXIT_TIMEOUT);
+            return Ok(exit_code::TIMEOUT);
         }
     }
     if !args.json {
@@ -255,11 +253,11 @@ pub fn run(args: &Args) -> Result<i32> {
     )?;
     report.seconds = started.elapsed().as_secs_f64();
     let code = match end {
-        End::Idle => 0,
+        End::Idle => exit_code::OK,
         End::Fault(fault) => {
             report.result = "fault";
             report.fault = Some(format!("{fault:?} (code {})", fault.code()));
-            EXIT_FAULT
+            exit_code::REFUSED
         }
         End::OtherState(state) => {
             bail!("commissioning ended in state {state:?} (another PC may have sent a command)")
@@ -268,10 +266,10 @@ pub fn run(args: &Args) -> Result<i32> {
             report.result = "timeout";
             // Leave the motors off rather than half-way through a duty step.
             let _ = ask(&mut port, &mut ids, &["STOP"]);
-            EXIT_TIMEOUT
+            exit_code::TIMEOUT
         }
     };
-    if code == 0 {
+    if code == exit_code::OK {
         let params = match ask(&mut port, &mut ids, &["PARAMS"])? {
             Some(Frame::Params { values, .. }) => Some(values),
             _ => None,

@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 mod chart;
 mod commission;
 mod demo;
+mod exit_code;
 mod kinematics;
 mod monitor;
 mod predict;
@@ -36,6 +37,8 @@ enum Command {
     Predict(predict::Args),
     /// Live view of the rig's telemetry, with CSV log and frame counters.
     Monitor(monitor::Args),
+    /// The serial ports on this computer, with their USB descriptions.
+    Ports,
     /// Send one command to the rig and print its answer.
     Send(send::Args),
     /// Run the motor identification on the rig; print the identified models and gains.
@@ -53,13 +56,26 @@ enum Command {
     Demo(demo::Args),
 }
 
-fn main() -> Result<()> {
+fn main() {
     let cli = Cli::parse();
+    if let Err(e) = run(cli) {
+        eprintln!("error: {e:#}");
+        let link = e.chain().any(|c| c.is::<serial::LinkError>());
+        std::process::exit(if link {
+            exit_code::LINK
+        } else {
+            exit_code::REFUSED
+        });
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Kinematics(args) => kinematics::run(&args),
         Command::Chart(args) => chart::run(&args),
         Command::Predict(args) => predict::run(&args),
         Command::Monitor(args) => monitor::run(&args),
+        Command::Ports => serial::run_ports(),
         Command::Send(args) => send::run(&args).map(|code| std::process::exit(code)),
         Command::Commission(args) => commission::run(&args).map(|code| std::process::exit(code)),
         Command::Replay(args) => replay::run(&args),

@@ -1,5 +1,5 @@
-//! `bowl send PORT COMMAND ...`: send one command, print the rig's answer. Exit status 0 when the
-//! rig did it, 2 when it (or the local check) rejected it, 3 when no answer came in time.
+//! `bowl send PORT COMMAND ...`: send one command, print the rig's answer. Exit status as in
+//! `exit_code`: 0 done, 1 refused (by the rig or the local check), 3 link problem, 4 no answer.
 
 use std::time::{Duration, Instant};
 
@@ -9,12 +9,9 @@ use model_core::wire::{
     Decoder, Frame, FrameError, PROTOCOL_VERSION, ParamId, Reason, decode_frame,
 };
 
+use crate::exit_code;
 use crate::serial::{Port, ReadOutcome};
 
-/// Exit status of a rejected command.
-pub const EXIT_REJECTED: i32 = 2;
-/// Exit status when no answer came.
-pub const EXIT_TIMEOUT: i32 = 3;
 
 /// Flags of `bowl send`.
 #[derive(clap::Args)]
@@ -139,7 +136,7 @@ pub fn run(args: &Args) -> Result<i32> {
                 reason.token(),
                 explain(reason)
             );
-            return Ok(EXIT_REJECTED);
+            return Ok(exit_code::REFUSED);
         }
     };
     let mut port = Port::open(&args.port, args.baud)?;
@@ -147,7 +144,7 @@ pub fn run(args: &Args) -> Result<i32> {
         Some(frame) => {
             println!("{}", describe(&frame));
             Ok(if matches!(frame, Frame::Reject { .. }) {
-                EXIT_REJECTED
+                exit_code::REFUSED
             } else {
                 0
             })
@@ -157,7 +154,7 @@ pub fn run(args: &Args) -> Result<i32> {
                 "timeout: no answer to id {id} within {} ms",
                 args.timeout_ms
             );
-            Ok(EXIT_TIMEOUT)
+            Ok(exit_code::TIMEOUT)
         }
     }
 }

@@ -219,13 +219,24 @@ impl Pty {
             .write(true)
             .open(&path)
             .with_context(|| format!("open {path}"))?;
-        crate::serial::make_raw(&slave, model_core::wire::DEFAULT_BAUD)?;
+        make_raw(&slave)?;
         Ok(Pty {
             master,
             slave,
             path,
         })
     }
+}
+
+/// Puts a terminal into raw 8N1 mode (no echo, no line buffering, reads return what is there).
+fn make_raw(file: &File) -> Result<()> {
+    use nix::sys::termios::{self, BaudRate, SetArg};
+    let mut t = termios::tcgetattr(file.as_fd()).context("not a terminal (tcgetattr)")?;
+    termios::cfmakeraw(&mut t);
+    termios::cfsetspeed(&mut t, BaudRate::B115200).context("cfsetspeed")?;
+    t.control_flags |= termios::ControlFlags::CLOCAL | termios::ControlFlags::CREAD;
+    termios::tcsetattr(file.as_fd(), SetArg::TCSANOW, &t).context("tcsetattr")?;
+    Ok(())
 }
 
 /// What happens to output bytes nobody reads.

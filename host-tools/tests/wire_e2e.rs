@@ -68,14 +68,14 @@ fn send_and_monitor_against_the_virtual_rig() {
 
     // Above the rig's speed limit (4000 mrad/s by default): rejected, not clamped.
     let too_fast = bowl(&["send", p, "speed", "9000", "2100"]);
-    assert_eq!(too_fast.status.code(), Some(2));
+    assert_eq!(too_fast.status.code(), Some(1));
     assert!(stdout(&too_fast).contains("RANGE"), "{}", stdout(&too_fast));
     // Outside the wire range: refused before it is sent.
     let local = bowl(&["send", p, "set", "TEETH1", "0"]);
-    assert_eq!(local.status.code(), Some(2));
+    assert_eq!(local.status.code(), Some(1));
     assert!(stdout(&local).contains("rejected locally"));
     let unknown = bowl(&["send", p, "set", "NO_SUCH", "1"]);
-    assert_eq!(unknown.status.code(), Some(2));
+    assert_eq!(unknown.status.code(), Some(1));
 
     // The rejected command changed nothing: the setpoints are still 1800/2100.
     let params = bowl(&["send", p, "params"]);
@@ -178,7 +178,7 @@ fn send_times_out_when_nobody_answers() {
     let (_master, path) = open_pty();
     let started = Instant::now();
     let out = bowl(&["send", &path, "status", "--timeout-ms", "300"]);
-    assert_eq!(out.status.code(), Some(3), "{}", stdout(&out));
+    assert_eq!(out.status.code(), Some(4), "{}", stdout(&out));
     assert!(stdout(&out).contains("timeout"));
     assert!(started.elapsed() >= Duration::from_millis(300));
 }

@@ -1,0 +1,14 @@
+//! The exit status of every `bowl` command, one set for all (documented in docs/console.md).
+//! Clap's own usage errors exit with 2, so a rig's refusal never shares its code with a typo.
+
+/// Done: the command ran and the rig (or the check) agreed.
+pub const OK: i32 = 0;
+/// The rig refused the command, or a check or report failed (e.g. a run that faulted).
+pub const REFUSED: i32 = 1;
+/// Usage: a flag or value on the command line is wrong (clap's code; also our own usage checks).
+#[allow(dead_code)] // clap exits with it; named here so the set is whole
+pub const USAGE: i32 = 2;
+/// The link: the port is missing, not a serial port, busy, not permitted, or went away.
+pub const LINK: i32 = 3;
+/// No answer came in time.
+pub const TIMEOUT: i32 = 4;
