@@ -109,7 +109,9 @@ impl Port {
     /// not taken as the device's end (a terminal may report readable and then have nothing):
     /// only a hang-up, an I/O error or the path's disappearance is.
     pub fn read(&mut self, buf: &mut [u8], timeout: Duration) -> Result<ReadOutcome, LinkError> {
-        let _ = self.inner.set_timeout(timeout.max(Duration::from_millis(1)));
+        let _ = self
+            .inner
+            .set_timeout(timeout.max(Duration::from_millis(1)));
         match self.inner.read(buf) {
             Ok(0) => Ok(if self.path_vanished() {
                 ReadOutcome::Gone

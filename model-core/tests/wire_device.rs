@@ -195,7 +195,13 @@ fn a_resent_command_runs_once_and_is_answered_again() {
     // A rejected command resent gets the same reject, and still reaches the rig once.
     let reject = answers(&mut d, &mut rig, &line("C1,41,CLEAR"));
     let reject_again = answers(&mut d, &mut rig, &line("C1,41,CLEAR"));
-    assert_eq!(reject, vec![Frame::Reject { id: 41, reason: Reason::State }]);
+    assert_eq!(
+        reject,
+        vec![Frame::Reject {
+            id: 41,
+            reason: Reason::State
+        }]
+    );
     assert_eq!(reject_again, reject);
     assert_eq!(rig.calls, vec!["start", "clear"]);
     // A new id is a new request, even with the same words.
