@@ -119,13 +119,13 @@ pub fn answers_kind(command: &Command, frame: &Frame) -> bool {
     }
 }
 
-/// How often a command is sent in all when its answer does not come (the same id each time:
-/// the rig carries a resend out once).
-pub const ATTEMPTS: u32 = 3;
+/// How long one attempt waits before the command is sent again with the same id (the rig carries
+/// a resend out once). The rig answers within a few ms; a damaged answer is never repaired.
+pub const RESEND_EVERY: Duration = Duration::from_millis(200);
 
 /// Sends the command `line` (request `id`) and waits for its answer: the frame with this id and
 /// the kind the command gets. Old input is discarded first; when no answer comes within
-/// `timeout / ATTEMPTS`, the same line is sent again, up to [`ATTEMPTS`] times.
+/// [`RESEND_EVERY`], the same line is sent again, until `timeout` has passed.
 pub fn transact(
     link: &mut Link,
     id: u16,
@@ -136,12 +136,12 @@ pub fn transact(
         Ok(Frame::Command { command, .. }) => command,
         _ => return Err(LinkError("not a command line (a bug in bowl)".into())),
     };
-    let per_try = timeout / ATTEMPTS;
+    let end = Instant::now() + timeout;
     let mut buf = [0u8; 4096];
-    for _ in 0..ATTEMPTS {
+    while let Some(left) = end.checked_duration_since(Instant::now()) {
         link.discard_input();
         link.write_all(line)?;
-        let deadline = Instant::now() + per_try;
+        let deadline = Instant::now() + left.min(RESEND_EVERY);
         let mut decoder = Decoder::new();
         while let Some(left) = deadline.checked_duration_since(Instant::now()) {
             match link.read(&mut buf, left.min(Duration::from_millis(50)))? {

@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 
 mod chart;
 mod commission;
+#[cfg(unix)]
 mod demo;
 mod exit_code;
 mod kinematics;
@@ -54,6 +55,7 @@ enum Command {
     /// stability, trace).
     #[command(subcommand)]
     Sim(sim::What),
+    #[cfg(unix)]
     /// The rig without hardware: a simulated rig, a scripted session, the live view, a summary.
     Demo(demo::Args),
 }
@@ -81,6 +83,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Send(args) => send::run(&args).map(|code| std::process::exit(code)),
         Command::Commission(args) => commission::run(&args).map(|code| std::process::exit(code)),
         Command::Replay(args) => replay::run(&args),
+        #[cfg(unix)]
         Command::Demo(args) => demo::run(&args),
         Command::Serve(args) => serve::run(&args),
         Command::Sim(report) => sim::run(&report),

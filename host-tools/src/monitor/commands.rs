@@ -1,15 +1,15 @@
 //! Commands typed into the monitor's own command line: sent on the port it holds, matched to
 //! their answers by id and kind, resent with the same id when the answer does not come.
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use model_core::wire::{Command, Frame, decode_frame};
 
-use crate::link::{ATTEMPTS, answers_kind};
+use crate::link::{RESEND_EVERY, answers_kind};
 use crate::send::{command_line, describe, explain};
 
-/// How long one attempt waits for its answer.
-const RESEND_AFTER: Duration = Duration::from_millis(500);
+/// How often a typed command is sent in all when no answer comes (1 s).
+const ATTEMPTS: u32 = 5;
 
 struct Pending {
     id: u16,
@@ -79,7 +79,7 @@ impl Commands {
         let mut resend = Vec::new();
         let mut gave_up = Vec::new();
         self.pending.retain_mut(|p| {
-            if p.sent_at.elapsed() < RESEND_AFTER {
+            if p.sent_at.elapsed() < RESEND_EVERY {
                 return true;
             }
             if p.attempts >= ATTEMPTS {

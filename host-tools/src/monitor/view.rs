@@ -1,6 +1,9 @@
 //! What the live view knows (latest telemetry, boot, events, link) and its text forms: the plain
 //! line of `bowl monitor --plain` and the ANSI dashboard `bowl demo` draws.
 
+// The ANSI dashboard and the pseudo-terminal serve the demo, which needs a Unix system.
+#![cfg_attr(not(unix), allow(dead_code, unused_imports))]
+
 use std::collections::VecDeque;
 
 use model_core::wire::{Decoder, Frame, Hello, Residence, Telemetry};

@@ -1,0 +1,140 @@
+//! One port, several tools: 40 `bowl send` commands through a running `bowl monitor` on the
+//! virtual rig, on a clean line and with 1 % line noise. Every answer must be the right one (the
+//! id asked, the kind the command gets, the outcome the rig's state implies) and the monitor must
+//! see no reconnect. Ctrl-C ends the monitor with its counters printed.
+
+mod common;
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use common::{BOWL, Sim, bowl, stdout, wait_within};
+
+/// A `bowl monitor --plain` on `port`; its stdout lines arrive on the receiver.
+fn start_monitor(port: &str) -> (Child, mpsc::Receiver<String>) {
+    let mut child = Command::new(BOWL)
+        .args(["monitor", port, "--plain"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("bowl monitor starts");
+    let (tx, rx) = mpsc::channel();
+    let out = child.stdout.take().unwrap();
+    std::thread::spawn(move || {
+        for line in BufReader::new(out).lines() {
+            let Ok(line) = line else { break };
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let opened = rx
+        .recv_timeout(Duration::from_secs(10))
+        .expect("monitor speaks");
+    assert!(opened.contains("open"), "{opened}");
+    (child, rx)
+}
+
+/// Ten commands whose answers the rig's state fixes, repeated four times: (words, exit code,
+/// how the answer starts, what else it must say).
+const ROUND: [(&str, i32, &str, &str); 10] = [
+    ("speed 1500 1500", 0, "ok", ""),
+    ("status", 0, "status", "state=Idle"),
+    ("clear", 1, "rejected", "STATE"),
+    ("speed 1800 30000", 1, "rejected", "RANGE"),
+    ("start", 0, "ok", ""),
+    ("status", 0, "status", "state=SpinningUp"),
+    ("ping", 0, "ok", ""),
+    ("stop", 0, "ok", ""),
+    ("ping", 0, "ok", ""),
+    ("status", 0, "status", "fault=None"),
+];
+
+/// Each `bowl send` may take this long (it resends every 200 ms meanwhile): with 1 % of the bytes
+/// damaged, a 40-byte answer arrives whole only two times in three.
+const TIMEOUT_MS: &str = "5000";
+
+fn forty_commands_through_the_monitor(noise_percent: &str) {
+    let sim = Sim::start(&["--line-noise-percent", noise_percent]);
+    let (mut monitor, lines) = start_monitor(&sim.path);
+    for round in 0..4u16 {
+        for (k, (words, code, starts, says)) in ROUND.iter().enumerate() {
+            let id = 1000 + round * 10 + k as u16;
+            let mut args = vec![
+                "send",
+                sim.path.as_str(),
+                "--timeout-ms",
+                TIMEOUT_MS,
+                "--id",
+            ];
+            let id_text = id.to_string();
+            args.push(&id_text);
+            args.extend(words.split(' '));
+            let out = bowl(&args);
+            let text = stdout(&out);
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(*code), "{words}: {text} {err}");
+            assert!(text.starts_with(starts), "{words}: {text}");
+            assert!(text.contains(&format!("(id {id})")), "{words}: {text}");
+            assert!(text.contains(says), "{words}: {text}");
+            assert!(err.contains("held by a running `bowl monitor`"), "{err}");
+            if *words == "stop" {
+                // Let the motors ramp down before the next round's Idle check.
+                std::thread::sleep(Duration::from_millis(1500));
+            }
+        }
+    }
+    // Ctrl-C.
+    let sent = Command::new("kill")
+        .args(["-INT", &monitor.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let status = wait_within(&mut monitor, Duration::from_secs(5), "monitor after Ctrl-C");
+    assert!(status.success(), "{status:?}");
+    let summary = lines
+        .iter()
+        .last()
+        .expect("the monitor prints its counters on Ctrl-C");
+    let counters: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    assert_eq!(counters["reconnects"], 0, "{summary}");
+    assert!(counters["frames_ok"].as_u64().unwrap() > 100, "{summary}");
+    if noise_percent == "0" {
+        // A clean line loses nothing, though 40 clients came and went.
+        assert_eq!(counters["frames_corrupt"], 0, "{summary}");
+        assert_eq!(counters["frames_missing"], 0, "{summary}");
+    }
+}
+
+#[test]
+fn forty_commands_through_the_monitor_on_a_clean_line() {
+    forty_commands_through_the_monitor("0");
+}
+
+#[test]
+fn forty_commands_through_the_monitor_with_line_noise() {
+    forty_commands_through_the_monitor("1");
+}
+
+#[test]
+fn monitor_refuses_a_path_that_is_no_port() {
+    let dir = common::temp_dir("monitor-refuses");
+    let file = dir.join("capture.bin");
+    std::fs::write(&file, b"$T1").unwrap();
+    for (path, says) in [
+        ("/nonexistent/ttyUSB9", "does not exist"),
+        (file.to_str().unwrap(), "regular file, not a serial port"),
+    ] {
+        let out = bowl(&["monitor", path, "--plain", "--seconds", "2"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(3), "{path}: {err}");
+        assert!(err.contains(says), "{path}: {err}");
+    }
+    let sim = Sim::start(&[]);
+    let out = bowl(&["monitor", &sim.path, "--baud", "7"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("7 is not in 50..=12000000"), "{err}");
+}
