@@ -85,6 +85,7 @@ fn a_person_sees_the_rig_commands_it_and_quits() {
             "set rad/s",
             "measured rad/s",
             "state Idle",
+            "no fault",
         ],
         "the dashboard",
     );
@@ -106,7 +107,10 @@ fn a_person_sees_the_rig_commands_it_and_quits() {
 
     // A fault cannot be missed.
     tmux.keys(&[":", "inject sensor1", "Enter"]);
-    tmux.wait_for(&["FAULT ", "motors off"], "the fault banner");
+    tmux.wait_for(
+        &["FAULT ", "the rig stopped the motors"],
+        "the fault banner",
+    );
 
     // The link dies: said so, and the values are no longer shown as current.
     drop(sim);

@@ -134,6 +134,7 @@ impl Tui {
         self.terminal.draw(|f| {
             let rows = Layout::vertical([
                 Constraint::Length(1),
+                Constraint::Length(1),
                 Constraint::Min(8),
                 Constraint::Length(5),
                 Constraint::Length(1),
@@ -142,8 +143,9 @@ impl Tui {
             ])
             .split(f.area());
             f.render_widget(banner(port, view, paused, tools), rows[0]);
+            f.render_widget(fault_line(view), rows[1]);
             let charts = Layout::horizontal([Constraint::Ratio(1, 2), Constraint::Ratio(1, 2)])
-                .split(rows[1]);
+                .split(rows[2]);
             let live = view.connected && view.latest.is_some();
             for (i, (name, area)) in ["precession w1", "spin w2"]
                 .iter()
@@ -152,10 +154,10 @@ impl Tui {
             {
                 speed_chart(f, *area, name, &history.axes[i], live);
             }
-            f.render_widget(values(view), rows[2]);
+            f.render_widget(values(view), rows[3]);
             f.render_widget(
                 Paragraph::new(view.counters(decoder)).style(Style::default().fg(Color::Cyan)),
-                rows[3],
+                rows[4],
             );
             let events: Vec<Line> = view
                 .events
@@ -167,7 +169,7 @@ impl Tui {
             f.render_widget(
                 Paragraph::new(events)
                     .block(Block::default().borders(Borders::TOP).title("events")),
-                rows[4],
+                rows[5],
             );
             let prompt = match input {
                 Some(text) => Line::from(vec![
@@ -184,7 +186,7 @@ impl Tui {
                     Style::default().fg(Color::DarkGray),
                 )),
             };
-            f.render_widget(Paragraph::new(prompt), rows[5]);
+            f.render_widget(Paragraph::new(prompt), rows[6]);
         })?;
         Ok(())
     }
@@ -215,22 +217,12 @@ fn banner<'a>(port: &'a str, view: &View, paused: bool, tools: usize) -> Paragra
         ));
     } else {
         spans.push(Span::styled(
-            " LINK LOST - reopening, values cleared ",
+            " LINK LOST - reopening; the values below are old ",
             alarm,
         ));
     }
     if let Some(t) = view.latest.filter(|_| view.connected) {
         spans.push(Span::raw(format!("  state {:?}  ", t.state)));
-        if t.fault != FaultCode::None {
-            spans.push(Span::styled(
-                format!(
-                    " FAULT {:?} (code {}): motors off, `clear` to reset ",
-                    t.fault,
-                    t.fault.code()
-                ),
-                alarm,
-            ));
-        }
     }
     if paused {
         spans.push(Span::styled(
@@ -242,6 +234,26 @@ fn banner<'a>(port: &'a str, view: &View, paused: bool, tools: usize) -> Paragra
         spans.push(Span::raw(format!("  {tools} tool(s) connected")));
     }
     Paragraph::new(Line::from(spans))
+}
+
+/// A whole red line while the rig reports a fault (the motors are off until `clear`).
+fn fault_line(view: &View) -> Paragraph<'static> {
+    match view.latest.filter(|_| view.connected) {
+        Some(t) if t.fault != FaultCode::None => Paragraph::new(format!(
+            " FAULT {:?} (code {}): the rig stopped the motors; type `:clear` once the cause is fixed",
+            t.fault,
+            t.fault.code()
+        ))
+        .style(
+            Style::default()
+                .fg(Color::White)
+                .bg(Color::Red)
+                .add_modifier(Modifier::BOLD),
+        ),
+        Some(_) => Paragraph::new(" no fault").style(Style::default().fg(Color::Green)),
+        None => Paragraph::new(" fault: unknown (no current telemetry)")
+            .style(Style::default().fg(Color::DarkGray)),
+    }
 }
 
 /// One axis: set (yellow) and measured (cyan) speed against device time, numbered axes.
