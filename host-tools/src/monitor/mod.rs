@@ -85,10 +85,12 @@ fn stdin_lines() -> mpsc::Receiver<String> {
 
 /// Runs `bowl monitor`.
 pub fn run(args: &Args) -> Result<()> {
-    let plain = args.plain || !std::io::stdout().is_terminal();
+    // The UI needs a screen and a keyboard; without either it prints lines.
+    let plain = args.plain || !std::io::stdout().is_terminal() || !std::io::stdin().is_terminal();
     // The port is checked before anything is drawn: a wrong path is an error, not a wait.
     let first = Port::open(&args.port, args.baud)?;
-    let mut relay = Relay::serve(&args.port)?;
+    // Served only while the port is held: a lost port's name may soon be another device's.
+    let mut relay = Some(Relay::serve(&args.port)?);
     let mut log = args.log.as_ref().map(open_log).transpose()?;
     let interrupted = Arc::new(AtomicBool::new(false));
     {
@@ -118,6 +120,13 @@ pub fn run(args: &Args) -> Result<()> {
             last_open_try = Instant::now();
             if let Ok(p) = Port::open(&args.port, args.baud) {
                 port = Some(p);
+                relay = match Relay::serve(&args.port) {
+                    Ok(r) => Some(r),
+                    Err(e) => {
+                        view.event(plain, format!("other tools cannot reach the rig: {e:#}"));
+                        None
+                    }
+                };
                 view.set_connected(true);
                 view.reconnects += 1;
                 view.event(plain, format!("port {} reopened", args.port));
@@ -132,7 +141,9 @@ pub fn run(args: &Args) -> Result<()> {
         };
         match outcome {
             ReadOutcome::Data(n) => {
-                relay.broadcast(&buf[..n]);
+                if let Some(r) = relay.as_mut() {
+                    r.broadcast(&buf[..n]);
+                }
                 for &b in &buf[..n] {
                     // Damaged frames are counted by the decoder (corrupt, oversize, truncated).
                     let Some(Ok(frame)) = decoder.push(b) else {
@@ -158,12 +169,13 @@ pub fn run(args: &Args) -> Result<()> {
             ReadOutcome::Timeout => {}
             ReadOutcome::Gone => {
                 port = None;
+                relay = None;
                 view.set_connected(false);
                 decoder.finish();
                 view.event(plain, format!("port {} lost; reopening", args.port));
             }
         }
-        let mut outgoing = relay.poll();
+        let mut outgoing = relay.as_mut().map(Relay::poll).unwrap_or_default();
         let mut typed_now: Vec<String> = typed.iter().flat_map(|rx| rx.try_iter()).collect();
         if let Some(ui) = tui.as_mut() {
             match ui.keys()? {
@@ -199,7 +211,8 @@ pub fn run(args: &Args) -> Result<()> {
                 w.flush().context("writing the log")?;
             }
             if let Some(ui) = tui.as_mut() {
-                ui.draw(&args.port, &view, &decoder, relay.client_count())?;
+                let tools = relay.as_ref().map_or(0, Relay::client_count);
+                ui.draw(&args.port, &view, &decoder, tools)?;
             }
         }
         if plain && now >= next_plain {
