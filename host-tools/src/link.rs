@@ -166,3 +166,129 @@ pub fn transact(
     }
     Ok(None)
 }
+
+#[cfg(all(test, unix))]
+mod tests {
+    use std::io::{BufRead, BufReader};
+
+    use model_core::wire::{DeviceState, FaultCode, ResetCause, Status, encode};
+
+    use super::*;
+    use crate::send::command_line;
+
+    fn bytes(frame: &Frame) -> Vec<u8> {
+        let mut buf = [0u8; 512];
+        let n = encode(frame, &mut buf).unwrap();
+        buf[..n].to_vec()
+    }
+
+    fn status(id: u16) -> Frame {
+        status_at(id, 5)
+    }
+
+    fn status_at(id: u16, uptime_ms: u32) -> Frame {
+        Frame::Status {
+            id,
+            status: Status {
+                state: DeviceState::Running,
+                fault: FaultCode::None,
+                reset_cause: ResetCause::Pin,
+                reset_count: 1,
+                uptime_ms,
+                telemetry_hz: 50,
+            },
+        }
+    }
+
+    /// A link whose other end is a scripted rig: it gets each command line the PC sent and
+    /// returns what to answer. Returns the link and the thread that yields the lines it saw.
+    fn scripted(
+        before: Vec<u8>,
+        mut answer: impl FnMut(usize, &str) -> Vec<u8> + Send + 'static,
+    ) -> (Link, std::thread::JoinHandle<Vec<String>>) {
+        let (pc, mut rig) = Stream::pair().unwrap();
+        rig.write_all(&before).unwrap();
+        let rig_thread = std::thread::spawn(move || {
+            let mut seen = Vec::new();
+            let mut reader = BufReader::new(rig.try_clone().unwrap());
+            let mut line = String::new();
+            while reader.read_line(&mut line).unwrap_or(0) > 0 {
+                let reply = answer(seen.len(), &line);
+                seen.push(std::mem::take(&mut line));
+                if rig.write_all(&reply).is_err() {
+                    break;
+                }
+            }
+            seen
+        });
+        // Let the stale bytes arrive before the command is sent.
+        std::thread::sleep(Duration::from_millis(20));
+        (Link::Monitor(pc), rig_thread)
+    }
+
+    #[test]
+    fn a_stale_answer_and_an_answer_of_the_wrong_kind_are_not_taken() {
+        // Left over from an earlier STATUS with the same id (its answer came late): discarded
+        // before sending.
+        let (mut link, rig) = scripted(bytes(&status_at(77, 1)), |_, _| {
+            // The same id but the kind STOP gets, then the STATUS answer.
+            let mut out = bytes(&Frame::Ack { id: 77 });
+            out.extend(bytes(&status(77)));
+            out
+        });
+        let line = command_line(77, &["status".into()]).unwrap();
+        let got = transact(&mut link, 77, &line, Duration::from_millis(1000)).unwrap();
+        assert_eq!(got, Some(status(77)));
+        drop(link);
+        assert_eq!(rig.join().unwrap().len(), 1, "answered at the first try");
+    }
+
+    #[test]
+    fn a_lost_answer_is_asked_again_with_the_same_id() {
+        // The first answer is lost on the way; the resend is answered.
+        let (mut link, rig) = scripted(Vec::new(), |n, _| {
+            if n == 0 {
+                Vec::new()
+            } else {
+                bytes(&Frame::Ack { id: 9 })
+            }
+        });
+        let line = command_line(9, &["start".into()]).unwrap();
+        let got = transact(&mut link, 9, &line, Duration::from_millis(1000)).unwrap();
+        assert_eq!(got, Some(Frame::Ack { id: 9 }));
+        drop(link);
+        let seen = rig.join().unwrap();
+        assert_eq!(seen.len(), 2);
+        assert_eq!(seen[0], seen[1], "the resend is the same line, same id");
+        assert_eq!(seen[0].as_bytes(), line.as_slice());
+    }
+
+    #[test]
+    fn no_answer_is_a_timeout_after_resends() {
+        let (mut link, rig) = scripted(Vec::new(), |_, _| Vec::new());
+        let line = command_line(5, &["stop".into()]).unwrap();
+        let started = Instant::now();
+        let got = transact(&mut link, 5, &line, Duration::from_millis(600)).unwrap();
+        assert_eq!(got, None);
+        assert!(started.elapsed() >= Duration::from_millis(600));
+        drop(link);
+        assert_eq!(rig.join().unwrap().len(), 3, "sent every 200 ms");
+    }
+
+    #[test]
+    fn each_command_takes_only_its_kind_of_answer() {
+        let ack = Frame::Ack { id: 1 };
+        let reject = Frame::Reject {
+            id: 1,
+            reason: model_core::wire::Reason::State,
+        };
+        assert!(answers_kind(&Command::Start, &ack));
+        assert!(answers_kind(&Command::Start, &reject));
+        assert!(!answers_kind(&Command::Start, &status(1)));
+        assert!(answers_kind(&Command::GetStatus, &status(1)));
+        assert!(answers_kind(&Command::GetStatus, &reject));
+        assert!(!answers_kind(&Command::GetStatus, &ack));
+        assert!(!answers_kind(&Command::GetParams, &ack));
+        assert!(!answers_kind(&Command::GetModels, &status(1)));
+    }
+}

@@ -13,9 +13,10 @@ use std::time::Duration;
 use common::{BOWL, Sim, bowl, stdout, wait_within};
 
 /// A `bowl monitor --plain` on `port`; its stdout lines arrive on the receiver.
-fn start_monitor(port: &str) -> (Child, mpsc::Receiver<String>) {
+fn start_monitor(port: &str, log: &std::path::Path) -> (Child, mpsc::Receiver<String>) {
     let mut child = Command::new(BOWL)
-        .args(["monitor", port, "--plain"])
+        .args(["monitor", port, "--plain", "--log"])
+        .arg(log)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .spawn()
@@ -64,7 +65,9 @@ fn forty_commands_through_the_monitor(noise_percent: &str) {
 /// The 40 commands through a monitor of `port`; `clean`: the line loses nothing. `ramp_down`:
 /// how long the rig takes from STOP to Idle.
 fn forty_commands(port: &str, clean: bool, ramp_down: Duration) {
-    let (mut monitor, lines) = start_monitor(port);
+    let dir = common::temp_dir(&format!("console-{}", port.replace('/', "_")));
+    let log = dir.join("log.csv");
+    let (mut monitor, lines) = start_monitor(port, &log);
     for round in 0..4u16 {
         for (k, (words, code, starts, says)) in ROUND.iter().enumerate() {
             let id = 1000 + round * 10 + k as u16;
@@ -100,6 +103,13 @@ fn forty_commands(port: &str, clean: bool, ramp_down: Duration) {
         .expect("the monitor prints its counters on Ctrl-C");
     let counters: serde_json::Value = serde_json::from_str(&summary).unwrap();
     assert_eq!(counters["reconnects"], 0, "{summary}");
+    // Ctrl-C flushed the log: every row the monitor counted is in the file.
+    let rows = std::fs::read_to_string(&log).unwrap().lines().count() - 1;
+    assert_eq!(
+        Some(rows as u64),
+        counters["logged_rows"].as_u64(),
+        "{summary}"
+    );
     assert!(counters["frames_ok"].as_u64().unwrap() > 100, "{summary}");
     if clean {
         // A clean line loses nothing, though 40 clients came and went.
