@@ -166,3 +166,37 @@ fn monitor_refuses_a_path_that_is_no_port() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("7 is not in 50..=12000000"), "{err}");
 }
+
+#[test]
+fn commands_typed_into_the_plain_monitor_are_answered() {
+    use std::io::Write;
+    let sim = Sim::start(&[]);
+    let mut child = Command::new(BOWL)
+        .args(["monitor", &sim.path, "--plain", "--seconds", "3"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    std::thread::sleep(Duration::from_millis(500));
+    writeln!(stdin, "speed 1500 1500").unwrap();
+    writeln!(stdin, "status").unwrap();
+    writeln!(stdin, "speed 1500").unwrap();
+    let out = child.wait_with_output().unwrap();
+    let text = stdout(&out);
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("speed 1500 1500 -> ok (id"), "{text}");
+    assert!(text.contains("status -> status (id"), "{text}");
+    assert!(text.contains("`speed 1500` not sent: MALFORMED"), "{text}");
+}
+
+#[test]
+fn ports_are_listed_or_their_absence_said() {
+    let out = bowl(&["ports"]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = stdout(&out);
+    assert!(
+        text.starts_with("/dev/") || text.starts_with("no serial ports found"),
+        "{text}"
+    );
+}
