@@ -59,9 +59,10 @@ pub struct Device {
     frames_scheduled: u32,
     schedule_start_ms: Option<u32>,
     encode_failures: u32,
-    /// The last command that changed something, and its answer: a resend with the same id and
-    /// the same command (the PC lost the answer) is answered again, not carried out twice.
-    last: Option<(Command, Frame)>,
+    /// The last command that changed something, its id and its outcome (its answer is an Ack
+    /// or a Reject): a resend with the same id and the same command (the PC lost the answer) is
+    /// answered again, not carried out twice.
+    last: Option<(u16, Command, Result<(), Reason>)>,
 }
 
 /// The default telemetry rate, frames per second.
@@ -154,16 +155,23 @@ impl Device {
             command,
             Command::GetStatus | Command::GetParams | Command::GetModels | Command::Ping
         );
-        if let Some((last_command, last_answer)) = self.last
+        if let Some((last_id, last_command, outcome)) = self.last
             && !query
+            && last_id == id
             && last_command == command
-            && last_answer.answer_id() == Some(id)
         {
-            return last_answer;
+            return match outcome {
+                Ok(()) => Frame::Ack { id },
+                Err(reason) => Frame::Reject { id, reason },
+            };
         }
         let answer = self.execute(backend, id, command);
         if !query {
-            self.last = Some((command, answer));
+            let outcome = match answer {
+                Frame::Reject { reason, .. } => Err(reason),
+                _ => Ok(()),
+            };
+            self.last = Some((id, command, outcome));
         }
         answer
     }
