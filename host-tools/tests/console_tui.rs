@@ -100,6 +100,22 @@ fn a_person_sees_the_rig_commands_it_and_quits() {
     // The set speed 1.500 rad/s shows in the values of both axes.
     tmux.wait_for(&["1.500"], "the set speed");
 
+    // A smaller window: the screen is drawn again to fit, axes and values still there.
+    assert!(
+        tmux.cmd(&["resize-window", "-t", "0", "-x", "90", "-y", "30"])
+            .status()
+            .unwrap()
+            .success()
+    );
+    let small = tmux.wait_for(
+        &["device time (s)", "speed (rad/s)", "measured rad/s"],
+        "after a resize",
+    );
+    assert!(
+        small.lines().all(|l| l.chars().count() <= 90),
+        "fits 90 columns:\n{small}"
+    );
+
     // Pause.
     tmux.keys(&["p"]);
     tmux.wait_for(&["PAUSED"], "the pause key");
