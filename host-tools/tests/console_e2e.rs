@@ -200,3 +200,16 @@ fn ports_are_listed_or_their_absence_said() {
         "{text}"
     );
 }
+
+#[test]
+fn a_second_monitor_is_told_the_port_is_held() {
+    let sim = Sim::start(&[]);
+    let dir = common::temp_dir("second-monitor");
+    let (mut first, _lines) = start_monitor(&sim.path, &dir.join("log.csv"));
+    let out = bowl(&["monitor", &sim.path, "--plain", "--seconds", "1"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(err.contains("is in use by another program"), "{err}");
+    let _ = first.kill();
+    let _ = first.wait();
+}
