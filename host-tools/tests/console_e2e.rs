@@ -59,12 +59,38 @@ const TIMEOUT_MS: &str = "5000";
 
 fn forty_commands_through_the_monitor(noise_percent: &str) {
     let sim = Sim::start(&["--line-noise-percent", noise_percent]);
-    forty_commands(&sim.path, noise_percent == "0", Duration::from_millis(1500));
+    forty_commands(&sim.path, noise_percent == "0");
 }
 
-/// The 40 commands through a monitor of `port`; `clean`: the line loses nothing. `ramp_down`:
-/// how long the rig takes from STOP to Idle.
-fn forty_commands(port: &str, clean: bool, ramp_down: Duration) {
+/// Asks STATUS (through the monitor as well) until the rig is Idle again after a STOP.
+fn wait_until_idle(port: &str, round: u16) {
+    let started = std::time::Instant::now();
+    for k in 0u16.. {
+        let id = (3000 + round * 100 + k).to_string();
+        let out = bowl(&[
+            "send",
+            port,
+            "--timeout-ms",
+            TIMEOUT_MS,
+            "--id",
+            &id,
+            "status",
+        ]);
+        let text = stdout(&out);
+        assert_eq!(out.status.code(), Some(0), "{text}");
+        if text.contains("state=Idle") {
+            return;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(20),
+            "not Idle: {text}"
+        );
+        std::thread::sleep(Duration::from_millis(250));
+    }
+}
+
+/// The 40 commands through a monitor of `port`; `clean`: the line loses nothing.
+fn forty_commands(port: &str, clean: bool) {
     let dir = common::temp_dir(&format!("console-{}", port.replace('/', "_")));
     let log = dir.join("log.csv");
     let (mut monitor, lines) = start_monitor(port, &log);
@@ -84,8 +110,8 @@ fn forty_commands(port: &str, clean: bool, ramp_down: Duration) {
             assert!(says.split('|').any(|s| text.contains(s)), "{words}: {text}");
             assert!(err.contains("held by a running `bowl monitor`"), "{err}");
             if *words == "stop" {
-                // Let the motors ramp down before the next round's Idle check.
-                std::thread::sleep(ramp_down);
+                // The motors ramp down before the next round's Idle check.
+                wait_until_idle(port, round);
             }
         }
     }
@@ -141,8 +167,7 @@ fn forty_commands_through_the_monitor_on_the_qemu_rig() {
     let board = qemu::PtyBoard::boot(&elf, qemu::Profile::RealTime, &["-append", "seconds=300"])
         .expect("the emulated board boots");
     let port = board.port.clone();
-    // The board runs at about 0.6x real time: its ramps take longer on the wall clock.
-    forty_commands(&port, true, Duration::from_millis(3000));
+    forty_commands(&port, true);
     board.stop();
 }
 
