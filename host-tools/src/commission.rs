@@ -4,9 +4,9 @@
 //! the state leaves "commissioning", then asks MODELS and PARAMS and prints the identified motor
 //! models and the speed-loop gains that follow from them, as text or `--json`.
 //!
-//! Exit status: 0 done, 2 the rig refused COMMISSION (the reason is printed), 3 no answer or
-//! commissioning did not end within `--timeout-s`, 4 commissioning ended in a fault (the rig's
-//! fault code is printed; the motors are off).
+//! Exit status (`exit_code`): 0 done, 1 the rig refused COMMISSION (the reason is printed) or
+//! commissioning ended in a fault (the rig's fault code is printed; the motors are off), 3 the
+//! link failed, 4 no answer or commissioning did not end within `--timeout-s`.
 
 use std::time::{Duration, Instant};
 
@@ -17,8 +17,9 @@ use model_core::wire::{
 use serde::Serialize;
 
 use crate::exit_code;
-use crate::send::{command_line, explain, transact};
-use crate::serial::{Port, ReadOutcome};
+use crate::link::{Link, transact};
+use crate::send::{command_line, explain};
+use crate::serial::ReadOutcome;
 
 /// How long one command waits for its answer.
 const ANSWER_TIMEOUT: Duration = Duration::from_millis(1000);
@@ -31,7 +32,7 @@ pub struct Args {
     /// The serial port or pseudo-terminal of the rig.
     port: String,
     /// Baud rate.
-    #[arg(long, default_value_t = 115_200)]
+    #[arg(long, default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(50..=12_000_000))]
     baud: u32,
     /// Give up when commissioning has not ended after this many seconds (the rig's own routine
     /// faults after 120 s).
@@ -80,12 +81,12 @@ impl Ids {
     }
 }
 
-fn ask(port: &mut Port, ids: &mut Ids, words: &[&str]) -> Result<Option<Frame>> {
+fn ask(port: &mut Link, ids: &mut Ids, words: &[&str]) -> Result<Option<Frame>> {
     let id = ids.next();
     let words: Vec<String> = words.iter().map(|w| w.to_string()).collect();
     let line = command_line(id, &words)
         .map_err(|r| anyhow::anyhow!("{} was refused locally ({})", words.join(" "), r.token()))?;
-    transact(port, id, &line, ANSWER_TIMEOUT)
+    Ok(transact(port, id, &line, ANSWER_TIMEOUT)?)
 }
 
 /// How commissioning ended.
@@ -97,7 +98,7 @@ enum End {
 }
 
 /// Follows the rig until it leaves the commissioning state.
-fn follow(port: &mut Port, ids: &mut Ids, timeout: Duration, quiet: bool) -> Result<End> {
+fn follow(port: &mut Link, ids: &mut Ids, timeout: Duration, quiet: bool) -> Result<End> {
     let start = Instant::now();
     let mut decoder = Decoder::new();
     let mut buf = [0u8; 4096];
@@ -214,7 +215,7 @@ pub fn run(args: &Args) -> Result<i32> {
     if !(args.timeout_s.is_finite() && args.timeout_s > 0.0 && args.timeout_s <= 86_400.0) {
         bail!("--timeout-s must be between 0 and 86400");
     }
-    let mut port = Port::open(&args.port, args.baud)?;
+    let mut port = Link::open(&args.port, args.baud)?;
     let seed = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map(|d| d.subsec_nanos())
@@ -253,11 +254,11 @@ pub fn run(args: &Args) -> Result<i32> {
     )?;
     report.seconds = started.elapsed().as_secs_f64();
     let code = match end {
-        End::Idle => 0,
+        End::Idle => exit_code::OK,
         End::Fault(fault) => {
             report.result = "fault";
             report.fault = Some(format!("{fault:?} (code {})", fault.code()));
-            exit_code::FAULT
+            exit_code::REFUSED
         }
         End::OtherState(state) => {
             bail!("commissioning ended in state {state:?} (another PC may have sent a command)")
@@ -269,7 +270,7 @@ pub fn run(args: &Args) -> Result<i32> {
             exit_code::TIMEOUT
         }
     };
-    if code == 0 {
+    if code == exit_code::OK {
         let params = match ask(&mut port, &mut ids, &["PARAMS"])? {
             Some(Frame::Params { values, .. }) => Some(values),
             _ => None,

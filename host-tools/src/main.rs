@@ -7,14 +7,17 @@ use clap::{Parser, Subcommand};
 
 mod chart;
 mod commission;
+#[cfg(unix)]
 mod demo;
 mod exit_code;
 mod experiment;
 mod family_file;
 mod fit;
 mod kinematics;
+mod link;
 mod monitor;
 mod predict;
+mod relay;
 mod replay;
 mod rig_file;
 mod send;
@@ -44,6 +47,8 @@ enum Command {
     Predict(predict::Args),
     /// Live view of the rig's telemetry, with CSV log and frame counters.
     Monitor(monitor::Args),
+    /// The serial ports on this computer, with their USB descriptions.
+    Ports,
     /// Send one command to the rig and print its answer.
     Send(send::Args),
     /// Run the motor identification on the rig; print the identified models and gains.
@@ -57,6 +62,7 @@ enum Command {
     /// stability, trace).
     #[command(subcommand)]
     Sim(sim::What),
+    #[cfg(unix)]
     /// The rig without hardware: a simulated rig, a scripted session, the live view, a summary.
     Demo(demo::Args),
     /// Run a plan of particle releases on a simulated rig and record residence times, or
@@ -84,8 +90,12 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(e) if exit_code::is_closed_output(&e) => exit_code::OK,
         Err(e) => {
-            eprintln!("bowl: {e:#}");
-            exit_code::for_error(&e)
+            eprintln!("error: {e:#}");
+            if e.chain().any(|c| c.is::<serial::LinkError>()) {
+                exit_code::LINK
+            } else {
+                exit_code::REFUSED
+            }
         }
     };
     ExitCode::from(u8::try_from(code).unwrap_or(1))
@@ -112,9 +122,11 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Chart(args) => done(chart::run(&args)),
         Command::Predict(args) => done(predict::run(&args)),
         Command::Monitor(args) => done(monitor::run(&args)),
+        Command::Ports => done(serial::run_ports()),
         Command::Send(args) => send::run(&args),
         Command::Commission(args) => commission::run(&args),
         Command::Replay(args) => done(replay::run(&args)),
+        #[cfg(unix)]
         Command::Demo(args) => done(demo::run(&args)),
         Command::Serve(args) => done(serve::run(&args)),
         Command::Sim(report) => done(sim::run(&report)),

@@ -53,6 +53,13 @@ pub fn decode_capture(bytes: &[u8], mut on_frame: impl FnMut(&DecodeStats, &Fram
 }
 
 /// CPU time of this thread, s (0 if the clock cannot be read).
+#[cfg(not(unix))]
+fn thread_cpu_seconds() -> f64 {
+    0.0
+}
+
+/// CPU time of this thread, s (0 if the clock cannot be read).
+#[cfg(unix)]
 fn thread_cpu_seconds() -> f64 {
     use nix::time::{ClockId, clock_gettime};
     clock_gettime(ClockId::CLOCK_THREAD_CPUTIME_ID)

@@ -1,16 +1,14 @@
-//! `bowl send PORT COMMAND ...`: send one command, print the rig's answer. Exit status 0 when the
-//! rig did it, 2 when it (or the local check) rejected it, 3 when no answer came in time.
+//! `bowl send PORT COMMAND ...`: send one command, print the rig's answer. Exit status as in
+//! `exit_code`: 0 done, 1 refused (by the rig or the local check), 3 link problem, 4 no answer.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use model_core::wire::crc::crc32;
-use model_core::wire::{
-    Decoder, Frame, FrameError, PROTOCOL_VERSION, ParamId, Reason, decode_frame,
-};
+use model_core::wire::{Frame, FrameError, PROTOCOL_VERSION, ParamId, Reason, decode_frame};
 
 use crate::exit_code;
-use crate::serial::{Port, ReadOutcome};
+use crate::link::{Link, transact};
 
 /// Flags of `bowl send`.
 #[derive(clap::Args)]
@@ -23,7 +21,7 @@ pub struct Args {
     #[arg(required = true, num_args = 1..)]
     command: Vec<String>,
     /// Baud rate.
-    #[arg(long, default_value_t = 115_200)]
+    #[arg(long, default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(50..=12_000_000))]
     baud: u32,
     /// Request id echoed by the rig (default: derived from the clock).
     #[arg(long)]
@@ -94,30 +92,6 @@ pub fn describe(frame: &Frame) -> String {
     }
 }
 
-/// Sends `line` and waits for the frame answering `id`.
-pub fn transact(port: &mut Port, id: u16, line: &[u8], timeout: Duration) -> Result<Option<Frame>> {
-    port.write_all(line)?;
-    let deadline = Instant::now() + timeout;
-    let mut decoder = Decoder::new();
-    let mut buf = [0u8; 4096];
-    while let Some(left) = deadline.checked_duration_since(Instant::now()) {
-        match port.read(&mut buf, left.min(Duration::from_millis(50)))? {
-            ReadOutcome::Data(n) => {
-                for &b in &buf[..n] {
-                    if let Some(Ok(frame)) = decoder.push(b)
-                        && frame.answer_id() == Some(id)
-                    {
-                        return Ok(Some(frame));
-                    }
-                }
-            }
-            ReadOutcome::Timeout => {}
-            ReadOutcome::Gone => bail!("the port went away while waiting for the answer"),
-        }
-    }
-    Ok(None)
-}
-
 /// Runs `bowl send`; returns the process exit status.
 pub fn run(args: &Args) -> Result<i32> {
     let id = args.id.unwrap_or_else(|| {
@@ -135,11 +109,11 @@ pub fn run(args: &Args) -> Result<i32> {
                 reason.token(),
                 explain(reason)
             );
-            return Ok(exit_code::ERROR);
+            return Ok(exit_code::REFUSED);
         }
     };
-    let mut port = Port::open(&args.port, args.baud)?;
-    match transact(&mut port, id, &line, Duration::from_millis(args.timeout_ms))? {
+    let mut link = Link::open(&args.port, args.baud)?;
+    match transact(&mut link, id, &line, Duration::from_millis(args.timeout_ms))? {
         Some(frame) => {
             println!("{}", describe(&frame));
             Ok(if matches!(frame, Frame::Reject { .. }) {

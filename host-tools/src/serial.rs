@@ -1,21 +1,34 @@
-//! A serial port (or a pseudo-terminal) in raw mode through termios, with read timeouts.
-//! No libudev: the port is a path, `/dev/ttyUSB0`, `/dev/ttyACM0` or `/dev/pts/N`.
+//! A serial port (or a pseudo-terminal) through the `serialport` crate: raw 8N1 at any baud rate,
+//! opened exclusively (no second program can open it while we hold it), read with timeouts.
+//! Linux, macOS and Windows. Open errors are explained in plain words ([`LinkError`]).
 
-use std::fs::{File, OpenOptions};
 use std::io::{Read, Write};
-use std::os::fd::{AsFd, AsRawFd};
-use std::os::unix::fs::OpenOptionsExt;
 use std::time::Duration;
 
-use anyhow::{Context, Result, bail};
-use nix::poll::{PollFd, PollFlags, PollTimeout, poll};
-use nix::sys::termios::{self, BaudRate, SetArg, SpecialCharacterIndices};
+use serialport::{ClearBuffer, SerialPort, SerialPortType};
 
-use crate::exit_code::LinkError;
+/// A problem with the link itself (missing, busy, not permitted, gone): `bowl` exits with
+/// `exit_code::LINK` when an error carries one of these.
+#[derive(Debug)]
+pub struct LinkError(pub String);
+
+impl std::fmt::Display for LinkError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for LinkError {}
+
+#[cfg(unix)]
+type Native = serialport::TTYPort;
+#[cfg(windows)]
+type Native = serialport::COMPort;
 
 /// An open port in raw 8N1 mode.
 pub struct Port {
-    file: File,
+    inner: Native,
+    path: String,
 }
 
 /// What a read returned.
@@ -28,134 +41,158 @@ pub enum ReadOutcome {
     Gone,
 }
 
-/// The termios speed for `baud`; an error in plain words for a rate the port cannot be set to.
-pub fn baud_rate(baud: u32) -> Result<BaudRate> {
-    Ok(match baud {
-        9600 => BaudRate::B9600,
-        19200 => BaudRate::B19200,
-        38400 => BaudRate::B38400,
-        57600 => BaudRate::B57600,
-        115_200 => BaudRate::B115200,
-        230_400 => BaudRate::B230400,
-        460_800 => BaudRate::B460800,
-        921_600 => BaudRate::B921600,
-        1_000_000 => BaudRate::B1000000,
-        2_000_000 => BaudRate::B2000000,
-        other => bail!(
-            "baud rate {other} is not one this port can be set to: use 9600, 19200, 38400, 57600, \
-             115200 (the rig's), 230400, 460800, 921600, 1000000 or 2000000"
-        ),
-    })
-}
-
-/// Puts an open terminal into raw 8N1 mode at `baud`.
-pub fn make_raw(file: &File, baud: u32) -> Result<()> {
-    let mut t = termios::tcgetattr(file.as_fd()).context("not a terminal (tcgetattr)")?;
-    termios::cfmakeraw(&mut t);
-    termios::cfsetspeed(&mut t, baud_rate(baud)?).context("cfsetspeed")?;
-    t.control_flags |= termios::ControlFlags::CLOCAL | termios::ControlFlags::CREAD;
-    t.control_flags &= !(termios::ControlFlags::CSTOPB | termios::ControlFlags::CRTSCTS);
-    t.control_chars[SpecialCharacterIndices::VMIN as usize] = 0;
-    t.control_chars[SpecialCharacterIndices::VTIME as usize] = 0;
-    termios::tcsetattr(file.as_fd(), SetArg::TCSANOW, &t).context("tcsetattr")?;
-    Ok(())
-}
-
-/// Checks, before waiting for it, that `path` can become a serial port: an existing path must
-/// be a character device (a regular file or a folder never will be). A missing path is fine:
-/// a USB adapter may be plugged in later.
-pub fn check_path(path: &str) -> Result<()> {
-    use std::os::unix::fs::FileTypeExt;
+/// Why `path` cannot be a serial port before we try to open it, if that can be told.
+fn refuse_before_open(path: &str) -> Option<String> {
+    if cfg!(windows) {
+        return None;
+    }
     match std::fs::metadata(path) {
-        Ok(m) if !m.file_type().is_char_device() => Err(LinkError(format!(
-            "{path} is not a serial port (it is a {}); give the rig's device, e.g. /dev/ttyUSB0, \
-             or see `ls /dev/tty*`",
-            if m.is_dir() { "folder" } else { "regular file" }
-        ))
-        .into()),
-        _ => Ok(()),
+        Err(_) => Some(format!(
+            "no serial port at {path}: the path does not exist. `bowl ports` lists the ports \
+             found; check the cable, or start a virtual rig with `bowl serve --pty`"
+        )),
+        Ok(m) if m.is_file() => Some(format!(
+            "{path} is a regular file, not a serial port; to decode a recorded capture use \
+             `bowl replay {path}`"
+        )),
+        Ok(m) if m.is_dir() => Some(format!("{path} is a directory, not a serial port")),
+        Ok(_) => None,
     }
 }
 
-/// Why a port did not open, in plain words with what to do.
-fn open_failure(path: &str, e: &std::io::Error) -> String {
-    let what_to_do = match e.raw_os_error() {
-        Some(nix::libc::EBUSY) => {
-            " - another program holds the port (a running `bowl monitor`, tio, screen?): \
-             close it first"
+/// The plain-words reason an open failed.
+fn explain_open_error(path: &str, e: &serialport::Error) -> String {
+    let text = e.to_string();
+    let lower = text.to_ascii_lowercase();
+    if lower.contains("permission") || lower.contains("access is denied") {
+        if cfg!(target_os = "linux") {
+            format!(
+                "permission denied opening {path}: your user may not use serial ports. Add it to \
+                 the `dialout` group (`sudo usermod -aG dialout $USER`), then log out and in again"
+            )
+        } else if cfg!(windows) {
+            format!("{path} is in use by another program (or access is denied): close it and retry")
+        } else {
+            format!("permission denied opening {path}: check the device's owner and group ({text})")
         }
-        Some(nix::libc::EACCES) | Some(nix::libc::EPERM) => {
-            " - no permission: add yourself to the group that owns it (usually `dialout`: \
-             `sudo usermod -aG dialout $USER`, then log in again)"
-        }
-        Some(nix::libc::ENOENT) => {
-            " - no such device: is the rig plugged in? `bowl monitor` waits for it to appear"
-        }
-        _ => "",
-    };
-    format!("cannot open the serial port {path}: {e}{what_to_do}")
+    } else if lower.contains("exclusive lock") || lower.contains("busy") {
+        format!(
+            "{path} is in use by another program (a second `bowl monitor`, tio, screen?); \
+             close it, or send through the running monitor"
+        )
+    } else if lower.contains("not a typewriter") || lower.contains("inappropriate ioctl") {
+        format!("{path} is not a serial port or terminal")
+    } else if lower.contains("no such file") || lower.contains("cannot find") {
+        format!("no serial port at {path}: it does not exist. `bowl ports` lists the ports found")
+    } else {
+        format!("cannot open the serial port {path}: {text}")
+    }
 }
 
 impl Port {
-    /// Opens `path` in raw mode at `baud`.
-    pub fn open(path: &str, baud: u32) -> Result<Port> {
-        let file = OpenOptions::new()
-            .read(true)
-            .write(true)
-            .custom_flags(nix::libc::O_NOCTTY)
-            .open(path)
-            .map_err(|e| LinkError(open_failure(path, &e)))?;
-        // Exclusive use: a second program opening the port would take half of the bytes.
-        // SAFETY: TIOCEXCL takes no argument and only sets a flag on this open terminal.
-        if unsafe { nix::libc::ioctl(file.as_raw_fd(), nix::libc::TIOCEXCL) } != 0 {
-            return Err(LinkError(format!(
-                "cannot take {path} for this program alone: {}",
-                std::io::Error::last_os_error()
-            ))
-            .into());
+    /// Opens `path` in raw 8N1 mode at `baud`, exclusively.
+    pub fn open(path: &str, baud: u32) -> Result<Port, LinkError> {
+        if let Some(why) = refuse_before_open(path) {
+            return Err(LinkError(why));
         }
-        make_raw(&file, baud).map_err(|e| {
-            LinkError(format!(
-                "cannot set up {path} as a serial port (is it a serial device?): {e:#}"
-            ))
-        })?;
-        Ok(Port { file })
+        let inner = serialport::new(path, baud)
+            .timeout(Duration::from_millis(50))
+            .open_native()
+            .map_err(|e| LinkError(explain_open_error(path, &e)))?;
+        Ok(Port {
+            inner,
+            path: path.to_owned(),
+        })
     }
 
-    /// Reads what is there, waiting at most `timeout` for the first byte.
-    pub fn read(&mut self, buf: &mut [u8], timeout: Duration) -> Result<ReadOutcome> {
-        let ms = u16::try_from(timeout.as_millis()).unwrap_or(u16::MAX);
-        let mut fds = [PollFd::new(self.file.as_fd(), PollFlags::POLLIN)];
-        let n = match poll(&mut fds, PollTimeout::from(ms)) {
-            Ok(n) => n,
-            Err(nix::errno::Errno::EINTR) => return Ok(ReadOutcome::Timeout),
-            Err(e) => return Err(e).context("poll"),
-        };
-        if n == 0 {
-            return Ok(ReadOutcome::Timeout);
+    /// Reads what is there, waiting at most `timeout` for the first byte. A read of 0 bytes is
+    /// not taken as the device's end (a terminal may report readable and then have nothing):
+    /// only a hang-up, an I/O error or the path's disappearance is.
+    pub fn read(&mut self, buf: &mut [u8], timeout: Duration) -> Result<ReadOutcome, LinkError> {
+        let _ = self
+            .inner
+            .set_timeout(timeout.max(Duration::from_millis(1)));
+        match self.inner.read(buf) {
+            Ok(0) => Ok(if self.path_vanished() {
+                ReadOutcome::Gone
+            } else {
+                ReadOutcome::Timeout
+            }),
+            Ok(n) => Ok(ReadOutcome::Data(n)),
+            Err(e) => match e.kind() {
+                std::io::ErrorKind::TimedOut
+                | std::io::ErrorKind::Interrupted
+                | std::io::ErrorKind::WouldBlock => Ok(ReadOutcome::Timeout),
+                // Hang-up (the other side closed), EIO (USB unplugged) and the like.
+                _ => Ok(ReadOutcome::Gone),
+            },
         }
-        let revents = fds[0].revents().unwrap_or(PollFlags::empty());
-        if revents.contains(PollFlags::POLLIN) {
-            return match self.file.read(buf) {
-                // Readable but empty (raw mode, VMIN = 0): nothing after all, unless the other side
-                // hung up. Never a reason on its own to call the device gone.
-                Ok(0) if revents.contains(PollFlags::POLLHUP) => Ok(ReadOutcome::Gone),
-                Ok(0) => Ok(ReadOutcome::Timeout),
-                Ok(n) => Ok(ReadOutcome::Data(n)),
-                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => Ok(ReadOutcome::Timeout),
-                // EIO: the pseudo-terminal's master closed, or the USB device vanished.
-                Err(_) => Ok(ReadOutcome::Gone),
-            };
-        }
-        if revents.intersects(PollFlags::POLLHUP | PollFlags::POLLERR | PollFlags::POLLNVAL) {
-            return Ok(ReadOutcome::Gone);
-        }
-        Ok(ReadOutcome::Timeout)
+    }
+
+    fn path_vanished(&self) -> bool {
+        !cfg!(windows) && std::fs::metadata(&self.path).is_err()
+    }
+
+    /// Throws away what arrived and was not read yet, so an old answer cannot be taken for the
+    /// answer to the next command. Telemetry in between is lost, which a command can afford.
+    pub fn discard_input(&mut self) {
+        let _ = self.inner.clear(ClearBuffer::Input);
     }
 
     /// Writes all of `bytes`.
-    pub fn write_all(&mut self, bytes: &[u8]) -> Result<()> {
-        self.file.write_all(bytes).context("write to port")?;
-        Ok(())
+    pub fn write_all(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
+        self.inner
+            .write_all(bytes)
+            .and_then(|()| self.inner.flush())
+            .map_err(|e| LinkError(format!("cannot write to {}: {e}", self.path)))
     }
+}
+
+impl Drop for Port {
+    fn drop(&mut self) {
+        // A terminal keeps its exclusive flag while anyone else holds it open (the virtual rig
+        // holds its pseudo-terminal), which would lock the next user out.
+        #[cfg(unix)]
+        let _ = self.inner.set_exclusive(false);
+    }
+}
+
+/// One line per serial port found, with its USB description where there is one.
+pub fn list_ports() -> Result<Vec<String>, LinkError> {
+    let ports = serialport::available_ports()
+        .map_err(|e| LinkError(format!("cannot list the serial ports: {e}")))?;
+    Ok(ports
+        .into_iter()
+        .map(|p| match p.port_type {
+            SerialPortType::UsbPort(u) => format!(
+                "{}  USB {:04x}:{:04x}  {}{}{}",
+                p.port_name,
+                u.vid,
+                u.pid,
+                u.manufacturer.unwrap_or_default(),
+                u.product.map(|s| format!(" {s}")).unwrap_or_default(),
+                u.serial_number
+                    .map(|s| format!(" (serial {s})"))
+                    .unwrap_or_default()
+            ),
+            SerialPortType::PciPort => format!("{}  PCI", p.port_name),
+            SerialPortType::BluetoothPort => format!("{}  Bluetooth", p.port_name),
+            SerialPortType::Unknown => p.port_name,
+        })
+        .collect())
+}
+
+/// Runs `bowl ports`.
+pub fn run_ports() -> anyhow::Result<()> {
+    let ports = list_ports()?;
+    if ports.is_empty() {
+        println!(
+            "no serial ports found (plug the rig in; a virtual rig: `bowl serve --pty`, whose \
+             path it prints)"
+        );
+    }
+    for p in ports {
+        println!("{p}");
+    }
+    Ok(())
 }

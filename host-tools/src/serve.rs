@@ -3,16 +3,23 @@
 //! faster than real time with exactly the bytes the rig would send (`--capture FILE --seconds S`).
 //! The demo serves its host rig with the same loop ([`serve_on_pty`]).
 
+// The ANSI dashboard and the pseudo-terminal serve the demo, which needs a Unix system.
+#![cfg_attr(not(unix), allow(dead_code, unused_imports))]
+
 use std::fs::File;
 use std::io::{BufWriter, Read, Write};
+#[cfg(unix)]
 use std::os::fd::AsFd;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
+#[cfg(unix)]
 use nix::fcntl::OFlag;
+#[cfg(unix)]
 use nix::pty::{PtyMaster, grantpt, posix_openpt, ptsname_r, unlockpt};
+#[cfg(unix)]
 use nix::sys::termios::{FlushArg, tcflush};
 
 use crate::send::command_line;
@@ -123,6 +130,13 @@ pub fn run(args: &Args) -> Result<()> {
         let seconds = args.seconds.unwrap_or(0.0);
         return capture(path, seconds, commands, args.seed, noise);
     }
+    #[cfg(not(unix))]
+    if args.pty {
+        bail!(
+            "--pty needs a Unix system (Linux, macOS); on Windows use --capture FILE --seconds S"
+        );
+    }
+    #[cfg(unix)]
     if args.pty {
         let pty = Pty::open()?;
         if let Some(link) = &args.link {
@@ -196,6 +210,7 @@ fn capture(
     Ok(())
 }
 
+#[cfg(unix)]
 /// A pseudo-terminal pair: the master side the rig is served on, and the slave's path.
 pub(crate) struct Pty {
     master: PtyMaster,
@@ -205,6 +220,7 @@ pub(crate) struct Pty {
     pub(crate) path: String,
 }
 
+#[cfg(unix)]
 impl Pty {
     /// Opens a pair. The slave is put in raw mode so nothing is echoed or line-buffered before a
     /// client configures it.
@@ -219,13 +235,25 @@ impl Pty {
             .write(true)
             .open(&path)
             .with_context(|| format!("open {path}"))?;
-        crate::serial::make_raw(&slave, model_core::wire::DEFAULT_BAUD)?;
+        make_raw(&slave)?;
         Ok(Pty {
             master,
             slave,
             path,
         })
     }
+}
+
+#[cfg(unix)]
+/// Puts a terminal into raw 8N1 mode (no echo, no line buffering, reads return what is there).
+fn make_raw(file: &File) -> Result<()> {
+    use nix::sys::termios::{self, BaudRate, SetArg};
+    let mut t = termios::tcgetattr(file.as_fd()).context("not a terminal (tcgetattr)")?;
+    termios::cfmakeraw(&mut t);
+    termios::cfsetspeed(&mut t, BaudRate::B115200).context("cfsetspeed")?;
+    t.control_flags |= termios::ControlFlags::CLOCAL | termios::ControlFlags::CREAD;
+    termios::tcsetattr(file.as_fd(), SetArg::TCSANOW, &t).context("tcsetattr")?;
+    Ok(())
 }
 
 /// What happens to output bytes nobody reads.
@@ -263,6 +291,7 @@ pub struct ServeStats {
 /// Serves `rig` on `pty` until `pacing` says stop: the rig catches up with the (scaled) wall
 /// clock one millisecond at a time, reading what the client sent before each millisecond and
 /// writing what the rig answered after each pass.
+#[cfg(unix)]
 pub(crate) fn serve_on_pty(
     mut pty: Pty,
     mut rig: VirtualRig,
@@ -313,6 +342,7 @@ pub(crate) fn serve_on_pty(
     Ok(stats)
 }
 
+#[cfg(unix)]
 /// Writes what the pty takes of `out`; what it does not take is kept or dropped per `backlog`.
 fn write_pending(pty: &mut Pty, out: &mut Vec<u8>, backlog: Backlog, stats: &mut ServeStats) {
     while !out.is_empty() {

@@ -180,6 +180,50 @@ fn each_command_gets_its_answer() {
 }
 
 #[test]
+fn a_resent_command_runs_once_and_is_answered_again() {
+    let mut rig = Recorder {
+        speed_max: 5000,
+        ..Default::default()
+    };
+    let mut d = Device::new();
+    // The answer to START id 40 was lost; the PC sends it again with the same id.
+    let first = answers(&mut d, &mut rig, &line("C1,40,START"));
+    let again = answers(&mut d, &mut rig, &line("C1,40,START"));
+    assert_eq!(first, vec![Frame::Ack { id: 40 }]);
+    assert_eq!(again, first);
+    assert_eq!(rig.calls, vec!["start"], "carried out once");
+    // A rejected command resent gets the same reject, and still reaches the rig once.
+    let reject = answers(&mut d, &mut rig, &line("C1,41,CLEAR"));
+    let reject_again = answers(&mut d, &mut rig, &line("C1,41,CLEAR"));
+    assert_eq!(
+        reject,
+        vec![Frame::Reject {
+            id: 41,
+            reason: Reason::State
+        }]
+    );
+    assert_eq!(reject_again, reject);
+    assert_eq!(rig.calls, vec!["start", "clear"]);
+    // A new id is a new request, even with the same words.
+    answers(&mut d, &mut rig, &line("C1,42,START"));
+    // The same id with other words is a new request too (the PC reused an id).
+    answers(&mut d, &mut rig, &line("C1,42,STOP"));
+    assert_eq!(rig.calls, vec!["start", "clear", "start", "stop"]);
+    // Queries are answered afresh each time: the second STATUS reports the time now.
+    let s1 = answers(&mut d, &mut rig, &line("C1,43,STATUS"));
+    rig.now_ms = 500;
+    let s2 = answers(&mut d, &mut rig, &line("C1,43,STATUS"));
+    let uptime = |f: &[Frame]| match f {
+        [Frame::Status { status, .. }] => status.uptime_ms,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!((uptime(&s1), uptime(&s2)), (0, 500));
+    // After another command, an old id with the same words runs again (only the last is kept).
+    answers(&mut d, &mut rig, &line("C1,40,START"));
+    assert_eq!(rig.calls, vec!["start", "clear", "start", "stop", "start"]);
+}
+
+#[test]
 fn telemetry_is_paced_and_numbered() {
     let mut rig = Recorder::default();
     let mut d = Device::new();

@@ -62,3 +62,31 @@ ensure_blackpill_emulator() {
   fi
   export BLACKPILL_PYTHON DEFMT_PRINT
 }
+
+# apt_install PACKAGE...: installs Debian packages (apt-get update first), quietly.
+apt_install() {
+  local sudo=""
+  if [ "$(id -u)" != 0 ]; then sudo="sudo"; fi
+  $sudo apt-get update -qq >/dev/null &&
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "$@" >/dev/null
+}
+
+# The Windows build check: the x86_64-pc-windows-gnu target and its MinGW-w64 linker.
+ensure_windows_target() {
+  if ! command -v x86_64-w64-mingw32-gcc >/dev/null; then
+    echo "== installing mingw-w64"
+    apt_install mingw-w64 || return 1
+  fi
+  if ! rustup target list --installed 2>/dev/null | grep -qx x86_64-pc-windows-gnu; then
+    echo "== installing the x86_64-pc-windows-gnu target"
+    rustup target add x86_64-pc-windows-gnu
+  fi
+}
+
+# tmux drives the terminal UI in the console tests.
+ensure_tmux() {
+  if ! command -v tmux >/dev/null; then
+    echo "== installing tmux"
+    apt_install tmux
+  fi
+}

@@ -213,7 +213,7 @@ impl Session {
             // Unanswered heartbeats: shown, not piled up.
             self.ping_ids.remove(0);
         }
-        self.port.write_all(&line)
+        Ok(self.port.write_all(&line)?)
     }
 
     fn draw(&mut self) -> Result<()> {

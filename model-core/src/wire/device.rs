@@ -60,6 +60,10 @@ pub struct Device {
     frames_scheduled: u32,
     schedule_start_ms: Option<u32>,
     encode_failures: u32,
+    /// The last command that changed something, its id and its outcome (its answer is an Ack
+    /// or a Reject): a resend with the same id and the same command (the PC lost the answer) is
+    /// answered again, not carried out twice.
+    last: Option<(u16, Command, Result<(), Reason>)>,
 }
 
 /// The default telemetry rate, frames per second.
@@ -81,6 +85,7 @@ impl Device {
             frames_scheduled: 0,
             schedule_start_ms: None,
             encode_failures: 0,
+            last: None,
         }
     }
 
@@ -119,7 +124,7 @@ impl Device {
         let mut out = [0u8; MAX_FRAME_LEN];
         for &b in bytes {
             let answer = match self.decoder.push_command(b) {
-                Some(Ok(Frame::Command { id, command })) => self.execute(backend, id, command),
+                Some(Ok(Frame::Command { id, command })) => self.answer(backend, id, command),
                 Some(Err(FrameError::BadCommand { id, reason })) => Frame::Reject { id, reason },
                 // Not a command, or damaged beyond reading an id: the PC times out and retries.
                 _ => continue,
@@ -142,7 +147,38 @@ impl Device {
         }
     }
 
-    /// Carries out one command and returns the answer frame.
+    /// The answer to a command from the PC: carried out once per request id. A command that
+    /// repeats the previous one's id and words is a resend after a lost answer, and gets the
+    /// same answer again without running twice. Queries (STATUS, PARAMS, MODELS, PING) change
+    /// nothing and are always answered afresh.
+    pub fn answer<B: Backend>(&mut self, backend: &mut B, id: u16, command: Command) -> Frame {
+        let query = matches!(
+            command,
+            Command::GetStatus | Command::GetParams | Command::GetModels | Command::Ping
+        );
+        if let Some((last_id, last_command, outcome)) = self.last
+            && !query
+            && last_id == id
+            && last_command == command
+        {
+            return match outcome {
+                Ok(()) => Frame::Ack { id },
+                Err(reason) => Frame::Reject { id, reason },
+            };
+        }
+        let answer = self.execute(backend, id, command);
+        if !query {
+            let outcome = match answer {
+                Frame::Reject { reason, .. } => Err(reason),
+                _ => Ok(()),
+            };
+            self.last = Some((id, command, outcome));
+        }
+        answer
+    }
+
+    /// Carries out one command and returns the answer frame (no resend check: see
+    /// [`Device::answer`]).
     pub fn execute<B: Backend>(&mut self, backend: &mut B, id: u16, command: Command) -> Frame {
         let done = match command {
             Command::SetSpeeds {

@@ -1,48 +1,17 @@
-//! `bowl monitor PORT`: live view of the rig's telemetry, CSV log keyed on device time, counters
-//! of good, corrupt and missing frames; reopens the port after an unplug and keeps logging.
-//!
-//! On a terminal it draws a dashboard (latest values and trend lines, ANSI escapes only); with
-//! `--plain` or when stdout is not a terminal it prints one line per second instead. It only
-//! listens: it never writes to the port, so it cannot disturb the rig.
+//! What the live view knows (latest telemetry, boot, events, link) and its text forms: the plain
+//! line of `bowl monitor --plain` and the ANSI dashboard `bowl demo` draws.
+
+// The ANSI dashboard and the pseudo-terminal serve the demo, which needs a Unix system.
+#![cfg_attr(not(unix), allow(dead_code, unused_imports))]
 
 use std::collections::VecDeque;
-use std::fs::{File, OpenOptions};
-use std::io::{BufWriter, IsTerminal, Write};
-use std::path::PathBuf;
-use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result};
 use model_core::wire::{Decoder, Frame, Hello, Residence, Telemetry};
-use serde_json::json;
 
-use crate::replay::stats_json;
 use crate::send::describe;
-use crate::serial::{Port, ReadOutcome};
-use crate::telemetry_csv;
-
-/// Flags of `bowl monitor`.
-#[derive(clap::Args)]
-pub struct Args {
-    /// The serial port or pseudo-terminal of the rig.
-    port: String,
-    /// Baud rate.
-    #[arg(long, default_value_t = 115_200)]
-    baud: u32,
-    /// Append the telemetry to this CSV file (header written when the file is new).
-    #[arg(long)]
-    log: Option<PathBuf>,
-    /// Stop after this many seconds (default: run until interrupted).
-    #[arg(long)]
-    seconds: Option<f64>,
-    /// One text line per second instead of the dashboard.
-    #[arg(long)]
-    plain: bool,
-}
 
 /// How many points a trend line keeps (one per redraw, 5 per second: 12 s).
 const TREND_LEN: usize = 60;
-const REDRAW: Duration = Duration::from_millis(200);
-const REOPEN_EVERY: Duration = Duration::from_millis(250);
 
 struct Trend {
     name: &'static str,
@@ -93,7 +62,7 @@ fn residence_s(r: Residence) -> f64 {
     }
 }
 
-fn residence_text(r: Residence) -> String {
+pub(crate) fn residence_text(r: Residence) -> String {
     match r {
         Residence::Ms(ms) => format!("{:.3} s", f64::from(ms) / 1000.0),
         Residence::NeverLeaves => "never leaves".into(),
@@ -103,13 +72,13 @@ fn residence_text(r: Residence) -> String {
 
 /// What the live view shows; also drawn by `bowl demo`.
 pub(crate) struct View {
-    latest: Option<Telemetry>,
+    pub(crate) latest: Option<Telemetry>,
     hello: Option<Hello>,
-    events: VecDeque<String>,
+    pub(crate) events: VecDeque<String>,
     trends: [Trend; 5],
-    reconnects: u64,
-    connected: bool,
-    logged_rows: u64,
+    pub(crate) reconnects: u64,
+    pub(crate) connected: bool,
+    pub(crate) logged_rows: u64,
 }
 
 impl View {
@@ -178,7 +147,7 @@ impl View {
         }
     }
 
-    fn counters(&self, d: &Decoder) -> String {
+    pub(crate) fn counters(&self, d: &Decoder) -> String {
         let s = d.stats();
         format!(
             "frames ok {}  corrupt {}  missing {}  bytes skipped {}  reconnects {}",
@@ -204,6 +173,10 @@ impl View {
             ),
             None => "no telemetry yet".into(),
         };
+        if !self.connected {
+            // The old values would read as current: say the link is down instead.
+            return format!("LINK LOST: no values | {}", self.counters(d));
+        }
         format!("{values} | {}", self.counters(d))
     }
 
@@ -258,123 +231,4 @@ impl View {
         }
         s
     }
-}
-
-fn open_log(path: &PathBuf) -> Result<BufWriter<File>> {
-    let is_new = std::fs::metadata(path)
-        .map(|m| m.len() == 0)
-        .unwrap_or(true);
-    let file = OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(path)
-        .with_context(|| format!("cannot open the log {}", path.display()))?;
-    let mut w = BufWriter::new(file);
-    if is_new {
-        writeln!(w, "{}", telemetry_csv::HEADER)?;
-    }
-    Ok(w)
-}
-
-/// Runs `bowl monitor`.
-pub fn run(args: &Args) -> Result<()> {
-    crate::serial::baud_rate(args.baud)?;
-    crate::serial::check_path(&args.port)?;
-    let plain = args.plain || !std::io::stdout().is_terminal();
-    let mut log = args.log.as_ref().map(open_log).transpose()?;
-    let started = Instant::now();
-    let deadline = args
-        .seconds
-        .map(|s| started + Duration::from_secs_f64(s.max(0.0)));
-    let mut decoder = Decoder::new();
-    let mut view = View::new();
-    let mut port: Option<Port> = None;
-    let mut last_open_try: Option<Instant> = None;
-    let mut next_redraw = Instant::now();
-    let mut next_plain = Instant::now() + Duration::from_secs(1);
-    let mut buf = [0u8; 4096];
-    let mut ever_connected = false;
-
-    while deadline.is_none_or(|d| Instant::now() < d) {
-        if port.is_none() && last_open_try.is_none_or(|t| t.elapsed() >= REOPEN_EVERY) {
-            last_open_try = Some(Instant::now());
-            match Port::open(&args.port, args.baud) {
-                Ok(p) => {
-                    port = Some(p);
-                    view.set_connected(true);
-                    if ever_connected {
-                        view.reconnects += 1;
-                        view.event(plain, format!("port {} reopened", args.port));
-                    } else {
-                        view.event(plain, format!("port {} open", args.port));
-                    }
-                    ever_connected = true;
-                }
-                Err(e) if !ever_connected && last_open_try == Some(started) => {
-                    view.event(plain, format!("waiting for {}: {e:#}", args.port));
-                }
-                Err(_) => {}
-            }
-        }
-        let outcome = match port.as_mut() {
-            Some(p) => p.read(&mut buf, Duration::from_millis(20))?,
-            None => {
-                std::thread::sleep(Duration::from_millis(20));
-                ReadOutcome::Timeout
-            }
-        };
-        match outcome {
-            ReadOutcome::Data(n) => {
-                for &b in &buf[..n] {
-                    // Damaged frames are counted by the decoder (corrupt, oversize, truncated).
-                    if let Some(Ok(frame)) = decoder.push(b) {
-                        if let (Frame::Telemetry(t), Some(w)) = (&frame, log.as_mut()) {
-                            telemetry_csv::write_row(w, decoder.stats().restarts, t)?;
-                            view.logged_rows += 1;
-                        }
-                        view.on_frame(plain, &frame);
-                    }
-                }
-            }
-            ReadOutcome::Timeout => {}
-            ReadOutcome::Gone => {
-                port = None;
-                view.set_connected(false);
-                decoder.finish();
-                view.event(plain, format!("port {} lost; reopening", args.port));
-            }
-        }
-        let now = Instant::now();
-        if now >= next_redraw {
-            next_redraw = now + REDRAW;
-            view.sample_trends();
-            if let Some(w) = log.as_mut() {
-                w.flush().context("writing the log")?;
-            }
-            if !plain {
-                print!("{}", view.dashboard(&args.port, &decoder));
-                std::io::stdout().flush()?;
-            }
-        }
-        if plain && now >= next_plain {
-            next_plain = now + Duration::from_secs(1);
-            println!("{}", view.plain_line(&decoder));
-        }
-    }
-    if let Some(w) = log.as_mut() {
-        w.flush().context("writing the log")?;
-    }
-    let mut summary = stats_json(decoder.stats());
-    summary["reconnects"] = json!(view.reconnects);
-    summary["logged_rows"] = json!(view.logged_rows);
-    println!("{summary}");
-    if !ever_connected {
-        return Err(crate::exit_code::LinkError(format!(
-            "no telemetry: {} never appeared or could not be opened in {:.0} s",
-            args.port,
-            started.elapsed().as_secs_f64()
-        ))
-        .into());
-    }
-    Ok(())
 }

@@ -1,0 +1,99 @@
+//! Commands typed into the monitor's own command line: sent on the port it holds, matched to
+//! their answers by id and kind, resent with the same id when the answer does not come.
+
+use std::time::Instant;
+
+use model_core::wire::{Command, Frame, decode_frame};
+
+use crate::link::{RESEND_EVERY, answers_kind};
+use crate::send::{command_line, describe, explain};
+
+/// How often a typed command is sent in all when no answer comes (1 s).
+const ATTEMPTS: u32 = 5;
+
+struct Pending {
+    id: u16,
+    words: String,
+    command: Command,
+    line: Vec<u8>,
+    sent_at: Instant,
+    attempts: u32,
+}
+
+/// The monitor's commands in flight.
+pub struct Commands {
+    next_id: u16,
+    pending: Vec<Pending>,
+}
+
+impl Commands {
+    pub fn new() -> Self {
+        // Ids from the clock, so two monitors in a row do not reuse each other's.
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.subsec_nanos())
+            .unwrap_or(0);
+        Self {
+            next_id: (nanos % 60_000) as u16 + 1,
+            pending: Vec::new(),
+        }
+    }
+
+    /// Takes a typed line; returns the bytes to send, or the reason it was refused here.
+    pub fn submit(&mut self, text: &str) -> Result<Vec<u8>, String> {
+        let words: Vec<String> = text.split_whitespace().map(str::to_owned).collect();
+        if words.is_empty() {
+            return Err("type a command, e.g. `status`, `speed 1800 2100`, `start`".into());
+        }
+        let id = self.next_id;
+        self.next_id = self.next_id.wrapping_add(1).max(1);
+        let line = command_line(id, &words)
+            .map_err(|r| format!("`{text}` not sent: {} - {}", r.token(), explain(r)))?;
+        let Ok(Frame::Command { command, .. }) = decode_frame(&line) else {
+            return Err(format!("`{text}` not sent: not a command"));
+        };
+        self.pending.push(Pending {
+            id,
+            words: text.trim().to_owned(),
+            command,
+            line: line.clone(),
+            sent_at: Instant::now(),
+            attempts: 1,
+        });
+        Ok(line)
+    }
+
+    /// An answer for one of ours: the text to show.
+    pub fn on_frame(&mut self, frame: &Frame) -> Option<String> {
+        let id = frame.answer_id()?;
+        let i = self
+            .pending
+            .iter()
+            .position(|p| p.id == id && answers_kind(&p.command, frame))?;
+        let p = self.pending.remove(i);
+        Some(format!("{} -> {}", p.words, describe(frame)))
+    }
+
+    /// Lines to send again (same id) and texts for commands that got no answer at all.
+    pub fn due(&mut self) -> (Vec<Vec<u8>>, Vec<String>) {
+        let mut resend = Vec::new();
+        let mut gave_up = Vec::new();
+        self.pending.retain_mut(|p| {
+            if p.sent_at.elapsed() < RESEND_EVERY {
+                return true;
+            }
+            if p.attempts >= ATTEMPTS {
+                gave_up.push(format!(
+                    "{} -> no answer (id {}, sent {} times)",
+                    p.words, p.id, p.attempts
+                ));
+                return false;
+            }
+            p.attempts += 1;
+            p.sent_at = Instant::now();
+            resend.push(p.line.clone());
+            true
+        });
+        (resend, gave_up)
+    }
+}

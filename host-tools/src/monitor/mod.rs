@@ -1,0 +1,233 @@
+//! `bowl monitor PORT`: the rig engineer's console. Live view of the telemetry (a terminal UI,
+//! or one text line per second with `--plain` or when stdout is not a terminal), CSV log keyed on
+//! device time, frame counters; reopens the port after an unplug and keeps logging.
+//!
+//! It holds the port exclusively and serves a local socket ([`crate::relay`]) through which
+//! `bowl send`, `bowl commission` and scripts reach the rig meanwhile. Commands can also be typed
+//! into the monitor itself (the UI's command line, or stdin lines in plain mode).
+
+mod commands;
+mod tui;
+mod view;
+
+pub(crate) use view::View;
+
+use std::fs::{File, OpenOptions};
+use std::io::{BufRead, BufWriter, IsTerminal, Write};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use model_core::wire::{Decoder, Frame};
+use serde_json::json;
+
+use crate::relay::Relay;
+use crate::replay::stats_json;
+use crate::serial::{Port, ReadOutcome};
+use crate::telemetry_csv;
+use commands::Commands;
+use tui::{Action, Tui};
+
+/// Flags of `bowl monitor`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The serial port or pseudo-terminal of the rig (`bowl ports` lists them).
+    port: String,
+    /// Baud rate (any rate the port supports).
+    #[arg(long, default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(50..=12_000_000))]
+    baud: u32,
+    /// Append the telemetry to this CSV file (header written when the file is new).
+    #[arg(long)]
+    log: Option<PathBuf>,
+    /// Stop after this many seconds (default: run until interrupted).
+    #[arg(long)]
+    seconds: Option<f64>,
+    /// One text line per second instead of the terminal UI (also when stdout is not a terminal).
+    #[arg(long)]
+    plain: bool,
+}
+
+const REDRAW: Duration = Duration::from_millis(100);
+const REOPEN_EVERY: Duration = Duration::from_millis(250);
+
+fn open_log(path: &PathBuf) -> Result<BufWriter<File>> {
+    let is_new = std::fs::metadata(path)
+        .map(|m| m.len() == 0)
+        .unwrap_or(true);
+    let file = OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .with_context(|| format!("cannot open the log {}", path.display()))?;
+    let mut w = BufWriter::new(file);
+    if is_new {
+        writeln!(w, "{}", telemetry_csv::HEADER)?;
+    }
+    Ok(w)
+}
+
+/// Lines typed on stdin (plain mode), read on their own thread.
+fn stdin_lines() -> mpsc::Receiver<String> {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in std::io::stdin().lock().lines() {
+            let Ok(line) = line else { break };
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    rx
+}
+
+/// Runs `bowl monitor`.
+pub fn run(args: &Args) -> Result<()> {
+    // The UI needs a screen and a keyboard; without either it prints lines.
+    let plain = args.plain || !std::io::stdout().is_terminal() || !std::io::stdin().is_terminal();
+    // The port is checked before anything is drawn: a wrong path is an error, not a wait.
+    let first = Port::open(&args.port, args.baud)?;
+    // Served only while the port is held: a lost port's name may soon be another device's.
+    let mut relay = Some(Relay::serve(&args.port)?);
+    let mut log = args.log.as_ref().map(open_log).transpose()?;
+    let interrupted = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupted.clone();
+        // In the UI, Ctrl-C arrives as a key; this catches it in plain mode.
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
+    let started = Instant::now();
+    let deadline = args
+        .seconds
+        .map(|s| started + Duration::from_secs_f64(s.max(0.0)));
+    let mut decoder = Decoder::new();
+    let mut view = View::new();
+    let mut commands = Commands::new();
+    let mut port = Some(first);
+    view.set_connected(true);
+    view.event(plain, format!("port {} open", args.port));
+    let mut tui = if plain { None } else { Some(Tui::start()?) };
+    let typed = if plain { Some(stdin_lines()) } else { None };
+    let mut last_open_try = Instant::now();
+    let mut next_redraw = Instant::now();
+    let mut next_plain = Instant::now() + Duration::from_secs(1);
+    let mut buf = [0u8; 4096];
+
+    while deadline.is_none_or(|d| Instant::now() < d) && !interrupted.load(Ordering::SeqCst) {
+        if port.is_none() && last_open_try.elapsed() >= REOPEN_EVERY {
+            last_open_try = Instant::now();
+            if let Ok(p) = Port::open(&args.port, args.baud) {
+                port = Some(p);
+                relay = match Relay::serve(&args.port) {
+                    Ok(r) => Some(r),
+                    Err(e) => {
+                        view.event(plain, format!("other tools cannot reach the rig: {e:#}"));
+                        None
+                    }
+                };
+                view.set_connected(true);
+                view.reconnects += 1;
+                view.event(plain, format!("port {} reopened", args.port));
+            }
+        }
+        let outcome = match port.as_mut() {
+            Some(p) => p.read(&mut buf, Duration::from_millis(10))?,
+            None => {
+                std::thread::sleep(Duration::from_millis(10));
+                ReadOutcome::Timeout
+            }
+        };
+        match outcome {
+            ReadOutcome::Data(n) => {
+                if let Some(r) = relay.as_mut() {
+                    r.broadcast(&buf[..n]);
+                }
+                for &b in &buf[..n] {
+                    // Damaged frames are counted by the decoder (corrupt, oversize, truncated).
+                    let Some(Ok(frame)) = decoder.push(b) else {
+                        continue;
+                    };
+                    if let Frame::Telemetry(t) = &frame {
+                        if let Some(w) = log.as_mut() {
+                            telemetry_csv::write_row(w, decoder.stats().restarts, t)?;
+                            view.logged_rows += 1;
+                        }
+                        if let Some(ui) = tui.as_mut() {
+                            ui.on_telemetry(t);
+                        }
+                    }
+                    match commands.on_frame(&frame) {
+                        Some(text) => view.event(plain, text),
+                        // Answers to other tools' commands are theirs to report.
+                        None if frame.answer_id().is_some() => {}
+                        None => view.on_frame(plain, &frame),
+                    }
+                }
+            }
+            ReadOutcome::Timeout => {}
+            ReadOutcome::Gone => {
+                port = None;
+                relay = None;
+                view.set_connected(false);
+                decoder.finish();
+                view.event(plain, format!("port {} lost; reopening", args.port));
+            }
+        }
+        let mut outgoing = relay.as_mut().map(Relay::poll).unwrap_or_default();
+        let mut typed_now: Vec<String> = typed.iter().flat_map(|rx| rx.try_iter()).collect();
+        if let Some(ui) = tui.as_mut() {
+            match ui.keys()? {
+                Action::Quit => break,
+                Action::Send(text) => typed_now.push(text),
+                Action::None => {}
+            }
+        }
+        for text in typed_now {
+            match commands.submit(&text) {
+                Ok(line) => outgoing.push(line),
+                Err(why) => view.event(plain, why),
+            }
+        }
+        let (resend, gave_up) = commands.due();
+        outgoing.extend(resend);
+        for text in gave_up {
+            view.event(plain, text);
+        }
+        if let Some(p) = port.as_mut() {
+            for line in &outgoing {
+                if let Err(e) = p.write_all(line) {
+                    view.event(plain, format!("{e}"));
+                }
+            }
+        } else if !outgoing.is_empty() {
+            view.event(plain, "not sent: the link is lost".into());
+        }
+        let now = Instant::now();
+        if now >= next_redraw {
+            next_redraw = now + REDRAW;
+            if let Some(w) = log.as_mut() {
+                w.flush().context("writing the log")?;
+            }
+            if let Some(ui) = tui.as_mut() {
+                let tools = relay.as_ref().map_or(0, Relay::client_count);
+                ui.draw(&args.port, &view, &decoder, tools)?;
+            }
+        }
+        if plain && now >= next_plain {
+            next_plain = now + Duration::from_secs(1);
+            println!("{}", view.plain_line(&decoder));
+        }
+    }
+    // Leave the alternate screen first, so the summary stays on the terminal.
+    drop(tui);
+    if let Some(w) = log.as_mut() {
+        w.flush().context("writing the log")?;
+    }
+    let mut summary = stats_json(decoder.stats());
+    summary["reconnects"] = json!(view.reconnects);
+    summary["logged_rows"] = json!(view.logged_rows);
+    println!("{summary}");
+    Ok(())
+}

@@ -1,0 +1,240 @@
+//! One port, several tools: 40 `bowl send` commands through a running `bowl monitor` on the
+//! virtual rig, on a clean line and with 1 % line noise. Every answer must be the right one (the
+//! id asked, the kind the command gets, the outcome the rig's state implies) and the monitor must
+//! see no reconnect. Ctrl-C ends the monitor with its counters printed.
+
+mod common;
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use common::{BOWL, Sim, bowl, stdout, wait_within};
+
+/// A `bowl monitor --plain` on `port`; its stdout lines arrive on the receiver.
+fn start_monitor(port: &str, log: &std::path::Path) -> (Child, mpsc::Receiver<String>) {
+    let mut child = Command::new(BOWL)
+        .args(["monitor", port, "--plain", "--log"])
+        .arg(log)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("bowl monitor starts");
+    let (tx, rx) = mpsc::channel();
+    let out = child.stdout.take().unwrap();
+    std::thread::spawn(move || {
+        for line in BufReader::new(out).lines() {
+            let Ok(line) = line else { break };
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let opened = rx
+        .recv_timeout(Duration::from_secs(10))
+        .expect("monitor speaks");
+    assert!(opened.contains("open"), "{opened}");
+    (child, rx)
+}
+
+/// Ten commands whose answers the rig's state fixes, repeated four times: (words, exit code,
+/// how the answer starts, what else it must say).
+const ROUND: [(&str, i32, &str, &str); 10] = [
+    ("speed 1500 1500", 0, "ok", ""),
+    ("status", 0, "status", "state=Idle"),
+    ("clear", 1, "rejected", "STATE"),
+    ("speed 1800 30000", 1, "rejected", "RANGE"),
+    ("start", 0, "ok", ""),
+    ("status", 0, "status", "state=SpinningUp|state=Running"),
+    ("ping", 0, "ok", ""),
+    ("stop", 0, "ok", ""),
+    ("ping", 0, "ok", ""),
+    ("status", 0, "status", "fault=None"),
+];
+
+/// Each `bowl send` may take this long (it resends every 200 ms meanwhile): with 1 % of the bytes
+/// damaged, a 40-byte answer arrives whole only two times in three.
+const TIMEOUT_MS: &str = "5000";
+
+fn forty_commands_through_the_monitor(noise_percent: &str) {
+    let sim = Sim::start(&["--line-noise-percent", noise_percent]);
+    forty_commands(&sim.path, noise_percent == "0");
+}
+
+/// Asks STATUS (through the monitor as well) until the rig is Idle again after a STOP.
+fn wait_until_idle(port: &str, round: u16) {
+    let started = std::time::Instant::now();
+    for k in 0u16.. {
+        let id = (3000 + round * 100 + k).to_string();
+        let out = bowl(&[
+            "send",
+            port,
+            "--timeout-ms",
+            TIMEOUT_MS,
+            "--id",
+            &id,
+            "status",
+        ]);
+        let text = stdout(&out);
+        assert_eq!(out.status.code(), Some(0), "{text}");
+        if text.contains("state=Idle") {
+            return;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(20),
+            "not Idle: {text}"
+        );
+        std::thread::sleep(Duration::from_millis(250));
+    }
+}
+
+/// The 40 commands through a monitor of `port`; `clean`: the line loses nothing.
+fn forty_commands(port: &str, clean: bool) {
+    let dir = common::temp_dir(&format!("console-{}", port.replace('/', "_")));
+    let log = dir.join("log.csv");
+    let (mut monitor, lines) = start_monitor(port, &log);
+    for round in 0..4u16 {
+        for (k, (words, code, starts, says)) in ROUND.iter().enumerate() {
+            let id = 1000 + round * 10 + k as u16;
+            let mut args = vec!["send", port, "--timeout-ms", TIMEOUT_MS, "--id"];
+            let id_text = id.to_string();
+            args.push(&id_text);
+            args.extend(words.split(' '));
+            let out = bowl(&args);
+            let text = stdout(&out);
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(*code), "{words}: {text} {err}");
+            assert!(text.starts_with(starts), "{words}: {text}");
+            assert!(text.contains(&format!("(id {id})")), "{words}: {text}");
+            assert!(says.split('|').any(|s| text.contains(s)), "{words}: {text}");
+            assert!(err.contains("held by a running `bowl monitor`"), "{err}");
+            if *words == "stop" {
+                // The motors ramp down before the next round's Idle check.
+                wait_until_idle(port, round);
+            }
+        }
+    }
+    // Ctrl-C.
+    let sent = Command::new("kill")
+        .args(["-INT", &monitor.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let status = wait_within(&mut monitor, Duration::from_secs(5), "monitor after Ctrl-C");
+    assert!(status.success(), "{status:?}");
+    let summary = lines
+        .iter()
+        .last()
+        .expect("the monitor prints its counters on Ctrl-C");
+    let counters: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    assert_eq!(counters["reconnects"], 0, "{summary}");
+    // Ctrl-C flushed the log: every row the monitor counted is in the file.
+    let rows = std::fs::read_to_string(&log).unwrap().lines().count() - 1;
+    assert_eq!(
+        Some(rows as u64),
+        counters["logged_rows"].as_u64(),
+        "{summary}"
+    );
+    assert!(counters["frames_ok"].as_u64().unwrap() > 100, "{summary}");
+    if clean {
+        // A clean line loses nothing, though 40 clients came and went.
+        assert_eq!(counters["frames_corrupt"], 0, "{summary}");
+        assert_eq!(counters["frames_missing"], 0, "{summary}");
+    }
+}
+
+#[test]
+fn forty_commands_through_the_monitor_on_a_clean_line() {
+    forty_commands_through_the_monitor("0");
+}
+
+#[test]
+fn forty_commands_through_the_monitor_with_line_noise() {
+    forty_commands_through_the_monitor("1");
+}
+
+/// The same 40 commands through the monitor on the emulated board (QEMU runs the firmware's
+/// `qemu-rig` image, real-time profile), whose device is the firmware's own.
+#[test]
+fn forty_commands_through_the_monitor_on_the_qemu_rig() {
+    use bowl_emulator::{image, qemu};
+    assert!(
+        qemu::installed(),
+        "qemu-system-arm is not installed (tests/lib/ensure-tools.sh installs it)"
+    );
+    let elf = image::build(image::RIG_IMAGE).expect("the qemu-rig image builds");
+    let board = qemu::PtyBoard::boot(&elf, qemu::Profile::RealTime, &["-append", "seconds=300"])
+        .expect("the emulated board boots");
+    let port = board.port.clone();
+    forty_commands(&port, true);
+    board.stop();
+}
+
+#[test]
+fn monitor_refuses_a_path_that_is_no_port() {
+    let dir = common::temp_dir("monitor-refuses");
+    let file = dir.join("capture.bin");
+    std::fs::write(&file, b"$T1").unwrap();
+    for (path, says) in [
+        ("/nonexistent/ttyUSB9", "does not exist"),
+        (file.to_str().unwrap(), "regular file, not a serial port"),
+    ] {
+        let out = bowl(&["monitor", path, "--plain", "--seconds", "2"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(3), "{path}: {err}");
+        assert!(err.contains(says), "{path}: {err}");
+    }
+    let sim = Sim::start(&[]);
+    let out = bowl(&["monitor", &sim.path, "--baud", "7"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("7 is not in 50..=12000000"), "{err}");
+}
+
+#[test]
+fn commands_typed_into_the_plain_monitor_are_answered() {
+    use std::io::Write;
+    let sim = Sim::start(&[]);
+    let mut child = Command::new(BOWL)
+        .args(["monitor", &sim.path, "--plain", "--seconds", "3"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    std::thread::sleep(Duration::from_millis(500));
+    writeln!(stdin, "speed 1500 1500").unwrap();
+    writeln!(stdin, "status").unwrap();
+    writeln!(stdin, "speed 1500").unwrap();
+    let out = child.wait_with_output().unwrap();
+    let text = stdout(&out);
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("speed 1500 1500 -> ok (id"), "{text}");
+    assert!(text.contains("status -> status (id"), "{text}");
+    assert!(text.contains("`speed 1500` not sent: MALFORMED"), "{text}");
+}
+
+#[test]
+fn ports_are_listed_or_their_absence_said() {
+    let out = bowl(&["ports"]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = stdout(&out);
+    assert!(
+        text.starts_with("/dev/") || text.starts_with("no serial ports found"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_second_monitor_is_told_the_port_is_held() {
+    let sim = Sim::start(&[]);
+    let dir = common::temp_dir("second-monitor");
+    let (mut first, _lines) = start_monitor(&sim.path, &dir.join("log.csv"));
+    let out = bowl(&["monitor", &sim.path, "--plain", "--seconds", "1"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(err.contains("is in use by another program"), "{err}");
+    let _ = first.kill();
+    let _ = first.wait();
+}

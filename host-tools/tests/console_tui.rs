@@ -1,0 +1,145 @@
+//! The monitor's terminal UI in a real terminal (tmux): what a person sees. Charts with labelled
+//! axes and numbers, the values, a command typed into the UI and its answer, a fault banner, the
+//! link-lost banner, and a quit key that gives the terminal back with the counters printed.
+
+mod common;
+
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use common::{BOWL, Sim};
+
+/// A tmux session (its own server socket), killed when dropped.
+struct Tmux {
+    socket: String,
+}
+
+impl Tmux {
+    fn start(name: &str, command: &str) -> Tmux {
+        let socket = format!("bowl-test-{name}-{}", std::process::id());
+        let tmux = Tmux { socket };
+        let ok = tmux
+            .cmd(&["new-session", "-d", "-x", "120", "-y", "40", command])
+            .status()
+            .expect("tmux runs (tests/lib/ensure-tools.sh installs it)")
+            .success();
+        assert!(ok, "tmux new-session");
+        tmux
+    }
+
+    fn cmd(&self, args: &[&str]) -> Command {
+        let mut c = Command::new("tmux");
+        c.args(["-L", &self.socket]).args(args);
+        c
+    }
+
+    fn keys(&self, keys: &[&str]) {
+        let mut args = vec!["send-keys", "-t", "0"];
+        args.extend_from_slice(keys);
+        assert!(self.cmd(&args).status().unwrap().success());
+    }
+
+    fn screen(&self) -> String {
+        let out = self
+            .cmd(&["capture-pane", "-p", "-t", "0"])
+            .output()
+            .unwrap();
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    }
+
+    /// Waits until the screen shows every one of `texts`; fails with the screen otherwise.
+    fn wait_for(&self, texts: &[&str], what: &str) -> String {
+        let started = Instant::now();
+        loop {
+            let screen = self.screen();
+            if texts.iter().all(|t| screen.contains(t)) {
+                return screen;
+            }
+            assert!(
+                started.elapsed() < Duration::from_secs(10),
+                "{what}: expected {texts:?} on the screen:\n{screen}"
+            );
+            std::thread::sleep(Duration::from_millis(200));
+        }
+    }
+}
+
+impl Drop for Tmux {
+    fn drop(&mut self) {
+        let _ = self.cmd(&["kill-server"]).status();
+    }
+}
+
+#[test]
+fn a_person_sees_the_rig_commands_it_and_quits() {
+    let sim = Sim::start(&[]);
+    // `; sleep` keeps the pane after the monitor exits, so what it leaves behind can be read.
+    let tmux = Tmux::start("tui", &format!("{BOWL} monitor {} ; sleep 30", sim.path));
+    let screen = tmux.wait_for(
+        &[
+            "LINK OK",
+            "precession w1",
+            "spin w2",
+            "device time (s)",
+            "speed (rad/s)",
+            "set rad/s",
+            "measured rad/s",
+            "state Idle",
+            "no fault",
+        ],
+        "the dashboard",
+    );
+    // The speed axis has numbers, and at rest spans at least 1 rad/s (noise does not fill it).
+    assert!(screen.contains("1.10"), "a numbered speed axis:\n{screen}");
+
+    // A command typed into the UI, and its answer.
+    tmux.keys(&[":", "speed 1500 1500", "Enter"]);
+    tmux.wait_for(&["speed 1500 1500 -> ok (id"], "the answer to speed");
+    tmux.keys(&[":", "start", "Enter"]);
+    tmux.wait_for(&["start -> ok (id", "state Running"], "running");
+    // The set speed 1.500 rad/s shows in the values of both axes.
+    tmux.wait_for(&["1.500"], "the set speed");
+
+    // A smaller window: the screen is drawn again to fit, axes and values still there.
+    assert!(
+        tmux.cmd(&["resize-window", "-t", "0", "-x", "90", "-y", "30"])
+            .status()
+            .unwrap()
+            .success()
+    );
+    let small = tmux.wait_for(
+        &["device time (s)", "speed (rad/s)", "measured rad/s"],
+        "after a resize",
+    );
+    assert!(
+        small.lines().all(|l| l.chars().count() <= 90),
+        "fits 90 columns:\n{small}"
+    );
+
+    // Pause.
+    tmux.keys(&["p"]);
+    tmux.wait_for(&["PAUSED"], "the pause key");
+    tmux.keys(&["p"]);
+
+    // A fault cannot be missed.
+    tmux.keys(&[":", "inject sensor1", "Enter"]);
+    tmux.wait_for(
+        &["FAULT ", "the rig stopped the motors"],
+        "the fault banner",
+    );
+
+    // The link dies: said so, and the values are no longer shown as current.
+    drop(sim);
+    tmux.wait_for(
+        &["LINK LOST", "last values before the link was lost"],
+        "link lost",
+    );
+
+    // q quits: the alternate screen is gone and the counters are printed.
+    tmux.keys(&["q"]);
+    let screen = tmux.wait_for(&["\"frames_ok\""], "the counters after quitting");
+    assert!(
+        !screen.contains("device time (s)"),
+        "terminal restored:\n{screen}"
+    );
+}
