@@ -257,11 +257,18 @@ pub fn run(args: &Args) -> Result<i32> {
         End::Idle => exit_code::OK,
         End::Fault(fault) => {
             report.result = "fault";
-            report.fault = Some(format!("{fault:?} (code {})", fault.code()));
+            report.fault = Some(format!(
+                "{} (code {})",
+                crate::words::fault(fault),
+                fault.code()
+            ));
             exit_code::REFUSED
         }
         End::OtherState(state) => {
-            bail!("commissioning ended in state {state:?} (another PC may have sent a command)")
+            bail!(
+                "commissioning ended with the rig {} (another PC may have sent a command)",
+                crate::words::state(state)
+            )
         }
         End::Timeout => {
             report.result = "timeout";

@@ -28,6 +28,7 @@ mod sim_reports;
 mod simulated_backend;
 mod telemetry_csv;
 mod virtual_rig;
+mod words;
 
 /// The PC side of the bowl granulation rig.
 #[derive(Parser)]

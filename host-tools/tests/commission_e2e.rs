@@ -77,7 +77,7 @@ fn refusal_and_fault_give_distinct_non_zero_exits() {
         got["fault"]
             .as_str()
             .unwrap()
-            .contains("SensorLostOrStallPrecession"),
+            .contains("precession motor: no sensor pulses"),
         "{got}"
     );
 }

@@ -84,7 +84,7 @@ fn a_person_sees_the_rig_commands_it_and_quits() {
             "speed (rad/s)",
             "set rad/s",
             "measured rad/s",
-            "state Idle",
+            "state idle",
             "no fault",
         ],
         "the dashboard",
@@ -96,7 +96,7 @@ fn a_person_sees_the_rig_commands_it_and_quits() {
     tmux.keys(&[":", "speed 1500 1500", "Enter"]);
     tmux.wait_for(&["speed 1500 1500 -> ok (id"], "the answer to speed");
     tmux.keys(&[":", "start", "Enter"]);
-    tmux.wait_for(&["start -> ok (id", "state Running"], "running");
+    tmux.wait_for(&["start -> ok (id", "state running"], "running");
     // The set speed 1.500 rad/s shows in the values of both axes.
     tmux.wait_for(&["1.500"], "the set speed");
 

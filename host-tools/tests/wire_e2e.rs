@@ -104,7 +104,7 @@ fn send_and_monitor_against_the_virtual_rig() {
     assert_eq!(summary["frames_missing"], 0, "{summary}");
     let text = stdout(&mon);
     assert!(
-        text.contains("state=Running") || text.contains("state=SpinningUp"),
+        text.contains("state=running") || text.contains("state=spinning up"),
         "{text}"
     );
     // The setpoints as sent, in rad/s.
@@ -318,7 +318,7 @@ fn monitor_on_a_screen_without_a_keyboard_prints_lines() {
     let screen = String::from_utf8_lossy(&reader.join().unwrap()).into_owned();
     assert!(!screen.contains("\x1b[?1049h"), "no alternate screen");
     assert!(screen.contains("frames ok"), "{screen}");
-    assert!(screen.contains("state=Idle"), "{screen}");
+    assert!(screen.contains("state=idle"), "{screen}");
 }
 
 #[test]

@@ -206,8 +206,9 @@ fn steps(
         Some(at) => {
             let fault = s.latest().map_or(FaultCode::None, |t| t.fault);
             s.event(format!(
-                "fault detected at t={:.3} s: {fault:?}",
-                f64::from(at) / 1000.0
+                "fault detected at t={:.3} s: {}",
+                f64::from(at) / 1000.0,
+                crate::words::fault(fault)
             ));
             let already_off = s.latest().is_some_and(motors_off);
             let off = if already_off {

@@ -222,7 +222,10 @@ fn banner<'a>(port: &'a str, view: &View, paused: bool, tools: usize) -> Paragra
         ));
     }
     if let Some(t) = view.latest.filter(|_| view.connected) {
-        spans.push(Span::raw(format!("  state {:?}  ", t.state)));
+        spans.push(Span::raw(format!(
+            "  state {}  ",
+            crate::words::state(t.state)
+        )));
     }
     if paused {
         spans.push(Span::styled(
@@ -240,9 +243,9 @@ fn banner<'a>(port: &'a str, view: &View, paused: bool, tools: usize) -> Paragra
 fn fault_line(view: &View) -> Paragraph<'static> {
     match view.latest.filter(|_| view.connected) {
         Some(t) if t.fault != FaultCode::None => Paragraph::new(format!(
-            " FAULT {:?} (code {}): the rig stopped the motors; type `:clear` once the cause is fixed",
-            t.fault,
-            t.fault.code()
+            " FAULT {}: the rig stopped the motors. {}. Type `:clear` once the cause is fixed",
+            t.fault.code(),
+            crate::words::fault(t.fault)
         ))
         .style(
             Style::default()

@@ -109,8 +109,9 @@ impl View {
                 self.event(
                     plain,
                     format!(
-                        "rig booted: reset cause {:?}, reset count {}",
-                        h.reset_cause, h.reset_count
+                        "rig booted: reset cause {}, reset count {}",
+                        crate::words::reset_cause(h.reset_cause),
+                        h.reset_count
                     ),
                 );
             }
@@ -158,11 +159,11 @@ impl View {
     pub(crate) fn plain_line(&self, d: &Decoder) -> String {
         let values = match self.latest {
             Some(t) => format!(
-                "t={:.3}s seq={} state={:?} fault={:?} w1={:.3}/{:.3} w2={:.3}/{:.3} rad/s bowl={:.3} rad/s T_flat={} T_cor={}",
+                "t={:.3}s seq={} state={} fault={} w1={:.3}/{:.3} w2={:.3}/{:.3} rad/s bowl={:.3} rad/s T_flat={} T_cor={}",
                 f64::from(t.time_ms) / 1000.0,
                 t.seq,
-                t.state,
-                t.fault,
+                crate::words::state(t.state),
+                crate::words::fault(t.fault),
                 f64::from(t.precession.measured_mrad_s) / 1000.0,
                 f64::from(t.precession.set_mrad_s) / 1000.0,
                 f64::from(t.spin.measured_mrad_s) / 1000.0,
@@ -191,11 +192,11 @@ impl View {
         match self.latest {
             Some(t) => {
                 s += &format!(
-                    "device time {:>12.3} s   seq {:>5}   state {:?}   fault {:?}\n\n",
+                    "device time {:>12.3} s   seq {:>5}   state {}   fault: {}\n\n",
                     f64::from(t.time_ms) / 1000.0,
                     t.seq,
-                    t.state,
-                    t.fault
+                    crate::words::state(t.state),
+                    crate::words::fault(t.fault)
                 );
                 s += "              set rad/s  measured rad/s   duty %   pulses\n";
                 for (name, m) in [("precession w1", t.precession), ("spin       w2", t.spin)] {
@@ -221,8 +222,9 @@ impl View {
         }
         if let Some(h) = self.hello {
             s += &format!(
-                "\nlast boot: reset cause {:?}, reset count {}\n",
-                h.reset_cause, h.reset_count
+                "\nlast boot: reset cause {}, reset count {}\n",
+                crate::words::reset_cause(h.reset_cause),
+                h.reset_count
             );
         }
         s += &format!("\n{}\n", self.counters(d));
