@@ -21,16 +21,20 @@ pub enum Member {
     HorizontalDisc,
     /// The straight roll down the tilted bottom, no rotation (closed form per azimuth).
     FixedIncline,
+    /// The tilted bowl spinning at the combined speed about its own axis, without precession
+    /// (integrated per azimuth, like the full model, with gravity fixed in the inertial frame).
+    TiltedPlane,
     /// The full rolling model (integrated per azimuth).
     Full,
 }
 
 /// Every member, cheapest first.
-pub const MEMBERS: [Member; 5] = [
+pub const MEMBERS: [Member; 6] = [
     Member::PaperFlat,
     Member::PaperCoriolis,
     Member::HorizontalDisc,
     Member::FixedIncline,
+    Member::TiltedPlane,
     Member::Full,
 ];
 
@@ -42,6 +46,7 @@ impl Member {
             Member::PaperCoriolis => "paper-coriolis",
             Member::HorizontalDisc => "horizontal-disc",
             Member::FixedIncline => "fixed-incline",
+            Member::TiltedPlane => "tilted-plane",
             Member::Full => "rolling",
         }
     }
@@ -86,6 +91,7 @@ pub fn mean_residence_s<T: Real>(
             }
             Some(sum / T::from_f64(AZIMUTHS_DEG.len() as f64))
         }
+        Member::TiltedPlane => mean_residence_s(Member::Full, &tilted_plane(scene), method),
         Member::Full => {
             let s = residence_over_azimuths(scene, method).ok()?;
             if s.left as usize == AZIMUTHS_DEG.len() {
@@ -94,6 +100,15 @@ pub fn mean_residence_s<T: Real>(
                 None
             }
         }
+    }
+}
+
+/// The scene without precession: the bowl spins at the combined speed about its tilted axis.
+fn tilted_plane<T: Real>(scene: &RollingScene<T>) -> RollingScene<T> {
+    RollingScene {
+        precession_rad_s: T::ZERO,
+        spin_rad_s: scene.combined_speed_rad_s(),
+        ..*scene
     }
 }
 
@@ -117,6 +132,7 @@ fn release_time_s<T: Real>(
 ) -> Option<T> {
     match member {
         Member::FixedIncline => incline_residence_s(scene, beta_rad),
+        Member::TiltedPlane => release_time_s(Member::Full, &tilted_plane(scene), beta_rad, method),
         Member::Full => match residence(scene, beta_rad, method).ok()?.outcome {
             RollingOutcome::Leaves {
                 residence_time_s, ..
@@ -135,7 +151,7 @@ pub fn differences<T: Real>(
     scene: &RollingScene<T>,
     method: RollingMethod<T>,
     wanted: Wanted,
-) -> [Option<T>; 5] {
+) -> [Option<T>; 6] {
     match wanted {
         Wanted::AzimuthMean => {
             let full = mean_residence_s(Member::Full, scene, method);
@@ -154,7 +170,7 @@ pub fn differences<T: Real>(
             for (slot, deg) in full.iter_mut().zip(AZIMUTHS_DEG) {
                 match release_time_s(Member::Full, scene, T::from_f64(deg.to_radians()), method) {
                     Some(t) => *slot = t,
-                    None => return [None; 5],
+                    None => return [None; 6],
                 }
             }
             MEMBERS.map(|m| {
@@ -210,5 +226,5 @@ pub fn cheapest_within<T: Real>(
             return (*m, Some(x));
         }
     }
-    (Member::Full, d[4])
+    (Member::Full, d[5])
 }
