@@ -92,6 +92,8 @@ impl SimulatedBackend {
             if sim.rig.controller().state() != State::Commissioning {
                 break;
             }
+            // The rig commissions itself before any host connects: no link to lose.
+            sim.rig.heartbeat();
             sim.tick(dt_s);
         }
         let ctrl = sim.rig.controller();
