@@ -225,8 +225,8 @@ fn replay_counts_what_the_capture_holds_and_what_damage_removed() {
     let clean = replay_to_csv(&capture, &csv);
     assert!(clean.status.success());
     let s = last_json(&clean);
-    // 1 hello + 2 acks + 5 s x 50 Hz telemetry.
-    assert_eq!(s["frames_ok"], 253, "{s}");
+    // 1 hello + 2 acks + 4 heartbeat acks (PING at 1, 2, 3, 4 s) + 5 s x 50 Hz telemetry.
+    assert_eq!(s["frames_ok"], 257, "{s}");
     assert_eq!(s["telemetry_frames"], 250, "{s}");
     assert_eq!(s["frames_corrupt"], 0);
     assert_eq!(s["frames_missing"], 0);
