@@ -404,3 +404,30 @@ fn a_noisy_capture_replays_with_every_loss_counted() {
     assert!((2990..=3000).contains(&(telemetry + missing)), "{s}");
     assert!(missing > 1000, "{s}");
 }
+
+/// Link loss stops the motors by default: a running virtual rig that hears nothing from the
+/// PC for longer than `LINK_TIMEOUT_MS` (3 s by default) faults with the host-silence fault.
+#[test]
+fn a_silent_host_faults_a_running_rig_by_default() {
+    let sim = Sim::start(&["--seconds", "30"]);
+    let send = |words: &[&str]| {
+        let mut args = vec!["send", sim.path.as_str()];
+        args.extend_from_slice(words);
+        let o = bowl(&args);
+        assert!(o.status.success(), "{words:?}: {o:?}");
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    send(&["speed", "1500", "1500"]);
+    send(&["start"]);
+    let running = send(&["status"]);
+    assert!(
+        !running.contains("state=Idle") && !running.contains("state=Faulted"),
+        "{running}"
+    );
+    std::thread::sleep(std::time::Duration::from_millis(4500));
+    let status = send(&["status"]);
+    assert!(
+        status.contains("state=Faulted") && status.contains("fault=HostSilent"),
+        "{status}"
+    );
+}
