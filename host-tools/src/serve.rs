@@ -123,7 +123,7 @@ const SCRIPT_PING_ID: u16 = 9000;
 
 /// The heartbeat line due at device time `now_ms`, if a script runs and one is due.
 fn script_heartbeat(scripted: bool, now_ms: u32) -> Option<Vec<u8>> {
-    (scripted && now_ms > 0 && now_ms % SCRIPT_PING_EVERY_MS == 0)
+    (scripted && now_ms > 0 && now_ms.is_multiple_of(SCRIPT_PING_EVERY_MS))
         .then(|| command_line(SCRIPT_PING_ID, &["PING".to_string()]).ok())
         .flatten()
 }
