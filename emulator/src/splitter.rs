@@ -184,4 +184,18 @@ impl Splitter {
             std::thread::sleep(Duration::from_millis(5));
         }
     }
+
+    /// [`Splitter::wait_device_ms`] as a host tool waits: PINGs once a second of device time,
+    /// so the board's link-loss timeout (`LINK_TIMEOUT_MS`) stays quiet.
+    pub fn wait_device_ms_alive(&self, bowl: &Path, from_ms: u32, ms: u32) -> Vec<Telemetry> {
+        let end_ms = from_ms + ms;
+        loop {
+            let now_ms = self.last().time_ms;
+            if now_ms >= end_ms {
+                return self.wait_device_ms(from_ms, ms);
+            }
+            self.wait_device_ms(now_ms, (end_ms - now_ms).min(1000));
+            self.send(bowl, &["ping"]);
+        }
+    }
 }

@@ -36,7 +36,7 @@ fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
     assert_eq!(split.send(&bowl, &["speed", "2000", "3000"]).0, 0);
     assert_eq!(split.send(&bowl, &["start"]).0, 0);
     let started_ms = split.last().time_ms;
-    let run = split.wait_device_ms(started_ms, 6_000);
+    let run = split.wait_device_ms_alive(&bowl, started_ms, 6_000);
     let tail: Vec<_> = run
         .iter()
         .filter(|t| t.time_ms >= started_ms + 4_000)
@@ -70,7 +70,7 @@ fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
     // becomes ill-conditioned (2.5 s would sit at 2.40 rad/s: 1 % of speed, 30 % of time).
     assert_eq!(split.send(&bowl, &["rtime", "flat", "800"]).0, 0);
     let from = split.last().time_ms;
-    let settled = split.wait_device_ms(from, 8_000);
+    let settled = split.wait_device_ms_alive(&bowl, from, 8_000);
     let last = settled.last().unwrap();
     match last.residence_flat {
         Residence::Ms(ms) => assert!((760..=840).contains(&ms), "{last:?}"),
@@ -81,7 +81,7 @@ fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
     // and the command's transit), both outputs at zero, latched.
     assert_eq!(split.send(&bowl, &["inject", "sensor2"]).0, 0);
     let injected_ms = split.last().time_ms;
-    let after = split.wait_device_ms(injected_ms, 2_000);
+    let after = split.wait_device_ms_alive(&bowl, injected_ms, 2_000);
     let first_fault = after
         .iter()
         .find(|t| t.state == DeviceState::Faulted)

@@ -81,6 +81,9 @@ impl Ids {
     }
 }
 
+/// Heartbeat period (well inside the rig's default link-loss timeout).
+const PING_EVERY: Duration = Duration::from_secs(1);
+
 fn ask(port: &mut Link, ids: &mut Ids, words: &[&str]) -> Result<Option<Frame>> {
     let id = ids.next();
     let words: Vec<String> = words.iter().map(|w| w.to_string()).collect();
@@ -104,9 +107,15 @@ fn follow(port: &mut Link, ids: &mut Ids, timeout: Duration, quiet: bool) -> Res
     let mut buf = [0u8; 4096];
     let mut last_seen = Instant::now();
     let mut last_report = Instant::now();
+    let mut last_ping = Instant::now();
     loop {
         if start.elapsed() > timeout {
             return Ok(End::Timeout);
+        }
+        // Telemetry out is not presence: the rig's link-loss timeout needs bytes from us.
+        if last_ping.elapsed() >= PING_EVERY {
+            last_ping = Instant::now();
+            ask(port, ids, &["PING"])?;
         }
         let mut state = None;
         match port.read(&mut buf, Duration::from_millis(50))? {

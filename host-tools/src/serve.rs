@@ -122,6 +122,19 @@ fn parse_commands(specs: &[String]) -> Result<Vec<Scheduled>> {
     Ok(out)
 }
 
+/// The scripted PC heartbeats like every host tool (PING once a second of device time), so the
+/// rig's link-loss timeout stays quiet between scripted commands.
+const SCRIPT_PING_EVERY_MS: u32 = 1000;
+/// The heartbeat's command id, apart from the scripted commands' 1, 2, ...
+const SCRIPT_PING_ID: u16 = 9000;
+
+/// The heartbeat line due at device time `now_ms`, if a script runs and one is due.
+fn script_heartbeat(scripted: bool, now_ms: u32) -> Option<Vec<u8>> {
+    (scripted && now_ms > 0 && now_ms.is_multiple_of(SCRIPT_PING_EVERY_MS))
+        .then(|| command_line(SCRIPT_PING_ID, &["PING".to_string()]).ok())
+        .flatten()
+}
+
 /// Runs `bowl serve`.
 pub fn run(args: &Args) -> Result<()> {
     let commands = parse_commands(&args.commands)?;
@@ -184,6 +197,7 @@ fn capture(
     let mut out = Vec::with_capacity(4096);
     rig.boot(&mut out);
     let total_ms = (seconds * 1000.0).round() as u64;
+    let scripted = !commands.is_empty();
     let mut pending = commands.into_iter().peekable();
     let mut written = 0u64;
     for _ in 0..total_ms {
@@ -191,6 +205,7 @@ fn capture(
         while let Some(c) = pending.next_if(|c| c.at_ms <= rig.now_ms) {
             received.extend(c.line);
         }
+        received.extend(script_heartbeat(scripted, rig.now_ms).unwrap_or_default());
         rig.step_1ms(&received, &mut out);
         if out.len() >= 4096 {
             noise.apply(&mut out);
@@ -306,6 +321,7 @@ pub(crate) fn serve_on_pty(
     rig.boot(&mut out);
     let mut noisy_from = 0;
     let started = Instant::now();
+    let scripted = !commands.is_empty();
     let mut pending = commands.into_iter().peekable();
     let mut inbuf = [0u8; 1024];
     while !pacing.stop.load(Ordering::Relaxed) {
@@ -325,6 +341,7 @@ pub(crate) fn serve_on_pty(
             while let Some(c) = pending.next_if(|c| c.at_ms <= rig.now_ms) {
                 received.extend(c.line);
             }
+            received.extend(script_heartbeat(scripted, rig.now_ms).unwrap_or_default());
             rig.step_1ms(&received, &mut out);
             steps += 1;
         }

@@ -92,6 +92,8 @@ impl SimulatedBackend {
             if sim.rig.controller().state() != State::Commissioning {
                 break;
             }
+            // The rig commissions itself before any host connects: no link to lose.
+            sim.rig.heartbeat();
             sim.tick(dt_s);
         }
         let ctrl = sim.rig.controller();
@@ -233,11 +235,13 @@ mod tests {
         /// is accepted changes exactly that parameter (to the value sent).
         #[test]
         fn a_rejected_set_changes_nothing(
-            i in 0..ParamId::ALL.len() - 1,
+            i in 0..ParamId::ALL.len(),
             frac in 0.0f64..=1.0,
             running in any::<bool>(),
         ) {
             let id = ParamId::ALL[i];
+            // The telemetry rate lives in the protocol device, not behind the backend.
+            prop_assume!(id != ParamId::TelemetryHz);
             let (lo, hi) = id.range();
             let value = lo + ((f64::from(hi) - f64::from(lo)) * frac) as i32;
             let mut rig = commissioned().clone();

@@ -225,8 +225,8 @@ fn replay_counts_what_the_capture_holds_and_what_damage_removed() {
     let clean = replay_to_csv(&capture, &csv);
     assert!(clean.status.success());
     let s = last_json(&clean);
-    // 1 hello + 2 acks + 5 s x 50 Hz telemetry.
-    assert_eq!(s["frames_ok"], 253, "{s}");
+    // 1 hello + 2 acks + 4 heartbeat acks (PING at 1, 2, 3, 4 s) + 5 s x 50 Hz telemetry.
+    assert_eq!(s["frames_ok"], 257, "{s}");
     assert_eq!(s["telemetry_frames"], 250, "{s}");
     assert_eq!(s["frames_corrupt"], 0);
     assert_eq!(s["frames_missing"], 0);
@@ -402,4 +402,31 @@ fn a_noisy_capture_replays_with_every_loss_counted() {
     // 3000 frames sent; the first and last may be lost unseen (nothing brackets them).
     assert!((2990..=3000).contains(&(telemetry + missing)), "{s}");
     assert!(missing > 1000, "{s}");
+}
+
+/// Link loss stops the motors by default: a running virtual rig that hears nothing from the
+/// PC for longer than `LINK_TIMEOUT_MS` (3 s by default) faults with the host-silence fault.
+#[test]
+fn a_silent_host_faults_a_running_rig_by_default() {
+    let sim = Sim::start(&["--seconds", "30"]);
+    let send = |words: &[&str]| {
+        let mut args = vec!["send", sim.path.as_str()];
+        args.extend_from_slice(words);
+        let o = bowl(&args);
+        assert!(o.status.success(), "{words:?}: {o:?}");
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    send(&["speed", "1500", "1500"]);
+    send(&["start"]);
+    let running = send(&["status"]);
+    assert!(
+        !running.contains("state=Idle") && !running.contains("state=Faulted"),
+        "{running}"
+    );
+    std::thread::sleep(std::time::Duration::from_millis(4500));
+    let status = send(&["status"]);
+    assert!(
+        status.contains("state=Faulted") && status.contains("fault=HostSilent"),
+        "{status}"
+    );
 }

@@ -34,6 +34,10 @@ class Session:
         self.stopping = False
         self.error = None
         self.wall0 = time.monotonic()
+        # Like every host tool, the session PINGs once a second of emulated time while it
+        # waits, so the rig's link-loss timeout (LINK_TIMEOUT_MS) stays quiet.
+        self.heartbeat = True
+        self.last_ping_s = 0.0
         self.thread = threading.Thread(target=self._run, daemon=True)
         self.thread.start()
 
@@ -66,6 +70,9 @@ class Session:
                 raise self.error
             if not self.thread.is_alive():
                 raise RuntimeError("the machine thread stopped")
+            if self.heartbeat and self.now_s() - self.last_ping_s >= 1.0:
+                self.last_ping_s = self.now_s()
+                self.bowl("ping")
             time.sleep(0.01)
 
     def wait_emulated(self, seconds: float):

@@ -65,7 +65,8 @@ def test_every_command_and_its_refusals():
     try:
         s.wait_until_s(0.3)
         p = s.params()
-        check(len(p) == 19 and p["TEETH1"] == 12 and p["SPEED_MAX1_MRAD_S"] == 4000,
+        check(len(p) == 20 and p["TEETH1"] == 12 and p["SPEED_MAX1_MRAD_S"] == 4000
+              and p["LINK_TIMEOUT_MS"] == 3000,
               f"PARAMS: {p}")
         check(s.bowl("set", "TEETH1", "24").startswith("ok"), "SET TEETH1 24 refused")
         check(s.params()["TEETH1"] == 24, "PARAMS does not show TEETH1 24 after SET")
@@ -136,6 +137,30 @@ def fault_stops_the_bridge(name: str, inject):
         check(duty == (0.0, 0.0), f"PWM still active after the fault: {duty}")
         check(not moe, "TIM1 main output (MOE) still enabled after the fault")
         print(f"   fault {st.get('fault')} reported within {s.now_s() - t_fault:.2f} s")
+    finally:
+        s.close()
+
+
+def test_link_loss_stops_the_motors_by_default():
+    """A driving board that hears nothing (no command, no PING) for LINK_TIMEOUT_MS (3 s by
+    default) faults HostSilent and turns the bridge off."""
+    s = Session(fresh_flash("link loss"))
+    try:
+        s.wait_until_s(0.3)
+        check(s.bowl("speed", "1000", "2000").startswith("ok"), "SPEED refused")
+        check(s.bowl("start").startswith("ok"), "START refused")
+        s.heartbeat = False
+        t_silent = s.now_s()
+        s.wait_emulated(2.5)
+        duty = s.call(lambda m: (m.board.tim1.pwm_fraction(0), m.board.tim1.pwm_fraction(1)))
+        check(duty != (0.0, 0.0), f"stopped before the 3 s link-loss timeout: {duty}")
+        s.wait_emulated(1.0)
+        duty, moe = s.call(lambda m: ((m.board.tim1.pwm_fraction(0), m.board.tim1.pwm_fraction(1)),
+                                      bool(m.board.tim1.regs[BDTR] & MOE)))
+        check(duty == (0.0, 0.0), f"PWM still active {s.now_s() - t_silent:.2f} s into silence")
+        check(not moe, "TIM1 main output (MOE) still enabled after the link loss")
+        st = s.status()
+        check(st.get("state") == "Faulted" and st.get("fault") == "HostSilent", f"{st}")
     finally:
         s.close()
 

@@ -61,7 +61,15 @@ pub struct SimulatedRig {
 impl SimulatedRig {
     /// A commissioned nominal rig with the given granule truth.
     pub fn new(particle: ParticleParams, seed: u32) -> Result<Self> {
-        let backend = SimulatedBackend::new(seed)?;
+        let mut backend = SimulatedBackend::new(seed)?;
+        // The experiment drives the controller directly, with no link to lose: the rig's
+        // link-loss watchdog (LINK_TIMEOUT_MS) is off here.
+        model_core::wire::device::Backend::set_param(
+            backend.bound_mut(),
+            model_core::wire::ParamId::LinkTimeoutMs,
+            0,
+        )
+        .map_err(|r| anyhow!("cannot turn the link watchdog off: {}", r.token()))?;
         let angle = f64::from(backend.bound().controller().config().axes_angle_rad);
         Ok(Self {
             backend,

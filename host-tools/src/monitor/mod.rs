@@ -84,6 +84,11 @@ fn stdin_lines() -> mpsc::Receiver<String> {
 }
 
 /// Runs `bowl monitor`.
+/// Heartbeat period, well inside the rig's default link-loss timeout (3 s).
+const HEARTBEAT_EVERY: Duration = Duration::from_secs(1);
+/// The heartbeat's command id: other tools match answers by id and kind and never wait for it.
+const HEARTBEAT_ID: u16 = u16::MAX;
+
 pub fn run(args: &Args) -> Result<()> {
     // The UI needs a screen and a keyboard; without either it prints lines.
     let plain = args.plain || !std::io::stdout().is_terminal() || !std::io::stdin().is_terminal();
@@ -111,6 +116,7 @@ pub fn run(args: &Args) -> Result<()> {
     let mut tui = if plain { None } else { Some(Tui::start()?) };
     let typed = if plain { Some(stdin_lines()) } else { None };
     let mut last_open_try = Instant::now();
+    let mut last_heartbeat = Instant::now();
     let mut next_redraw = Instant::now();
     let mut next_plain = Instant::now() + Duration::from_secs(1);
     let mut buf = [0u8; 4096];
@@ -192,6 +198,14 @@ pub fn run(args: &Args) -> Result<()> {
         }
         let (resend, gave_up) = commands.due();
         outgoing.extend(resend);
+        // The rig's link-loss watchdog (LINK_TIMEOUT_MS) needs bytes from the PC: the monitor,
+        // the one program holding the port, keeps the link alive while it watches.
+        if port.is_some() && last_heartbeat.elapsed() >= HEARTBEAT_EVERY {
+            last_heartbeat = Instant::now();
+            if let Ok(line) = crate::send::command_line(HEARTBEAT_ID, &["PING".to_string()]) {
+                outgoing.push(line);
+            }
+        }
         for text in gave_up {
             view.event(plain, text);
         }

@@ -301,9 +301,10 @@ impl<I: Injector> Backend for ControllerBackend<I> {
                     .map_err(reason)?;
             }
             // Everything else rebuilds the controller: idle or faulted only.
-            ParamRole::AxesAngle | ParamRole::SplitRatio | ParamRole::Axis(..) => {
-                self.ctrl.set_parameters(cfg).map_err(reason)?
-            }
+            ParamRole::AxesAngle
+            | ParamRole::SplitRatio
+            | ParamRole::LinkTimeout
+            | ParamRole::Axis(..) => self.ctrl.set_parameters(cfg).map_err(reason)?,
         }
         self.scene = scene;
         self.params = next;

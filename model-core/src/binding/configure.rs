@@ -60,6 +60,8 @@ pub enum ParamRole {
     Axis(usize, AxisSetting),
     /// The telemetry rate: the protocol device's, never the controller's.
     TelemetryRate,
+    /// The host link silence timeout: rebuilds the controller (idle or faulted).
+    LinkTimeout,
 }
 
 impl ParamRole {
@@ -84,6 +86,7 @@ impl ParamRole {
             P::Teeth1 => ParamRole::Axis(0, S::PulsesPerRev),
             P::Teeth2 => ParamRole::Axis(1, S::PulsesPerRev),
             P::TelemetryHz => ParamRole::TelemetryRate,
+            P::LinkTimeoutMs => ParamRole::LinkTimeout,
         }
     }
 }
@@ -140,6 +143,7 @@ pub fn config_from_params(
             ParamRole::Scene | ParamRole::TelemetryRate => {}
             ParamRole::AxesAngle => cfg.axes_angle_rad = (value as f32 * 1e-3).to_radians(),
             ParamRole::SplitRatio => cfg.spin_per_precession = value as f32 * 1e-6,
+            ParamRole::LinkTimeout => cfg.host_timeout_s = value as f32 / 1000.0,
             ParamRole::Axis(axis, setting) => {
                 let a = cfg.axes.get_mut(axis).ok_or(Reason::Internal)?;
                 apply_axis(a, setting, value)?;
@@ -207,11 +211,15 @@ mod tests {
             i32::from(b.pulses_per_rev),
             micro(cfg.spin_per_precession),
             i32::from(DEFAULT_TELEMETRY_HZ),
+            // The rig's link-loss timeout is on (3 s) by default; the controller's own
+            // default is off so the closed-loop simulations need no heartbeat.
+            3_000,
         ];
         assert_eq!(default_params(), expected);
         let derived = config_from_params(&cfg, &default_params()).expect("defaults pass");
         assert_eq!(derived.axes[0].overspeed_rad_s, cfg.axes[0].overspeed_rad_s);
         assert_eq!(derived.axes[1].pulses_per_rev, cfg.axes[1].pulses_per_rev);
+        assert_eq!(derived.host_timeout_s, 3.0);
     }
 
     /// One scene mapping for f32 (the rig) and f64 (the host's re-check): the same scene to

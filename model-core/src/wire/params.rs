@@ -113,6 +113,9 @@ parameter_table! {
     RatioPpm: "RATIO_PPM", "ppm", range (1_000, 8_000_000), default 1_000_000;
     /// Telemetry rate, 0 = off (50 fills under half of 115 200 baud).
     TelemetryHz: "TELEM_HZ", "frames/s", range (0, 50), default 50;
+    /// Host link silence (no command, PING included) after which a driving rig faults and
+    /// stops both motors; 0 disables the check. Host tools PING every second.
+    LinkTimeoutMs: "LINK_TIMEOUT_MS", "ms", range (0, 3_600_000), default 3_000;
 }
 
 /// The values of all parameters, indexed by [`ParamId::index`].
