@@ -96,8 +96,9 @@ pub(crate) struct CommonArgs {
 pub(crate) struct StepArgs {
     #[command(flatten)]
     common: CommonArgs,
-    /// Pulses per revolution of both sensors.
-    #[arg(long, default_value_t = 12)]
+    /// Pulses per revolution of both sensors (at least 1: the controller measures speed from
+    /// the pulses).
+    #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u16).range(1..))]
     pulses_per_rev: u16,
     /// Step target, rad/s.
     #[arg(long, default_value_t = 3.0)]
@@ -196,6 +197,7 @@ pub(crate) fn run(what: &What) -> Result<()> {
                 ),
             };
             println!("{}", serde_json::to_string_pretty(&out)?);
+            check_step(&out.outcome)?;
         }
         What::Family(a) if a.rig_file.is_some() => {
             let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
@@ -250,6 +252,7 @@ pub(crate) fn run(what: &What) -> Result<()> {
                 ),
             };
             println!("{}", serde_json::to_string_pretty(&out)?);
+            check_step(&out.outcome)?;
         }
         What::Family(a) => {
             if a.plants < 50 && !a.allow_small {
@@ -284,6 +287,24 @@ pub(crate) fn run(what: &What) -> Result<()> {
             };
             trace(a.common.seed, a.plant, rig, a.target_rad_s)
         }
+    }
+    Ok(())
+}
+
+/// A step run that faulted or was never commissioned has no step figures: say so, fail.
+fn check_step(o: &StepOutcome) -> Result<()> {
+    if !o.commissioned {
+        bail!(
+            "commissioning did not finish (fault code {}): the figures above are not a step response",
+            o.fault_code
+        );
+    }
+    if o.fault_code != 0 {
+        bail!(
+            "the run faulted (fault code {}, see docs/protocol.md): the figures above are not a step \
+             response",
+            o.fault_code
+        );
     }
     Ok(())
 }
@@ -328,4 +349,35 @@ pub(crate) fn parallel<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync
             .flat_map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
             .collect()
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn outcome(fault_code: u8, commissioned: bool) -> StepOutcome {
+        let axis = AxisFigures {
+            rise_time_s: 0.5,
+            overshoot_pct: 0.0,
+            settling_time_s: 0.0,
+            steady_state_error_pct: 0.0,
+            rms_ripple_pct: 0.0,
+        };
+        StepOutcome {
+            axes: [axis; 2],
+            worst: axis,
+            fault_code,
+            commissioned,
+        }
+    }
+
+    /// A faulted or uncommissioned run is an error that says why, never a row of zeros.
+    #[test]
+    fn a_faulted_step_is_an_error() {
+        assert!(check_step(&outcome(0, true)).is_ok());
+        let e = check_step(&outcome(3, true)).unwrap_err().to_string();
+        assert!(e.contains("faulted (fault code 3"), "{e}");
+        let e = check_step(&outcome(6, false)).unwrap_err().to_string();
+        assert!(e.contains("commissioning did not finish"), "{e}");
+    }
 }
