@@ -5,8 +5,8 @@
 //! `k2` default to 9.81 and 5/7 when their columns are absent), any extra columns carried
 //! through unchanged. Output: the same rows plus `residence_time_s`,
 //! `exit_radial_velocity_m_s`, `exit_total_velocity_m_s` in shortest round-trip f64 form;
-//! `inf` (and `nan` velocities) when the particle never leaves, `0` (radial 0, total omega R)
-//! when it starts at the rim. A bad row is reported on stderr with its line number and left
+//! `inf` (and `nan` velocities) when the particle never leaves. A row that starts at or beyond
+//! the rim is refused, as the rig refuses it. A bad row is reported on stderr with its line number and left
 //! out; the others are written; the exit status is non-zero if any row failed.
 
 use anyhow::{Context, Result, anyhow, bail};
@@ -14,6 +14,7 @@ use model_core::particle::{self, Model, Outcome, Scene};
 
 mod ode;
 mod rolling;
+mod words;
 
 /// Which model(s) to evaluate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -133,7 +134,7 @@ pub fn predict(
     match method {
         MethodChoice::Closed => {
             let outcome =
-                particle::residence(scene, model).map_err(|e| anyhow!("invalid scene: {e:?}"))?;
+                particle::residence(scene, model).map_err(|e| anyhow!(words::scene(e)))?;
             Ok(Prediction {
                 outcome,
                 rhs_evaluations: 0,
@@ -166,6 +167,7 @@ pub fn run(args: &Args) -> Result<()> {
         ModelChoice::Both => &[Model::Flat, Model::Coriolis],
         ModelChoice::Rolling => return rolling::run(args, &args.rolling),
     };
+    words::check(&scene)?;
     if let Some(target) = args.target_time_s {
         return run_inverse(&scene, models, target, args.json);
     }
@@ -309,8 +311,13 @@ fn describe(model: Model, method: MethodChoice, p: &Prediction) -> String {
 fn run_inverse(scene: &Scene<f64>, models: &[Model], target: f64, json: bool) -> Result<()> {
     let mut out = Vec::new();
     for &model in models {
-        let w = particle::omega_for_residence_time(scene, model, target)
-            .map_err(|e| anyhow!("no bowl speed for T = {target} s ({model:?}): {e:?}"))?;
+        let w = particle::omega_for_residence_time(scene, model, target).map_err(|e| {
+            anyhow!(
+                "no bowl speed for T = {target} s ({} model): {}",
+                model_name(model),
+                words::inverse(e, target)
+            )
+        })?;
         out.push((model, w));
     }
     if json {
@@ -402,9 +409,7 @@ fn parse_row(row: &csv::StringRecord, cols: &Columns) -> Result<(Model, Scene<f6
         ri_m: field(cols.ri, "ri_m")?,
         rim_radius_m: field(cols.rim, "R_m")?,
     };
-    scene
-        .validate()
-        .map_err(|e| anyhow!("invalid scene: {e:?}"))?;
+    words::check(&scene)?;
     Ok((model, scene))
 }
 

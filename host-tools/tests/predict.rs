@@ -108,7 +108,15 @@ fn inverse_gives_a_speed_that_gives_the_target() {
 fn bad_scene_is_a_clear_error() {
     let out = bowl(&["predict", "--k2", "1.5"]);
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("InvalidK2"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(err.contains("--k2 must lie in (0, 1]"), "{err}");
+    assert!(!err.contains("InvalidK2"), "no Rust names: {err}");
+    // The rig refuses a start at or beyond the rim: so does predict (it answered T = 0).
+    let out = bowl(&["predict", "--ri-m", "0.2", "--rim-radius-m", "0.1"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--ri-m 0.2 m is not inside the rim"), "{err}");
 }
 
 #[test]
@@ -137,6 +145,10 @@ fn batch_writes_every_good_row_and_names_bad_lines() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("line 5") && err.contains("\"fast\""), "{err}");
     assert!(err.contains("line 6") && err.contains("sideways"), "{err}");
+    assert!(
+        err.contains("line 4") && err.contains("not inside the rim"),
+        "{err}"
+    );
 
     let mut rdr = csv::Reader::from_path(&output).unwrap();
     let header: Vec<String> = rdr.headers().unwrap().iter().map(String::from).collect();
@@ -150,7 +162,11 @@ fn batch_writes_every_good_row_and_names_bad_lines() {
         ]
     );
     let rows: Vec<csv::StringRecord> = rdr.records().map(|r| r.unwrap()).collect();
-    assert_eq!(rows.len(), 4, "rows a, b, c, f");
+    assert_eq!(
+        rows.len(),
+        3,
+        "rows a, b, f (c starts at the rim: refused, as the rig does)"
+    );
     // a: extra column carried through (with its comma), full-precision time.
     assert_eq!(&rows[0][0], "a, quoted");
     let t: f64 = rows[0][8].parse().unwrap();
@@ -162,11 +178,8 @@ fn batch_writes_every_good_row_and_names_bad_lines() {
         (&rows[1][8], &rows[1][9], &rows[1][10]),
         ("inf", "nan", "nan")
     );
-    // c: at the rim: T 0, radial 0, total omega R.
-    assert_eq!((&rows[2][8], &rows[2][9]), ("0", "0"));
-    assert_eq!(rows[2][10].parse::<f64>().unwrap(), 2.0 * 0.1);
     // f: Coriolis slower than flat at the same scene.
-    let tc: f64 = rows[3][8].parse().unwrap();
+    let tc: f64 = rows[2][8].parse().unwrap();
     assert!(tc > flat_time(3.0, 0.029, 0.05, 0.1));
     let _ = std::fs::remove_file(input);
     let _ = std::fs::remove_file(output);
@@ -248,7 +261,8 @@ fn a_step_beyond_stability_is_an_error_not_a_number() {
         "3",
     ]);
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("BeyondStabilityLimit"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("beyond the method's stability limit"), "{err}");
 }
 
 /// `--model rolling` on the tilted rig's reference scene (60 deg, R 150 mm, mu_r 0.029,

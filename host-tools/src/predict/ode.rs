@@ -33,9 +33,9 @@ pub fn predict(
         },
         MethodChoice::Closed => unreachable!("closed forms are handled by the caller"),
     };
-    let closed = particle::residence(scene, model).map_err(|e| anyhow!("invalid scene: {e:?}"))?;
-    let report = ode::integrate_constant(scene, model, m)
-        .map_err(|e| anyhow!("{method:?} failed: {e:?}"))?;
+    let closed = particle::residence(scene, model).map_err(|e| anyhow!(super::words::scene(e)))?;
+    let report =
+        ode::integrate_constant(scene, model, m).map_err(|e| anyhow!(super::words::ode(e)))?;
     let outcome = match report.outcome {
         OdeOutcome::Leaves {
             residence_time_s,
