@@ -7,7 +7,8 @@ use crate::Real;
 /// Newton iterations allowed; it needs 2 to 4.
 const MAX_NEWTON: u32 = 40;
 
-/// The root `u = l1 T` of `F(u) = x`, with `F` of [`Shape::eval`], and `F'` at the root.
+/// The root `u = l1 T` of `F(u) = x`, with `F` of [`Shape::eval`], and `expm1(-q u)` at the root
+/// (for the exit velocity's identity in [`residence`]).
 ///
 /// `F` is convex and increasing with `F'(0) = 0`, so Newton from 0 divides by zero; from any
 /// point above the root it decreases monotonically onto it, and from a point below it the first
@@ -32,13 +33,13 @@ pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneEr
     let mut u = acosh_1p_ratio(x, ac * (T::ONE + shape.q)).min(upper);
     let far = T::from_f64(4.0);
     for _ in 0..MAX_NEWTON {
-        let (f, fp, fpp) = shape.eval(u);
+        let (f, fp, fpp, eb) = shape.eval_with_decay(u);
         if !(f.is_finite() && fp.is_finite() && fpp.is_finite()) {
             return Err(SceneError::OutOfRange);
         }
         if fp <= T::ZERO {
             // Only at u = 0, i.e. x = 0 (R - ri underflowed against ri - a): T = 0.
-            return Ok((u, fp));
+            return Ok((u, eb));
         }
         if f < x {
             lower = u;
@@ -51,38 +52,61 @@ pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneEr
         }
         let d = (f - x) / fp;
         let next = (u - d).max(lower).min(upper);
-        // F' at the new point to first order, for the exit velocity.
-        let fp_next = fp - fpp * (u - next);
         let converged = fpp * d * d <= T::HALF * T::EPSILON * fp * next;
-        u = next;
         if converged {
-            return Ok((u, fp_next));
+            // expm1(-q next) to first order from expm1(-q u): the step is below sqrt(eps) u.
+            let eb_next = eb - (T::ONE + eb) * shape.q * (next - u);
+            return Ok((next, eb_next));
         }
+        u = next;
     }
     Err(SceneError::NoConvergence)
 }
 
-/// Coriolis model, `a < ri < R` (checked by the caller). `T = u / l1`, `l1 = k omega/(s + k mu)`;
-/// `r'(T) = (ri - a) l1 F'(u)` (paper Eq. 11: `(ri - a)(k omega/(2 s))(e^{l1 T} - e^{l2 T})`).
+/// The root of `F(u) = x` for `x > 1/eps` (and for an `x` that overflows, e.g. a subnormal
+/// `ri - a`): there `e^{-q u}` is below `eps` and `F(u) = A e^u + B e^{-q u} - (A + B)`
+/// (docs/model.md §4) gives `u = ln(x / A) + ln(1 + (A + B)/x)` to rounding, with
+/// `ln x = ln(R - ri) - ln(ri - a)` so that `x` itself is never formed. No iteration.
+fn large_u<T: Real>(shape: &Shape<T>, rise: T, den: T) -> T {
+    let sum = shape.a_coef + shape.b_coef;
+    (rise.ln() - den.ln()) - shape.a_coef.ln() + sum * (den / rise)
+}
+
+/// Coriolis model, `a < ri < R` (checked by the caller). `T = u / l1`, `l1 = k omega/(s + k mu)`.
+///
+/// Exit velocity `r'(T) = (ri - a) l1 F'(u)` (paper Eq. 11: `(ri - a)(k omega/(2 s))
+/// (e^{l1 T} - e^{l2 T})`) through the identity `F'(u) = x - (A + B) expm1(-q u)` (from
+/// `F = A e^u + B e^{-q u} - (A + B) = x` and `B q = A`): `F'` from `e^u` would carry `u`'s
+/// rounding times `u`; the identity depends on `u` only through a bounded term. Then
+/// `r'(T) = l1 ((R - ri) - (ri - a)(A + B) expm1(-q u))`, which never forms `x`.
 pub(crate) fn residence<T: Real>(scene: &Scene<T>, a: T) -> Result<Exit<T>, SceneError> {
     let shape = Shape::new(scene, Model::Coriolis)?;
     let (ri, rim) = (scene.ri_m, scene.rim_radius_m);
     let den = ri - a;
-    let x = (rim - ri) / den;
-    if !x.is_finite() {
-        return Err(SceneError::OutOfRange);
-    }
-    let (u, fp) = solve_u(&shape, x)?;
+    let rise = rim - ri;
+    let x = rise / den;
+    let (u, eb) = if x.is_finite() && x * T::EPSILON <= T::ONE {
+        solve_u(&shape, x)?
+    } else {
+        (large_u(&shape, rise, den), -T::ONE)
+    };
     let l1 = shape.c1 * scene.omega_rad_s;
+    // (ri - a) F'(u), finite even where x is not.
+    let den_fp = rise - den * (shape.a_coef + shape.b_coef) * eb;
     // kx = x / (u F'(u)); as x -> 0, F ~ A (1 + q) u^2 / 2, so the ratio tends to 1/2.
-    let kx = if u * fp > T::ZERO {
-        x / (u * fp)
+    let kx = if u * den_fp > T::ZERO {
+        rise / (u * den_fp)
     } else {
         T::HALF
     };
+    let time = u / l1;
+    let radial = l1 * den_fp;
+    if !(time.is_finite() && radial.is_finite()) {
+        return Err(SceneError::OutOfRange);
+    }
     Ok(Exit {
-        time: u / l1,
-        radial: den * l1 * fp,
+        time,
+        radial,
         condition: condition(kx, a, ri),
     })
 }

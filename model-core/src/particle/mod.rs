@@ -271,6 +271,13 @@ impl<T: Real> Shape<T> {
     /// `F'' = A (e^u + q e^{-q u})`.
     #[inline]
     pub(crate) fn eval(&self, u: T) -> (T, T, T) {
+        let (f, fp, fpp, _) = self.eval_with_decay(u);
+        (f, fp, fpp)
+    }
+
+    /// [`Self::eval`] and `expm1(-q u)`, which it computes on the way.
+    #[inline]
+    pub(crate) fn eval_with_decay(&self, u: T) -> (T, T, T, T) {
         let (pa, ea) = phi_expm1(u);
         let qu = self.q * u;
         let (pb, eb) = phi_expm1(-qu);
@@ -283,7 +290,7 @@ impl<T: Real> Shape<T> {
         let f = self.a_coef * pa + b_term;
         let fp = self.a_coef * (ea - eb);
         let fpp = self.a_coef * ((T::ONE + ea) + self.q * (T::ONE + eb));
-        (f, fp, fpp)
+        (f, fp, fpp, eb)
     }
 }
 

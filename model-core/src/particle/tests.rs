@@ -246,28 +246,71 @@ fn any_finite_f64() -> impl Strategy<Value = f64> {
     ]
 }
 
-fn check_outcome<T: Real>(o: Result<Outcome<T>, SceneError>) -> Result<(), TestCaseError> {
-    if let Ok(o) = o {
-        match o {
-            Outcome::Leaves {
-                residence_time_s: t,
-                exit_radial_velocity_m_s: v,
-                exit_total_velocity_m_s: vt,
-                condition_number: c,
-                ..
-            } => {
-                prop_assert!(t.is_finite() && t >= T::ZERO);
-                prop_assert!(v.is_finite() && v >= T::ZERO);
-                prop_assert!(vt.is_finite() && c.is_finite() && c >= T::ONE);
-            }
-            Outcome::AlreadyAtRim {
-                exit_total_velocity_m_s: v,
-            } => prop_assert!(v.is_finite()),
-            Outcome::NeverLeaves {
-                equilibrium_radius_m: a,
-                ..
-            } => prop_assert!(!a.is_nan()),
+/// Every answer is either a finite outcome or the one error the inputs call for: an invalid
+/// scene gives exactly the error its validation names, a valid one may only be out of range
+/// for the number type (never unconverged, never a silent skip).
+fn check_outcome<T: Real>(
+    valid: Result<(), SceneError>,
+    o: Result<Outcome<T>, SceneError>,
+) -> Result<(), TestCaseError> {
+    let o = match (valid, o) {
+        (Err(want), got) => {
+            prop_assert_eq!(got.err(), Some(want));
+            return Ok(());
         }
+        (Ok(()), Err(e)) => {
+            prop_assert_eq!(e, SceneError::OutOfRange, "a valid scene failed otherwise");
+            return Ok(());
+        }
+        (Ok(()), Ok(o)) => o,
+    };
+    match o {
+        Outcome::Leaves {
+            residence_time_s: t,
+            exit_radial_velocity_m_s: v,
+            exit_total_velocity_m_s: vt,
+            condition_number: c,
+            ..
+        } => {
+            prop_assert!(t.is_finite() && t >= T::ZERO);
+            prop_assert!(v.is_finite() && v >= T::ZERO);
+            prop_assert!(vt.is_finite() && c.is_finite() && c >= T::ONE);
+        }
+        Outcome::AlreadyAtRim {
+            exit_total_velocity_m_s: v,
+        } => prop_assert!(v.is_finite()),
+        Outcome::NeverLeaves {
+            equilibrium_radius_m: a,
+            ..
+        } => prop_assert!(!a.is_nan()),
+    }
+    Ok(())
+}
+
+/// `r(t)`, `r'(t)`: finite, or the scene's validation error, or an invalid time, or out of range.
+fn check_value<T: Real>(
+    valid: Result<(), SceneError>,
+    t: T,
+    r: Result<T, SceneError>,
+) -> Result<(), TestCaseError> {
+    match (valid, r) {
+        (Ok(()), Ok(v)) => prop_assert!(v.is_finite()),
+        (Err(want), Ok(v)) => prop_assert!(false, "invalid scene ({want:?}) answered {v:?}"),
+        (Err(want), Err(e)) => prop_assert!(e == want || e == SceneError::InvalidTime, "{e:?}"),
+        (Ok(()), Err(e)) if !(t.is_finite() && t >= T::ZERO) => {
+            prop_assert_eq!(e, SceneError::InvalidTime)
+        }
+        (Ok(()), Err(e)) => prop_assert_eq!(e, SceneError::OutOfRange),
+    }
+    Ok(())
+}
+
+/// The inverse answers a finite positive speed or an error that names a reason; an iteration
+/// that did not settle is a defect.
+fn check_inverse<T: Real>(r: Result<T, InverseError>) -> Result<(), TestCaseError> {
+    match r {
+        Ok(v) => prop_assert!(v.is_finite() && v > T::ZERO),
+        Err(e) => prop_assert_ne!(e, InverseError::NotConverged),
     }
     Ok(())
 }
@@ -282,16 +325,16 @@ proptest! {
         let s32 = Scene { omega_rad_s: w as f32, mu: mu as f32, g_m_s2: g as f32, k2: k2 as f32,
                           ri_m: ri as f32, rim_radius_m: rim as f32 };
         for model in [Model::Flat, Model::Coriolis] {
-            check_outcome(residence(&s, model))?;
-            check_outcome(residence(&s32, model))?;
-            for v in [position_m(&s, model, t), radial_velocity_m_s(&s, model, t)].into_iter().flatten() {
-                prop_assert!(v.is_finite());
+            check_outcome(s.validate(), residence(&s, model))?;
+            check_outcome(s32.validate(), residence(&s32, model))?;
+            for r in [position_m(&s, model, t), radial_velocity_m_s(&s, model, t)] {
+                check_value(s.validate(), t, r)?;
             }
-            for v in [position_m(&s32, model, t as f32), radial_velocity_m_s(&s32, model, t as f32)].into_iter().flatten() {
-                prop_assert!(v.is_finite());
+            for r in [position_m(&s32, model, t as f32), radial_velocity_m_s(&s32, model, t as f32)] {
+                check_value(s32.validate(), t as f32, r)?;
             }
-            if let Ok(v) = omega_for_residence_time(&s, model, t) { prop_assert!(v.is_finite() && v > 0.0); }
-            if let Ok(v) = omega_for_residence_time(&s32, model, t as f32) { prop_assert!(v.is_finite() && v > 0.0); }
+            check_inverse(omega_for_residence_time(&s, model, t))?;
+            check_inverse(omega_for_residence_time(&s32, model, t as f32))?;
         }
     }
 
@@ -405,5 +448,102 @@ fn inverse_refuses_targets_beyond_the_precision() {
         .unwrap()
         .residence_time_s();
         assert!((back - 5.0).abs() < 1e-9, "{model:?}: {back}");
+    }
+}
+
+/// A start radius (or `ri - a`) so small that `x = (R - ri)/(ri - a)` overflows: the Coriolis
+/// model must answer as the flat one does (it once returned OutOfRange). Reference: for such `x`,
+/// `e^{-q u}` vanishes and `F(u) = x` gives `u = ln(x / A)`, so at `mu -> 0` (`A = 1/2`)
+/// `T = ln(2 (R - ri)/(ri - a)) / (k omega)`, formed here with logarithms of the parts.
+#[test]
+fn coriolis_copes_with_subnormal_start_radius() {
+    let (omega, g, k2, rim) = (10.0f64, 9.81, 5.0 / 7.0, 0.1);
+    for (ri, mu) in [
+        (1e-310f64, 0.0),
+        (5e-324, 0.0),
+        (1e-310, 1e-320),
+        (1e-300, 1e-302),
+    ] {
+        let s = Scene {
+            omega_rad_s: omega,
+            mu,
+            g_m_s2: g,
+            k2,
+            ri_m: ri,
+            rim_radius_m: rim,
+        };
+        let a = mu * g / (omega * omega);
+        let t_ref = (2.0f64.ln() + (rim - ri).ln() - (ri - a).ln()) / (k2.sqrt() * omega);
+        for model in [Model::Flat, Model::Coriolis] {
+            let (t, v, _) = leaves(residence(&s, model).unwrap());
+            assert!(
+                (t - t_ref).abs() <= 4.0 * f64::EPSILON * t_ref,
+                "{model:?} ri {ri:e}: {t} vs {t_ref}"
+            );
+            let v_ref = k2.sqrt() * omega * rim;
+            assert!(
+                (v - v_ref).abs() <= 4.0 * f64::EPSILON * v_ref,
+                "{model:?} ri {ri:e}: v {v} vs {v_ref}"
+            );
+        }
+    }
+    for ri in [1e-40f32, 1e-45] {
+        let s = Scene {
+            omega_rad_s: 10.0f32,
+            mu: 0.0,
+            g_m_s2: 9.81,
+            k2: 5.0 / 7.0,
+            ri_m: ri,
+            rim_radius_m: 0.1,
+        };
+        let t_ref = ((2.0 * 0.1f64).ln() - f64::from(ri).ln()) / ((5.0f64 / 7.0).sqrt() * 10.0);
+        match residence(&s, Model::Coriolis).unwrap() {
+            Outcome::Leaves {
+                residence_time_s: t,
+                ..
+            } => {
+                let err = (f64::from(t) - t_ref).abs() / t_ref;
+                assert!(
+                    err <= 4.0 * f64::from(f32::EPSILON),
+                    "f32 ri {ri:e}: {t} vs {t_ref}"
+                );
+            }
+            o => panic!("f32 ri {ri:e}: {o:?}"),
+        }
+    }
+}
+
+/// The exit radial speed through `F'(u) = x - (A + B) expm1(-q u)` keeps full precision where
+/// `u` is large (it once lost about `u` ulps through `e^u`). Reference: for `u` near 25,
+/// `e^{-q u} < 1e-10`, so `r'(T) = l1 ((R - ri) + (ri - a)(A + B))` to far below an ulp, with `A`,
+/// `B`, `l1` written out from docs/model.md §3.
+#[test]
+fn coriolis_exit_speed_keeps_full_precision_far_from_the_rim() {
+    let (omega, g, k2, rim) = (40.0f64, 9.81, 5.0 / 7.0, 0.15);
+    for mu in [0.05f64, 0.4, 2.0, 8.0] {
+        let a = mu * g / (omega * omega);
+        for x in [1e8f64, 1e10, 1e12] {
+            // ri - a = (R - ri)/x  =>  ri = (R + a x)/(1 + x).
+            let ri = (rim + a * x) / (1.0 + x);
+            let s = Scene {
+                omega_rad_s: omega,
+                mu,
+                g_m_s2: g,
+                k2,
+                ri_m: ri,
+                rim_radius_m: rim,
+            };
+            let k = k2.sqrt();
+            let m = k * mu;
+            let sq = (1.0 + m * m).sqrt();
+            let (a_c, b_c) = ((1.0 + m / sq) / 2.0, (1.0 - m / sq) / 2.0);
+            let l1 = k * omega / (sq + m);
+            let v_ref = l1 * ((rim - ri) + (ri - a) * (a_c + b_c));
+            let (_, v, _) = leaves(residence(&s, Model::Coriolis).unwrap());
+            assert!(
+                (v - v_ref).abs() <= 4.0 * f64::EPSILON * v_ref,
+                "mu {mu} x {x:e}: {v} vs {v_ref}"
+            );
+        }
     }
 }
