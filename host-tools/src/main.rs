@@ -17,6 +17,7 @@ mod kinematics;
 mod link;
 mod monitor;
 mod predict;
+mod refusal;
 mod relay;
 mod replay;
 mod rig_file;

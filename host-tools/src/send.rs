@@ -9,6 +9,7 @@ use model_core::wire::{Frame, FrameError, PROTOCOL_VERSION, ParamId, Reason, dec
 
 use crate::exit_code;
 use crate::link::{Link, transact};
+use crate::refusal;
 
 /// Flags of `bowl send`.
 #[derive(clap::Args)]
@@ -109,13 +110,24 @@ pub fn run(args: &Args) -> Result<i32> {
                 reason.token(),
                 explain(reason)
             );
+            if let Some(why) = refusal::particulars(None, id, &args.command, reason, Duration::ZERO)
+            {
+                println!("  {why}");
+            }
             return Ok(exit_code::REFUSED);
         }
     };
     let mut link = Link::open(&args.port, args.baud)?;
-    match transact(&mut link, id, &line, Duration::from_millis(args.timeout_ms))? {
+    let timeout = Duration::from_millis(args.timeout_ms);
+    match transact(&mut link, id, &line, timeout)? {
         Some(frame) => {
             println!("{}", describe(&frame));
+            if let Frame::Reject { reason, .. } = frame
+                && let Some(why) =
+                    refusal::particulars(Some(&mut link), id, &args.command, reason, timeout)
+            {
+                println!("  {why}");
+            }
             Ok(if matches!(frame, Frame::Reject { .. }) {
                 exit_code::REFUSED
             } else {

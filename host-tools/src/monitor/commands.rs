@@ -1,11 +1,12 @@
 //! Commands typed into the monitor's own command line: sent on the port it holds, matched to
 //! their answers by id and kind, resent with the same id when the answer does not come.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use model_core::wire::{Command, Frame, decode_frame};
 
 use crate::link::{RESEND_EVERY, answers_kind};
+use crate::refusal::particulars;
 use crate::send::{command_line, describe, explain};
 
 /// How often a typed command is sent in all when no answer comes (1 s).
@@ -47,8 +48,13 @@ impl Commands {
         }
         let id = self.next_id;
         self.next_id = self.next_id.wrapping_add(1).max(1);
-        let line = command_line(id, &words)
-            .map_err(|r| format!("`{text}` not sent: {} - {}", r.token(), explain(r)))?;
+        let line = command_line(id, &words).map_err(|r| {
+            let mut why = format!("`{text}` not sent: {} - {}", r.token(), explain(r));
+            if let Some(more) = particulars(None, id, &words, r, Duration::ZERO) {
+                why.push_str(&format!(" ({more})"));
+            }
+            why
+        })?;
         let Ok(Frame::Command { command, .. }) = decode_frame(&line) else {
             return Err(format!("`{text}` not sent: not a command"));
         };
@@ -71,7 +77,15 @@ impl Commands {
             .iter()
             .position(|p| p.id == id && answers_kind(&p.command, frame))?;
         let p = self.pending.remove(i);
-        Some(format!("{} -> {}", p.words, describe(frame)))
+        let mut text = format!("{} -> {}", p.words, describe(frame));
+        // The particulars that need no question to the rig (its state is on the screen).
+        if let Frame::Reject { reason, .. } = frame {
+            let words: Vec<String> = p.words.split_whitespace().map(str::to_owned).collect();
+            if let Some(more) = particulars(None, id, &words, *reason, Duration::ZERO) {
+                text.push_str(&format!(" ({more})"));
+            }
+        }
+        Some(text)
     }
 
     /// Lines to send again (same id) and texts for commands that got no answer at all.

@@ -1,0 +1,95 @@
+//! A refusal says why in particulars: the value and its limit (`RANGE`), the state the rig is
+//! in (`STATE`), the residence times it can give (`INFEASIBLE`). Checked against the virtual rig
+//! itself: the ends of the range `bowl send` prints are accepted just inside and refused just
+//! outside by the rig.
+
+mod common;
+
+use common::{Sim, bowl, stdout};
+use model_core::binding::default_params;
+use model_core::wire::ParamId;
+
+fn send(port: &str, words: &str) -> (i32, String) {
+    let mut args = vec!["send", port, "--timeout-ms", "3000"];
+    args.extend(words.split_whitespace());
+    let out = bowl(&args);
+    (out.status.code().unwrap_or(-1), stdout(&out))
+}
+
+#[test]
+fn state_refusal_says_the_state_and_what_to_do() {
+    let sim = Sim::start(&[]);
+    let (code, text) = send(&sim.path, "clear");
+    assert_eq!(code, 1, "{text}");
+    assert!(text.contains("rejected"), "{text}");
+    assert!(
+        text.contains("the rig is idle: there is no fault to clear"),
+        "{text}"
+    );
+}
+
+#[test]
+fn speed_refusal_names_the_axis_and_its_limit() {
+    let sim = Sim::start(&[]);
+    let max2 = default_params()[ParamId::SpeedMax2MradS.index()];
+    let (code, text) = send(&sim.path, &format!("speed 1500 {}", max2 + 100));
+    assert_eq!(code, 1, "{text}");
+    let limit = format!(
+        "the spin speed {:.3} rad/s is above SPEED_MAX2_MRAD_S = {:.3} rad/s",
+        f64::from(max2 + 100) * 1e-3,
+        f64::from(max2) * 1e-3
+    );
+    assert!(text.contains(&limit), "{text}");
+}
+
+#[test]
+fn parameter_out_of_its_range_is_refused_locally_with_the_range() {
+    let (lo, hi) = ParamId::MuPpm.range();
+    let out = bowl(&[
+        "send",
+        "/dev/null-not-used",
+        "set",
+        "MU_PPM",
+        &(i64::from(hi) + 1).to_string(),
+    ]);
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    assert!(text.contains("rejected locally"), "{text}");
+    assert!(
+        text.contains(&format!("is outside its range {lo}..={hi}")),
+        "{text}"
+    );
+}
+
+/// The range printed is the rig's: 2 % inside either end is accepted, 2 % outside refused.
+#[test]
+fn infeasible_residence_time_gives_the_range_the_rig_accepts() {
+    let sim = Sim::start(&[]);
+    let (code, text) = send(&sim.path, "rtime cori 1");
+    assert_eq!(code, 1, "{text}");
+    assert!(text.contains("INFEASIBLE"), "{text}");
+    let range = text
+        .split("this rig can give ")
+        .nth(1)
+        .unwrap_or_else(|| panic!("no range in {text}"));
+    let seconds = |part: &str| -> f64 {
+        part.trim()
+            .split(" s")
+            .next()
+            .and_then(|t| t.parse().ok())
+            .unwrap_or_else(|| panic!("no time in {part:?} of {text}"))
+    };
+    let shortest_s = seconds(range);
+    let longest_s = seconds(range.split(" to ").nth(1).unwrap_or(""));
+    assert!(shortest_s < longest_s, "{text}");
+    let ms = |t: f64| ((t * 1000.0).round() as i64).to_string();
+    for (t, accepted) in [
+        (shortest_s * 1.02, true),
+        (shortest_s * 0.98, false),
+        (longest_s * 0.98, true),
+        (longest_s * 1.02, false),
+    ] {
+        let (code, text) = send(&sim.path, &format!("rtime cori {}", ms(t)));
+        assert_eq!(code, if accepted { 0 } else { 1 }, "{t} s: {text}");
+    }
+}
