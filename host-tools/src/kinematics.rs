@@ -1,7 +1,7 @@
 //! `bowl kinematics`: paper Eq. 2 both ways.
 
 use anyhow::{Result, anyhow};
-use model_core::bowl::{BowlGeometry, MotorSpeeds};
+use model_core::bowl::{BowlError, BowlGeometry, MotorSpeeds};
 
 /// Flags of `bowl kinematics`.
 #[derive(clap::Args)]
@@ -28,12 +28,21 @@ pub struct Args {
 
 /// Runs `bowl kinematics`.
 pub fn run(args: &Args) -> Result<()> {
-    let geometry = BowlGeometry::new(args.axes_angle_deg.to_radians())
-        .map_err(|e| anyhow!("invalid --axes-angle-deg {}: {e:?}", args.axes_angle_deg))?;
+    let geometry = BowlGeometry::new(args.axes_angle_deg.to_radians()).map_err(|e| {
+        anyhow!(
+            "invalid --axes-angle-deg {}: {}",
+            args.axes_angle_deg,
+            geometry_words(e)
+        )
+    })?;
     let speeds = match args.split_rad_s {
-        Some(omega) => geometry
-            .split(omega, args.ratio)
-            .map_err(|e| anyhow!("cannot split {omega} rad/s at ratio {}: {e:?}", args.ratio))?,
+        Some(omega) => geometry.split(omega, args.ratio).map_err(|e| {
+            anyhow!(
+                "cannot split {omega} rad/s at ratio {}: {}",
+                args.ratio,
+                geometry_words(e)
+            )
+        })?,
         None => MotorSpeeds {
             precession_rad_s: args.precession_rad_s,
             spin_rad_s: args.spin_rad_s,
@@ -41,7 +50,7 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let omega = geometry
         .combined_speed_rad_s(speeds)
-        .map_err(|e| anyhow!("invalid motor speeds: {e:?}"))?;
+        .map_err(|e| anyhow!("invalid motor speeds: {}", geometry_words(e)))?;
     if args.json {
         println!(
             "{}",
@@ -59,4 +68,16 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Paper Eq. 2's refusals in plain words.
+fn geometry_words(e: BowlError) -> &'static str {
+    match e {
+        BowlError::NonFiniteSpeed => "each motor speed must be a finite number (rad/s)",
+        BowlError::NegativeTargetSpeed => "the bowl speed to split must be 0 or more (rad/s)",
+        BowlError::InvalidRatio => "--ratio must be a finite number, 0 or more",
+        BowlError::InvalidAxesAngle => {
+            "the angle between the axes must lie in [0, 180) degrees (at 180 the axes oppose and              equal speeds cancel)"
+        }
+    }
 }

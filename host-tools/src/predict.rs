@@ -16,6 +16,9 @@ mod ode;
 mod rolling;
 mod words;
 
+pub use rolling::words as rolling_words;
+pub use words::scene as scene_words;
+
 /// Which model(s) to evaluate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum ModelChoice {

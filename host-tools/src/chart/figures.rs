@@ -29,9 +29,12 @@ fn scene_for(size_mm: f64, omega: f64) -> Scene<f64> {
     }
 }
 
-/// The model's errors are `no_std` enums without `std::error::Error`; name the variant.
+/// The model's refusal of a chart's scene, in the words `bowl predict` uses.
 pub fn scene_err(e: SceneError) -> anyhow::Error {
-    anyhow::anyhow!("model rejected the scene: {e:?}")
+    anyhow::anyhow!(
+        "model rejected the scene: {}",
+        crate::predict::scene_words(e)
+    )
 }
 
 fn model_name(m: Model) -> &'static str {

@@ -36,10 +36,10 @@ fn rig(omega: f64, tilt_deg: f64, size_mm: f64) -> RollingScene<f64> {
 }
 
 fn err(e: RollingError) -> anyhow::Error {
-    match e {
-        RollingError::Integration(i) => anyhow!("the integration gave up ({i:?})"),
-        other => anyhow!("the rolling model refused the scene: {other:?}"),
-    }
+    anyhow!(
+        "the rolling model gave no answer: {}",
+        crate::predict::rolling_words(e)
+    )
 }
 
 fn cell(v: Option<f64>) -> String {
@@ -143,7 +143,12 @@ pub fn trajectories() -> Result<(Figure, Table)> {
                 max_steps: 100_000,
             },
         )
-        .map_err(|e| anyhow!("integration failed: {e:?}"))?;
+        .map_err(|e| {
+            anyhow!(
+                "integration failed: {}",
+                crate::predict::rolling_words(RollingError::Integration(e))
+            )
+        })?;
         if let Ended::Event { t, y } = run.ended {
             path.push((y[0], y[1]));
             rows.push((t, y[0], y[1]));

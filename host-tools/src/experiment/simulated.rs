@@ -139,8 +139,10 @@ impl SimulatedRig {
         let ctrl = self.backend.bound_mut().controller_mut();
         if let Err(e) = ctrl.set_motor_speeds(targets[0] as f32, targets[1] as f32) {
             return Err(Release::MotorFault(format!(
-                "speeds {:.3}, {:.3} rad/s refused by the controller ({e:?})",
-                targets[0], targets[1]
+                "speeds {:.3}, {:.3} rad/s refused by the controller: {}",
+                targets[0],
+                targets[1],
+                crate::words::rejection(e)
             )));
         }
         if ctrl.state() == State::Idle {

@@ -3,6 +3,7 @@
 //! and max over the twelve azimuths 0, 30, ..., 330 degrees.
 
 use anyhow::{Result, bail};
+use model_core::ode::system::SystemError;
 use model_core::particle::rolling::hierarchy::{Wanted, tolerance_from_resistance_uncertainty};
 use model_core::particle::rolling::{
     self, AZIMUTHS_DEG, RollingError, RollingMethod, RollingOutcome, RollingScene,
@@ -52,7 +53,7 @@ pub struct RollingArgs {
     each_release: bool,
 }
 
-fn words(e: RollingError) -> String {
+pub fn words(e: RollingError) -> String {
     match e {
         RollingError::InvalidPrecession => "--precession-rad-s must be a finite number".into(),
         RollingError::InvalidSpin => "--spin-rad-s must be a finite number".into(),
@@ -73,10 +74,19 @@ fn words(e: RollingError) -> String {
                 .into()
         }
         RollingError::InvalidAzimuth => "--release-azimuth-deg must be a finite number".into(),
-        RollingError::Integration(e) => format!(
-            "the integration did not finish ({e:?}); try --method dp54 with a looser --tol, or a \
+        RollingError::Integration(SystemError::StepLimit) => {
+            "the integration took too many steps: try --method dp54 with a looser --tol, or a \
              larger --step-s"
-        ),
+                .into()
+        }
+        RollingError::Integration(SystemError::NotFinite) => {
+            "the integration diverged (a state became infinite): give a smaller --step-s or a \
+             tighter --tol"
+                .into()
+        }
+        RollingError::Integration(SystemError::InvalidStep) => {
+            "--step-s and --tol must be positive numbers".into()
+        }
     }
 }
 
