@@ -8,7 +8,7 @@
 //! stalled motor gets no drive (its duty never reaches the plant).
 
 use anyhow::{Result, anyhow};
-use model_core::binding::{ControllerBackend, Injector, default_params, persisted};
+use model_core::binding::{ControllerBackend, Injector, Record, default_params, persisted};
 use model_core::control::{ControllerConfig, State};
 use model_core::sim::PlantParams;
 use model_core::wire::{Hello, Injection, ParamId, Reason, ResetCause};
@@ -71,7 +71,11 @@ impl SimulatedBackend {
         let models = [base.axes[0].model, base.axes[1].model];
         let (rig, checked) = ControllerBackend::new(
             base,
-            persisted(&params, &models),
+            persisted(&Record {
+                params,
+                models,
+                identified: [false; 2],
+            }),
             hello,
             SimFaults(Injection::None),
         );

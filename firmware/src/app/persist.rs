@@ -173,7 +173,7 @@ mod tests {
         assert_eq!(p.step(&core), NOTHING, "saved once");
         let loaded = log.load::<PERSISTED_COUNT>().expect("the record loads");
         assert_eq!(loaded, record);
-        let (params, _) = split_persisted(&loaded);
+        let params = split_persisted(&loaded).params;
         assert_eq!(params[ParamId::Teeth2.index()], 60);
         assert_eq!(params[ParamId::Teeth1.index()], 12);
     }

@@ -240,8 +240,11 @@ async fn supervisor_task(
             }
             match report.saved {
                 Some(Ok(record)) => {
-                    let (_, models) = split_persisted(&record);
-                    info!("params: saved; motor models {} / {}", models[0], models[1]);
+                    let r = split_persisted(&record);
+                    info!(
+                        "params: saved; motor models {} / {}, identified {}",
+                        r.models[0], r.models[1], r.identified
+                    );
                 }
                 Some(Err(e)) => error!("params: save failed: {}", e),
                 None => {}

@@ -3,7 +3,7 @@
 //! and turns the controller's states, faults and refusals into the wire's codes.
 
 use super::configure::{AxisSetting, ParamRole, derive, with_models};
-use super::record::{Persisted, persisted, split_persisted};
+use super::record::{Persisted, Record, persisted, split_persisted};
 use super::{AXES, Injector, default_params};
 use crate::control::{
     BowlSpeedForResidence, Controller, ControllerConfig, Fault, InverseFailure, MotorModel,
@@ -109,6 +109,9 @@ pub struct ControllerBackend<I: Injector> {
     now_ms: u32,
     params_dirty: bool,
     saved_models: [MotorModel; AXES],
+    saved_identified: [bool; AXES],
+    /// Axes whose model in force came identified from the stored record.
+    stored_identified: [bool; AXES],
     injector: I,
 }
 
@@ -122,11 +125,12 @@ impl<I: Injector> ControllerBackend<I> {
         hello: Hello,
         injector: I,
     ) -> (Self, Result<(), Reason>) {
-        let (params, models) = split_persisted(&stored);
-        let stored_base = with_models(&base, &models);
-        let (base, params, outcome) = match derive(&stored_base, &params) {
-            Ok(_) => (stored_base, params, Ok(())),
-            Err(r) => (base, default_params(), Err(r)),
+        let record = split_persisted(&stored);
+        let stored_base = with_models(&base, &record.models);
+        let (base, params, stored_identified, outcome) = match derive(&stored_base, &record.params)
+        {
+            Ok(_) => (stored_base, record.params, record.identified, Ok(())),
+            Err(r) => (base, default_params(), [false; AXES], Err(r)),
         };
         let (cfg, scene) = match derive(&base, &params) {
             Ok(x) => x,
@@ -143,6 +147,8 @@ impl<I: Injector> ControllerBackend<I> {
             now_ms: 0,
             params_dirty: false,
             saved_models: [cfg.axes[0].model, cfg.axes[1].model],
+            saved_identified: stored_identified,
+            stored_identified,
             injector,
         };
         (rig, outcome)
@@ -151,6 +157,16 @@ impl<I: Injector> ControllerBackend<I> {
     fn models(&self) -> [MotorModel; AXES] {
         let a = &self.ctrl.config().axes;
         [a[0].model, a[1].model]
+    }
+
+    /// Per axis: the model in force was identified by commissioning, on this boot or on the
+    /// one that stored it.
+    pub fn identified(&self) -> [bool; AXES] {
+        let now = self.ctrl.identified();
+        [
+            now[0].is_some() || self.stored_identified[0],
+            now[1].is_some() || self.stored_identified[1],
+        ]
     }
 
     /// The controller (diagnostics).
@@ -183,7 +199,11 @@ impl<I: Injector> ControllerBackend<I> {
     pub fn to_persist(&self, telemetry_hz: u8) -> Persisted {
         let mut params = self.params;
         params[ParamId::TelemetryHz.index()] = i32::from(telemetry_hz);
-        persisted(&params, &self.models())
+        persisted(&Record {
+            params,
+            models: self.models(),
+            identified: self.identified(),
+        })
     }
 
     /// The parameters in force, wire units.
@@ -196,10 +216,15 @@ impl<I: Injector> ControllerBackend<I> {
     pub fn take_params_to_save(&mut self) -> bool {
         let idle = matches!(self.ctrl.state(), State::Idle | State::Fault);
         let models = self.models();
-        let due = idle && (self.params_dirty || models != self.saved_models);
+        let identified = self.identified();
+        let due = idle
+            && (self.params_dirty
+                || models != self.saved_models
+                || identified != self.saved_identified);
         if due {
             self.params_dirty = false;
             self.saved_models = models;
+            self.saved_identified = identified;
         }
         due
     }
@@ -329,7 +354,7 @@ impl<I: Injector> Backend for ControllerBackend<I> {
     }
 
     fn models(&self) -> Result<[AxisModel; AXES], Reason> {
-        let identified = self.ctrl.identified();
+        let identified = self.identified();
         let mut out = [AxisModel::default(); AXES];
         for (axis, slot) in out.iter_mut().enumerate() {
             let m = self.ctrl.config().axes[axis].model;
@@ -351,7 +376,7 @@ impl<I: Injector> Backend for ControllerBackend<I> {
                 *out = scaled as u32;
             }
             *slot = AxisModel {
-                identified: identified[axis].is_some(),
+                identified: identified[axis],
                 back_emf_uv_per_rad_s: v[0],
                 friction_ppm: v[1],
                 time_constant_us: v[2],

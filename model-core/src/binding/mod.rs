@@ -22,7 +22,9 @@ pub use backend::ControllerBackend;
 pub use configure::{
     OVERSPEED_PER_MAX, ParamRole, config_from_params, default_params, scene_from_params,
 };
-pub use record::{PERSISTED_COUNT, Persisted, default_persisted, persisted, split_persisted};
+pub use record::{
+    PERSISTED_COUNT, Persisted, Record, default_persisted, persisted, split_persisted,
+};
 
 use crate::wire::{Injection, Reason};
 

@@ -1,7 +1,9 @@
 //! The layout of the record persisted in flash: the wire parameters (wire order), then per axis
 //! the motor model in force (identified by commissioning, or nominal): back-EMF constant,
-//! friction duty, time constant, as f32 bit patterns. The flash format around it (slots,
-//! version, CRC) is the firmware's parameter log.
+//! friction duty, time constant, as f32 bit patterns; then one word whose bit `i` says that
+//! axis `i`'s model was identified by commissioning (so the flag survives a reset with the
+//! model it describes). The flash format around it (slots, version, CRC) is the firmware's
+//! parameter log.
 
 use super::AXES;
 use super::configure::default_params;
@@ -9,25 +11,43 @@ use crate::control::{ControllerConfig, MotorModel};
 use crate::wire::{PARAM_COUNT, ParamValues};
 
 /// Values in one persisted record.
-pub const PERSISTED_COUNT: usize = PARAM_COUNT + 3 * AXES;
+pub const PERSISTED_COUNT: usize = PARAM_COUNT + 3 * AXES + 1;
 /// One persisted record's values.
 pub type Persisted = [i32; PERSISTED_COUNT];
 
-/// Joins parameters and motor models into a record.
-pub fn persisted(params: &ParamValues, models: &[MotorModel; AXES]) -> Persisted {
+/// What a persisted record holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Record {
+    /// The wire parameters.
+    pub params: ParamValues,
+    /// The motor models in force, precession then spin.
+    pub models: [MotorModel; AXES],
+    /// Whether each model was identified by commissioning (on this board, at some boot).
+    pub identified: [bool; AXES],
+}
+
+const FLAGS_AT: usize = PARAM_COUNT + 3 * AXES;
+
+/// Joins parameters, motor models and their identified flags into a record.
+pub fn persisted(r: &Record) -> Persisted {
     let mut v = [0i32; PERSISTED_COUNT];
-    v[..PARAM_COUNT].copy_from_slice(params);
-    for (i, m) in models.iter().enumerate() {
+    v[..PARAM_COUNT].copy_from_slice(&r.params);
+    for (i, m) in r.models.iter().enumerate() {
         let at = PARAM_COUNT + 3 * i;
         v[at] = m.volts_per_rad_s.to_bits() as i32;
         v[at + 1] = m.friction_duty.to_bits() as i32;
         v[at + 2] = m.time_constant_s.to_bits() as i32;
     }
+    v[FLAGS_AT] = r
+        .identified
+        .iter()
+        .enumerate()
+        .fold(0, |acc, (i, &on)| acc | (i32::from(on) << i));
     v
 }
 
-/// Splits a record into parameters and motor models.
-pub fn split_persisted(v: &Persisted) -> (ParamValues, [MotorModel; AXES]) {
+/// Splits a record into parameters, motor models and their identified flags.
+pub fn split_persisted(v: &Persisted) -> Record {
     let mut params = [0i32; PARAM_COUNT];
     params.copy_from_slice(&v[..PARAM_COUNT]);
     let f = |k: usize| f32::from_bits(v[k] as u32);
@@ -39,13 +59,23 @@ pub fn split_persisted(v: &Persisted) -> (ParamValues, [MotorModel; AXES]) {
             time_constant_s: f(at + 2),
         }
     };
-    (params, [model(0), model(1)])
+    let flag = |i: usize| v[FLAGS_AT] & (1 << i) != 0;
+    Record {
+        params,
+        models: [model(0), model(1)],
+        identified: [flag(0), flag(1)],
+    }
 }
 
-/// The record a new board starts with: [`default_params`] and the nominal motor models.
+/// The record a new board starts with: [`default_params`], the nominal motor models, nothing
+/// identified.
 pub fn default_persisted() -> Persisted {
     let cfg = ControllerConfig::nominal();
-    persisted(&default_params(), &[cfg.axes[0].model, cfg.axes[1].model])
+    persisted(&Record {
+        params: default_params(),
+        models: [cfg.axes[0].model, cfg.axes[1].model],
+        identified: [false; AXES],
+    })
 }
 
 #[cfg(test)]
@@ -68,9 +98,21 @@ mod tests {
                 time_constant_s: 7.5,
             },
         ];
-        let (p, m) = split_persisted(&persisted(&params, &models));
-        assert_eq!(p, params);
-        for (a, b) in m.iter().zip(&models) {
+        for identified in [[false, false], [true, false], [false, true], [true, true]] {
+            let r = split_persisted(&persisted(&Record {
+                params,
+                models,
+                identified,
+            }));
+            assert_eq!(r.identified, identified);
+        }
+        let r = split_persisted(&persisted(&Record {
+            params,
+            models,
+            identified: [true, false],
+        }));
+        assert_eq!(r.params, params);
+        for (a, b) in r.models.iter().zip(&models) {
             assert_eq!(a.volts_per_rad_s.to_bits(), b.volts_per_rad_s.to_bits());
             assert_eq!(a.friction_duty.to_bits(), b.friction_duty.to_bits());
             assert_eq!(a.time_constant_s.to_bits(), b.time_constant_s.to_bits());

@@ -256,8 +256,8 @@ pub enum Command {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AxisModel {
-    /// Whether the model was identified by COMMISSION since the rig's last reset (otherwise it
-    /// is the stored or the nominal one).
+    /// Whether the model was identified by COMMISSION, on this boot or on the one that stored
+    /// it (the flag is persisted with the model); otherwise it is the nominal one.
     pub identified: bool,
     /// Effective back-EMF constant, microvolts per rad/s (0..=[`MODEL_FIELD_MAX`]).
     pub back_emf_uv_per_rad_s: u32,

@@ -52,9 +52,10 @@ fn command(s: &mut TestDevice, line: &str) -> Frame {
 fn defaults_round_trip_through_params_and_persisting() {
     let s = station();
     assert_eq!(s.params_to_persist(), default_persisted());
-    let (params, models) = split_persisted(&default_persisted());
-    assert_eq!(params, default_params());
-    assert_eq!(models[1], ControllerConfig::nominal().axes[1].model);
+    let r = split_persisted(&default_persisted());
+    assert_eq!(r.params, default_params());
+    assert_eq!(r.models[1], ControllerConfig::nominal().axes[1].model);
+    assert_eq!(r.identified, [false, false]);
 }
 
 #[test]
@@ -123,11 +124,17 @@ fn stored_motor_models_are_used_and_bad_ones_refused() {
         reset_cause: ResetCause::Software,
         reset_count: 2,
     };
-    let (params, mut models) = split_persisted(&default_persisted());
+    let Record {
+        params, mut models, ..
+    } = split_persisted(&default_persisted());
     models[0].time_constant_s = 0.11;
     let (rig, ok) = ControllerBackend::new(
         ControllerConfig::nominal(),
-        persisted(&params, &models),
+        persisted(&Record {
+            params,
+            models,
+            identified: [false; AXES],
+        }),
         hello,
         NoInjection,
     );
@@ -139,7 +146,11 @@ fn stored_motor_models_are_used_and_bad_ones_refused() {
     models[1].volts_per_rad_s = f32::NAN;
     let (rig, ok) = ControllerBackend::new(
         ControllerConfig::nominal(),
-        persisted(&params, &models),
+        persisted(&Record {
+            params,
+            models,
+            identified: [false; AXES],
+        }),
         hello,
         NoInjection,
     );
@@ -232,4 +243,49 @@ fn models_report_the_models_and_gains_in_force() {
         assert!((f64::from(a.kp_ppm_per_rad_s) - kp).abs() <= 1e-5 * kp + 1.0);
         assert!((f64::from(a.ki_ppm_per_rad) - ki).abs() <= 1e-5 * ki + 1.0);
     }
+}
+
+/// A model identified on an earlier boot is reported identified after a reset, and only on the
+/// axes whose stored flag says so; a record that fails its checks brings no flag with it.
+#[test]
+fn identified_flags_survive_a_reset_with_their_models() {
+    let boot = |identified: [bool; AXES], models: [MotorModel; AXES]| {
+        let (rig, ok) = ControllerBackend::new(
+            ControllerConfig::nominal(),
+            persisted(&Record {
+                params: default_params(),
+                models,
+                identified,
+            }),
+            Hello {
+                reset_cause: ResetCause::Pin,
+                reset_count: 1,
+            },
+            NoInjection,
+        );
+        let mut s = TestDevice {
+            device: Device::new(),
+            rig,
+        };
+        let Frame::Models { axes, .. } = command(&mut s, "C1,7,MODELS") else {
+            panic!("MODELS answers with a models frame");
+        };
+        (ok, axes, s)
+    };
+    let nominal = ControllerConfig::nominal();
+    let mut models = [nominal.axes[0].model, nominal.axes[1].model];
+    models[1].time_constant_s = 0.21;
+    let (ok, axes, s) = boot([false, true], models);
+    assert_eq!(ok, Ok(()));
+    assert_eq!([axes[0].identified, axes[1].identified], [false, true]);
+    assert_eq!(axes[1].time_constant_us, 210_000);
+    // Persisting again keeps the flags: the record round-trips.
+    assert_eq!(
+        split_persisted(&s.params_to_persist()).identified,
+        [false, true]
+    );
+    models[1].volts_per_rad_s = f32::NAN;
+    let (ok, axes, _) = boot([true, true], models);
+    assert_eq!(ok, Err(Reason::Range));
+    assert!(!axes[0].identified && !axes[1].identified);
 }
