@@ -1,45 +1,76 @@
 //! Residence time of the Coriolis model (paper Eq. 10, 11 with the corrected A, B of docs/model.md §3).
 
-use super::flat::acosh_1p_ratio;
+use super::flat::{acosh_1p_parts, acosh_1p_ratio};
 use super::{Exit, Model, Scene, SceneError, Shape, condition};
 use crate::Real;
 
-/// Newton iterations allowed; it needs 2 to 4.
+/// Iterations allowed; it needs 1 or 2 on the rig's scenes (2 or 3 in f64).
 const MAX_NEWTON: u32 = 40;
+
+/// Below this `m/s` the start that is first order in `m` is used; above it the
+/// curvature-matched one.
+const PERTURBATIVE_M: f64 = 0.25;
+
+/// The start of the iteration for `F(u) = x`.
+///
+/// With `m = k mu`, `F(u) = A e^u + B e^{-q u} - 1` (`A + B = 1`) expands to first order as
+/// `cosh u - 1 + m (sinh u - u e^{-u})`, so `u = u0 - m (1 - u0 e^{-u0} / sinh u0)` with
+/// `u0 = acosh(1 + x)` (the flat model's root, exact at `mu = 0`). `sinh u0 = sqrt(x (x + 2))`
+/// and `e^{-u0} = 1 / (1 + x + sinh u0)` come with `u0` at no further transcendental cost; the
+/// start is off by `O(m^2)`, so on the rig's scenes (`m` below 0.03) one Halley step lands within
+/// rounding. For larger `m` the flat root scaled to the same curvature at 0,
+/// `acosh(1 + x / (A (1 + q)))`, is the better start (docs/model.md §4).
+///
+/// Returns the start and an upper end for the bracket: the perturbative start is within
+/// rounding of the root, so the bracket starts open above (no square root spent on it); the
+/// other start comes with `sqrt(2 x / A)` (`F >= A u^2 / 2`, docs/model.md §4).
+fn start<T: Real>(shape: &Shape<T>, x: T) -> (T, T) {
+    // m / s, which is m to second order.
+    let m = T::TWO * shape.a_coef - T::ONE;
+    if m < T::from_f64(PERTURBATIVE_M) {
+        let (u0, w) = acosh_1p_parts(x, T::ONE);
+        let decay = if w > T::ZERO {
+            u0 / ((T::ONE + x + w) * w)
+        } else {
+            T::ONE
+        };
+        ((u0 - m * (T::ONE - decay)).max(T::ZERO), T::INFINITY)
+    } else {
+        let upper = (T::TWO * x / shape.a_coef).sqrt();
+        let u = acosh_1p_ratio(x, shape.a_coef * (T::ONE + shape.q)).min(upper);
+        (u, upper)
+    }
+}
 
 /// The root `u = l1 T` of `F(u) = x`, with `F` of [`Shape::eval`], and `expm1(-q u)` at the root
 /// (for the exit velocity's identity in [`residence`]).
 ///
-/// `F` is convex and increasing with `F'(0) = 0`, so Newton from 0 divides by zero; from any
-/// point above the root it decreases monotonically onto it, and from a point below it the first
-/// step lands above the root (the tangent of a convex function lies below it). We start at the
-/// flat model's closed form scaled to the same curvature at 0,
-/// `u0 = acosh(1 + x / (A (1 + q)))` (exact at `mu = 0`, within about `k mu` otherwise), inside
-/// the bracket `[0, sqrt(2 x / A)]` (`F >= A u^2 / 2`, docs/model.md §4). Every iterate is
-/// clamped to the bracket, which shrinks as Newton learns which side each point is on.
+/// `F` is convex and increasing with `F'(0) = 0`. Every iterate is clamped to a bracket of the
+/// root (from [`start`]), which shrinks as each evaluation tells on which side its point lies.
 ///
-/// Where `F` is a factor off `x` with `u > 1` (a large `k mu` with a start far from the rim:
-/// `u0` is then far from the root), `F` behaves like `A e^u` and a Newton step moves `u` by
-/// about one unit: there we step by `ln(x / F)` instead, which lands within a unit of the root
-/// (`F <= A e^u`, docs/model.md §4's `ln((1 + x)/A)` bound). Ordinary scenes never take it, so
-/// it costs no logarithm on the MCU where it is not needed.
-/// Stop test: after a step `d` the remaining error is about `F''/(2 F') d^2`; we stop when that
-/// is below a quarter of an ulp of `u`, which saves the customary extra iteration. An iteration
-/// that has not converged is an error, never a result.
+/// Each step is Halley's, `d / (1 - d F'' / (2 F'))` with the Newton step `d = (F - x) / F'`
+/// (the derivatives come with `F` from the same two exponentials). Its error is `C h^3` with
+/// `C = F''' / (6 F') - (F'' / (2 F'))^2`: we stop when that is below a quarter of an ulp of `u`.
+/// Far from the root (`d F'' / F'` not small) it takes Newton's step; where `F` is a factor off
+/// `x` with `u > 1`, `F` behaves like `A e^u` and we step by `ln(x / F)` (`F <= A e^u`,
+/// docs/model.md §4's `ln((1 + x) / A)` bound). An iteration that has not converged is an
+/// error, never a result.
 pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneError> {
-    let ac = shape.a_coef;
     let mut lower = T::ZERO;
-    let mut upper = (T::TWO * x / ac).sqrt();
-    let mut u = acosh_1p_ratio(x, ac * (T::ONE + shape.q)).min(upper);
+    let (mut u, mut upper) = start(shape, x);
     let far = T::from_f64(4.0);
+    let quarter_ulp = T::from_f64(0.25) * T::EPSILON;
     for _ in 0..MAX_NEWTON {
-        let (f, fp, fpp, eb) = shape.eval_with_decay(u);
-        if !(f.is_finite() && fp.is_finite() && fpp.is_finite()) {
+        let e = shape.eval_parts(u);
+        let (f, fp, fpp) = (e.f, e.fp, e.fpp);
+        // F and F' are below F'' + 1 (both exponentials enter F'' with positive weights), so
+        // a finite F'' vouches for all three.
+        if !fpp.is_finite() {
             return Err(SceneError::OutOfRange);
         }
         if fp <= T::ZERO {
             // Only at u = 0, i.e. x = 0 (R - ri underflowed against ri - a): T = 0.
-            return Ok((u, eb));
+            return Ok((u, e.decay_m1));
         }
         if f < x {
             lower = u;
@@ -51,12 +82,23 @@ pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneEr
             continue;
         }
         let d = (f - x) / fp;
-        let next = (u - d).max(lower).min(upper);
-        let converged = fpp * d * d <= T::HALF * T::EPSILON * fp * next;
+        let half_curv = fpp / (T::TWO * fp);
+        let bend = d * half_curv;
+        let halley = bend.abs() < T::HALF;
+        let step = if halley { d / (T::ONE - bend) } else { d };
+        let next = (u - step).max(lower).min(upper);
+        let converged = if halley {
+            let c = (e.fppp / (T::from_f64(6.0) * fp) - half_curv * half_curv).abs();
+            c * step * step * step.abs() <= quarter_ulp * next
+        } else {
+            fpp * d * d <= T::HALF * T::EPSILON * fp * next
+        };
         if converged {
-            // expm1(-q next) to first order from expm1(-q u): the step is below sqrt(eps) u.
-            let eb_next = eb - (T::ONE + eb) * shape.q * (next - u);
-            return Ok((next, eb_next));
+            // expm1(-q next) from expm1(-q u): e^{-q next} = e^{-q u} e^{-q (next - u)}, the
+            // last factor to third order (the step is below eps^(1/3) u).
+            let z = -shape.q * (next - u);
+            let em1 = z * (T::ONE + z * (T::HALF + z * T::from_f64(1.0 / 6.0)));
+            return Ok((next, e.decay_m1 + (T::ONE + e.decay_m1) * em1));
         }
         u = next;
     }
@@ -99,14 +141,10 @@ pub(crate) fn residence<T: Real>(scene: &Scene<T>, a: T) -> Result<Exit<T>, Scen
     } else {
         T::HALF
     };
-    let time = u / l1;
-    let radial = l1 * den_fp;
-    if !(time.is_finite() && radial.is_finite()) {
-        return Err(SceneError::OutOfRange);
-    }
+    // The caller checks that these are finite.
     Ok(Exit {
-        time,
-        radial,
+        time: u / l1,
+        radial: l1 * den_fp,
         condition: condition(kx, a, ri),
     })
 }

@@ -271,13 +271,14 @@ impl<T: Real> Shape<T> {
     /// `F'' = A (e^u + q e^{-q u})`.
     #[inline]
     pub(crate) fn eval(&self, u: T) -> (T, T, T) {
-        let (f, fp, fpp, _) = self.eval_with_decay(u);
-        (f, fp, fpp)
+        let e = self.eval_parts(u);
+        (e.f, e.fp, e.fpp)
     }
 
-    /// [`Self::eval`] and `expm1(-q u)`, which it computes on the way.
+    /// [`Self::eval`], `F''' = A (e^u - q^2 e^{-q u})` and `expm1(-q u)`, from the same two
+    /// exponentials.
     #[inline]
-    pub(crate) fn eval_with_decay(&self, u: T) -> (T, T, T, T) {
+    pub(crate) fn eval_parts(&self, u: T) -> ShapeAt<T> {
         let (pa, ea) = phi_expm1(u);
         let qu = self.q * u;
         let (pb, eb) = phi_expm1(-qu);
@@ -287,11 +288,25 @@ impl<T: Real> Shape<T> {
         } else {
             self.b_coef * eb + self.a_coef * u
         };
-        let f = self.a_coef * pa + b_term;
-        let fp = self.a_coef * (ea - eb);
-        let fpp = self.a_coef * ((T::ONE + ea) + self.q * (T::ONE + eb));
-        (f, fp, fpp, eb)
+        let grow = T::ONE + ea;
+        let decay = self.q * (T::ONE + eb);
+        ShapeAt {
+            f: self.a_coef * pa + b_term,
+            fp: self.a_coef * (ea - eb),
+            fpp: self.a_coef * (grow + decay),
+            fppp: self.a_coef * (grow - self.q * decay),
+            decay_m1: eb,
+        }
     }
+}
+
+/// `F` and its derivatives at one point, and `expm1(-q u)` (see [`Shape::eval_parts`]).
+pub(crate) struct ShapeAt<T> {
+    pub f: T,
+    pub fp: T,
+    pub fpp: T,
+    pub fppp: T,
+    pub decay_m1: T,
 }
 
 /// Residence time `T` and exit velocities (paper Eq. 7, 11, 12; docs/model.md §4, "Residence time T").
