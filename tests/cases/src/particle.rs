@@ -45,7 +45,7 @@ pub static BENCHES: &[Bench] = &[
         name: "particle::residence_coriolis_f32",
         inputs: GRID,
         run: bench_coriolis,
-        budget_instructions: Some(800),
+        budget_instructions: Some(600),
     },
     Bench {
         name: "particle::omega_for_residence_time_coriolis_f32",
