@@ -171,6 +171,94 @@ fn forty_commands_through_the_monitor_on_the_qemu_rig() {
     board.stop();
 }
 
+/// And on the QEMU rig with 1 % of the board's bytes damaged on their way to the PC (a relay
+/// between QEMU's pty and a fresh one, as a noisy cable would): still every answer right.
+#[test]
+fn forty_commands_through_the_monitor_on_the_qemu_rig_with_line_noise() {
+    use bowl_emulator::{image, qemu};
+    assert!(
+        qemu::installed(),
+        "qemu-system-arm is not installed (tests/lib/ensure-tools.sh installs it)"
+    );
+    let elf = image::build(image::RIG_IMAGE).expect("the qemu-rig image builds");
+    let board = qemu::PtyBoard::boot(&elf, qemu::Profile::RealTime, &["-append", "seconds=400"])
+        .expect("the emulated board boots");
+    let line = noisy_line(&board.port, 1.0, 7);
+    forty_commands(&line, false);
+    board.stop();
+}
+
+/// A pty whose other end is `port`, with `percent` % of the bytes from `port` damaged (each
+/// damaged byte changes: a non-zero XOR mask). Returns the new pty's path; the relay threads
+/// live until the process ends.
+fn noisy_line(port: &str, percent: f64, seed: u64) -> String {
+    use nix::sys::termios::{SetArg, cfmakeraw, tcgetattr, tcsetattr};
+    use std::io::{Read, Write};
+    use std::os::fd::AsFd;
+    let raw = |f: &std::fs::File| {
+        let mut t = tcgetattr(f.as_fd()).unwrap();
+        cfmakeraw(&mut t);
+        tcsetattr(f.as_fd(), SetArg::TCSANOW, &t).unwrap();
+    };
+    let open = |path: &str| {
+        std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(path)
+            .unwrap()
+    };
+    let board = open(port);
+    raw(&board);
+    let (master, path) = common::open_pty();
+    // Held open (raw) so the master never sees the line hang up between the monitor's opens.
+    let slave = open(&path);
+    raw(&slave);
+    let master = std::fs::File::from(master.as_fd().try_clone_to_owned().unwrap());
+    let (mut board_in, mut board_out) = (board.try_clone().unwrap(), board);
+    let (mut pc_in, mut pc_out) = (master.try_clone().unwrap(), master);
+    let threshold = (percent / 100.0 * u64::MAX as f64) as u64;
+    std::thread::spawn(move || {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64 ^ seed;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut buf = [0u8; 4096];
+        while let Ok(n) = board_in.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            for b in &mut buf[..n] {
+                if next() < threshold {
+                    *b ^= (next() % 255 + 1) as u8;
+                }
+            }
+            if pc_out.write_all(&buf[..n]).is_err() {
+                break;
+            }
+        }
+    });
+    std::thread::spawn(move || {
+        let _slave = slave;
+        let mut buf = [0u8; 4096];
+        loop {
+            match pc_in.read(&mut buf) {
+                Ok(0) => break,
+                Ok(n) => {
+                    if board_out.write_all(&buf[..n]).is_err() {
+                        break;
+                    }
+                }
+                // No reader on the pty side for a moment: try again.
+                Err(_) => std::thread::sleep(Duration::from_millis(10)),
+            }
+        }
+    });
+    path
+}
+
 #[test]
 fn monitor_refuses_a_path_that_is_no_port() {
     let dir = common::temp_dir("monitor-refuses");
