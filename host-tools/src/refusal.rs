@@ -209,7 +209,8 @@ fn bisect(mut inside: f64, mut outside: f64, accepts: &dyn Fn(f64) -> Option<[f3
 }
 
 fn ask(link: &mut Link, id: u16, word: &str, timeout: Duration) -> Option<Frame> {
-    let query_id = id.wrapping_add(1);
+    // Far from the refused command's id, so a script's next id is never this question's.
+    let query_id = id ^ 0x8000;
     let line = command_line(query_id, &[word.to_string()]).ok()?;
     transact(link, query_id, &line, timeout).ok().flatten()
 }

@@ -89,6 +89,32 @@ pub fn describe(frame: &Frame) -> String {
             }
             out
         }
+        Frame::Models { id, axes } => {
+            let mut out = format!("models (id {id}):");
+            for (name, a) in ["precession", "spin"].iter().zip(axes.iter()) {
+                out.push_str(&format!(
+                    " {name}: identified={} back_emf_uv_per_rad_s={} friction_ppm={} \
+                     time_constant_us={} kp_ppm_per_rad_s={} ki_ppm_per_rad={};",
+                    u8::from(a.identified),
+                    a.back_emf_uv_per_rad_s,
+                    a.friction_ppm,
+                    a.time_constant_us,
+                    a.kp_ppm_per_rad_s,
+                    a.ki_ppm_per_rad
+                ));
+            }
+            out.pop();
+            out
+        }
+        Frame::Event(e) => format!(
+            "gate event: {} gate at {} us (boot {})",
+            match e.kind {
+                model_core::wire::GateKind::Release => "release",
+                model_core::wire::GateKind::Exit => "exit",
+            },
+            e.time_us,
+            e.boot
+        ),
         other => format!("{other:?}"),
     }
 }

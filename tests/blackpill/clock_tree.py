@@ -14,8 +14,9 @@ _APB_DIV = {4: 2, 5: 4, 6: 8, 7: 16}
 class ClockTree:
     """Reads RCC_CR/PLLCFGR/CFGR on each query (they change during `embassy_stm32::init`)."""
 
-    def __init__(self, rcc):
+    def __init__(self, rcc, hse_hz: float = HSE_HZ):
         self.rcc = rcc
+        self.hse_hz = hse_hz
         self._key = None
         self._sysclk = HSI_HZ
 
@@ -32,9 +33,9 @@ class ClockTree:
         if sws == 0:
             return HSI_HZ
         if sws == 1:
-            return HSE_HZ
+            return self.hse_hz
         pll = self.rcc.instance.PLLCFGR
-        src = HSE_HZ if pll & (1 << 22) else HSI_HZ
+        src = self.hse_hz if pll & (1 << 22) else HSI_HZ
         m = pll & 0x3F
         n = (pll >> 6) & 0x1FF
         p = (((pll >> 16) & 3) + 1) * 2

@@ -19,7 +19,7 @@ from qiling.extensions.mcu.stm32f4 import stm32f411
 from unicorn import UC_HOOK_CODE, UcError
 from unicorn.arm_const import UC_ARM_REG_FPSCR, UC_ARM_REG_S0
 
-from clock_tree import ClockTree
+from clock_tree import HSE_HZ, ClockTree
 from dma import Dma
 from flash import BACKED_BASE, BACKED_SIZE, FlashInterface, FlashStore
 from iwdg import Iwdg
@@ -93,7 +93,7 @@ class Board:
         for label in ("rcc", "pwr", "gpioa", "gpiob", "gpioc", "syscfg", "exti", "dbgmcu"):
             ql.hw.create(label)
         self.rcc = ql.hw.rcc
-        self.clocks = ClockTree(self.rcc)
+        self.clocks = ClockTree(self.rcc, m.hse_hz)
         self.rcc.instance.CSR = (self.rcc.instance.CSR & 0x00FF_FFFF) | CSR_FLAGS[reset_kind]
         self.gpiob = ql.hw.gpiob
 
@@ -226,8 +226,10 @@ class Board:
 
 class Machine:
     def __init__(self, elf: str, flash_path: str, plant=None, link=None, defmt_print=None,
-                 log_dir=None, realtime=False):
+                 log_dir=None, realtime=False, hse_hz=HSE_HZ):
         self.elf = elf
+        # The crystal on the emulated board (the Black Pill's is 25 MHz).
+        self.hse_hz = hse_hz
         self.store = FlashStore(flash_path)
         self.plant = plant
         self.link = link

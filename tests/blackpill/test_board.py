@@ -7,6 +7,7 @@ Ends with `blackpill: N passed, M failed` and exits non-zero on a failure. Each 
 its reference: the plant's true speed, the timer's registers, the flash file, the wire."""
 
 import os
+import re
 import shutil
 import sys
 import tempfile
@@ -16,6 +17,8 @@ import traceback
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from flash import SECTOR_BASES, BACKED_BASE, SECTOR_SIZE  # noqa: E402
+# Bytes per parameter slot (firmware/src/app/params.rs: 4 header words, 48 values, the CRC).
+SLOT_BYTES = 16 + 4 * 48 + 4
 from session import LOGS, Session  # noqa: E402
 from timers import BDTR, MOE  # noqa: E402
 
@@ -70,7 +73,7 @@ def test_every_command_and_its_refusals():
               f"PARAMS: {p}")
         check(s.bowl("set", "TEETH1", "24").startswith("ok"), "SET TEETH1 24 refused")
         check(s.params()["TEETH1"] == 24, "PARAMS does not show TEETH1 24 after SET")
-        check("axes" in s.bowl("models"), "MODELS answer has no axes")
+        check("spin: identified=" in s.bowl("models"), "MODELS answer has no spin axis")
         check(s.bowl("ping").startswith("ok"), "PING not acknowledged")
         out = s.bowl("speed", "5000", "0")
         check("RANGE" in out, f"SPEED above SPEED_MAX1 (4000): {out}")
@@ -212,6 +215,121 @@ def test_parameters_survive_a_reset():
         st = s.status()
         check(st.get("reset_cause") == "Pin" and st.get("reset_count") == "1", f"status: {st}")
         check(s.params()["TEETH2"] == 24, "TEETH2 not restored from flash after the reset")
+    finally:
+        s.close()
+
+
+MODEL_FIELDS = ("back_emf_uv_per_rad_s", "friction_ppm", "time_constant_us")
+
+
+def models(s: Session) -> list:
+    """MODELS per axis: (identified, back-EMF, friction, time constant) from `bowl send`."""
+    out = s.bowl("models")
+    axes = re.findall(r"identified=([01]) back_emf_uv_per_rad_s=(\d+) "
+                      r"friction_ppm=(\d+) time_constant_us=(\d+)", out)
+    check(len(axes) == 2, f"MODELS answer: {out}")
+    return [(a[0] == "1", int(a[1]), int(a[2]), int(a[3])) for a in axes]
+
+
+def wait_for_state(s: Session, state: str, seconds: float) -> dict:
+    deadline = s.now_s() + seconds
+    st = s.status()
+    while st.get("state") != state and s.now_s() < deadline:
+        s.wait_emulated(0.5)
+        st = s.status()
+    return st
+
+
+def test_identified_models_survive_a_reset():
+    """COMMISSION identifies both motors of the plant; the models and their identified flags
+    are saved once the rig is idle and come back after a pin reset (reference: the MODELS
+    answer before the reset, and the nominal models the board starts with)."""
+    s = Session(fresh_flash("models"))
+    try:
+        s.wait_until_s(0.3)
+        before = models(s)
+        check(not before[0][0] and not before[1][0], f"identified before COMMISSION: {before}")
+        check(s.bowl("commission").startswith("ok"), "COMMISSION refused")
+        s.wait_emulated(1.0)
+        st = wait_for_state(s, "Idle", 60.0)
+        check(st.get("state") == "Idle" and st.get("fault") == "None",
+              f"commissioning did not end idle: {st}")
+        found = models(s)
+        check(found[0][0] and found[1][0], f"not identified after COMMISSION: {found}")
+        check([a[1:] for a in found] != [a[1:] for a in before],
+              f"COMMISSION left the nominal models: {found}")
+        # Saved at the next persistence tick (rate limit 2 s, an erase first may take 1 s).
+        s.wait_emulated(3.5)
+        s.call(lambda m: m.reset("pin"))
+        s.wait_emulated(0.3)
+        st = s.status()
+        check(st.get("reset_cause") == "Pin", f"status after the reset: {st}")
+        after = models(s)
+        check(after == found, f"models after the reset {after}, before {found}")
+    finally:
+        s.close()
+
+
+def saves_in(log: list) -> int:
+    """Saves among flash steps: the distinct parameter slots programmed."""
+    slots = set()
+    for step in log:
+        if step.startswith("program "):
+            offset = int(step.split()[1], 16)
+            for sector, base in SECTOR_BASES.items():
+                start = base - BACKED_BASE
+                if start <= offset < start + SECTOR_SIZE:
+                    slots.add((sector, (offset - start) // SLOT_BYTES))
+    return len(slots)
+
+
+def test_saves_are_rate_limited():
+    """Ten parameter changes, one every 0.3 s: without a limit the persistence loop (every
+    0.5 s) would save about six times; with the 2 s limit at most three saves happen, and the
+    last value is the one stored (it survives a reset)."""
+    s = Session(fresh_flash("rate limit"))
+    try:
+        s.wait_until_s(0.3)
+        t0 = s.now_s()
+        for i, teeth in enumerate(range(13, 23)):
+            s.wait_until_s(t0 + 0.3 * i)
+            check(s.bowl("set", "TEETH2", str(teeth)).startswith("ok"), f"SET TEETH2 {teeth}")
+        span = s.now_s() - t0
+        s.wait_emulated(3.0)
+        n = s.call(lambda m: saves_in(m.store.log))
+        print(f"   {n} saves for 10 changes over {span:.1f} s")
+        check(1 <= n <= 3 and n <= span / 2.0 + 2, f"{n} saves in {span:.1f} s of changes")
+        s.call(lambda m: m.reset("pin"))
+        s.wait_emulated(0.3)
+        check(s.params()["TEETH2"] == 22, "the last change was not the one stored")
+    finally:
+        s.close()
+
+
+def test_a_clock_tree_that_does_not_fit_the_board_is_caught():
+    """The clocks come from the RCC registers the image writes and from the board's crystal,
+    never hard-wired: on a board with an 8 MHz crystal the image's PLL setting (made for the
+    Black Pill's 25 MHz) gives 32 MHz instead of 100 MHz, USART2 runs at 36,864 baud instead of
+    115,200, and the PC's adapter reads garbage: no answer, as on a real misclocked board."""
+    s = Session(fresh_flash("wrong crystal"), hse_hz=8_000_000)
+    try:
+        s.wait_until_s(0.3)
+        sysclk, baud = s.call(lambda m: (m.board.clocks.sysclk_hz(), m.board.usart2.baud()))
+        check(abs(sysclk - 32e6) < 1e3, f"SYSCLK {sysclk / 1e6:.3f} MHz, expected 32")
+        check(abs(baud / 115_200 - 0.32) < 0.01, f"USART2 at {baud:.0f} baud")
+        out = s.bowl("status")
+        check(out.startswith("timeout"), f"a misclocked board answered: {out}")
+        errors = s.call(lambda m: m.board.usart2.baud_errors)
+        check(errors > 0, "no byte was garbled")
+    finally:
+        s.close()
+    s = Session(fresh_flash("right crystal"))
+    try:
+        s.wait_until_s(0.3)
+        sysclk, baud = s.call(lambda m: (m.board.clocks.sysclk_hz(), m.board.usart2.baud()))
+        check(abs(sysclk - 100e6) < 1e3, f"SYSCLK {sysclk / 1e6:.3f} MHz on the 25 MHz board")
+        check(abs(baud / 115_200 - 1) < 0.01, f"USART2 at {baud:.0f} baud")
+        check(s.bowl("status").startswith("status"), "the right board does not answer")
     finally:
         s.close()
 
