@@ -92,19 +92,30 @@ pub fn omega_for_residence_time<T: Real>(
         return Err(InverseError::OutOfRange);
     }
     let tol = T::from_f64(4.0) * T::EPSILON;
-    let settle = |omega: T| {
-        // Forward would find ri within rounding of a, or F overflows at the target time (a
-        // target so long that only a speed within rounding of the threshold gives it): T is
-        // not determined by this omega.
+    // Forward would find ri within rounding of a (a target so long that only a speed within
+    // rounding of the threshold gives it): T is not determined by this omega.
+    let determined = |omega: T| {
         let a = mu_g / omega / omega;
-        let (f, _, _) = shape.eval(l * omega);
-        if a >= ri * (T::ONE - T::from_f64(8.0) * T::EPSILON) || !f.is_finite() {
+        if a >= ri * (T::ONE - T::from_f64(8.0) * T::EPSILON) {
             Err(InverseError::BeyondPrecision)
         } else {
             Ok(omega)
         }
     };
+    // The same, and F must not overflow at the target time (checked where no evaluation near
+    // this omega has shown it finite).
+    let settle = |omega: T| {
+        let (f, _, _) = shape.eval(l * omega);
+        if f.is_finite() {
+            determined(omega)
+        } else {
+            Err(InverseError::BeyondPrecision)
+        }
+    };
     let mut omega = lo;
+    // The previous Newton step: in the quadratic regime the next error is about
+    // `d^2 |d| / d_prev^2`, which lets the iteration stop one evaluation early.
+    let mut d_prev: Option<T> = None;
     for _ in 0..MAX_ITERATIONS {
         let a = mu_g / omega / omega;
         let z = l * omega;
@@ -137,10 +148,22 @@ pub fn omega_for_residence_time<T: Real>(
             None
         };
         match step {
+            // F was finite at omega, and the last step moves it by far less than it could grow.
             Some(d) if d.abs() <= tol * omega => {
-                return settle((omega - d).max(lo).min(hi));
+                return determined((omega - d).max(lo).min(hi));
             }
-            Some(d) if omega - d > lo && omega - d < hi => omega -= d,
+            Some(d) if omega - d > lo && omega - d < hi => {
+                let next = omega - d;
+                if let Some(p) = d_prev
+                    && d.abs() < T::from_f64(1e-2) * omega
+                    && d.abs() <= T::HALF * p.abs()
+                    && d * d * d.abs() <= T::from_f64(0.25) * tol * omega * p * p
+                {
+                    return determined(next);
+                }
+                d_prev = Some(d);
+                omega = next;
+            }
             _ => {
                 if hi - lo <= tol * hi {
                     return settle(hi);

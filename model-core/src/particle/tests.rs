@@ -203,7 +203,7 @@ fn inverse_round_trips() {
             .unwrap();
             let (t, _, c) = leaves(back);
             assert!(
-                (t - target).abs() < 1e-12 * c * target,
+                (t - target).abs() <= 4.0 * f64::EPSILON * c * target,
                 "{model:?} {mu} {ri}: {t} vs {target}"
             );
         }
@@ -353,7 +353,7 @@ proptest! {
             };
             let back = residence(&Scene { omega_rad_s: w, ..s }, model).unwrap();
             let (t, c) = match back { Outcome::Leaves { residence_time_s, condition_number, .. } => (residence_time_s, condition_number), o => panic!("{o:?}") };
-            prop_assert!((t - target).abs() < 1e-12 * c * target, "{:?}: {} vs {}", model, t, target);
+            prop_assert!((t - target).abs() <= 4.0 * f64::EPSILON * c * target, "{:?}: {} vs {}", model, t, target);
         }
     }
 }
@@ -361,7 +361,7 @@ proptest! {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(2000))]
     /// f32 inverse: the speed it returns, put through the f64 forward model with the same f32
-    /// inputs, gives the target within 2e-6 x condition (or it says BeyondPrecision, only where
+    /// inputs, gives the target within 4 f32 epsilons x condition (measured worst 2.8 over 20,000 random scenes) (or it says BeyondPrecision, only where
     /// the needed start lies within f32 rounding of the threshold).
     #[test]
     fn f32_inverse_round_trips_through_f64(mu in 0.0f32..0.3, ri_frac in 0.01f32..0.999,
@@ -379,7 +379,7 @@ proptest! {
             };
             let back = residence(&Scene { omega_rad_s: w as f64, ..wide }, model).unwrap();
             let (t, c) = match back { Outcome::Leaves { residence_time_s, condition_number, .. } => (residence_time_s, condition_number), o => panic!("{o:?}") };
-            prop_assert!((t - target as f64).abs() < 2e-6 * c * target as f64, "{:?}: {} vs {} (cond {})", model, t, target, c);
+            prop_assert!((t - target as f64).abs() <= 4.0 * f64::from(f32::EPSILON) * c * target as f64, "{:?}: {} vs {} (cond {})", model, t, target, c);
         }
     }
 }

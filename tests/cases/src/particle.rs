@@ -51,13 +51,13 @@ pub static BENCHES: &[Bench] = &[
         name: "particle::omega_for_residence_time_coriolis_f32",
         inputs: GRID,
         run: bench_inverse,
-        budget_instructions: Some(3000),
+        budget_instructions: Some(1500),
     },
     Bench {
         name: "particle::omega_for_residence_time_flat_f32",
         inputs: GRID,
         run: bench_inverse_flat,
-        budget_instructions: Some(3000),
+        budget_instructions: Some(1500),
     },
     // The same paths with micromath's functions (for the chart; no budget).
     Bench {
