@@ -35,8 +35,7 @@ def load_library(path: str):
                                 ctypes.c_uint32]
     lib.plant_speed_rad_s.argtypes = [ctypes.c_void_p, ctypes.c_uint32]
     lib.plant_speed_rad_s.restype = ctypes.c_float
-    lib.plant_block_shaft.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.c_float]
-    lib.plant_kill_sensor.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.c_float]
+    lib.plant_inject.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_float]
     return lib
 
 
@@ -84,11 +83,19 @@ class RigPlant:
     def speed_rad_s(self, axis: int) -> float:
         return self.lib.plant_speed_rad_s(self.handle, axis)
 
+    def _inject(self, axis: int, kind: int, from_s: float):
+        if self.lib.plant_inject(self.handle, axis, kind, from_s) != 0:
+            raise RuntimeError(f"plant_inject({axis}, {kind}) refused")
+
     def block_shaft(self, axis: int, from_s: float):
-        self.lib.plant_block_shaft(self.handle, axis, from_s)
+        self._inject(axis, 0, from_s)
 
     def kill_sensor(self, axis: int, from_s: float):
-        self.lib.plant_kill_sensor(self.handle, axis, from_s)
+        self._inject(axis, 1, from_s)
+
+    def stick_bridge(self, axis: int, from_s: float):
+        """The bridge stuck on: any nonzero duty drives at full duty (a shorted driver input)."""
+        self._inject(axis, 2, from_s)
 
     def next_event_ns(self):
         t = self.time_ns

@@ -118,7 +118,7 @@ def test_closed_loop_step_reaches_the_setpoints():
         s.close()
 
 
-def fault_stops_the_bridge(name: str, inject):
+def fault_stops_the_bridge(name: str, inject, expected: str):
     s = Session(fresh_flash(name))
     try:
         s.wait_until_s(0.3)
@@ -134,6 +134,7 @@ def fault_stops_the_bridge(name: str, inject):
             if st.get("fault", "None") != "None":
                 break
         check(st.get("fault", "None") != "None", f"no fault within 4 s of the {name}: {st}")
+        check(st.get("fault") == expected, f"the {name} faulted {st.get('fault')}, not {expected}")
         s.wait_emulated(0.01)
         duty, moe = s.call(lambda m: ((m.board.tim1.pwm_fraction(0), m.board.tim1.pwm_fraction(1)),
                                       bool(m.board.tim1.regs[BDTR] & MOE)))
@@ -169,11 +170,18 @@ def test_link_loss_stops_the_motors_by_default():
 
 
 def test_blocked_shaft_faults_and_the_bridge_goes_off():
-    fault_stops_the_bridge("blocked spin shaft", lambda plant, t: plant.block_shaft(1, t))
+    fault_stops_the_bridge("blocked spin shaft", lambda plant, t: plant.block_shaft(1, t),
+                           "SensorLostOrStallSpin")
 
 
 def test_dead_sensor_faults_and_the_bridge_goes_off():
-    fault_stops_the_bridge("dead spin sensor", lambda plant, t: plant.kill_sensor(1, t))
+    fault_stops_the_bridge("dead spin sensor", lambda plant, t: plant.kill_sensor(1, t),
+                           "SensorLostOrStallSpin")
+
+
+def test_stuck_bridge_faults_overspeed_and_the_bridge_goes_off():
+    fault_stops_the_bridge("stuck spin bridge", lambda plant, t: plant.stick_bridge(1, t),
+                           "OverspeedSpin")
 
 
 def test_no_flash_operation_while_a_motor_is_driven():

@@ -169,36 +169,29 @@ pub unsafe extern "C" fn plant_speed_rad_s(plant: *const Plant, axis: u32) -> f3
     }
 }
 
-/// Blocks the shaft of `axis` from plant time `from_s` on (an injected stall). Returns 0 or -1.
+/// Injects a fault into `axis` from plant time `from_s` on: `kind` 0 blocks the shaft (a stall),
+/// 1 silences the sensor, 2 sticks the bridge on (any nonzero duty drives at full duty). Returns
+/// 0, or -1 for a null plant, an axis other than 0 or 1, or an unknown kind.
 ///
 /// # Safety
 /// `plant` is null or came from [`plant_new`].
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn plant_block_shaft(plant: *mut Plant, axis: u32, from_s: f32) -> i32 {
+pub unsafe extern "C" fn plant_inject(plant: *mut Plant, axis: u32, kind: u32, from_s: f32) -> i32 {
     // SAFETY: the caller passes null or a live plant.
-    match unsafe { plant.as_mut() } {
-        Some(p) if axis <= 1 => {
-            p.params_mut().axes[axis as usize].faults.blocked_from_s = from_s;
-            0
-        }
-        _ => -1,
+    let Some(p) = (unsafe { plant.as_mut() }) else {
+        return -1;
+    };
+    if axis > 1 {
+        return -1;
     }
-}
-
-/// Silences the sensor of `axis` from plant time `from_s` on. Returns 0 or -1.
-///
-/// # Safety
-/// `plant` is null or came from [`plant_new`].
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn plant_kill_sensor(plant: *mut Plant, axis: u32, from_s: f32) -> i32 {
-    // SAFETY: the caller passes null or a live plant.
-    match unsafe { plant.as_mut() } {
-        Some(p) if axis <= 1 => {
-            p.params_mut().axes[axis as usize].faults.dead_sensor_from_s = from_s;
-            0
-        }
-        _ => -1,
+    let faults = &mut p.params_mut().axes[axis as usize].faults;
+    match kind {
+        0 => faults.blocked_from_s = from_s,
+        1 => faults.dead_sensor_from_s = from_s,
+        2 => faults.bridge_stuck_from_s = from_s,
+        _ => return -1,
     }
+    0
 }
 
 #[cfg(test)]
