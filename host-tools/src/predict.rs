@@ -1,17 +1,12 @@
 //! `bowl predict`: residence time and exit velocities of a particle (paper Eq. 5 to 12, corrected
 //! per docs/model.md), for one scene from flags or for every row of a CSV file.
 //!
-//! Batch format: a header row naming at least `model,w_rad_s,mu,ri_m,R_m` (any order; `g` and
-//! `k2` default to 9.81 and 5/7 when their columns are absent), any extra columns carried
-//! through unchanged. Output: the same rows plus `residence_time_s`,
-//! `exit_radial_velocity_m_s`, `exit_total_velocity_m_s` in shortest round-trip f64 form;
-//! `inf` (and `nan` velocities) when the particle never leaves. A row that starts at or beyond
-//! the rim is refused, as the rig refuses it. A bad row is reported on stderr with its line number and left
-//! out; the others are written; the exit status is non-zero if any row failed.
+//! The batch format and its all-or-nothing output: [`batch`].
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Result, anyhow};
 use model_core::particle::{self, Model, Outcome, Scene};
 
+mod batch;
 mod ode;
 mod rolling;
 mod words;
@@ -154,7 +149,7 @@ pub fn run(args: &Args) -> Result<()> {
         return rolling::run(args, &args.rolling);
     }
     if let (Some(input), Some(output)) = (&args.batch, &args.out) {
-        return run_batch(input, output, args);
+        return batch::run(input, output, args);
     }
     let scene = Scene {
         omega_rad_s: args.omega_rad_s,
@@ -339,147 +334,6 @@ fn run_inverse(scene: &Scene<f64>, models: &[Model], target: f64, json: bool) ->
                 model_name(m)
             );
         }
-    }
-    Ok(())
-}
-
-/// Formats an f64 for the batch output: shortest round-trip digits, `inf`, `nan`.
-pub fn format_f64(x: f64) -> String {
-    if x.is_nan() {
-        "nan".into()
-    } else if x.is_infinite() {
-        if x > 0.0 { "inf".into() } else { "-inf".into() }
-    } else {
-        format!("{x}")
-    }
-}
-
-/// The columns a batch file must (or may) have.
-struct Columns {
-    model: usize,
-    omega: usize,
-    mu: usize,
-    ri: usize,
-    rim: usize,
-    g: Option<usize>,
-    k2: Option<usize>,
-}
-
-impl Columns {
-    fn find(header: &csv::StringRecord) -> Result<Self> {
-        let pos = |name: &str| header.iter().position(|h| h.trim() == name);
-        let need = |name: &str| {
-            pos(name).ok_or_else(|| anyhow!("header row has no `{name}` column (need model,w_rad_s,mu,ri_m,R_m; g,k2 optional)"))
-        };
-        Ok(Self {
-            model: need("model")?,
-            omega: need("w_rad_s")?,
-            mu: need("mu")?,
-            ri: need("ri_m")?,
-            rim: need("R_m")?,
-            g: pos("g"),
-            k2: pos("k2"),
-        })
-    }
-}
-
-fn parse_row(row: &csv::StringRecord, cols: &Columns) -> Result<(Model, Scene<f64>)> {
-    let field = |i: usize, name: &str| -> Result<f64> {
-        let text = row
-            .get(i)
-            .ok_or_else(|| anyhow!("missing `{name}` (row has {} fields)", row.len()))?
-            .trim();
-        text.parse::<f64>()
-            .map_err(|_| anyhow!("`{name}` = {text:?} is not a number"))
-    };
-    let model = match row.get(cols.model).map(|s| s.trim().to_ascii_lowercase()) {
-        Some(m) if m == "flat" => Model::Flat,
-        Some(m) if m == "coriolis" => Model::Coriolis,
-        Some(m) => bail!("`model` = {m:?}: expected flat or coriolis"),
-        None => bail!("missing `model` (row has {} fields)", row.len()),
-    };
-    let scene = Scene {
-        omega_rad_s: field(cols.omega, "w_rad_s")?,
-        mu: field(cols.mu, "mu")?,
-        g_m_s2: match cols.g {
-            Some(i) => field(i, "g")?,
-            None => 9.81,
-        },
-        k2: match cols.k2 {
-            Some(i) => field(i, "k2")?,
-            None => 5.0 / 7.0,
-        },
-        ri_m: field(cols.ri, "ri_m")?,
-        rim_radius_m: field(cols.rim, "R_m")?,
-    };
-    words::check(&scene)?;
-    Ok((model, scene))
-}
-
-fn run_batch(input: &std::path::Path, output: &std::path::Path, args: &Args) -> Result<()> {
-    let mut reader = csv::ReaderBuilder::new()
-        .flexible(true)
-        .from_path(input)
-        .with_context(|| format!("cannot open {}", input.display()))?;
-    let header = reader
-        .headers()
-        .with_context(|| format!("{}: cannot read the header row", input.display()))?
-        .clone();
-    let cols = Columns::find(&header).with_context(|| format!("{}: line 1", input.display()))?;
-    let mut writer = csv::Writer::from_path(output)
-        .with_context(|| format!("cannot create {}", output.display()))?;
-    let mut out_header = header.clone();
-    for name in [
-        "residence_time_s",
-        "exit_radial_velocity_m_s",
-        "exit_total_velocity_m_s",
-    ] {
-        out_header.push_field(name);
-    }
-    writer.write_record(&out_header)?;
-    let (mut failed, mut written) = (0usize, 0usize);
-    for (index, record) in reader.records().enumerate() {
-        // Line numbers as a user sees them: the header is line 1. (For rows with embedded
-        // newlines the csv reader's own position is the truth.)
-        let line = record
-            .as_ref()
-            .ok()
-            .and_then(|r| r.position().map(|p| p.line()))
-            .unwrap_or(index as u64 + 2);
-        let result = record.map_err(|e| anyhow!("{e}")).and_then(|row| {
-            let (model, scene) = parse_row(&row, &cols)?;
-            let p = predict(&scene, model, args.method, args.step_s, args.tol)?;
-            Ok((row, p))
-        });
-        match result {
-            Ok((row, p)) => {
-                let (t, vr, vt) = match p.outcome {
-                    Outcome::NeverLeaves { .. } => (f64::INFINITY, f64::NAN, f64::NAN),
-                    o => {
-                        let (vr, vt) = o.exit_velocities_m_s().unwrap_or((f64::NAN, f64::NAN));
-                        (o.residence_time_s(), vr, vt)
-                    }
-                };
-                let mut out = row.clone();
-                for x in [t, vr, vt] {
-                    out.push_field(&format_f64(x));
-                }
-                writer.write_record(&out)?;
-                written += 1;
-            }
-            Err(e) => {
-                failed += 1;
-                eprintln!("{}: line {line}: {e:#}", input.display());
-            }
-        }
-    }
-    writer.flush()?;
-    if failed > 0 {
-        bail!(
-            "{failed} row(s) of {} failed (see above); {written} written to {}",
-            input.display(),
-            output.display()
-        );
     }
     Ok(())
 }
