@@ -102,6 +102,9 @@ pub struct Prediction {
     pub rhs_evaluations: u64,
     /// Steps taken (0 for closed forms).
     pub steps: u64,
+    /// An integrator's answer against the closed form of the same scene: `None` for the
+    /// closed form itself.
+    pub check: Option<ode::StepCheck>,
 }
 
 fn model_name(m: Model) -> &'static str {
@@ -137,6 +140,7 @@ pub fn predict(
                 outcome,
                 rhs_evaluations: 0,
                 steps: 0,
+                check: None,
             })
         }
         other => ode::predict(scene, model, other, step_s, tol),
@@ -172,6 +176,9 @@ pub fn run(args: &Args) -> Result<()> {
     let mut rows = Vec::new();
     for &model in models {
         let p = predict(&scene, model, args.method, args.step_s, args.tol)?;
+        if let Some(warning) = p.check.as_ref().and_then(ode::StepCheck::warning) {
+            eprintln!("warning: {} model: {warning}", model_name(model));
+        }
         rows.push((model, p));
     }
     if args.json {
@@ -209,10 +216,18 @@ fn finite_or_null(x: f64) -> serde_json::Value {
 }
 
 fn json_result(model: Model, method: MethodChoice, p: &Prediction) -> serde_json::Value {
-    let base = serde_json::json!({
+    let mut base = serde_json::json!({
         "model": model_name(model), "method": method_name(method),
         "rhs_evaluations": p.rhs_evaluations, "steps": p.steps,
     });
+    if let (Some(c), Some(obj)) = (&p.check, base.as_object_mut()) {
+        obj.insert(
+            "error_vs_closed_form".into(),
+            c.relative_error
+                .map_or(serde_json::Value::Null, |e| serde_json::json!(e)),
+        );
+        obj.insert("step_warning".into(), serde_json::json!(c.warning()));
+    }
     let extra = match p.outcome {
         Outcome::Leaves {
             residence_time_s,

@@ -411,3 +411,38 @@ fn rolling_model_on_the_tilted_rig() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--precession-rad-s"), "{err}");
 }
+
+/// A step far beyond a method's accuracy gets a warning that says how far off the answer is and
+/// which step to use; the step it suggests does bring the answer within 1 % of the closed form.
+#[test]
+fn a_coarse_step_is_warned_and_the_suggested_step_is_accurate() {
+    for (method, model, step) in [
+        ("semi-implicit", "coriolis", "1"),
+        ("euler", "flat", "0.5"),
+        ("rk4", "flat", "0.6"),
+    ] {
+        let out = bowl(&[
+            "predict", "--method", method, "--model", model, "--step-s", step, "--json",
+        ]);
+        assert_eq!(out.status.code(), Some(0), "a warning, not a refusal");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("% off the closed form"), "{method}: {err}");
+        let suggested = err
+            .split("use --step-s ")
+            .nth(1)
+            .and_then(|t| t.split_whitespace().next())
+            .unwrap_or_else(|| panic!("{method}: no step suggested: {err}"));
+        let again = bowl(&[
+            "predict", "--method", method, "--model", model, "--step-s", suggested, "--json",
+        ]);
+        let err2 = String::from_utf8_lossy(&again.stderr);
+        assert!(!err2.contains("warning"), "{method} at {suggested}: {err2}");
+        let v: serde_json::Value = serde_json::from_slice(&again.stdout).unwrap();
+        let e = v["results"][0]["error_vs_closed_form"].as_f64().unwrap();
+        assert!(e < 0.01, "{method} at {suggested}: {e}");
+        let closed = json(&["predict", "--model", model, "--json"]);
+        let t_ref = closed["results"][0]["residence_time_s"].as_f64().unwrap();
+        let t = v["results"][0]["residence_time_s"].as_f64().unwrap();
+        assert!((t - t_ref).abs() / t_ref < 0.01, "{method}: {t} vs {t_ref}");
+    }
+}

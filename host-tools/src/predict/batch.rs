@@ -8,7 +8,8 @@
 //! granule never leaves), `condition_number` (relative condition of T; empty where T is not
 //! defined) and `flags`: `ill_conditioned` (more than half of T's digits may be lost: a start
 //! just above the equilibrium radius), `near_threshold` (never leaves, but within rounding of
-//! the threshold), `never_leaves`, separated by `;`.
+//! the threshold), `never_leaves`, `inaccurate_step` (an integrator more than 1 % off the closed
+//! form of the row's scene; also warned on stderr), separated by `;`.
 //!
 //! A row that fails (a field count that is not the header's, a value that is not a number, a
 //! scene the rig refuses such as a start at or beyond the rim) is reported on stderr with its
@@ -217,7 +218,16 @@ pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
         match result {
             Ok((row, p)) if failed == 0 => {
                 let mut out = row.clone();
-                for f in result_fields(&p.outcome) {
+                let mut fields = result_fields(&p.outcome);
+                if let Some(w) = p.check.as_ref().and_then(super::ode::StepCheck::warning) {
+                    eprintln!("{}: line {line}: warning: {w}", input.display());
+                    let flags = &mut fields[4];
+                    if !flags.is_empty() {
+                        flags.push(';');
+                    }
+                    flags.push_str("inaccurate_step");
+                }
+                for f in fields {
                     out.push_field(&f);
                 }
                 writer.write_record(&out)?;

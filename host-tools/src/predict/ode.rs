@@ -74,9 +74,131 @@ pub fn predict(
             ),
         },
     };
+    let relative_error = match (closed, outcome) {
+        (
+            Outcome::Leaves {
+                residence_time_s: exact,
+                ..
+            },
+            Outcome::Leaves {
+                residence_time_s: t,
+                ..
+            },
+        ) if exact > 0.0 => Some((t - exact).abs() / exact),
+        _ => None,
+    };
+    let disagrees =
+        matches!(closed, Outcome::Leaves { .. }) != matches!(outcome, Outcome::Leaves { .. });
+    let off = if disagrees {
+        Some(1.0)
+    } else {
+        relative_error.filter(|&e| e > WARN_RELATIVE_ERROR)
+    };
+    let check = StepCheck {
+        method,
+        relative_error,
+        disagrees,
+        suggested: off.and_then(|err| suggest(scene, model, method, h, tol, err)),
+    };
     Ok(Prediction {
         outcome,
         rhs_evaluations: report.rhs_evaluations as u64,
         steps: report.steps as u64,
+        check: Some(check),
     })
+}
+
+/// Relative error in T above which an integrator's answer gets a warning.
+pub const WARN_RELATIVE_ERROR: f64 = 0.01;
+
+/// The step (or DP5(4) tolerance) that brings this scene within half the warning level of its
+/// closed form: a first guess from the method's order (error ~ h^p), then halved (or divided by
+/// ten) until an actual run meets it.
+fn suggest(
+    scene: &Scene<f64>,
+    model: Model,
+    method: MethodChoice,
+    h: f64,
+    tol: f64,
+    err: f64,
+) -> Option<f64> {
+    let exact = particle::residence(scene, model).ok()?.residence_time_s();
+    let aim = 0.5 * WARN_RELATIVE_ERROR;
+    let meets = |m: Method<f64>| match ode::integrate_constant(scene, model, m) {
+        Ok(r) => match r.outcome {
+            OdeOutcome::Leaves {
+                residence_time_s, ..
+            } => (residence_time_s - exact).abs() <= aim * exact,
+            _ => false,
+        },
+        Err(_) => false,
+    };
+    let order = match method {
+        MethodChoice::Rk4 => 4.0,
+        _ => 1.0,
+    };
+    let mut setting = match method {
+        MethodChoice::Dp54 => tol * aim / err,
+        _ => h * (aim / err).powf(1.0 / order),
+    };
+    for _ in 0..40 {
+        let m = match method {
+            MethodChoice::Euler => Method::Euler { step_s: setting },
+            MethodChoice::SemiImplicit => Method::SemiImplicitEuler { step_s: setting },
+            MethodChoice::Rk4 => Method::Rk4 { step_s: setting },
+            MethodChoice::Dp54 => Method::Dp54 {
+                rtol: setting,
+                atol: setting * 1e-2,
+            },
+            MethodChoice::Closed => return None,
+        };
+        if meets(m) {
+            return Some(setting);
+        }
+        setting *= if method == MethodChoice::Dp54 {
+            0.1
+        } else {
+            0.5
+        };
+    }
+    None
+}
+
+/// An integrator's answer held against the closed form of the same constant-speed scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepCheck {
+    method: MethodChoice,
+    /// `|T - T_closed| / T_closed` where both leave.
+    pub relative_error: Option<f64>,
+    /// One says the granule leaves, the other that it does not.
+    pub disagrees: bool,
+    /// Where the answer is off: the step (or tolerance) found to meet half the warning level.
+    pub suggested: Option<f64>,
+}
+
+impl StepCheck {
+    /// The warning to print, if the step (or tolerance) is too coarse for this scene: how far
+    /// off, and the setting found to bring it within half the warning level.
+    pub fn warning(&self) -> Option<String> {
+        let fix = match (self.method, self.suggested) {
+            (MethodChoice::Dp54, Some(tol)) => format!("use --tol {tol:.0e} or tighter"),
+            (_, Some(h)) => {
+                format!("use --step-s {h:.2e} or less, or the closed form (--method closed)")
+            }
+            (_, None) => "use the closed form (--method closed)".to_string(),
+        };
+        if self.disagrees {
+            return Some(format!(
+                "this setting and the closed form disagree on whether the granule leaves: {fix}"
+            ));
+        }
+        let err = self.relative_error?;
+        (err > WARN_RELATIVE_ERROR).then(|| {
+            format!(
+                "the {} answer is {:.1} % off the closed form of this scene: {fix}",
+                super::method_name(self.method),
+                100.0 * err
+            )
+        })
+    }
 }
