@@ -193,7 +193,6 @@ fn sweep(which: Sweep) -> anyhow::Result<(Figure, Table)> {
             let mut grid = omega_grid();
             grid.extend((1..=6).map(|e| th * (1.0 + 10f64.powi(-e))));
             grid.sort_by(f64::total_cmp);
-            let mut never = Vec::new();
             for (j, w) in grid.into_iter().enumerate() {
                 let s = scene_for(size, w);
                 let out = residence(&s, model).map_err(scene_err)?;
@@ -228,22 +227,6 @@ fn sweep(which: Sweep) -> anyhow::Result<(Figure, Table)> {
                     Sweep::Residence => t,
                 };
                 pts.push((w, if y.is_finite() { y } else { f64::NAN }));
-                // One marker per 0.1 rad/s where it never leaves, on a row of its own per bowl.
-                if kind == "never_leaves" && model == Model::Flat && j % 10 == 0 {
-                    let row = match which {
-                        Sweep::Velocity => 0.02 * (i + 1) as f64,
-                        Sweep::Residence => 0.05 * 1.3f64.powi(i as i32),
-                    };
-                    never.push((w, row));
-                }
-            }
-            if model == Model::Flat {
-                series.push(Series {
-                    name: format!("{size:.0} mm: never leaves"),
-                    points: std::mem::take(&mut never),
-                    mark: Mark::Crosses,
-                    color: i,
-                });
             }
             series.push(Series {
                 name: format!("{size:.0} mm, {}", model_name(model)),
@@ -262,7 +245,8 @@ fn sweep(which: Sweep) -> anyhow::Result<(Figure, Table)> {
         "bowl size read as diameter; ri = R/2, mu = 0.029".to_string(),
         "dashed verticals: threshold speed sqrt(mu g / ri)".to_string(),
         "left of it the particle never leaves (ri <= a):".to_string(),
-        "no curve; crosses in a row of its own per bowl".to_string(),
+        "no curve there (the CSV says never_leaves); no marker".to_string(),
+        "is drawn at a value the model does not give".to_string(),
         format!("largest T_coriolis/T_flat on this grid: {:.4}", max_ratio),
     ];
     let (title, y_label, y_scale) = match which {
