@@ -35,6 +35,7 @@ pub fn stats_json(s: &DecodeStats) -> serde_json::Value {
         "oversize": s.oversize,
         "truncated": s.truncated,
         "duplicates": s.duplicates,
+        "reordered": s.reordered,
         "restarts": s.restarts,
     })
 }

@@ -27,7 +27,7 @@ pub mod types;
 pub use decode::{FrameError, decode_frame, parse_command_line, parse_line};
 pub use encode::{EncodeError, encode};
 pub use params::*;
-pub use stream::{DecodeStats, Decoder};
+pub use stream::{DecodeStats, Decoder, REORDER_FRAMES};
 pub use types::*;
 
 /// The protocol version in every frame header (`$T1`): one decimal digit.

@@ -14,8 +14,12 @@ pub struct DecodeStats {
     /// Frame candidates (a `$` followed by bytes) that were dropped: the sum of the four
     /// counters below. One damaged frame can count twice (a `$` hit inside it splits it).
     pub frames_corrupt: u64,
-    /// Telemetry frames lost: the sum of the sequence-number gaps between accepted telemetry
-    /// frames (frames lost before the first or after the last accepted one cannot be seen).
+    /// Telemetry frames that never arrived in any form: the gaps between accepted telemetry
+    /// frames (by sequence number, with the device clock deciding how often the 16-bit number
+    /// wrapped), less the corrupt candidates seen in each gap, which are counted there. So
+    /// `frames_ok + frames_corrupt + frames_missing` is the number of frames sent (more only
+    /// where a `$` hit split a frame). Frames lost before the first or after the last accepted
+    /// one cannot be seen.
     pub frames_missing: u64,
     /// Bytes not part of an accepted frame: line noise plus the bytes of dropped frames.
     pub bytes_skipped: u64,
@@ -27,12 +31,20 @@ pub struct DecodeStats {
     pub oversize: u64,
     /// Dropped: cut by a `$` or a byte that cannot be in a frame.
     pub truncated: u64,
-    /// Telemetry frames that repeated the previous sequence number.
+    /// Telemetry frames that repeated the previous sequence number and device time.
     pub duplicates: u64,
-    /// Device restarts seen (a Hello frame, or telemetry time going backwards): the sequence
-    /// gap across a restart is not counted as missing.
+    /// Telemetry frames that came late (up to [`REORDER_FRAMES`] behind the newest): counted
+    /// here and no longer as missing.
+    pub reordered: u64,
+    /// Device restarts seen (a Hello frame, or telemetry time going back further than a late
+    /// frame could): the sequence gap across a restart is not counted as missing. A wrap of
+    /// the 32-bit device clock is not a restart.
     pub restarts: u64,
 }
+
+/// How far behind the newest telemetry frame a frame may arrive and count as late rather than
+/// as a device restart, in frames.
+pub const REORDER_FRAMES: u16 = 16;
 
 /// A streaming decoder with a fixed [`MAX_FRAME_LEN`]-byte buffer: feed it bytes as they come.
 ///
@@ -44,8 +56,12 @@ pub struct Decoder {
     len: usize,
     in_frame: bool,
     stats: DecodeStats,
-    last_seq: Option<u16>,
-    last_time_ms: u32,
+    /// Sequence number and device time of the newest accepted telemetry frame.
+    last: Option<(u16, u32)>,
+    /// Device time between two consecutive telemetry frames, ms (0 until seen).
+    period_ms: u32,
+    /// Corrupt candidates since the newest accepted telemetry frame.
+    corrupt_in_gap: u64,
 }
 
 impl Default for Decoder {
@@ -72,10 +88,12 @@ impl Decoder {
                 oversize: 0,
                 truncated: 0,
                 duplicates: 0,
+                reordered: 0,
                 restarts: 0,
             },
-            last_seq: None,
-            last_time_ms: 0,
+            last: None,
+            period_ms: 0,
+            corrupt_in_gap: 0,
         }
     }
 
@@ -208,6 +226,7 @@ impl Decoder {
 
     fn count_error(&mut self, error: FrameError) {
         self.stats.frames_corrupt += 1;
+        self.corrupt_in_gap += 1;
         match error {
             FrameError::BadCrc => self.stats.bad_crc += 1,
             FrameError::Oversize => self.stats.oversize += 1,
@@ -236,21 +255,62 @@ impl Decoder {
         match frame {
             Frame::Hello(_) => {
                 self.stats.restarts += 1;
-                self.last_seq = None;
+                self.last = None;
+                self.corrupt_in_gap = 0;
             }
-            Frame::Telemetry(t) => {
-                match self.last_seq {
-                    Some(_) if t.time_ms < self.last_time_ms => self.stats.restarts += 1,
-                    Some(last) if t.seq == last => self.stats.duplicates += 1,
-                    Some(last) => {
-                        self.stats.frames_missing += u64::from(t.seq.wrapping_sub(last) - 1)
-                    }
-                    None => {}
-                }
-                self.last_seq = Some(t.seq);
-                self.last_time_ms = t.time_ms;
-            }
+            Frame::Telemetry(t) => self.track_telemetry(t.seq, t.time_ms),
             _ => {}
         }
+    }
+
+    fn track_telemetry(&mut self, seq: u16, time_ms: u32) {
+        let corrupt = core::mem::take(&mut self.corrupt_in_gap);
+        let Some((last_seq, last_ms)) = self.last else {
+            self.last = Some((seq, time_ms));
+            return;
+        };
+        // Wrapping differences: a wrap of the 32-bit clock or the 16-bit sequence is a step
+        // forward like any other.
+        let dt_ms = time_ms.wrapping_sub(last_ms);
+        let dseq = seq.wrapping_sub(last_seq);
+        if dt_ms > u32::MAX / 2 {
+            // Earlier than the newest frame: a late frame, or a device that started again.
+            let behind = last_seq.wrapping_sub(seq);
+            if (1..=REORDER_FRAMES).contains(&behind) {
+                self.stats.reordered += 1;
+                self.stats.frames_missing = self.stats.frames_missing.saturating_sub(1);
+                // The newest frame stays the reference.
+                self.corrupt_in_gap = corrupt;
+                return;
+            }
+            self.stats.restarts += 1;
+        } else {
+            match self.sequence_advance(dseq, dt_ms) {
+                0 => self.stats.duplicates += 1,
+                advance => {
+                    self.stats.frames_missing += (advance - 1).saturating_sub(corrupt);
+                    if advance == 1 && dt_ms > 0 {
+                        self.period_ms = dt_ms;
+                    }
+                }
+            }
+        }
+        self.last = Some((seq, time_ms));
+    }
+
+    /// Frames sent from the newest to this one (0: the same frame again): the sequence
+    /// difference plus as many whole 16-bit wraps as the device clock says went by, once the
+    /// telemetry period is known (a 30-minute outage at 50 Hz is 90,000 frames, not 90,000
+    /// mod 65,536).
+    fn sequence_advance(&self, dseq: u16, dt_ms: u32) -> u64 {
+        const WRAP: u64 = 1 << 16;
+        let dseq = u64::from(dseq);
+        if self.period_ms == 0 {
+            return dseq;
+        }
+        let period = u64::from(self.period_ms);
+        let by_time = (u64::from(dt_ms) + period / 2) / period;
+        let wraps = (by_time.saturating_sub(dseq) + WRAP / 2) / WRAP;
+        dseq + wraps * WRAP
     }
 }
