@@ -91,7 +91,7 @@ pub fn run(args: &Args) -> Result<()> {
             telemetry += 1;
             if let Some(w) = csv.as_mut()
                 && csv_error.is_none()
-                && let Err(e) = telemetry_csv::write_row(w, stats.restarts, t)
+                && let Err(e) = telemetry_csv::write_row(w, stats.restarts, t, None)
             {
                 csv_error = Some(e);
             }

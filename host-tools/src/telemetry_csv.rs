@@ -1,8 +1,13 @@
-//! The CSV form of telemetry, shared by `bowl replay --csv` and `bowl monitor --log`: one row per
-//! telemetry frame, keyed on (boot, device time); the values stay the wire's scaled integers, with
-//! the unit in each column name.
+//! The CSV form of telemetry, shared by `bowl replay --csv`, `bowl monitor --log` and the demo:
+//! one row per telemetry frame, keyed on (boot, device time); the values stay the wire's scaled
+//! integers, with the unit in each column name. Two columns close each row: `host_time_utc`, the
+//! PC's wall clock when the frame arrived (ISO 8601, UTC, milliseconds; empty when replaying a
+//! capture, which holds no PC time), and `event`: empty for telemetry, or what happened on the
+//! link (`port open`, `link lost`, `port reopened`, `device restart`, `monitor end`), on a row of
+//! its own with the telemetry columns empty, so a gap in the data shows its cause.
 
 use std::io::Write;
+use std::time::SystemTime;
 
 use anyhow::Result;
 use model_core::wire::{Residence, Telemetry};
@@ -11,7 +16,10 @@ use model_core::wire::{Residence, Telemetry};
 pub const HEADER: &str = "boot,device_time_ms,seq,state,fault,\
 prec_set_mrad_s,prec_measured_mrad_s,prec_duty_bp,prec_pulses,\
 spin_set_mrad_s,spin_measured_mrad_s,spin_duty_bp,spin_pulses,\
-bowl_mrad_s,residence_flat_ms,residence_coriolis_ms";
+bowl_mrad_s,residence_flat_ms,residence_coriolis_ms,host_time_utc,event";
+
+/// Telemetry columns between `boot` and `host_time_utc`.
+const TELEMETRY_COLUMNS: usize = 15;
 
 fn residence(r: Residence) -> String {
     match r {
@@ -21,12 +29,43 @@ fn residence(r: Residence) -> String {
     }
 }
 
-/// Writes one row. `boot` counts the device restarts seen before this frame, so the key stays
-/// unique when the device time starts again from zero.
-pub fn write_row(out: &mut impl Write, boot: u64, t: &Telemetry) -> Result<()> {
+/// `2026-11-25T02:44:26.123Z` for a wall-clock time (empty before 1970).
+pub fn utc(t: SystemTime) -> String {
+    let Ok(d) = t.duration_since(SystemTime::UNIX_EPOCH) else {
+        return String::new();
+    };
+    let secs = d.as_secs();
+    let (days, rem) = (secs / 86_400, secs % 86_400);
+    // Civil date from days since 1970-01-01 (proleptic Gregorian, H. Hinnant's algorithm).
+    let z = days as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1_460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}.{:03}Z",
+        rem / 3_600,
+        rem / 60 % 60,
+        rem % 60,
+        d.subsec_millis()
+    )
+}
+
+/// Writes one telemetry row. `boot` counts the device restarts seen before this frame, so the
+/// key stays unique when the device time starts again from zero; `host` is when it arrived.
+pub fn write_row(
+    out: &mut impl Write,
+    boot: u64,
+    t: &Telemetry,
+    host: Option<SystemTime>,
+) -> Result<()> {
     writeln!(
         out,
-        "{},{},{},{:?},{:?},{},{},{},{},{},{},{},{},{},{},{}",
+        "{},{},{},{:?},{:?},{},{},{},{},{},{},{},{},{},{},{},{},",
         boot,
         t.time_ms,
         t.seq,
@@ -43,6 +82,47 @@ pub fn write_row(out: &mut impl Write, boot: u64, t: &Telemetry) -> Result<()> {
         t.bowl_mrad_s,
         residence(t.residence_flat),
         residence(t.residence_coriolis),
+        host.map(utc).unwrap_or_default(),
     )?;
     Ok(())
+}
+
+/// Writes a link event's row: `boot`, empty telemetry columns, the time and the event.
+pub fn write_event(out: &mut impl Write, boot: u64, host: SystemTime, event: &str) -> Result<()> {
+    writeln!(
+        out,
+        "{boot},{}{},{event}",
+        ",".repeat(TELEMETRY_COLUMNS),
+        utc(host)
+    )?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    #[test]
+    fn utc_dates_match_known_instants() {
+        let at = |s: u64, ms: u64| SystemTime::UNIX_EPOCH + Duration::from_millis(s * 1000 + ms);
+        assert_eq!(utc(at(0, 0)), "1970-01-01T00:00:00.000Z");
+        // `date -u -d @951782400`: the leap day of 2000.
+        assert_eq!(utc(at(951_782_400, 5)), "2000-02-29T00:00:00.005Z");
+        assert_eq!(utc(at(1_764_038_666, 123)), "2025-11-25T02:44:26.123Z");
+        assert_eq!(utc(at(4_102_444_799, 999)), "2099-12-31T23:59:59.999Z");
+    }
+
+    #[test]
+    fn event_rows_have_as_many_fields_as_the_header() {
+        let mut out = Vec::new();
+        write_event(&mut out, 2, SystemTime::UNIX_EPOCH, "link lost").unwrap();
+        let line = String::from_utf8(out).unwrap();
+        assert_eq!(
+            line.trim_end().split(',').count(),
+            HEADER.split(',').count(),
+            "{line}"
+        );
+        assert!(line.starts_with("2,") && line.trim_end().ends_with(",link lost"));
+    }
 }

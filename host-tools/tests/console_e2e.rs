@@ -129,12 +129,21 @@ fn forty_commands(port: &str, clean: bool) {
         .expect("the monitor prints its counters on Ctrl-C");
     let counters: serde_json::Value = serde_json::from_str(&summary).unwrap();
     assert_eq!(counters["reconnects"], 0, "{summary}");
-    // Ctrl-C flushed the log: every row the monitor counted is in the file.
-    let rows = std::fs::read_to_string(&log).unwrap().lines().count() - 1;
+    // Ctrl-C flushed the log: every telemetry row the monitor counted is in the file, and the
+    // log ends with the monitor's own end (link events have no device time).
+    let rows = common::csv_rows(&log);
+    let telemetry = rows
+        .iter()
+        .filter(|r| !r["device_time_ms"].is_empty())
+        .count();
     assert_eq!(
-        Some(rows as u64),
+        Some(telemetry as u64),
         counters["logged_rows"].as_u64(),
         "{summary}"
+    );
+    assert_eq!(
+        rows.last().map(|r| r["event"].as_str()),
+        Some("monitor end")
     );
     assert!(counters["frames_ok"].as_u64().unwrap() > 100, "{summary}");
     if clean {

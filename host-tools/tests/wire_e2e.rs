@@ -10,19 +10,29 @@ use std::time::{Duration, Instant};
 
 use common::{BOWL, Sim, bowl, last_json, open_pty, spawn_on_terminal, stdout, temp_dir};
 
-/// CSV rows as (boot, device_time_ms).
+/// Telemetry rows of a CSV as (boot, device_time_ms); link-event rows (no device time) left out.
 fn csv_keys(path: &Path) -> Vec<(u64, u64)> {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
     assert!(lines.next().unwrap().starts_with("boot,device_time_ms,seq"));
     lines
-        .map(|l| {
+        .filter_map(|l| {
             let mut f = l.split(',');
-            (
-                f.next().unwrap().parse().unwrap(),
-                f.next().unwrap().parse().unwrap(),
-            )
+            let boot = f.next().unwrap().parse().unwrap();
+            let time = f.next().unwrap();
+            (!time.is_empty()).then(|| (boot, time.parse().unwrap()))
         })
+        .collect()
+}
+
+/// The `event` column of a CSV's link-event rows, in order.
+fn csv_events(path: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(path).unwrap();
+    text.lines()
+        .skip(1)
+        .filter_map(|l| l.rsplit(',').next())
+        .filter(|e| !e.is_empty())
+        .map(String::from)
         .collect()
 }
 
@@ -120,11 +130,28 @@ fn send_and_monitor_against_the_virtual_rig() {
     for w in keys.windows(2) {
         assert_eq!(w[1].1 - w[0].1, 20, "{w:?}");
     }
-    // The controller has the precession motor turning by the end of the log (mrad/s).
-    let last = std::fs::read_to_string(&log).unwrap();
-    let last = last.lines().last().unwrap().split(',').collect::<Vec<_>>();
+    // The controller has the precession motor turning by the end of the log (mrad/s); each
+    // telemetry row carries the PC's wall clock, the log opens and closes with its events.
+    let text = std::fs::read_to_string(&log).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    let last = rows.iter().rev().find(|r| !r[1].is_empty()).unwrap();
     let precession_measured: i32 = last[6].parse().unwrap();
     assert!(precession_measured > 900, "{last:?}");
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let at = header.iter().position(|h| *h == "host_time_utc").unwrap();
+    assert!(
+        last[at].len() == 24 && last[at].starts_with("20") && last[at].ends_with('Z'),
+        "{last:?}"
+    );
+    assert!(
+        rows.iter().all(|r| r.len() == header.len()),
+        "every row as wide as the header"
+    );
+    assert_eq!(csv_events(&log), ["port open", "monitor end"]);
 
     let status = bowl(&["send", p, "status"]);
     assert!(
@@ -170,6 +197,28 @@ fn monitor_reopens_the_port_and_keeps_the_log() {
     let restarts = keys.windows(2).filter(|w| w[1].1 < w[0].1).count();
     assert_eq!(restarts, 1, "one restart of the device clock");
     assert!(keys.len() > 100, "{} rows", keys.len());
+    // The gap in the data has its cause on rows of its own.
+    let events = csv_events(&log);
+    assert_eq!(
+        events.first().map(String::as_str),
+        Some("port open"),
+        "{events:?}"
+    );
+    assert_eq!(
+        events.last().map(String::as_str),
+        Some("monitor end"),
+        "{events:?}"
+    );
+    let lost = events
+        .iter()
+        .position(|e| e == "link lost")
+        .expect("link lost row");
+    let back = events
+        .iter()
+        .position(|e| e == "port reopened")
+        .expect("reopened row");
+    assert!(lost < back, "{events:?}");
+    assert!(events.iter().any(|e| e == "device restart"), "{events:?}");
 }
 
 #[test]

@@ -168,7 +168,12 @@ impl Session {
         self.last_frame_at = Instant::now();
         match frame {
             Frame::Telemetry(t) => {
-                telemetry_csv::write_row(&mut self.csv, self.decoder.stats().restarts, &t)?;
+                telemetry_csv::write_row(
+                    &mut self.csv,
+                    self.decoder.stats().restarts,
+                    &t,
+                    Some(std::time::SystemTime::now()),
+                )?;
                 self.record.telemetry.push(t);
                 self.view.on_frame(self.plain, &frame);
             }

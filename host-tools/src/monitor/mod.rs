@@ -18,7 +18,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
-use std::time::{Duration, Instant};
+use std::time::{Duration, Instant, SystemTime};
 
 use anyhow::{Context, Result};
 use model_core::wire::{Decoder, Frame};
@@ -113,6 +113,13 @@ pub fn run(args: &Args) -> Result<()> {
     let mut port = Some(first);
     view.set_connected(true);
     view.event(plain, format!("port {} open", args.port));
+    let link_event = |log: &mut Option<BufWriter<File>>, boot: u64, what: &str| -> Result<()> {
+        if let Some(w) = log.as_mut() {
+            telemetry_csv::write_event(w, boot, SystemTime::now(), what)?;
+        }
+        Ok(())
+    };
+    link_event(&mut log, 0, "port open")?;
     let mut tui = if plain { None } else { Some(Tui::start()?) };
     let typed = if plain { Some(stdin_lines()) } else { None };
     let mut last_open_try = Instant::now();
@@ -136,6 +143,7 @@ pub fn run(args: &Args) -> Result<()> {
                 view.set_connected(true);
                 view.reconnects += 1;
                 view.event(plain, format!("port {} reopened", args.port));
+                link_event(&mut log, decoder.stats().restarts, "port reopened")?;
             }
         }
         let outcome = match port.as_mut() {
@@ -152,12 +160,17 @@ pub fn run(args: &Args) -> Result<()> {
                 }
                 for &b in &buf[..n] {
                     // Damaged frames are counted by the decoder (corrupt, oversize, truncated).
+                    let restarts = decoder.stats().restarts;
                     let Some(Ok(frame)) = decoder.push(b) else {
                         continue;
                     };
+                    if decoder.stats().restarts > restarts {
+                        link_event(&mut log, decoder.stats().restarts, "device restart")?;
+                    }
                     if let Frame::Telemetry(t) = &frame {
                         if let Some(w) = log.as_mut() {
-                            telemetry_csv::write_row(w, decoder.stats().restarts, t)?;
+                            let boot = decoder.stats().restarts;
+                            telemetry_csv::write_row(w, boot, t, Some(SystemTime::now()))?;
                             view.logged_rows += 1;
                         }
                         if let Some(ui) = tui.as_mut() {
@@ -179,6 +192,7 @@ pub fn run(args: &Args) -> Result<()> {
                 view.set_connected(false);
                 decoder.finish();
                 view.event(plain, format!("port {} lost; reopening", args.port));
+                link_event(&mut log, decoder.stats().restarts, "link lost")?;
             }
         }
         let mut outgoing = relay.as_mut().map(Relay::poll).unwrap_or_default();
@@ -236,6 +250,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     // Leave the alternate screen first, so the summary stays on the terminal.
     drop(tui);
+    link_event(&mut log, decoder.stats().restarts, "monitor end")?;
     if let Some(w) = log.as_mut() {
         w.flush().context("writing the log")?;
     }
