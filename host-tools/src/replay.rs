@@ -2,7 +2,7 @@
 //! one JSON line of statistics (and the decoding speed) on stdout.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{BufWriter, Read, Write};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -40,19 +40,6 @@ pub fn stats_json(s: &DecodeStats) -> serde_json::Value {
     })
 }
 
-/// Decodes `bytes`, calling `on_frame` for every good frame (with the counters right after
-/// it); returns the final statistics.
-pub fn decode_capture(bytes: &[u8], mut on_frame: impl FnMut(&DecodeStats, &Frame)) -> DecodeStats {
-    let mut decoder = Decoder::new();
-    decoder.push_slice(bytes, |r, stats| {
-        if let Ok(frame) = r {
-            on_frame(stats, &frame);
-        }
-    });
-    decoder.finish();
-    *decoder.stats()
-}
-
 /// CPU time of this thread, s (0 if the clock cannot be read).
 #[cfg(not(unix))]
 fn thread_cpu_seconds() -> f64 {
@@ -68,10 +55,13 @@ fn thread_cpu_seconds() -> f64 {
         .unwrap_or(0.0)
 }
 
-/// Runs `bowl replay`.
+/// Read size of the streaming replay: the capture is never held whole, whatever its size.
+const CHUNK_BYTES: usize = 1 << 16;
+
+/// Runs `bowl replay`: reads the capture in chunks into one decoder (constant memory).
 pub fn run(args: &Args) -> Result<()> {
-    let bytes = std::fs::read(&args.file)
-        .with_context(|| format!("cannot read {}", args.file.display()))?;
+    let mut file =
+        File::open(&args.file).with_context(|| format!("cannot read {}", args.file.display()))?;
     let mut csv = match &args.csv {
         Some(path) => {
             let mut w = BufWriter::new(
@@ -86,17 +76,31 @@ pub fn run(args: &Args) -> Result<()> {
     let mut csv_error = None;
     let started = Instant::now();
     let cpu_started = thread_cpu_seconds();
-    let stats = decode_capture(&bytes, |stats, frame| {
-        if let Frame::Telemetry(t) = frame {
-            telemetry += 1;
-            if let Some(w) = csv.as_mut()
-                && csv_error.is_none()
-                && let Err(e) = telemetry_csv::write_row(w, stats.restarts, t, None)
-            {
-                csv_error = Some(e);
+    let mut decoder = Decoder::new();
+    let mut chunk = vec![0u8; CHUNK_BYTES];
+    loop {
+        let n = match file.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => {
+                return Err(e).with_context(|| format!("cannot read {}", args.file.display()));
             }
-        }
-    });
+        };
+        decoder.push_slice(&chunk[..n], |r, stats| {
+            if let Ok(Frame::Telemetry(t)) = r {
+                telemetry += 1;
+                if let Some(w) = csv.as_mut()
+                    && csv_error.is_none()
+                    && let Err(e) = telemetry_csv::write_row(w, stats.restarts, &t, None)
+                {
+                    csv_error = Some(e);
+                }
+            }
+        });
+    }
+    decoder.finish();
+    let stats = *decoder.stats();
     let seconds = started.elapsed().as_secs_f64();
     let cpu_seconds = thread_cpu_seconds() - cpu_started;
     if let Some(e) = csv_error {
@@ -109,14 +113,14 @@ pub fn run(args: &Args) -> Result<()> {
     out["telemetry_frames"] = json!(telemetry);
     out["decode_seconds"] = json!(seconds);
     out["decode_mb_s"] = json!(if seconds > 0.0 {
-        bytes.len() as f64 / 1e6 / seconds
+        stats.bytes as f64 / 1e6 / seconds
     } else {
         0.0
     });
     // On a shared machine the wall-clock figure depends on the load; the CPU-time one does not.
     out["decode_cpu_seconds"] = json!(cpu_seconds);
     out["decode_mb_per_cpu_s"] = json!(if cpu_seconds > 0.0 {
-        bytes.len() as f64 / 1e6 / cpu_seconds
+        stats.bytes as f64 / 1e6 / cpu_seconds
     } else {
         0.0
     });
