@@ -11,6 +11,7 @@ use clap::Subcommand;
 pub mod control;
 pub mod family;
 pub mod figures;
+pub mod log;
 pub mod plot;
 pub mod qemu_log;
 pub mod reference;
@@ -60,6 +61,21 @@ enum Which {
     RollingHierarchy(RollingHierarchyArgs),
     /// Rolling model: work-precision of DP5(4) and RK4, on the rig and near the stick threshold.
     RollingWorkPrecision(Out),
+    /// A logged run (bowl monitor --log, bowl replay --csv, the demo's telemetry.csv): set and
+    /// measured speed per axis with link events and faults marked (FILE-precession.svg,
+    /// FILE-spin.svg, PNGs beside them).
+    Log(LogArgs),
+}
+
+/// Options of `bowl chart log`.
+#[derive(clap::Args)]
+struct LogArgs {
+    /// The telemetry CSV.
+    #[arg(long)]
+    csv: PathBuf,
+    /// The SVG file name the charts are named after (FILE-precession.svg, FILE-spin.svg).
+    #[arg(long)]
+    out: PathBuf,
 }
 
 /// Options of `bowl chart rolling-residence`.
@@ -318,6 +334,11 @@ pub fn run(args: &Args) -> Result<()> {
             write_all(out, &f, &t)
         }
         Which::Scipy(a) => scipy_charts(a),
+        Which::Log(a) => {
+            let written = log::draw(&a.csv, &a.out)?;
+            report(&written.iter().map(PathBuf::as_path).collect::<Vec<_>>());
+            Ok(())
+        }
         Which::RollingResidence(a) => {
             let (f, t) = rolling::residence(a.axes_angle_deg)?;
             write_all(&a.out, &f, &t)

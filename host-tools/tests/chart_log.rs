@@ -1,0 +1,66 @@
+//! `bowl chart log`: a run logged by `bowl monitor --log` drawn per axis, with its link events.
+
+mod common;
+
+use common::{Sim, bowl, stdout, temp_dir};
+
+#[test]
+fn a_monitor_log_is_drawn_with_its_link_events() {
+    let sim = Sim::start(&[
+        "--seconds",
+        "10",
+        "--command",
+        "0:speed,1800,2100",
+        "--command",
+        "0:start",
+    ]);
+    let dir = temp_dir("chart-log");
+    let log = dir.join("run.csv");
+    let mon = bowl(&[
+        "monitor",
+        &sim.path,
+        "--seconds",
+        "2",
+        "--plain",
+        "--log",
+        log.to_str().unwrap(),
+    ]);
+    assert_eq!(mon.status.code(), Some(0), "{}", stdout(&mon));
+    let out = dir.join("run.svg");
+    let drawn = bowl(&[
+        "chart",
+        "log",
+        "--csv",
+        log.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        drawn.status.success(),
+        "{}",
+        String::from_utf8_lossy(&drawn.stderr)
+    );
+    for axis in ["precession", "spin"] {
+        let svg = std::fs::read_to_string(dir.join(format!("run-{axis}.svg"))).unwrap();
+        for label in ["port open", "monitor end", "measured", "PC clock"] {
+            assert!(svg.contains(label), "{axis}: no {label:?} in the chart");
+        }
+        let png = std::fs::read(dir.join(format!("run-{axis}.png"))).unwrap();
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    }
+    // A file that is not a telemetry log is refused in plain words.
+    let other = dir.join("other.csv");
+    std::fs::write(&other, "a,b\n1,2\n").unwrap();
+    let refused = bowl(&[
+        "chart",
+        "log",
+        "--csv",
+        other.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(err.contains("no `device_time_ms` column"), "{err}");
+    let _ = std::fs::remove_dir_all(dir);
+}
