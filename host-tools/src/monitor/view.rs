@@ -33,25 +33,37 @@ impl Trend {
         self.points.push_back(v);
     }
 
-    /// A sparkline of the points, scaled between their min and max.
+    /// A sparkline of the points and the range it spans, `[lo .. hi]`. The range is the
+    /// points' own, widened to at least `MIN_SPAN` (1 unit) about its middle, so a few thousandths
+    /// of noise stay a flat line instead of filling the height.
     fn sparkline(&self) -> String {
         const BARS: [char; 8] = ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'];
+        const MIN_SPAN: f64 = 1.0;
         let finite = self.points.iter().copied().filter(|v| v.is_finite());
         let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(v), hi.max(v))
         });
-        self.points
+        if !(lo.is_finite() && hi.is_finite()) {
+            return "(no values)".into();
+        }
+        let (lo, hi) = if hi - lo < MIN_SPAN {
+            let mid = 0.5 * (lo + hi);
+            (mid - 0.5 * MIN_SPAN, mid + 0.5 * MIN_SPAN)
+        } else {
+            (lo, hi)
+        };
+        let line: String = self
+            .points
             .iter()
             .map(|&v| {
-                if !v.is_finite() {
-                    ' '
-                } else if hi - lo < 1e-12 {
-                    BARS[3]
-                } else {
+                if v.is_finite() {
                     BARS[(((v - lo) / (hi - lo)) * 7.0).round().clamp(0.0, 7.0) as usize]
+                } else {
+                    ' '
                 }
             })
-            .collect()
+            .collect();
+        format!("{line} [{lo:.2} .. {hi:.2}]")
     }
 }
 
@@ -232,5 +244,34 @@ impl View {
             s += &format!("  {e}\n");
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn trend(values: impl IntoIterator<Item = f64>) -> Trend {
+        let mut t = Trend::new("w1 rad/s");
+        for v in values {
+            t.push(v);
+        }
+        t
+    }
+
+    /// +-5 mrad/s of noise on 1.8 rad/s is a flat line with its range written beside it; a
+    /// real ramp fills the height.
+    #[test]
+    fn sparklines_say_their_range_and_do_not_magnify_noise() {
+        let noisy = trend((0..40).map(|i| 1.8 + if i % 2 == 0 { 0.005 } else { -0.005 }));
+        let line = noisy.sparkline();
+        let bars: std::collections::BTreeSet<char> =
+            line.chars().take_while(|c| *c != ' ').collect();
+        assert!(bars.len() <= 2, "{line}");
+        assert!(line.ends_with("[1.30 .. 2.30]"), "{line}");
+        let ramp = trend((0..=30).map(|i| f64::from(i) * 0.1));
+        let line = ramp.sparkline();
+        assert!(line.starts_with('▁') && line.contains('█'), "{line}");
+        assert!(line.ends_with("[0.00 .. 3.00]"), "{line}");
     }
 }
