@@ -1,0 +1,70 @@
+//! A closed pipe is not a crash: `bowl sim sweep | head -1` and `bowl monitor PORT | head -2`
+//! end the way Unix tools do (SIGPIPE, or quietly), never with a panic. A run that cannot be
+//! measured (`sim step --pulses-per-rev 0`) is refused with the flag, the value and the range.
+
+mod common;
+
+use std::io::{BufRead, BufReader};
+use std::os::unix::process::ExitStatusExt;
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+use common::{BOWL, Sim, bowl, wait_within};
+
+/// Runs `bowl ARGS`, reads `lines` lines of its output, closes the pipe; the run must then end
+/// by SIGPIPE or with status 0, and say nothing of a panic.
+fn ends_quietly_when_the_reader_goes(args: &[&str], lines: usize) {
+    let mut child = Command::new(BOWL)
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    for _ in 0..lines {
+        let mut line = String::new();
+        assert!(
+            out.read_line(&mut line).unwrap() > 0,
+            "{args:?}: output ended early"
+        );
+    }
+    drop(out);
+    let status = wait_within(
+        &mut child,
+        Duration::from_secs(30),
+        "bowl after its reader left",
+    );
+    let mut err = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    assert!(
+        status.signal() == Some(nix::libc::SIGPIPE) || status.code() == Some(0),
+        "{args:?}: {status:?}: {err}"
+    );
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+}
+
+#[test]
+fn sim_sweep_into_a_closed_pipe() {
+    ends_quietly_when_the_reader_goes(&["sim", "sweep"], 1);
+}
+
+#[test]
+fn monitor_into_a_closed_pipe() {
+    let sim = Sim::start(&["--seconds", "30"]);
+    ends_quietly_when_the_reader_goes(&["monitor", &sim.path, "--plain"], 2);
+}
+
+#[test]
+fn a_step_with_no_pulses_is_refused_in_plain_words() {
+    let out = bowl(&["sim", "step", "--pulses-per-rev", "0"]);
+    assert_eq!(out.status.code(), Some(2), "a usage error");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("'0'") && err.contains("1..=65535"), "{err}");
+}
