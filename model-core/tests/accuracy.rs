@@ -3,8 +3,10 @@
 //! and tiny omega; and the stability failures our code avoids (naive acosh near the rim, Newton
 //! started at T = 0, f32 just above the threshold).
 //!
-//! Targets: f64 within 1e-12 x condition number, f32 within 2e-6 x condition number.
-//! Run with `--nocapture` to see the worst error/condition ratios.
+//! Target: within 4 epsilons of the number type times the condition number, where the
+//! condition number is the reference's own (the sum over the six inputs of |d ln T / d ln p|,
+//! by perturbing each input in the 320-bit solve), never the code's estimate.
+//! Run with `--nocapture` to see the worst error / (condition x epsilon).
 
 use astro_float::{BigFloat, Consts, RoundingMode};
 use model_core::Real;
@@ -185,8 +187,53 @@ fn grid() -> Vec<Scene<f64>> {
     out
 }
 
-/// Checks one type over the grid; returns (cases that leave, worst error / (condition x tol)).
-fn check<T: Real>(tol: f64, narrow: impl Fn(&Scene<f64>) -> Scene<T>) -> (usize, f64) {
+/// The relative condition numbers of `T` and of `r'(T)` by the reference: for each input `p`,
+/// `|d ln T / d ln p|` from a relative perturbation of about 1e-12 (its exact size as f64 holds
+/// it), summed. `None` if a perturbation crosses the threshold (the verdict itself is then in
+/// doubt, which the flags cover).
+fn reference_conditions(
+    hp: &mut Hp,
+    s: &Scene<f64>,
+    model: Model,
+    t: f64,
+    v: f64,
+) -> Option<(f64, f64)> {
+    let fields: [fn(&mut Scene<f64>) -> &mut f64; 6] = [
+        |s| &mut s.omega_rad_s,
+        |s| &mut s.mu,
+        |s| &mut s.g_m_s2,
+        |s| &mut s.k2,
+        |s| &mut s.ri_m,
+        |s| &mut s.rim_radius_m,
+    ];
+    let (mut ct, mut cv) = (0.0, 0.0);
+    for field in fields {
+        let mut moved = *s;
+        let p = field(&mut moved);
+        if *p == 0.0 {
+            continue;
+        }
+        let before = *p;
+        *p *= 1.0 + 2f64.powi(-40);
+        let h = (*p - before) / before;
+        match hp.solve(&moved, model) {
+            Want::Leaves { time_s, radial_m_s } => {
+                ct += ((time_s - t) / t / h).abs();
+                cv += ((radial_m_s - v) / v / h).abs();
+            }
+            _ => return None,
+        }
+    }
+    Some((ct, cv))
+}
+
+/// Errors allowed, in units of the number type's epsilon times the reference's condition number
+/// (plus one epsilon for the result's own rounding).
+const EPS_BUDGET: f64 = 4.0;
+
+/// Checks one type over the grid; returns (cases that leave, worst error / (condition x eps)).
+fn check<T: Real>(narrow: impl Fn(&Scene<f64>) -> Scene<T>) -> (usize, f64) {
+    let eps = T::EPSILON.to_f64();
     let mut hp = Hp::new();
     let (mut leaves, mut worst) = (0, 0.0f64);
     for s64 in grid() {
@@ -201,20 +248,23 @@ fn check<T: Real>(tol: f64, narrow: impl Fn(&Scene<f64>) -> Scene<T>) -> (usize,
                     Outcome::Leaves {
                         residence_time_s,
                         exit_radial_velocity_m_s,
-                        condition_number,
                         ..
                     },
                 ) => {
                     leaves += 1;
-                    let c = condition_number.to_f64();
+                    // The grid's starts lie at least 1e-9 from the threshold: no perturbation
+                    // crosses it, so every leaving case is checked.
+                    let (ct, cv) =
+                        reference_conditions(&mut hp, &exact, model, *time_s, *radial_m_s)
+                            .unwrap_or_else(|| panic!("{model:?} {exact:?}: perturbation crossed"));
                     let e_t = (residence_time_s.to_f64() - time_s).abs() / time_s;
                     let e_v = (exit_radial_velocity_m_s.to_f64() - radial_m_s).abs() / radial_m_s;
-                    let ratio = e_t.max(e_v) / (c * tol);
+                    let ratio = (e_t / (ct + 1.0)).max(e_v / (cv + 1.0)) / eps;
                     worst = worst.max(ratio);
                     assert!(
-                        ratio <= 1.0,
-                        "{model:?} {exact:?}: T {residence_time_s:?} vs {time_s} (rel {e_t:e}), \
-                         v rel {e_v:e}, condition {c}"
+                        ratio <= EPS_BUDGET,
+                        "{model:?} {exact:?}: T {residence_time_s:?} vs {time_s} (rel {e_t:e}, \
+                         cond {ct:.3e}), v rel {e_v:e} (cond {cv:.3e}): {ratio:.2} eps x cond"
                     );
                 }
                 (Want::AtRim, Outcome::AlreadyAtRim { .. }) => {}
@@ -245,15 +295,15 @@ fn check<T: Real>(tol: f64, narrow: impl Fn(&Scene<f64>) -> Scene<T>) -> (usize,
 }
 
 #[test]
-fn f64_closed_forms_within_1e_12_times_condition() {
-    let (n, worst) = check::<f64>(1e-12, |s| *s);
-    println!("f64: {n} leaving cases, worst error = {worst:.3e} x 1e-12 x condition");
+fn f64_closed_forms_within_4_eps_times_the_reference_condition() {
+    let (n, worst) = check::<f64>(|s| *s);
+    println!("f64: {n} leaving cases, worst error = {worst:.3} eps x condition");
     assert!(n > 200);
 }
 
 #[test]
-fn f32_closed_forms_within_2e_6_times_condition() {
-    let (n, worst) = check::<f32>(2e-6, |s| Scene {
+fn f32_closed_forms_within_4_eps_times_the_reference_condition() {
+    let (n, worst) = check::<f32>(|s| Scene {
         omega_rad_s: s.omega_rad_s as f32,
         mu: s.mu as f32,
         g_m_s2: s.g_m_s2 as f32,
@@ -261,7 +311,7 @@ fn f32_closed_forms_within_2e_6_times_condition() {
         ri_m: s.ri_m as f32,
         rim_radius_m: s.rim_radius_m as f32,
     });
-    println!("f32: {n} leaving cases, worst error = {worst:.3e} x 2e-6 x condition");
+    println!("f32: {n} leaving cases, worst error = {worst:.3} eps x condition");
     assert!(n > 150);
 }
 
