@@ -32,6 +32,15 @@ fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
         && t.precession.duty_bp == 0
         && t.spin.duty_bp == 0));
 
+    // The board was commissioned on its plant before it came up: it runs on identified models.
+    let (rc, models) = split.send(&bowl, &["models"]);
+    assert_eq!(rc, 0, "{models}");
+    assert_eq!(
+        models.matches("identified=1").count(),
+        2,
+        "both motors identified at boot: {models}"
+    );
+
     // Speeds, start, and 6 s of device time.
     assert_eq!(split.send(&bowl, &["speed", "2000", "3000"]).0, 0);
     assert_eq!(split.send(&bowl, &["start"]).0, 0);
@@ -104,6 +113,43 @@ fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
     let from = split.last().time_ms;
     let cleared = split.wait_device_ms(from, 300);
     assert_eq!(cleared.last().unwrap().state, DeviceState::Idle);
+
+    // A blocked precession shaft (the plant blocks it): the stall faults the rig within the
+    // same bound at the precession's pulse rate, both outputs at zero. (CLEAR dropped the
+    // residence target and with it the setpoints.)
+    assert_eq!(split.send(&bowl, &["speed", "2000", "3000"]).0, 0);
+    assert_eq!(split.send(&bowl, &["start"]).0, 0);
+    let restarted_ms = split.last().time_ms;
+    split.wait_device_ms_alive(&bowl, restarted_ms, 3_000);
+    assert_eq!(split.send(&bowl, &["inject", "stall1"]).0, 0);
+    let stalled_ms = split.last().time_ms;
+    let after_stall = split.wait_device_ms_alive(&bowl, stalled_ms, 2_000);
+    let stall_fault = after_stall
+        .iter()
+        .find(|t| t.state == DeviceState::Faulted)
+        .unwrap_or_else(|| {
+            panic!(
+                "the blocked shaft faults the rig: {:?}",
+                &after_stall[after_stall.len().saturating_sub(3)..]
+            )
+        });
+    assert_eq!(stall_fault.fault, FaultCode::SensorLostOrStallPrecession);
+    let pulse_period_ms = 1000.0 * core::f32::consts::TAU / (12.0 * 2.0);
+    let bound_ms = (200.0f32).max(3.0 * pulse_period_ms) + 20.0 + 150.0;
+    let latency = stall_fault.time_ms - stalled_ms;
+    println!("stall fault after {latency} ms of device time (bound {bound_ms:.0} ms)");
+    assert!(
+        (latency as f32) <= bound_ms,
+        "stall fault after {latency} ms"
+    );
+    assert!(
+        after_stall
+            .iter()
+            .filter(|t| t.time_ms >= stall_fault.time_ms)
+            .all(|t| (t.precession.duty_bp, t.spin.duty_bp) == (0, 0))
+    );
+    assert_eq!(split.send(&bowl, &["inject", "none"]).0, 0);
+    assert_eq!(split.send(&bowl, &["clear"]).0, 0);
 
     // The plant's own record: true speeds near the setpoints while running, duties zero
     // after the fault.

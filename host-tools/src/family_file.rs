@@ -63,7 +63,7 @@ mod tests {
     #[test]
     fn the_family_parses_and_stays_inside_its_spread() {
         let text = super::family_toml(3, 20);
-        let rigs = crate::rig_file::parse(&text, "gen", "x").unwrap();
+        let rigs = rig_file::parse(&text, "gen", "x").unwrap();
         assert_eq!(rigs.len(), 20);
         let nominal = model_core::sim::PlantParams::nominal();
         for r in &rigs {

@@ -20,7 +20,6 @@ mod predict;
 mod refusal;
 mod relay;
 mod replay;
-mod rig_file;
 mod send;
 mod serial;
 mod serve;

@@ -47,6 +47,11 @@ pub struct Args {
     /// Seed of the simulated plant's noise (and of the line noise).
     #[arg(long, default_value_t = 1)]
     seed: u32,
+    /// Serve this rig instead of the nominal one: a rig file (docs/rigs/*.toml, keys in
+    /// docs/rigs/nominal.toml); its own `seed` key then seeds the plant's tooth offsets and jitter.
+    /// The virtual rig commissions itself on it before it answers.
+    #[arg(long, value_name = "RIG.toml")]
+    rig_file: Option<PathBuf>,
     /// A noisy line: this percentage of the bytes sent is replaced by a different random byte
     /// (what the PC receives, to try the decoder and the counters; default 0).
     #[arg(long, default_value_t = 0.0)]
@@ -139,9 +144,25 @@ fn script_heartbeat(scripted: bool, now_ms: u32) -> Option<Vec<u8>> {
 pub fn run(args: &Args) -> Result<()> {
     let commands = parse_commands(&args.commands)?;
     let noise = LineNoise::new(args.line_noise_percent, args.seed)?;
+    let new_rig = || match &args.rig_file {
+        None => VirtualRig::new(args.seed),
+        Some(path) => {
+            let rigs = rig_file::load(path)?;
+            let [rig] = rigs.as_slice() else {
+                bail!(
+                    "{} holds {} rigs ([[plant]] tables); bowl serve runs one: give a rig file \
+                     with one rig",
+                    path.display(),
+                    rigs.len()
+                );
+            };
+            VirtualRig::with_plant(rig.params, rig.seed)
+                .with_context(|| format!("the rig in {}", path.display()))
+        }
+    };
     if let Some(path) = &args.capture {
         let seconds = args.seconds.unwrap_or(0.0);
-        return capture(path, seconds, commands, args.seed, noise);
+        return capture(path, seconds, commands, new_rig()?, noise);
     }
     #[cfg(not(unix))]
     if args.pty {
@@ -162,7 +183,7 @@ pub fn run(args: &Args) -> Result<()> {
         let never = AtomicBool::new(false);
         let served = serve_on_pty(
             pty,
-            VirtualRig::new(args.seed)?,
+            new_rig()?,
             Pacing {
                 device_ms_per_wall_ms: 1.0,
                 stop: &never,
@@ -184,7 +205,7 @@ fn capture(
     path: &PathBuf,
     seconds: f64,
     commands: Vec<Scheduled>,
-    seed: u32,
+    mut rig: VirtualRig,
     mut noise: LineNoise,
 ) -> Result<()> {
     if !(seconds.is_finite() && (0.0..=4_000_000.0).contains(&seconds)) {
@@ -193,7 +214,6 @@ fn capture(
     let mut file = BufWriter::new(
         File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
     );
-    let mut rig = VirtualRig::new(seed)?;
     let mut out = Vec::with_capacity(4096);
     rig.boot(&mut out);
     let total_ms = (seconds * 1000.0).round() as u64;

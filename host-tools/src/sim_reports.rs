@@ -3,9 +3,9 @@
 //! fixed JSON shapes docs/control.md describes. Every figure is taken on the plant's *true*
 //! speed, never on the controller's estimate.
 
-use crate::rig_file::Rig;
 use model_core::control::{Controller, ControllerConfig, Fault, State};
 use model_core::sim::{ClosedLoop, Plant};
+use rig_file::Rig;
 use serde::Serialize;
 use std::f64::consts::TAU;
 

@@ -8,13 +8,13 @@
 //! stalled motor gets no drive (its duty never reaches the plant).
 
 use anyhow::{Result, anyhow};
-use model_core::binding::{ControllerBackend, Injector, Record, default_params, persisted};
-use model_core::control::{ControllerConfig, State};
+use model_core::binding::{
+    AssemblyError, ControllerBackend, Injector, Record, commission_on_plant, default_params,
+    persisted,
+};
+use model_core::control::ControllerConfig;
 use model_core::sim::PlantParams;
 use model_core::wire::{Hello, Injection, ParamId, Reason, ResetCause};
-
-/// Simulated seconds of the identification run at boot (it ends much sooner).
-const COMMISSION_MAX_S: f32 = 300.0;
 
 /// The fault injected into the simulation, if any (INJECT replaces it; `NONE` clears it).
 #[derive(Debug, Clone, Copy)]
@@ -54,11 +54,15 @@ pub struct SimulatedBackend {
 }
 
 impl SimulatedBackend {
-    /// The nominal plant (seeded noise) and the nominal controller (told the plant's teeth),
+    /// The nominal plant (seeded noise) and the nominal controller, commissioned on it.
+    pub fn new(seed: u32) -> Result<Self> {
+        Self::with_plant(PlantParams::nominal(), seed)
+    }
+
+    /// The plant (seeded noise) and the nominal controller (told the plant's teeth),
     /// commissioned on the plant as the real rig is once after assembly (through the same
     /// COMMISSION path the wire uses), then at rest at device time 0.
-    pub fn new(seed: u32) -> Result<Self> {
-        let plant_params = PlantParams::nominal();
+    pub fn with_plant(plant_params: PlantParams, seed: u32) -> Result<Self> {
         let base = ControllerConfig::nominal();
         let mut params = default_params();
         for (id, axis) in [(ParamId::Teeth1, 0), (ParamId::Teeth2, 1)] {
@@ -87,27 +91,15 @@ impl SimulatedBackend {
             total_ms: 0,
             now_ms: 0,
         };
-        use model_core::wire::device::Backend as _;
-        sim.rig
-            .commission()
-            .map_err(|r| anyhow!("commissioning refused: {}", r.token()))?;
-        let dt_s = sim.dt_s();
-        for _ in 0..(COMMISSION_MAX_S / dt_s) as u32 {
-            if sim.rig.controller().state() != State::Commissioning {
-                break;
-            }
-            // The rig commissions itself before any host connects: no link to lose.
-            sim.rig.heartbeat();
-            sim.tick(dt_s);
-        }
-        let ctrl = sim.rig.controller();
-        if ctrl.state() != State::Idle {
-            return Err(anyhow!(
-                "commissioning on the simulated plant ended in {:?} ({:?})",
-                ctrl.state(),
-                ctrl.identify_error()
-            ));
-        }
+        commission_on_plant(&mut sim.rig, &mut sim.plant).map_err(|e| match e {
+            AssemblyError::Refused(r) => anyhow!("commissioning refused: {}", r.token()),
+            AssemblyError::Ended(state, why) => anyhow!(
+                "commissioning on the simulated plant ended {} ({}): check the rig's motor, \
+                 supply and friction values",
+                crate::words::controller_state(state),
+                why.map_or("no reason given", |e| e.reason())
+            ),
+        })?;
         sim.ticks = 0;
         sim.rig.set_now_ms(0);
         Ok(sim)

@@ -18,8 +18,13 @@ pub(crate) struct VirtualRig {
 
 impl VirtualRig {
     pub(crate) fn new(seed: u32) -> Result<Self> {
+        Self::with_plant(model_core::sim::PlantParams::nominal(), seed)
+    }
+
+    /// A virtual rig on the given plant (a rig file's), commissioned on it.
+    pub(crate) fn with_plant(plant: model_core::sim::PlantParams, seed: u32) -> Result<Self> {
         Ok(Self {
-            rig: SimulatedBackend::new(seed)?,
+            rig: SimulatedBackend::with_plant(plant, seed)?,
             device: Device::new(),
             now_ms: 0,
         })

@@ -101,7 +101,7 @@ pub fn rejection(e: Rejection) -> String {
         Rejection::InvalidResidenceTime => "the residence time must lie in 1 us ..= 1e6 s".into(),
         Rejection::Inverse(_) => "no bowl speed gives that residence time".into(),
         Rejection::SplitFailed => "the bowl speed cannot be split into motor speeds".into(),
-        Rejection::WrongState(s) => format!("not allowed while {}", state_of(s)),
+        Rejection::WrongState(s) => format!("not allowed while {}", controller_state(s)),
         Rejection::Faulted(_) => "the rig is faulted: clear the fault first".into(),
         Rejection::NotFaulted => "there is no fault to clear".into(),
         Rejection::InvalidConfig(c) => config(c),
@@ -109,7 +109,8 @@ pub fn rejection(e: Rejection) -> String {
     }
 }
 
-fn state_of(s: ControllerState) -> &'static str {
+/// The controller's state in plain words.
+pub fn controller_state(s: ControllerState) -> &'static str {
     match s {
         ControllerState::Idle => "idle",
         ControllerState::Commissioning => "commissioning",

@@ -3,6 +3,7 @@ emulated board: it reads TIM1's PWM outputs and the DIR pins (PB12, PB13), steps
 and delivers each sensor edge to TIM2's capture channels at its own time."""
 
 import ctypes
+import os
 from collections import deque
 
 # The plant runs this far ahead of the CPU: one physics step (a quarter control period).
@@ -29,6 +30,9 @@ def load_library(path: str):
     lib.plant_params_nominal.argtypes = [ctypes.POINTER(RigParams)]
     lib.plant_new.argtypes = [ctypes.POINTER(RigParams), ctypes.c_uint32]
     lib.plant_new.restype = ctypes.c_void_p
+    lib.plant_new_from_rig_file.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_char_p,
+                                            ctypes.c_uint32]
+    lib.plant_new_from_rig_file.restype = ctypes.c_void_p
     lib.plant_free.argtypes = [ctypes.c_void_p]
     lib.plant_advance.argtypes = [ctypes.c_void_p, ctypes.c_float, ctypes.c_float, ctypes.c_float]
     lib.plant_edges.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.POINTER(ctypes.c_uint32),
@@ -39,16 +43,29 @@ def load_library(path: str):
     return lib
 
 
+class RigFileError(ValueError):
+    """A rig file the plant library refused; the message names the file, line, key and range."""
+
+
 class RigPlant:
-    def __init__(self, library_path: str, seed: int = 1):
+    def __init__(self, library_path: str, seed: int = 1, rig_file=None):
+        """The nominal rig, or the rig a rig file describes (docs/rigs/*.toml; its seed then
+        comes from the file)."""
         self.lib = load_library(library_path)
-        params = RigParams()
-        if self.lib.plant_params_nominal(ctypes.byref(params)) != 0:
-            raise RuntimeError("plant_params_nominal failed")
-        params.timer_hz = PLANT_TIMER_HZ
-        self.handle = self.lib.plant_new(ctypes.byref(params), seed)
-        if not self.handle:
-            raise RuntimeError("plant_new failed")
+        if rig_file is None:
+            params = RigParams()
+            if self.lib.plant_params_nominal(ctypes.byref(params)) != 0:
+                raise RuntimeError("plant_params_nominal failed")
+            params.timer_hz = PLANT_TIMER_HZ
+            self.handle = self.lib.plant_new(ctypes.byref(params), seed)
+            if not self.handle:
+                raise RuntimeError("plant_new failed")
+        else:
+            message = ctypes.create_string_buffer(1024)
+            self.handle = self.lib.plant_new_from_rig_file(os.fsencode(rig_file), PLANT_TIMER_HZ,
+                                                           message, len(message))
+            if not self.handle:
+                raise RigFileError(message.value.decode(errors="replace"))
         self.time_ns = 0
         self.edges = deque()  # (time_ns, axis)
         self.buf = (ctypes.c_uint32 * 64)()

@@ -24,7 +24,7 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
 
 from machine import EmulationError, Machine  # noqa: E402
-from plant import RigPlant  # noqa: E402
+from plant import RigFileError, RigPlant  # noqa: E402
 from pty_link import PtyLink  # noqa: E402
 
 
@@ -69,6 +69,8 @@ def main():
     ap.add_argument("--flash-file", default=d["flash"])
     ap.add_argument("--log-dir", default=d["logs"])
     ap.add_argument("--defmt-print", default=d["defmt_print"])
+    ap.add_argument("--rig-file", default=None,
+                    help="the rig the plant simulates (docs/rigs/*.toml); the nominal rig if left out")
     ap.add_argument("--seconds", type=float, default=3600.0)
     ap.add_argument("--pty-link", default=None, help="also make this symlink to the pty")
     ap.add_argument("--stop-file", default=None)
@@ -81,8 +83,11 @@ def main():
             sys.exit(f"error: the {what} {path} does not exist: build it first "
                      "(cargo fw; cargo build -p plant-ffi)")
     os.makedirs(os.path.dirname(args.flash_file), exist_ok=True)
+    try:
+        plant = RigPlant(args.plant_lib, rig_file=args.rig_file)
+    except RigFileError as e:
+        sys.exit(f"error: {e}")
     link = PtyLink(args.pty_link)
-    plant = RigPlant(args.plant_lib)
     m = Machine(args.elf, args.flash_file, plant=plant, link=link,
                 defmt_print=args.defmt_print, log_dir=args.log_dir, realtime=True)
     print(f"pty: {link.path}", flush=True)

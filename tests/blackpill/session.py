@@ -25,9 +25,10 @@ ANSWER_TIMEOUT_MS = 8000
 
 
 class Session:
-    def __init__(self, flash_path: str, realtime: bool = True, seed: int = 1, hse_hz=None):
+    def __init__(self, flash_path: str, realtime: bool = True, seed: int = 1, hse_hz=None,
+                 rig_file=None):
+        self.plant = RigPlant(PLANT_LIB, seed, rig_file)
         self.link = PtyLink()
-        self.plant = RigPlant(PLANT_LIB, seed)
         extra = {} if hse_hz is None else {"hse_hz": hse_hz}
         self.machine = Machine(ELF, flash_path, plant=self.plant, link=self.link,
                                defmt_print=DEFMT_PRINT, log_dir=LOGS, realtime=realtime, **extra)

@@ -27,8 +27,9 @@ use firmware::app::tasks::{self, Heartbeat, SharedCore};
 use firmware::qemu::plant::{self, PlantClock, PlantInjector, SimMotor};
 use firmware::qemu::watchdog::SoftWatchdog;
 use firmware::qemu::{self, executor, time_driver, usart};
+use model_core::binding::{AssemblyError, commission_on_plant};
 use model_core::control::ControllerConfig;
-use model_core::sim::PlantParams;
+use model_core::sim::{Plant, PlantParams};
 use model_core::wire::{Hello, ResetCause};
 
 type Core = SharedCore<ThreadModeRawMutex, DeviceCore<PlantInjector>>;
@@ -41,6 +42,8 @@ const WATCHDOG_TIMEOUT_US: u64 = 250_000;
 /// How late a control tick's work may end: the plant task shares this executor (the Black
 /// Pill's image has no plant), and a plant step can hold the CPU past the next tick.
 const CONTROL_DEADLINE: Duration = Duration::from_millis(20);
+/// Seed of the plant's tooth offsets and jitter.
+const PLANT_SEED: u32 = 1;
 /// Truth log period.
 const TRUTH_EVERY_MS: u32 = 500;
 
@@ -69,10 +72,13 @@ async fn supervisor_task() {
 }
 
 #[embassy_executor::task]
-async fn plant_task() {
+async fn plant_task(rig: Plant) {
     let mut next_log_ms = 0u32;
-    plant::run(PlantParams::nominal(), 1, |rig| {
-        let t_ms = (rig.time_s() * 1000.0) as u32;
+    // The truth log counts from power-on, as the device time does, not from the plant's
+    // commissioning run before it.
+    let boot_s = rig.time_s();
+    plant::run(rig, move |rig| {
+        let t_ms = ((rig.time_s() - boot_s) * 1000.0) as u32;
         if t_ms >= next_log_ms {
             next_log_ms = t_ms + TRUTH_EVERY_MS;
             let d = plant::duties();
@@ -118,19 +124,34 @@ fn run_seconds() -> Option<u32> {
 fn main() -> ! {
     let resets = reset::count_this_boot();
     let core_p = cortex_m::Peripherals::take().unwrap_or_else(|| qemu::exit(false));
-    time_driver::start(core_p.SYST);
-    let (tx, rx) = usart::enable();
     let hello = Hello {
         reset_cause: ResetCause::Unknown,
         reset_count: resets as u16,
     };
-    // The emulated board has no parameter flash: it boots with the defaults every time.
-    let (rig, _) = ControllerBackend::new(
+    // The emulated board keeps no parameters across a power cycle: it boots with the defaults,
+    // then is commissioned on its plant as a real rig is once after assembly (and as the host's
+    // virtual rig is), so it runs on the models it identified, not on the datasheet's.
+    let (mut rig, _) = ControllerBackend::new(
         ControllerConfig::nominal(),
         default_persisted(),
         hello,
         PlantInjector,
     );
+    let mut plant = Plant::new(PlantParams::nominal(), PLANT_SEED);
+    match commission_on_plant(&mut rig, &mut plant) {
+        Ok(()) => hprintln!("qemu-rig: commissioned on the plant"),
+        Err(e) => hprintln!(
+            "qemu-rig: commissioning on the plant failed ({}); running on the nominal models",
+            match e {
+                AssemblyError::Ended(_, Some(why)) => why.reason(),
+                AssemblyError::Ended(_, None) => "it did not end idle",
+                AssemblyError::Refused(_) => "COMMISSION was refused",
+            }
+        ),
+    }
+    // Device time starts now, after the commissioning run (which took CPU time, not plant time).
+    time_driver::start(core_p.SYST);
+    let (tx, rx) = usart::enable();
     let core = CORE
         .put(Mutex::new(RefCell::new(DeviceCore::new(rig))))
         .unwrap_or_else(|| qemu::exit(false));
@@ -138,7 +159,7 @@ fn main() -> ! {
     hprintln!("qemu-rig: up, run for {:?} s of virtual time", seconds);
     executor::start(|spawner| {
         let ok = [
-            plant_task().map(|t| spawner.spawn(t)).is_ok(),
+            plant_task(plant).map(|t| spawner.spawn(t)).is_ok(),
             control_task(core).map(|t| spawner.spawn(t)).is_ok(),
             link_task(core, rx, tx).map(|t| spawner.spawn(t)).is_ok(),
             supervisor_task().map(|t| spawner.spawn(t)).is_ok(),

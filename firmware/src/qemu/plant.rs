@@ -12,7 +12,7 @@
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use embassy_time::{Duration, Instant, Ticker};
-use model_core::sim::{Plant, PlantParams};
+use model_core::sim::Plant;
 use model_core::wire::{Injection, Reason};
 
 use crate::app::binding::Injector;
@@ -28,6 +28,8 @@ static DUTIES: [AtomicU32; 2] = [AtomicU32::new(0), AtomicU32::new(0)];
 static NOW_TICKS: AtomicU32 = AtomicU32::new(0);
 /// Sensors whose edges no longer reach the firmware.
 static SENSOR_DEAD: [AtomicBool; 2] = [AtomicBool::new(false), AtomicBool::new(false)];
+/// Shafts blocked by INJECT STALL (the plant task blocks them in the simulation).
+static BLOCKED: [AtomicBool; 2] = [AtomicBool::new(false), AtomicBool::new(false)];
 
 /// Plant step: the control tick rate, so each tick sees the edges of one step.
 pub const PLANT_PERIOD: Duration = Duration::from_millis(1);
@@ -65,8 +67,8 @@ impl CaptureClock for PlantClock {
     }
 }
 
-/// Sensor injections go to the plant; a blocked shaft needs support inside the simulation
-/// that it does not offer at run time, so those are refused.
+/// Injections go to the plant: a lost sensor's edges stop reaching the firmware, a stalled
+/// shaft is blocked inside the simulation from its next step on.
 pub struct PlantInjector;
 
 impl Injector for PlantInjector {
@@ -74,18 +76,21 @@ impl Injector for PlantInjector {
         match what {
             Injection::None => SENSOR_DEAD
                 .iter()
+                .chain(&BLOCKED)
                 .for_each(|d| d.store(false, Ordering::Relaxed)),
             Injection::SensorLostPrecession => SENSOR_DEAD[0].store(true, Ordering::Relaxed),
             Injection::SensorLostSpin => SENSOR_DEAD[1].store(true, Ordering::Relaxed),
-            Injection::StallPrecession | Injection::StallSpin => return Err(Reason::Unsupported),
+            Injection::StallPrecession => BLOCKED[0].store(true, Ordering::Relaxed),
+            Injection::StallSpin => BLOCKED[1].store(true, Ordering::Relaxed),
         }
         Ok(())
     }
 }
 
-/// Runs the plant forever; `observe` sees the rig after every step (for the truth log).
-pub async fn run(params: PlantParams, seed: u32, mut observe: impl FnMut(&Plant)) -> ! {
-    let mut rig = Plant::new(params, seed);
+/// Runs the plant forever from its present state; `observe` sees the rig after every step (for
+/// the truth log).
+pub async fn run(mut rig: Plant, mut observe: impl FnMut(&Plant)) -> ! {
+    NOW_TICKS.store(rig.now_ticks(), Ordering::Relaxed);
     let mut ticker = Ticker::every(PLANT_PERIOD);
     let mut last = Instant::now();
     loop {
@@ -93,6 +98,14 @@ pub async fn run(params: PlantParams, seed: u32, mut observe: impl FnMut(&Plant)
         let now = Instant::now();
         let dt_s = (now - last).as_micros() as f32 * 1e-6;
         last = now;
+        for (axis, blocked) in BLOCKED.iter().enumerate() {
+            let from_s = &mut rig.params_mut().axes[axis].faults.blocked_from_s;
+            match (blocked.load(Ordering::Relaxed), from_s.is_finite()) {
+                (true, false) => *from_s = 0.0,
+                (false, true) => *from_s = f32::INFINITY,
+                _ => {}
+            }
+        }
         rig.advance(duties(), dt_s);
         for (axis, queue) in EDGES.iter().enumerate() {
             if !SENSOR_DEAD[axis].load(Ordering::Relaxed) {

@@ -3,8 +3,8 @@
 
 use super::plot::{Figure, Mark, Scale, Series, VLine};
 use super::table::Table;
-use crate::rig_file::Rig;
 use crate::sim_reports::{self, PlantStep};
+use rig_file::Rig;
 
 /// Settling shown for an axis that never settled (the end of the run), s.
 fn never_s(target: f32) -> f64 {

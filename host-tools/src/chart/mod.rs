@@ -368,7 +368,7 @@ pub fn run(args: &Args) -> Result<()> {
             write_all(out, &f, &t)
         }
         Which::Family(a) => {
-            let rigs = crate::rig_file::load(&a.rig_file)?;
+            let rigs = rig_file::load(&a.rig_file)?;
             let name = a
                 .rig_file
                 .file_name()

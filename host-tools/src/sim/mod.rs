@@ -17,7 +17,7 @@ use anyhow::{Result, bail};
 use model_core::control::ControllerConfig;
 use model_core::sim::experiments::rig_with_pulses;
 
-use crate::{family_file, rig_file, sim_reports};
+use crate::{family_file, sim_reports};
 
 mod nominal;
 

@@ -7,7 +7,7 @@ use model_core::sim::experiments::{self, STEP_RUN_S, family_plant, rig_with_puls
 use model_core::sim::{ClosedLoop, Plant, PlantParams, StepReport};
 use serde::Serialize;
 
-use crate::{rig_file, sim_reports};
+use crate::sim_reports;
 
 /// The step-response figures of one axis.
 #[derive(Serialize, Clone, Copy, Debug)]

@@ -7,17 +7,21 @@
 //! - [`configure`]: wire parameters (the table in [`crate::wire::params`]) to the controller's
 //!   configuration and the particle scene, and when each may change;
 //! - [`record`]: the layout of the record persisted in flash (parameters and motor models);
-//! - [`backend`]: [`ControllerBackend`], the controller and the scene behind the protocol.
+//! - [`backend`]: [`ControllerBackend`], the controller and the scene behind the protocol;
+//! - [`assembly`]: commissioning on a simulated plant before a virtual rig or an emulated board
+//!   starts.
 //!
 //! The parameters in force are kept in wire units (what SET sent is what PARAMS reports,
 //! exactly), and the controller's configuration is derived from them. A value the scene check
 //! or the controller's validation refuses is rejected with `RANGE` (or `STATE` when the
 //! controller is busy) and changes nothing.
 
+pub mod assembly;
 pub mod backend;
 pub mod configure;
 pub mod record;
 
+pub use assembly::{ASSEMBLY_COMMISSION_MAX_S, AssemblyError, commission_on_plant};
 pub use backend::ControllerBackend;
 pub use configure::{
     OVERSPEED_PER_MAX, ParamRole, config_from_params, default_params, scene_from_params,

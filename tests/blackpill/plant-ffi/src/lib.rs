@@ -10,6 +10,7 @@
 //! Every function takes a pointer returned by [`plant_new`]; a null pointer or an axis other
 //! than 0 or 1 is refused (a negative or zero result), never a crash.
 
+use core::ffi::{CStr, c_char};
 use model_core::sim::{Plant, PlantParams};
 
 /// The rig parameters the harness may set, flat and `repr(C)`. [`plant_params_nominal`] fills
@@ -33,16 +34,21 @@ pub struct RigParams {
     pub ripple_nm: [f32; 2],
 }
 
+/// What the harness needs of any plant, whatever the rig: a 32-bit capture clock at
+/// `timer_hz`, and one physics step per call of [`plant_advance`] (the harness advances in a
+/// quarter of a control period, the nominal rig's step length).
+fn fit_to_harness(p: &mut PlantParams, timer_hz: u32) {
+    p.timer_hz = timer_hz;
+    p.timer_bits = 32;
+    p.substeps = 1;
+}
+
 impl RigParams {
     fn to_plant(self) -> PlantParams {
         let mut p = PlantParams::nominal();
         p.supply_v = self.supply_v;
         p.coupling = self.coupling;
-        p.timer_hz = self.timer_hz;
-        p.timer_bits = 32;
-        // The harness advances in short steps (a quarter of a control period): one physics
-        // step each keeps the nominal rig's step length.
-        p.substeps = 1;
+        fit_to_harness(&mut p, self.timer_hz);
         for (i, axis) in p.axes.iter_mut().enumerate() {
             axis.sensor.pulses_per_rev = self.pulses_per_rev[i].max(1);
             axis.sensor.tooth_error = self.tooth_error[i];
@@ -93,6 +99,59 @@ pub unsafe extern "C" fn plant_new(params: *const RigParams, seed: u32) -> *mut 
         Some(p) => Box::into_raw(Box::new(Plant::new(p.to_plant(), seed))),
         None => core::ptr::null_mut(),
     }
+}
+
+/// A new plant for the rig described by the rig file at `path` (docs/rigs/nominal.toml lists
+/// the keys), its capture clock at `timer_hz`; the file's own seed drives its tooth offsets and
+/// jitter. On a bad file returns null and writes the reader's message (file, line, key, range),
+/// NUL-terminated and cut to `message_cap` bytes, to `message`.
+///
+/// # Safety
+/// `path` is null or a NUL-terminated string; `message` is null or writable for `message_cap`
+/// bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_new_from_rig_file(
+    path: *const c_char,
+    timer_hz: u32,
+    message: *mut c_char,
+    message_cap: u32,
+) -> *mut Plant {
+    let report = |text: &str| {
+        if message.is_null() || message_cap == 0 {
+            return;
+        }
+        let n = text.len().min(message_cap as usize - 1);
+        // SAFETY: the caller gives `message_cap` writable bytes; n + 1 <= message_cap.
+        unsafe {
+            core::ptr::copy_nonoverlapping(text.as_ptr().cast::<c_char>(), message, n);
+            *message.add(n) = 0;
+        }
+    };
+    if path.is_null() {
+        report("no rig file path was given");
+        return core::ptr::null_mut();
+    }
+    // SAFETY: the caller passes a NUL-terminated string.
+    let path = unsafe { CStr::from_ptr(path) }
+        .to_string_lossy()
+        .into_owned();
+    let rigs = match rig_file::load(std::path::Path::new(&path)) {
+        Ok(rigs) => rigs,
+        Err(e) => {
+            report(&format!("{e:#}"));
+            return core::ptr::null_mut();
+        }
+    };
+    let [rig] = rigs.as_slice() else {
+        report(&format!(
+            "{path} holds {} rigs ([[plant]] tables); the emulated board runs one: give a file with one rig",
+            rigs.len()
+        ));
+        return core::ptr::null_mut();
+    };
+    let mut params = rig.params;
+    fit_to_harness(&mut params, timer_hz);
+    Box::into_raw(Box::new(Plant::new(params, rig.seed)))
 }
 
 /// Frees a plant from [`plant_new`] (null is ignored).
@@ -224,5 +283,54 @@ mod tests {
             plant_free(p);
             assert_eq!(plant_advance(core::ptr::null_mut(), 0.0, 0.0, 0.001), -1);
         }
+    }
+
+    fn spin_speed_after_a_tenth_of_a_second(p: *mut Plant) -> f32 {
+        let mut buf = [0u32; 64];
+        // SAFETY: a live plant and a valid buffer.
+        unsafe {
+            for _ in 0..400 {
+                assert_eq!(plant_advance(p, 0.0, 0.8, 0.00025), 0);
+                plant_edges(p, 1, buf.as_mut_ptr(), 64);
+            }
+            plant_speed_rad_s(p, 1)
+        }
+    }
+
+    #[test]
+    fn a_rig_file_plant_is_the_rig_it_describes() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../docs/rigs/");
+        let mut message = [0 as c_char; 256];
+        let open = |name: &str, message: &mut [c_char; 256]| {
+            let path = std::ffi::CString::new(format!("{dir}{name}")).unwrap();
+            // SAFETY: valid strings and buffer.
+            unsafe { plant_new_from_rig_file(path.as_ptr(), 1_000_000, message.as_mut_ptr(), 256) }
+        };
+        let nominal = open("nominal.toml", &mut message);
+        let heavy = open("heavy-bowl.toml", &mut message);
+        assert!(!nominal.is_null() && !heavy.is_null());
+        // Three times the spin inertia: the heavy bowl gains speed at most a third as fast in the
+        // first tenth of a second at the same duty (friction takes more of its torque too).
+        let (w_nominal, w_heavy) = (
+            spin_speed_after_a_tenth_of_a_second(nominal),
+            spin_speed_after_a_tenth_of_a_second(heavy),
+        );
+        assert!(
+            w_heavy < 0.8 * w_nominal,
+            "heavy {w_heavy} vs nominal {w_nominal} rad/s"
+        );
+        // SAFETY: both came from plant_new_from_rig_file.
+        unsafe {
+            plant_free(nominal);
+            plant_free(heavy);
+        }
+        let missing = open("no-such-rig.toml", &mut message);
+        assert!(missing.is_null());
+        // SAFETY: the function NUL-terminated the message.
+        let text = unsafe { CStr::from_ptr(message.as_ptr()) }.to_string_lossy();
+        assert!(
+            text.contains("cannot read the rig file") && text.contains("no-such-rig.toml"),
+            "{text}"
+        );
     }
 }

@@ -116,6 +116,17 @@ pub fn parse(text: &str, file: &str, default_name: &str) -> Result<Vec<Rig>> {
     Ok(rigs)
 }
 
+/// `x` as written by a person: the plant holds f32, so a nominal 0.02 reads 0.02, not the
+/// f64 digits of the nearest f32.
+fn shortest(x: f64) -> String {
+    let narrow = x as f32;
+    if f64::from(narrow) == x {
+        format!("{narrow}")
+    } else {
+        format!("{x}")
+    }
+}
+
 struct Checker<'a> {
     file: &'a str,
     at: &'a dyn Fn(usize) -> usize,
@@ -130,10 +141,13 @@ impl Checker<'_> {
             Ok(x)
         } else {
             Err(anyhow!(
-                "rig file {}, line {}: {key} = {x} is outside its range {lo} to {hi}; \
-                 change it or leave the key out for the nominal value {default}",
+                "rig file {}, line {}: {key} = {x} is outside its range {} to {}; \
+                 change it or leave the key out for the nominal value {}",
                 self.file,
-                (self.at)(v.span().start)
+                (self.at)(v.span().start),
+                shortest(lo),
+                shortest(hi),
+                shortest(default)
             ))
         }
     }
