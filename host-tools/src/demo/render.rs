@@ -77,7 +77,7 @@ pub fn text(s: &Summary) -> String {
         o += &format!(
             "fault at t={:.3} s: {} detected after {} (expected {}), both duties 0 after {}, stayed off {}, precession {:.3} -> {:.3} rad/s (stopped after {})\n",
             f.injected_at_s,
-            f.fault.as_deref().unwrap_or("NONE"),
+            f.fault_text.as_deref().unwrap_or("no fault"),
             opt(f.detection_s, "s"),
             f.expected_detection_s
                 .map_or("-".into(), |[a, b]| format!("{a:.3}..{b:.3} s")),

@@ -101,8 +101,10 @@ pub struct Step {
 pub struct FaultReaction {
     /// Device time of the injection (last telemetry frame before the rig's answer), s.
     pub injected_at_s: f64,
-    /// The fault the rig reported.
+    /// The fault the rig reported (its protocol name).
     pub fault: Option<String>,
+    /// The same in plain words.
+    pub fault_text: Option<String>,
     /// From the injection to the first frame reporting the fault, s.
     pub detection_s: Option<f64>,
     /// When the fault must be seen, s after the injection: the controller's sensor timeout
