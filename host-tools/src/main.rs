@@ -45,7 +45,7 @@ enum Command {
     /// Charts: work-precision (error against cost), and the paper's Figures 5-7 redrawn.
     Chart(chart::Args),
     /// Residence time and exit velocities of a particle (paper Eq. 5-12, corrected), or a batch CSV.
-    Predict(predict::Args),
+    Predict(Box<predict::Args>),
     /// Live view of the rig's telemetry, with CSV log and frame counters.
     Monitor(monitor::Args),
     /// The serial ports on this computer, with their USB descriptions.

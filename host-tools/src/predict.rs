@@ -7,8 +7,10 @@ use anyhow::{Result, anyhow};
 use model_core::particle::{self, Model, Outcome, Scene};
 
 mod batch;
+mod choice;
 mod ode;
 mod rolling;
+mod trace;
 mod words;
 
 pub use rolling::words as rolling_words;
@@ -17,6 +19,9 @@ pub use words::scene as scene_words;
 /// Which model(s) to evaluate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum ModelChoice {
+    /// The chooser picks the least model the scene needs (the tolerance from --tolerance or
+    /// --uncertainty) and says why.
+    Auto,
     /// Paper Eq. 5 to 7: no Coriolis term.
     Flat,
     /// Paper Eq. 9 to 11 with the corrected A, B.
@@ -64,9 +69,23 @@ pub struct Args {
     /// k2 = m rp^2 / (I + m rp^2): 5/7 solid sphere, 3/5 hollow.
     #[arg(long, default_value_t = 5.0 / 7.0)]
     k2: f64,
-    /// Model: flat, coriolis or both.
-    #[arg(long, value_enum, default_value_t = ModelChoice::Both)]
+    /// Model: auto (the chooser), flat, coriolis, both or rolling.
+    #[arg(long, value_enum, default_value_t = ModelChoice::Auto)]
     model: ModelChoice,
+    /// The chooser: relative tolerance on T (0.01 = 1 %).
+    #[arg(long, conflicts_with = "uncertainty")]
+    tolerance: Option<f64>,
+    /// The chooser: the parameters' uncertainty, `mu=REL,radius_m=M,omega=REL` (default
+    /// mu=0.2,radius_m=0.001,omega=0.01); the tolerance is a tenth of the spread it causes in T.
+    #[arg(long, value_name = "mu=REL,radius_m=M,omega=REL")]
+    uncertainty: Option<String>,
+    /// The bowl speed from a logged run (bowl monitor --log, bowl replay --csv): the chooser
+    /// decides between the closed form at the mean speed and an integrator over the trace.
+    #[arg(long, value_name = "RUN.csv")]
+    omega_trace: Option<std::path::PathBuf>,
+    /// With --omega-trace: the device time of the release, ms (default: the log's first row).
+    #[arg(long, requires = "omega_trace")]
+    release_at_ms: Option<f64>,
     /// Method: closed form or one of the integrators.
     #[arg(long, value_enum, default_value_t = MethodChoice::Closed)]
     method: MethodChoice,
@@ -107,7 +126,7 @@ pub struct Prediction {
     pub check: Option<ode::StepCheck>,
 }
 
-fn model_name(m: Model) -> &'static str {
+pub(crate) fn model_name(m: Model) -> &'static str {
     match m {
         Model::Flat => "flat",
         Model::Coriolis => "coriolis",
@@ -163,13 +182,38 @@ pub fn run(args: &Args) -> Result<()> {
         ri_m: args.ri_m,
         rim_radius_m: args.rim_radius_m,
     };
+    let need = choice::need(args.tolerance, args.uncertainty.as_deref())?;
+    if let Some(path) = &args.omega_trace {
+        if args.model != ModelChoice::Auto || args.method != MethodChoice::Closed {
+            anyhow::bail!(
+                "--omega-trace lets the chooser pick the model and the method: leave out \
+                 --model and --method (give --tolerance or --uncertainty instead)"
+            );
+        }
+        return trace::run(&scene, path, args.release_at_ms, &need, args.json);
+    }
+    words::check(&scene)?;
+    const BOTH: &[Model] = &[Model::Flat, Model::Coriolis];
+    let mut chosen = None;
     let models: &[Model] = match args.model {
         ModelChoice::Flat => &[Model::Flat],
         ModelChoice::Coriolis => &[Model::Coriolis],
-        ModelChoice::Both => &[Model::Flat, Model::Coriolis],
+        ModelChoice::Both => BOTH,
+        ModelChoice::Auto if args.target_time_s.is_some() => BOTH,
+        ModelChoice::Auto => match model_core::choose::choose_constant_for(&scene, &need) {
+            Ok(c) => {
+                chosen = Some(c);
+                match c.model {
+                    Model::Flat => &[Model::Flat],
+                    Model::Coriolis => &[Model::Coriolis],
+                }
+            }
+            // Nothing to choose between: both models say so below.
+            Err(model_core::choose::ChooseError::DoesNotLeave) => BOTH,
+            Err(e) => anyhow::bail!(choice::error_words(e)),
+        },
         ModelChoice::Rolling => return rolling::run(args, &args.rolling),
     };
-    words::check(&scene)?;
     if let Some(target) = args.target_time_s {
         return run_inverse(&scene, models, target, args.json);
     }
@@ -186,12 +230,19 @@ pub fn run(args: &Args) -> Result<()> {
             .iter()
             .map(|(m, p)| json_result(*m, args.method, p))
             .collect();
-        println!(
-            "{}",
-            serde_json::json!({ "scene": json_scene(&scene), "results": results })
-        );
+        let mut v = serde_json::json!({ "scene": json_scene(&scene), "results": results });
+        if let (Some(c), Some(obj)) = (&chosen, v.as_object_mut()) {
+            obj.insert("choice".into(), choice::json(c));
+        }
+        println!("{v}");
     } else {
         println!("{}", describe_scene(&scene));
+        if let Some(c) = &chosen {
+            println!(
+                "{}\n  (--model flat, coriolis or both to override)",
+                choice::describe(c, &need)
+            );
+        }
         for (m, p) in &rows {
             println!("{}", describe(*m, args.method, p));
         }

@@ -446,3 +446,156 @@ fn a_coarse_step_is_warned_and_the_suggested_step_is_accurate() {
         assert!((t - t_ref).abs() / t_ref < 0.01, "{method}: {t} vs {t_ref}");
     }
 }
+
+#[test]
+fn the_chooser_answers_by_default_and_its_reason_holds() {
+    let auto = json(&["predict", "--json"]);
+    let both = json(&["predict", "--model", "both", "--json"]);
+    let t = |v: &serde_json::Value, i: usize| v["results"][i]["residence_time_s"].as_f64().unwrap();
+    let (tf, tc) = (t(&both, 0), t(&both, 1));
+    let effect = (tc - tf).abs() / tf;
+    let c = &auto["choice"];
+    assert!(
+        (c["coriolis_effect_rel"].as_f64().unwrap() - effect).abs() < 1e-12,
+        "{c}"
+    );
+    // The default uncertainty (mu 20 %): the spread of T, measured here by moving mu alone by
+    // 20 %, exceeds the Coriolis term, so flat is enough and the chooser says so.
+    let at_mu = |mu: &str| {
+        t(
+            &json(&["predict", "--model", "coriolis", "--mu", mu, "--json"]),
+            0,
+        )
+    };
+    let mu_spread = (at_mu("0.0348") - tc)
+        .abs()
+        .max((at_mu("0.0232") - tc).abs())
+        / tc;
+    assert!(mu_spread > 10.0 * effect, "{mu_spread} vs {effect}");
+    assert_eq!(c["model"], "flat", "{c}");
+    assert_eq!(c["coriolis_below_uncertainty"], true, "{c}");
+    assert_eq!(auto["results"].as_array().unwrap().len(), 1);
+    assert_eq!(t(&auto, 0), tf);
+    let text = String::from_utf8(bowl(&["predict"]).stdout).unwrap();
+    assert!(
+        text.contains("chosen: flat model, closed form")
+            && text.contains("the Coriolis term is below the uncertainty here"),
+        "{text}"
+    );
+    // A tolerance tighter than the Coriolis term: the Coriolis model answers.
+    let tight = json(&["predict", "--tolerance", "1e-6", "--json"]);
+    assert_eq!(tight["choice"]["model"], "coriolis");
+    assert_eq!(t(&tight, 0), tc);
+    let out = bowl(&["predict", "--tolerance", "2"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("between 0 and 0.1"));
+}
+
+/// A telemetry log with the bowl speed `omega(t)` every 20 ms for `seconds`.
+fn write_trace(path: &std::path::Path, seconds: f64, omega: impl Fn(f64) -> f64) {
+    let mut text = String::from("boot,device_time_ms,bowl_mrad_s,event\n");
+    let n = (seconds / 0.02) as usize;
+    for i in 0..=n {
+        let t = i as f64 * 0.02;
+        text += &format!("1,{},{:.0},\n", 1000 + i * 20, omega(t) * 1000.0);
+    }
+    text += ",,,link lost\n";
+    std::fs::write(path, text).unwrap();
+}
+
+/// The residence time on a piecewise-linear speed trace (the log's samples, in rad/s, every
+/// 20 ms), by RK4 at a 10 us step with static friction holding the particle while
+/// r omega^2 <= mu g: an independent reference for `--omega-trace`.
+fn reference_time(samples: &[f64], coriolis: bool) -> f64 {
+    let (mu, g, k2, ri, rim) = (0.029, 9.81, 5.0 / 7.0, 0.05, 0.1);
+    let w = |t: f64| {
+        let x = t / 0.02;
+        let i = (x.floor() as usize).min(samples.len() - 1);
+        let j = (i + 1).min(samples.len() - 1);
+        samples[i] + (samples[j] - samples[i]) * (x - i as f64)
+    };
+    let c = if coriolis { 1.0 } else { 0.0 };
+    let acc = |t: f64, r: f64, v: f64| {
+        let wt = w(t);
+        if v == 0.0 && r * wt * wt <= mu * g {
+            0.0
+        } else {
+            k2 * (r * wt * wt - mu * g - c * 2.0 * mu * wt * v)
+        }
+    };
+    let (mut t, mut r, mut v, h) = (0.0, ri, 0.0, 1e-5);
+    loop {
+        let (k1r, k1v) = (v, acc(t, r, v));
+        let (k2r, k2v) = (
+            v + 0.5 * h * k1v,
+            acc(t + 0.5 * h, r + 0.5 * h * k1r, v + 0.5 * h * k1v),
+        );
+        let (k3r, k3v) = (
+            v + 0.5 * h * k2v,
+            acc(t + 0.5 * h, r + 0.5 * h * k2r, v + 0.5 * h * k2v),
+        );
+        let (k4r, k4v) = (v + h * k3v, acc(t + h, r + h * k3r, v + h * k3v));
+        let r1 = r + h / 6.0 * (k1r + 2.0 * k2r + 2.0 * k3r + k4r);
+        let v1 = v + h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+        if r1 >= rim {
+            return t + h * (rim - r) / (r1 - r);
+        }
+        (t, r, v) = (t + h, r1, v1);
+    }
+}
+
+#[test]
+fn a_logged_speed_trace_is_predicted_within_the_tolerance() {
+    // A settled loop with 0.5 % ripple: the closed form at the mean speed is enough.
+    let steady = temp("steady.csv");
+    let ripple = |t: f64| 3.0 * (1.0 + 0.005 * (7.0 * std::f64::consts::TAU * t).sin());
+    write_trace(&steady, 3.0, ripple);
+    let v = json(&[
+        "predict",
+        "--omega-trace",
+        steady.to_str().unwrap(),
+        "--tolerance",
+        "1e-3",
+        "--json",
+    ]);
+    assert_eq!(v["choice"]["method"], "closed", "{v}");
+    let samples: Vec<f64> = (0..=150)
+        .map(|i| (ripple(i as f64 * 0.02) * 1000.0).round() / 1000.0)
+        .collect();
+    let coriolis = v["choice"]["model"] == "coriolis";
+    let want = reference_time(&samples, coriolis);
+    let got = v["residence_time_s"].as_f64().unwrap();
+    assert!((got - want).abs() <= 1e-3 * want, "{got} vs {want}");
+    // A spin-up from 0.5 to 3 rad/s: the particle waits for the speed, then leaves while it
+    // still rises; an integrator over the trace is needed for 1e-5.
+    let spin_up = temp("spin-up.csv");
+    let rise = |t: f64| 3.0 + (0.5 - 3.0) * (-t / 0.3).exp();
+    write_trace(&spin_up, 3.0, rise);
+    let v = json(&[
+        "predict",
+        "--omega-trace",
+        spin_up.to_str().unwrap(),
+        "--tolerance",
+        "1e-5",
+        "--json",
+    ]);
+    assert_ne!(v["choice"]["method"], "closed", "{v}");
+    let samples: Vec<f64> = (0..=150)
+        .map(|i| (rise(i as f64 * 0.02) * 1000.0).round() / 1000.0)
+        .collect();
+    let want = reference_time(&samples, v["choice"]["model"] == "coriolis");
+    let got = v["residence_time_s"].as_f64().unwrap();
+    assert!((got - want).abs() <= 1e-5 * want, "{got} vs {want}: {v}");
+    // --model with a trace is refused in words.
+    let out = bowl(&[
+        "predict",
+        "--omega-trace",
+        spin_up.to_str().unwrap(),
+        "--model",
+        "flat",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("leave out --model"));
+    let _ = std::fs::remove_file(steady);
+    let _ = std::fs::remove_file(spin_up);
+}

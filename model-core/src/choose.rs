@@ -33,11 +33,27 @@ pub struct Knowledge<T> {
     pub omega_rel: T,
 }
 
+/// What the answer must meet: a tolerance the caller states, or one derived from how well the
+/// scene's parameters are known.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Need<T> {
+    /// The parameters' uncertainty: the tolerance is a tenth of the spread it causes in `T`.
+    Uncertainty(Knowledge<T>),
+    /// An explicit relative tolerance on `T` (clamped to `[64 epsilon, 0.1]`).
+    Tolerance(T),
+}
+
 /// How to compute `T`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Plan<T> {
     /// [`particle::residence`].
     ClosedForm,
+    /// [`particle::residence`] at the mean of a varying speed over the residence time: enough
+    /// when the speed varies little while the particle is in the bowl.
+    ClosedFormAtMeanSpeed {
+        /// The mean bowl speed over `[0, T]`, rad/s.
+        omega_rad_s: T,
+    },
     /// [`ode::integrate`] with this method.
     Integrate(Method<T>),
 }
@@ -52,8 +68,8 @@ pub struct Choice<T> {
     /// Relative tolerance on `T` the scene warrants.
     pub tolerance_rel: T,
     /// Relative spread of `T` over the parameters' uncertainty (infinite if some parameter
-    /// set within it never leaves).
-    pub spread_rel: T,
+    /// set within it never leaves); `None` when the tolerance was given instead.
+    pub spread_rel: Option<T>,
     /// `|T_coriolis - T_flat| / T_flat`, computed.
     pub coriolis_effect_rel: T,
     /// The plan's error, measured against a tight reference (0 for the closed form: rounding).
@@ -87,6 +103,20 @@ fn check_knowledge<T: Real>(k: &Knowledge<T>) -> Result<(), ChooseError> {
     } else {
         Err(ChooseError::InvalidKnowledge)
     }
+}
+
+fn check_need<T: Real>(need: &Need<T>) -> Result<(), ChooseError> {
+    match need {
+        Need::Uncertainty(k) => check_knowledge(k),
+        Need::Tolerance(t) if t.is_nonneg_finite() && *t > T::ZERO => Ok(()),
+        Need::Tolerance(_) => Err(ChooseError::InvalidKnowledge),
+    }
+}
+
+/// The tolerance an explicit need asks for (clamped like a derived one).
+fn clamp_tolerance<T: Real>(tolerance: T) -> T {
+    let floor = T::from_f64(64.0) * T::EPSILON;
+    tolerance.max(floor).min(T::from_f64(0.1))
 }
 
 /// The perturbed scenes: each parameter at both ends of its range, the others nominal.
@@ -140,8 +170,7 @@ fn spread<T: Real>(nominal: T, times: &[T; 8]) -> T {
 }
 
 fn tolerance_from<T: Real>(spread: T) -> T {
-    let floor = T::from_f64(64.0) * T::EPSILON;
-    (spread * T::from_f64(0.1)).max(floor).min(T::from_f64(0.1))
+    clamp_tolerance(spread * T::from_f64(0.1))
 }
 
 fn time_of<T: Real>(s: &Scene<T>, m: Model) -> T {
@@ -153,14 +182,23 @@ fn time_of<T: Real>(s: &Scene<T>, m: Model) -> T {
     }
 }
 
-/// Chooses for a constant bowl speed (`scene.omega_rad_s`): always the closed form; the model
-/// by the Coriolis effect against the tolerance.
+/// Chooses for a constant bowl speed (`scene.omega_rad_s`), the tolerance from the parameters'
+/// uncertainty: see [`choose_constant_for`].
 pub fn choose_constant<T: Real>(
     scene: &Scene<T>,
     knowledge: &Knowledge<T>,
 ) -> Result<Choice<T>, ChooseError> {
+    choose_constant_for(scene, &Need::Uncertainty(*knowledge))
+}
+
+/// Chooses for a constant bowl speed (`scene.omega_rad_s`): always the closed form; the model
+/// by the Coriolis effect against the tolerance.
+pub fn choose_constant_for<T: Real>(
+    scene: &Scene<T>,
+    need: &Need<T>,
+) -> Result<Choice<T>, ChooseError> {
     scene.validate().map_err(ChooseError::Scene)?;
-    check_knowledge(knowledge)?;
+    check_need(need)?;
     let flat = particle::residence(scene, Model::Flat).map_err(ChooseError::Scene)?;
     let coriolis = particle::residence(scene, Model::Coriolis).map_err(ChooseError::Scene)?;
     let (tf, tc) = match (flat, coriolis) {
@@ -193,15 +231,20 @@ pub fn choose_constant<T: Real>(
     } else {
         tf
     };
-    let spread_rel = if nominal > T::ZERO {
-        spread(
-            nominal,
-            &perturbations(scene, knowledge).map(|s| time_of(&s, model_for_spread)),
-        )
-    } else {
-        T::ZERO
+    let (spread_rel, tolerance) = match need {
+        Need::Tolerance(t) => (None, clamp_tolerance(*t)),
+        Need::Uncertainty(knowledge) => {
+            let spread_rel = if nominal > T::ZERO {
+                spread(
+                    nominal,
+                    &perturbations(scene, knowledge).map(|s| time_of(&s, model_for_spread)),
+                )
+            } else {
+                T::ZERO
+            };
+            (Some(spread_rel), tolerance_from(spread_rel))
+        }
     };
-    let tolerance = tolerance_from(spread_rel);
     Ok(Choice {
         model: if effect <= tolerance {
             Model::Flat
@@ -243,15 +286,25 @@ fn dp<T: Real>(rtol: T, scene: &Scene<T>) -> Method<T> {
     }
 }
 
-/// Chooses for a time-varying bowl speed (`scene.omega_rad_s` is ignored): an integrator,
-/// calibrated on this scene and profile (see the module docs).
+/// Chooses for a time-varying bowl speed, the tolerance from the parameters' uncertainty: see
+/// [`choose_varying_for`].
 pub fn choose_varying<T: Real, P: OmegaProfile<T>>(
     scene: &Scene<T>,
     knowledge: &Knowledge<T>,
     profile: &P,
 ) -> Result<Choice<T>, ChooseError> {
+    choose_varying_for(scene, &Need::Uncertainty(*knowledge), profile)
+}
+
+/// Chooses for a time-varying bowl speed (`scene.omega_rad_s` is ignored): an integrator,
+/// calibrated on this scene and profile (see the module docs).
+pub fn choose_varying_for<T: Real, P: OmegaProfile<T>>(
+    scene: &Scene<T>,
+    need: &Need<T>,
+    profile: &P,
+) -> Result<Choice<T>, ChooseError> {
     scene.validate_except_omega().map_err(ChooseError::Scene)?;
-    check_knowledge(knowledge)?;
+    check_need(need)?;
     let limits = Limits::for_scene(scene, profile);
     let ref_tol = (T::from_f64(1e-12)).max(T::from_f64(16.0) * T::EPSILON);
     let loose = T::from_f64(1e-7).max(T::from_f64(64.0) * T::EPSILON);
@@ -266,37 +319,42 @@ pub fn choose_varying<T: Real, P: OmegaProfile<T>>(
             model: Model::Flat,
             plan: Plan::ClosedForm,
             tolerance_rel: tolerance_from(T::ZERO),
-            spread_rel: T::ZERO,
+            spread_rel: Some(T::ZERO),
             coriolis_effect_rel: T::ZERO,
             measured_error_rel: T::ZERO,
             rhs_evaluations: 0,
         });
     }
     let effect = (tc - tf).abs() / tf;
-    let mut times = [T::ZERO; 8];
-    let up = T::ONE + knowledge.omega_rel;
-    let down = (T::ONE - knowledge.omega_rel).max(T::ZERO);
-    for (i, (slot, s)) in times
-        .iter_mut()
-        .zip(perturbations(scene, knowledge).iter())
-        .enumerate()
-    {
-        // omega's uncertainty scales the whole profile (entries 6 and 7).
-        let factor = match i {
-            6 => down,
-            7 => up,
-            _ => T::ONE,
-        };
-        let scaled = ScaledProfile {
-            inner: profile,
-            factor,
-        };
-        *slot = run(s, Model::Coriolis, &scaled, dp(loose, scene), limits)
-            .map(|r| r.0)
-            .unwrap_or(T::INFINITY);
-    }
-    let spread_rel = spread(tc, &times);
-    let tolerance = tolerance_from(spread_rel);
+    let (spread_rel, tolerance) = match need {
+        Need::Tolerance(t) => (None, clamp_tolerance(*t)),
+        Need::Uncertainty(knowledge) => {
+            let mut times = [T::ZERO; 8];
+            let up = T::ONE + knowledge.omega_rel;
+            let down = (T::ONE - knowledge.omega_rel).max(T::ZERO);
+            for (i, (slot, s)) in times
+                .iter_mut()
+                .zip(perturbations(scene, knowledge).iter())
+                .enumerate()
+            {
+                // omega's uncertainty scales the whole profile (entries 6 and 7).
+                let factor = match i {
+                    6 => down,
+                    7 => up,
+                    _ => T::ONE,
+                };
+                let scaled = ScaledProfile {
+                    inner: profile,
+                    factor,
+                };
+                *slot = run(s, Model::Coriolis, &scaled, dp(loose, scene), limits)
+                    .map(|r| r.0)
+                    .unwrap_or(T::INFINITY);
+            }
+            let spread_rel = spread(tc, &times);
+            (Some(spread_rel), tolerance_from(spread_rel))
+        }
+    };
     let model = if effect <= tolerance {
         Model::Flat
     } else {
@@ -415,6 +473,10 @@ impl<T: Real> ExpTimes for T {
         (self * T::from_f64(p)).exp()
     }
 }
+
+mod trace;
+
+pub use trace::{SampledOmega, TraceError, choose_trace, mean_omega_rad_s};
 
 #[cfg(test)]
 mod tests;

@@ -153,3 +153,124 @@ fn bad_knowledge_and_stuck_particles_are_errors() {
         Err(ChooseError::DoesNotLeave)
     );
 }
+
+/// `(t, omega(t))` sampled every 20 ms (the console's 50 Hz log) for 3 s.
+fn sampled(omega: impl Fn(f64) -> f64) -> ([f64; 150], [f64; 150]) {
+    let times: [f64; 150] = core::array::from_fn(|i| i as f64 * 0.02);
+    (times, times.map(omega))
+}
+
+#[test]
+fn a_steady_trace_is_answered_by_the_closed_form_at_its_mean_speed() {
+    let s = scene(3.0, 0.029, 0.05);
+    // 0.5 % ripple at 7 Hz around 3 rad/s: a settled speed loop.
+    let (ts, ws) = sampled(|t| 3.0 * (1.0 + 0.005 * (7.0 * core::f64::consts::TAU * t).sin()));
+    let trace = SampledOmega::new(&ts, &ws).unwrap();
+    let c = choose_trace(&s, &Need::Tolerance(1e-3), &trace).unwrap();
+    let Plan::ClosedFormAtMeanSpeed { omega_rad_s } = c.plan else {
+        panic!("{c:?}")
+    };
+    // Independently: the tight integration over the trace, and the closed form at the mean
+    // speed over [0, T] by the trapezoid rule on the samples themselves.
+    let limits = Limits::for_scene(&s, &trace);
+    let truth = run(&s, c.model, &trace, dp(1e-12, &s), limits).unwrap().0;
+    let n = ts.iter().filter(|&&t| t <= truth).count();
+    let mut area = 0.0;
+    for i in 1..n {
+        area += 0.5 * (ws[i] + ws[i - 1]) * (ts[i] - ts[i - 1]);
+    }
+    // The last piece, from the last sample before T to T.
+    let w_end = ws[n - 1] + (ws[n] - ws[n - 1]) * (truth - ts[n - 1]) / (ts[n] - ts[n - 1]);
+    area += 0.5 * (ws[n - 1] + w_end) * (truth - ts[n - 1]);
+    let mean = area / truth;
+    assert!(
+        (omega_rad_s - mean).abs() < 1e-4 * mean,
+        "{omega_rad_s} vs {mean}"
+    );
+    let t_mean = particle::residence(
+        &Scene {
+            omega_rad_s: mean,
+            ..s
+        },
+        c.model,
+    )
+    .unwrap()
+    .residence_time_s();
+    let err = (t_mean - truth).abs() / truth;
+    assert!(err <= c.tolerance_rel, "{c:?}: error {err:e}");
+    assert!(
+        (err - c.measured_error_rel).abs() < 1e-6,
+        "{c:?}: error {err:e}"
+    );
+    assert_eq!(c.rhs_evaluations, 0);
+}
+
+#[test]
+fn a_spin_up_trace_needs_an_integrator_that_meets_the_tolerance() {
+    let s = scene(3.0, 0.029, 0.05);
+    let (ts, ws) = sampled(|t| 3.0 + (0.5 - 3.0) * (-t / 0.3).exp());
+    let trace = SampledOmega::new(&ts, &ws).unwrap();
+    let c = choose_trace(&s, &Need::Tolerance(1e-4), &trace).unwrap();
+    let Plan::Integrate(method) = c.plan else {
+        panic!("{c:?}")
+    };
+    let limits = Limits::for_scene(&s, &trace);
+    let truth = run(&s, c.model, &trace, dp(1e-12, &s), limits).unwrap().0;
+    let (t, _) = run(&s, c.model, &trace, method, limits).unwrap();
+    assert!((t - truth).abs() <= 1e-4 * truth, "{c:?}: {t} vs {truth}");
+    // The closed form at the mean speed would miss: that is why it was not chosen.
+    let mean = mean_omega_rad_s(&trace, truth);
+    let t_mean = particle::residence(
+        &Scene {
+            omega_rad_s: mean,
+            ..s
+        },
+        c.model,
+    )
+    .unwrap()
+    .residence_time_s();
+    assert!((t_mean - truth).abs() > 1e-4 * truth, "{t_mean} vs {truth}");
+}
+
+#[test]
+fn bad_traces_name_the_sample() {
+    assert_eq!(SampledOmega::<f64>::new(&[], &[]), Err(TraceError::Empty));
+    assert_eq!(
+        SampledOmega::new(&[0.0, 0.02, 0.02], &[1.0, 1.0, 1.0]),
+        Err(TraceError::TimeNotIncreasing { index: 2 })
+    );
+    assert_eq!(
+        SampledOmega::new(&[0.0, 0.02], &[1.0, -0.1]),
+        Err(TraceError::BadSpeed { index: 1 })
+    );
+    assert_eq!(
+        choose_trace(
+            &scene(3.0, 0.029, 0.05),
+            &Need::Tolerance(0.0),
+            &ConstantOmegaTrace
+        ),
+        Err(ChooseError::InvalidKnowledge)
+    );
+}
+
+/// A constant speed as a profile (the trace tests' invalid-tolerance case).
+struct ConstantOmegaTrace;
+
+impl crate::ode::OmegaProfile<f64> for ConstantOmegaTrace {
+    fn omega_rad_s(&self, _t_s: f64) -> f64 {
+        3.0
+    }
+    fn max_omega_rad_s(&self) -> f64 {
+        3.0
+    }
+}
+
+#[test]
+fn the_mean_of_a_ramp_is_its_midpoint() {
+    let ts = [0.0, 1.0];
+    let ws = [1.0, 3.0];
+    let trace = SampledOmega::new(&ts, &ws).unwrap();
+    assert!((mean_omega_rad_s(&trace, 1.0) - 2.0).abs() < 1e-12);
+    // Held after the last sample: over [0, 2] the mean is (2 + 3) / 2.
+    assert!((mean_omega_rad_s(&trace, 2.0) - 2.5).abs() < 1e-6);
+}

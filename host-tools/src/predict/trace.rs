@@ -1,0 +1,188 @@
+//! `bowl predict --omega-trace run.csv`: the bowl speed of a logged run (`bowl monitor --log`,
+//! `bowl replay --csv`, the demo's telemetry.csv: the `bowl_mrad_s` column against
+//! `device_time_ms`), from the release on, as the speed the particle sees.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, anyhow, bail};
+
+/// The trace from the release: times (s after it) and bowl speeds (rad/s).
+pub struct Trace {
+    /// Seconds after the release.
+    pub times_s: Vec<f64>,
+    /// Combined bowl speed omega (paper Eq. 2), rad/s.
+    pub omega_rad_s: Vec<f64>,
+    /// Device time of the release, ms.
+    pub release_ms: f64,
+}
+
+/// Reads the rows of one boot from `release_ms` on (default: the log's first telemetry row).
+pub fn read(path: &Path, release_ms: Option<f64>) -> Result<Trace> {
+    let mut reader = csv::ReaderBuilder::new()
+        .flexible(true)
+        .from_path(path)
+        .with_context(|| format!("cannot open {}", path.display()))?;
+    let header = reader.headers()?.clone();
+    let col = |name: &str| {
+        header.iter().position(|h| h == name).ok_or_else(|| {
+            anyhow!(
+                "{}: no `{name}` column: give a telemetry log (bowl monitor --log, bowl replay \
+                 --csv, the demo's telemetry.csv)",
+                path.display()
+            )
+        })
+    };
+    let (time, omega) = (col("device_time_ms")?, col("bowl_mrad_s")?);
+    let boot_col = header.iter().position(|h| h == "boot");
+    let mut trace = Trace {
+        times_s: Vec::new(),
+        omega_rad_s: Vec::new(),
+        release_ms: f64::NAN,
+    };
+    let mut boot: Option<String> = None;
+    for (i, record) in reader.records().enumerate() {
+        let line = i + 2;
+        let r = record.with_context(|| format!("{}: line {line}", path.display()))?;
+        let cell = |k: usize| r.get(k).unwrap_or("").trim();
+        // Link event rows carry no telemetry.
+        let (Ok(t_ms), Ok(w_mrad_s)) = (cell(time).parse::<f64>(), cell(omega).parse::<f64>())
+        else {
+            continue;
+        };
+        if release_ms.is_some_and(|at| t_ms < at) {
+            continue;
+        }
+        let this_boot = boot_col.map(|k| cell(k).to_string()).unwrap_or_default();
+        match &boot {
+            None => {
+                trace.release_ms = release_ms.unwrap_or(t_ms);
+                boot = Some(this_boot);
+            }
+            // The rig restarted: its speed after that is another run.
+            Some(b) if *b != this_boot => break,
+            Some(_) => {}
+        }
+        let t_s = (t_ms - trace.release_ms) / 1000.0;
+        if trace.times_s.last().is_some_and(|&last| t_s <= last) {
+            bail!(
+                "{}: line {line}: device time {t_ms} ms does not follow the row before",
+                path.display()
+            );
+        }
+        trace.times_s.push(t_s);
+        trace.omega_rad_s.push(w_mrad_s / 1000.0);
+    }
+    if trace.times_s.is_empty() {
+        bail!(
+            "{}: no telemetry rows{}",
+            path.display(),
+            release_ms.map_or(String::new(), |at| format!(" at or after {at} ms"))
+        );
+    }
+    // The first row may come after the release: its speed holds from the release on.
+    if trace.times_s[0] > 0.0 {
+        trace.times_s.insert(0, 0.0);
+        let w0 = trace.omega_rad_s[0];
+        trace.omega_rad_s.insert(0, w0);
+    }
+    Ok(trace)
+}
+
+/// Runs `bowl predict --omega-trace`: the chooser picks the model and the method for the
+/// trace, and the chosen plan computes the residence time.
+pub fn run(
+    scene: &model_core::particle::Scene<f64>,
+    path: &Path,
+    release_ms: Option<f64>,
+    need: &model_core::choose::Need<f64>,
+    json: bool,
+) -> Result<()> {
+    use model_core::choose::{Plan, SampledOmega, TraceError, choose_trace};
+    use model_core::ode::{self, Limits, OdeOutcome};
+    use model_core::particle;
+
+    scene
+        .validate_except_omega()
+        .map_err(|e| anyhow!(super::words::scene(e)))?;
+    let trace = read(path, release_ms)?;
+    let profile = SampledOmega::new(&trace.times_s, &trace.omega_rad_s).map_err(|e| match e {
+        TraceError::Empty => anyhow!("{}: no speed samples", path.display()),
+        TraceError::TimeNotIncreasing { index } => anyhow!(
+            "{}: sample {index}: the device time does not increase",
+            path.display()
+        ),
+        TraceError::BadSpeed { index } => anyhow!(
+            "{}: sample {index}: the bowl speed is negative or not a number",
+            path.display()
+        ),
+    })?;
+    let choice =
+        choose_trace(scene, need, &profile).map_err(|e| anyhow!(super::choice::error_words(e)))?;
+    let time_s = match choice.plan {
+        Plan::ClosedForm => 0.0,
+        Plan::ClosedFormAtMeanSpeed { omega_rad_s } => {
+            let at_mean = particle::Scene {
+                omega_rad_s,
+                ..*scene
+            };
+            particle::residence(&at_mean, choice.model)
+                .map_err(|e| anyhow!(super::words::scene(e)))?
+                .residence_time_s()
+        }
+        Plan::Integrate(method) => {
+            let limits = Limits::for_scene(scene, &profile);
+            match ode::integrate(scene, choice.model, &profile, method, limits)
+                .map_err(|e| anyhow!(super::words::ode(e)))?
+                .outcome
+            {
+                OdeOutcome::Leaves {
+                    residence_time_s, ..
+                } => residence_time_s,
+                OdeOutcome::AlreadyAtRim { .. } => 0.0,
+                _ => f64::INFINITY,
+            }
+        }
+    };
+    let (lo, hi) = trace
+        .omega_rad_s
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), &w| {
+            (lo.min(w), hi.max(w))
+        });
+    let covered_s = trace.times_s.last().copied().unwrap_or(0.0);
+    if json {
+        println!(
+            "{}",
+            serde_json::json!({
+                "trace": {
+                    "file": path.display().to_string(), "samples": trace.times_s.len(),
+                    "release_device_ms": trace.release_ms, "covers_s": covered_s,
+                    "omega_min_rad_s": lo, "omega_max_rad_s": hi,
+                },
+                "choice": super::choice::json(&choice),
+                "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
+            })
+        );
+    } else {
+        println!(
+            "trace: {}, {} samples from device time {} ms over {covered_s:.3} s, bowl speed \
+             {lo:.3} to {hi:.3} rad/s (held at the last sample after that)",
+            path.display(),
+            trace.times_s.len(),
+            trace.release_ms
+        );
+        println!("{}", super::choice::describe(&choice, need));
+        if time_s.is_finite() {
+            println!(
+                "{:<8} leaves after T = {time_s:.9} s",
+                super::model_name(choice.model)
+            );
+        } else {
+            println!(
+                "{:<8} NEVER LEAVES within the run's horizon",
+                super::model_name(choice.model)
+            );
+        }
+    }
+    Ok(())
+}
