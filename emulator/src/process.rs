@@ -19,22 +19,20 @@ pub struct EmulatorProcess {
 }
 
 impl EmulatorProcess {
-    /// Reads `stdout` on a thread: the first line that `names_port` recognises is sent to `tx`
-    /// (and not kept); of the others the last [`KEPT_LINES`] are kept.
+    /// Reads `stdout` on a thread: every line that `announces` recognises (the one naming the
+    /// board's serial device, the board's "up" line) is also sent to `tx`; the last
+    /// [`KEPT_LINES`] lines are kept.
     pub fn watch(
         child: Child,
         stdout: ChildStdout,
-        names_port: fn(&str) -> bool,
+        announces: fn(&str) -> bool,
         tx: Sender<String>,
     ) -> EmulatorProcess {
         let console = std::thread::spawn(move || {
             let mut keep = Vec::new();
-            let mut reported = false;
             for line in BufReader::new(stdout).lines().map_while(|l| l.ok()) {
-                if !reported && names_port(&line) {
-                    reported = true;
-                    let _ = tx.send(line);
-                    continue;
+                if announces(&line) {
+                    let _ = tx.send(line.clone());
                 }
                 if keep.len() == KEPT_LINES {
                     keep.remove(0);

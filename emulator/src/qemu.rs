@@ -16,6 +16,11 @@ use crate::workspace;
 
 /// The emulator's program.
 pub const PROGRAM: &str = "qemu-system-arm";
+/// The rig image's semihosting line once its link is up (firmware/src/bin/qemu-rig.rs).
+const RIG_UP: &str = "qemu-rig: up";
+/// How long the rig may take to commission itself on its plant at boot (about 0.5 s of CPU
+/// time; a loaded 2-core machine takes several times that).
+const RIG_UP_WITHIN: Duration = Duration::from_secs(60);
 
 /// How the emulated board's clock relates to the instructions it runs and to the wall clock.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -99,8 +104,8 @@ pub struct PtyBoard {
 }
 
 impl PtyBoard {
-    /// Boots `elf` with `extra` QEMU arguments and waits (10 s at most) for QEMU to name the
-    /// pseudo-terminal. The semihosting console's last 200 lines are kept for [`Self::stop`].
+    /// Boots the rig image `elf` with `extra` QEMU arguments, waits (10 s at most) for QEMU to
+    /// name the pseudo-terminal, then for the rig to say it is up. The semihosting console's last 200 lines are kept for [`Self::stop`].
     pub fn boot(elf: &Path, profile: Profile, extra: &[&str]) -> Result<PtyBoard> {
         if !installed() {
             bail!("{PROGRAM} is not installed (`bash tests/run` installs it)");
@@ -123,8 +128,12 @@ impl PtyBoard {
             }
         });
         let stdout = child.stdout.take().ok_or_else(|| anyhow!("no stdout"))?;
-        let process =
-            EmulatorProcess::watch(child, stdout, |l| pty_named_in(l).is_some(), tx.clone());
+        let process = EmulatorProcess::watch(
+            child,
+            stdout,
+            |l| pty_named_in(l).is_some() || l.starts_with(RIG_UP),
+            tx.clone(),
+        );
         let deadline = Instant::now() + Duration::from_secs(10);
         let mut qemu_said = Vec::new();
         let mut found = None;
@@ -147,6 +156,22 @@ impl PtyBoard {
                     .map_or(String::new(), |l| format!(" (it said: {l})"))
             );
         };
+        // The rig commissions itself on its plant before its link comes up: wait for that.
+        let deadline = Instant::now() + RIG_UP_WITHIN;
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match rx.recv_timeout(left) {
+                Ok(line) if line.starts_with(RIG_UP) => break,
+                Ok(_) => {}
+                Err(_) => {
+                    drop(process);
+                    bail!(
+                        "the emulated board did not come up within {} s (no `{RIG_UP}` line)",
+                        RIG_UP_WITHIN.as_secs()
+                    );
+                }
+            }
+        }
         Ok(PtyBoard { port, process })
     }
 

@@ -55,6 +55,7 @@ pub struct SimulatedBackend {
 
 impl SimulatedBackend {
     /// The nominal plant (seeded noise) and the nominal controller, commissioned on it.
+    #[cfg(test)]
     pub fn new(seed: u32) -> Result<Self> {
         Self::with_plant(PlantParams::nominal(), seed)
     }

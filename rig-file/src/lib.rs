@@ -7,6 +7,8 @@
 //! Keys and units: docs/rigs/nominal.toml.
 
 use anyhow::{Result, anyhow};
+use model_core::particle::Model;
+use model_core::sim::granule::ParticleParams;
 use model_core::sim::{AxisParams, PlantParams};
 use serde::Deserialize;
 use std::path::Path;
@@ -21,6 +23,9 @@ pub struct Rig {
     pub params: PlantParams,
     /// Seed of the tooth offsets and the edge jitter.
     pub seed: u32,
+    /// The `[particle]` table: the hidden truth of the simulated granules (`bowl experiment`),
+    /// if the file has one.
+    pub particle: Option<ParticleParams>,
 }
 
 type Num = Option<Spanned<f64>>;
@@ -44,6 +49,19 @@ struct AxisToml {
 
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
+struct ParticleToml {
+    model: Option<Spanned<String>>,
+    mu: Num,
+    mu_spread: Num,
+    k2: Num,
+    release_radius_m: Num,
+    rim_radius_m: Num,
+    release_spread_m: Num,
+    gate_jitter_s: Num,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
 struct RigToml {
     name: Option<String>,
     supply_v: Num,
@@ -53,6 +71,7 @@ struct RigToml {
     seed: Num,
     precession: Option<AxisToml>,
     spin: Option<AxisToml>,
+    particle: Option<ParticleToml>,
 }
 
 #[derive(Deserialize)]
@@ -110,6 +129,7 @@ pub fn parse(text: &str, file: &str, default_name: &str) -> Result<Vec<Rig>> {
         rigs.push(Rig {
             params: check.rig(t)?,
             seed: check.get(&t.seed, "seed", 0.0, u32::MAX as f64, 1.0)? as u32,
+            particle: t.particle.as_ref().map(|p| check.particle(p)).transpose()?,
             name,
         });
     }
@@ -191,6 +211,68 @@ impl Checker<'_> {
         Ok(p)
     }
 
+    /// The `[particle]` table, each key checked against [`ParticleParams::ranges`].
+    fn particle(&self, t: &ParticleToml) -> Result<ParticleParams> {
+        let mut p = ParticleParams::default();
+        if let Some(m) = &t.model {
+            p.model = match m.get_ref().as_str() {
+                "flat" => Model::Flat,
+                "coriolis" => Model::Coriolis,
+                other => {
+                    return Err(anyhow!(
+                        "rig file {}, line {}: [particle] model = {other:?} must be \"flat\" or \
+                         \"coriolis\"",
+                        self.file,
+                        (self.at)(m.span().start)
+                    ));
+                }
+            };
+        }
+        // In the order of `ParticleParams::ranges`: mu, mu_spread, k2, release_radius_m,
+        // rim_radius_m, release_spread_m, gate_jitter_s.
+        let given: [&Num; 7] = [
+            &t.mu,
+            &t.mu_spread,
+            &t.k2,
+            &t.release_radius_m,
+            &t.rim_radius_m,
+            &t.release_spread_m,
+            &t.gate_jitter_s,
+        ];
+        let mut values = [0.0; 7];
+        for ((slot, (key, default, lo, hi)), v) in values
+            .iter_mut()
+            .zip(ParticleParams::default().ranges())
+            .zip(given)
+        {
+            *slot = self.get(v, &format!("[particle] {key}"), lo, hi, default)?;
+        }
+        [
+            p.mu,
+            p.mu_spread,
+            p.k2,
+            p.release_radius_m,
+            p.rim_radius_m,
+            p.release_spread_m,
+            p.gate_jitter_s,
+        ] = values;
+        if p.release_radius_m >= p.rim_radius_m {
+            let line = t
+                .release_radius_m
+                .as_ref()
+                .or(t.rim_radius_m.as_ref())
+                .map_or(0, |v| (self.at)(v.span().start));
+            return Err(anyhow!(
+                "rig file {}, line {line}: [particle] release_radius_m = {} must lie inside the \
+                 rim (rim_radius_m = {})",
+                self.file,
+                p.release_radius_m,
+                p.rim_radius_m
+            ));
+        }
+        Ok(p)
+    }
+
     fn axis(&self, section: &str, a: &AxisToml, p: &mut AxisParams) -> Result<()> {
         let key = |k: &str| format!("[{section}] {k}");
         let m = &mut p.motor;
@@ -267,6 +349,70 @@ mod tests {
         assert_eq!(r.len(), 1);
         assert_eq!(r[0].params, PlantParams::nominal());
         assert_eq!(r[0].seed, 1);
+        assert_eq!(r[0].particle, None);
+    }
+
+    fn particle(text: &str) -> Result<ParticleParams> {
+        Ok(parse(text, "rig.toml", "rig")?[0].particle.unwrap())
+    }
+
+    #[test]
+    fn the_particle_table_reads_every_key() {
+        let p = particle(
+            "[particle]\nmodel = \"flat\"\nmu = 0.03\nmu_spread = 0.001\nk2 = 0.6\n\
+             release_radius_m = 0.04\nrim_radius_m = 0.12\nrelease_spread_m = 0.002\n\
+             gate_jitter_s = 0.01\n",
+        )
+        .unwrap();
+        assert_eq!(p.model, Model::Flat);
+        assert_eq!(
+            (p.mu, p.mu_spread, p.k2, p.release_radius_m),
+            (0.03, 0.001, 0.6, 0.04)
+        );
+        assert_eq!(
+            (p.rim_radius_m, p.release_spread_m, p.gate_jitter_s),
+            (0.12, 0.002, 0.01)
+        );
+        // Keys left out keep the defaults; the plant keys beside it are read too.
+        let r = &parse(
+            "supply_v = 10.0\n[particle]\nmu = 0.05\n",
+            "rig.toml",
+            "rig",
+        )
+        .unwrap()[0];
+        assert_eq!(r.params.supply_v, 10.0);
+        let p = r.particle.unwrap();
+        assert_eq!((p.mu, p.k2), (0.05, ParticleParams::default().k2));
+    }
+
+    #[test]
+    fn particle_errors_name_the_line_the_key_and_the_range() {
+        let e = particle("\n[particle]\nmu = -1\n").unwrap_err().to_string();
+        assert!(
+            e.contains("rig.toml, line 3")
+                && e.contains("[particle] mu = -1 is outside its range 0 to 1"),
+            "{e}"
+        );
+        let e = particle("[particle]\nmodel = \"round\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("line 2") && e.contains("\"flat\" or \"coriolis\""),
+            "{e}"
+        );
+        let e = particle("[particle]\nmus = 1\n").unwrap_err().to_string();
+        assert!(e.contains("unknown field `mus`"), "{e}");
+        let e = particle("[particle]\nk2 = \"a\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 2"), "{e}");
+        let e = particle("[particle]\nrelease_radius_m = 0.2\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("must lie inside the rim (rim_radius_m = 0.15)"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -24,7 +24,13 @@ struct Outcome {
 }
 
 /// Runs the benchmark and prints its summary.
-pub fn run(plan: &Plan, particle: &ParticleParams, seeds: u32, out: &Path) -> Result<()> {
+pub fn run(
+    plan: &Plan,
+    plant: &model_core::sim::PlantParams,
+    particle: &ParticleParams,
+    seeds: u32,
+    out: &Path,
+) -> Result<()> {
     let truth = match particle.model {
         Model::Flat => "flat",
         Model::Coriolis => "coriolis",
@@ -38,7 +44,7 @@ pub fn run(plan: &Plan, particle: &ParticleParams, seeds: u32, out: &Path) -> Re
     for seed in 1..=seeds {
         let path = dir.join(format!("{stem}_seed{seed}.csv"));
         let started = Instant::now();
-        let mut rig = SimulatedRig::new(*particle, seed)?;
+        let mut rig = SimulatedRig::new(*plant, *particle, seed)?;
         let mut writer = Writer::create(&path)?;
         run_plan(&mut rig, plan, &mut writer, false)?;
         slowest_s = slowest_s.max(started.elapsed().as_secs_f64());

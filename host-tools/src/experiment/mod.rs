@@ -3,7 +3,6 @@
 //! Method and limits: docs/experiment.md.
 
 pub mod benchmark;
-pub mod particle_table;
 pub mod plan;
 pub mod results;
 pub mod simulated;
@@ -51,47 +50,32 @@ pub struct Args {
     pub seed: Option<u32>,
 }
 
-/// The parts of a rig file this command reads: `seed` and `[particle]`. The plant keys are the
-/// rig file parser's; until it is wired in, the simulated rig is the nominal plant.
-fn read_rig_file(path: &PathBuf) -> Result<(ParticleParams, u32, Vec<String>)> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read the rig file {file}"))?;
-    let table: toml::Table = text
-        .parse()
-        .with_context(|| format!("{file}: not valid TOML"))?;
-    let particle = match table.get("particle") {
-        Some(toml::Value::Table(t)) => particle_table::particle_from_table(t, &file)?,
-        Some(_) => bail!("{file}: particle must be a table ([particle])"),
-        None => bail!("{file}: no [particle] table: the simulated rig needs the granules' truth"),
+/// The rig file's one rig: its plant, its `[particle]` truth and its seed.
+fn read_rig_file(path: &PathBuf) -> Result<(model_core::sim::PlantParams, ParticleParams, u32)> {
+    let rigs = rig_file::load(path)?;
+    let [rig] = rigs.as_slice() else {
+        bail!(
+            "{} holds {} rigs ([[plant]] tables); an experiment runs on one: give a rig file \
+             with one rig",
+            path.display(),
+            rigs.len()
+        );
     };
-    let seed = match table.get("seed") {
-        None => 1,
-        Some(v) => v
-            .as_integer()
-            .and_then(|i| u32::try_from(i).ok())
-            .with_context(|| format!("{file}: seed must be an integer in 0 ..= 4294967295"))?,
+    let Some(particle) = rig.particle else {
+        bail!(
+            "{}: no [particle] table: the simulated rig needs the granules' truth (keys: \
+             docs/experiment.md)",
+            path.display()
+        );
     };
-    let ignored = table
-        .keys()
-        .filter(|k| !matches!(k.as_str(), "particle" | "seed"))
-        .cloned()
-        .collect();
-    Ok((particle, seed, ignored))
+    Ok((rig.params, particle, rig.seed))
 }
 
 /// `bowl experiment`.
 pub fn run(args: &Args) -> Result<()> {
-    let (particle, file_seed, ignored) = read_rig_file(&args.rig_file)?;
-    if !ignored.is_empty() {
-        eprintln!(
-            "note: {}: plant keys {} are not read by bowl experiment yet; the plant is nominal",
-            args.rig_file.display(),
-            ignored.join(", ")
-        );
-    }
+    let (plant, particle, file_seed) = read_rig_file(&args.rig_file)?;
     let seed = args.seed.unwrap_or(file_seed);
-    let mut rig = SimulatedRig::new(particle, seed)?;
+    let mut rig = SimulatedRig::new(plant, particle, seed)?;
     if args.suggest {
         let max_bowl = 0.95 * rig.max_bowl_rad_s()?;
         print!(
@@ -113,7 +97,7 @@ pub fn run(args: &Args) -> Result<()> {
         .with_context(|| format!("cannot read the plan {}", plan_path.display()))?;
     let plan = plan::parse(&text, &plan_path.display().to_string())?;
     if let Some(seeds) = args.benchmark_seeds {
-        return benchmark::run(&plan, &particle, seeds, out);
+        return benchmark::run(&plan, &plant, &particle, seeds, out);
     }
     let mut writer = Writer::create(out)?;
     let progress = std::io::stderr().is_terminal();

@@ -8,6 +8,7 @@ use anyhow::{Result, anyhow};
 use model_core::bowl::{MotorSpeeds, combined_speed_from_trig};
 use model_core::control::State;
 use model_core::control::supervisor::Fault;
+use model_core::sim::PlantParams;
 use model_core::sim::granule::ParticleParams;
 use model_core::sim::prng::Prng;
 
@@ -59,9 +60,9 @@ pub struct SimulatedRig {
 }
 
 impl SimulatedRig {
-    /// A commissioned nominal rig with the given granule truth.
-    pub fn new(particle: ParticleParams, seed: u32) -> Result<Self> {
-        let mut backend = SimulatedBackend::new(seed)?;
+    /// The plant, commissioned, with the given granule truth.
+    pub fn new(plant: PlantParams, particle: ParticleParams, seed: u32) -> Result<Self> {
+        let mut backend = SimulatedBackend::with_plant(plant, seed)?;
         // The experiment drives the controller directly, with no link to lose: the rig's
         // link-loss watchdog (LINK_TIMEOUT_MS) is off here.
         model_core::wire::device::Backend::set_param(
