@@ -51,7 +51,9 @@ pub struct Args {
 }
 
 /// The rig file's one rig: its plant, its `[particle]` truth and its seed.
-fn read_rig_file(path: &PathBuf) -> Result<(model_core::sim::PlantParams, ParticleParams, u32)> {
+fn read_rig_file(
+    path: &std::path::Path,
+) -> Result<(model_core::sim::PlantParams, ParticleParams, u32)> {
     let rigs = rig_file::load(path)?;
     let [rig] = rigs.as_slice() else {
         bail!(
