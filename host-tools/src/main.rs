@@ -25,6 +25,7 @@ mod serial;
 mod serve;
 mod sim;
 mod sim_reports;
+mod sim_world;
 mod simulated_backend;
 mod telemetry_csv;
 mod virtual_rig;

@@ -30,6 +30,14 @@ pub fn particulars(
     let word = words.first()?.to_ascii_lowercase();
     match (reason, word.as_str()) {
         (Reason::Range, "set") => set_range(words),
+        (Reason::State, "release") => Some(
+            "a granule is still in the bowl (one at a time): wait for its exit gate event".into(),
+        ),
+        (Reason::Unsupported, "release") => Some(
+            "this rig has no release solenoid: drop the granule by hand (the release gate still \
+             times it once wired)"
+                .into(),
+        ),
         (Reason::State, _) => {
             let status = ask_status(link?, id, timeout)?;
             Some(state_words(&status, &word))

@@ -88,14 +88,24 @@ pub fn run(args: &Args) -> Result<()> {
             }
         };
         decoder.push_slice(&chunk[..n], |r, stats| {
-            if let Ok(Frame::Telemetry(t)) = r {
-                telemetry += 1;
-                if let Some(w) = csv.as_mut()
-                    && csv_error.is_none()
-                    && let Err(e) = telemetry_csv::write_row(w, stats.restarts, &t, None)
-                {
-                    csv_error = Some(e);
+            let written = match (r, csv.as_mut()) {
+                (Ok(Frame::Telemetry(t)), w) => {
+                    telemetry += 1;
+                    w.map(|w| telemetry_csv::write_row(w, stats.restarts, &t, None))
                 }
+                // Gate events are logged too: nothing the rig sends is dropped.
+                (Ok(Frame::Event(e)), Some(w)) => Some(telemetry_csv::write_event(
+                    w,
+                    stats.restarts,
+                    None,
+                    &telemetry_csv::gate_event_text(&e),
+                )),
+                _ => None,
+            };
+            if let Some(Err(e)) = written
+                && csv_error.is_none()
+            {
+                csv_error = Some(e);
             }
         });
     }

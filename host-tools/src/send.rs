@@ -106,15 +106,7 @@ pub fn describe(frame: &Frame) -> String {
             out.pop();
             out
         }
-        Frame::Event(e) => format!(
-            "gate event: {} gate at {} us (boot {})",
-            match e.kind {
-                model_core::wire::GateKind::Release => "release",
-                model_core::wire::GateKind::Exit => "exit",
-            },
-            e.time_us,
-            e.boot
-        ),
+        Frame::Event(e) => format!("gate event: {}", crate::telemetry_csv::gate_event_text(e)),
         other => format!("{other:?}"),
     }
 }

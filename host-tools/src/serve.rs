@@ -48,8 +48,9 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     seed: u32,
     /// Serve this rig instead of the nominal one: a rig file (docs/rigs/*.toml, keys in
-    /// docs/rigs/nominal.toml); its own `seed` key then seeds the plant's tooth offsets and jitter.
-    /// The virtual rig commissions itself on it before it answers.
+    /// docs/rigs/nominal.toml); its own `seed` key then seeds the plant's tooth offsets and jitter,
+    /// its `[particle]` table the granules RELEASE drops. The virtual rig commissions itself on
+    /// it before it answers.
     #[arg(long, value_name = "RIG.toml")]
     rig_file: Option<PathBuf>,
     /// A noisy line: this percentage of the bytes sent is replaced by a different random byte
@@ -156,7 +157,7 @@ pub fn run(args: &Args) -> Result<()> {
                     rigs.len()
                 );
             };
-            VirtualRig::with_plant(rig.params, rig.seed)
+            VirtualRig::with_plant(rig.params, rig.particle.unwrap_or_default(), rig.seed)
                 .with_context(|| format!("the rig in {}", path.display()))
         }
     };

@@ -3,51 +3,28 @@
 //! binding of the controller and the particle model to the protocol that the firmware runs
 //! (`model_core::binding::ControllerBackend`).
 //!
-//! Only the fault injection (INJECT) is particular to the simulation. It sits between the
-//! plant and the controller: a lost sensor withholds the plant's edges from the controller, a
-//! stalled motor gets no drive (its duty never reaches the plant).
+//! Only the simulated world is particular to it ([`SimWorld`]): injected faults sit between the
+//! plant and the controller (a lost sensor withholds the plant's edges, a stalled motor gets no
+//! drive), and granules dropped by RELEASE move under the plant's true bowl speed, timed by the
+//! gates.
 
 use anyhow::{Result, anyhow};
 use model_core::binding::{
-    AssemblyError, ControllerBackend, Injector, Record, commission_on_plant, default_params,
-    persisted,
+    AssemblyError, ControllerBackend, Record, commission_on_plant, default_params, persisted,
 };
+use model_core::bowl::{MotorSpeeds, combined_speed_from_trig};
 use model_core::control::ControllerConfig;
 use model_core::sim::PlantParams;
-use model_core::wire::{Hello, Injection, ParamId, Reason, ResetCause};
+use model_core::sim::granule::ParticleParams;
+use model_core::wire::{Hello, ParamId, ResetCause};
 
-/// The fault injected into the simulation, if any (INJECT replaces it; `NONE` clears it).
-#[derive(Debug, Clone, Copy)]
-pub struct SimFaults(Injection);
-
-impl Injector for SimFaults {
-    fn inject(&mut self, what: Injection) -> Result<(), Reason> {
-        self.0 = what;
-        Ok(())
-    }
-}
-
-impl SimFaults {
-    fn sensor_lost(&self, axis: usize) -> bool {
-        matches!(
-            (self.0, axis),
-            (Injection::SensorLostPrecession, 0) | (Injection::SensorLostSpin, 1)
-        )
-    }
-
-    fn stalled(&self, axis: usize) -> bool {
-        matches!(
-            (self.0, axis),
-            (Injection::StallPrecession, 0) | (Injection::StallSpin, 1)
-        )
-    }
-}
+use crate::sim_world::SimWorld;
 
 /// The plant, and the controller bound to the protocol.
 #[derive(Clone)]
 pub struct SimulatedBackend {
     plant: model_core::sim::Plant,
-    rig: ControllerBackend<SimFaults>,
+    rig: ControllerBackend<SimWorld>,
     ticks: u64,
     total_ms: u64,
     now_ms: u32,
@@ -57,13 +34,17 @@ impl SimulatedBackend {
     /// The nominal plant (seeded noise) and the nominal controller, commissioned on it.
     #[cfg(test)]
     pub fn new(seed: u32) -> Result<Self> {
-        Self::with_plant(PlantParams::nominal(), seed)
+        Self::with_plant(PlantParams::nominal(), ParticleParams::default(), seed)
     }
 
     /// The plant (seeded noise) and the nominal controller (told the plant's teeth),
     /// commissioned on the plant as the real rig is once after assembly (through the same
     /// COMMISSION path the wire uses), then at rest at device time 0.
-    pub fn with_plant(plant_params: PlantParams, seed: u32) -> Result<Self> {
+    pub fn with_plant(
+        plant_params: PlantParams,
+        particle: ParticleParams,
+        seed: u32,
+    ) -> Result<Self> {
         let base = ControllerConfig::nominal();
         let mut params = default_params();
         for (id, axis) in [(ParamId::Teeth1, 0), (ParamId::Teeth2, 1)] {
@@ -82,7 +63,7 @@ impl SimulatedBackend {
                 identified: [false; 2],
             }),
             hello,
-            SimFaults(Injection::None),
+            SimWorld::new(particle, seed),
         );
         checked.map_err(|r| anyhow!("rig parameters refused: {}", r.token()))?;
         let mut sim = Self {
@@ -107,17 +88,12 @@ impl SimulatedBackend {
     }
 
     /// The controller and particle model behind the protocol.
-    pub fn bound(&self) -> &ControllerBackend<SimFaults> {
+    pub fn bound(&self) -> &ControllerBackend<SimWorld> {
         &self.rig
     }
 
-    /// The simulated plant (its true shaft speeds, for a simulated granule).
-    pub fn plant(&self) -> &model_core::sim::Plant {
-        &self.plant
-    }
-
     /// The same, to hand to the protocol device.
-    pub fn bound_mut(&mut self) -> &mut ControllerBackend<SimFaults> {
+    pub fn bound_mut(&mut self) -> &mut ControllerBackend<SimWorld> {
         &mut self.rig
     }
 
@@ -141,31 +117,50 @@ impl SimulatedBackend {
 
     fn tick(&mut self, dt_s: f32) {
         let now = self.plant.now_ticks();
-        let faults = *self.rig.injector();
+        let world = self.rig.injector();
+        let (lost, stalled) = (
+            [0, 1].map(|a| world.sensor_lost(a)),
+            [0, 1].map(|a| world.stalled(a)),
+        );
         let plant = &self.plant;
-        let edges = |axis: usize| -> &[u32] {
-            if faults.sensor_lost(axis) {
-                &[]
-            } else {
-                plant.edges(axis)
-            }
-        };
+        let edges = |axis: usize| -> &[u32] { if lost[axis] { &[] } else { plant.edges(axis) } };
         let duties = self.rig.controller_mut().tick(now, [edges(0), edges(1)]);
-        let driven = [0, 1].map(|axis| {
-            if faults.stalled(axis) {
-                0.0
-            } else {
-                duties[axis]
-            }
-        });
+        let driven = [0, 1].map(|axis| if stalled[axis] { 0.0 } else { duties[axis] });
+        // A granule moves during the period under the bowl speed the plant has over it; gate
+        // times are device time (0 when commissioning at boot ended).
+        let tick_hz = f64::from(self.rig.controller().config().tick_hz);
+        let (bowl_rad_s, now_s) = (self.true_bowl_rad_s(), self.ticks as f64 / tick_hz);
         self.plant.advance(driven, dt_s);
+        self.rig
+            .injector_mut()
+            .step(bowl_rad_s, now_s, f64::from(dt_s));
         self.ticks += 1;
+    }
+
+    /// The plant's true combined bowl speed (paper Eq. 2 from the two true shaft speeds), rad/s.
+    pub fn true_bowl_rad_s(&self) -> f64 {
+        let angle = f64::from(self.rig.controller().config().axes_angle_rad);
+        combined_speed_from_trig(
+            angle.cos(),
+            angle.sin(),
+            MotorSpeeds {
+                precession_rad_s: f64::from(self.plant.speed_rad_s(0)),
+                spin_rad_s: f64::from(self.plant.speed_rad_s(1)),
+            },
+        )
+        .unwrap_or(0.0)
+    }
+
+    /// The simulated world: faults, granules and gates.
+    pub fn world_mut(&mut self) -> &mut SimWorld {
+        self.rig.injector_mut()
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use model_core::wire::Reason;
     use model_core::wire::device::Backend as _;
 
     /// The nominal parameters are all inside their wire ranges (else PARAMS would fail).

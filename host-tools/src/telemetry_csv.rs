@@ -87,15 +87,31 @@ pub fn write_row(
     Ok(())
 }
 
-/// Writes a link event's row: `boot`, empty telemetry columns, the time and the event.
-pub fn write_event(out: &mut impl Write, boot: u64, host: SystemTime, event: &str) -> Result<()> {
+/// Writes an event's row (a link event, a gate event): `boot`, empty telemetry columns, the
+/// PC's time if known and the event.
+pub fn write_event(
+    out: &mut impl Write,
+    boot: u64,
+    host: Option<SystemTime>,
+    event: &str,
+) -> Result<()> {
     writeln!(
         out,
         "{boot},{}{},{event}",
         ",".repeat(TELEMETRY_COLUMNS),
-        utc(host)
+        host.map(utc).unwrap_or_default()
     )?;
     Ok(())
+}
+
+/// A gate event in words, for the log's event column and the console: `release gate at
+/// 5000123 us (boot 0)`.
+pub fn gate_event_text(e: &model_core::wire::GateEvent) -> String {
+    let gate = match e.kind {
+        model_core::wire::GateKind::Release => "release",
+        model_core::wire::GateKind::Exit => "exit",
+    };
+    format!("{gate} gate at {} us (boot {})", e.time_us, e.boot)
 }
 
 #[cfg(test)]
@@ -116,7 +132,7 @@ mod tests {
     #[test]
     fn event_rows_have_as_many_fields_as_the_header() {
         let mut out = Vec::new();
-        write_event(&mut out, 2, SystemTime::UNIX_EPOCH, "link lost").unwrap();
+        write_event(&mut out, 2, Some(SystemTime::UNIX_EPOCH), "link lost").unwrap();
         let line = String::from_utf8(out).unwrap();
         assert_eq!(
             line.trim_end().split(',').count(),

@@ -18,13 +18,21 @@ pub(crate) struct VirtualRig {
 
 impl VirtualRig {
     pub(crate) fn new(seed: u32) -> Result<Self> {
-        Self::with_plant(model_core::sim::PlantParams::nominal(), seed)
+        Self::with_plant(
+            model_core::sim::PlantParams::nominal(),
+            model_core::sim::granule::ParticleParams::default(),
+            seed,
+        )
     }
 
-    /// A virtual rig on the given plant (a rig file's), commissioned on it.
-    pub(crate) fn with_plant(plant: model_core::sim::PlantParams, seed: u32) -> Result<Self> {
+    /// A virtual rig on the given plant and granules (a rig file's), commissioned on it.
+    pub(crate) fn with_plant(
+        plant: model_core::sim::PlantParams,
+        particle: model_core::sim::granule::ParticleParams,
+        seed: u32,
+    ) -> Result<Self> {
         Ok(Self {
-            rig: SimulatedBackend::with_plant(plant, seed)?,
+            rig: SimulatedBackend::with_plant(plant, particle, seed)?,
             device: Device::new(),
             now_ms: 0,
         })
@@ -47,6 +55,9 @@ impl VirtualRig {
         self.now_ms = self.now_ms.wrapping_add(1);
         self.rig.advance_to_ms(self.now_ms);
         let mut buf = [0u8; MAX_FRAME_LEN];
+        while let Some(n) = self.device.poll_gate_event(self.rig.bound_mut(), &mut buf) {
+            out.extend_from_slice(&buf[..n]);
+        }
         if let Some(n) = self
             .device
             .poll_telemetry(self.rig.bound(), self.now_ms, &mut buf)

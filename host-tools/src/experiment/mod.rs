@@ -1,9 +1,11 @@
-//! `bowl experiment PLAN.toml --rig-file FILE --out results.csv`: runs a plan of releases on a
-//! simulated rig and writes one row per release (see [`results`]); `--suggest` prints a plan.
-//! Method and limits: docs/experiment.md.
+//! `bowl experiment PLAN.toml (--rig-file FILE | --port PORT) --out results.csv`: runs a plan of
+//! releases on a simulated rig ([`simulated`]) or on a rig over its serial line ([`port`]) and
+//! writes one row per release (see [`results`]); `--suggest` prints a plan. Method and limits:
+//! docs/experiment.md.
 
 pub mod benchmark;
 pub mod plan;
+pub mod port;
 pub mod results;
 pub mod simulated;
 pub mod suggest;
@@ -24,8 +26,15 @@ pub struct Args {
     /// repeats). Not needed with --suggest.
     pub plan: Option<PathBuf>,
     /// Run on a simulated rig described by this rig file (its [particle] table is the truth).
+    #[arg(long, required_unless_present = "port", conflicts_with = "port")]
+    pub rig_file: Option<PathBuf>,
+    /// Run on the rig on this serial port (or a `bowl serve --pty` pseudo-terminal): releases by
+    /// RELEASE, residence times from the rig's gate events.
     #[arg(long)]
-    pub rig_file: PathBuf,
+    pub port: Option<String>,
+    /// Baud rate of --port.
+    #[arg(long, default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(50..=12_000_000))]
+    pub baud: u32,
     /// The results file to write (traces go to `<stem>_traces/` beside it).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -73,9 +82,47 @@ fn read_rig_file(
     Ok((rig.params, particle, rig.seed))
 }
 
+/// A rig the plan's releases run on.
+pub trait ReleaseRig {
+    /// The nominal start radius (m), rim radius (m) and k2 of its granules (results columns).
+    fn geometry(&self) -> (f64, f64, f64);
+    /// Motor speeds for a combined bowl speed by the rig's split rule, rad/s.
+    fn split(&self, bowl_rad_s: f64) -> Result<[f64; 2]>;
+    /// Sets the motor speeds (starting the loop if idle) and waits until both measured speeds
+    /// are within 2 % for a second, then `settle_s` more.
+    fn settle(&mut self, targets: [f64; 2], settle_s: f64) -> Result<(), Release>;
+    /// Drops one granule and follows it to the exit gate.
+    fn release(&mut self) -> Release;
+    /// Stops the motors.
+    fn stop(&mut self);
+}
+
 /// `bowl experiment`.
 pub fn run(args: &Args) -> Result<()> {
-    let (plant, particle, file_seed) = read_rig_file(&args.rig_file)?;
+    if let Some(port) = &args.port {
+        if args.suggest || args.benchmark_seeds.is_some() {
+            bail!(
+                "--suggest and --benchmark-seeds need a simulated rig (--rig-file): the plan is \
+                 designed on the rig's known truth"
+            );
+        }
+        let (Some(plan_path), Some(out)) = (&args.plan, &args.out) else {
+            bail!("give a plan and --out results.csv");
+        };
+        let text = std::fs::read_to_string(plan_path)
+            .with_context(|| format!("cannot read the plan {}", plan_path.display()))?;
+        let plan = plan::parse(&text, &plan_path.display().to_string())?;
+        let mut rig = port::PortRig::open(port, args.baud)?;
+        let mut writer = Writer::create(out)?;
+        let progress = std::io::stderr().is_terminal();
+        let run_no = run_plan(&mut rig, &plan, &mut writer, progress)?;
+        println!("{run_no} releases written to {}", out.display());
+        return Ok(());
+    }
+    let Some(rig_file) = &args.rig_file else {
+        bail!("give --rig-file FILE (a simulated rig) or --port PORT (a rig on a serial line)");
+    };
+    let (plant, particle, file_seed) = read_rig_file(rig_file)?;
     let seed = args.seed.unwrap_or(file_seed);
     let mut rig = SimulatedRig::new(plant, particle, seed)?;
     if args.suggest {
@@ -112,12 +159,12 @@ pub fn run(args: &Args) -> Result<()> {
 /// Runs every release of `plan` on `rig`, writing each row as it is measured; returns the
 /// number of releases. A progress bar on standard error when `progress`.
 pub fn run_plan(
-    rig: &mut SimulatedRig,
+    rig: &mut impl ReleaseRig,
     plan: &plan::Plan,
     writer: &mut Writer,
     progress: bool,
 ) -> Result<usize> {
-    let particle = *rig.particle();
+    let (release_radius_m, rim_radius_m, k2) = rig.geometry();
     let total = plan::releases(plan);
     let mut run_no = 0;
     for (ci, c) in plan.condition.iter().enumerate() {
@@ -142,9 +189,9 @@ pub fn run_plan(
                 bowl_rad_s: bowl,
                 precession_rad_s: targets[0],
                 spin_rad_s: targets[1],
-                release_radius_m: particle.release_radius_m,
-                rim_radius_m: particle.rim_radius_m,
-                k2: particle.k2,
+                release_radius_m,
+                rim_radius_m,
+                k2,
                 status: results::STATUS_OK.into(),
                 residence_s: None,
                 trace_mean_rad_s: None,

@@ -5,12 +5,11 @@
 //! gate's jitter) and the controller's *measured* speeds.
 
 use anyhow::{Result, anyhow};
-use model_core::bowl::{MotorSpeeds, combined_speed_from_trig};
 use model_core::control::State;
 use model_core::control::supervisor::Fault;
 use model_core::sim::PlantParams;
 use model_core::sim::granule::ParticleParams;
-use model_core::sim::prng::Prng;
+use model_core::wire::GateKind;
 
 use crate::simulated_backend::SimulatedBackend;
 
@@ -53,16 +52,13 @@ fn fault_words(fault: Option<Fault>) -> String {
 /// The simulated rig with its granules.
 pub struct SimulatedRig {
     backend: SimulatedBackend,
-    particle: ParticleParams,
-    rng: Prng,
     now_ms: u32,
-    cos_sin: (f64, f64),
 }
 
 impl SimulatedRig {
     /// The plant, commissioned, with the given granule truth.
     pub fn new(plant: PlantParams, particle: ParticleParams, seed: u32) -> Result<Self> {
-        let mut backend = SimulatedBackend::with_plant(plant, seed)?;
+        let mut backend = SimulatedBackend::with_plant(plant, particle, seed)?;
         // The experiment drives the controller directly, with no link to lose: the rig's
         // link-loss watchdog (LINK_TIMEOUT_MS) is off here.
         model_core::wire::device::Backend::set_param(
@@ -71,23 +67,16 @@ impl SimulatedRig {
             0,
         )
         .map_err(|r| anyhow!("cannot turn the link watchdog off: {}", r.token()))?;
-        let angle = f64::from(backend.bound().controller().config().axes_angle_rad);
-        Ok(Self {
-            backend,
-            particle,
-            rng: Prng::new(seed ^ 0x6772_616e),
-            now_ms: 0,
-            cos_sin: (angle.cos(), angle.sin()),
-        })
+        Ok(Self { backend, now_ms: 0 })
     }
 
     /// The granule truth.
-    pub fn particle(&self) -> &ParticleParams {
-        &self.particle
+    pub fn particle(&self) -> ParticleParams {
+        *self.backend.bound().injector().particle()
     }
 
     /// Motor speeds for a combined bowl speed by the controller's split rule.
-    pub fn split(&self, bowl_rad_s: f64) -> Result<[f64; 2]> {
+    fn split_speeds(&self, bowl_rad_s: f64) -> Result<[f64; 2]> {
         let cfg = self.backend.bound().controller().config();
         let s = model_core::control::planner::split_combined(
             bowl_rad_s as f32,
@@ -101,23 +90,11 @@ impl SimulatedRig {
 
     /// The fastest combined bowl speed whose split keeps both motors within their limits.
     pub fn max_bowl_rad_s(&self) -> Result<f64> {
-        let per_unit = self.split(1.0)?;
+        let per_unit = self.split_speeds(1.0)?;
         let cfg = self.backend.bound().controller().config();
         Ok((0..2)
             .map(|i| f64::from(cfg.axes[i].max_speed_rad_s) / per_unit[i].abs().max(1e-9))
             .fold(f64::INFINITY, f64::min))
-    }
-
-    fn combined(&self, w: [f64; 2]) -> f64 {
-        combined_speed_from_trig(
-            self.cos_sin.0,
-            self.cos_sin.1,
-            MotorSpeeds {
-                precession_rad_s: w[0],
-                spin_rad_s: w[1],
-            },
-        )
-        .unwrap_or(0.0)
     }
 
     fn tick_ms(&mut self) {
@@ -134,9 +111,7 @@ impl SimulatedRig {
         let _ = self.backend.bound_mut().controller_mut().clear_fault();
     }
 
-    /// Sets the motor speeds (starting the loop if idle) and waits until both measured speeds
-    /// are within the band for a second, then `settle_s` more.
-    pub fn settle(&mut self, targets: [f64; 2], settle_s: f64) -> Result<(), Release> {
+    fn settle_speeds(&mut self, targets: [f64; 2], settle_s: f64) -> Result<(), Release> {
         let ctrl = self.backend.bound_mut().controller_mut();
         if let Err(e) = ctrl.set_motor_speeds(targets[0] as f32, targets[1] as f32) {
             return Err(Release::MotorFault(format!(
@@ -174,9 +149,15 @@ impl SimulatedRig {
         Ok(())
     }
 
-    /// Drops one granule and follows it to the exit gate.
-    pub fn release(&mut self) -> Release {
-        let mut granule = self.particle.release(&mut self.rng);
+    /// Drops one granule (RELEASE, as on the wire) and follows it to the exit gate; the
+    /// residence time is the exit gate's time minus the release gate's, as a real rig's
+    /// events give it.
+    fn drop_granule(&mut self) -> Release {
+        use model_core::wire::device::Backend as _;
+        if let Err(r) = self.backend.bound_mut().release() {
+            return Release::MotorFault(format!("RELEASE refused: {}", r.token()));
+        }
+        let mut released_us = None;
         let mut trace = Vec::new();
         for ms in 0..RESIDENCE_TIMEOUT_MS {
             if ms % TRACE_PERIOD_MS == 0 {
@@ -189,23 +170,23 @@ impl SimulatedRig {
                 );
                 trace.push((f64::from(ms) * 1e-3, w));
             }
-            let plant = self.backend.plant();
-            let truth = self.combined([
-                f64::from(plant.speed_rad_s(0)),
-                f64::from(plant.speed_rad_s(1)),
-            ]);
-            // The granule moves during the tick, under the speed the plant has over it.
             self.tick_ms();
             if let Some(f) = self.fault() {
                 self.clear_fault();
+                self.backend.world_mut().clear_bowl();
                 return Release::MotorFault(f);
             }
-            if let Some(exit_s) = granule.step(truth, 1e-3) {
-                let jitter = self.particle.gate_error_s(&mut self.rng);
-                let measured = ((exit_s + jitter).max(0.0) * 1e6).round() * 1e-6;
-                return Release::Left(measured, trace);
+            while let Some(e) = self.backend.bound_mut().next_gate_event() {
+                match (e.kind, released_us) {
+                    (GateKind::Release, _) => released_us = Some(e.time_us),
+                    (GateKind::Exit, Some(at)) => {
+                        return Release::Left(f64::from(e.time_us.wrapping_sub(at)) * 1e-6, trace);
+                    }
+                    (GateKind::Exit, None) => {}
+                }
             }
         }
+        self.backend.world_mut().clear_bowl();
         Release::NeverLeft(trace)
     }
 
@@ -218,9 +199,28 @@ impl SimulatedRig {
             .inject(what)
             .map_err(|r| anyhow!("injection refused: {}", r.token()))
     }
+}
+
+impl super::ReleaseRig for SimulatedRig {
+    fn geometry(&self) -> (f64, f64, f64) {
+        let p = self.particle();
+        (p.release_radius_m, p.rim_radius_m, p.k2)
+    }
+
+    fn split(&self, bowl_rad_s: f64) -> Result<[f64; 2]> {
+        self.split_speeds(bowl_rad_s)
+    }
+
+    fn settle(&mut self, targets: [f64; 2], settle_s: f64) -> Result<(), Release> {
+        self.settle_speeds(targets, settle_s)
+    }
+
+    fn release(&mut self) -> Release {
+        self.drop_granule()
+    }
 
     /// Stops the motors (ramping down).
-    pub fn stop(&mut self) {
+    fn stop(&mut self) {
         let _ = self.backend.bound_mut().controller_mut().stop();
     }
 }

@@ -115,7 +115,7 @@ pub fn run(args: &Args) -> Result<()> {
     view.event(plain, format!("port {} open", args.port));
     let link_event = |log: &mut Option<BufWriter<File>>, boot: u64, what: &str| -> Result<()> {
         if let Some(w) = log.as_mut() {
-            telemetry_csv::write_event(w, boot, SystemTime::now(), what)?;
+            telemetry_csv::write_event(w, boot, Some(SystemTime::now()), what)?;
         }
         Ok(())
     };
@@ -166,6 +166,10 @@ pub fn run(args: &Args) -> Result<()> {
                     };
                     if decoder.stats().restarts > restarts {
                         link_event(&mut log, decoder.stats().restarts, "device restart")?;
+                    }
+                    if let Frame::Event(e) = &frame {
+                        let boot = decoder.stats().restarts;
+                        link_event(&mut log, boot, &telemetry_csv::gate_event_text(e))?;
                     }
                     if let Frame::Telemetry(t) = &frame {
                         if let Some(w) = log.as_mut() {

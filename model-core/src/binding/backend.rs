@@ -12,8 +12,8 @@ use crate::control::{
 use crate::particle::{self, InverseError, Model, Outcome, Scene};
 use crate::wire::device::Backend;
 use crate::wire::{
-    AxisModel, DeviceState, FaultCode, Hello, Injection, MODEL_FIELD_MAX, MotorTelemetry, ParamId,
-    ParamValues, Reason, Residence, ResidenceModel, Telemetry,
+    AxisModel, DeviceState, FaultCode, GateEvent, Hello, Injection, MODEL_FIELD_MAX,
+    MotorTelemetry, ParamId, ParamValues, Reason, Residence, ResidenceModel, Telemetry,
 };
 
 /// Nearest integer as f32 (ties away from zero); a cast after it saturates and maps NaN to 0.
@@ -184,6 +184,11 @@ impl<I: Injector> ControllerBackend<I> {
         &self.injector
     }
 
+    /// The same, for the simulation to take releases from and hand gate events to.
+    pub fn injector_mut(&mut self) -> &mut I {
+        &mut self.injector
+    }
+
     /// The device time telemetry frames carry, ms (set before each telemetry poll).
     pub fn set_now_ms(&mut self, now_ms: u32) {
         self.now_ms = now_ms;
@@ -351,6 +356,14 @@ impl<I: Injector> Backend for ControllerBackend<I> {
 
     fn inject(&mut self, what: Injection) -> Result<(), Reason> {
         self.injector.inject(what)
+    }
+
+    fn release(&mut self) -> Result<(), Reason> {
+        self.injector.release()
+    }
+
+    fn next_gate_event(&mut self) -> Option<GateEvent> {
+        self.injector.gate_event()
     }
 
     fn models(&self) -> Result<[AxisModel; AXES], Reason> {

@@ -30,15 +30,25 @@ pub use record::{
     PERSISTED_COUNT, Persisted, Record, default_persisted, persisted, split_persisted,
 };
 
-use crate::wire::{Injection, Reason};
+use crate::wire::{GateEvent, Injection, Reason};
 
 /// Motor axes: precession (0) and spin (1).
 pub const AXES: usize = 2;
 
-/// Where fault injections go: the emulated board's plant, or nowhere on real hardware.
+/// Where fault injections and granule releases go: the simulated world of an emulated board or
+/// a virtual rig; on real hardware injections go nowhere.
 pub trait Injector {
     /// Applies `what` or says why not.
     fn inject(&mut self, what: Injection) -> Result<(), Reason>;
+    /// Drops one granule (RELEASE): a simulated granule, or the real rig's release solenoid.
+    /// A rig without one refuses.
+    fn release(&mut self) -> Result<(), Reason> {
+        Err(Reason::Unsupported)
+    }
+    /// The oldest gate event (release trigger, exit light gate) not yet sent.
+    fn gate_event(&mut self) -> Option<GateEvent> {
+        None
+    }
 }
 
 /// Real hardware: nothing can be injected.

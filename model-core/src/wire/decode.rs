@@ -254,6 +254,7 @@ fn command(f: &mut Fields<'_>) -> Result<Command, Reason> {
         b"PING" => Command::Ping,
         b"COMMISSION" => Command::Commission,
         b"MODELS" => Command::GetModels,
+        b"RELEASE" => Command::Release,
         _ => return Err(Reason::UnknownCommand),
     };
     f.end()?;

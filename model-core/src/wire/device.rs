@@ -7,7 +7,8 @@ use super::encode::{EncodeError, encode};
 use super::params::{PARAM_COUNT, ParamId, ParamValues};
 use super::stream::Decoder;
 use super::types::{
-    AxisModel, Command, Frame, Hello, Injection, Reason, ResidenceModel, Status, Telemetry,
+    AxisModel, Command, Frame, GateEvent, Hello, Injection, Reason, ResidenceModel, Status,
+    Telemetry,
 };
 use super::{MAX_FRAME_LEN, max_telemetry_hz};
 
@@ -42,6 +43,14 @@ pub trait Backend {
     /// The motor models and loop gains in force, precession then spin (for MODELS).
     fn models(&self) -> Result<[AxisModel; 2], Reason> {
         Err(Reason::Unsupported)
+    }
+    /// Drop one granule (RELEASE). A rig without a release solenoid refuses it.
+    fn release(&mut self) -> Result<(), Reason> {
+        Err(Reason::Unsupported)
+    }
+    /// The oldest gate event not yet sent, if any (sent as an `E` frame).
+    fn next_gate_event(&mut self) -> Option<GateEvent> {
+        None
     }
     /// Make a simulated rig misbehave. Real hardware keeps the default: `Unsupported`.
     fn inject(&mut self, what: Injection) -> Result<(), Reason> {
@@ -234,6 +243,7 @@ impl Device {
                 Ok(())
             }
             Command::Commission => backend.commission(),
+            Command::Release => backend.release(),
             Command::GetModels => match backend.models() {
                 Ok(axes) => return Frame::Models { id, axes },
                 Err(reason) => Err(reason),
@@ -298,6 +308,17 @@ impl Device {
         t.seq = self.seq;
         self.seq = self.seq.wrapping_add(1);
         self.encoded(&Frame::Telemetry(t), out)
+    }
+
+    /// The next gate event as an `E` frame, if the backend has one (call after each step; each
+    /// event is sent once, as soon as it is known).
+    pub fn poll_gate_event<B: Backend>(
+        &mut self,
+        backend: &mut B,
+        out: &mut [u8; MAX_FRAME_LEN],
+    ) -> Option<usize> {
+        let event = backend.next_gate_event()?;
+        self.encoded(&Frame::Event(event), out)
     }
 
     fn encoded(&mut self, frame: &Frame, out: &mut [u8; MAX_FRAME_LEN]) -> Option<usize> {

@@ -226,6 +226,7 @@ fn command_body(out: &mut Out<'_>, command: &Command) {
         Command::Ping => out.token("PING"),
         Command::Commission => out.token("COMMISSION"),
         Command::GetModels => out.token("MODELS"),
+        Command::Release => out.token("RELEASE"),
     }
 }
 

@@ -249,6 +249,9 @@ pub enum Command {
     Commission,
     /// `MODELS`: answered by a [`Frame::Models`] frame: the motor models and loop gains in force.
     GetModels,
+    /// `RELEASE`: drop one granule at the start radius (the release solenoid; on a simulated
+    /// rig, a simulated granule). The gates report its release and exit as `E` frames.
+    Release,
 }
 
 /// One axis's motor model and speed-loop gains as the rig uses them (a `M` answer), scaled

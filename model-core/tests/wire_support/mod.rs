@@ -104,6 +104,7 @@ pub fn command() -> impl Strategy<Value = Command> {
         Just(Command::Ping),
         Just(Command::Commission),
         Just(Command::GetModels),
+        Just(Command::Release),
         (0..Injection::ALL.len()).prop_map(|i| Command::Inject(Injection::ALL[i])),
     ]
 }
