@@ -25,6 +25,8 @@ pub struct Seen {
     pub telemetry: Vec<Telemetry>,
     /// Boot announcements.
     pub hello: usize,
+    /// Gate events, in arrival order.
+    pub gate_events: Vec<model_core::wire::GateEvent>,
     /// Frames that failed their check or did not parse.
     pub corrupt: usize,
 }
@@ -92,6 +94,7 @@ impl Splitter {
                         match decoder.push(b) {
                             Some(Ok(Frame::Telemetry(t))) => s.telemetry.push(t),
                             Some(Ok(Frame::Hello(_))) => s.hello += 1,
+                            Some(Ok(Frame::Event(e))) => s.gate_events.push(e),
                             Some(Ok(_)) => {}
                             Some(Err(_)) => s.corrupt += 1,
                             None => {}

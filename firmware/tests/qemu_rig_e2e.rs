@@ -11,13 +11,14 @@ use bowl_emulator::board::Board;
 use bowl_emulator::image;
 use bowl_emulator::plant_log::plant_truth;
 use bowl_emulator::splitter::Splitter;
-use model_core::wire::{DeviceState, FaultCode, Residence};
+use model_core::particle::{self, Model, Scene};
+use model_core::wire::{DeviceState, FaultCode, GateKind, Residence};
 
 #[test]
 fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
     let bowl = image::build_bowl().expect("bowl builds");
     let elf = image::build(image::RIG_IMAGE).expect("the image builds");
-    let board = Board::boot_with(&elf, &["-append", "seconds=40"]);
+    let board = Board::boot_with(&elf, &["-append", "seconds=60"]);
     let usart = board.usart.try_clone().unwrap();
     let split = Splitter::start(usart, false);
 
@@ -150,6 +151,46 @@ fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
     );
     assert_eq!(split.send(&bowl, &["inject", "none"]).0, 0);
     assert_eq!(split.send(&bowl, &["clear"]).0, 0);
+
+    // RELEASE drops a simulated granule; the gates report its release and exit. Reference: the
+    // Coriolis closed form (a different method from the granule's RK4 steps) at the combined
+    // speed of 2 and 3 rad/s, 60 degrees apart (paper Eq. 2: sqrt(3 + 16) rad/s).
+    assert_eq!(split.send(&bowl, &["speed", "2000", "3000"]).0, 0);
+    assert_eq!(split.send(&bowl, &["start"]).0, 0);
+    let from = split.last().time_ms;
+    split.wait_device_ms_alive(&bowl, from, 3_000);
+    assert_eq!(split.send(&bowl, &["release"]).0, 0);
+    let (again, said) = split.send(&bowl, &["release"]);
+    assert_eq!(
+        again, 1,
+        "a second granule while one is in the bowl: {said}"
+    );
+    let from = split.last().time_ms;
+    split.wait_device_ms_alive(&bowl, from, 2_000);
+    let events = split.with_seen(|s| s.gate_events.clone());
+    assert_eq!(events.len(), 2, "{events:?}");
+    assert_eq!(
+        (events[0].kind, events[1].kind),
+        (GateKind::Release, GateKind::Exit)
+    );
+    let measured_s = f64::from(events[1].time_us.wrapping_sub(events[0].time_us)) * 1e-6;
+    let scene = Scene {
+        omega_rad_s: 19.0f64.sqrt(),
+        mu: 0.029,
+        g_m_s2: 9.81,
+        k2: 5.0 / 7.0,
+        ri_m: 0.05,
+        rim_radius_m: 0.15,
+    };
+    let want_s = particle::residence(&scene, Model::Coriolis)
+        .unwrap()
+        .residence_time_s();
+    println!("granule: {measured_s:.6} s in the bowl (closed form {want_s:.6} s)");
+    assert!(
+        (measured_s - want_s).abs() < 0.01 * want_s,
+        "{measured_s} s vs {want_s} s"
+    );
+    assert_eq!(split.send(&bowl, &["stop"]).0, 0);
 
     // The plant's own record: true speeds near the setpoints while running, duties zero
     // after the fault.

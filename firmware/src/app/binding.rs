@@ -79,6 +79,10 @@ impl<I: Injector> TaskCore for DeviceCore<I> {
         self.device.poll_telemetry(&self.backend, now_ms, out)
     }
 
+    fn poll_gate_event(&mut self, out: &mut [u8; FRAME_BYTES]) -> Option<usize> {
+        self.device.poll_gate_event(&mut self.backend, out)
+    }
+
     fn set_dropped_edges(&mut self, dropped: [u32; AXES]) {
         self.dropped_edges = dropped;
     }

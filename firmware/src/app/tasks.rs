@@ -47,6 +47,11 @@ pub trait TaskCore {
     fn receive(&mut self, bytes: &[u8], send: &mut dyn FnMut(&[u8]));
     /// A telemetry frame, if one is due at `now_ms`.
     fn poll_telemetry(&mut self, now_ms: u32, out: &mut [u8; FRAME_BYTES]) -> Option<usize>;
+    /// The next gate event as a frame, if one is waiting (sent as soon as the link polls).
+    fn poll_gate_event(&mut self, out: &mut [u8; FRAME_BYTES]) -> Option<usize> {
+        let _ = out;
+        None
+    }
     /// Tells the core how many edges the capture queues have dropped so far (per axis).
     fn set_dropped_edges(&mut self, dropped: [u32; AXES]) {
         let _ = dropped;
@@ -180,6 +185,9 @@ pub async fn link<RM: RawMutex, C: TaskCore, R: Read, W: Write>(
             }
             Either::First(Err(_)) => {} // framing/noise error: the decoder resyncs on the next frame
             Either::Second(()) => {
+                while let Some(n) = core.lock(|c| c.borrow_mut().poll_gate_event(&mut frame)) {
+                    let _ = tx.write_all(&frame[..n]).await;
+                }
                 let due = core.lock(|c| c.borrow_mut().poll_telemetry(now_ms(), &mut frame));
                 if let Some(n) = due {
                     let _ = tx.write_all(&frame[..n]).await;

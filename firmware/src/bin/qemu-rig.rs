@@ -24,6 +24,7 @@ use firmware::app::motors::Motors;
 use firmware::app::reset;
 use firmware::app::slot::Slot;
 use firmware::app::tasks::{self, Heartbeat, SharedCore};
+use firmware::qemu::gates::{self, Granules};
 use firmware::qemu::plant::{self, PlantClock, PlantInjector, SimMotor};
 use firmware::qemu::watchdog::SoftWatchdog;
 use firmware::qemu::{self, executor, time_driver, usart};
@@ -72,12 +73,12 @@ async fn supervisor_task() {
 }
 
 #[embassy_executor::task]
-async fn plant_task(rig: Plant) {
+async fn plant_task(rig: Plant, granules: Granules) {
     let mut next_log_ms = 0u32;
     // The truth log counts from power-on, as the device time does, not from the plant's
     // commissioning run before it.
     let boot_s = rig.time_s();
-    plant::run(rig, move |rig| {
+    plant::run(rig, granules, move |rig| {
         let t_ms = ((rig.time_s() - boot_s) * 1000.0) as u32;
         if t_ms >= next_log_ms {
             next_log_ms = t_ms + TRUTH_EVERY_MS;
@@ -149,6 +150,8 @@ fn main() -> ! {
             }
         ),
     }
+    gates::set_boot(resets as u16);
+    let granules = Granules::new(PLANT_SEED, ControllerConfig::nominal().axes_angle_rad);
     // Device time starts now, after the commissioning run (which took CPU time, not plant time).
     time_driver::start(core_p.SYST);
     let (tx, rx) = usart::enable();
@@ -159,7 +162,9 @@ fn main() -> ! {
     hprintln!("qemu-rig: up, run for {:?} s of virtual time", seconds);
     executor::start(|spawner| {
         let ok = [
-            plant_task(plant).map(|t| spawner.spawn(t)).is_ok(),
+            plant_task(plant, granules)
+                .map(|t| spawner.spawn(t))
+                .is_ok(),
             control_task(core).map(|t| spawner.spawn(t)).is_ok(),
             link_task(core, rx, tx).map(|t| spawner.spawn(t)).is_ok(),
             supervisor_task().map(|t| spawner.spawn(t)).is_ok(),

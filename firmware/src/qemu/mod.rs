@@ -5,6 +5,7 @@
 //! Run it with `-icount shift=0,sleep=off` (see `firmware/qemu-rig-run`).
 
 pub mod executor;
+pub mod gates;
 pub mod plant;
 pub mod ram_flash;
 pub mod reference_timer;

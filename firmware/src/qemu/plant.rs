@@ -19,6 +19,7 @@ use crate::app::binding::Injector;
 use crate::app::edges::EdgeQueue;
 use crate::app::hal::{CaptureClock, MotorOutput};
 use crate::app::motors::sanitize_duty;
+use crate::qemu::gates::{self, Granules};
 
 /// The edge queues, `[precession, spin]`, filled by the plant task.
 pub static EDGES: [EdgeQueue; 2] = [EdgeQueue::new(), EdgeQueue::new()];
@@ -68,7 +69,8 @@ impl CaptureClock for PlantClock {
 }
 
 /// Injections go to the plant: a lost sensor's edges stop reaching the firmware, a stalled
-/// shaft is blocked inside the simulation from its next step on.
+/// shaft is blocked inside the simulation from its next step on. RELEASE drops a simulated
+/// granule ([`gates`]).
 pub struct PlantInjector;
 
 impl Injector for PlantInjector {
@@ -85,11 +87,19 @@ impl Injector for PlantInjector {
         }
         Ok(())
     }
+
+    fn release(&mut self) -> Result<(), Reason> {
+        gates::release()
+    }
+
+    fn gate_event(&mut self) -> Option<model_core::wire::GateEvent> {
+        gates::next_event()
+    }
 }
 
-/// Runs the plant forever from its present state; `observe` sees the rig after every step (for
-/// the truth log).
-pub async fn run(mut rig: Plant, mut observe: impl FnMut(&Plant)) -> ! {
+/// Runs the plant and its granules forever from their present state; `observe` sees the rig
+/// after every step (for the truth log).
+pub async fn run(mut rig: Plant, mut granules: Granules, mut observe: impl FnMut(&Plant)) -> ! {
     NOW_TICKS.store(rig.now_ticks(), Ordering::Relaxed);
     let mut ticker = Ticker::every(PLANT_PERIOD);
     let mut last = Instant::now();
@@ -106,6 +116,12 @@ pub async fn run(mut rig: Plant, mut observe: impl FnMut(&Plant)) -> ! {
                 _ => {}
             }
         }
+        // A granule moves during the step under the speeds the shafts have over it.
+        granules.step(
+            [rig.speed_rad_s(0), rig.speed_rad_s(1)],
+            rig.now_ticks(),
+            dt_s,
+        );
         rig.advance(duties(), dt_s);
         for (axis, queue) in EDGES.iter().enumerate() {
             if !SENSOR_DEAD[axis].load(Ordering::Relaxed) {
