@@ -12,7 +12,6 @@ use anyhow::{Result, anyhow};
 use model_core::binding::{
     AssemblyError, ControllerBackend, Record, commission_on_plant, default_params, persisted,
 };
-use model_core::bowl::{MotorSpeeds, combined_speed_from_trig};
 use model_core::control::ControllerConfig;
 use model_core::sim::PlantParams;
 use model_core::sim::granule::ParticleParams;
@@ -63,7 +62,7 @@ impl SimulatedBackend {
                 identified: [false; 2],
             }),
             hello,
-            SimWorld::new(particle, seed),
+            SimWorld::new(particle, seed, f64::from(base.axes_angle_rad)),
         );
         checked.map_err(|r| anyhow!("rig parameters refused: {}", r.token()))?;
         let mut sim = Self {
@@ -126,29 +125,16 @@ impl SimulatedBackend {
         let edges = |axis: usize| -> &[u32] { if lost[axis] { &[] } else { plant.edges(axis) } };
         let duties = self.rig.controller_mut().tick(now, [edges(0), edges(1)]);
         let driven = [0, 1].map(|axis| if stalled[axis] { 0.0 } else { duties[axis] });
-        // A granule moves during the period under the bowl speed the plant has over it; gate
-        // times are device time (0 when commissioning at boot ended).
-        let tick_hz = f64::from(self.rig.controller().config().tick_hz);
-        let (bowl_rad_s, now_s) = (self.true_bowl_rad_s(), self.ticks as f64 / tick_hz);
+        // A granule moves during the period under the speeds the shafts have over it; gate
+        // times are device time in us (0 when commissioning at boot ended).
+        let tick_hz = u64::from(self.rig.controller().config().tick_hz);
+        let now_us = ((self.ticks * 1_000_000 / tick_hz) & 0xFFFF_FFFF) as u32;
+        let speeds = [0, 1].map(|a| f64::from(self.plant.speed_rad_s(a)));
         self.plant.advance(driven, dt_s);
         self.rig
             .injector_mut()
-            .step(bowl_rad_s, now_s, f64::from(dt_s));
+            .step(speeds, now_us, f64::from(dt_s));
         self.ticks += 1;
-    }
-
-    /// The plant's true combined bowl speed (paper Eq. 2 from the two true shaft speeds), rad/s.
-    pub fn true_bowl_rad_s(&self) -> f64 {
-        let angle = f64::from(self.rig.controller().config().axes_angle_rad);
-        combined_speed_from_trig(
-            angle.cos(),
-            angle.sin(),
-            MotorSpeeds {
-                precession_rad_s: f64::from(self.plant.speed_rad_s(0)),
-                spin_rad_s: f64::from(self.plant.speed_rad_s(1)),
-            },
-        )
-        .unwrap_or(0.0)
     }
 
     /// The simulated world: faults, granules and gates.

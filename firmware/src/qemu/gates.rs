@@ -1,18 +1,17 @@
-//! The emulated board's release solenoid and gates: RELEASE drops a simulated granule
-//! (`model_core::sim::granule`, the project's default scene: Coriolis, mu 0.029, start 0.05 m,
-//! rim 0.15 m), the plant task moves it under the plant's true combined bowl speed (paper Eq. 2
-//! from the two true shaft speeds) one plant step at a time, and the release and exit gates
-//! report its times on the plant's capture clock (microseconds, the proximity sensors' time
-//! base), as the Black Pill's timer capture will.
+//! The emulated board's release solenoid and gates: RELEASE drops a simulated granule (the
+//! simulated rigs' one `model_core::sim::gates::Gates`, the project's default scene: Coriolis,
+//! mu 0.029, start 0.05 m, rim 0.15 m), the plant task moves it under the plant's true bowl
+//! speed one plant step at a time, and the release and exit gates report its times on the
+//! plant's capture clock (microseconds, the proximity sensors' time base), as the Black Pill's
+//! timer capture will.
 //!
 //! One granule at a time, so at most one release and one exit are ever pending: two slots, the
 //! release always taken first.
 
 use core::sync::atomic::{AtomicBool, AtomicU16, AtomicU32, Ordering};
 
-use model_core::bowl::{MotorSpeeds, combined_speed_from_trig};
-use model_core::sim::granule::{Granule, ParticleParams};
-use model_core::sim::prng::Prng;
+use model_core::sim::gates::Gates;
+use model_core::sim::granule::ParticleParams;
 use model_core::wire::{GateEvent, GateKind, Reason};
 
 /// Asked for by RELEASE, taken by the plant task at its next step.
@@ -59,52 +58,31 @@ pub fn next_event() -> Option<GateEvent> {
 }
 
 /// The granules of the plant task.
-pub struct Granules {
-    particle: ParticleParams,
-    rng: Prng,
-    cos_sin: (f64, f64),
-    in_flight: Option<(Granule, u32)>,
-}
+pub struct Granules(Gates);
 
 impl Granules {
     /// Granules of the default scene, drawn with `seed`, in a bowl whose axes are `axes_rad`
     /// apart.
     pub fn new(seed: u32, axes_rad: f32) -> Self {
-        let a = f64::from(axes_rad);
-        Self {
-            particle: ParticleParams::default(),
-            rng: Prng::new(seed ^ 0x6772_616e),
-            cos_sin: (libm::cos(a), libm::sin(a)),
-            in_flight: None,
-        }
+        Self(Gates::new(
+            ParticleParams::default(),
+            seed,
+            f64::from(axes_rad),
+        ))
     }
 
     /// One plant step of `dt_s` from capture time `now_us`, the shafts at `speeds_rad_s`.
     pub fn step(&mut self, speeds_rad_s: [f32; 2], now_us: u32, dt_s: f32) {
         if RELEASE_ASKED.swap(false, Ordering::AcqRel) {
-            self.in_flight = Some((self.particle.release(&mut self.rng), now_us));
+            self.0.drop_granule(now_us);
             IN_FLIGHT.store(true, Ordering::Release);
             RELEASE_US.store(now_us, Ordering::Release);
             RELEASE_PENDING.store(true, Ordering::Release);
         }
-        let Some((granule, released_us)) = &mut self.in_flight else {
-            return;
-        };
-        let bowl_rad_s = combined_speed_from_trig(
-            self.cos_sin.0,
-            self.cos_sin.1,
-            MotorSpeeds {
-                precession_rad_s: f64::from(speeds_rad_s[0]),
-                spin_rad_s: f64::from(speeds_rad_s[1]),
-            },
-        )
-        .unwrap_or(0.0);
-        if let Some(exit_s) = granule.step(bowl_rad_s, f64::from(dt_s)) {
-            let error_s = self.particle.gate_error_s(&mut self.rng);
-            let after_us = libm::round((exit_s + error_s).max(0.0) * 1e6) as u32;
-            EXIT_US.store(released_us.wrapping_add(after_us), Ordering::Release);
+        let speeds = speeds_rad_s.map(f64::from);
+        if let Some(exit_us) = self.0.step(speeds, f64::from(dt_s)) {
+            EXIT_US.store(exit_us, Ordering::Release);
             EXIT_PENDING.store(true, Ordering::Release);
-            self.in_flight = None;
             IN_FLIGHT.store(false, Ordering::Release);
         }
     }

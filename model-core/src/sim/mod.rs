@@ -9,6 +9,7 @@
 //! (second order at these speeds), gearbox backlash.
 
 pub mod experiments;
+pub mod gates;
 pub mod granule;
 pub mod harness;
 pub mod motor;
