@@ -104,6 +104,53 @@ pub fn write_event(
     Ok(())
 }
 
+/// A telemetry log opened for reading (`bowl monitor --log`, `bowl replay --csv`, the demo's
+/// telemetry.csv): its records, and its columns found by name.
+pub struct LogReader {
+    /// The records after the header (flexible: event rows are shorter in old logs).
+    pub reader: csv::Reader<std::fs::File>,
+    header: csv::StringRecord,
+    path: std::path::PathBuf,
+}
+
+impl LogReader {
+    /// Opens `path` and reads its header.
+    pub fn open(path: &std::path::Path) -> Result<Self> {
+        use anyhow::Context as _;
+        let mut reader = csv::ReaderBuilder::new()
+            .flexible(true)
+            .from_path(path)
+            .with_context(|| format!("cannot open {}", path.display()))?;
+        let header = reader.headers()?.clone();
+        Ok(Self {
+            reader,
+            header,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// The index of column `name`, or an error that says what file is expected.
+    pub fn column(&self, name: &str) -> Result<usize> {
+        self.optional(name).ok_or_else(|| {
+            anyhow::anyhow!(
+                "{}: no `{name}` column: is this a telemetry log (bowl monitor --log, bowl \
+                 replay --csv, the demo's telemetry.csv)?",
+                self.path.display()
+            )
+        })
+    }
+
+    /// The index of column `name`, if the log has it.
+    pub fn optional(&self, name: &str) -> Option<usize> {
+        self.header.iter().position(|h| h == name)
+    }
+
+    /// The column names, in order.
+    pub fn names(&self) -> Vec<String> {
+        self.header.iter().map(str::to_string).collect()
+    }
+}
+
 /// A gate event in words, for the log's event column and the console: `release gate at
 /// 5000123 us (boot 0)`.
 pub fn gate_event_text(e: &model_core::wire::GateEvent) -> String {

@@ -68,26 +68,6 @@ fn an_experiment_runs_on_the_plant_and_the_particle_of_its_rig_file() {
     assert!(err.contains("no [particle] table"), "{err}");
 }
 
-/// The residence time at a constant speed from the Coriolis equation of motion (paper Eq. 9,
-/// corrected), integrated finely here (RK4, 10 us): an independent reference for one release.
-fn coriolis_time_s(omega: f64, mu: f64, ri: f64, rim: f64) -> f64 {
-    let (g, k2) = (9.81, 5.0 / 7.0);
-    let acc = |r: f64, v: f64| k2 * (r * omega * omega - mu * g - 2.0 * mu * omega * v);
-    let (mut t, mut r, mut v, h) = (0.0, ri, 0.0, 1e-5);
-    loop {
-        let (k1r, k1v) = (v, acc(r, v));
-        let (k2r, k2v) = (v + 0.5 * h * k1v, acc(r + 0.5 * h * k1r, v + 0.5 * h * k1v));
-        let (k3r, k3v) = (v + 0.5 * h * k2v, acc(r + 0.5 * h * k2r, v + 0.5 * h * k2v));
-        let (k4r, k4v) = (v + h * k3v, acc(r + h * k3r, v + h * k3v));
-        let r1 = r + h / 6.0 * (k1r + 2.0 * k2r + 2.0 * k3r + k4r);
-        let v1 = v + h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
-        if r1 >= rim {
-            return t + h * (rim - r) / (r1 - r);
-        }
-        (t, r, v) = (t + h, r1, v1);
-    }
-}
-
 #[test]
 fn an_experiment_over_a_port_times_granules_by_the_rigs_gate_events() {
     let dir = temp_dir("experiment-port");
@@ -117,7 +97,7 @@ fn an_experiment_over_a_port_times_granules_by_the_rigs_gate_events() {
     let rows = csv_rows(&out);
     assert_eq!(rows.len(), 2, "{rows:?}");
     // The rig's parameters give the geometry columns (START_UM, RIM_UM of the virtual rig).
-    let want = coriolis_time_s(3.5, 0.03, 0.05, 0.15);
+    let want = common::reference_residence_s(|_| 3.5, 0.03, 0.05, 0.15, true);
     for r in &rows {
         assert_eq!(r["status"], "ok", "{r:?}");
         let t: f64 = r["residence_s"].parse().unwrap();

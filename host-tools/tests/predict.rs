@@ -1,6 +1,8 @@
 //! `bowl predict` end to end: runs the built binary and checks its output against independent
 //! formulas (the textbook acosh form of paper Eq. 6, the energy identity of Eq. 7).
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -504,44 +506,15 @@ fn write_trace(path: &std::path::Path, seconds: f64, omega: impl Fn(f64) -> f64)
 }
 
 /// The residence time on a piecewise-linear speed trace (the log's samples, in rad/s, every
-/// 20 ms), by RK4 at a 10 us step with static friction holding the particle while
-/// r omega^2 <= mu g: an independent reference for `--omega-trace`.
+/// 20 ms): the shared independent reference on the trace's own interpolation.
 fn reference_time(samples: &[f64], coriolis: bool) -> f64 {
-    let (mu, g, k2, ri, rim) = (0.029, 9.81, 5.0 / 7.0, 0.05, 0.1);
     let w = |t: f64| {
         let x = t / 0.02;
         let i = (x.floor() as usize).min(samples.len() - 1);
         let j = (i + 1).min(samples.len() - 1);
         samples[i] + (samples[j] - samples[i]) * (x - i as f64)
     };
-    let c = if coriolis { 1.0 } else { 0.0 };
-    let acc = |t: f64, r: f64, v: f64| {
-        let wt = w(t);
-        if v == 0.0 && r * wt * wt <= mu * g {
-            0.0
-        } else {
-            k2 * (r * wt * wt - mu * g - c * 2.0 * mu * wt * v)
-        }
-    };
-    let (mut t, mut r, mut v, h) = (0.0, ri, 0.0, 1e-5);
-    loop {
-        let (k1r, k1v) = (v, acc(t, r, v));
-        let (k2r, k2v) = (
-            v + 0.5 * h * k1v,
-            acc(t + 0.5 * h, r + 0.5 * h * k1r, v + 0.5 * h * k1v),
-        );
-        let (k3r, k3v) = (
-            v + 0.5 * h * k2v,
-            acc(t + 0.5 * h, r + 0.5 * h * k2r, v + 0.5 * h * k2v),
-        );
-        let (k4r, k4v) = (v + h * k3v, acc(t + h, r + h * k3r, v + h * k3v));
-        let r1 = r + h / 6.0 * (k1r + 2.0 * k2r + 2.0 * k3r + k4r);
-        let v1 = v + h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
-        if r1 >= rim {
-            return t + h * (rim - r) / (r1 - r);
-        }
-        (t, r, v) = (t + h, r1, v1);
-    }
+    common::reference_residence_s(w, 0.029, 0.05, 0.1, coriolis)
 }
 
 #[test]

@@ -56,31 +56,20 @@ fn iso_seconds(s: &str) -> Option<f64> {
 
 /// The rows, and whether their times are the PC's clock.
 fn read(path: &Path) -> Result<(Vec<Row>, bool)> {
-    let mut reader = csv::ReaderBuilder::new()
-        .flexible(true)
-        .from_path(path)
-        .with_context(|| format!("cannot open {}", path.display()))?;
-    let header = reader.headers()?.clone();
-    let col = |name: &str| {
-        header.iter().position(|h| h == name).ok_or_else(|| {
-            anyhow!(
-                "{}: no `{name}` column: is this a telemetry log (bowl monitor --log, bowl \
-                 replay --csv, the demo's telemetry.csv)?",
-                path.display()
-            )
-        })
-    };
+    let mut log = crate::telemetry_csv::LogReader::open(path)?;
+    let col = |name: &str| log.column(name);
     let time = col("device_time_ms")?;
     let fault = col("fault")?;
     let speeds = [
         [col("prec_set_mrad_s")?, col("prec_measured_mrad_s")?],
         [col("spin_set_mrad_s")?, col("spin_measured_mrad_s")?],
     ];
-    let host = header.iter().position(|h| h == "host_time_utc");
-    let event = header.iter().position(|h| h == "event");
+    let host = log.optional("host_time_utc");
+    let event = log.optional("event");
     let mut first_host: Option<f64> = None;
     let mut rows = Vec::new();
-    for (i, record) in reader.records().enumerate() {
+    let names = log.names();
+    for (i, record) in log.reader.records().enumerate() {
         let line = i + 2;
         let r = record.with_context(|| format!("{}: line {line}", path.display()))?;
         let cell = |k: usize| r.get(k).unwrap_or("").trim();
@@ -109,7 +98,7 @@ fn read(path: &Path) -> Result<(Vec<Row>, bool)> {
                 anyhow!(
                     "{}: line {line}: {} = {:?} is not a number",
                     path.display(),
-                    header.get(k).unwrap_or("?"),
+                    names.get(k).map_or("?", String::as_str),
                     cell(k)
                 )
             })

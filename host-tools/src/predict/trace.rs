@@ -18,29 +18,16 @@ pub struct Trace {
 
 /// Reads the rows of one boot from `release_ms` on (default: the log's first telemetry row).
 pub fn read(path: &Path, release_ms: Option<f64>) -> Result<Trace> {
-    let mut reader = csv::ReaderBuilder::new()
-        .flexible(true)
-        .from_path(path)
-        .with_context(|| format!("cannot open {}", path.display()))?;
-    let header = reader.headers()?.clone();
-    let col = |name: &str| {
-        header.iter().position(|h| h == name).ok_or_else(|| {
-            anyhow!(
-                "{}: no `{name}` column: give a telemetry log (bowl monitor --log, bowl replay \
-                 --csv, the demo's telemetry.csv)",
-                path.display()
-            )
-        })
-    };
-    let (time, omega) = (col("device_time_ms")?, col("bowl_mrad_s")?);
-    let boot_col = header.iter().position(|h| h == "boot");
+    let mut log = crate::telemetry_csv::LogReader::open(path)?;
+    let (time, omega) = (log.column("device_time_ms")?, log.column("bowl_mrad_s")?);
+    let boot_col = log.optional("boot");
     let mut trace = Trace {
         times_s: Vec::new(),
         omega_rad_s: Vec::new(),
         release_ms: f64::NAN,
     };
     let mut boot: Option<String> = None;
-    for (i, record) in reader.records().enumerate() {
+    for (i, record) in log.reader.records().enumerate() {
         let line = i + 2;
         let r = record.with_context(|| format!("{}: line {line}", path.display()))?;
         let cell = |k: usize| r.get(k).unwrap_or("").trim();

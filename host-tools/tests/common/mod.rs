@@ -143,3 +143,46 @@ pub fn csv_rows(path: &Path) -> Vec<HashMap<String, String>> {
         })
         .collect()
 }
+
+/// The residence time, s, of a granule started at rest at `ri` (m) in a bowl of rim `rim` (m)
+/// turning at `omega(t)` rad/s: paper Eq. 5 (flat) or Eq. 9 with the corrected Coriolis term
+/// (`coriolis`), g = 9.81, k2 = 5/7, static friction holding the granule while
+/// r omega^2 <= mu g. RK4 at a 10 us step, the exit interpolated in its step: an independent
+/// reference for the end-to-end tests.
+pub fn reference_residence_s(
+    omega: impl Fn(f64) -> f64,
+    mu: f64,
+    ri: f64,
+    rim: f64,
+    coriolis: bool,
+) -> f64 {
+    let (g, k2) = (9.81, 5.0 / 7.0);
+    let c = if coriolis { 1.0 } else { 0.0 };
+    let acc = |t: f64, r: f64, v: f64| {
+        let w = omega(t);
+        if v == 0.0 && r * w * w <= mu * g {
+            0.0
+        } else {
+            k2 * (r * w * w - mu * g - c * 2.0 * mu * w * v)
+        }
+    };
+    let (mut t, mut r, mut v, h) = (0.0, ri, 0.0, 1e-5);
+    loop {
+        let (k1r, k1v) = (v, acc(t, r, v));
+        let (k2r, k2v) = (
+            v + 0.5 * h * k1v,
+            acc(t + 0.5 * h, r + 0.5 * h * k1r, v + 0.5 * h * k1v),
+        );
+        let (k3r, k3v) = (
+            v + 0.5 * h * k2v,
+            acc(t + 0.5 * h, r + 0.5 * h * k2r, v + 0.5 * h * k2v),
+        );
+        let (k4r, k4v) = (v + h * k3v, acc(t + h, r + h * k3r, v + h * k3v));
+        let r1 = r + h / 6.0 * (k1r + 2.0 * k2r + 2.0 * k3r + k4r);
+        let v1 = v + h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+        if r1 >= rim {
+            return t + h * (rim - r) / (r1 - r);
+        }
+        (t, r, v) = (t + h, r1, v1);
+    }
+}
