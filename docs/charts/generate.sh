@@ -22,6 +22,9 @@ if [ -f "$log" ]; then qemu=(--qemu-log "$log"); fi
 cargo build --release -q -p host-tools
 bowl=target/release/bowl
 "$bowl" chart work-precision --out docs/charts/work-precision.svg "${qemu[@]}"
+# The chooser's cost table, fitted to those measurements (model-core/src/choose/cost_table.rs).
+"$bowl" chart costs --csv docs/charts/work-precision.csv --out model-core/src/choose/cost_table.rs
+"$bowl" chart chooser --out docs/charts/chooser.svg
 for c in radial velocity residence stability; do
   "$bowl" chart "$c" --out "docs/charts/$c.svg"
 done

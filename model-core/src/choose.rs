@@ -76,6 +76,8 @@ pub struct Choice<T> {
     pub measured_error_rel: T,
     /// Right-hand-side evaluations the plan costs (0 for the closed form).
     pub rhs_evaluations: u32,
+    /// The plan's measured cost on the target of `T` (f64: host ns; f32: M4F instructions).
+    pub predicted_cost: f64,
 }
 
 /// Why no choice was made.
@@ -257,6 +259,7 @@ pub fn choose_constant_for<T: Real>(
         coriolis_effect_rel: effect,
         measured_error_rel: T::ZERO,
         rhs_evaluations: 0,
+        predicted_cost: plan_cost(&Plan::<T>::ClosedForm, 0, Target::for_precision::<T>()),
     })
 }
 
@@ -323,6 +326,7 @@ pub fn choose_varying_for<T: Real, P: OmegaProfile<T>>(
             coriolis_effect_rel: T::ZERO,
             measured_error_rel: T::ZERO,
             rhs_evaluations: 0,
+            predicted_cost: plan_cost(&Plan::<T>::ClosedForm, 0, Target::for_precision::<T>()),
         });
     }
     let effect = (tc - tf).abs() / tf;
@@ -364,10 +368,13 @@ pub fn choose_varying_for<T: Real, P: OmegaProfile<T>>(
     let err_of = |t: T| (t - t_ref).abs() / t_ref;
     let w_max = profile.max_omega_rad_s().max(T::EPSILON);
 
-    let mut best: Option<(Method<T>, T, u32)> = None;
+    // Ranked by measured cost on the target, not by evaluations.
+    let target = Target::for_precision::<T>();
+    let mut best: Option<(Method<T>, T, u32, f64)> = None;
     let mut consider = |method: Method<T>, err: T, evals: u32| {
-        if err <= tolerance && best.is_none_or(|(_, _, e)| evals < e) {
-            best = Some((method, err, evals));
+        let cost = plan_cost(&Plan::Integrate(method), evals, target);
+        if err <= tolerance && best.is_none_or(|(_, _, _, c)| cost < c) {
+            best = Some((method, err, evals, cost));
         }
     };
     // Fixed-step methods: calibrate at h0, rescale by the order, verify, halve until it holds.
@@ -377,6 +384,18 @@ pub fn choose_varying_for<T: Real, P: OmegaProfile<T>>(
         (|h| Method::SemiImplicitEuler { step_s: h }, 1.0),
     ];
     let quarter = tolerance * T::from_f64(0.25);
+    // A setting is taken when it meets the tolerance and so does the next finer one: a lucky
+    // cancellation of errors at one setting (it happens with the kink of a spin-up from rest)
+    // does not survive refining. Returns the setting's T and evaluations.
+    let robust = |method: Method<T>, finer: Method<T>| -> Option<(T, u32)> {
+        let (t, evals) = run(scene, model, profile, method, limits).ok()?;
+        let (t2, _) = run(scene, model, profile, finer, limits).ok()?;
+        (err_of(t) <= tolerance && err_of(t2) <= tolerance).then_some((t, evals))
+    };
+    let grow_step = T::from_f64(core::f64::consts::SQRT_2.sqrt());
+    let grow_rtol = T::from_f64(1.778_279_410_038_923);
+    // Stay well inside RK4's stability limit (2.785 / |l2|; |l2| <= 1.5 k omega here).
+    let step_cap = T::from_f64(1.5) / w_max;
     for (make, order) in fixed {
         let h0 = T::from_f64(0.1) / w_max;
         let Ok((t0, _)) = run(scene, model, profile, make(h0), limits) else {
@@ -388,26 +407,32 @@ pub fn choose_varying_for<T: Real, P: OmegaProfile<T>>(
         } else {
             h0
         };
-        // Stay well inside RK4's stability limit (2.785 / |l2|; |l2| <= 1.5 k omega here).
-        h = h.min(T::from_f64(1.5) / w_max);
+        h = h.min(step_cap);
         for _ in 0..8 {
             // Skip plans that would need more steps than the cap allows.
             if t_ref / h > T::from_f64(limits.max_steps as f64) {
                 break;
             }
-            match run(scene, model, profile, make(h), limits) {
-                // Confirmed at half the step too: a lucky cancellation of errors at one step
-                // (it happens with the kink of a spin-up from rest) does not survive halving.
-                Ok((t, evals))
-                    if err_of(t) <= tolerance
-                        && run(scene, model, profile, make(h * T::HALF), limits)
-                            .is_ok_and(|(t2, _)| err_of(t2) <= tolerance) =>
-                {
-                    consider(make(h), err_of(t), evals);
-                    break;
+            if let Some((t, evals)) = robust(make(h), make(h * T::HALF)) {
+                // Then the longest step that is robust too, of the twelve 2^(1/4) apart above
+                // it (up to 8x, within the stability margin): the calibration aimed at a
+                // quarter of the tolerance, and the error is not monotonic in the step (the
+                // kink of a spin-up, the event's interpolation).
+                let (mut best_h, mut best) = (h, (t, evals));
+                let mut longer = h;
+                for _ in 0..12 {
+                    longer = (longer * grow_step).min(step_cap);
+                    if let Some(found) = robust(make(longer), make(longer * T::HALF)) {
+                        (best_h, best) = (longer, found);
+                    }
+                    if longer >= step_cap {
+                        break;
+                    }
                 }
-                _ => h *= T::HALF,
+                consider(make(best_h), err_of(best.0), best.1);
+                break;
             }
+            h *= T::HALF;
         }
     }
     // DP54: its global error is roughly proportional to rtol; rescale, verify, halve.
@@ -416,15 +441,24 @@ pub fn choose_varying_for<T: Real, P: OmegaProfile<T>>(
         if rtol < ref_tol {
             break;
         }
-        match run(scene, model, profile, dp(rtol, scene), limits) {
-            Ok((t, evals))
-                if err_of(t) <= tolerance
-                    && run(scene, model, profile, dp(rtol * T::HALF, scene), limits)
-                        .is_ok_and(|(t2, _)| err_of(t2) <= tolerance) =>
-            {
-                consider(dp(rtol, scene), err_of(t), evals);
-                break;
+        if let Some((t, evals)) = robust(dp(rtol, scene), dp(rtol * T::HALF, scene)) {
+            // Then the loosest robust tolerance of the twelve 10^(1/4) apart above it (up to
+            // 1000x, at most 0.1).
+            let (mut best_rtol, mut best) = (rtol, (t, evals));
+            let mut looser = rtol;
+            for _ in 0..12 {
+                looser = (looser * grow_rtol).min(T::from_f64(0.1));
+                if let Some(found) = robust(dp(looser, scene), dp(looser * T::HALF, scene)) {
+                    (best_rtol, best) = (looser, found);
+                }
+                if looser >= T::from_f64(0.1) {
+                    break;
+                }
             }
+            consider(dp(best_rtol, scene), err_of(best.0), best.1);
+            break;
+        }
+        match run(scene, model, profile, dp(rtol, scene), limits) {
             Ok((t, _)) => {
                 let e = err_of(t);
                 let factor = (tolerance * T::HALF / e).min(T::HALF);
@@ -433,7 +467,7 @@ pub fn choose_varying_for<T: Real, P: OmegaProfile<T>>(
             Err(_) => rtol *= T::HALF,
         }
     }
-    let (method, err, evals) = best.ok_or(ChooseError::NoMethodMeetsTolerance)?;
+    let (method, err, evals, cost) = best.ok_or(ChooseError::NoMethodMeetsTolerance)?;
     Ok(Choice {
         model,
         plan: Plan::Integrate(method),
@@ -442,6 +476,7 @@ pub fn choose_varying_for<T: Real, P: OmegaProfile<T>>(
         coriolis_effect_rel: effect,
         measured_error_rel: err,
         rhs_evaluations: evals,
+        predicted_cost: cost,
     })
 }
 
@@ -474,7 +509,10 @@ impl<T: Real> ExpTimes for T {
     }
 }
 
+pub mod cost;
 mod trace;
+
+pub use cost::{MethodCost, Target, plan_cost};
 
 pub use trace::{SampledOmega, TraceError, choose_trace, mean_omega_rad_s};
 

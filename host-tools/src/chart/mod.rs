@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Subcommand;
 
+pub mod chooser;
 pub mod control;
+pub mod costs;
 pub mod family;
 pub mod figures;
 pub mod log;
@@ -65,6 +67,23 @@ enum Which {
     /// measured speed per axis with link events and faults marked (FILE-precession.svg,
     /// FILE-spin.svg, PNGs beside them).
     Log(LogArgs),
+    /// The chooser's cost table (Rust source for model-core) fitted to the work-precision
+    /// measurements: per call and per right-hand-side evaluation, host ns and M4F instructions.
+    Costs(CostArgs),
+    /// The chooser's plans against the cheapest plan meeting the same tolerance, by brute force
+    /// on a grid of spin-up scenes (cost ratio per scene; CSV with the plans).
+    Chooser(Out),
+}
+
+/// Options of `bowl chart costs`.
+#[derive(clap::Args)]
+struct CostArgs {
+    /// The work-precision CSV (docs/charts/work-precision.csv).
+    #[arg(long)]
+    csv: PathBuf,
+    /// The Rust file to write (model-core/src/choose/cost_table.rs).
+    #[arg(long)]
+    out: PathBuf,
 }
 
 /// Options of `bowl chart log`.
@@ -334,6 +353,11 @@ pub fn run(args: &Args) -> Result<()> {
             write_all(out, &f, &t)
         }
         Which::Scipy(a) => scipy_charts(a),
+        Which::Costs(a) => costs::write(&a.csv, &a.out),
+        Which::Chooser(out) => {
+            let (f, t) = chooser::chart()?;
+            write_all(out, &f, &t)
+        }
         Which::Log(a) => {
             let written = log::draw(&a.csv, &a.out)?;
             report(&written.iter().map(PathBuf::as_path).collect::<Vec<_>>());

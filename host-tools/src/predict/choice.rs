@@ -147,6 +147,11 @@ pub fn describe(c: &Choice<f64>, need: &Need<f64>) -> String {
             c.measured_error_rel, c.rhs_evaluations
         );
     }
+    out += &format!(
+        "\n  predicted cost {:.0} {} on the host (measured table: docs/model.md, the chooser)",
+        c.predicted_cost,
+        model_core::choose::Target::Host.unit()
+    );
     if coriolis_below_uncertainty(c) {
         out += "\n  the Coriolis term is below the uncertainty here: the parameters' uncertainty \
                 moves T more than the paper's flat-bowl idealisation does";
@@ -191,6 +196,7 @@ pub fn json(c: &Choice<f64>) -> serde_json::Value {
         "coriolis_below_uncertainty": coriolis_below_uncertainty(c),
         "measured_error_rel": c.measured_error_rel,
         "rhs_evaluations": c.rhs_evaluations,
+        "predicted_cost_ns": c.predicted_cost,
         "reason": describe_reason(c),
     })
 }

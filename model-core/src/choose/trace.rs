@@ -136,12 +136,16 @@ pub fn choose_trace<T: Real, P: OmegaProfile<T>>(
         .map(|o| o.residence_time_s())
         .filter(|t| t.is_finite());
     match closed {
-        Some(t) if (t - t_ref).abs() <= integrated.tolerance_rel * t_ref => Ok(Choice {
-            plan: Plan::ClosedFormAtMeanSpeed { omega_rad_s: mean },
-            measured_error_rel: (t - t_ref).abs() / t_ref,
-            rhs_evaluations: 0,
-            ..integrated
-        }),
+        Some(t) if (t - t_ref).abs() <= integrated.tolerance_rel * t_ref => {
+            let plan = Plan::ClosedFormAtMeanSpeed { omega_rad_s: mean };
+            Ok(Choice {
+                plan,
+                measured_error_rel: (t - t_ref).abs() / t_ref,
+                rhs_evaluations: 0,
+                predicted_cost: super::plan_cost(&plan, 0, super::Target::for_precision::<T>()),
+                ..integrated
+            })
+        }
         _ => Ok(integrated),
     }
 }

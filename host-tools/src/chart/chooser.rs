@@ -1,0 +1,184 @@
+//! `bowl chart chooser`: how good the chooser's plans are. On a grid of spin-up scenes (the
+//! speed omega(t) a PI loop gives from rest or a low speed, docs/model.md) and tolerances, the
+//! plan `choose::choose_varying_for` picks is compared with the cheapest plan found by brute
+//! force: every method at a fine geometric grid of settings (RK4 and semi-implicit Euler steps
+//! 2^(1/4) apart, DP5(4) tolerances 10^(1/4) apart), each measured against a tight DP5(4)
+//! (rtol 1e-12) of the same model, priced by the same measured cost table (host ns). The chart
+//! draws the chosen plan's cost over the cheapest's for each scene; the CSV has the plans, their
+//! errors and whether the chosen one met the tolerance.
+
+use anyhow::Result;
+use model_core::choose::{Need, Plan, Target, choose_varying_for, plan_cost};
+use model_core::ode::{self, Limits, Method, OdeOutcome, SpinUp};
+use model_core::particle::{Model, Scene};
+
+use super::plot::{Figure, Mark, Scale, Series};
+use super::table::Table;
+
+/// `T` of one run, infinite when it does not leave (or fails).
+fn time(s: &Scene<f64>, m: Model, p: &SpinUp<f64>, method: Method<f64>) -> (f64, u32) {
+    let limits = Limits::for_scene(s, p);
+    match ode::integrate(s, m, p, method, limits) {
+        Ok(r) => match r.outcome {
+            OdeOutcome::Leaves {
+                residence_time_s, ..
+            } => (residence_time_s, r.rhs_evaluations),
+            _ => (f64::INFINITY, r.rhs_evaluations),
+        },
+        Err(_) => (f64::INFINITY, u32::MAX),
+    }
+}
+
+fn dp(rtol: f64, s: &Scene<f64>) -> Method<f64> {
+    Method::Dp54 {
+        rtol,
+        atol: rtol * s.rim_radius_m * 1e-2,
+    }
+}
+
+/// The cheapest plan meeting `tolerance`: (cost, plan, error).
+fn cheapest(
+    s: &Scene<f64>,
+    m: Model,
+    p: &SpinUp<f64>,
+    t_ref: f64,
+    tolerance: f64,
+) -> Option<(f64, Method<f64>, f64)> {
+    let w_max = p.final_rad_s.max(p.start_rad_s).max(1e-9);
+    let mut candidates: Vec<Method<f64>> = Vec::new();
+    for k in 0..72 {
+        let h = 1.5 / w_max * 2f64.powf(-f64::from(k) / 4.0);
+        candidates.push(Method::Rk4 { step_s: h });
+        candidates.push(Method::SemiImplicitEuler { step_s: h });
+    }
+    for k in 0..44 {
+        candidates.push(dp(0.1 * 10f64.powf(-f64::from(k) / 4.0), s));
+    }
+    candidates
+        .into_iter()
+        .filter_map(|method| {
+            let (t, evals) = time(s, m, p, method);
+            let err = (t - t_ref).abs() / t_ref;
+            (err <= tolerance).then(|| {
+                (
+                    plan_cost(&Plan::Integrate(method), evals, Target::Host),
+                    method,
+                    err,
+                )
+            })
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+fn method_name(m: &Method<f64>) -> String {
+    match m {
+        Method::Rk4 { step_s } => format!("rk4 h={step_s:.3e}"),
+        Method::SemiImplicitEuler { step_s } => format!("semi-implicit h={step_s:.3e}"),
+        Method::Euler { step_s } => format!("euler h={step_s:.3e}"),
+        Method::Dp54 { rtol, .. } => format!("dp54 rtol={rtol:.1e}"),
+    }
+}
+
+/// The chart and its table.
+pub fn chart() -> Result<(Figure, Table)> {
+    let mut table = Table::new(&[
+        "scene",
+        "tolerance",
+        "model",
+        "chosen",
+        "chosen_error",
+        "chosen_cost_ns",
+        "cheapest",
+        "cheapest_error",
+        "cheapest_cost_ns",
+        "cost_ratio",
+        "met_tolerance",
+    ]);
+    let mut series: Vec<Series> = Vec::new();
+    let (mut worst, mut misses, mut n) = (0.0f64, 0, 0);
+    for (ti, tolerance) in [1e-3, 1e-5, 1e-7].into_iter().enumerate() {
+        let mut points = Vec::new();
+        for mu in [0.01, 0.029, 0.1] {
+            for (start, end) in [(0.0, 3.0), (1.0, 3.0), (0.0, 6.0)] {
+                for tau in [0.3, 2.0] {
+                    let s = Scene {
+                        omega_rad_s: end,
+                        mu,
+                        g_m_s2: 9.81,
+                        k2: 5.0 / 7.0,
+                        ri_m: 0.05,
+                        rim_radius_m: 0.1,
+                    };
+                    let p = SpinUp {
+                        start_rad_s: start,
+                        final_rad_s: end,
+                        time_constant_s: tau,
+                    };
+                    let Ok(c) = choose_varying_for(&s, &Need::Tolerance(tolerance), &p) else {
+                        continue;
+                    };
+                    let Plan::Integrate(method) = c.plan else {
+                        continue;
+                    };
+                    let (t_ref, _) = time(&s, c.model, &p, dp(1e-12, &s));
+                    if !t_ref.is_finite() {
+                        continue;
+                    }
+                    let (t, _) = time(&s, c.model, &p, method);
+                    let err = (t - t_ref).abs() / t_ref;
+                    // The chooser's own plan is a candidate too: its step lies off the grid.
+                    let (best_cost, best, best_err) =
+                        match cheapest(&s, c.model, &p, t_ref, tolerance) {
+                            Some(b) if b.0 < c.predicted_cost || err > tolerance => b,
+                            _ => (c.predicted_cost, method, err),
+                        };
+                    let ratio = c.predicted_cost / best_cost;
+                    n += 1;
+                    worst = worst.max(ratio);
+                    let met = err <= tolerance;
+                    if !met {
+                        misses += 1;
+                    }
+                    let name = format!("mu={mu} {start}->{end} rad/s tau={tau} s");
+                    points.push((points.len() as f64 + 1.0, ratio));
+                    table.row(vec![
+                        name,
+                        format!("{tolerance:e}"),
+                        format!("{:?}", c.model).to_lowercase(),
+                        method_name(&method),
+                        format!("{err:.3e}"),
+                        format!("{:.0}", c.predicted_cost),
+                        method_name(&best),
+                        format!("{best_err:.3e}"),
+                        format!("{best_cost:.0}"),
+                        format!("{ratio:.3}"),
+                        met.to_string(),
+                    ]);
+                }
+            }
+        }
+        series.push(Series {
+            name: format!("tolerance {tolerance:e}"),
+            points,
+            mark: Mark::Points,
+            color: ti,
+        });
+    }
+    let fig = Figure {
+        title: "The chooser's plan against the cheapest plan that meets the tolerance".into(),
+        x_label: "scene (mu x spin-up x time constant; see the CSV)".into(),
+        y_label: "cost of the chosen plan / cost of the cheapest (host ns, measured table)".into(),
+        x_scale: Scale::Linear,
+        y_scale: Scale::Linear,
+        series,
+        vlines: Vec::new(),
+        notes: vec![
+            format!("{n} scenes: worst ratio {worst:.2}, tolerance missed {misses} times"),
+            "1 = the chooser found the cheapest plan".into(),
+            "brute force: every method, steps 2^(1/4)".into(),
+            "and DP5(4) tolerances 10^(1/4) apart".into(),
+        ],
+    };
+    println!("chooser: {n} scenes, worst cost ratio {worst:.3}, tolerance missed {misses} times");
+    Ok((fig, table))
+}
