@@ -94,12 +94,9 @@ pub fn run(args: &Args) -> Result<()> {
                     w.map(|w| telemetry_csv::write_row(w, stats.restarts, &t, None))
                 }
                 // Gate events are logged too: nothing the rig sends is dropped.
-                (Ok(Frame::Event(e)), Some(w)) => Some(telemetry_csv::write_event(
-                    w,
-                    stats.restarts,
-                    None,
-                    &telemetry_csv::gate_event_text(&e),
-                )),
+                (Ok(Frame::Event(e)), Some(w)) => {
+                    Some(telemetry_csv::write_gate_event(w, stats.restarts, None, &e))
+                }
                 _ => None,
             };
             if let Some(Err(e)) = written

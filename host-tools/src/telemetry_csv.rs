@@ -151,6 +151,25 @@ impl LogReader {
     }
 }
 
+/// Writes a gate event's row: as [`write_event`], with the event's device time (ms, from its
+/// microseconds) in `device_time_ms`, so a chart places it on the telemetry's time axis.
+pub fn write_gate_event(
+    out: &mut impl Write,
+    boot: u64,
+    host: Option<SystemTime>,
+    e: &model_core::wire::GateEvent,
+) -> Result<()> {
+    writeln!(
+        out,
+        "{boot},{:.3}{}{},{}",
+        f64::from(e.time_us) / 1000.0,
+        ",".repeat(TELEMETRY_COLUMNS),
+        host.map(utc).unwrap_or_default(),
+        gate_event_text(e)
+    )?;
+    Ok(())
+}
+
 /// A gate event in words, for the log's event column and the console: `release gate at
 /// 5000123 us (boot 0)`.
 pub fn gate_event_text(e: &model_core::wire::GateEvent) -> String {

@@ -517,48 +517,47 @@ fn reference_time(samples: &[f64], coriolis: bool) -> f64 {
     common::reference_residence_s(w, 0.029, 0.05, 0.1, coriolis)
 }
 
-#[test]
-fn a_logged_speed_trace_is_predicted_within_the_tolerance() {
-    // A settled loop with 0.5 % ripple: the closed form at the mean speed is enough.
-    let steady = temp("steady.csv");
-    let ripple = |t: f64| 3.0 * (1.0 + 0.005 * (7.0 * std::f64::consts::TAU * t).sin());
-    write_trace(&steady, 3.0, ripple);
+/// `bowl predict --omega-trace` on a log of `omega(t)` (3 s at 50 Hz, mrad/s as logged) with
+/// `tolerance`: its JSON, its T and the reference's T on the same logged samples.
+fn trace_prediction(
+    name: &str,
+    omega: impl Fn(f64) -> f64,
+    tolerance: &str,
+) -> (serde_json::Value, f64, f64) {
+    let path = temp(name);
+    write_trace(&path, 3.0, &omega);
     let v = json(&[
         "predict",
         "--omega-trace",
-        steady.to_str().unwrap(),
+        path.to_str().unwrap(),
         "--tolerance",
-        "1e-3",
+        tolerance,
         "--json",
     ]);
-    assert_eq!(v["choice"]["method"], "closed", "{v}");
+    let _ = std::fs::remove_file(&path);
     let samples: Vec<f64> = (0..=150)
-        .map(|i| (ripple(i as f64 * 0.02) * 1000.0).round() / 1000.0)
-        .collect();
-    let coriolis = v["choice"]["model"] == "coriolis";
-    let want = reference_time(&samples, coriolis);
-    let got = v["residence_time_s"].as_f64().unwrap();
-    assert!((got - want).abs() <= 1e-3 * want, "{got} vs {want}");
-    // A spin-up from 0.5 to 3 rad/s: the particle waits for the speed, then leaves while it
-    // still rises; an integrator over the trace is needed for 1e-5.
-    let spin_up = temp("spin-up.csv");
-    let rise = |t: f64| 3.0 + (0.5 - 3.0) * (-t / 0.3).exp();
-    write_trace(&spin_up, 3.0, rise);
-    let v = json(&[
-        "predict",
-        "--omega-trace",
-        spin_up.to_str().unwrap(),
-        "--tolerance",
-        "1e-5",
-        "--json",
-    ]);
-    assert_ne!(v["choice"]["method"], "closed", "{v}");
-    let samples: Vec<f64> = (0..=150)
-        .map(|i| (rise(i as f64 * 0.02) * 1000.0).round() / 1000.0)
+        .map(|i| (omega(i as f64 * 0.02) * 1000.0).round() / 1000.0)
         .collect();
     let want = reference_time(&samples, v["choice"]["model"] == "coriolis");
     let got = v["residence_time_s"].as_f64().unwrap();
+    (v, got, want)
+}
+
+#[test]
+fn a_logged_speed_trace_is_predicted_within_the_tolerance() {
+    // A settled loop with 0.5 % ripple: the closed form at the mean speed is enough.
+    let ripple = |t: f64| 3.0 * (1.0 + 0.005 * (7.0 * std::f64::consts::TAU * t).sin());
+    let (v, got, want) = trace_prediction("steady.csv", ripple, "1e-3");
+    assert_eq!(v["choice"]["method"], "closed", "{v}");
+    assert!((got - want).abs() <= 1e-3 * want, "{got} vs {want}");
+    // A spin-up from 0.5 to 3 rad/s: the particle waits for the speed, then leaves while it
+    // still rises; an integrator over the trace is needed for 1e-5.
+    let rise = |t: f64| 3.0 + (0.5 - 3.0) * (-t / 0.3).exp();
+    let (v, got, want) = trace_prediction("spin-up.csv", rise, "1e-5");
+    assert_ne!(v["choice"]["method"], "closed", "{v}");
     assert!((got - want).abs() <= 1e-5 * want, "{got} vs {want}: {v}");
+    let spin_up = temp("spin-up.csv");
+    write_trace(&spin_up, 3.0, rise);
     // --model with a trace is refused in words.
     let out = bowl(&[
         "predict",
@@ -569,6 +568,5 @@ fn a_logged_speed_trace_is_predicted_within_the_tolerance() {
     ]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("leave out --model"));
-    let _ = std::fs::remove_file(steady);
     let _ = std::fs::remove_file(spin_up);
 }

@@ -496,3 +496,39 @@ fn a_silent_host_faults_a_running_rig_by_default() {
         "{status}"
     );
 }
+
+#[test]
+fn gate_events_are_logged_on_the_device_clock() {
+    let dir = temp_dir("gates");
+    let capture = sim_capture(
+        &dir,
+        &[
+            "--seconds",
+            "8",
+            "--command",
+            "0:speed,1800,2100",
+            "--command",
+            "0:start",
+            "--command",
+            "5000:release",
+        ],
+    );
+    let csv = dir.join("t.csv");
+    assert!(replay_to_csv(&capture, &csv).status.success());
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let gates: Vec<Vec<&str>> = csv_cells(&text)
+        .into_iter()
+        .filter(|r| r.last().is_some_and(|e| e.contains(" gate at ")))
+        .collect();
+    assert_eq!(gates.len(), 2, "{text}");
+    assert!(
+        gates[0][17].starts_with("release gate at 5000000 us"),
+        "{:?}",
+        gates[0]
+    );
+    assert_eq!(gates[0][1], "5000.000");
+    let exit_ms: f64 = gates[1][1].parse().unwrap();
+    assert!(gates[1][17].starts_with("exit gate at"), "{:?}", gates[1]);
+    // The granule leaves within a second at about 2.9 rad/s (Coriolis, mu 0.029, R 0.15 m).
+    assert!((5300.0..6500.0).contains(&exit_ms), "{exit_ms}");
+}

@@ -15,7 +15,8 @@ use super::plot::{Figure, Mark, Scale, Series, VLine};
 /// Palette indices (the demo's charts use the same).
 const SET_COLOUR: usize = 6;
 const MEASURED_COLOUR: usize = 0;
-const FAULT_COLOUR: usize = 8;
+/// Faults and a lost link.
+pub const FAULT_COLOUR: usize = 8;
 const EVENT_COLOUR: usize = 7;
 
 /// One row of the log: a telemetry frame, or a link event.
@@ -144,9 +145,12 @@ fn figure(rows: &[Row], axis: usize, file: &str, wall_clock: bool) -> Figure {
                 }
             }
             Row::Event { t_s, what } => {
-                // A break in both lines: nothing is known across a link event.
-                set.push((*t_s, f64::NAN));
-                measured.push((*t_s, f64::NAN));
+                // A link event breaks both lines: nothing is known across it. A gate event
+                // (`... gate at ...`) is only marked: telemetry goes on through it.
+                if !what.contains(" gate at ") {
+                    set.push((*t_s, f64::NAN));
+                    measured.push((*t_s, f64::NAN));
+                }
                 vlines.push(VLine {
                     x: *t_s,
                     label: what.clone(),
@@ -159,13 +163,38 @@ fn figure(rows: &[Row], axis: usize, file: &str, wall_clock: bool) -> Figure {
             }
         }
     }
+    let x_label = if wall_clock {
+        "time since the log's first row (PC clock), s"
+    } else {
+        "device time, s"
+    };
+    let mut fig = speed_figure(
+        format!("{file}: {name} motor {symbol}, set vs measured"),
+        x_label,
+        symbol,
+        [set, measured],
+        vec![
+            "Vertical lines: link events (red: link".into(),
+            "lost), gate events and fault changes;".into(),
+            "the speed lines break at each link event.".into(),
+        ],
+    );
+    fig.vlines = vlines;
+    fig
+}
+
+/// One axis's set and measured speed, rad/s, against time (`bowl chart log` and the demo's
+/// charts): `[set, measured]` points, no marker lines yet.
+pub fn speed_figure(
+    title: String,
+    x_label: &str,
+    symbol: &str,
+    [set, measured]: [Vec<(f64, f64)>; 2],
+    notes: Vec<String>,
+) -> Figure {
     Figure {
-        title: format!("{file}: {name} motor {symbol}, set vs measured"),
-        x_label: if wall_clock {
-            "time since the log's first row (PC clock), s".into()
-        } else {
-            "device time, s".into()
-        },
+        title,
+        x_label: x_label.into(),
         y_label: format!("{symbol}, rad/s"),
         x_scale: Scale::Linear,
         y_scale: Scale::Linear,
@@ -183,12 +212,8 @@ fn figure(rows: &[Row], axis: usize, file: &str, wall_clock: bool) -> Figure {
                 color: MEASURED_COLOUR,
             },
         ],
-        vlines,
-        notes: vec![
-            "Vertical lines: link events (red: link".into(),
-            "lost) and fault changes; the speed lines".into(),
-            "break at each link event.".into(),
-        ],
+        vlines: Vec::new(),
+        notes,
     }
 }
 

@@ -10,9 +10,7 @@ use super::script::{Mark, MarkKind};
 use crate::chart::plot::{Figure, Mark as Style, PlotError, Scale, Series, VLine};
 
 /// Palette indices (see the plot module).
-const SET_COLOUR: usize = 6;
-const MEASURED_COLOUR: usize = 0;
-const FAULT_COLOUR: usize = 8;
+use crate::chart::log::{self, FAULT_COLOUR};
 const STEP_COLOUR: usize = 7;
 
 fn t_s(t: &Telemetry) -> f64 {
@@ -44,46 +42,30 @@ fn markers(marks: &[Mark], tel: &[Telemetry]) -> Vec<VLine> {
 }
 
 fn speed_figure(axis: usize, tel: &[Telemetry], marks: &[Mark]) -> Figure {
-    let (name, symbol) = if axis == 0 {
-        ("precession", "w1")
-    } else {
-        ("spin", "w2")
-    };
+    let (name, symbol) = [("precession", "w1"), ("spin", "w2")][axis];
     let pick = |t: &Telemetry| if axis == 0 { t.precession } else { t.spin };
-    Figure {
-        title: format!("Demo: {name} motor {symbol}, set vs measured (telemetry)"),
-        x_label: "device time, s".into(),
-        y_label: format!("{symbol}, rad/s"),
-        x_scale: Scale::Linear,
-        y_scale: Scale::Linear,
-        series: vec![
-            Series {
-                name: format!("{symbol} set"),
-                points: tel
-                    .iter()
-                    .map(|t| (t_s(t), f64::from(pick(t).set_mrad_s) / 1000.0))
-                    .collect(),
-                mark: Style::Dashed,
-                color: SET_COLOUR,
-            },
-            Series {
-                name: format!("{symbol} measured"),
-                points: tel
-                    .iter()
-                    .map(|t| (t_s(t), f64::from(pick(t).measured_mrad_s) / 1000.0))
-                    .collect(),
-                mark: Style::Line,
-                color: MEASURED_COLOUR,
-            },
+    let points = |value: &dyn Fn(&Telemetry) -> i16| -> Vec<(f64, f64)> {
+        tel.iter()
+            .map(|t| (t_s(t), f64::from(value(t)) / 1000.0))
+            .collect()
+    };
+    let mut fig = log::speed_figure(
+        format!("Demo: {name} motor {symbol}, set vs measured (telemetry)"),
+        "device time, s",
+        symbol,
+        [
+            points(&|t| pick(t).set_mrad_s),
+            points(&|t| pick(t).measured_mrad_s),
         ],
-        vlines: markers(marks, tel),
-        notes: vec![
+        vec![
             "set: the commanded target; measured: the".into(),
             "rig's pulse-based estimate (50 frames/s).".into(),
             "Red lines: fault injected / detected.".into(),
             "The drive duties are in telemetry.csv.".into(),
         ],
-    }
+    );
+    fig.vlines = markers(marks, tel);
+    fig
 }
 
 fn residence_figure(tel: &[Telemetry], marks: &[Mark]) -> Figure {

@@ -167,9 +167,9 @@ pub fn run(args: &Args) -> Result<()> {
                     if decoder.stats().restarts > restarts {
                         link_event(&mut log, decoder.stats().restarts, "device restart")?;
                     }
-                    if let Frame::Event(e) = &frame {
+                    if let (Frame::Event(e), Some(w)) = (&frame, log.as_mut()) {
                         let boot = decoder.stats().restarts;
-                        link_event(&mut log, boot, &telemetry_csv::gate_event_text(e))?;
+                        telemetry_csv::write_gate_event(w, boot, Some(SystemTime::now()), e)?;
                     }
                     if let Frame::Telemetry(t) = &frame {
                         if let Some(w) = log.as_mut() {
