@@ -31,7 +31,10 @@ pub fn particulars(
     match (reason, word.as_str()) {
         (Reason::Range, "set") => set_range(words),
         (Reason::State, "release") => Some(
-            "a granule is still in the bowl (one at a time): wait for its exit gate event".into(),
+            "the last release is not over: a simulated rig still has its granule in the bowl \
+             (wait for its exit gate event), the Black Pill's solenoid is still energised \
+             (40 ms)"
+                .into(),
         ),
         (Reason::Unsupported, "release") => Some(
             "this rig has no release solenoid: drop the granule by hand (the release gate still \

@@ -10,7 +10,8 @@
 
 use anyhow::{Result, anyhow};
 use model_core::binding::{
-    AssemblyError, ControllerBackend, Record, commission_on_plant, default_params, persisted,
+    AssemblyError, ControllerBackend, Record, commission_on_plant, default_params, describe_bowl,
+    persisted,
 };
 use model_core::control::ControllerConfig;
 use model_core::sim::PlantParams;
@@ -49,6 +50,7 @@ impl SimulatedBackend {
         for (id, axis) in [(ParamId::Teeth1, 0), (ParamId::Teeth2, 1)] {
             params[id.index()] = i32::from(plant_params.axes[axis].sensor.pulses_per_rev);
         }
+        describe_bowl(&mut params, &particle);
         let hello = Hello {
             reset_cause: ResetCause::Unknown,
             reset_count: 0,

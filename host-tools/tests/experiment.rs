@@ -96,10 +96,16 @@ fn an_experiment_over_a_port_times_granules_by_the_rigs_gate_events() {
     assert!(run.status.success(), "{}", common::stdout(&run));
     let rows = csv_rows(&out);
     assert_eq!(rows.len(), 2, "{rows:?}");
-    // The rig's parameters give the geometry columns (START_UM, RIM_UM of the virtual rig).
+    // The rig's parameters give the geometry columns: the virtual rig's table describes the
+    // bowl of its rig file (START_UM, RIM_UM, K2_PPM), as an engineer sets a real rig's.
     let want = common::reference_residence_s(|_| 3.5, 0.03, 0.05, 0.15, true);
     for r in &rows {
         assert_eq!(r["status"], "ok", "{r:?}");
+        let geometry: Vec<f64> = ["release_radius_m", "rim_radius_m", "k2"]
+            .iter()
+            .map(|k| r[*k].parse().unwrap())
+            .collect();
+        assert_eq!(geometry, [0.05, 0.15, 0.714286], "{r:?}");
         let t: f64 = r["residence_s"].parse().unwrap();
         // The speed loop holds 3.5 rad/s to about 0.3 %; T moves about 2x as much.
         assert!((t - want).abs() < 0.01 * want, "{t} s vs {want} s: {r:?}");
@@ -113,5 +119,5 @@ fn an_experiment_over_a_port_times_granules_by_the_rigs_gate_events() {
     let again = bowl(&["send", &sim.path, "release"]);
     assert_eq!(again.status.code(), Some(1));
     let text = common::stdout(&again);
-    assert!(text.contains("a granule is still in the bowl"), "{text}");
+    assert!(text.contains("still has its granule in the bowl"), "{text}");
 }

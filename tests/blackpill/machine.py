@@ -21,10 +21,11 @@ from unicorn.arm_const import UC_ARM_REG_FPSCR, UC_ARM_REG_S0
 
 from clock_tree import HSE_HZ, ClockTree
 from dma import Dma
+from exti import Exti
 from flash import BACKED_BASE, BACKED_SIZE, FlashInterface, FlashStore
 from iwdg import Iwdg
 from nvic import Nvic
-from plant import DIR_PINS
+from plant import DIR_PINS, SOLENOID_PIN
 from rtt import RttReader
 from timers import Timer
 from usart import Usart
@@ -34,6 +35,9 @@ SLICE_NS = 20_000
 CODE_FLASH_SIZE = BACKED_BASE - 0x0800_0000
 
 IRQ_TIM1_UP, IRQ_TIM1_CC, IRQ_TIM2, IRQ_TIM5 = 25, 27, 28, 50
+IRQ_EXTI0 = 6
+# The release push button: PA0 (the Black Pill's KEY), active low.
+BUTTON_PORT, BUTTON_PIN = "a", 0
 IRQ_USART2 = 38
 IRQ_DMA1_STREAM = {5: 16, 6: 17}
 # DMA1 requests (RM0383 table 27): (stream, channel) -> (peripheral label, direction).
@@ -90,7 +94,7 @@ class Board:
                     verbose=QL_VERBOSE.DISABLED)
         self.ql = ql
         self.uc = ql.uc
-        for label in ("rcc", "pwr", "gpioa", "gpiob", "gpioc", "syscfg", "exti", "dbgmcu"):
+        for label in ("rcc", "pwr", "gpioa", "gpiob", "gpioc", "syscfg", "dbgmcu"):
             ql.hw.create(label)
         self.rcc = ql.hw.rcc
         self.clocks = ClockTree(self.rcc, m.hse_hz)
@@ -110,6 +114,7 @@ class Board:
         self.dma1 = add("dma1", Dma(ql, "dma1", m), 0x4002_6000)
         self.iwdg = add("iwdg", Iwdg(ql, "iwdg", m), 0x4000_3000)
         self.flash = add("flash", FlashInterface(ql, "flash", m, m.store), 0x4002_3C00)
+        self.exti = add("exti", Exti(ql, "exti", ql.hw.syscfg), 0x4001_3C00)
         self.timers = (self.tim1, self.tim2, self.tim5)
         self.clocked = (self.tim1, self.tim2, self.tim5, self.usart2, self.iwdg)
         self.stepping = [e for k, e in ql.hw.stepable.items() if k in ("rcc", "pwr")]
@@ -119,6 +124,7 @@ class Board:
         self.nvic.connect(IRQ_TIM2, lambda: self.tim2.irq_level(0x1F))
         self.nvic.connect(IRQ_TIM5, lambda: self.tim5.irq_level(0x1F))
         self.nvic.connect(IRQ_USART2, self.usart2.irq_level)
+        self.nvic.connect(IRQ_EXTI0, lambda: self.exti.irq_level(1 << BUTTON_PIN))
         for stream, irq in IRQ_DMA1_STREAM.items():
             self.nvic.connect(irq, lambda s=stream: self.dma1.irq_level(s))
 
@@ -127,6 +133,7 @@ class Board:
         scb = ql.hw.scb
         scb.hook_write(self._scb_write)
         self.dir_pins = self.gpiob.instance.ODR & DIR_MASK
+        self.solenoid_on = False
         self.gpiob.hook_write(self._gpiob_written, intercept=QL_INTERCEPT.EXIT)
 
         for addr in m.wfe_sites:
@@ -158,6 +165,10 @@ class Board:
     def _gpiob_written(self, gpio, access, offset, size, value):
         # A DIR pin that turns while its PWM channel still drives the bridge drives the new
         # direction with the old duty: the harness records every such moment.
+        solenoid = bool(gpio.instance.ODR & (1 << SOLENOID_PIN))
+        if solenoid != self.solenoid_on:
+            self.solenoid_on = solenoid
+            self.m.solenoid_changed(solenoid)
         pins = gpio.instance.ODR & DIR_MASK
         changed = pins ^ self.dir_pins
         self.dir_pins = pins
@@ -247,6 +258,10 @@ class Machine:
         self.interrupts = 0
         self.slices = 0
         self.tx_bytes = bytearray()
+        # Input changes from outside the board (the release button): sorted (time ns, action).
+        self.inputs = []
+        # Each release solenoid pulse: [on ns, off ns or None].
+        self.solenoid_pulses = []
         self.rtt = None
         if defmt_print and log_dir:
             os.makedirs(log_dir, exist_ok=True)
@@ -285,6 +300,27 @@ class Machine:
         self.tx_bytes.append(byte)
         if self.link is not None:
             self.link.send(bytes([byte]))
+
+    def solenoid_changed(self, on: bool):
+        """PB5 changed: a rising edge energises the release solenoid and drops a granule."""
+        if on:
+            self.solenoid_pulses.append([self.now_ns, None])
+            if self.plant is not None:
+                self.plant.release(self.now_ns)
+        elif self.solenoid_pulses:
+            self.solenoid_pulses[-1][1] = self.now_ns
+
+    def press_button(self, at_ns: int, bounces_ns=()):
+        """The release button pressed at `at_ns` (PA0 falls), its contacts bouncing open and
+        shut again at each of `at_ns + bounces_ns[k]`, then released 200 ms later."""
+        board_edge = lambda falling: lambda b: b.exti.pin_edge(BUTTON_PORT, BUTTON_PIN,
+                                                               rising=not falling)
+        self.inputs.append((at_ns, board_edge(True)))
+        for d in bounces_ns:
+            self.inputs.append((at_ns + d - 1000, board_edge(False)))
+            self.inputs.append((at_ns + d, board_edge(True)))
+        self.inputs.append((at_ns + 200_000_000, board_edge(False)))
+        self.inputs.sort(key=lambda e: e[0])
 
     def request_reset(self, kind: str):
         self.reset_request = kind
@@ -330,6 +366,8 @@ class Machine:
     # --- the loop ------------------------------------------------------------------------
     def _next_event_ns(self):
         t = self.board.next_event_ns()
+        if self.inputs:
+            t = self.inputs[0][0] if t is None else min(t, self.inputs[0][0])
         if self.plant is not None:
             p = self.plant.next_event_ns()
             t = p if t is None else min(t, p)
@@ -337,6 +375,9 @@ class Machine:
 
     def _process_events(self):
         b = self.board
+        while self.inputs and self.inputs[0][0] <= self.now_ns:
+            _, action = self.inputs.pop(0)
+            action(b)
         if self.plant is not None:
             while self.plant.edges and self.plant.edges[0][0] <= self.now_ns:
                 at, axis = self.plant.edges.popleft()

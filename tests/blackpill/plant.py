@@ -1,6 +1,8 @@
 """The project's plant (`model_core::sim::Plant`, through the plant-ffi C ABI) wired to the
 emulated board: it reads TIM1's PWM outputs and the DIR pins (PB12, PB13), steps the physics,
-and delivers each sensor edge to TIM2's capture channels at its own time."""
+and delivers each sensor edge to TIM2's capture channels at its own time. Its granules drop
+when the board's release solenoid (PB5) fires, and the exit light gate's edge goes to TIM2's
+channel 3 (PB10) when one reaches the rim."""
 
 import ctypes
 import os
@@ -11,6 +13,10 @@ STEP_S = 0.00025
 STEP_NS = 250_000
 PLANT_TIMER_HZ = 1_000_000
 DIR_PINS = (12, 13)
+# GPIOB pin of the release solenoid driver.
+SOLENOID_PIN = 5
+# TIM2 channel index of the exit light gate (CH3, PB10).
+EXIT_GATE_CHANNEL = 2
 
 
 class RigParams(ctypes.Structure):
@@ -40,6 +46,8 @@ def load_library(path: str):
     lib.plant_speed_rad_s.argtypes = [ctypes.c_void_p, ctypes.c_uint32]
     lib.plant_speed_rad_s.restype = ctypes.c_float
     lib.plant_inject.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_float]
+    lib.plant_release.argtypes = [ctypes.c_void_p, ctypes.c_uint32]
+    lib.plant_exit.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_uint32)]
     return lib
 
 
@@ -70,6 +78,9 @@ class RigPlant:
         self.edges = deque()  # (time_ns, axis)
         self.buf = (ctypes.c_uint32 * 64)()
         self.duties = (0.0, 0.0)
+        self.exit_us = ctypes.c_uint32(0)
+        # (release time ns, exit gate time ns or None) of each granule, for the tests.
+        self.granules = []
 
     def duties_from_board(self, tim1, gpiob):
         duties = []
@@ -80,6 +91,14 @@ class RigPlant:
             duties.append(-frac if reverse else frac)
         return tuple(duties)
 
+    @staticmethod
+    def _unwrap_us(ticks: int, start_us: int) -> int:
+        # A 32-bit microsecond stamp, unwrapped against the step's start.
+        us = start_us + ((ticks - start_us) & 0xFFFF_FFFF)
+        if us - start_us > 0x8000_0000:
+            us -= 1 << 32
+        return us
+
     def step(self, tim1, gpiob):
         """One physics step from `time_ns` with the board's present outputs held."""
         self.duties = self.duties_from_board(tim1, gpiob)
@@ -88,14 +107,20 @@ class RigPlant:
         for axis in (0, 1):
             n = self.lib.plant_edges(self.handle, axis, self.buf, 64)
             for k in range(max(n, 0)):
-                ticks = self.buf[k]
-                # Unwrap the 32-bit microsecond stamp against the step's start.
-                us = start_us + ((ticks - start_us) & 0xFFFF_FFFF)
-                if us - start_us > 0x8000_0000:
-                    us -= 1 << 32
-                self.edges.append((us * 1000, axis))
+                self.edges.append((self._unwrap_us(self.buf[k], start_us) * 1000, axis))
+        if self.lib.plant_exit(self.handle, ctypes.byref(self.exit_us)) == 1:
+            at_ns = self._unwrap_us(self.exit_us.value, start_us) * 1000
+            self.edges.append((at_ns, EXIT_GATE_CHANNEL))
+            if self.granules and self.granules[-1][1] is None:
+                self.granules[-1] = (self.granules[-1][0], at_ns)
         self.edges = deque(sorted(self.edges))
         self.time_ns += STEP_NS
+
+    def release(self, at_ns: int):
+        """The release solenoid fired at `at_ns`: a granule drops at the start radius."""
+        if self.lib.plant_release(self.handle, (at_ns // 1000) & 0xFFFF_FFFF) != 0:
+            raise RuntimeError("plant_release refused")
+        self.granules.append((at_ns, None))
 
     def speed_rad_s(self, axis: int) -> float:
         return self.lib.plant_speed_rad_s(self.handle, axis)

@@ -10,7 +10,6 @@ import os
 import re
 import shutil
 import sys
-import tempfile
 import time
 import traceback
 
@@ -21,30 +20,11 @@ from flash import SECTOR_BASES, BACKED_BASE, SECTOR_SIZE  # noqa: E402
 SLOT_BYTES = 16 + 4 * 48 + 4
 from session import LOGS, ROOT, Session  # noqa: E402
 from timers import BDTR, MOE  # noqa: E402
+from checks import WORK, check, fresh_flash, mean_speed  # noqa: E402
+from test_gates import *  # noqa: E402,F401,F403  (the gate tests join this run)
 
-WORK = tempfile.mkdtemp(prefix="blackpill-")
 # The control task's tick counter in the image (`HEARTBEAT` static).
 HEARTBEAT = None
-
-
-def fresh_flash(name: str) -> str:
-    path = os.path.join(WORK, name + ".bin")
-    if os.path.exists(path):
-        os.unlink(path)
-    return path
-
-
-def check(cond, what):
-    if not cond:
-        raise AssertionError(what)
-
-
-def mean_speed(s: Session, axis: int, seconds: float, samples: int = 10) -> float:
-    total = 0.0
-    for _ in range(samples):
-        s.wait_emulated(seconds / samples)
-        total += s.call(lambda m: m.plant.speed_rad_s(axis))
-    return total / samples
 
 
 def test_boot_says_hello_and_reports_power_on():

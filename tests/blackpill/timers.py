@@ -141,13 +141,18 @@ class Timer(QlPeripheral):
 
     # --- capture -----------------------------------------------------------------------
     def capture(self, ch: int, at_ns: int):
-        """An input edge on channel `ch` at `at_ns` (not before the last sync)."""
+        """An input edge on channel `ch` at `at_ns`. A register access in the slice the edge
+        fell in may have brought the counter past `at_ns` already: the latched value is still
+        the counter at `at_ns`."""
         self.sync(at_ns)
         if not self.running() or not self._capture_mode(ch) or not self.regs[CCER] & (1 << (4 * ch)):
             return
         if self.regs[SR] & (2 << ch):
             self.regs[SR] |= 1 << (9 + ch)
-        self.ccr[ch] = self.cnt
+        behind = 0
+        if at_ns < self.anchor_ns:
+            behind = -(-(self.anchor_ns - at_ns) * self.tick_hz() // 1_000_000_000)
+        self.ccr[ch] = int(self.cnt - behind) % (self.arr + 1)
         self.regs[SR] |= 2 << ch
 
     # --- PWM output --------------------------------------------------------------------

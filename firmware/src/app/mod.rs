@@ -6,6 +6,7 @@
 //!   region); the byte stream is `embedded_io_async`.
 //! - [`binding`]: the controller + particle model behind the wire protocol (`TaskCore`).
 //! - [`edges`]: the queue from the pulse-capture interrupt/task to the control tick.
+//! - [`gates`]: a real board's release trigger and exit light gate, debounced, as gate events.
 //! - [`params`]: parameters persisted in flash (version + CRC-32, append-only records).
 //! - [`persist`]: the loop that saves changed parameters and reports lost capture edges.
 //! - [`reset`]: reset cause and a reset counter that survives resets in uninitialised RAM.
@@ -14,6 +15,7 @@
 
 pub mod binding;
 pub mod edges;
+pub mod gates;
 pub mod hal;
 pub mod motors;
 pub mod params;

@@ -3,8 +3,9 @@
 //! Boot: read the reset cause and count the reset, bring the outputs up *off*, load the
 //! parameters from flash, then run the tasks: control tick (1 kHz), host link (commands,
 //! answers, telemetry over USART2 with DMA), supervisor (watchdog, parameter persistence) and a
-//! heartbeat LED. Pulse capture is the TIM2 interrupt. Pin map: `firmware::blackpill` and
-//! docs/wiring.md. Flash and run: `cargo flash` (probe-rs; defmt logs over RTT).
+//! heartbeat LED, and the release solenoid. Pulse capture and the exit light gate are the TIM2
+//! interrupt, the release button EXTI0. Pin map: `firmware::blackpill` and docs/wiring.md.
+//! Flash and run: `cargo flash` (probe-rs; defmt logs over RTT).
 #![no_std]
 #![no_main]
 
@@ -28,7 +29,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
 use embassy_time::{Duration, Ticker};
 use firmware::app::binding::{
-    ControllerBackend, DeviceCore, NoInjection, PERSISTED_COUNT, default_persisted, split_persisted,
+    ControllerBackend, DeviceCore, PERSISTED_COUNT, default_persisted, split_persisted,
 };
 use firmware::app::hal::Watchdog;
 use firmware::app::motors::Motors;
@@ -40,6 +41,7 @@ use firmware::app::tasks::{self, Heartbeat, SharedCore};
 use firmware::blackpill::capture::{self, Tim2Clock};
 use firmware::blackpill::clocks;
 use firmware::blackpill::flash_region::ParamSector;
+use firmware::blackpill::gates::{self, BoardGates, ReleaseButton};
 use firmware::blackpill::motor_pwm::{self, PWM_HZ, PwmMotor};
 use firmware::blackpill::reset_cause::{self, ResetFlag};
 use model_core::control::ControllerConfig;
@@ -51,7 +53,7 @@ bind_interrupts!(struct Irqs {
     DMA1_STREAM6 => dma::InterruptHandler<DMA1_CH6>;
 });
 
-type Core = SharedCore<ThreadModeRawMutex, DeviceCore<NoInjection>>;
+type Core = SharedCore<ThreadModeRawMutex, DeviceCore<BoardGates>>;
 
 /// Watchdog timeout: 25 control periods of slack over the supervisor's 20 ms feeding period.
 const WATCHDOG_TIMEOUT_US: u32 = 250_000;
@@ -115,7 +117,9 @@ async fn main(spawner: Spawner) {
         ),
     ]);
     motors.all_off();
-    let capture = capture::start(p.TIM2, p.PA15, p.PB3);
+    let solenoid = Output::new(p.PB5, Level::Low, Speed::Low);
+    let capture = capture::start(p.TIM2, p.PA15, p.PB3, p.PB10);
+    let button = gates::start_button(p.PA0, p.EXTI0);
 
     info!(
         "boot: reset cause {}, resets since power-on {}",
@@ -142,8 +146,12 @@ async fn main(spawner: Spawner) {
         reset_cause: wire_cause(flag),
         reset_count: resets as u16,
     };
-    let (rig, outcome) =
-        ControllerBackend::new(ControllerConfig::nominal(), stored, hello, NoInjection);
+    let (rig, outcome) = ControllerBackend::new(
+        ControllerConfig::nominal(),
+        stored,
+        hello,
+        BoardGates::new(hello.reset_count),
+    );
     if let Err(r) = outcome {
         warn!("params: stored values rejected ({}), using defaults", r);
     }
@@ -170,6 +178,7 @@ async fn main(spawner: Spawner) {
     spawn(spawner, link_task(core, rx, tx));
     spawn(spawner, supervisor_task(Iwdg(iwdg), core, log));
     spawn(spawner, heartbeat_task(led));
+    spawn(spawner, solenoid_task(solenoid, button));
     info!("running");
 }
 
@@ -252,6 +261,12 @@ async fn supervisor_task(
         }
     };
     embassy_futures::join::join(feed, persist).await;
+}
+
+/// Fires the release solenoid for each RELEASE (and keeps the release button configured).
+#[embassy_executor::task]
+async fn solenoid_task(solenoid: Output<'static>, _button: ReleaseButton) {
+    gates::run_solenoid(solenoid).await
 }
 
 #[embassy_executor::task]

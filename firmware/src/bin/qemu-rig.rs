@@ -19,7 +19,9 @@ use cortex_m_semihosting::hprintln;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
 use embassy_time::{Duration, Timer};
-use firmware::app::binding::{ControllerBackend, DeviceCore, default_persisted};
+use firmware::app::binding::{
+    ControllerBackend, DeviceCore, default_persisted, describe_bowl, persisted, split_persisted,
+};
 use firmware::app::motors::Motors;
 use firmware::app::reset;
 use firmware::app::slot::Slot;
@@ -30,6 +32,7 @@ use firmware::qemu::watchdog::SoftWatchdog;
 use firmware::qemu::{self, executor, time_driver, usart};
 use model_core::binding::{AssemblyError, commission_on_plant};
 use model_core::control::ControllerConfig;
+use model_core::sim::granule::ParticleParams;
 use model_core::sim::{Plant, PlantParams};
 use model_core::wire::{Hello, ResetCause};
 
@@ -132,9 +135,12 @@ fn main() -> ! {
     // The emulated board keeps no parameters across a power cycle: it boots with the defaults,
     // then is commissioned on its plant as a real rig is once after assembly (and as the host's
     // virtual rig is), so it runs on the models it identified, not on the datasheet's.
+    // Its table describes the bowl its granules fall in (Granules: the default scene).
+    let mut record = split_persisted(&default_persisted());
+    describe_bowl(&mut record.params, &ParticleParams::default());
     let (mut rig, _) = ControllerBackend::new(
         ControllerConfig::nominal(),
-        default_persisted(),
+        persisted(&record),
         hello,
         PlantInjector,
     );

@@ -1,17 +1,17 @@
 //! Pulse capture: both proximity sensors on TIM2 (32 bit, 1 MHz): CH1 on PA15 (precession),
-//! CH2 on PB3 (spin), rising edges. The TIM2 interrupt moves each latched timestamp into the
-//! axis's [`EdgeQueue`]; an edge overwritten before the interrupt read it (over-capture) is
-//! counted as lost, never silently dropped.
+//! CH2 on PB3 (spin), rising edges; and the exit light gate on CH3, PB10 ([`super::gates`]).
+//! The TIM2 interrupt moves each latched timestamp into its [`EdgeQueue`]; an edge overwritten
+//! before the interrupt read it (over-capture) is counted as lost, never silently dropped.
 
 use embassy_stm32::Peri;
 use embassy_stm32::gpio::Pull;
 use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::InterruptExt;
-use embassy_stm32::peripherals::{PA15, PB3, TIM2};
+use embassy_stm32::peripherals::{PA15, PB3, PB10, TIM2};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::input_capture::CapturePin;
 use embassy_stm32::timer::low_level::{FilterValue, InputCaptureMode, InputTISelection, Timer};
-use embassy_stm32::timer::{Ch1, Ch2, Channel};
+use embassy_stm32::timer::{Ch1, Ch2, Ch3, Channel};
 
 use crate::app::edges::EdgeQueue;
 use crate::app::hal::CaptureClock;
@@ -28,6 +28,7 @@ pub struct Capture {
     _pins: (
         CapturePin<'static, TIM2, Ch1>,
         CapturePin<'static, TIM2, Ch2>,
+        CapturePin<'static, TIM2, Ch3>,
     ),
 }
 
@@ -41,17 +42,21 @@ impl CaptureClock for Tim2Clock {
     }
 }
 
-/// Starts TIM2 at [`CAPTURE_HZ`] with both channels capturing rising edges.
+/// Starts TIM2 at [`CAPTURE_HZ`] with the sensors' and the exit gate's channels capturing
+/// rising edges.
 pub fn start(
     tim: Peri<'static, TIM2>,
     pa15: Peri<'static, PA15>,
     pb3: Peri<'static, PB3>,
+    pb10: Peri<'static, PB10>,
 ) -> Capture {
     // The sensor outputs are level-shifted push-pull or open collector with an external
     // pull-up (docs/wiring.md); no internal pull so a dead sensor reads as no edges.
     let pins = (
         CapturePin::new(pa15, Pull::None),
         CapturePin::new(pb3, Pull::None),
+        // The light gate drives its output; the pull-down keeps an unplugged gate silent.
+        CapturePin::new(pb10, Pull::Down),
     );
     let mut timer = Timer::new(tim);
     timer.set_tick_freq(Hertz(CAPTURE_HZ));
@@ -66,6 +71,14 @@ pub fn start(
         timer.enable_channel(ch, true);
         timer.enable_input_interrupt(ch, true);
     }
+    // The light gate's edge is slower and noisier than a sensor's: 8 samples at fDTS/32
+    // (about 2.6 us), still far below the time a granule takes to cross the beam.
+    timer.set_input_capture_filter(Channel::Ch3, FilterValue::FDTS_DIV32_N8);
+    timer.set_input_ti_selection(Channel::Ch3, InputTISelection::Normal);
+    timer.set_input_capture_mode(Channel::Ch3, InputCaptureMode::Rising);
+    timer.set_input_capture_prescaler(Channel::Ch3, 0);
+    timer.enable_channel(Channel::Ch3, true);
+    timer.enable_input_interrupt(Channel::Ch3, true);
     timer.generate_update_event();
     timer.start();
     interrupt::TIM2.unpend();
@@ -81,7 +94,8 @@ pub fn start(
 fn TIM2() {
     let tim = embassy_stm32::pac::TIM2;
     let sr = tim.sr().read();
-    for (i, queue) in EDGES.iter().enumerate() {
+    let queues = [&EDGES[0], &EDGES[1], &super::gates::EDGES[1]];
+    for (i, queue) in queues.into_iter().enumerate() {
         if sr.ccif(i) {
             // Reading CCRx clears CCxIF.
             let t = tim.ccr(i).read();

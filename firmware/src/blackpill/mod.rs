@@ -9,6 +9,9 @@
 //! | Spin motor direction         | PB13 | GPIO out                                     |
 //! | Precession proximity sensor  | PA15 | TIM2_CH1 (AF1) input capture, 1 MHz, 32 bit  |
 //! | Spin proximity sensor        | PB3  | TIM2_CH2 (AF1) input capture, same counter   |
+//! | Exit light gate              | PB10 | TIM2_CH3 (AF1) input capture, same counter   |
+//! | Release push button (KEY)    | PA0  | EXTI0 falling edge, reads the same counter   |
+//! | Release solenoid driver      | PB5  | GPIO out, high = energised                   |
 //! | Host link TX                 | PA2  | USART2_TX, DMA1 stream 6                      |
 //! | Host link RX                 | PA3  | USART2_RX, DMA1 stream 5 (circular)           |
 //! | Heartbeat LED (active low)   | PC13 | GPIO out                                     |
@@ -21,5 +24,6 @@
 pub mod capture;
 pub mod clocks;
 pub mod flash_region;
+pub mod gates;
 pub mod motor_pwm;
 pub mod reset_cause;

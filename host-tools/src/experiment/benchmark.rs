@@ -50,7 +50,7 @@ pub fn run(
         slowest_s = slowest_s.max(started.elapsed().as_secs_f64());
         let (runs, excluded) = fit::load(&path)?;
         let excluded_n = excluded.len();
-        let f = fit::fit(runs, excluded)?;
+        let f = fit::fit(runs, excluded, false)?;
         let m = f
             .models
             .iter()

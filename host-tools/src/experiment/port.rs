@@ -70,6 +70,16 @@ impl PortRig {
             Frame::Params { values, .. } => rig.params = values,
             other => bail!("{port}: PARAMS answered {}", crate::send::describe(&other)),
         }
+        // A faulted rig refuses every speed: say so once, before the plan starts.
+        if let Frame::Status { status, .. } = rig.command(&["status"])?
+            && status.state == model_core::wire::DeviceState::Faulted
+        {
+            bail!(
+                "{port}: the rig is stopped by a fault ({}); check the rig, clear it with \
+                 `bowl send {port} clear` and run the plan again",
+                crate::words::fault(status.fault)
+            );
+        }
         Ok(rig)
     }
 
@@ -260,9 +270,10 @@ impl PortRig {
 impl ReleaseRig for PortRig {
     fn geometry(&self) -> (f64, f64, f64) {
         (
-            param(&self.params, ParamId::StartUm) * 1e-6,
-            param(&self.params, ParamId::RimUm) * 1e-6,
-            param(&self.params, ParamId::K2Ppm) * 1e-6,
+            // Divided, not multiplied by 1e-6: 50000 um is 0.05 m, not 0.049999999999999996.
+            param(&self.params, ParamId::StartUm) / 1e6,
+            param(&self.params, ParamId::RimUm) / 1e6,
+            param(&self.params, ParamId::K2Ppm) / 1e6,
         )
     }
 

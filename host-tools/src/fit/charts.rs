@@ -12,19 +12,23 @@ use model_core::sim::granule::G_M_S2;
 
 use super::models::Equation;
 use super::stats::t_quantile_975;
-use super::{Fit, condition_table};
+use super::{Fit, K2, ModelFit, condition_table};
 use crate::chart::plot::{Figure, Mark, Scale, Series};
 
 /// Points along each model curve.
 const CURVE_POINTS: usize = 120;
 
-fn scene(fit: &Fit, mu: f64, omega: f64) -> Scene<f64> {
+/// The scene of a fitted model at `omega`: its `mu`, and its `k2` where it was fitted.
+fn scene(fit: &Fit, m: &ModelFit, omega: f64) -> Scene<f64> {
     let r = &fit.runs[0];
     Scene {
         omega_rad_s: omega,
-        mu,
+        mu: m.mu,
         g_m_s2: G_M_S2,
-        k2: r.k2,
+        k2: match m.k2 {
+            K2::Fitted(k2, _) => k2,
+            _ => r.k2,
+        },
         ri_m: r.release_radius_m,
         rim_radius_m: r.rim_radius_m,
     }
@@ -82,7 +86,7 @@ fn model_curves(
             points: (0..=CURVE_POINTS)
                 .map(|k| {
                     let w = lo + (hi - lo) * k as f64 / CURVE_POINTS as f64;
-                    (w, value(&scene(fit, m.mu, w), model))
+                    (w, value(&scene(fit, m, w), model))
                 })
                 .collect(),
             mark: if i == 0 { Mark::Dashed } else { Mark::Line },
@@ -182,7 +186,7 @@ pub fn write(fit: &Fit, dir: &Path) -> Result<()> {
             Equation::Rolling => None,
         })
         .map(|(i, m, model)| {
-            let s = scene(fit, m.mu, w5);
+            let s = scene(fit, m, w5);
             let t_end = 1.5 * t5;
             Series {
                 name: format!("{} model, mu {:.4}", m.candidate.name, m.mu),

@@ -1,8 +1,10 @@
-//! `bowl fit results.csv [--json]`: the effective rolling resistance `mu` of each candidate model
-//! from measured residence times, its 95 % interval, the residuals per condition, and which model
-//! the data supports (AIC). Method and limits: docs/experiment.md.
+//! `bowl fit results.csv [--json] [--fit-k2]`: the effective rolling resistance `mu` of each
+//! candidate model (and with `--fit-k2` the granule's `k2` too) from measured residence times,
+//! its 95 % interval, the residuals per condition, and which model the data supports (AIC).
+//! Method and limits: docs/experiment.md.
 
 pub mod charts;
+pub mod joint;
 pub mod models;
 pub mod stats;
 
@@ -15,6 +17,7 @@ use serde_json::json;
 use crate::experiment::results::{self, STATUS_OK};
 use models::{
     CANDIDATES, Candidate, Equation, Method, Run, STEADY_REL_SD, mu_ceiling_for, predict,
+    predict_with_k2,
 };
 use stats::{AIC_DECISIVE, aic, crossing, minimise, t_quantile_975};
 
@@ -36,6 +39,10 @@ pub struct Args {
     /// model's tilt; the results file does not record it).
     #[arg(long, default_value_t = DEFAULT_AXES_ANGLE_DEG)]
     pub axes_angle_deg: f64,
+    /// Fit the granule's k2 as well as mu (needs conditions spread over the speed range; the
+    /// results file's k2 is the starting point).
+    #[arg(long)]
+    pub fit_k2: bool,
 }
 
 /// The rig's axes angle unless told otherwise, degrees (the controller's default, paper Eq. 2).
@@ -48,6 +55,17 @@ pub struct Excluded {
     pub row: usize,
     /// Plain words.
     pub reason: String,
+}
+
+/// What the fit did with `k2`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum K2 {
+    /// Taken from the results file.
+    Given,
+    /// Fitted with `mu`: estimate and 95 % interval.
+    Fitted(f64, (f64, f64)),
+    /// Asked for, but could not be fitted (plain words); `mu` is the one-parameter fit's.
+    NotFitted(String),
 }
 
 /// The fit of one model.
@@ -65,6 +83,11 @@ pub struct ModelFit {
     pub aic: f64,
     /// Relative error of each run, % (prediction minus measurement, over the measurement).
     pub errors_pct: Vec<f64>,
+    /// The granule's `k2`.
+    pub k2: K2,
+    /// The best `mu` is the search's upper limit (the largest at which every run still
+    /// leaves): the model does not describe these runs, whatever its interval says.
+    pub at_limit: bool,
 }
 
 /// The whole fit.
@@ -156,8 +179,52 @@ pub fn sse(runs: &[Run], equation: Equation, mu: f64) -> f64 {
         .sum()
 }
 
-/// Fits one model (needs at least 3 runs).
-pub fn fit_model(runs: &[Run], candidate: Candidate) -> ModelFit {
+/// Fits one model (needs at least 3 runs); with `fit_k2`, `k2` as well (at least 4).
+pub fn fit_model(runs: &[Run], candidate: Candidate, fit_k2: bool) -> ModelFit {
+    let one = fit_mu(runs, candidate);
+    if !fit_k2 {
+        return one;
+    }
+    let model = candidate.equation;
+    let ceiling = runs
+        .iter()
+        .map(|r| mu_ceiling_for(r, model))
+        .fold(f64::INFINITY, f64::min);
+    let k2_start = runs.iter().map(|r| r.k2).sum::<f64>() / runs.len() as f64;
+    match joint::fit_mu_k2(runs, model, (one.mu, k2_start), ceiling) {
+        Ok(j) => {
+            let n = runs.len();
+            let errors_pct: Vec<f64> = runs
+                .iter()
+                .map(|r| {
+                    100.0 * (predict_with_k2(r, model, j.mu, j.k2) - r.residence_s) / r.residence_s
+                })
+                .collect();
+            ModelFit {
+                candidate,
+                mu: j.mu,
+                mu_ci95: j.mu_ci95,
+                rms_error_pct: rms(&errors_pct),
+                // mu, k2 and the noise.
+                aic: aic(j.sse, n, 3),
+                errors_pct,
+                k2: K2::Fitted(j.k2, j.k2_ci95),
+                at_limit: j.mu >= ceiling * (1.0 - 1e-9),
+            }
+        }
+        Err(e) => ModelFit {
+            k2: K2::NotFitted(e.words()),
+            ..one
+        },
+    }
+}
+
+fn rms(errors_pct: &[f64]) -> f64 {
+    (errors_pct.iter().map(|e| e * e).sum::<f64>() / errors_pct.len() as f64).sqrt()
+}
+
+/// Fits `mu` alone, `k2` from the results file.
+fn fit_mu(runs: &[Run], candidate: Candidate) -> ModelFit {
     let n = runs.len();
     let model = candidate.equation;
     let ceiling = runs
@@ -179,14 +246,15 @@ pub fn fit_model(runs: &[Run], candidate: Candidate) -> ModelFit {
         .iter()
         .map(|r| 100.0 * (predict(r, model, mu) - r.residence_s) / r.residence_s)
         .collect();
-    let rms = (errors_pct.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
     ModelFit {
         candidate,
         mu,
         mu_ci95: (lo, hi),
-        rms_error_pct: rms,
+        rms_error_pct: rms(&errors_pct),
         aic: aic(s_min, n, 2),
         errors_pct,
+        k2: K2::Given,
+        at_limit: mu >= ceiling * (1.0 - 1e-9),
     }
 }
 
@@ -202,9 +270,10 @@ fn preferred_by_aic(models: &[ModelFit]) -> &'static str {
     }
 }
 
-/// Fits every candidate of [`CANDIDATES`] and decides between them by AIC.
-pub fn fit(runs: Vec<Run>, excluded: Vec<Excluded>) -> Result<Fit> {
-    fit_candidates(runs, excluded, &CANDIDATES)
+/// Fits every candidate of [`CANDIDATES`] (with `fit_k2`, `k2` too) and decides between them
+/// by AIC.
+pub fn fit(runs: Vec<Run>, excluded: Vec<Excluded>, fit_k2: bool) -> Result<Fit> {
+    fit_candidates(runs, excluded, &CANDIDATES, fit_k2)
 }
 
 /// Fits the given candidates and decides between them by AIC.
@@ -212,6 +281,7 @@ pub fn fit_candidates(
     runs: Vec<Run>,
     excluded: Vec<Excluded>,
     candidates: &[Candidate],
+    fit_k2: bool,
 ) -> Result<Fit> {
     if runs.len() < 3 {
         bail!(
@@ -221,7 +291,10 @@ pub fn fit_candidates(
             excluded.len()
         );
     }
-    let models: Vec<ModelFit> = candidates.iter().map(|&c| fit_model(&runs, c)).collect();
+    let models: Vec<ModelFit> = candidates
+        .iter()
+        .map(|&c| fit_model(&runs, c, fit_k2))
+        .collect();
     let preferred = preferred_by_aic(&models);
     Ok(Fit {
         runs,
@@ -235,15 +308,24 @@ pub fn fit_candidates(
 pub fn to_json(fit: &Fit) -> serde_json::Value {
     let mut models = serde_json::Map::new();
     for m in &fit.models {
-        models.insert(
-            m.candidate.name.into(),
-            json!({
-                "mu": m.mu,
-                "mu_ci95": [m.mu_ci95.0, m.mu_ci95.1],
-                "rms_error_pct": m.rms_error_pct,
-                "aic": m.aic,
-            }),
-        );
+        let mut model = json!({
+            "mu": m.mu,
+            "mu_ci95": [m.mu_ci95.0, m.mu_ci95.1],
+            "rms_error_pct": m.rms_error_pct,
+            "aic": m.aic,
+        });
+        match &m.k2 {
+            K2::Given => {}
+            K2::Fitted(k2, ci) => {
+                model["k2"] = json!(k2);
+                model["k2_ci95"] = json!([ci.0, ci.1]);
+            }
+            K2::NotFitted(why) => model["k2_not_fitted"] = json!(why),
+        }
+        if m.at_limit {
+            model["at_search_limit"] = json!(true);
+        }
+        models.insert(m.candidate.name.into(), model);
     }
     json!({
         "models": models,
@@ -311,7 +393,7 @@ pub fn run(args: &Args) -> Result<()> {
     for r in &mut runs {
         r.axes_angle_rad = args.axes_angle_deg.to_radians();
     }
-    let fit = fit(runs, excluded)?;
+    let fit = fit(runs, excluded, args.fit_k2)?;
     if !args.no_charts {
         let dir = args.charts.clone().unwrap_or_else(|| {
             let stem = args
@@ -353,6 +435,18 @@ pub fn run(args: &Args) -> Result<()> {
             "{:<10} {:.5}  [{:.5}, {:.5}]   {:>8.2}   {:>10.2}",
             m.candidate.name, m.mu, m.mu_ci95.0, m.mu_ci95.1, m.rms_error_pct, m.aic
         );
+        match &m.k2 {
+            K2::Given => {}
+            K2::Fitted(k2, ci) => println!("{:<10} k2 {:.4}  [{:.4}, {:.4}]", "", k2, ci.0, ci.1),
+            K2::NotFitted(why) => println!("{:<10} k2 not fitted: {why}", ""),
+        }
+        if m.at_limit {
+            println!(
+                "{:<10} its best mu is the largest at which every run still leaves: this model \
+                 does not describe these runs",
+                ""
+            );
+        }
     }
     println!(
         "preferred: {} (a model is preferred when its AIC is lower by more than {AIC_DECISIVE})",

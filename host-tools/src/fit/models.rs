@@ -99,15 +99,21 @@ pub struct Run {
 /// Predicted residence time at `mu` (for the rolling model, its rolling resistance), s;
 /// infinite when the granule would never leave.
 pub fn predict(run: &Run, equation: Equation, mu: f64) -> f64 {
+    predict_with_k2(run, equation, mu, run.k2)
+}
+
+/// As [`predict`], the granule's `k2` (its moment of inertia over `m r^2`) given instead of the
+/// run's.
+pub fn predict_with_k2(run: &Run, equation: Equation, mu: f64, k2: f64) -> f64 {
     let model = match equation {
         Equation::Paper(m) => m,
-        Equation::Rolling => return rolling_mean(run, mu),
+        Equation::Rolling => return rolling_mean(run, mu, k2),
     };
     match run.method {
-        Method::ClosedForm => closed_form(run, model, mu, run.mean_rad_s),
+        Method::ClosedForm => closed_form_with_k2(run, model, mu, k2, run.mean_rad_s),
         Method::Integrated => {
             let give_up = 20.0 * run.residence_s + 10.0;
-            Granule::new(model, mu, run.k2, run.release_radius_m, run.rim_radius_m)
+            Granule::new(model, mu, k2, run.release_radius_m, run.rim_radius_m)
                 .residence_over_trace(&run.trace, TRACE_STEP_S, give_up)
                 .unwrap_or(f64::INFINITY)
         }
@@ -116,11 +122,15 @@ pub fn predict(run: &Run, equation: Equation, mu: f64) -> f64 {
 
 /// Closed-form residence time at a constant speed, s (infinite: never leaves or invalid).
 pub fn closed_form(run: &Run, model: Model, mu: f64, omega_rad_s: f64) -> f64 {
+    closed_form_with_k2(run, model, mu, run.k2, omega_rad_s)
+}
+
+fn closed_form_with_k2(run: &Run, model: Model, mu: f64, k2: f64, omega_rad_s: f64) -> f64 {
     let scene = Scene {
         omega_rad_s,
         mu,
         g_m_s2: G_M_S2,
-        k2: run.k2,
+        k2,
         ri_m: run.release_radius_m,
         rim_radius_m: run.rim_radius_m,
     };
@@ -130,10 +140,10 @@ pub fn closed_form(run: &Run, model: Model, mu: f64, omega_rad_s: f64) -> f64 {
 /// The rolling model's mean residence time over the azimuths at the run's mean speed, s
 /// (infinite when a release does not leave). The rolling model takes constant motor speeds: a
 /// drifting speed trace is represented by its mean.
-fn rolling_mean(run: &Run, mu: f64) -> f64 {
+fn rolling_mean(run: &Run, mu: f64, k2: f64) -> f64 {
     let scene = RollingScene {
         rolling_resistance: mu,
-        k2: run.k2,
+        k2,
         ri_m: run.release_radius_m,
         rim_radius_m: run.rim_radius_m,
         g_m_s2: G_M_S2,

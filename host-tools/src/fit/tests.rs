@@ -42,7 +42,7 @@ fn synthetic(model: Model, mu: f64, sigma_s: f64, per_speed: usize, seed: u32) -
 /// integration would make a debug build's fits minutes long; [`rolling_truth_is_recognised`]
 /// fits all three).
 fn fit_paper(runs: Vec<Run>, excluded: Vec<Excluded>) -> anyhow::Result<Fit> {
-    super::fit_candidates(runs, excluded, &CANDIDATES[..2])
+    super::fit_candidates(runs, excluded, &CANDIDATES[..2], false)
 }
 
 fn fitted(fit: &Fit, name: &str) -> ModelFit {
@@ -314,7 +314,7 @@ fn rolling_truth_is_recognised() {
             runs.push(run);
         }
     }
-    let f = fit(runs, Vec::new()).unwrap();
+    let f = fit(runs, Vec::new(), false).unwrap();
     assert_eq!(f.preferred, "rolling");
     let r = fitted(&f, "rolling");
     assert!(

@@ -24,7 +24,8 @@ pub mod record;
 pub use assembly::{ASSEMBLY_COMMISSION_MAX_S, AssemblyError, commission_on_plant};
 pub use backend::ControllerBackend;
 pub use configure::{
-    OVERSPEED_PER_MAX, ParamRole, config_from_params, default_params, scene_from_params,
+    OVERSPEED_PER_MAX, ParamRole, config_from_params, default_params, describe_bowl,
+    scene_from_params,
 };
 pub use record::{
     PERSISTED_COUNT, Persisted, Record, default_persisted, persisted, split_persisted,

@@ -7,11 +7,41 @@
 //! Why a C ABI and not a Rust harness on the unicorn engine: the peripheral models need
 //! qiling's STM32F411 RCC/GPIO/EXTI models and its ELF loader, which are Python.
 //!
+//! The handle also carries the rig's granules (`model_core::sim::gates::Gates`, the same
+//! granule-and-gates simulation as every simulated rig): the harness drops one when the
+//! board's release solenoid fires ([`plant_release`]) and feeds the exit gate's time
+//! ([`plant_exit`]) to the capture timer.
+//!
 //! Every function takes a pointer returned by [`plant_new`]; a null pointer or an axis other
 //! than 0 or 1 is refused (a negative or zero result), never a crash.
 
 use core::ffi::{CStr, c_char};
+use model_core::control::ControllerConfig;
+use model_core::sim::gates::Gates;
+use model_core::sim::granule::ParticleParams;
 use model_core::sim::{Plant, PlantParams};
+
+/// A simulated rig: the plant and the granules in its bowl.
+pub struct SimRig {
+    plant: Plant,
+    gates: Gates,
+    /// The exit gate's capture time from the last [`plant_advance`], if a granule left in it.
+    exit_us: Option<u32>,
+}
+
+impl SimRig {
+    fn new(params: PlantParams, seed: u32, particle: ParticleParams) -> Self {
+        Self {
+            plant: Plant::new(params, seed),
+            gates: Gates::new(
+                particle,
+                seed,
+                f64::from(ControllerConfig::nominal().axes_angle_rad),
+            ),
+            exit_us: None,
+        }
+    }
+}
 
 /// The rig parameters the harness may set, flat and `repr(C)`. [`plant_params_nominal`] fills
 /// it with the nominal rig; a rig file loader fills the same struct.
@@ -93,10 +123,14 @@ pub unsafe extern "C" fn plant_params_nominal(out: *mut RigParams) -> i32 {
 /// # Safety
 /// `params` is null or points to a valid [`RigParams`].
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn plant_new(params: *const RigParams, seed: u32) -> *mut Plant {
+pub unsafe extern "C" fn plant_new(params: *const RigParams, seed: u32) -> *mut SimRig {
     // SAFETY: the caller passes null or a valid pointer.
     match unsafe { params.as_ref() } {
-        Some(p) => Box::into_raw(Box::new(Plant::new(p.to_plant(), seed))),
+        Some(p) => Box::into_raw(Box::new(SimRig::new(
+            p.to_plant(),
+            seed,
+            ParticleParams::default(),
+        ))),
         None => core::ptr::null_mut(),
     }
 }
@@ -115,7 +149,7 @@ pub unsafe extern "C" fn plant_new_from_rig_file(
     timer_hz: u32,
     message: *mut c_char,
     message_cap: u32,
-) -> *mut Plant {
+) -> *mut SimRig {
     let report = |text: &str| {
         if message.is_null() || message_cap == 0 {
             return;
@@ -151,7 +185,8 @@ pub unsafe extern "C" fn plant_new_from_rig_file(
     };
     let mut params = rig.params;
     fit_to_harness(&mut params, timer_hz);
-    Box::into_raw(Box::new(Plant::new(params, rig.seed)))
+    let particle = rig.particle.unwrap_or_default();
+    Box::into_raw(Box::new(SimRig::new(params, rig.seed, particle)))
 }
 
 /// Frees a plant from [`plant_new`] (null is ignored).
@@ -159,7 +194,7 @@ pub unsafe extern "C" fn plant_new_from_rig_file(
 /// # Safety
 /// `plant` is null or came from [`plant_new`] and is not used afterwards.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn plant_free(plant: *mut Plant) {
+pub unsafe extern "C" fn plant_free(plant: *mut SimRig) {
     if !plant.is_null() {
         // SAFETY: the pointer came from `Box::into_raw` in `plant_new`.
         drop(unsafe { Box::from_raw(plant) });
@@ -173,7 +208,7 @@ pub unsafe extern "C" fn plant_free(plant: *mut Plant) {
 /// `plant` is null or came from [`plant_new`].
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn plant_advance(
-    plant: *mut Plant,
+    plant: *mut SimRig,
     duty0: f32,
     duty1: f32,
     dt_s: f32,
@@ -185,8 +220,47 @@ pub unsafe extern "C" fn plant_advance(
     if !(dt_s.is_finite() && dt_s > 0.0) {
         return -1;
     }
-    p.advance([duty0, duty1], dt_s);
+    p.plant.advance([duty0, duty1], dt_s);
+    // The granule moves under the speeds the shafts reached in the step.
+    let speeds = [0, 1].map(|axis| f64::from(p.plant.speed_rad_s(axis)));
+    p.exit_us = p.gates.step(speeds, f64::from(dt_s));
     0
+}
+
+/// Drops a granule at the start radius at capture time `time_ticks` (when the board's release
+/// solenoid fired); it moves from the next [`plant_advance`] on, and its exit gate time counts
+/// from `time_ticks`. One still in the bowl is replaced. Returns 0, or -1 for a null plant.
+///
+/// # Safety
+/// `plant` is null or came from [`plant_new`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_release(plant: *mut SimRig, time_ticks: u32) -> i32 {
+    // SAFETY: the caller passes null or a live plant.
+    let Some(p) = (unsafe { plant.as_mut() }) else {
+        return -1;
+    };
+    p.gates.drop_granule(time_ticks);
+    0
+}
+
+/// Whether a granule reached the rim in the last [`plant_advance`]: 1 and its exit gate time
+/// (capture ticks) in `out`, 0 if none did, -1 for a bad pointer.
+///
+/// # Safety
+/// `plant` is null or came from [`plant_new`]; `out` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_exit(plant: *const SimRig, out: *mut u32) -> i32 {
+    // SAFETY: the caller passes null or valid pointers.
+    let (Some(p), Some(out)) = (unsafe { plant.as_ref() }, unsafe { out.as_mut() }) else {
+        return -1;
+    };
+    match p.exit_us {
+        Some(t) => {
+            *out = t;
+            1
+        }
+        None => 0,
+    }
 }
 
 /// Copies the edges of `axis` from the last [`plant_advance`] (timer ticks, oldest first) to
@@ -196,7 +270,7 @@ pub unsafe extern "C" fn plant_advance(
 /// `plant` is null or came from [`plant_new`]; `out` points to `cap` writable `u32`s.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn plant_edges(
-    plant: *const Plant,
+    plant: *const SimRig,
     axis: u32,
     out: *mut u32,
     cap: u32,
@@ -208,7 +282,7 @@ pub unsafe extern "C" fn plant_edges(
     if axis > 1 || out.is_null() {
         return -1;
     }
-    let edges = p.edges(axis as usize);
+    let edges = p.plant.edges(axis as usize);
     let n = edges.len().min(cap as usize);
     // SAFETY: `out` has room for `cap >= n` values.
     unsafe { core::ptr::copy_nonoverlapping(edges.as_ptr(), out, n) };
@@ -220,10 +294,10 @@ pub unsafe extern "C" fn plant_edges(
 /// # Safety
 /// `plant` is null or came from [`plant_new`].
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn plant_speed_rad_s(plant: *const Plant, axis: u32) -> f32 {
+pub unsafe extern "C" fn plant_speed_rad_s(plant: *const SimRig, axis: u32) -> f32 {
     // SAFETY: the caller passes null or a live plant.
     match unsafe { plant.as_ref() } {
-        Some(p) if axis <= 1 => p.speed_rad_s(axis as usize),
+        Some(p) if axis <= 1 => p.plant.speed_rad_s(axis as usize),
         _ => f32::NAN,
     }
 }
@@ -235,7 +309,12 @@ pub unsafe extern "C" fn plant_speed_rad_s(plant: *const Plant, axis: u32) -> f3
 /// # Safety
 /// `plant` is null or came from [`plant_new`].
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn plant_inject(plant: *mut Plant, axis: u32, kind: u32, from_s: f32) -> i32 {
+pub unsafe extern "C" fn plant_inject(
+    plant: *mut SimRig,
+    axis: u32,
+    kind: u32,
+    from_s: f32,
+) -> i32 {
     // SAFETY: the caller passes null or a live plant.
     let Some(p) = (unsafe { plant.as_mut() }) else {
         return -1;
@@ -243,7 +322,7 @@ pub unsafe extern "C" fn plant_inject(plant: *mut Plant, axis: u32, kind: u32, f
     if axis > 1 {
         return -1;
     }
-    let faults = &mut p.params_mut().axes[axis as usize].faults;
+    let faults = &mut p.plant.params_mut().axes[axis as usize].faults;
     match kind {
         0 => faults.blocked_from_s = from_s,
         1 => faults.dead_sensor_from_s = from_s,
@@ -280,12 +359,30 @@ mod tests {
             assert!(edges > 12, "edges {edges}");
             assert_eq!(plant_advance(p, 0.0, 0.0, f32::NAN), -1);
             assert_eq!(plant_edges(p, 2, buf.as_mut_ptr(), 64), -1);
+            // A granule dropped into the spinning bowl leaves through the exit gate, after
+            // the time it was dropped at; none is reported before it was dropped.
+            let mut exit = 0u32;
+            assert_eq!(plant_exit(p, &mut exit), 0);
+            assert_eq!(plant_release(p, 2_000_000), 0);
+            let mut steps = 0;
+            while plant_exit(p, &mut exit) == 0 && steps < 40_000 {
+                assert_eq!(plant_advance(p, 0.0, 0.8, 0.00025), 0);
+                steps += 1;
+            }
+            assert_eq!(plant_exit(p, &mut exit), 1, "no exit in 10 s");
+            let after_s = f64::from(exit - 2_000_000) * 1e-6;
+            let moved_s = f64::from(steps) * 0.00025;
+            assert!(
+                after_s <= moved_s && after_s > moved_s - 0.00025,
+                "exit {after_s} s after the drop, in step ending {moved_s} s"
+            );
+            assert_eq!(plant_exit(p, core::ptr::null_mut()), -1);
             plant_free(p);
             assert_eq!(plant_advance(core::ptr::null_mut(), 0.0, 0.0, 0.001), -1);
         }
     }
 
-    fn spin_speed_after_a_tenth_of_a_second(p: *mut Plant) -> f32 {
+    fn spin_speed_after_a_tenth_of_a_second(p: *mut SimRig) -> f32 {
         let mut buf = [0u32; 64];
         // SAFETY: a live plant and a valid buffer.
         unsafe {
