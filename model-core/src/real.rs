@@ -6,6 +6,7 @@
 
 use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 
+pub mod log1p;
 #[cfg(feature = "micromath")]
 pub mod micro;
 
@@ -49,6 +50,9 @@ pub trait Real:
     /// True for `+0`, `-0` and every finite positive value; false for NaN, infinities and
     /// negatives. One integer compare on the bits (input validation runs on every call).
     fn is_nonneg_finite(self) -> bool;
+    /// True for `0 < x <= 1`; false for NaN and everything else. One integer compare on the
+    /// bits (positive floats order as their bit patterns).
+    fn is_in_unit_interval(self) -> bool;
     /// Absolute value.
     fn abs(self) -> Self;
     /// Square root (hardware `VSQRT` on the Cortex-M4F for `f32`).
@@ -61,6 +65,13 @@ pub trait Real:
     fn ln(self) -> Self;
     /// ln(1 + x), accurate near 0.
     fn ln_1p(self) -> Self;
+    /// ln(1 + x) for a finite `x > -1` that the caller has established: the closed forms'
+    /// arguments are sums of non-negative finite values. Skips the domain checks where a type
+    /// has a cheaper path (f32 on the MCU); outside the domain the value is meaningless.
+    #[inline]
+    fn ln_1p_in_domain(self) -> Self {
+        self.ln_1p()
+    }
     /// Hyperbolic cosine.
     fn cosh(self) -> Self;
     /// Hyperbolic sine.
@@ -121,6 +132,11 @@ impl Real for f64 {
     fn is_nonneg_finite(self) -> bool {
         let bits = self.to_bits();
         bits < 0x7FF0_0000_0000_0000 || bits == 0x8000_0000_0000_0000
+    }
+    #[inline]
+    fn is_in_unit_interval(self) -> bool {
+        // 1 <= bits <= bits(1.0): the positive values up to 1 (zero, signs and NaN wrap out).
+        self.to_bits().wrapping_sub(1) < 0x3FF0_0000_0000_0000
     }
     #[inline]
     fn abs(self) -> Self {
@@ -199,6 +215,10 @@ impl Real for f32 {
         bits < 0x7F80_0000 || bits == 0x8000_0000
     }
     #[inline]
+    fn is_in_unit_interval(self) -> bool {
+        self.to_bits().wrapping_sub(1) < 0x3F80_0000
+    }
+    #[inline]
     fn abs(self) -> Self {
         f32::abs(self)
     }
@@ -220,7 +240,11 @@ impl Real for f32 {
     }
     #[inline]
     fn ln_1p(self) -> Self {
-        libm::log1pf(self)
+        log1p::ln_1p_f32(self)
+    }
+    #[inline]
+    fn ln_1p_in_domain(self) -> Self {
+        log1p::ln_1p_in_domain(self)
     }
     #[inline]
     fn cosh(self) -> Self {
@@ -289,6 +313,27 @@ mod tests {
             let want = (x as f64).sqrt() as f32;
             assert_eq!(Real::sqrt(x), want, "sqrt({x})");
         }
+    }
+
+    #[test]
+    fn unit_interval_classifies() {
+        for (x, want) in [
+            (0.5f64, true),
+            (1.0, true),
+            (1e-310, true),
+            (0.0, false),
+            (-0.0, false),
+            (1.0000000000000002, false),
+            (-0.5, false),
+            (f64::NAN, false),
+            (f64::INFINITY, false),
+        ] {
+            assert_eq!(x.is_in_unit_interval(), want, "{x}");
+            // f32: 1e-310 rounds to 0 (outside), 1.0000000000000002 to 1 (inside).
+            let y = x as f32;
+            assert_eq!(y.is_in_unit_interval(), y > 0.0 && y <= 1.0, "{x} as f32");
+        }
+        assert!(!1.000_000_1f32.is_in_unit_interval());
     }
 
     #[test]

@@ -27,7 +27,8 @@ use super::timing::{Budget, Timing, ns_per_call};
 pub enum Precision {
     /// f64 with libm (the host's analysis type).
     F64,
-    /// f32 with libm (and VSQRT on the target): the model's `Real for f32`.
+    /// f32 as the model's `Real for f32` computes it: libm, VSQRT on the target, and the
+    /// project's own `ln_1p` (model_core::real::log1p); the name is the historical one.
     F32Libm,
     /// f32 with micromath's functions, its rough `sqrt` included (`MicroF32`).
     F32Micromath,

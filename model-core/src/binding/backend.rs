@@ -9,7 +9,7 @@ use crate::control::{
     BowlSpeedForResidence, Controller, ControllerConfig, Fault, InverseFailure, MotorModel,
     Rejection, State,
 };
-use crate::particle::{self, InverseError, Model, Outcome, Scene};
+use crate::particle::{self, InverseError, Model, Scene};
 use crate::wire::device::Backend;
 use crate::wire::{
     AxisModel, DeviceState, FaultCode, GateEvent, Hello, Injection, MODEL_FIELD_MAX,
@@ -48,12 +48,10 @@ impl SceneModel {
             omega_rad_s,
             ..self.scene
         };
-        match particle::residence(&scene, self.model) {
-            Ok(Outcome::Leaves {
-                residence_time_s, ..
-            }) => Residence::from_seconds(Some(residence_time_s)),
-            Ok(Outcome::AlreadyAtRim { .. }) => Residence::Ms(0),
-            Ok(Outcome::NeverLeaves { .. }) => Residence::NeverLeaves,
+        // The time alone: telemetry carries nothing else, and on the MCU it is half the work.
+        match particle::residence_time_s(&scene, self.model) {
+            Ok(t) if t.is_infinite() => Residence::NeverLeaves,
+            Ok(t) => Residence::from_seconds(Some(t)),
             Err(_) => Residence::Unavailable,
         }
     }

@@ -11,12 +11,13 @@ use crate::Real;
 /// `sqrt(x (x + 2)) = x + 1` to within epsilon, computed from `num` and `den` so an overflowing
 /// quotient does no harm. The second value, `sqrt(num (num + 2 den))`, is `sinh` of the first
 /// times `den`: the flat exit velocity needs it.
-#[inline]
+#[inline(always)]
 pub(crate) fn acosh_1p_parts<T: Real>(num: T, den: T) -> (T, T) {
     let x = num / den;
     if x < T::ONE / T::EPSILON {
         let w = (x * (x + T::TWO)).sqrt();
-        ((x + w).ln_1p(), den * w)
+        // x + w is finite and >= 0 here (x below 1/epsilon, and num, den > 0 by the caller).
+        ((x + w).ln_1p_in_domain(), den * w)
     } else {
         (
             T::from_f64(core::f64::consts::LN_2) + num.ln() - den.ln(),
@@ -53,4 +54,12 @@ pub(crate) fn residence<T: Real>(scene: &Scene<T>, a: T) -> Exit<T> {
         radial: k_omega * sinh_den,
         condition: condition(kx, a, ri),
     }
+}
+
+/// The flat model's residence time alone, `a < ri < R` (checked by the caller): the same
+/// arithmetic as [`residence`]'s time, none of its exit speed or condition.
+#[inline(always)]
+pub(crate) fn time<T: Real>(scene: &Scene<T>, a: T) -> T {
+    let k_omega = scene.k2.sqrt() * scene.omega_rad_s;
+    acosh_1p_ratio(scene.rim_radius_m - scene.ri_m, scene.ri_m - a) / k_omega
 }

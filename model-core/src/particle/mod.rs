@@ -193,7 +193,7 @@ impl<T: Real> Scene<T> {
         if !nonneg_finite(self.g_m_s2) {
             return Err(SceneError::InvalidGravity);
         }
-        if !(self.k2.is_finite() && self.k2 > T::ZERO && self.k2 <= T::ONE) {
+        if !self.k2.is_in_unit_interval() {
             return Err(SceneError::InvalidK2);
         }
         if !nonneg_finite(self.ri_m) {
@@ -355,6 +355,31 @@ pub fn residence<T: Real>(scene: &Scene<T>, model: Model) -> Result<Outcome<T>, 
         condition_number: cond,
         ill_conditioned: cond * cond * T::EPSILON > T::ONE,
     })
+}
+
+/// The residence time alone, s (paper Eq. 6 / 10, as [`residence`]): 0 at the rim, infinity
+/// when the particle never leaves. What the rig's telemetry and RTIME need: it skips the exit
+/// speeds and the condition number, so on the MCU the flat form is about half of
+/// [`residence`]'s instructions. The time is bit for bit the one [`residence`] gives.
+pub fn residence_time_s<T: Real>(scene: &Scene<T>, model: Model) -> Result<T, SceneError> {
+    scene.validate()?;
+    let (ri, rim) = (scene.ri_m, scene.rim_radius_m);
+    if ri >= rim {
+        return Ok(T::ZERO);
+    }
+    let a = scene.equilibrium_radius_m();
+    if ri <= a {
+        return Ok(T::INFINITY);
+    }
+    let time = match model {
+        Model::Flat => flat::time(scene, a),
+        Model::Coriolis => coriolis::residence(scene, a)?.time,
+    };
+    if time.is_finite() {
+        Ok(time)
+    } else {
+        Err(SceneError::OutOfRange)
+    }
 }
 
 /// `sqrt(x^2 + y^2)` (paper Eq. 12's total exit speed) that cannot overflow where the result is

@@ -249,6 +249,27 @@ fn any_finite_f64() -> impl Strategy<Value = f64> {
 /// Every answer is either a finite outcome or the one error the inputs call for: an invalid
 /// scene gives exactly the error its validation names, a valid one may only be out of range
 /// for the number type (never unconverged, never a silent skip).
+/// [`residence_time_s`] gives [`residence`]'s time bit for bit; where the full outcome is out of
+/// range (an exit speed that overflows) the time alone may still be finite.
+fn check_time_alone<T: Real + core::fmt::Debug>(
+    full: Result<Outcome<T>, SceneError>,
+    alone: Result<T, SceneError>,
+) -> Result<(), TestCaseError> {
+    match (full, alone) {
+        (Ok(o), Ok(t)) => {
+            let want = o.residence_time_s();
+            prop_assert!(
+                t == want || (t.is_nan() && want.is_nan()),
+                "{t:?} vs {want:?}"
+            );
+        }
+        (Err(SceneError::OutOfRange), Ok(t)) => prop_assert!(t.is_finite() && t >= T::ZERO),
+        (Err(a), Err(b)) => prop_assert_eq!(a, b),
+        (a, b) => prop_assert!(false, "residence {a:?}, residence_time_s {b:?}"),
+    }
+    Ok(())
+}
+
 fn check_outcome<T: Real>(
     valid: Result<(), SceneError>,
     o: Result<Outcome<T>, SceneError>,
@@ -327,6 +348,8 @@ proptest! {
         for model in [Model::Flat, Model::Coriolis] {
             check_outcome(s.validate(), residence(&s, model))?;
             check_outcome(s32.validate(), residence(&s32, model))?;
+            check_time_alone(residence(&s, model), residence_time_s(&s, model))?;
+            check_time_alone(residence(&s32, model), residence_time_s(&s32, model))?;
             for r in [position_m(&s, model, t), radial_velocity_m_s(&s, model, t)] {
                 check_value(s.validate(), t, r)?;
             }
@@ -374,7 +397,21 @@ proptest! {
             let z_th = sh.c1 * (wide.mu * wide.g_m_s2 / wide.ri_m).sqrt() * target as f64;
             let w = match omega_for_residence_time(&s, model, target) {
                 Ok(w) => w,
-                Err(InverseError::BeyondPrecision) if z_th > 8.0 => continue,
+                Err(InverseError::BeyondPrecision) => {
+                    // Only where the f64 answer puts the threshold a within f32 rounding of ri
+                    // (the f32 check uses 8 epsilons; its own iterate may sit a few ulps off).
+                    let w64 = match omega_for_residence_time(&wide, model, target as f64) {
+                        Ok(w) => w,
+                        // Beyond f64's precision too, so certainly beyond f32's.
+                        Err(InverseError::BeyondPrecision) => continue,
+                        Err(e) => panic!("f64: {e:?} at z_th {z_th}"),
+                    };
+                    let a = wide.mu * wide.g_m_s2 / (w64 * w64);
+                    let gap = (wide.ri_m - a) / wide.ri_m;
+                    prop_assert!(gap <= 32.0 * f64::from(f32::EPSILON),
+                                 "BeyondPrecision with ri {gap:e} above a (z_th {z_th})");
+                    continue;
+                }
                 Err(e) => panic!("{e:?} at z_th {z_th}"),
             };
             let back = residence(&Scene { omega_rad_s: w as f64, ..wide }, model).unwrap();

@@ -104,6 +104,10 @@ macro_rules! micro_newtype {
                 self.0.is_nonneg_finite()
             }
             #[inline]
+            fn is_in_unit_interval(self) -> bool {
+                self.0.is_in_unit_interval()
+            }
+            #[inline]
             fn abs(self) -> Self {
                 Self(f32::abs(self.0))
             }

@@ -6,6 +6,7 @@ use crate::check::{Bench, Case, Failure, close, ensure};
 use model_core::Real;
 use model_core::particle::{
     self, InverseError, Model, Outcome, Scene, omega_for_residence_time, residence,
+    residence_time_s,
 };
 use model_core::real::micro::{MicroF32, MicroF32HwSqrt};
 
@@ -31,6 +32,10 @@ pub static CASES: &[Case] = &[
         name: "particle::near_threshold_is_flagged_f32",
         run: near_threshold_flagged,
     },
+    Case {
+        name: "particle::time_alone_is_the_full_forms_time_f32",
+        run: time_alone_is_the_full_forms_time,
+    },
 ];
 
 /// Benchmarks of this module (instruction budgets: worst case over the grid).
@@ -40,6 +45,19 @@ pub static BENCHES: &[Bench] = &[
         inputs: GRID,
         run: bench_flat,
         budget_instructions: Some(250),
+    },
+    // The time alone: what the rig's telemetry computes every frame.
+    Bench {
+        name: "particle::residence_time_flat_f32",
+        inputs: GRID,
+        run: bench_time_flat,
+        budget_instructions: Some(150),
+    },
+    Bench {
+        name: "particle::residence_time_coriolis_f32",
+        inputs: GRID,
+        run: bench_time_coriolis,
+        budget_instructions: Some(600),
     },
     Bench {
         name: "particle::residence_coriolis_f32",
@@ -413,6 +431,29 @@ fn bench_flat(i: usize) -> f32 {
     residence(scene_f32(i), Model::Flat)
         .map(|o| o.residence_time_s())
         .unwrap_or(f32::NAN)
+}
+
+fn bench_time_flat(i: usize) -> f32 {
+    residence_time_s(scene_f32(i), Model::Flat).unwrap_or(f32::NAN)
+}
+
+fn bench_time_coriolis(i: usize) -> f32 {
+    residence_time_s(scene_f32(i), Model::Coriolis).unwrap_or(f32::NAN)
+}
+
+/// On the target too, over the bench grid: the time alone is the full outcome's, bit for bit.
+fn time_alone_is_the_full_forms_time() -> Result<(), Failure> {
+    for i in 0..GRID {
+        for model in [Model::Flat, Model::Coriolis] {
+            let full = residence(scene_f32(i), model).map(|o| o.residence_time_s().to_bits());
+            let alone = residence_time_s(scene_f32(i), model).map(f32::to_bits);
+            ensure(
+                "residence_time_s == residence(..).residence_time_s()",
+                full == alone,
+            )?;
+        }
+    }
+    Ok(())
 }
 
 fn bench_coriolis(i: usize) -> f32 {
