@@ -204,3 +204,53 @@ proptest! {
         }
     }
 }
+
+/// A worn wheel at a steady 3 rad/s: 12 teeth up to 5 % of a pitch off their places. Each
+/// reading comes from one gap, so unlearned it is off by up to 10 %. Once the estimator has
+/// learned the gaps (a few revolutions), what is left is the pattern's once-per-revolution part
+/// (deliberately not learned: an eccentric load looks the same), computed here independently.
+#[test]
+fn a_worn_wheels_tooth_offsets_are_learned_at_steady_speed() {
+    let offsets = [
+        0.0, 0.05, -0.03, 0.02, -0.05, 0.04, 0.01, -0.02, 0.03, -0.04, 0.0, 0.05,
+    ];
+    let w = 3.0;
+    let pitch_s = std::f64::consts::TAU / 12.0 / w;
+    let edges: Vec<f64> = (1..200)
+        .map(|k| 0.0123 + (k as f64 + offsets[k % 12]) * pitch_s)
+        .collect();
+    // The residual after learning: the gaps' first harmonic, as a share of each gap.
+    let gap = |j: usize| 1.0 + offsets[j] - offsets[(j + 11) % 12];
+    let harmonic = |j: usize| {
+        (0..12)
+            .map(|k| (gap(k) - 1.0) * ((j as f64 - k as f64) * std::f64::consts::TAU / 12.0).cos())
+            .sum::<f64>()
+            / 6.0
+    };
+    let worst_residual = (0..12)
+        .map(|j| (harmonic(j) / gap(j)).abs())
+        .fold(0.0, f64::max);
+    let mut f = Feed::new(12, 32);
+    let (mut early, mut late) = (0.0f64, 0.0f64);
+    for (k, &t) in edges.iter().enumerate().skip(1) {
+        let v = f.run(t + 0.0005 - f.t_s, &edges) as f64;
+        let error = (v - w).abs() / w;
+        // The filter (weight 0.7) spreads one gap's error over the next readings.
+        if (24..48).contains(&k) {
+            early = early.max(error);
+        }
+        if k >= 150 {
+            late = late.max(error);
+        }
+    }
+    assert!(
+        f.est.teeth_revolutions_learned() >= 10,
+        "{}",
+        f.est.teeth_revolutions_learned()
+    );
+    assert!(early > 0.02, "unlearned error {early}");
+    assert!(
+        late < worst_residual + 0.002,
+        "learned error {late}, first-harmonic residual {worst_residual}"
+    );
+}

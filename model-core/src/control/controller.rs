@@ -321,10 +321,15 @@ impl Controller {
     #[inline(always)]
     fn axis_loop(&mut self, i: usize, r: f32, extra_duty: f32, seen: bool, dt: f32) -> bool {
         let a = &mut self.axes[i];
+        let was = a.direction;
         if r > 0.0 {
             a.direction = 1.0;
         } else if r < 0.0 {
             a.direction = -1.0;
+        }
+        if a.direction != was {
+            // The wheel's gaps now pass in the opposite order.
+            a.est.forget_teeth();
         }
         let input = LoopInput {
             reference_rad_s: r,

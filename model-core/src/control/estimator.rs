@@ -31,12 +31,19 @@
 //! interval of about 2 or 3 measured periods (within 0.3 of the integer) is taken as that many
 //! pulses with the middle ones missing (counted in [`PulseSpeedEstimator::inferred_missing`]).
 //!
+//! # Tooth offsets
+//! Each window counts its gaps by their learned lengths ([`super::teeth::ToothMap`]): at
+//! steady speed the estimator learns how long each gap of the wheel is, so a worn or unevenly
+//! cut wheel does not read as speed ripple. The lockout, the missing-pulse inference and the
+//! stall bound keep using the nominal pitch.
+//!
 //! # Direction
 //! One proximity sensor cannot tell the direction of rotation: the estimate is a magnitude.
 //! The controller gives it the sign of the commanded (ramped) direction, and the planner only
 //! reverses once this estimator reads zero.
 
 use super::config::{AxisConfig, ControllerConfig};
+use super::teeth::ToothMap;
 
 /// Shortest counting window, s: at high pulse rates a raw sample averages over at least this.
 pub const WINDOW_S: f32 = 0.025;
@@ -103,6 +110,9 @@ pub struct PulseSpeedEstimator {
     last_interval: u32,
     win_start: u32,
     win_pulses: u32,
+    /// The window's angle in pitches, by the learned gap lengths.
+    win_pitches: f32,
+    teeth: ToothMap,
     valid: bool,
     raw_period_ticks: f32,
     lockout_now: u32,
@@ -144,6 +154,8 @@ impl PulseSpeedEstimator {
             last_interval: 0,
             win_start: 0,
             win_pulses: 0,
+            win_pitches: 0.0,
+            teeth: ToothMap::new(axis.pulses_per_rev),
             valid: false,
             raw_period_ticks: 0.0,
             lockout_now: (0.5 * min_period_s * ticks_per_s) as u32,
@@ -194,6 +206,10 @@ impl PulseSpeedEstimator {
                 on_edge(at, pulses);
             }
         }
+        if edges.is_empty() {
+            // A tick without an edge has time to learn the wheel's gaps.
+            self.teeth.learn_pending();
+        }
         self.clock = self.clock.wrapping_add(span);
         self.prev_now = now;
         self.speed = self.bounded_speed(if steady { 2 } else { 1 });
@@ -206,9 +222,12 @@ impl PulseSpeedEstimator {
             self.last_edge = at;
             self.win_start = at;
             self.win_pulses = 0;
+            self.win_pitches = 0.0;
             self.restart_at = Some(at);
             self.last_interval = 0;
             self.accepted = self.accepted.wrapping_add(1);
+            // The next tooth, but no interval to learn from.
+            self.teeth.edge(0, 1, false);
             return Some(1);
         }
         let dt = at.wrapping_sub(self.last_edge);
@@ -243,10 +262,11 @@ impl PulseSpeedEstimator {
         self.last_edge = at;
         self.last_interval = dt / pulses;
         self.win_pulses += pulses;
+        self.win_pitches += self.teeth.edge(dt, pulses, steady);
         let wspan = at.wrapping_sub(self.win_start);
         if wspan >= self.window_ticks {
             let period = wspan as f32 / self.win_pulses as f32;
-            let raw = self.rad_ticks_per_pulse_s / period;
+            let raw = self.rad_ticks_per_pulse_s * self.win_pitches / wspan as f32;
             if self.valid {
                 self.speed_filt += self.filter_weight * (raw - self.speed_filt);
             } else {
@@ -268,6 +288,7 @@ impl PulseSpeedEstimator {
             self.closed_raw = raw;
             self.win_start = at;
             self.win_pulses = 0;
+            self.win_pitches = 0.0;
         }
         Some(pulses)
     }
@@ -375,6 +396,15 @@ impl PulseSpeedEstimator {
     /// Radians per pulse.
     pub fn rad_per_pulse(&self) -> f32 {
         self.rad_per_pulse
+    }
+    /// Forgets the learned tooth offsets (the shaft turns the other way: the gaps come in the
+    /// opposite order).
+    pub fn forget_teeth(&mut self) {
+        self.teeth.forget();
+    }
+    /// Revolutions of tooth offsets learned since the last [`Self::forget_teeth`].
+    pub fn teeth_revolutions_learned(&self) -> u16 {
+        self.teeth.revolutions_learned()
     }
     /// Extended clock at the last tick, timer ticks (wrapping).
     pub fn clock_ticks(&self) -> u32 {

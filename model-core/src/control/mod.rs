@@ -67,6 +67,7 @@ pub mod estimator;
 pub mod pi;
 pub mod planner;
 pub mod supervisor;
+pub mod teeth;
 
 pub use commission::{Identified, IdentifyError};
 pub use config::{

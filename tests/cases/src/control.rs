@@ -37,7 +37,7 @@ pub static CASES: &[Case] = &[
 /// Benchmarks of this module.
 pub static BENCHES: &[Bench] = &[Bench {
     name: "control::tick_both_axes_f32",
-    inputs: 420,
+    inputs: 12_000,
     run: bench_tick,
     budget_instructions: Some(1200),
 }];
@@ -228,7 +228,9 @@ static BENCH: BenchCell = BenchCell(UnsafeCell::new(BenchState {
 
 /// One 1 kHz tick. Both sensors give an edge every 35 ticks (3 rad/s at 60 pulses/rev), in the
 /// same tick, so the grid holds the worst case (two edges, two windows closing, both loops
-/// updating) as well as plain ticks; 420 calls cover the start of the ramp and steady pulses.
+/// updating) as well as plain ticks; 12,000 calls cover the ramp, steady pulses, and the
+/// tooth-offset learning (steady after the ramp: a revolution of 60 gaps fills the chain, two
+/// more warm it up, then the learned pattern is in use and updated at every edge).
 fn bench_tick(_i: usize) -> f32 {
     // SAFETY: see `BenchCell`.
     let s = unsafe { &mut *BENCH.0.get() };
