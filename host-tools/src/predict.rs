@@ -10,6 +10,7 @@ mod batch;
 mod choice;
 mod ode;
 mod rolling;
+mod throughput;
 mod trace;
 mod words;
 
@@ -107,6 +108,10 @@ pub struct Args {
     /// Batch mode: write results to this CSV file.
     #[arg(long, requires = "batch")]
     out: Option<std::path::PathBuf>,
+    /// Batch mode: also measure the closed forms' throughput over the file's scenes (the time
+    /// alone, ns per scene on one thread and on every core; JSON on standard output).
+    #[arg(long, requires = "batch")]
+    throughput: bool,
     /// The rolling model's own flags.
     #[command(flatten)]
     rolling: rolling::RollingArgs,

@@ -320,6 +320,44 @@ fn batch_without_g_and_k2_uses_the_defaults() {
     let _ = std::fs::remove_file(output);
 }
 
+/// `--throughput` times each model the file holds (and only those), on one thread and on every
+/// core, after writing the results as usual.
+#[test]
+fn batch_throughput_is_measured_per_model() {
+    let input = temp("throughput.csv");
+    let output = temp("throughput-out.csv");
+    std::fs::write(
+        &input,
+        "model,w_rad_s,mu,ri_m,R_m\nflat,3.6,0.01,0.03,0.1\nflat,4,0.02,0.05,0.1\n",
+    )
+    .unwrap();
+    let out = bowl(&[
+        "predict",
+        "--batch",
+        input.to_str().unwrap(),
+        "--out",
+        output.to_str().unwrap(),
+        "--throughput",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let flat = &j["flat"];
+    assert_eq!(flat["scenes"], 2, "{j}");
+    for key in ["ns_per_scene_one_thread", "ns_per_scene_all_cores"] {
+        let ns = flat[key].as_f64().unwrap();
+        assert!(ns > 0.0 && ns < 1e6, "{key} {ns}");
+    }
+    assert!(flat["threads"].as_u64().unwrap() >= 1);
+    assert!(j.get("coriolis").is_none(), "{j}");
+    assert_eq!(std::fs::read_to_string(&output).unwrap().lines().count(), 3);
+    let _ = std::fs::remove_file(input);
+    let _ = std::fs::remove_file(output);
+}
+
 #[test]
 fn batch_without_required_column_fails_naming_it() {
     let input = temp("nocol.csv");

@@ -160,7 +160,11 @@ impl Real for f64 {
     }
     #[inline]
     fn ln_1p(self) -> Self {
-        libm::log1p(self)
+        log1p::ln_1p_f64(self)
+    }
+    #[inline]
+    fn ln_1p_in_domain(self) -> Self {
+        log1p::ln_1p_in_domain_f64(self)
     }
     #[inline]
     fn cosh(self) -> Self {

@@ -2,7 +2,8 @@
 # Side by side with scipy: one run makes a Python venv (numpy, scipy from PyPI), has `bowl`
 # measure our integrators (CSV), runs scipy.integrate.solve_ivp (RK45, DOP853) with a terminal
 # event at r = R on the same scenes, and writes docs/charts/scipy-comparison.{md,csv} plus the
-# charts docs/charts/scipy-comparison{,-time}.{svg,png}.
+# charts docs/charts/scipy-comparison{,-time}.{svg,png}; then the batch closed forms beside
+# vectorised numpy (tests/scipy/batch.py: docs/charts/batch-throughput.{md,json}).
 # Not part of tests/run: it downloads scipy. Usage: tests/scipy/compare.sh [--quick]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
@@ -21,3 +22,7 @@ bowl=target/release/bowl
   --out target/scipy/ours.svg ${1:+--quick}
 "$venv/bin/python" tests/scipy/compare.py target/scipy/ours.csv docs/charts/scipy-comparison
 "$bowl" chart scipy --csv docs/charts/scipy-comparison.csv --out docs/charts/scipy-comparison.svg
+# Batch closed forms beside vectorised numpy on the same scenes, in the same run
+# (docs/charts/batch-throughput.{md,json}; docs/model.md, "Batch throughput").
+"$venv/bin/python" tests/scipy/batch.py "$bowl" docs/charts/batch-throughput
+rm -f docs/charts/batch-throughput-scenes.csv docs/charts/batch-throughput-ours.csv

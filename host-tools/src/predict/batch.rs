@@ -201,6 +201,7 @@ pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
     }
     writer.write_record(&out_header)?;
     let (mut failed, mut rows) = (0usize, 0usize);
+    let mut scenes = Vec::new();
     for (index, record) in reader.records().enumerate() {
         rows += 1;
         // Line numbers as a user sees them: the header is line 1. (For rows with embedded
@@ -213,6 +214,7 @@ pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
         let result = record.map_err(|e| anyhow!("{e}")).and_then(|row| {
             let (model, scene) = parse_row(&row, &cols, header.len())?;
             let p = predict(&scene, model, args.method, args.step_s, args.tol)?;
+            scenes.push((model, scene));
             Ok((row, p))
         });
         match result {
@@ -253,5 +255,8 @@ pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
         .with_context(|| format!("cannot write {}", output.display()))?;
     let mut partial = partial;
     partial.kept = true;
+    if args.throughput {
+        println!("{}", super::throughput::measure(&scenes));
+    }
     Ok(())
 }

@@ -1,4 +1,6 @@
-//! `ln(1 + y)` in f32 for the Cortex-M4F, in about half the instructions of libm's `log1pf`.
+//! `ln(1 + y)` in f32 for the Cortex-M4F, in about half the instructions of libm's `log1pf`,
+//! and in f64 for the host, about three times as fast as libm's `log1p` (the batch closed
+//! forms spent a third of their time there).
 //!
 //! The closed forms need it for `acosh(1 + x) = ln(1 + (x + sqrt(x (x + 2))))` (paper Eq. 6) and
 //! the Coriolis form's logarithm (Eq. 10, corrected); on the MCU it was a third of the flat
@@ -54,6 +56,52 @@ pub fn ln_1p_in_domain(y: f32) -> f32 {
     s * (hfsq + r) + (k * LN2_LO + c) - hfsq + f + k * LN2_HI
 }
 
+// fdlibm's `log` constants, by their bits.
+const LN2_HI_64: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
+const LN2_LO_64: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
+const LG1_64: f64 = f64::from_bits(0x3fe5_5555_5555_5593);
+const LG2_64: f64 = f64::from_bits(0x3fd9_9999_9997_fa04);
+const LG3_64: f64 = f64::from_bits(0x3fd2_4924_9422_9359);
+const LG4_64: f64 = f64::from_bits(0x3fcc_71c5_1d8e_78af);
+const LG5_64: f64 = f64::from_bits(0x3fc7_4664_96cb_03de);
+const LG6_64: f64 = f64::from_bits(0x3fc3_9a09_d078_c69f);
+const LG7_64: f64 = f64::from_bits(0x3fc2_f112_df3e_5244);
+
+/// `ln(1 + y)` in f64: NaN below -1 and for NaN, -infinity at -1, +infinity at +infinity.
+#[inline]
+pub fn ln_1p_f64(y: f64) -> f64 {
+    if y.is_nan() || y < -1.0 {
+        return f64::NAN;
+    }
+    if y == -1.0 {
+        return f64::NEG_INFINITY;
+    }
+    if y == f64::INFINITY {
+        return y;
+    }
+    ln_1p_in_domain_f64(y)
+}
+
+/// `ln(1 + y)` in f64 for a finite `y > -1`: the same method as [`ln_1p_in_domain`] with
+/// fdlibm's degree-7 polynomial of `log` (error below 2^-58.45 relative).
+#[inline]
+pub fn ln_1p_in_domain_f64(y: f64) -> f64 {
+    let u = 1.0 + y;
+    let c = (y - (u - 1.0)) / u;
+    let ix = u
+        .to_bits()
+        .wrapping_add(0x3ff0_0000_0000_0000 - 0x3fe6_a09e_0000_0000);
+    let k = ((ix >> 52) as i64 - 0x3ff) as f64;
+    let f = f64::from_bits((ix & 0x000f_ffff_ffff_ffff).wrapping_add(0x3fe6_a09e_0000_0000)) - 1.0;
+    let s = f / (2.0 + f);
+    let z = s * s;
+    let w = z * z;
+    let t1 = w * (LG2_64 + w * (LG4_64 + w * LG6_64));
+    let t2 = z * (LG1_64 + w * (LG3_64 + w * (LG5_64 + w * LG7_64)));
+    let hfsq = 0.5 * f * f;
+    s * (hfsq + t1 + t2) + (k * LN2_LO_64 + c) - hfsq + f + k * LN2_HI_64
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -84,6 +132,48 @@ mod tests {
         extern crate std;
         std::println!("worst {:.3} ulp at y = {:e}", worst.0, worst.1);
         assert!(worst.0 <= 1.0, "{:.3} ulp at y = {:e}", worst.0, worst.1);
+    }
+
+    /// f64 against glibc's `log1p` (through std, within about half an ulp of the truth) on a
+    /// million values spread over every exponent: within 1 ulp of it.
+    #[test]
+    fn f64_within_one_ulp_of_glibc() {
+        extern crate std;
+        let mut worst = (0.0f64, 0.0f64);
+        let mut bits = 0x0000_0000_0000_1234u64;
+        for _ in 0..1_000_000 {
+            // A 64-bit LCG over the bit patterns: every exponent, sign and mantissa.
+            bits = bits
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            let y = f64::from_bits(bits >> 1);
+            let y = if bits & 1 == 1 { -y.min(0.999_999) } else { y };
+            if !y.is_finite() {
+                continue;
+            }
+            let want = std::primitive::f64::ln_1p(y);
+            let got = ln_1p_f64(y);
+            let ulp = f64::from_bits(want.abs().to_bits() + 1) - want.abs();
+            let e = if want == 0.0 {
+                got.abs()
+            } else {
+                (got - want).abs() / ulp
+            };
+            if e > worst.0 {
+                worst = (e, y);
+            }
+        }
+        std::println!(
+            "f64: worst {:.3} ulp from glibc at y = {:e}",
+            worst.0,
+            worst.1
+        );
+        assert!(worst.0 <= 1.0, "{:.3} ulp at y = {:e}", worst.0, worst.1);
+        assert!(ln_1p_f64(-1.5).is_nan() && ln_1p_f64(f64::NAN).is_nan());
+        assert_eq!(ln_1p_f64(-1.0), f64::NEG_INFINITY);
+        assert_eq!(ln_1p_f64(f64::INFINITY), f64::INFINITY);
+        assert_eq!(ln_1p_f64(1e-300), 1e-300);
+        assert_eq!(ln_1p_f64(0.0), 0.0);
     }
 
     #[test]
