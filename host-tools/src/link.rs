@@ -108,13 +108,15 @@ impl Link {
 }
 
 /// Whether `frame` is the kind of answer `command` gets: `S` to STATUS, `P` to PARAMS, `M` to
-/// MODELS, `A` or `R` to the rest (and `R` to anything: a query can be refused too).
+/// MODELS, `W` to RTIME, `A` or `R` to the rest (and `R` to anything: a query can be refused
+/// too).
 pub fn answers_kind(command: &Command, frame: &Frame) -> bool {
     match (command, frame) {
         (_, Frame::Reject { .. }) => true,
         (Command::GetStatus, f) => matches!(f, Frame::Status { .. }),
         (Command::GetParams, f) => matches!(f, Frame::Params { .. }),
         (Command::GetModels, f) => matches!(f, Frame::Models { .. }),
+        (Command::SetResidence { .. }, f) => matches!(f, Frame::ResidenceSet { .. }),
         (_, f) => matches!(f, Frame::Ack { .. }),
     }
 }

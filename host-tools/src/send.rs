@@ -107,6 +107,20 @@ pub fn describe(frame: &Frame) -> String {
             out
         }
         Frame::Event(e) => format!("gate event: {}", crate::telemetry_csv::gate_event_text(e)),
+        Frame::ResidenceSet {
+            id,
+            model,
+            precession_mrad_s,
+            spin_mrad_s,
+        } => format!(
+            "ok (id {id}): the {} model answered: precession {:.3} rad/s, spin {:.3} rad/s",
+            match model {
+                model_core::wire::ResidenceModel::Flat => "flat",
+                model_core::wire::ResidenceModel::Coriolis => "Coriolis",
+            },
+            f64::from(*precession_mrad_s) * 1e-3,
+            f64::from(*spin_mrad_s) * 1e-3
+        ),
         other => format!("{other:?}"),
     }
 }

@@ -391,7 +391,10 @@ fn a_residence_time_target_is_reached_in_closed_loop() {
         ],
     );
     let raw = String::from_utf8_lossy(&std::fs::read(&capture).unwrap()).into_owned();
-    assert!(raw.contains("$A1,1*"), "RTIME accepted");
+    assert!(
+        raw.contains("$W1,1,CORI,"),
+        "RTIME accepted, the Coriolis model answering"
+    );
     assert!(
         raw.contains("$R1,3,INFEASIBLE*"),
         "unreachable target refused"

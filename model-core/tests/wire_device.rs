@@ -3,7 +3,7 @@
 
 mod wire_support;
 
-use model_core::wire::device::{Backend, Device};
+use model_core::wire::device::{Backend, Device, ResidenceChoice};
 use model_core::wire::*;
 use proptest::prelude::*;
 
@@ -39,9 +39,17 @@ impl Backend for Recorder {
         self.calls.push(format!("speeds {p} {s}"));
         Ok(())
     }
-    fn set_residence(&mut self, m: ResidenceModel, t: u32) -> Result<(), Reason> {
+    /// The Coriolis model answers (with setpoints made from the target), the flat one cannot.
+    fn set_residence(&mut self, m: ResidenceModel, t: u32) -> Result<ResidenceChoice, Reason> {
         self.calls.push(format!("residence {m:?} {t}"));
-        Err(Reason::Infeasible)
+        match m {
+            ResidenceModel::Coriolis => Ok(ResidenceChoice {
+                model: m,
+                precession_mrad_s: (t / 2) as i16,
+                spin_mrad_s: (t / 3) as i16,
+            }),
+            ResidenceModel::Flat => Err(Reason::Infeasible),
+        }
     }
     fn start(&mut self) -> Result<(), Reason> {
         self.calls.push("start".into());
@@ -78,6 +86,28 @@ fn line(payload: &str) -> Vec<u8> {
         model_core::wire::crc::crc32(payload.as_bytes())
     )
     .into_bytes()
+}
+
+/// RTIME is answered with the model that answered and the setpoints it chose; a resend after a
+/// lost answer gets the same answer without a second run.
+#[test]
+fn rtime_says_which_model_answered_and_a_resend_repeats_it() {
+    let mut rig = Recorder {
+        speed_max: 5000,
+        ..Default::default()
+    };
+    let mut d = Device::new();
+    let mut input = line("C1,21,RTIME,CORI,3000");
+    input.extend(line("C1,21,RTIME,CORI,3000"));
+    let got = answers(&mut d, &mut rig, &input);
+    let want = Frame::ResidenceSet {
+        id: 21,
+        model: ResidenceModel::Coriolis,
+        precession_mrad_s: 1500,
+        spin_mrad_s: 1000,
+    };
+    assert_eq!(got, vec![want, want]);
+    assert_eq!(rig.calls, vec!["residence Coriolis 3000"]);
 }
 
 #[test]

@@ -10,7 +10,7 @@ use crate::control::{
     Rejection, State,
 };
 use crate::particle::{self, InverseError, Model, Scene};
-use crate::wire::device::Backend;
+use crate::wire::device::{Backend, ResidenceChoice};
 use crate::wire::{
     AxisModel, DeviceState, FaultCode, GateEvent, Hello, Injection, MODEL_FIELD_MAX,
     MotorTelemetry, ParamId, ParamValues, Reason, Residence, ResidenceModel, Telemetry,
@@ -283,13 +283,22 @@ impl<I: Injector> Backend for ControllerBackend<I> {
             .map_err(reason)
     }
 
-    fn set_residence(&mut self, model: ResidenceModel, time_ms: u32) -> Result<(), Reason> {
+    fn set_residence(
+        &mut self,
+        model: ResidenceModel,
+        time_ms: u32,
+    ) -> Result<ResidenceChoice, Reason> {
         let m = self.model(model);
         match self
             .ctrl
             .set_target_residence_time(time_ms as f32 * 1e-3, &m)
         {
-            Ok(_) => Ok(()),
+            // Within the motors' range (checked), so the casts cannot saturate.
+            Ok(speeds) => Ok(ResidenceChoice {
+                model,
+                precession_mrad_s: round(speeds[0] * 1e3) as i16,
+                spin_mrad_s: round(speeds[1] * 1e3) as i16,
+            }),
             // The speed that gives this time is outside the motors' range.
             Err(Rejection::AboveMaxSpeed(_) | Rejection::BelowMinSpeed(_)) => {
                 Err(Reason::Infeasible)

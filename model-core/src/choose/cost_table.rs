@@ -2,22 +2,22 @@
 // from the measurements in docs/charts/work-precision.csv (paper scene, both models). Do not edit.
 
 /// closed: host ns, f64, fastest batch; fitted to 2 rows.
-pub const HOST_CLOSED: MethodCost = MethodCost { per_call: 151.9, per_eval: 0.00 };
+pub const HOST_CLOSED: MethodCost = MethodCost { per_call: 114.8, per_eval: 0.00 };
 /// euler: host ns, f64, fastest batch; fitted to 24 rows.
-pub const HOST_EULER: MethodCost = MethodCost { per_call: 624.2, per_eval: 9.18 };
+pub const HOST_EULER: MethodCost = MethodCost { per_call: 329.3, per_eval: 7.85 };
 /// semi-implicit-euler: host ns, f64, fastest batch; fitted to 24 rows.
-pub const HOST_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 2294.6, per_eval: 13.95 };
+pub const HOST_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 312.8, per_eval: 12.11 };
 /// rk4: host ns, f64, fastest batch; fitted to 22 rows.
-pub const HOST_RK4: MethodCost = MethodCost { per_call: 512.4, per_eval: 7.20 };
+pub const HOST_RK4: MethodCost = MethodCost { per_call: 381.1, per_eval: 5.72 };
 /// dp54: host ns, f64, fastest batch; fitted to 22 rows.
-pub const HOST_DP54: MethodCost = MethodCost { per_call: 786.5, per_eval: 22.68 };
+pub const HOST_DP54: MethodCost = MethodCost { per_call: 672.3, per_eval: 19.65 };
 /// closed: Cortex-M4F instructions, f32 libm, QEMU; fitted to 2 rows.
-pub const MCU_CLOSED: MethodCost = MethodCost { per_call: 494.5, per_eval: 0.00 };
+pub const MCU_CLOSED: MethodCost = MethodCost { per_call: 388.0, per_eval: 0.00 };
 /// euler: Cortex-M4F instructions, f32 libm, QEMU; fitted to 4 rows.
-pub const MCU_EULER: MethodCost = MethodCost { per_call: 873.2, per_eval: 57.06 };
+pub const MCU_EULER: MethodCost = MethodCost { per_call: 866.2, per_eval: 57.06 };
 /// semi-implicit-euler: Cortex-M4F instructions, f32 libm, QEMU; fitted to 4 rows.
-pub const MCU_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 1097.2, per_eval: 64.29 };
+pub const MCU_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 1090.2, per_eval: 64.29 };
 /// rk4: Cortex-M4F instructions, f32 libm, QEMU; fitted to 10 rows.
-pub const MCU_RK4: MethodCost = MethodCost { per_call: 1094.9, per_eval: 25.63 };
+pub const MCU_RK4: MethodCost = MethodCost { per_call: 1087.9, per_eval: 25.63 };
 /// dp54: Cortex-M4F instructions, f32 libm, QEMU; fitted to 10 rows.
-pub const MCU_DP54: MethodCost = MethodCost { per_call: 1715.4, per_eval: 72.53 };
+pub const MCU_DP54: MethodCost = MethodCost { per_call: 1708.4, per_eval: 72.53 };

@@ -155,7 +155,7 @@ impl PulseSpeedEstimator {
             win_start: 0,
             win_pulses: 0,
             win_pitches: 0.0,
-            teeth: ToothMap::new(axis.pulses_per_rev),
+            teeth: ToothMap::new(axis.pulses_per_rev, ticks_per_s),
             valid: false,
             raw_period_ticks: 0.0,
             lockout_now: (0.5 * min_period_s * ticks_per_s) as u32,

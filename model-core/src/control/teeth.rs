@@ -34,6 +34,12 @@ pub const MAX_TEETH: usize = 64;
 /// wheel that changes, and 0.1 ms of edge jitter leaves a few percent of its noise).
 pub const LEARN_WEIGHT: f32 = 0.2;
 
+/// The slowest revolution learned from, s. Slower, the loop's gain (scheduled by the pulse
+/// rate) barely follows single gaps, so tooth offsets cost little ripple, while an eccentric
+/// load's torque is a large share of the drive and bends the gaps' pattern with its harmonics:
+/// learned, they would hide a real speed variation (measured on the test family at 0.5 rad/s).
+pub const SLOWEST_LEARNED_REVOLUTION_S: f32 = 4.0;
+
 /// A revolution whose gaps the pattern in use explains this much worse than no pattern means
 /// the count slipped.
 const SLIP_MISFIT_RATIO: f32 = 1.5;
@@ -58,6 +64,8 @@ pub struct ToothMap {
     /// Sum of the `teeth` intervals in `intervals` once the chain is full (a revolution that
     /// does not fit in 32 bits of ticks is not learned).
     revolution_ticks: u32,
+    /// Revolutions longer than this are not learned from ([`SLOWEST_LEARNED_REVOLUTION_S`]).
+    slowest_revolution_ticks: u32,
     /// Learned length of each gap, pitches (1 = nominal).
     fraction: [f32; MAX_TEETH],
     /// `sum f_j (1, cos, sin)` over the revolution being learned, gap by gap as each is
@@ -87,8 +95,8 @@ pub struct ToothMap {
 const PENDING: usize = 4;
 
 impl ToothMap {
-    /// A wheel of `pulses_per_rev` teeth, nothing learned.
-    pub const fn new(pulses_per_rev: u16) -> Self {
+    /// A wheel of `pulses_per_rev` teeth timed by a clock of `ticks_per_s`, nothing learned.
+    pub const fn new(pulses_per_rev: u16, ticks_per_s: f32) -> Self {
         let teeth = if (pulses_per_rev as usize) <= MAX_TEETH {
             pulses_per_rev
         } else {
@@ -119,6 +127,7 @@ impl ToothMap {
             intervals: [0; MAX_TEETH],
             chain: 0,
             revolution_ticks: 0,
+            slowest_revolution_ticks: (SLOWEST_LEARNED_REVOLUTION_S * ticks_per_s) as u32,
             fraction: [1.0; MAX_TEETH],
             next_sums: [0.0; 3],
             scale: 1.0,
@@ -240,7 +249,7 @@ impl ToothMap {
         };
         self.revolution_ticks = total;
         self.intervals[j] = dt_ticks;
-        if (self.chain as usize) == n {
+        if (self.chain as usize) == n && self.revolution_ticks <= self.slowest_revolution_ticks {
             self.learn(j, n, dt_ticks);
         }
     }
@@ -328,7 +337,7 @@ mod tests {
     fn learns_the_gaps_but_leaves_the_once_per_revolution_part() {
         let e = offsets();
         let g = gaps(&e);
-        let mut map = ToothMap::new(12);
+        let mut map = ToothMap::new(12, 1e6);
         let mut index = 0;
         let (mut worst, mut rms_learned, mut rms_plain) = (0.0f64, 0.0f64, 0.0f64);
         for rev in 0..12 {
@@ -360,7 +369,7 @@ mod tests {
     #[test]
     fn a_slipped_count_is_noticed_and_relearned() {
         let e = offsets();
-        let mut map = ToothMap::new(12);
+        let mut map = ToothMap::new(12, 1e6);
         let mut index = 0;
         for _ in 0..8 * 12 {
             index = (index + 1) % 12;
@@ -384,13 +393,13 @@ mod tests {
 
     #[test]
     fn unsteady_or_unlearnable_wheels_count_plain_pitches() {
-        let mut map = ToothMap::new(12);
+        let mut map = ToothMap::new(12, 1e6);
         assert_eq!(map.edge(1000, 1, false), 1.0);
         assert_eq!(map.edge(2000, 2, true), 2.0);
-        let mut big = ToothMap::new(200);
+        let mut big = ToothMap::new(200, 1e6);
         assert_eq!(big.edge(1000, 1, true), 1.0);
-        let mut one = ToothMap::new(1);
+        let mut one = ToothMap::new(1, 1e6);
         assert_eq!(one.edge(1000, 1, true), 1.0);
-        assert_eq!(ToothMap::new(12).fraction(99), 1.0);
+        assert_eq!(ToothMap::new(12, 1e6).fraction(99), 1.0);
     }
 }

@@ -18,7 +18,7 @@ pub enum FrameError {
     BadTrailer,
     /// The CRC did not match: the line was damaged on the way.
     BadCrc,
-    /// The CRC matched but the kind letter is not one of `T H E C A R S P M`.
+    /// The CRC matched but the kind letter is not one of `T H E C A R S P M W`.
     UnknownKind,
     /// The CRC matched but the protocol version is not the one spoken here.
     UnsupportedVersion,
@@ -372,6 +372,16 @@ fn parse_payload(payload: &[u8]) -> Result<Frame, FrameError> {
         b'P' => Frame::Params {
             id: u16_field(&mut f)?,
             values: params(&mut f)?,
+        },
+        b'W' => Frame::ResidenceSet {
+            id: u16_field(&mut f)?,
+            model: match f.next_token()? {
+                b"FLAT" => ResidenceModel::Flat,
+                b"CORI" => ResidenceModel::Coriolis,
+                _ => return Err(FrameError::Malformed),
+            },
+            precession_mrad_s: i16_field(&mut f)?,
+            spin_mrad_s: i16_field(&mut f)?,
         },
         b'M' => Frame::Models {
             id: u16_field(&mut f)?,

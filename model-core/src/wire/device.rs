@@ -12,6 +12,17 @@ use super::types::{
 };
 use super::{MAX_FRAME_LEN, max_telemetry_hz};
 
+/// What RTIME chose: the model that answered and the motor setpoints, mrad/s.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ResidenceChoice {
+    /// The model that answered.
+    pub model: ResidenceModel,
+    /// Precession setpoint, mrad/s.
+    pub precession_mrad_s: i16,
+    /// Spin setpoint, mrad/s.
+    pub spin_mrad_s: i16,
+}
+
 /// What the protocol needs from the controller, in wire units. Every setter either applies the
 /// whole change and returns `Ok`, or changes nothing and returns the reason.
 pub trait Backend {
@@ -21,8 +32,13 @@ pub trait Backend {
     fn reset_info(&self) -> Hello;
     /// New motor setpoints, mrad/s; [`Device`] has already checked each against 0..=its SPEED_MAX.
     fn set_speeds(&mut self, precession_mrad_s: i16, spin_mrad_s: i16) -> Result<(), Reason>;
-    /// Choose the setpoints whose predicted residence time is `time_ms`.
-    fn set_residence(&mut self, model: ResidenceModel, time_ms: u32) -> Result<(), Reason>;
+    /// Choose the setpoints whose predicted residence time is `time_ms`; says which model
+    /// answered and the setpoints it chose.
+    fn set_residence(
+        &mut self,
+        model: ResidenceModel,
+        time_ms: u32,
+    ) -> Result<ResidenceChoice, Reason>;
     /// Run the motors towards the setpoints.
     fn start(&mut self) -> Result<(), Reason>;
     /// Ramp the motors down. Always possible.
@@ -69,10 +85,10 @@ pub struct Device {
     frames_scheduled: u32,
     schedule_start_ms: Option<u32>,
     encode_failures: u32,
-    /// The last command that changed something, its id and its outcome (its answer is an Ack
-    /// or a Reject): a resend with the same id and the same command (the PC lost the answer) is
-    /// answered again, not carried out twice.
-    last: Option<(u16, Command, Result<(), Reason>)>,
+    /// The last command that changed something, its id and its answer: a resend with the same
+    /// id and the same command (the PC lost the answer) gets the same answer again, not carried
+    /// out twice.
+    last: Option<(u16, Command, Frame)>,
 }
 
 /// The default telemetry rate, frames per second.
@@ -165,23 +181,16 @@ impl Device {
             command,
             Command::GetStatus | Command::GetParams | Command::GetModels | Command::Ping
         );
-        if let Some((last_id, last_command, outcome)) = self.last
+        if let Some((last_id, last_command, answer)) = self.last
             && !query
             && last_id == id
             && last_command == command
         {
-            return match outcome {
-                Ok(()) => Frame::Ack { id },
-                Err(reason) => Frame::Reject { id, reason },
-            };
+            return answer;
         }
         let answer = self.execute(backend, id, command);
         if !query {
-            let outcome = match answer {
-                Frame::Reject { reason, .. } => Err(reason),
-                _ => Ok(()),
-            };
-            self.last = Some((id, command, outcome));
+            self.last = Some((id, command, answer));
         }
         answer
     }
@@ -204,7 +213,19 @@ impl Device {
                     Err(Reason::Range)
                 }
             }
-            Command::SetResidence { model, time_ms } => backend.set_residence(model, time_ms),
+            Command::SetResidence { model, time_ms } => {
+                match backend.set_residence(model, time_ms) {
+                    Ok(c) => {
+                        return Frame::ResidenceSet {
+                            id,
+                            model: c.model,
+                            precession_mrad_s: c.precession_mrad_s,
+                            spin_mrad_s: c.spin_mrad_s,
+                        };
+                    }
+                    Err(reason) => Err(reason),
+                }
+            }
             Command::Start => backend.start(),
             Command::Stop => {
                 backend.stop();

@@ -191,6 +191,17 @@ fn body(out: &mut Out<'_>, frame: &Frame) {
                 out.int(v.into());
             }
         }
+        Frame::ResidenceSet {
+            id,
+            model,
+            precession_mrad_s,
+            spin_mrad_s,
+        } => {
+            out.int((*id).into());
+            out.token(model.token());
+            out.int((*precession_mrad_s).into());
+            out.int((*spin_mrad_s).into());
+        }
     }
 }
 
@@ -242,6 +253,7 @@ pub fn kind_letter(frame: &Frame) -> u8 {
         Frame::Status { .. } => b'S',
         Frame::Params { .. } => b'P',
         Frame::Models { .. } => b'M',
+        Frame::ResidenceSet { .. } => b'W',
     }
 }
 

@@ -376,6 +376,18 @@ pub enum Frame {
     },
     /// `$E1`: a gate event (device to PC).
     Event(GateEvent),
+    /// `$W1`: the answer to RTIME: the model that answered (`FLAT` or `CORI`) and the motor
+    /// setpoints it chose, mrad/s.
+    ResidenceSet {
+        /// Request id.
+        id: Wrapping16,
+        /// The model that answered.
+        model: ResidenceModel,
+        /// Precession setpoint, mrad/s.
+        precession_mrad_s: i16,
+        /// Spin setpoint, mrad/s.
+        spin_mrad_s: i16,
+    },
     /// `$M1`: the answer to MODELS, precession then spin.
     Models {
         /// Request id.
@@ -393,6 +405,7 @@ impl Frame {
             | Frame::Reject { id, .. }
             | Frame::Status { id, .. }
             | Frame::Params { id, .. }
+            | Frame::ResidenceSet { id, .. }
             | Frame::Models { id, .. } => Some(id),
             _ => None,
         }

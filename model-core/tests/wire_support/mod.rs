@@ -154,6 +154,20 @@ pub fn frame() -> impl Strategy<Value = Frame> {
         1 => (any::<u16>(), param_values()).prop_map(|(id, values)| Frame::Params { id, values }),
         1 => (any::<u16>(), axis_model(), axis_model())
             .prop_map(|(id, a, b)| Frame::Models { id, axes: [a, b] }),
+        1 => (
+            any::<u16>(),
+            prop_oneof![Just(ResidenceModel::Flat), Just(ResidenceModel::Coriolis)],
+            any::<i16>(),
+            any::<i16>()
+        )
+            .prop_map(|(id, model, precession_mrad_s, spin_mrad_s)| {
+                Frame::ResidenceSet {
+                    id,
+                    model,
+                    precession_mrad_s,
+                    spin_mrad_s,
+                }
+            }),
     ]
 }
 

@@ -170,8 +170,19 @@ fn stored_motor_models_are_used_and_bad_ones_refused() {
 fn residence_target_sets_speeds_whose_prediction_matches() {
     let mut s = station();
     let f = command(&mut s, "C1,10,RTIME,FLAT,2500");
-    assert_eq!(f, Frame::Ack { id: 10 });
     let st = s.rig.controller().status();
+    // The answer names the model and carries the setpoints the controller now holds.
+    let Frame::ResidenceSet {
+        id: 10,
+        model: ResidenceModel::Flat,
+        precession_mrad_s,
+        spin_mrad_s,
+    } = f
+    else {
+        panic!("{f:?}");
+    };
+    let held = st.axes.map(|a| (a.target_rad_s * 1e3).round() as i16);
+    assert_eq!([precession_mrad_s, spin_mrad_s], held);
     // The forward model at the combined target speed gives back the target.
     let m = s.rig.model(ResidenceModel::Flat);
     let Residence::Ms(t) = m.predicted(st.combined_target_rad_s) else {
