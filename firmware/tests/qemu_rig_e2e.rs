@@ -159,6 +159,7 @@ fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
     assert_eq!(split.send(&bowl, &["start"]).0, 0);
     let from = split.last().time_ms;
     split.wait_device_ms_alive(&bowl, from, 3_000);
+    let before_release_ms = split.last().time_ms;
     assert_eq!(split.send(&bowl, &["release"]).0, 0);
     let (again, said) = split.send(&bowl, &["release"]);
     assert_eq!(
@@ -172,6 +173,14 @@ fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
     assert_eq!(
         (events[0].kind, events[1].kind),
         (GateKind::Release, GateKind::Exit)
+    );
+    // Gate events carry device time, as telemetry does (a speed trace is cut from telemetry
+    // by them): the release lies between the telemetry before RELEASE and the last one.
+    let release_ms = events[0].time_us / 1000;
+    assert!(
+        (before_release_ms..=split.last().time_ms).contains(&release_ms),
+        "release at {release_ms} ms device time, telemetry {before_release_ms}..{} ms",
+        split.last().time_ms
     );
     let measured_s = f64::from(events[1].time_us.wrapping_sub(events[0].time_us)) * 1e-6;
     let scene = Scene {

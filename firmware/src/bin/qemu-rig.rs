@@ -158,7 +158,9 @@ fn main() -> ! {
     }
     gates::set_boot(resets as u16);
     let granules = Granules::new(PLANT_SEED, ControllerConfig::nominal().axes_angle_rad);
-    // Device time starts now, after the commissioning run (which took CPU time, not plant time).
+    // Device time starts now, after the commissioning run (which took CPU time, and plant
+    // time: gate events are told where device time 0 is on the plant's clock).
+    gates::set_time_origin(plant.now_ticks());
     time_driver::start(core_p.SYST);
     let (tx, rx) = usart::enable();
     let core = CORE

@@ -1,9 +1,9 @@
 //! The emulated board's release solenoid and gates: RELEASE drops a simulated granule (the
 //! simulated rigs' one `model_core::sim::gates::Gates`, the project's default scene: Coriolis,
 //! mu 0.029, start 0.05 m, rim 0.15 m), the plant task moves it under the plant's true bowl
-//! speed one plant step at a time, and the release and exit gates report its times on the
-//! plant's capture clock (microseconds, the proximity sensors' time base), as the Black Pill's
-//! timer capture will.
+//! speed one plant step at a time, and the release and exit gates report its times in device
+//! time (microseconds since the device's clock started, as telemetry's milliseconds), taken on
+//! the plant's capture clock, as the Black Pill's timer capture does.
 //!
 //! One granule at a time, so at most one release and one exit are ever pending: two slots, the
 //! release always taken first.
@@ -25,6 +25,14 @@ static EXIT_US: AtomicU32 = AtomicU32::new(0);
 static EXIT_PENDING: AtomicBool = AtomicBool::new(false);
 /// The boot's reset counter (the `H` frame's), carried by every event.
 static BOOT: AtomicU16 = AtomicU16::new(0);
+/// The plant's capture clock at device time 0: the plant ran the commissioning before the
+/// device's clock started, and events carry device time, as telemetry does.
+static ORIGIN_US: AtomicU32 = AtomicU32::new(0);
+
+/// Records the plant clock's value at device time 0.
+pub fn set_time_origin(plant_us: u32) {
+    ORIGIN_US.store(plant_us, Ordering::Relaxed);
+}
 
 /// Records the reset counter the events of this boot carry.
 pub fn set_boot(reset_count: u16) {
@@ -43,9 +51,10 @@ pub fn release() -> Result<(), Reason> {
 /// The oldest pending gate event.
 pub fn next_event() -> Option<GateEvent> {
     let boot = BOOT.load(Ordering::Relaxed);
-    let event = |kind, time_us| GateEvent {
+    let origin = ORIGIN_US.load(Ordering::Relaxed);
+    let event = |kind, plant_us: u32| GateEvent {
         kind,
-        time_us,
+        time_us: plant_us.wrapping_sub(origin),
         boot,
     };
     if RELEASE_PENDING.swap(false, Ordering::AcqRel) {
