@@ -290,55 +290,54 @@ fn batch_rows_carry_the_results_condition_and_flags_of_single_predictions() {
     let _ = std::fs::remove_file(output);
 }
 
-#[test]
-fn batch_without_g_and_k2_uses_the_defaults() {
-    let input = temp("defaults.csv");
-    let output = temp("defaults-out.csv");
-    std::fs::write(
-        &input,
-        "R_m,ri_m,mu,w_rad_s,model\n0.1,0.03,0.01,3.6,flat\n",
-    )
-    .unwrap();
-    let out = bowl(&[
+/// `bowl predict --batch` on a file holding `csv` (named after `name`), with `extra` flags:
+/// its output, the results file's text (empty if none was written), both files removed.
+fn run_batch(name: &str, csv: &str, extra: &[&str]) -> (Output, String) {
+    let input = temp(&format!("{name}.csv"));
+    let output = temp(&format!("{name}-out.csv"));
+    std::fs::write(&input, csv).unwrap();
+    let mut args = vec![
         "predict",
         "--batch",
         input.to_str().unwrap(),
         "--out",
         output.to_str().unwrap(),
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let out = bowl(&args);
+    let text = std::fs::read_to_string(&output).unwrap_or_default();
+    let _ = std::fs::remove_file(input);
+    let _ = std::fs::remove_file(output);
+    (out, text)
+}
+
+#[test]
+fn batch_without_g_and_k2_uses_the_defaults() {
+    let (out, text) = run_batch(
+        "defaults",
+        "R_m,ri_m,mu,w_rad_s,model\n0.1,0.03,0.01,3.6,flat\n",
+        &[],
+    );
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let text = std::fs::read_to_string(&output).unwrap();
     let last = text.lines().nth(1).unwrap();
     let t: f64 = last.split(',').nth(5).unwrap().parse().unwrap();
     let want = flat_time(3.6, 0.01, 0.03, 0.1);
     assert!((t - want).abs() < 1e-12 * want);
-    let _ = std::fs::remove_file(input);
-    let _ = std::fs::remove_file(output);
 }
 
 /// `--throughput` times each model the file holds (and only those), on one thread and on every
 /// core, after writing the results as usual.
 #[test]
 fn batch_throughput_is_measured_per_model() {
-    let input = temp("throughput.csv");
-    let output = temp("throughput-out.csv");
-    std::fs::write(
-        &input,
+    let (out, text) = run_batch(
+        "throughput",
         "model,w_rad_s,mu,ri_m,R_m\nflat,3.6,0.01,0.03,0.1\nflat,4,0.02,0.05,0.1\n",
-    )
-    .unwrap();
-    let out = bowl(&[
-        "predict",
-        "--batch",
-        input.to_str().unwrap(),
-        "--out",
-        output.to_str().unwrap(),
-        "--throughput",
-    ]);
+        &["--throughput"],
+    );
     assert!(
         out.status.success(),
         "{}",
@@ -353,9 +352,7 @@ fn batch_throughput_is_measured_per_model() {
     }
     assert!(flat["threads"].as_u64().unwrap() >= 1);
     assert!(j.get("coriolis").is_none(), "{j}");
-    assert_eq!(std::fs::read_to_string(&output).unwrap().lines().count(), 3);
-    let _ = std::fs::remove_file(input);
-    let _ = std::fs::remove_file(output);
+    assert_eq!(text.lines().count(), 3);
 }
 
 #[test]

@@ -196,10 +196,8 @@ pub fn fit_mu_k2(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::models::{Method, closed_form};
+    use crate::fit::tests::{Truth, synthetic_runs};
     use model_core::particle::Model;
-    use model_core::sim::granule::gaussian;
-    use model_core::sim::prng::Prng;
 
     /// The results file's k2 (a solid sphere); the truth below is another granule.
     const K2_FILE: f64 = 5.0 / 7.0;
@@ -209,28 +207,12 @@ mod tests {
     /// `per_speed` releases at each of `speeds` of a granule with [`K2_TRUE`] and [`MU_TRUE`],
     /// timed with Gaussian noise `sigma_s`; the rows say [`K2_FILE`].
     fn runs(model: Model, speeds: &[f64], per_speed: usize, sigma_s: f64, seed: u32) -> Vec<Run> {
-        let mut rng = Prng::new(seed);
-        let mut out = Vec::new();
-        for (c, &w) in speeds.iter().enumerate() {
-            for _ in 0..per_speed {
-                let mut run = Run {
-                    condition: c + 1,
-                    residence_s: 0.0,
-                    mean_rad_s: w,
-                    release_radius_m: 0.05,
-                    rim_radius_m: 0.15,
-                    k2: K2_TRUE,
-                    trace: vec![(0.0, w)],
-                    method: Method::ClosedForm,
-                    axes_angle_rad: 60f64.to_radians(),
-                };
-                run.residence_s =
-                    closed_form(&run, model, MU_TRUE, w) + sigma_s * gaussian(&mut rng);
-                run.k2 = K2_FILE;
-                out.push(run);
-            }
-        }
-        out
+        let truth = Truth {
+            model,
+            mu: MU_TRUE,
+            k2: K2_TRUE,
+        };
+        synthetic_runs(truth, K2_FILE, speeds, per_speed, sigma_s, seed)
     }
 
     /// Over 100 data sets of 20 runs spread from 2.6 to 5 rad/s the 95 % intervals of both

@@ -14,11 +14,27 @@ use crate::experiment::{plan, run_plan};
 
 const SPEEDS: [f64; 3] = [2.9, 3.5, 4.2];
 
-/// `per_speed` releases at each of [`SPEEDS`] for the given truth, noise `sigma_s`.
-fn synthetic(model: Model, mu: f64, sigma_s: f64, per_speed: usize, seed: u32) -> Vec<Run> {
+/// A granule's truth for synthetic runs: its model, `mu` and `k2`.
+#[derive(Clone, Copy)]
+pub(super) struct Truth {
+    pub model: Model,
+    pub mu: f64,
+    pub k2: f64,
+}
+
+/// `per_speed` releases at each of `speeds` of a granule with `truth`, timed with Gaussian noise
+/// `sigma_s` (closed form at a steady speed, no plant); the rows say `k2_file`.
+pub(super) fn synthetic_runs(
+    truth: Truth,
+    k2_file: f64,
+    speeds: &[f64],
+    per_speed: usize,
+    sigma_s: f64,
+    seed: u32,
+) -> Vec<Run> {
     let mut rng = Prng::new(seed);
     let mut runs = Vec::new();
-    for (c, &w) in SPEEDS.iter().enumerate() {
+    for (c, &w) in speeds.iter().enumerate() {
         for _ in 0..per_speed {
             let mut run = Run {
                 condition: c + 1,
@@ -26,16 +42,32 @@ fn synthetic(model: Model, mu: f64, sigma_s: f64, per_speed: usize, seed: u32) -
                 mean_rad_s: w,
                 release_radius_m: 0.05,
                 rim_radius_m: 0.15,
-                k2: 5.0 / 7.0,
+                k2: truth.k2,
                 trace: vec![(0.0, w)],
                 method: Method::ClosedForm,
                 axes_angle_rad: 60f64.to_radians(),
             };
-            run.residence_s = closed_form(&run, model, mu, w) + sigma_s * gaussian(&mut rng);
+            run.residence_s =
+                closed_form(&run, truth.model, truth.mu, w) + sigma_s * gaussian(&mut rng);
+            run.k2 = k2_file;
             runs.push(run);
         }
     }
     runs
+}
+
+/// `per_speed` releases at each of [`SPEEDS`] for the given truth (a solid sphere), noise
+/// `sigma_s`.
+fn synthetic(model: Model, mu: f64, sigma_s: f64, per_speed: usize, seed: u32) -> Vec<Run> {
+    let k2 = 5.0 / 7.0;
+    synthetic_runs(
+        Truth { model, mu, k2 },
+        k2,
+        &SPEEDS,
+        per_speed,
+        sigma_s,
+        seed,
+    )
 }
 
 /// The fit over the paper's two models only: the tests of their behaviour (the rolling model's
