@@ -122,6 +122,7 @@ pub fn chart() -> Result<(Figure, Table)> {
     let mut series: Vec<Series> = Vec::new();
     let (mut worst, mut misses, mut n) = (0.0f64, 0, 0);
     let (mut worst_dependable, mut within, mut within_dependable) = (0.0f64, 0, 0);
+    let mut dependable_points = Vec::new();
     for (ti, tolerance) in [1e-3, 1e-5, 1e-7].into_iter().enumerate() {
         let mut points = Vec::new();
         for mu in [0.01, 0.029, 0.1] {
@@ -174,6 +175,7 @@ pub fn chart() -> Result<(Figure, Table)> {
                     }
                     let name = format!("mu={mu} {start}->{end} rad/s tau={tau} s");
                     points.push((points.len() as f64 + 1.0, ratio));
+                    dependable_points.push((points.len() as f64, ratio_dependable));
                     table.row(vec![
                         name,
                         format!("{tolerance:e}"),
@@ -200,6 +202,12 @@ pub fn chart() -> Result<(Figure, Table)> {
             color: ti,
         });
     }
+    series.push(Series {
+        name: "each, vs dependable cheapest".into(),
+        points: dependable_points,
+        mark: Mark::Points,
+        color: 3,
+    });
     let fig = Figure {
         title: "The chooser's plan against the cheapest plan that meets the tolerance".into(),
         x_label: "scene (mu x spin-up x time constant; see the CSV)".into(),
