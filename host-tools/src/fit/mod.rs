@@ -186,10 +186,7 @@ pub fn fit_model(runs: &[Run], candidate: Candidate, fit_k2: bool) -> ModelFit {
         return one;
     }
     let model = candidate.equation;
-    let ceiling = runs
-        .iter()
-        .map(|r| mu_ceiling_for(r, model))
-        .fold(f64::INFINITY, f64::min);
+    let ceiling = mu_ceiling(runs, model);
     let k2_start = runs.iter().map(|r| r.k2).sum::<f64>() / runs.len() as f64;
     match joint::fit_mu_k2(runs, model, (one.mu, k2_start), ceiling) {
         Ok(j) => {
@@ -209,7 +206,7 @@ pub fn fit_model(runs: &[Run], candidate: Candidate, fit_k2: bool) -> ModelFit {
                 aic: aic(j.sse, n, 3),
                 errors_pct,
                 k2: K2::Fitted(j.k2, j.k2_ci95),
-                at_limit: j.mu >= ceiling * (1.0 - 1e-9),
+                at_limit: at_limit(j.mu, ceiling),
             }
         }
         Err(e) => ModelFit {
@@ -217,6 +214,18 @@ pub fn fit_model(runs: &[Run], candidate: Candidate, fit_k2: bool) -> ModelFit {
             ..one
         },
     }
+}
+
+/// The largest `mu` at which every run can still leave under `equation`: the fits' search limit.
+fn mu_ceiling(runs: &[Run], equation: Equation) -> f64 {
+    runs.iter()
+        .map(|r| mu_ceiling_for(r, equation))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Whether `mu` sits at the search limit (the model does not describe the runs).
+fn at_limit(mu: f64, ceiling: f64) -> bool {
+    mu >= ceiling * (1.0 - 1e-9)
 }
 
 fn rms(errors_pct: &[f64]) -> f64 {
@@ -227,10 +236,7 @@ fn rms(errors_pct: &[f64]) -> f64 {
 fn fit_mu(runs: &[Run], candidate: Candidate) -> ModelFit {
     let n = runs.len();
     let model = candidate.equation;
-    let ceiling = runs
-        .iter()
-        .map(|r| mu_ceiling_for(r, model))
-        .fold(f64::INFINITY, f64::min);
+    let ceiling = mu_ceiling(runs, model);
     let s = |mu: f64| sse(runs, model, mu);
     let mu = minimise(&s, 0.0, ceiling);
     let s_min = s(mu);
@@ -254,7 +260,7 @@ fn fit_mu(runs: &[Run], candidate: Candidate) -> ModelFit {
         aic: aic(s_min, n, 2),
         errors_pct,
         k2: K2::Given,
-        at_limit: mu >= ceiling * (1.0 - 1e-9),
+        at_limit: at_limit(mu, ceiling),
     }
 }
 

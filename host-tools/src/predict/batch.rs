@@ -214,7 +214,9 @@ pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
         let result = record.map_err(|e| anyhow!("{e}")).and_then(|row| {
             let (model, scene) = parse_row(&row, &cols, header.len())?;
             let p = predict(&scene, model, args.method, args.step_s, args.tol)?;
-            scenes.push((model, scene));
+            if args.throughput {
+                scenes.push((model, scene));
+            }
             Ok((row, p))
         });
         match result {
