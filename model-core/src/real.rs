@@ -6,6 +6,7 @@
 
 use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 
+pub mod exp;
 pub mod log1p;
 #[cfg(feature = "micromath")]
 pub mod micro;
@@ -148,7 +149,7 @@ impl Real for f64 {
     }
     #[inline]
     fn exp(self) -> Self {
-        libm::exp(self)
+        exp::exp_f64(self)
     }
     #[inline]
     fn exp_m1(self) -> Self {

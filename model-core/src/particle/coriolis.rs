@@ -1,7 +1,9 @@
 //! Residence time of the Coriolis model (paper Eq. 10, 11 with the corrected A, B of docs/model.md §3).
 
 use super::flat::{acosh_1p_parts, acosh_1p_ratio};
-use super::{Exit, Model, Scene, SceneError, Shape, condition};
+use super::{
+    Before, Exit, Model, Scene, SceneError, Shape, ShapeAt, condition, finite_time, phi_expm1,
+};
 use crate::Real;
 
 /// Iterations allowed; it needs 1 or 2 on the rig's scenes (2 or 3 in f64).
@@ -53,42 +55,80 @@ fn start<T: Real>(shape: &Shape<T>, x: T) -> (T, T) {
 /// `C = F''' / (6 F') - (F'' / (2 F'))^2`: we stop when that is below a quarter of an ulp of `u`.
 /// Far from the root (`d F'' / F'` not small) it takes Newton's step; where `F` is a factor off
 /// `x` with `u > 1`, `F` behaves like `A e^u` and we step by `ln(x / F)` (`F <= A e^u`,
-/// docs/model.md §4's `ln((1 + x) / A)` bound). An iteration that has not converged is an
-/// error, never a result.
+/// docs/model.md §4's `ln((1 + x) / A)` bound). In f64, where Halley's step is not yet within
+/// rounding, the expansion of `F` at the same point usually is ([`local_root`]): one evaluation
+/// instead of two on the batch's scenes. An iteration that has not converged is an error, never
+/// a result.
 pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneError> {
-    let mut lower = T::ZERO;
-    let (mut u, mut upper) = start(shape, x);
-    let far = T::from_f64(4.0);
-    let quarter_ulp = T::from_f64(0.25) * T::EPSILON;
-    for _ in 0..MAX_NEWTON {
+    let mut search = Search::new(shape, x);
+    loop {
+        if let Some(done) = search.step(shape, x) {
+            return done;
+        }
+    }
+}
+
+/// One root search of [`solve_u`] between its iterations, so that a batch can advance several
+/// scenes' searches in turn ([`times_s`]).
+#[derive(Clone, Copy)]
+pub(crate) struct Search<T> {
+    lower: T,
+    upper: T,
+    u: T,
+    iterations_left: u32,
+}
+
+impl<T: Real> Search<T> {
+    pub(crate) fn new(shape: &Shape<T>, x: T) -> Self {
+        let (u, upper) = start(shape, x);
+        Self {
+            lower: T::ZERO,
+            upper,
+            u,
+            iterations_left: MAX_NEWTON,
+        }
+    }
+
+    /// One iteration of [`solve_u`]: `None` while it goes on, then the root and `expm1(-q u)`
+    /// there, or the error.
+    pub(crate) fn step(&mut self, shape: &Shape<T>, x: T) -> Option<Result<(T, T), SceneError>> {
+        if self.iterations_left == 0 {
+            return Some(Err(SceneError::NoConvergence));
+        }
+        self.iterations_left -= 1;
+        let far = T::from_f64(4.0);
+        let quarter_ulp = T::from_f64(0.25) * T::EPSILON;
+        let u = self.u;
         let e = shape.eval_parts(u);
         let (f, fp, fpp) = (e.f, e.fp, e.fpp);
         // F and F' are below F'' + 1 (both exponentials enter F'' with positive weights), so
         // a finite F'' vouches for all three.
         if !fpp.is_finite() {
-            return Err(SceneError::OutOfRange);
+            return Some(Err(SceneError::OutOfRange));
         }
         if fp <= T::ZERO {
             // Only at u = 0, i.e. x = 0 (R - ri underflowed against ri - a): T = 0.
-            return Ok((u, e.decay_m1));
+            return Some(Ok((u, e.decay_m1)));
         }
         if f < x {
-            lower = u;
+            self.lower = u;
         } else {
-            upper = u;
+            self.upper = u;
         }
         if u > T::ONE && (f > far * x || x > far * f) {
-            u = (u - (f / x).ln()).max(lower).min(upper);
-            continue;
+            self.u = (u - (f / x).ln()).max(self.lower).min(self.upper);
+            return None;
         }
-        let d = (f - x) / fp;
-        let half_curv = fpp / (T::TWO * fp);
+        // One division for the three ratios to F' (a division costs what a dozen products do).
+        let per_fp = T::ONE / fp;
+        let d = (f - x) * per_fp;
+        let half_curv = T::HALF * fpp * per_fp;
         let bend = d * half_curv;
         let halley = bend.abs() < T::HALF;
         let step = if halley { d / (T::ONE - bend) } else { d };
-        let next = (u - step).max(lower).min(upper);
+        let next = (u - step).max(self.lower).min(self.upper);
         let converged = if halley {
-            let c = (e.fppp / (T::from_f64(6.0) * fp) - half_curv * half_curv).abs();
+            let c = (e.fppp * T::from_f64(1.0 / 6.0) * per_fp - half_curv * half_curv).abs();
             c * step * step * step.abs() <= quarter_ulp * next
         } else {
             fpp * d * d <= T::HALF * T::EPSILON * fp * next
@@ -98,11 +138,75 @@ pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneEr
             // last factor to third order (the step is below eps^(1/3) u).
             let z = -shape.q * (next - u);
             let em1 = z * (T::ONE + z * (T::HALF + z * T::from_f64(1.0 / 6.0)));
-            return Ok((next, e.decay_m1 + (T::ONE + e.decay_m1) * em1));
+            return Some(Ok((next, e.decay_m1 + (T::ONE + e.decay_m1) * em1)));
         }
-        u = next;
+        // In f32 (the MCU) Halley's first step is within rounding on the rig's scenes, and the
+        // polynomial's code alone costs some 17 Cortex-M4F instructions a call: f64 only.
+        let host = T::EPSILON.to_f64() < 1e-10;
+        if halley
+            && host
+            && let Some(root) = local_root(shape, &e, u, f - x, next - u, half_curv)
+            && root >= self.lower
+            && root <= self.upper
+        {
+            // As above, the last factor in full (the step may reach 1e-2 u).
+            let em1 = phi_expm1(-shape.q * (root - u)).1;
+            return Some(Ok((root, e.decay_m1 + (T::ONE + e.decay_m1) * em1)));
+        }
+        self.u = next;
+        None
     }
-    Err(SceneError::NoConvergence)
+}
+
+/// The root from `F`'s Taylor expansion at `u` to fifth order, where that is within rounding of
+/// the root: `None` otherwise (the search then evaluates `F` again at Halley's point).
+///
+/// Every derivative of `F` comes from the two exponentials of the evaluation at `u`
+/// (`F^(n) = A (e^u + (-1)^n q^(n-1) e^{-q u})`), so where Halley's step alone is not yet
+/// within rounding (a start off by more than about `eps^(1/3)`, the rig's larger `mu`) the
+/// polynomial takes the place of a second evaluation: Newton on it from Halley's point
+/// (`delta`), `g = F(u) - x`, `half_curv = F'' / (2 F')`. Accepted when Newton's last correction `c` leaves an error
+/// `F'' c^2 / (2 F')` and the expansion's remainder `F^(6) delta^6 / 720 / F'` (bounded with
+/// `F^(6)` at `u` doubled, for `q |delta| <= 1/2`) both below a quarter of an ulp of the root.
+fn local_root<T: Real>(
+    shape: &Shape<T>,
+    e: &ShapeAt<T>,
+    u: T,
+    g: T,
+    delta: T,
+    half_curv: T,
+) -> Option<T> {
+    let (q, a) = (shape.q, shape.a_coef);
+    if (delta * q.max(T::ONE)).abs() > T::HALF {
+        return None;
+    }
+    let q2 = q * q;
+    let f4 = a * (e.grow + q2 * e.decay);
+    let f5 = a * (e.grow - q2 * q * e.decay);
+    let f6 = a * (e.grow + q2 * q2 * e.decay);
+    let c2 = T::HALF * e.fpp;
+    let c3 = e.fppp * T::from_f64(1.0 / 6.0);
+    let c4 = f4 * T::from_f64(1.0 / 24.0);
+    let c5 = f5 * T::from_f64(1.0 / 120.0);
+    let quarter_ulp = T::from_f64(0.25) * T::EPSILON;
+    let mut d = delta;
+    for _ in 0..3 {
+        let r = g + d * (e.fp + d * (c2 + d * (c3 + d * (c4 + d * c5))));
+        let dr = e.fp
+            + d * (T::TWO * c2
+                + d * (T::from_f64(3.0) * c3
+                    + d * (T::from_f64(4.0) * c4 + d * T::from_f64(5.0) * c5)));
+        let c = r / dr;
+        d -= c;
+        let root = u + d;
+        let d3 = d * d * d;
+        let remainder = f6 * d3 * d3 * T::from_f64(2.0 / 720.0);
+        let limit = quarter_ulp * root;
+        if (half_curv * c * c).abs() <= limit && remainder <= limit * e.fp {
+            return Some(root);
+        }
+    }
+    None
 }
 
 /// The root of `F(u) = x` for `x > 1/eps` (and for an `x` that overflows, e.g. a subnormal
@@ -114,6 +218,113 @@ fn large_u<T: Real>(shape: &Shape<T>, rise: T, den: T) -> T {
     (rise.ln() - den.ln()) - shape.a_coef.ln() + sum * (den / rise)
 }
 
+/// What a Coriolis scene's root starts from (`a < ri < R`, checked by the caller).
+#[derive(Clone, Copy)]
+struct Setup<T> {
+    shape: Shape<T>,
+    /// `R - ri`.
+    rise: T,
+    /// `ri - a`.
+    den: T,
+    /// `x = (R - ri) / (ri - a)`, the right-hand side of `F(u) = x`.
+    x: T,
+}
+
+impl<T: Real> Setup<T> {
+    fn new(scene: &Scene<T>, a: T) -> Result<Self, SceneError> {
+        let shape = Shape::new(scene, Model::Coriolis)?;
+        let den = scene.ri_m - a;
+        let rise = scene.rim_radius_m - scene.ri_m;
+        Ok(Self {
+            shape,
+            rise,
+            den,
+            x: rise / den,
+        })
+    }
+
+    /// The root and `expm1(-q u)` where no search is needed ([`large_u`]), else `None`.
+    fn direct_root(&self) -> Option<(T, T)> {
+        if self.x.is_finite() && self.x * T::EPSILON <= T::ONE {
+            None
+        } else {
+            Some((large_u(&self.shape, self.rise, self.den), -T::ONE))
+        }
+    }
+}
+
+/// Scenes whose root searches a batch advances in turn.
+const LANES: usize = 4;
+
+/// One batch scene whose root is being searched.
+#[derive(Clone, Copy)]
+struct Lane<T> {
+    shape: Shape<T>,
+    x: T,
+    omega_rad_s: T,
+    search: Search<T>,
+}
+
+/// The residence times of `scenes` into `out` (paired in order), each bit for bit what
+/// [`super::residence_time_s`] gives for it. One root search is a chain of dependent
+/// exponentials and divisions that keeps the host's out-of-order core waiting; advancing
+/// [`LANES`] independent searches in turn lets it overlap them (the batch closed form's
+/// throughput, `bowl predict --batch --throughput`).
+pub(crate) fn times_s<T: Real>(scenes: &[Scene<T>], out: &mut [Result<T, SceneError>]) {
+    for (group, answers) in scenes.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        // Phase by phase across the lanes, so that each phase's lanes sit together in the
+        // core's window.
+        let mut setups: [Option<Setup<T>>; LANES] = [None; LANES];
+        for ((scene, answer), setup) in group.iter().zip(answers.iter_mut()).zip(&mut setups) {
+            *answer = match super::before_model(scene) {
+                Ok(Before::Answer(time)) => Ok(time),
+                Ok(Before::Leaves { a }) => match Setup::new(scene, a) {
+                    Ok(ready) => {
+                        *setup = Some(ready);
+                        continue;
+                    }
+                    Err(e) => Err(e),
+                },
+                Err(e) => Err(e),
+            };
+        }
+        let mut lanes: [Option<Lane<T>>; LANES] = [None; LANES];
+        for (((scene, answer), setup), lane) in group
+            .iter()
+            .zip(answers.iter_mut())
+            .zip(&setups)
+            .zip(&mut lanes)
+        {
+            let Some(setup) = setup else { continue };
+            match setup.direct_root() {
+                Some((u, _)) => {
+                    *answer = finite_time(u / (setup.shape.c1 * scene.omega_rad_s));
+                }
+                None => {
+                    *lane = Some(Lane {
+                        search: Search::new(&setup.shape, setup.x),
+                        shape: setup.shape,
+                        x: setup.x,
+                        omega_rad_s: scene.omega_rad_s,
+                    });
+                }
+            }
+        }
+        let mut searching = lanes.iter().filter(|l| l.is_some()).count();
+        while searching > 0 {
+            for (slot, answer) in lanes.iter_mut().zip(answers.iter_mut()) {
+                let Some(lane) = slot else { continue };
+                if let Some(done) = lane.search.step(&lane.shape, lane.x) {
+                    let l1 = lane.shape.c1 * lane.omega_rad_s;
+                    *answer = done.and_then(|(u, _)| finite_time(u / l1));
+                    *slot = None;
+                    searching -= 1;
+                }
+            }
+        }
+    }
+}
+
 /// Coriolis model, `a < ri < R` (checked by the caller). `T = u / l1`, `l1 = k omega/(s + k mu)`.
 ///
 /// Exit velocity `r'(T) = (ri - a) l1 F'(u)` (paper Eq. 11: `(ri - a)(k omega/(2 s))
@@ -122,16 +333,13 @@ fn large_u<T: Real>(shape: &Shape<T>, rise: T, den: T) -> T {
 /// rounding times `u`; the identity depends on `u` only through a bounded term. Then
 /// `r'(T) = l1 ((R - ri) - (ri - a)(A + B) expm1(-q u))`, which never forms `x`.
 pub(crate) fn residence<T: Real>(scene: &Scene<T>, a: T) -> Result<Exit<T>, SceneError> {
-    let shape = Shape::new(scene, Model::Coriolis)?;
-    let (ri, rim) = (scene.ri_m, scene.rim_radius_m);
-    let den = ri - a;
-    let rise = rim - ri;
-    let x = rise / den;
-    let (u, eb) = if x.is_finite() && x * T::EPSILON <= T::ONE {
-        solve_u(&shape, x)?
-    } else {
-        (large_u(&shape, rise, den), -T::ONE)
+    let setup = Setup::new(scene, a)?;
+    let (shape, rise, den) = (setup.shape, setup.rise, setup.den);
+    let (u, eb) = match setup.direct_root() {
+        Some(root) => root,
+        None => solve_u(&shape, setup.x)?,
     };
+    let ri = scene.ri_m;
     let l1 = shape.c1 * scene.omega_rad_s;
     // (ri - a) F'(u), finite even where x is not.
     let den_fp = rise - den * (shape.a_coef + shape.b_coef) * eb;

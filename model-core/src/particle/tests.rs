@@ -584,3 +584,43 @@ fn coriolis_exit_speed_keeps_full_precision_far_from_the_rim() {
         }
     }
 }
+
+extern crate std;
+use std::vec;
+use std::vec::Vec;
+
+/// One scene from six inputs: physical ones mostly, any finite values now and then.
+fn batch_scene() -> impl Strategy<Value = Scene<f64>> {
+    prop_oneof![
+        3 => (0.5f64..20.0, 0.0f64..0.5, 0.001f64..0.3, 0.05f64..0.3)
+            .prop_map(|(w, mu, ri, rim)| Scene { omega_rad_s: w, mu, g_m_s2: 9.81, k2: 5.0 / 7.0, ri_m: ri, rim_radius_m: rim }),
+        1 => (any_finite_f64(), any_finite_f64(), any_finite_f64(), any_finite_f64(), any_finite_f64(), any_finite_f64())
+            .prop_map(|(w, mu, g, k2, ri, rim)| Scene { omega_rad_s: w, mu, g_m_s2: g, k2, ri_m: ri, rim_radius_m: rim }),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(500))]
+    /// The batch (interleaved root searches) gives every scene exactly the one-scene answer,
+    /// errors included, in f64 and f32, whatever the mix of scenes in its lanes.
+    #[test]
+    fn batch_answers_are_the_one_scene_answers(scenes in prop::collection::vec(batch_scene(), 0..23)) {
+        let narrow: Vec<Scene<f32>> = scenes.iter().map(|s| Scene {
+            omega_rad_s: s.omega_rad_s as f32, mu: s.mu as f32, g_m_s2: s.g_m_s2 as f32,
+            k2: s.k2 as f32, ri_m: s.ri_m as f32, rim_radius_m: s.rim_radius_m as f32 }).collect();
+        for model in [Model::Flat, Model::Coriolis] {
+            let mut out = vec![Ok(-1.0); scenes.len()];
+            residence_times_s(&scenes, model, &mut out);
+            for (s, got) in scenes.iter().zip(&out) {
+                let want = residence_time_s(s, model);
+                prop_assert!(got == &want || matches!((got, &want), (Ok(a), Ok(b)) if a.is_nan() && b.is_nan()),
+                             "{model:?} {s:?}: batch {got:?}, one scene {want:?}");
+            }
+            let mut out32 = vec![Ok(-1.0f32); narrow.len()];
+            residence_times_s(&narrow, model, &mut out32);
+            for (s, got) in narrow.iter().zip(&out32) {
+                prop_assert_eq!(*got, residence_time_s(s, model), "{:?} {:?}", model, s);
+            }
+        }
+    }
+}
