@@ -10,6 +10,7 @@ use model_core::wire::{Frame, FrameError, PROTOCOL_VERSION, ParamId, Reason, dec
 use crate::exit_code;
 use crate::link::{Link, transact};
 use crate::refusal;
+use crate::words;
 
 /// Flags of `bowl send`.
 #[derive(clap::Args)]
@@ -79,8 +80,16 @@ pub fn describe(frame: &Frame) -> String {
             )
         }
         Frame::Status { id, status: s } => format!(
-            "status (id {id}): state={:?} fault={:?} reset_cause={:?} reset_count={} uptime_ms={} telemetry_hz={}",
-            s.state, s.fault, s.reset_cause, s.reset_count, s.uptime_ms, s.telemetry_hz
+            "status (id {id}): state={} fault={} reset_cause={} reset_count={} uptime_ms={} telemetry_hz={} ({}; {}; last reset: {})",
+            words::state_token(s.state),
+            words::fault_token(s.fault),
+            words::reset_cause_token(s.reset_cause),
+            s.reset_count,
+            s.uptime_ms,
+            s.telemetry_hz,
+            words::state(s.state),
+            words::fault(s.fault),
+            words::reset_cause(s.reset_cause),
         ),
         Frame::Params { id, values } => {
             let mut out = format!("params (id {id}):");

@@ -46,6 +46,45 @@ pub fn reset_cause(r: ResetCause) -> &'static str {
     }
 }
 
+/// The device's state as one lower-case word for `key=value` lines (`bowl send status`), which
+/// scripts read: the same states as [`state`], without its explanations.
+pub fn state_token(s: DeviceState) -> &'static str {
+    match s {
+        DeviceState::Idle => "idle",
+        DeviceState::Commissioning => "commissioning",
+        DeviceState::SpinningUp => "spinning-up",
+        DeviceState::Running => "running",
+        DeviceState::Stopping => "stopping",
+        DeviceState::Faulted => "faulted",
+    }
+}
+
+/// A fault as one lower-case word for `key=value` lines (see [`state_token`]).
+pub fn fault_token(f: FaultCode) -> &'static str {
+    match f {
+        FaultCode::None => "none",
+        FaultCode::SensorLostOrStallPrecession => "no-pulses-precession",
+        FaultCode::SensorLostOrStallSpin => "no-pulses-spin",
+        FaultCode::OverspeedPrecession => "overspeed-precession",
+        FaultCode::OverspeedSpin => "overspeed-spin",
+        FaultCode::HostSilent => "link-lost",
+        FaultCode::InvalidConfiguration => "invalid-configuration",
+    }
+}
+
+/// A reset cause as one lower-case word for `key=value` lines (see [`state_token`]).
+pub fn reset_cause_token(r: ResetCause) -> &'static str {
+    match r {
+        ResetCause::PowerOn => "power-on",
+        ResetCause::Pin => "pin",
+        ResetCause::Software => "software",
+        ResetCause::IndependentWatchdog => "watchdog",
+        ResetCause::WindowWatchdog => "window-watchdog",
+        ResetCause::LowPower => "low-power",
+        ResetCause::Unknown => "unknown",
+    }
+}
+
 const AXES: [&str; 2] = ["precession", "spin"];
 
 fn axis(i: u8) -> &'static str {
@@ -151,6 +190,51 @@ mod tests {
             assert!(!camel(fault(f)), "{f:?}");
         }
         assert!(!camel(state(DeviceState::SpinningUp)));
+        // The key=value tokens: one lower-case word each, distinct within their kind.
+        let token =
+            |t: &str| !t.is_empty() && t.chars().all(|c| c.is_ascii_lowercase() || c == '-');
+        let faults: Vec<&str> = [
+            FaultCode::None,
+            FaultCode::SensorLostOrStallPrecession,
+            FaultCode::SensorLostOrStallSpin,
+            FaultCode::OverspeedPrecession,
+            FaultCode::OverspeedSpin,
+            FaultCode::HostSilent,
+            FaultCode::InvalidConfiguration,
+        ]
+        .into_iter()
+        .map(fault_token)
+        .collect();
+        let states: Vec<&str> = [
+            DeviceState::Idle,
+            DeviceState::Commissioning,
+            DeviceState::SpinningUp,
+            DeviceState::Running,
+            DeviceState::Stopping,
+            DeviceState::Faulted,
+        ]
+        .into_iter()
+        .map(state_token)
+        .collect();
+        let causes: Vec<&str> = [
+            ResetCause::PowerOn,
+            ResetCause::Pin,
+            ResetCause::Software,
+            ResetCause::IndependentWatchdog,
+            ResetCause::WindowWatchdog,
+            ResetCause::LowPower,
+            ResetCause::Unknown,
+        ]
+        .into_iter()
+        .map(reset_cause_token)
+        .collect();
+        for kind in [faults, states, causes] {
+            assert!(kind.iter().all(|t| token(t)), "{kind:?}");
+            let mut unique = kind.clone();
+            unique.sort_unstable();
+            unique.dedup();
+            assert_eq!(unique.len(), kind.len(), "{kind:?}");
+        }
         assert!(!camel(reset_cause(ResetCause::IndependentWatchdog)));
         use model_core::control::InverseFailure;
         let configs = [

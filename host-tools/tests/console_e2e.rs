@@ -42,15 +42,15 @@ fn start_monitor(port: &str, log: &std::path::Path) -> (Child, mpsc::Receiver<St
 /// how the answer starts, what else it must say).
 const ROUND: [(&str, i32, &str, &str); 10] = [
     ("speed 1500 1500", 0, "ok", ""),
-    ("status", 0, "status", "state=Idle"),
+    ("status", 0, "status", "state=idle"),
     ("clear", 1, "rejected", "STATE"),
     ("speed 1800 30000", 1, "rejected", "RANGE"),
     ("start", 0, "ok", ""),
-    ("status", 0, "status", "state=SpinningUp|state=Running"),
+    ("status", 0, "status", "state=spinning-up|state=running"),
     ("ping", 0, "ok", ""),
     ("stop", 0, "ok", ""),
     ("ping", 0, "ok", ""),
-    ("status", 0, "status", "fault=None"),
+    ("status", 0, "status", "fault=none"),
 ];
 
 /// Each `bowl send` may take this long (it resends every 200 ms meanwhile): with 1 % of the bytes
@@ -78,7 +78,7 @@ fn wait_until_idle(port: &str, round: u16) {
         ]);
         let text = stdout(&out);
         assert_eq!(out.status.code(), Some(0), "{text}");
-        if text.contains("state=Idle") {
+        if text.contains("state=idle") {
             return;
         }
         assert!(

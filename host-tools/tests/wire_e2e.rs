@@ -155,7 +155,7 @@ fn send_and_monitor_against_the_virtual_rig() {
 
     let status = bowl(&["send", p, "status"]);
     assert!(
-        stdout(&status).contains("fault=None"),
+        stdout(&status).contains("fault=none"),
         "{}",
         stdout(&status)
     );
@@ -489,13 +489,13 @@ fn a_silent_host_faults_a_running_rig_by_default() {
     send(&["start"]);
     let running = send(&["status"]);
     assert!(
-        !running.contains("state=Idle") && !running.contains("state=Faulted"),
+        !running.contains("state=idle") && !running.contains("state=faulted"),
         "{running}"
     );
     std::thread::sleep(std::time::Duration::from_millis(4500));
     let status = send(&["status"]);
     assert!(
-        status.contains("state=Faulted") && status.contains("fault=HostSilent"),
+        status.contains("state=faulted") && status.contains("fault=link-lost"),
         "{status}"
     );
 }

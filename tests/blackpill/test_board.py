@@ -34,7 +34,7 @@ def test_boot_says_hello_and_reports_power_on():
         first = s.call(lambda m: bytes(m.tx_bytes[:4]))
         check(first == b"$H1,", f"first bytes on the link {first!r}, expected a Hello frame '$H1,'")
         st = s.status()
-        check(st.get("state") == "Idle" and st.get("reset_cause") == "PowerOn"
+        check(st.get("state") == "idle" and st.get("reset_cause") == "power-on"
               and st.get("reset_count") == "0", f"status after power-on: {st}")
         with open(os.path.join(LOGS, "blackpill-defmt.log"), errors="replace") as f:
             log = f.read()
@@ -65,7 +65,7 @@ def test_every_command_and_its_refusals():
         check(s.bowl("start").startswith("ok"), "START refused")
         s.wait_emulated(0.3)
         st = s.status()
-        check(st.get("state") in ("SpinningUp", "Running"), f"not driving after START: {st}")
+        check(st.get("state") in ("spinning-up", "running"), f"not driving after START: {st}")
         check(s.bowl("stop").startswith("ok"), "STOP refused")
         out = s.bowl("clear")
         check(out.startswith(("ok", "rejected")), f"CLEAR: {out}")
@@ -128,9 +128,9 @@ def fault_stops_the_bridge(name: str, inject, expected: str):
         while s.now_s() < deadline:
             s.wait_emulated(0.25)
             st = s.status()
-            if st.get("fault", "None") != "None":
+            if st.get("fault", "none") != "none":
                 break
-        check(st.get("fault", "None") != "None", f"no fault within 4 s of the {name}: {st}")
+        check(st.get("fault", "none") != "none", f"no fault within 4 s of the {name}: {st}")
         check(st.get("fault") == expected, f"the {name} faulted {st.get('fault')}, not {expected}")
         s.wait_emulated(0.01)
         duty, moe = s.call(lambda m: ((m.board.tim1.pwm_fraction(0), m.board.tim1.pwm_fraction(1)),
@@ -161,24 +161,24 @@ def test_link_loss_stops_the_motors_by_default():
         check(duty == (0.0, 0.0), f"PWM still active {s.now_s() - t_silent:.2f} s into silence")
         check(not moe, "TIM1 main output (MOE) still enabled after the link loss")
         st = s.status()
-        check(st.get("state") == "Faulted" and st.get("fault") == "HostSilent", f"{st}")
+        check(st.get("state") == "faulted" and st.get("fault") == "link-lost", f"{st}")
     finally:
         s.close()
 
 
 def test_blocked_shaft_faults_and_the_bridge_goes_off():
     fault_stops_the_bridge("blocked spin shaft", lambda plant, t: plant.block_shaft(1, t),
-                           "SensorLostOrStallSpin")
+                           "no-pulses-spin")
 
 
 def test_dead_sensor_faults_and_the_bridge_goes_off():
     fault_stops_the_bridge("dead spin sensor", lambda plant, t: plant.kill_sensor(1, t),
-                           "SensorLostOrStallSpin")
+                           "no-pulses-spin")
 
 
 def test_stuck_bridge_faults_overspeed_and_the_bridge_goes_off():
     fault_stops_the_bridge("stuck spin bridge", lambda plant, t: plant.stick_bridge(1, t),
-                           "OverspeedSpin")
+                           "overspeed-spin")
 
 
 def test_no_flash_operation_while_a_motor_is_driven():
@@ -197,7 +197,7 @@ def test_no_flash_operation_while_a_motor_is_driven():
         # ... and accepted and saved once the rig is idle again.
         s.bowl("stop")
         deadline = s.now_s() + 8.0
-        while s.status().get("state") != "Idle" and s.now_s() < deadline:
+        while s.status().get("state") != "idle" and s.now_s() < deadline:
             s.wait_emulated(0.25)
         out = s.bowl("set", "TEETH2", "24")
         check(out.startswith("ok"), f"SET after STOP: {out}; status {s.status()}")
@@ -218,7 +218,7 @@ def test_parameters_survive_a_reset():
         s.call(lambda m: m.reset("pin"))
         s.wait_emulated(0.3)
         st = s.status()
-        check(st.get("reset_cause") == "Pin" and st.get("reset_count") == "1", f"status: {st}")
+        check(st.get("reset_cause") == "pin" and st.get("reset_count") == "1", f"status: {st}")
         check(s.params()["TEETH2"] == 24, "TEETH2 not restored from flash after the reset")
     finally:
         s.close()
@@ -259,8 +259,8 @@ def test_identified_models_survive_a_reset():
         check(not before[0][0] and not before[1][0], f"identified before COMMISSION: {before}")
         check(s.bowl("commission").startswith("ok"), "COMMISSION refused")
         s.wait_emulated(1.0)
-        st = wait_for_state(s, "Idle", 60.0)
-        check(st.get("state") == "Idle" and st.get("fault") == "None",
+        st = wait_for_state(s, "idle", 60.0)
+        check(st.get("state") == "idle" and st.get("fault") == "none",
               f"commissioning did not end idle: {st}")
         found = models(s)
         check(found[0][0] and found[1][0], f"not identified after COMMISSION: {found}")
@@ -273,7 +273,7 @@ def test_identified_models_survive_a_reset():
         s.call(lambda m: m.reset("pin"))
         s.wait_emulated(0.3)
         st = s.status()
-        check(st.get("reset_cause") == "Pin", f"status after the reset: {st}")
+        check(st.get("reset_cause") == "pin", f"status after the reset: {st}")
         after = models(s)
         check(after == found, f"models after the reset {after}, before {found}")
         check(s.bowl("speed", "1000", "2000").startswith("ok"), "SPEED refused")
@@ -374,7 +374,7 @@ def test_wedged_cpu_is_reset_by_the_watchdog():
         # IWDG timeout 250 ms (firmware); LSI 32 kHz as modelled.
         check(after_ms <= 260, f"watchdog reset {after_ms:.0f} ms after the wedge (limit 260)")
         st = s.status()
-        check(st.get("reset_cause") == "IndependentWatchdog" and st.get("reset_count") == "1",
+        check(st.get("reset_cause") == "watchdog" and st.get("reset_count") == "1",
               f"status after the watchdog reset: {st}")
     finally:
         s.close()
@@ -398,7 +398,7 @@ def test_late_control_ticks_starve_the_watchdog():
         after_ms = (resets[0][0] - t0) / 1e6
         check(after_ms <= 300, f"watchdog reset {after_ms:.0f} ms after ticks began to be late")
         st = s.status()
-        check(st.get("reset_cause") == "IndependentWatchdog", f"status: {st}")
+        check(st.get("reset_cause") == "watchdog", f"status: {st}")
     finally:
         s.close()
 

@@ -67,6 +67,14 @@ pub fn chart(rigs: &[Rig], target: f32, file: &str) -> (Figure, Table) {
         .fold(11.0, f64::max);
     let settle_target = if target < 1.0 { 10.0 } else { 3.0 };
     let band = if target < 1.0 { 5 } else { 2 };
+    // Judged against this run's own target (the summary's share is the 3 s of a 3 rad/s step).
+    let axes_count = pts.iter().map(Vec::len).sum::<usize>() + never.len();
+    let settled = pts
+        .iter()
+        .flatten()
+        .filter(|p| p.1 <= settle_target)
+        .count();
+    let settled_share = 100.0 * settled as f64 / axes_count.max(1) as f64;
     let mut series = vec![
         Series {
             name: "precession axes".into(),
@@ -124,8 +132,8 @@ pub fn chart(rigs: &[Rig], target: f32, file: &str) -> (Figure, Table) {
                 s.overshoot_within_5_pct_share, s.overshoot_worst_pct
             ),
             format!(
-                "settled <= 3 s: {:.1} % of axes, never: {}",
-                s.settled_within_3_s_share, s.never_settled
+                "settled <= {settle_target} s: {:.1} % of axes, never: {}",
+                settled_share, s.never_settled
             ),
             format!(
                 "ripple median {:.2} %, worst {:.2} %",

@@ -383,25 +383,15 @@ impl Figure {
             .draw()
             .map_err(be)?;
 
-        for (i, v) in self.vlines.iter().enumerate() {
+        for v in &self.vlines {
             if let Some(x) = to_axis(self.x_scale, v.x) {
-                // Labels staggered downwards so neighbouring lines stay readable.
-                let label_y = ya.hi - (ya.hi - ya.lo) * 0.035 * (i % 8) as f64;
-                let c = colour(v.color);
                 chart
                     .draw_series(DashedLineSeries::new(
                         vec![(x, ya.lo), (x, ya.hi)],
                         6,
                         4,
-                        c.stroke_width(1),
+                        colour(v.color).stroke_width(1),
                     ))
-                    .map_err(be)?;
-                chart
-                    .draw_series(std::iter::once(Text::new(
-                        v.label.clone(),
-                        (x, label_y),
-                        (FONT, 13).into_font().color(&c),
-                    )))
                     .map_err(be)?;
             }
         }
@@ -445,6 +435,21 @@ impl Figure {
                     }
                     _ => {}
                 }
+            }
+        }
+
+        // The lines' labels over the data, staggered downwards from one step below the top
+        // (a series along the top edge, such as a target, would cross the first one).
+        for (i, v) in self.vlines.iter().enumerate() {
+            if let Some(x) = to_axis(self.x_scale, v.x) {
+                let label_y = ya.hi - (ya.hi - ya.lo) * 0.035 * (1 + i % 8) as f64;
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        v.label.clone(),
+                        (x, label_y),
+                        (FONT, 13).into_font().color(&colour(v.color)),
+                    )))
+                    .map_err(be)?;
             }
         }
 
