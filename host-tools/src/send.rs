@@ -130,7 +130,16 @@ pub fn describe(frame: &Frame) -> String {
             f64::from(*precession_mrad_s) * 1e-3,
             f64::from(*spin_mrad_s) * 1e-3
         ),
-        other => format!("{other:?}"),
+        // Frames that are never an answer, should one be shown in an answer's place.
+        Frame::Telemetry(t) => format!(
+            "telemetry (not an answer): t={:.3} s, {}",
+            f64::from(t.time_ms) / 1000.0,
+            words::state(t.state)
+        ),
+        Frame::Hello(_) => "the rig's hello (it has just started; not an answer)".into(),
+        Frame::Command { id, .. } => {
+            format!("a command line (id {id}), not an answer: is the line echoing what was sent?")
+        }
     }
 }
 

@@ -164,6 +164,16 @@ pub fn controller_state(s: ControllerState) -> &'static str {
 mod tests {
     use super::*;
 
+    const FAULTS: [FaultCode; 7] = [
+        FaultCode::None,
+        FaultCode::SensorLostOrStallPrecession,
+        FaultCode::SensorLostOrStallSpin,
+        FaultCode::OverspeedPrecession,
+        FaultCode::OverspeedSpin,
+        FaultCode::HostSilent,
+        FaultCode::InvalidConfiguration,
+    ];
+
     /// No word is a Rust name (no CamelCase run of two capitals).
     #[test]
     fn plain_words_only() {
@@ -178,33 +188,14 @@ mod tests {
             })
         };
         assert!(camel("state SpinningUp") && !camel("10 kHz"));
-        for f in [
-            FaultCode::None,
-            FaultCode::SensorLostOrStallPrecession,
-            FaultCode::SensorLostOrStallSpin,
-            FaultCode::OverspeedPrecession,
-            FaultCode::OverspeedSpin,
-            FaultCode::HostSilent,
-            FaultCode::InvalidConfiguration,
-        ] {
+        for f in FAULTS {
             assert!(!camel(fault(f)), "{f:?}");
         }
         assert!(!camel(state(DeviceState::SpinningUp)));
         // The key=value tokens: one lower-case word each, distinct within their kind.
         let token =
             |t: &str| !t.is_empty() && t.chars().all(|c| c.is_ascii_lowercase() || c == '-');
-        let faults: Vec<&str> = [
-            FaultCode::None,
-            FaultCode::SensorLostOrStallPrecession,
-            FaultCode::SensorLostOrStallSpin,
-            FaultCode::OverspeedPrecession,
-            FaultCode::OverspeedSpin,
-            FaultCode::HostSilent,
-            FaultCode::InvalidConfiguration,
-        ]
-        .into_iter()
-        .map(fault_token)
-        .collect();
+        let faults: Vec<&str> = FAULTS.into_iter().map(fault_token).collect();
         let states: Vec<&str> = [
             DeviceState::Idle,
             DeviceState::Commissioning,

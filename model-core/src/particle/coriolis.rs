@@ -6,7 +6,7 @@ use super::{
 };
 use crate::Real;
 
-/// Iterations allowed; it needs 1 or 2 on the rig's scenes (2 or 3 in f64).
+/// Iterations allowed; it needs 1 or 2 on the rig's scenes (in f64 mostly 1, see [`local_root`]).
 const MAX_NEWTON: u32 = 40;
 
 /// Below this `m/s` the start that is first order in `m` is used; above it the
@@ -165,8 +165,8 @@ impl<T: Real> Search<T> {
 /// (`F^(n) = A (e^u + (-1)^n q^(n-1) e^{-q u})`), so where Halley's step alone is not yet
 /// within rounding (a start off by more than about `eps^(1/3)`, the rig's larger `mu`) the
 /// polynomial takes the place of a second evaluation: Newton on it from Halley's point
-/// (`delta`), `g = F(u) - x`, `half_curv = F'' / (2 F')`. Accepted when Newton's last correction `c` leaves an error
-/// `F'' c^2 / (2 F')` and the expansion's remainder `F^(6) delta^6 / 720 / F'` (bounded with
+/// (`delta`), `g = F(u) - x`, `half_curv = F'' / (2 F')`. Accepted when Newton's last
+/// correction `c` leaves an error `F'' c^2 / (2 F')` and the expansion's remainder `F^(6) delta^6 / 720 / F'` (bounded with
 /// `F^(6)` at `u` doubled, for `q |delta| <= 1/2`) both below a quarter of an ulp of the root.
 fn local_root<T: Real>(
     shape: &Shape<T>,
