@@ -9,6 +9,8 @@
 //!
 //! * [`residence`]: `T` and the exit velocities, as an explicit [`Outcome`] (leaves / already at
 //!   the rim / never leaves) with a condition number, never NaN.
+//! * [`residence_time_s`]: `T` alone (telemetry, RTIME); [`residence_times_s`]: the same for a
+//!   batch of scenes, at a higher host throughput (`bowl predict --batch --throughput`).
 //! * [`position_m`], [`radial_velocity_m_s`]: `r(t)` and `r'(t)` (paper Eq. 6, 7, 10, 11).
 //! * [`omega_for_residence_time`]: the inverse, the bowl speed that gives a target `T`.
 //!
