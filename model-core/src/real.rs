@@ -73,6 +73,12 @@ pub trait Real:
     fn ln_1p_in_domain(self) -> Self {
         self.ln_1p()
     }
+    /// Single precision (f32 and its variants: the MCU's types), not f64 (the host's): where the
+    /// two want different methods (instruction count against latency).
+    #[inline]
+    fn is_single_precision() -> bool {
+        Self::EPSILON.to_f64() > 1e-10
+    }
     /// Hyperbolic cosine.
     fn cosh(self) -> Self;
     /// Hyperbolic sine.

@@ -88,15 +88,20 @@ fn line(payload: &str) -> Vec<u8> {
     .into_bytes()
 }
 
+/// A recording rig that allows 5,000 mrad/s, and a fresh device.
+fn rig_and_device() -> (Recorder, Device) {
+    let rig = Recorder {
+        speed_max: 5000,
+        ..Default::default()
+    };
+    (rig, Device::new())
+}
+
 /// RTIME is answered with the model that answered and the setpoints it chose; a resend after a
 /// lost answer gets the same answer without a second run.
 #[test]
 fn rtime_says_which_model_answered_and_a_resend_repeats_it() {
-    let mut rig = Recorder {
-        speed_max: 5000,
-        ..Default::default()
-    };
-    let mut d = Device::new();
+    let (mut rig, mut d) = rig_and_device();
     let mut input = line("C1,21,RTIME,CORI,3000");
     input.extend(line("C1,21,RTIME,CORI,3000"));
     let got = answers(&mut d, &mut rig, &input);
@@ -112,11 +117,7 @@ fn rtime_says_which_model_answered_and_a_resend_repeats_it() {
 
 #[test]
 fn each_command_gets_its_answer() {
-    let mut rig = Recorder {
-        speed_max: 5000,
-        ..Default::default()
-    };
-    let mut d = Device::new();
+    let (mut rig, mut d) = rig_and_device();
     let mut input = Vec::new();
     for p in [
         "C1,1,SPEED,1800,2100",
@@ -211,11 +212,7 @@ fn each_command_gets_its_answer() {
 
 #[test]
 fn a_resent_command_runs_once_and_is_answered_again() {
-    let mut rig = Recorder {
-        speed_max: 5000,
-        ..Default::default()
-    };
-    let mut d = Device::new();
+    let (mut rig, mut d) = rig_and_device();
     // The answer to START id 40 was lost; the PC sends it again with the same id.
     let first = answers(&mut d, &mut rig, &line("C1,40,START"));
     let again = answers(&mut d, &mut rig, &line("C1,40,START"));
@@ -288,8 +285,7 @@ proptest! {
     /// Any bytes: at most one answer per `\n`, no panic, each answer a valid frame.
     #[test]
     fn arbitrary_input_gets_valid_answers(bytes in proptest::collection::vec(any::<u8>(), 0..2000)) {
-        let mut rig = Recorder { speed_max: 5000, ..Default::default() };
-        let mut d = Device::new();
+        let (mut rig, mut d) = rig_and_device();
         let got = answers(&mut d, &mut rig, &bytes);
         let newlines = bytes.iter().filter(|&&b| b == b'\n').count();
         prop_assert!(got.len() <= newlines);
@@ -298,8 +294,7 @@ proptest! {
     /// Every well-formed command gets exactly one answer with its id.
     #[test]
     fn every_command_is_answered(id in any::<u16>(), command in wire_support::command()) {
-        let mut rig = Recorder { speed_max: 5000, ..Default::default() };
-        let mut d = Device::new();
+        let (mut rig, mut d) = rig_and_device();
         let bytes = wire_support::encode_vec(&Frame::Command { id, command });
         let got = answers(&mut d, &mut rig, &bytes);
         prop_assert_eq!(got.len(), 1);

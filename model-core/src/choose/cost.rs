@@ -35,7 +35,7 @@ pub enum Target {
 impl Target {
     /// f32 runs on the MCU, f64 on the host.
     pub fn for_precision<T: Real>() -> Self {
-        if T::EPSILON.to_f64() > 1e-10 {
+        if T::is_single_precision() {
             Target::Mcu
         } else {
             Target::Host

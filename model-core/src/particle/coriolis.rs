@@ -142,9 +142,8 @@ impl<T: Real> Search<T> {
         }
         // In f32 (the MCU) Halley's first step is within rounding on the rig's scenes, and the
         // polynomial's code alone costs some 17 Cortex-M4F instructions a call: f64 only.
-        let host = T::EPSILON.to_f64() < 1e-10;
         if halley
-            && host
+            && !T::is_single_precision()
             && let Some(root) = local_root(shape, &e, u, f - x, next - u, half_curv)
             && root >= self.lower
             && root <= self.upper

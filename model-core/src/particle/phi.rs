@@ -19,7 +19,7 @@ use crate::real::exp::phi_terms_f64;
 #[inline]
 pub(crate) fn phi_expm1<T: Real>(z: T) -> (T, T) {
     if z.abs() < T::ONE {
-        let p = if T::EPSILON.to_f64() > 1e-10 {
+        let p = if T::is_single_precision() {
             horner_f32_terms(z)
         } else {
             T::from_f64(phi_terms_f64(z.to_f64()))
