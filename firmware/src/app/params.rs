@@ -21,7 +21,7 @@ use super::hal::{FlashError, FlashRegion};
 /// `BOWL` in ASCII, little-endian.
 pub const MAGIC: u32 = u32::from_le_bytes(*b"BOWL");
 /// Layout version of the values: bump when their meaning or order changes.
-pub const RECORD_VERSION: u16 = 1;
+pub const RECORD_VERSION: u16 = 2;
 /// Values a slot can hold.
 pub const MAX_VALUES: usize = 48;
 /// Bytes per slot: 4 header words, the values, the CRC.
@@ -425,16 +425,17 @@ mod tests {
         let mut log = ParamLog::new(RamFlash::<{ 2 * SLOT_BYTES }>::new());
         log.save(&[1, 2, 3]).unwrap();
         assert_eq!(log.load::<2>(), Err(LoadError::OtherCount(3)));
-        // Rewrite the record as version 2 with a valid CRC.
+        // Rewrite the record as another version with a valid CRC.
         let mut flash = log.into_inner();
         let mut slot: [u8; SLOT_BYTES] = flash.bytes[..SLOT_BYTES].try_into().unwrap();
-        put_word(&mut slot, 4, 2 | (3 << 16));
+        let other = RECORD_VERSION + 1;
+        put_word(&mut slot, 4, u32::from(other) | (3 << 16));
         let crc = crc32(&slot[..SLOT_BYTES - 4]);
         put_word(&mut slot, SLOT_BYTES - 4, crc);
         flash.bytes[..SLOT_BYTES].copy_from_slice(&slot);
         assert_eq!(
             ParamLog::new(flash).load::<3>(),
-            Err(LoadError::OtherVersion(2))
+            Err(LoadError::OtherVersion(other))
         );
     }
 }

@@ -193,6 +193,10 @@ pub struct AxisIdentification {
     pub time_constant_s: f32,
     /// True value (`J R / (k^2 + R b)`).
     pub true_time_constant_s: f32,
+    /// Identified breakaway duty (the breakaway search's duty at the first edge).
+    pub breakaway_duty: f32,
+    /// True value (`R Ts / (k V)`, stiction `Ts`).
+    pub true_breakaway_duty: f32,
 }
 
 /// `bowl sim commission`'s JSON.
@@ -223,6 +227,10 @@ pub(super) fn commission_report(seed: u32) -> CommissionJson {
                     true_friction_duty: fd,
                     time_constant_s: id.model.time_constant_s,
                     true_time_constant_s: tau,
+                    breakaway_duty: id.model.breakaway_duty,
+                    true_breakaway_duty: rig.axes[i].motor.resistance_ohm
+                        * rig.axes[i].motor.stiction_nm
+                        / (rig.axes[i].motor.torque_constant * rig.supply_v),
                 }
             })
         })

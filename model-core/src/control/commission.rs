@@ -146,7 +146,9 @@ pub struct Identified {
     pub low_speed_rad_s: f32,
     /// Steady speed at the high duty, rad/s.
     pub high_speed_rad_s: f32,
-    /// Duty at which the shaft broke away from rest.
+    /// Duty at which the shaft broke away from rest: the search's duty at the first edge, an
+    /// upper bound (the duty kept rising while the shaft travelled to the edge, up to a pitch;
+    /// edges alone cannot tell how far).
     pub breakaway_duty: f32,
 }
 
@@ -271,10 +273,7 @@ impl Commissioning {
         let mut duty = 0.0;
         match self.phase {
             Phase::Breakaway => {
-                // With sparse pulses the first edge comes up to a pitch after the shaft starts:
-                // the duty rises slower so that it overshoots the breakaway duty as little.
-                let sparse = if n < 12 { n as f32 / 12.0 } else { 1.0 };
-                self.duty = BREAKAWAY_START_DUTY + BREAKAWAY_RATE_PER_S * sparse * t_s;
+                self.duty = BREAKAWAY_START_DUTY + search_rate_per_s(n) * t_s;
                 if self.duty > BREAKAWAY_MAX_DUTY {
                     return Err(IdentifyError::NoBreakaway);
                 }
@@ -346,6 +345,7 @@ impl Commissioning {
             volts_per_rad_s: a,
             friction_duty,
             time_constant_s: tau,
+            breakaway_duty: self.breakaway_duty,
         };
         model
             .validate(self.axis as u8)
@@ -357,4 +357,12 @@ impl Commissioning {
             breakaway_duty: self.breakaway_duty,
         })
     }
+}
+
+/// The breakaway search's duty rise with `n` pulses per revolution: with sparse pulses the
+/// first edge comes up to a pitch after the shaft starts, so the duty rises slower and
+/// overshoots the breakaway duty as little.
+fn search_rate_per_s(n: u32) -> f32 {
+    let sparse = if n < 12 { n as f32 / 12.0 } else { 1.0 };
+    BREAKAWAY_RATE_PER_S * sparse
 }

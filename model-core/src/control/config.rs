@@ -55,6 +55,10 @@ pub struct MotorModel {
     pub friction_duty: f32,
     /// Mechanical time constant of the duty-to-speed step response, s.
     pub time_constant_s: f32,
+    /// Duty that started the shaft from rest (stiction; fraction of full duty). At or below
+    /// `friction_duty` (the nominal model) the loop knows no stiction and starts without a
+    /// kick.
+    pub breakaway_duty: f32,
 }
 
 /// Configuration of one axis.
@@ -144,6 +148,7 @@ impl AxisConfig {
                 volts_per_rad_s: 1.75,
                 friction_duty: 0.06,
                 time_constant_s: 0.06,
+                breakaway_duty: 0.06,
             },
             bandwidth_rad_s: 8.0,
             per_pulse_bandwidth: 0.5,
@@ -281,6 +286,7 @@ impl MotorModel {
         let ok = self.volts_per_rad_s > 0.0
             && self.volts_per_rad_s <= 100.0
             && in_range(self.friction_duty, 0.0, 0.9)
+            && in_range(self.breakaway_duty, 0.0, 1.0)
             && self.time_constant_s > 0.0
             && self.time_constant_s <= 10.0;
         if ok {

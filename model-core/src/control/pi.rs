@@ -31,24 +31,36 @@
 //! is exactly zero and the integral is cleared: no hum, no creep.
 //!
 //! # Breaking stiction
-//! A shaft at rest (no edge since it last stopped) whose plant model has turned
-//! [`STUCK_PITCHES`] gets a breakaway push on top of the feedforward that rises at
-//! [`BREAKAWAY_PUSH_PER_S`] until the first edge comes, then drops to zero: the feedforward holds Coulomb friction once the shaft slides,
-//! but only stiction's larger torque starts it. The push does not depend on the loop's gain,
-//! which the pulse-rate schedule makes small at low speed. The push only starts a shaft from
-//! rest: once the loop has seen it move, a shaft that goes quiet is not pushed (a dead sensor on
-//! a turning shaft would otherwise run it away before the supervisor's expected-edge watch
-//! faults it); the integral keeps what the push found.
+//! Stiction needs more torque than sliding friction, so the feedforward alone (which holds
+//! Coulomb friction) does not start a shaft from rest. Two mechanisms do, neither depending on
+//! the loop's gain (which the pulse-rate schedule makes small at low speed):
+//! - The kick: when commissioning identified a breakaway duty above the friction duty, a shaft
+//!   at rest gets the difference on top of the feedforward (less what the reference alone
+//!   already adds) until a model of the shaft driven by the applied duty reaches the reference.
+//!   A gradual push would overshoot stiction by as much as it rises before the first edge can
+//!   tell, up to a pitch of travel; the kick gives the known amount at once.
+//! - The push: a shaft at rest (no edge since it last stopped) whose plant model has turned
+//!   [`STUCK_PITCHES`] gets a push that starts from the kick's level and rises at
+//!   [`BEYOND_KICK_PUSH_PER_S`] when a breakaway is known (only load added since is missing),
+//!   else at [`BREAKAWAY_PUSH_PER_S`], until the first edge comes; then it drops to zero and
+//!   the integral keeps [`PUSH_KEPT`] of what it found beyond stiction (that part is load).
+//!
+//! Both only start a shaft from rest: once the loop has seen it move, a shaft that goes quiet is
+//! not pushed (a dead sensor on a turning shaft would otherwise run it away before the
+//! supervisor's expected-edge watch faults it).
 
 use super::config::AxisConfig;
 use super::estimator::WindowEvents;
 
 /// Rise of the breakaway push on a shaft at rest, duty per second.
 pub const BREAKAWAY_PUSH_PER_S: f32 = 0.15;
+/// Rise of the push beyond the identified breakaway duty: what stiction needed is known, only
+/// a load added since (material poured in) is not, and it is small beside stiction.
+pub const BEYOND_KICK_PUSH_PER_S: f32 = 0.08;
 /// The shaft counts as stuck once the plant model has turned this many pitches since the last
 /// edge without a new one (a shaft following the model would have given one).
 pub const STUCK_PITCHES: f32 = 1.2;
-/// Share of the breakaway push the integral keeps once the shaft moves.
+/// Share of the push beyond the kick's level the integral keeps once the shaft moves.
 pub const PUSH_KEPT: f32 = 0.5;
 
 /// State of one axis's loop.
@@ -64,6 +76,7 @@ pub struct SpeedLoop {
     kp_prev: f32,
     push: f32,
     moved: bool,
+    kick_rad_s: f32,
 }
 
 /// Inputs of one loop step.
@@ -100,6 +113,8 @@ pub struct LoopConstants {
     per_pulse_bw_times_pulses_per_rad: f32,
     filter_weight: f32,
     push_per_tick: f32,
+    kick_excess: f32,
+    kick_gain_per_tick: f32,
     stuck_angle_rad: f32,
     duty_limit: f32,
     slew_per_tick: f32,
@@ -121,11 +136,32 @@ impl LoopConstants {
             bandwidth_rad_s: axis.bandwidth_rad_s,
             per_pulse_bw_times_pulses_per_rad: axis.per_pulse_bandwidth * pulses_per_rad,
             filter_weight: w,
-            push_per_tick: BREAKAWAY_PUSH_PER_S * dt_s,
+            push_per_tick: if axis.model.breakaway_duty > axis.model.friction_duty {
+                BEYOND_KICK_PUSH_PER_S * dt_s
+            } else {
+                BREAKAWAY_PUSH_PER_S * dt_s
+            },
+            kick_excess: if axis.model.breakaway_duty > axis.model.friction_duty {
+                axis.model.breakaway_duty - axis.model.friction_duty
+            } else {
+                0.0
+            },
+            // The model's speed gain per tick and per duty above friction:
+            // `tau dw/dt = (d - friction) / duty_per_rad_s - w` (Backward Euler like the model).
+            kick_gain_per_tick: dt_s
+                / ((axis.model.time_constant_s + dt_s) * axis.model.volts_per_rad_s / supply_v),
             stuck_angle_rad: STUCK_PITCHES / pulses_per_rad,
             duty_limit: axis.duty_limit,
             slew_per_tick: axis.duty_slew_per_s * dt_s,
         }
+    }
+
+    /// Duty above friction the identified stiction needs at reference speed `r_abs` (none once
+    /// the reference's own feedforward gives it).
+    #[inline]
+    fn kick_level(&self, r_abs: f32) -> f32 {
+        let level = self.kick_excess - r_abs * self.duty_per_rad_s;
+        if level > 0.0 { level } else { 0.0 }
     }
 
     /// Closed-loop bandwidth the schedule picks at reference speed `r_abs`, rad/s.
@@ -182,6 +218,7 @@ impl SpeedLoop {
         kp_prev: 0.0,
         push: 0.0,
         moved: false,
+        kick_rad_s: 0.0,
     };
 
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
@@ -237,7 +274,12 @@ impl SpeedLoop {
         // stick again at once.
         let first_edge = !input.at_rest && !self.moved;
         if first_edge || (input.measurement_valid && self.push != 0.0) {
-            self.integral += PUSH_KEPT * self.push;
+            // Stiction is gone once the shaft slides: only what the push found beyond it is
+            // load.
+            let beyond = self.push - k.kick_level(r_abs);
+            if beyond > 0.0 {
+                self.integral += PUSH_KEPT * beyond;
+            }
             self.push = 0.0;
         }
         if !input.at_rest {
@@ -249,11 +291,32 @@ impl SpeedLoop {
         // supervisor's to judge, and pushing it would run away a shaft with a dead sensor.
         let starting = input.at_rest && !self.moved;
         let crawling = !input.at_rest && !input.measurement_valid;
+        // The kick: from rest, the identified breakaway duty, just long enough for the model
+        // driven by it to reach the reference; then the feedforward holds Coulomb friction.
+        // Stiction needs more than sliding does, and a gradual push overshoots it by as much
+        // as it rises before the first edge can tell (up to a pitch of travel).
+        let mut kick = 0.0;
+        if starting && input.feedback && self.push == 0.0 && self.kick_rad_s < r_abs {
+            kick = k.kick_level(r_abs);
+            // Driven by the applied duty (the slew limit holds it back at first) above
+            // friction: the true breakaway lies below the identified one (the search's duty
+            // kept rising until the first edge), so the shaft may already slide.
+            let applied_excess = self.duty.abs() - k.friction_duty;
+            if applied_excess > 0.0 {
+                self.kick_rad_s +=
+                    (applied_excess - self.kick_rad_s * k.duty_per_rad_s) * k.kick_gain_per_tick;
+            }
+        }
         if (starting || crawling)
             && input.feedback
             && self.model_angle_rad.abs() > k.stuck_angle_rad
             && self.push < 1.0
         {
+            // Not started by the kick: push on from its level.
+            let kick_level = k.kick_level(r_abs);
+            if self.push < kick_level {
+                self.push = kick_level;
+            }
             self.push += k.push_per_tick;
         }
         // The stall bound is only active with a valid measurement.
@@ -274,7 +337,7 @@ impl SpeedLoop {
         self.kp_prev = kp;
 
         // r != 0 here, so its sign is the commanded direction.
-        let ff = (k.friction_duty + self.push) * input.direction
+        let ff = (k.friction_duty + self.push + kick) * input.direction
             + r * k.duty_per_rad_s
             + input.extra_duty;
         let candidate_i = self.integral + ki_dt * e;
