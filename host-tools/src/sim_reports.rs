@@ -36,7 +36,11 @@ pub fn commissioned(rig: &Rig, cfg: ControllerConfig) -> Result<ClosedLoop, Stri
         _ => Err(match cl.ctrl.identify_error() {
             Some(e) => e.reason().to_string(),
             None => match cl.ctrl.fault() {
-                Some(f) => format!("fault {} during identification", f.code()),
+                Some(f) => format!(
+                    "{} during identification",
+                    model_core::wire::FaultCode::from_code(i64::from(f.code()))
+                        .map_or("an unknown fault", crate::words::fault)
+                ),
                 None => "did not finish".to_string(),
             },
         }),

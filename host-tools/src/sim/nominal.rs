@@ -197,6 +197,11 @@ pub struct AxisIdentification {
     pub breakaway_duty: f32,
     /// True value (`R Ts / (k V)`, stiction `Ts`).
     pub true_breakaway_duty: f32,
+    /// Identified duty per rad/s^2 of the other axis's acceleration (precession; 0: not
+    /// measured).
+    pub reaction_duty_s2_per_rad: f32,
+    /// True value on the precession axis (`coupling J2 R1 / (k1 V)`), 0 on the spin.
+    pub true_reaction_duty_s2_per_rad: f32,
 }
 
 /// `bowl sim commission`'s JSON.
@@ -231,6 +236,12 @@ pub(super) fn commission_report(seed: u32) -> CommissionJson {
                     true_breakaway_duty: rig.axes[i].motor.resistance_ohm
                         * rig.axes[i].motor.stiction_nm
                         / (rig.axes[i].motor.torque_constant * rig.supply_v),
+                    reaction_duty_s2_per_rad: id.model.reaction_duty_s2_per_rad,
+                    true_reaction_duty_s2_per_rad: if i == 0 {
+                        true_reaction_duty_s2_per_rad(&rig)
+                    } else {
+                        0.0
+                    },
                 }
             })
         })
@@ -336,4 +347,12 @@ pub(super) fn trace(seed: u32, plant: Option<u32>, from_file: Option<rig_file::R
             );
         }
     });
+}
+
+/// The precession duty that cancels a unit spin acceleration on `rig`: the reaction
+/// `coupling J2 dw2/dt` over the precession motor's torque per duty `k1 V / R1`.
+pub fn true_reaction_duty_s2_per_rad(rig: &PlantParams) -> f32 {
+    let p = &rig.axes[0].motor;
+    rig.coupling * rig.axes[1].motor.inertia_kg_m2 * p.resistance_ohm
+        / (p.torque_constant * rig.supply_v)
 }

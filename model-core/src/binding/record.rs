@@ -1,6 +1,6 @@
 //! The layout of the record persisted in flash: the wire parameters (wire order), then per axis
 //! the motor model in force (identified by commissioning, or nominal): back-EMF constant,
-//! friction duty, time constant, breakaway duty, as f32 bit patterns; then one word whose bit `i` says that
+//! friction duty, time constant, breakaway duty, reaction duty, as f32 bit patterns; then one word whose bit `i` says that
 //! axis `i`'s model was identified by commissioning (so the flag survives a reset with the
 //! model it describes). The flash format around it (slots, version, CRC) is the firmware's
 //! parameter log.
@@ -11,7 +11,9 @@ use crate::control::{ControllerConfig, MotorModel};
 use crate::wire::{PARAM_COUNT, ParamValues};
 
 /// Values in one persisted record.
-pub const PERSISTED_COUNT: usize = PARAM_COUNT + 4 * AXES + 1;
+pub const PERSISTED_COUNT: usize = PARAM_COUNT + MODEL_VALUES * AXES + 1;
+/// Values of one motor model in the record.
+const MODEL_VALUES: usize = 5;
 /// One persisted record's values.
 pub type Persisted = [i32; PERSISTED_COUNT];
 
@@ -26,18 +28,19 @@ pub struct Record {
     pub identified: [bool; AXES],
 }
 
-const FLAGS_AT: usize = PARAM_COUNT + 4 * AXES;
+const FLAGS_AT: usize = PARAM_COUNT + MODEL_VALUES * AXES;
 
 /// Joins parameters, motor models and their identified flags into a record.
 pub fn persisted(r: &Record) -> Persisted {
     let mut v = [0i32; PERSISTED_COUNT];
     v[..PARAM_COUNT].copy_from_slice(&r.params);
     for (i, m) in r.models.iter().enumerate() {
-        let at = PARAM_COUNT + 4 * i;
+        let at = PARAM_COUNT + MODEL_VALUES * i;
         v[at] = m.volts_per_rad_s.to_bits() as i32;
         v[at + 1] = m.friction_duty.to_bits() as i32;
         v[at + 2] = m.time_constant_s.to_bits() as i32;
         v[at + 3] = m.breakaway_duty.to_bits() as i32;
+        v[at + 4] = m.reaction_duty_s2_per_rad.to_bits() as i32;
     }
     v[FLAGS_AT] = r
         .identified
@@ -53,12 +56,13 @@ pub fn split_persisted(v: &Persisted) -> Record {
     params.copy_from_slice(&v[..PARAM_COUNT]);
     let f = |k: usize| f32::from_bits(v[k] as u32);
     let model = |i: usize| {
-        let at = PARAM_COUNT + 4 * i;
+        let at = PARAM_COUNT + MODEL_VALUES * i;
         MotorModel {
             volts_per_rad_s: f(at),
             friction_duty: f(at + 1),
             time_constant_s: f(at + 2),
             breakaway_duty: f(at + 3),
+            reaction_duty_s2_per_rad: f(at + 4),
         }
     };
     let flag = |i: usize| v[FLAGS_AT] & (1 << i) != 0;
@@ -94,12 +98,14 @@ mod tests {
                 friction_duty: 0.031,
                 time_constant_s: 0.11,
                 breakaway_duty: 0.2,
+                reaction_duty_s2_per_rad: 0.0043,
             },
             MotorModel {
                 volts_per_rad_s: -0.0,
                 friction_duty: f32::MIN_POSITIVE,
                 time_constant_s: 7.5,
                 breakaway_duty: 1.0,
+                reaction_duty_s2_per_rad: -1e-30,
             },
         ];
         for identified in [[false, false], [true, false], [false, true], [true, true]] {
@@ -121,6 +127,10 @@ mod tests {
             assert_eq!(a.friction_duty.to_bits(), b.friction_duty.to_bits());
             assert_eq!(a.time_constant_s.to_bits(), b.time_constant_s.to_bits());
             assert_eq!(a.breakaway_duty.to_bits(), b.breakaway_duty.to_bits());
+            assert_eq!(
+                a.reaction_duty_s2_per_rad.to_bits(),
+                b.reaction_duty_s2_per_rad.to_bits()
+            );
         }
     }
 }

@@ -13,6 +13,14 @@
 //! 2. *High step*: duty `max(high_duty, low + 0.2)` (at most 0.95), same rule, gives `w_H` and
 //!    the line's intercept.
 //! 3. *Coast*: zero duty until the estimator reads zero, then the next axis.
+//! 4. *Reaction* (after the precession's high step, which keeps running): the spin's duty
+//!    ramps from zero to its own high duty over [`REACTION_RAMP_S`] (a step's reaction can stall
+//!    a light rod under a heavy bowl; the lost angle does not depend on the profile). Its
+//!    acceleration reacts on the rod and the precession loses an angle; once both have settled, a line fitted as in the steps gives the precession's
+//!    angle, and the lost angle against the high step's line (at the instant of the spin step)
+//!    measures the reaction. Then the spin's duty ramps down the same way while the precession
+//!    holds its duty (a coasting light rod would be driven over its speed limit by a heavy
+//!    bowl's slowing down), and both coast.
 //!
 //! # What is estimated
 //! - Steady state `d V = a |w| + c`: two points give the effective back-EMF constant
@@ -26,6 +34,15 @@
 //!   This works with sparse pulses (one pitch may take longer than tau), where timing the 63 %
 //!   point of a speed step could not.
 //!
+//! - Reaction: the precession obeys `tau1 dw1/dt + w1 = K1 (d1 - c1 - g dw2/dt)` with
+//!   `K1 = V / volts_per_rad_s` and `g` the duty that cancels a unit spin acceleration. At
+//!   constant `d1`, integrating over the transient (steady before and after) gives the lost
+//!   angle `dtheta1 = -K1 g dw2`, so `g = -dtheta1 / (K1 dw2)` with `dw2` the spin's speed at its
+//!   high duty (its own high step's fit). This measures the coupling and the two motors'
+//!   torque ratio together, which the axes' geometry alone cannot (it assumes the same motor
+//!   type on both axes). A reaction that cannot be fitted leaves `g = 0`, and the controller
+//!   falls back to the geometry.
+//!
 //! The feedforward and the PI gains follow from the model (see `pi`).
 
 use super::config::{CommissioningConfig, MotorModel};
@@ -36,6 +53,8 @@ pub const BREAKAWAY_RATE_PER_S: f32 = 0.2;
 pub const BREAKAWAY_START_DUTY: f32 = 0.05;
 /// The breakaway search gives up at this duty.
 pub const BREAKAWAY_MAX_DUTY: f32 = 0.9;
+/// The spin's duty ramp while the reaction is measured, s.
+pub const REACTION_RAMP_S: f32 = 2.0;
 /// Largest duty of the high step.
 const TOP_DUTY: f32 = 0.95;
 
@@ -93,6 +112,8 @@ pub enum Phase {
     Low,
     /// High duty step on the axis.
     High,
+    /// The precession's high step continues while the spin steps (its reaction is measured).
+    Reaction,
     /// Coasting to rest.
     Coast,
     /// Both axes identified.
@@ -172,6 +193,15 @@ pub struct Commissioning {
     breakaway_duty: f32,
     low_duty: f32,
     high_duty: f32,
+    /// The spin's high duty, applied again during the reaction phase.
+    spin_high_duty: f32,
+    /// The precession's angle after the spin step has settled.
+    reaction_fit: LineFit,
+    /// From the spin step, s on the precession's clock: when the fit starts.
+    reaction_fit_from_s: f32,
+    /// When the spin's ramp down started (the reaction is measured), s on the precession's
+    /// clock.
+    reaction_done_s: Option<f32>,
     results: [Option<Identified>; 2],
 }
 
@@ -203,6 +233,10 @@ impl Commissioning {
             breakaway_duty: 0.0,
             low_duty: cfg.low_duty,
             high_duty: cfg.high_duty,
+            spin_high_duty: 0.0,
+            reaction_fit: LineFit::default(),
+            reaction_fit_from_s: 0.0,
+            reaction_done_s: None,
             results: [None, None],
         }
     }
@@ -237,6 +271,12 @@ impl Commissioning {
         let t_s = at_ticks.wrapping_sub(t0) as f32 / self.ticks_per_s;
         self.angle_pulses += pulses;
         let angle = self.angle_pulses as f32 * rad_per_pulse;
+        if self.phase == Phase::Reaction {
+            if t_s >= self.reaction_fit_from_s {
+                self.reaction_fit.add(t_s, angle);
+            }
+            return;
+        }
         let phase_start = if self.phase == Phase::Low {
             0.0
         } else {
@@ -291,9 +331,29 @@ impl Commissioning {
                 duty = self.high_duty;
                 if t_s - self.step_at_s >= self.cfg.step_time_s && whole(self.high_fit.count()) {
                     self.results[self.axis] = Some(self.identify()?);
-                    self.phase = Phase::Coast;
-                    self.coast_s = 0.0;
-                    duty = 0.0;
+                    if self.axis == 1 {
+                        self.spin_high_duty = self.high_duty;
+                        self.phase = Phase::Coast;
+                        self.coast_s = 0.0;
+                        duty = 0.0;
+                    } else {
+                        self.start_reaction(t_s);
+                    }
+                }
+            }
+            Phase::Reaction => {
+                duty = self.high_duty;
+                if let Some(done_s) = self.reaction_done_s {
+                    if t_s - done_s >= REACTION_RAMP_S {
+                        self.phase = Phase::Coast;
+                        self.coast_s = 0.0;
+                        duty = 0.0;
+                    }
+                } else if t_s >= self.reaction_fit_from_s + 0.5 * self.cfg.step_time_s
+                    && whole(self.reaction_fit.count())
+                {
+                    self.measure_reaction();
+                    self.reaction_done_s = Some(t_s);
                 }
             }
             Phase::Coast => {
@@ -317,7 +377,54 @@ impl Commissioning {
         }
         let mut duties = [0.0; 2];
         duties[self.axis] = duty;
+        if self.phase == Phase::Reaction {
+            let ramp = match self.reaction_done_s {
+                None => (t_s - self.step_at_s) / REACTION_RAMP_S,
+                Some(done_s) => 1.0 - (t_s - done_s) / REACTION_RAMP_S,
+            };
+            duties[1] = self.spin_high_duty * ramp.clamp(0.0, 1.0);
+        }
         Ok(duties)
+    }
+
+    /// The spin's ramp starts at `t_s` (the precession's clock); the fit starts once the ramp
+    /// is done and both axes have settled (five time constants of each, at least the step
+    /// time).
+    fn start_reaction(&mut self, t_s: f32) {
+        let tau = |i: usize| {
+            self.results[i]
+                .map(|r| r.model.time_constant_s)
+                .unwrap_or(0.0)
+        };
+        let settle_s = 5.0 * (tau(0) + tau(1));
+        self.step_at_s = t_s;
+        self.reaction_fit_from_s = t_s + REACTION_RAMP_S + settle_s.max(self.cfg.step_time_s);
+        self.reaction_fit = LineFit::default();
+        self.reaction_done_s = None;
+        self.phase = Phase::Reaction;
+    }
+
+    /// `g = -dtheta1 / (K1 dw2)` (module docs) into the precession's model; left at 0 (the
+    /// geometry's estimate) when a fit fails or the result is not plausible.
+    fn measure_reaction(&mut self) {
+        let (Some(before), Some(after), Some(spin), Some(prec)) = (
+            self.high_fit.solve(),
+            self.reaction_fit.solve(),
+            self.results[1],
+            self.results[0].as_mut(),
+        ) else {
+            return;
+        };
+        // Where the spin accelerated: the middle of its ramp (should the precession's speed
+        // differ slightly before and after, the lines' gap is taken there).
+        let t = self.step_at_s + 0.5 * REACTION_RAMP_S;
+        let lost_rad = (after.0 + after.1 * t) - (before.0 + before.1 * t);
+        let gain = self.supply_v / prec.model.volts_per_rad_s;
+        let g = -lost_rad / (gain * spin.high_speed_rad_s);
+        if g.is_finite() && g.abs() <= 1.0 {
+            // Exactly 0 means "not measured".
+            prec.model.reaction_duty_s2_per_rad = if g == 0.0 { f32::MIN_POSITIVE } else { g };
+        }
     }
 
     fn identify(&self) -> Result<Identified, IdentifyError> {
@@ -346,6 +453,7 @@ impl Commissioning {
             friction_duty,
             time_constant_s: tau,
             breakaway_duty: self.breakaway_duty,
+            reaction_duty_s2_per_rad: 0.0,
         };
         model
             .validate(self.axis as u8)

@@ -59,6 +59,11 @@ pub struct MotorModel {
     /// `friction_duty` (the nominal model) the loop knows no stiction and starts without a
     /// kick.
     pub breakaway_duty: f32,
+    /// Duty this axis needs per rad/s^2 of the other axis's acceleration to cancel its
+    /// reaction torque (the spin's reaction on the precession axis, measured by commissioning;
+    /// duty s^2/rad). 0 means not measured: the controller then estimates it from the axes'
+    /// geometry and the spin model, assuming the same motor type on both axes.
+    pub reaction_duty_s2_per_rad: f32,
 }
 
 /// Configuration of one axis.
@@ -149,6 +154,7 @@ impl AxisConfig {
                 friction_duty: 0.06,
                 time_constant_s: 0.06,
                 breakaway_duty: 0.06,
+                reaction_duty_s2_per_rad: 0.0,
             },
             bandwidth_rad_s: 8.0,
             per_pulse_bandwidth: 0.5,
@@ -287,6 +293,7 @@ impl MotorModel {
             && self.volts_per_rad_s <= 100.0
             && in_range(self.friction_duty, 0.0, 0.9)
             && in_range(self.breakaway_duty, 0.0, 1.0)
+            && in_range(self.reaction_duty_s2_per_rad, -1.0, 1.0)
             && self.time_constant_s > 0.0
             && self.time_constant_s <= 10.0;
         if ok {

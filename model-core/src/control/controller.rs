@@ -109,8 +109,26 @@ pub struct Controller {
     /// cos and sin of the axes angle (paper Eq. 2), computed once per configuration.
     cos_axes: f32,
     sin_axes: f32,
+    /// Precession duty per rad/s of the spin's reference above its model speed: cancels the
+    /// spin's reaction (see [`decouple_duty_per_rad_s`]).
+    decouple_duty_per_rad_s: f32,
     /// Both references were reached since the last start or setpoint (arms the runaway check).
     reached: bool,
+}
+
+/// Precession duty per rad/s of `r - r_p` of the spin (its model accelerates at
+/// `(r - r_p) / tau2`): the measured reaction `g / tau2` when commissioning measured it;
+/// otherwise the geometry's estimate `cos(angle) volts_per_rad_s,spin / V` (the spin's
+/// reaction `J2 dw2/dt` projected on the vertical, with `J2 dw2/dt = tau2 k2 a2 / R2 dw2/dt` and
+/// the same motor type on both axes).
+const fn decouple_duty_per_rad_s(cfg: &ControllerConfig) -> f32 {
+    let spin = cfg.axes[1].model;
+    let g = cfg.axes[0].model.reaction_duty_s2_per_rad;
+    if g != 0.0 {
+        g / spin.time_constant_s
+    } else {
+        cos_const(cfg.axes_angle_rad) * spin.volts_per_rad_s / cfg.supply_v
+    }
 }
 
 /// An edge interval faster than this many times the plant model's speed (plus the margin) is a
@@ -169,6 +187,7 @@ impl Controller {
             feedback: true,
             cos_axes: cos_const(cfg.axes_angle_rad),
             sin_axes: sin_const(cfg.axes_angle_rad),
+            decouple_duty_per_rad_s: decouple_duty_per_rad_s(&cfg),
             reached: false,
         }
     }
@@ -284,13 +303,10 @@ impl Controller {
         if self.axis_loop(1, ramped[1], 0.0, seen[1], dt) {
             return;
         }
-        // The spin's accelerating torque reacts on the rod: J2 a2 projected on the vertical.
-        // With J2 a2 = tau2 k2 a2 dr_p/dt / R2 and the same motor type on both axes, the
-        // precession duty that cancels it is cos(angle) * (r - r_p) * duty_per_rad_s of the spin
-        // model.
+        // The spin's accelerating torque reacts on the rod; the spin model accelerates at
+        // (r - r_p) / tau2.
         let s = &self.axes[1];
-        let decouple =
-            self.cos_axes * (ramped[1] - s.speed_loop.model_rad_s()) * s.k.duty_per_rad_s();
+        let decouple = self.decouple_duty_per_rad_s * (ramped[1] - s.speed_loop.model_rad_s());
         if self.axis_loop(0, ramped[0], decouple, seen[0], dt) {
             return;
         }
