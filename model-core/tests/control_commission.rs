@@ -14,13 +14,19 @@ fn commission(rig: PlantParams, seed: u32) -> ClosedLoop {
     cl
 }
 
-fn check_identified(rig: &PlantParams, cl: &ClosedLoop, what: &str) {
+/// Commissioning ended in Idle (identified), or says which fault stopped it.
+fn assert_commissioned(cl: &ClosedLoop, what: &str) {
     assert_eq!(
         cl.ctrl.state(),
         State::Idle,
-        "{what}: {:?}",
-        cl.ctrl.fault()
+        "{what}: {:?} {:?}",
+        cl.ctrl.fault(),
+        cl.ctrl.identify_error()
     );
+}
+
+fn check_identified(rig: &PlantParams, cl: &ClosedLoop, what: &str) {
+    assert_commissioned(cl, what);
     for i in 0..2 {
         let id = cl.ctrl.identified()[i].expect("identified");
         let (a, fd, tau) = rig.axes[i].motor.ideal_model(rig.supply_v);
@@ -85,12 +91,7 @@ fn a_stiff_shaft_is_broken_away_and_identified() {
         a.motor.stiction_nm = 0.8;
     }
     let cl = commission(rig, 3);
-    assert_eq!(
-        cl.ctrl.state(),
-        State::Idle,
-        "{:?}",
-        cl.ctrl.identify_error()
-    );
+    assert_commissioned(&cl, "stiff");
     for (i, id) in cl.ctrl.identified().iter().enumerate() {
         let id = id.expect("identified");
         let (a, fd, _) = rig.axes[i].motor.ideal_model(rig.supply_v);
@@ -101,8 +102,7 @@ fn a_stiff_shaft_is_broken_away_and_identified() {
         assert!((id.model.friction_duty - fd).abs() < 0.02, "{id:?} vs {fd}");
         // Breakaway needs the stiction torque: duty 0.8 * R / (k V) = 0.333; the search's
         // duty at the first edge is above it, and it is what the model keeps.
-        let true_breakaway = 0.8 * rig.axes[i].motor.resistance_ohm
-            / (rig.axes[i].motor.torque_constant * rig.supply_v);
+        let true_breakaway = rig.axes[i].motor.ideal_breakaway_duty(rig.supply_v);
         assert!(id.breakaway_duty > true_breakaway, "{id:?}");
         assert_eq!(id.model.breakaway_duty, id.breakaway_duty);
     }
@@ -120,14 +120,6 @@ fn a_shaft_that_does_not_speed_up_fails_identification() {
     let _ = IdentifyError::NoSpeedIncrease;
 }
 
-/// The precession duty that cancels a unit spin acceleration, from the plant's parameters:
-/// the reaction `coupling J2 dw2/dt` over the precession motor's torque per duty `k1 V / R1`.
-fn true_reaction_duty_s2_per_rad(rig: &PlantParams) -> f32 {
-    let p = &rig.axes[0].motor;
-    rig.coupling * rig.axes[1].motor.inertia_kg_m2 * p.resistance_ohm
-        / (p.torque_constant * rig.supply_v)
-}
-
 #[test]
 fn the_spin_reaction_on_the_rod_is_measured() {
     // The nominal rig, a heavy bowl on a weaker precession motor with the axes closer to
@@ -142,17 +134,12 @@ fn the_spin_reaction_on_the_rod_is_measured() {
     }
     for (what, rig) in rigs {
         let cl = commission(rig, 1);
-        assert_eq!(
-            cl.ctrl.state(),
-            State::Idle,
-            "{what}: {:?}",
-            cl.ctrl.fault()
-        );
+        assert_commissioned(&cl, what);
         let measured = cl.ctrl.identified()[0]
             .expect("identified")
             .model
             .reaction_duty_s2_per_rad;
-        let truth = true_reaction_duty_s2_per_rad(&rig);
+        let truth = rig.ideal_reaction_duty_s2_per_rad();
         // Measured: 0.06 % to 4 % on the nominal and mismatched rigs, up to 10 % on the family
         // plants (eccentric loads and tooth errors in the fitted lines).
         assert!(

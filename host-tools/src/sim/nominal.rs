@@ -233,12 +233,10 @@ pub(super) fn commission_report(seed: u32) -> CommissionJson {
                     time_constant_s: id.model.time_constant_s,
                     true_time_constant_s: tau,
                     breakaway_duty: id.model.breakaway_duty,
-                    true_breakaway_duty: rig.axes[i].motor.resistance_ohm
-                        * rig.axes[i].motor.stiction_nm
-                        / (rig.axes[i].motor.torque_constant * rig.supply_v),
+                    true_breakaway_duty: rig.axes[i].motor.ideal_breakaway_duty(rig.supply_v),
                     reaction_duty_s2_per_rad: id.model.reaction_duty_s2_per_rad,
                     true_reaction_duty_s2_per_rad: if i == 0 {
-                        true_reaction_duty_s2_per_rad(&rig)
+                        rig.ideal_reaction_duty_s2_per_rad()
                     } else {
                         0.0
                     },
@@ -347,12 +345,4 @@ pub(super) fn trace(seed: u32, plant: Option<u32>, from_file: Option<rig_file::R
             );
         }
     });
-}
-
-/// The precession duty that cancels a unit spin acceleration on `rig`: the reaction
-/// `coupling J2 dw2/dt` over the precession motor's torque per duty `k1 V / R1`.
-pub fn true_reaction_duty_s2_per_rad(rig: &PlantParams) -> f32 {
-    let p = &rig.axes[0].motor;
-    rig.coupling * rig.axes[1].motor.inertia_kg_m2 * p.resistance_ohm
-        / (p.torque_constant * rig.supply_v)
 }

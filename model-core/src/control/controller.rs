@@ -16,7 +16,10 @@ use super::commission::{Commissioning, Identified, IdentifyError, Phase};
 use super::config::{ConfigError, ControllerConfig};
 use super::pi::LoopInput;
 use super::planner::{InverseFailure, ResidenceForBowlSpeed, SetpointPlanner};
-use super::supervisor::{Fault, State, fault_code};
+use super::supervisor::{
+    Fault, PAIR_RUNAWAY_MARGIN_RAD_S, PAIR_RUNAWAY_RATIO, PAIR_RUNAWAY_STEADY_S,
+    RUNAWAY_MARGIN_RAD_S, RUNAWAY_RATIO, State, fault_code,
+};
 use crate::bowl::{MotorSpeeds, combined_speed_from_trig};
 
 /// Why a command was refused. A refused command changes nothing.
@@ -131,12 +134,14 @@ const fn decouple_duty_per_rad_s(cfg: &ControllerConfig) -> f32 {
     }
 }
 
-/// An edge interval faster than this many times the plant model's speed (plus the margin) is a
-/// runaway: tooth offsets (up to 10 % on one interval), a 10 % overshoot and the breakaway of a
-/// stiff shaft at the lowest speed stay inside.
-const RUNAWAY_RATIO: f32 = 1.2;
-/// See [`RUNAWAY_RATIO`], rad/s.
-const RUNAWAY_MARGIN_RAD_S: f32 = 0.3;
+/// The two-interval runaway rule (see [`PAIR_RUNAWAY_RATIO`]), once armed near the top speed;
+/// out of line: it runs only on edges near the top speed and keeps the tick's common path short.
+#[cold]
+#[inline(never)]
+fn pair_runaway(a: &AxisState, model_rad_s: f32, steady_s: f32) -> bool {
+    steady_s > PAIR_RUNAWAY_STEADY_S
+        && a.est.pair_speed_rad_s() > PAIR_RUNAWAY_RATIO * model_rad_s + PAIR_RUNAWAY_MARGIN_RAD_S
+}
 
 impl Controller {
     /// A controller in [`State::Idle`] for a configuration that passes validation.
@@ -213,10 +218,11 @@ impl Controller {
             // Runaway (a bridge stuck on): once both axes have reached their references, an
             // edge that came far sooner than the plant model expects faults at once, without
             // waiting for the filtered speed to reach the absolute limit.
-            let runaway = self.reached
-                && seen[i]
-                && a.est.edge_speed_rad_s()
-                    > RUNAWAY_RATIO * a.speed_loop.model_rad_s().abs() + RUNAWAY_MARGIN_RAD_S;
+            let runaway = self.reached && seen[i] && {
+                let model = a.speed_loop.model_rad_s().abs();
+                a.est.edge_speed_rad_s() > RUNAWAY_RATIO * model + RUNAWAY_MARGIN_RAD_S
+                    || (model > a.k.pair_runaway_above_rad_s() && pair_runaway(a, model, steady[i]))
+            };
             if speed > self.cfg.axes[i].overspeed_rad_s || runaway {
                 self.latch(Fault::Overspeed(i as u8));
             }

@@ -108,6 +108,8 @@ pub struct PulseSpeedEstimator {
     has_edge: bool,
     last_edge: u32,
     last_interval: u32,
+    /// The pulse interval before the last, ticks (0 until there are two since rest).
+    prev_interval: u32,
     win_start: u32,
     win_pulses: u32,
     /// The window's angle in pitches, by the learned gap lengths.
@@ -152,6 +154,7 @@ impl PulseSpeedEstimator {
             has_edge: false,
             last_edge: 0,
             last_interval: 0,
+            prev_interval: 0,
             win_start: 0,
             win_pulses: 0,
             win_pitches: 0.0,
@@ -225,6 +228,7 @@ impl PulseSpeedEstimator {
             self.win_pitches = 0.0;
             self.restart_at = Some(at);
             self.last_interval = 0;
+            self.prev_interval = 0;
             self.accepted = self.accepted.wrapping_add(1);
             // The next tooth, but no interval to learn from.
             self.teeth.edge(0, 1, false);
@@ -260,6 +264,7 @@ impl PulseSpeedEstimator {
         }
         self.accepted = self.accepted.wrapping_add(1);
         self.last_edge = at;
+        self.prev_interval = self.last_interval;
         self.last_interval = dt / pulses;
         self.win_pulses += pulses;
         self.win_pitches += self.teeth.edge(dt, pulses, steady);
@@ -357,6 +362,17 @@ impl PulseSpeedEstimator {
     pub fn edge_speed_rad_s(&self) -> f32 {
         if self.has_edge && self.last_interval > 0 {
             self.rad_ticks_per_pulse_s / self.last_interval as f32
+        } else {
+            0.0
+        }
+    }
+    /// Speed over the last two pulse intervals, rad/s (0 before two intervals since rest): a
+    /// wheel's tooth offsets (each at most 5 % of a pitch) shorten one interval by up to 10 %
+    /// but two neighbouring ones together by at most 5 %, so a smaller excess is evidence.
+    pub fn pair_speed_rad_s(&self) -> f32 {
+        if self.has_edge && self.prev_interval > 0 && self.last_interval > 0 {
+            2.0 * self.rad_ticks_per_pulse_s
+                / (self.prev_interval as f32 + self.last_interval as f32)
         } else {
             0.0
         }

@@ -40,10 +40,14 @@
 //!   A gradual push would overshoot stiction by as much as it rises before the first edge can
 //!   tell, up to a pitch of travel; the kick gives the known amount at once.
 //! - The push: a shaft at rest (no edge since it last stopped) whose plant model has turned
-//!   [`STUCK_PITCHES`] gets a push that starts from the kick's level and rises at
-//!   [`BEYOND_KICK_PUSH_PER_S`] when a breakaway is known (only load added since is missing),
-//!   else at [`BREAKAWAY_PUSH_PER_S`], until the first edge comes; then it drops to zero and
-//!   the integral keeps [`PUSH_KEPT`] of what it found beyond stiction (that part is load).
+//!   [`STUCK_PITCHES`] gets a push that starts from the kick's level and rises in proportion to
+//!   the reference, to [`PUSH_SPAN_DUTY`] above it by the time the expected-edge watch would
+//!   fault, until the first edge comes; then it drops to zero and the integral keeps
+//!   [`PUSH_KEPT`] of what started the shaft (the push, or the kick): stiction and whatever
+//!   load the model does not know (material poured in since commissioning). Keeping only what
+//!   was found beyond the kick left loaded shafts crawling below 0.2 rad/s until the watch
+//!   faulted them (2 to 6 healthy plants per 60-plant family); keeping half the kick costs
+//!   overshoot on an unloaded shaft (35 % on the nominal rig at 0.5 rad/s).
 //!
 //! Both only start a shaft from rest: once the loop has seen it move, a shaft that goes quiet is
 //! not pushed (a dead sensor on a turning shaft would otherwise run it away before the
@@ -51,12 +55,16 @@
 
 use super::config::AxisConfig;
 use super::estimator::WindowEvents;
+use super::supervisor::{
+    PAIR_RUNAWAY_ARMED_SHARE, RUNAWAY_MARGIN_RAD_S, RUNAWAY_RATIO, WATCH_PITCHES,
+};
 
-/// Rise of the breakaway push on a shaft at rest, duty per second.
-pub const BREAKAWAY_PUSH_PER_S: f32 = 0.15;
-/// Rise of the push beyond the identified breakaway duty: what stiction needed is known, only
-/// a load added since (material poured in) is not, and it is small beside stiction.
-pub const BEYOND_KICK_PUSH_PER_S: f32 = 0.08;
+/// Duty the push adds above the kick's level by the time the expected-edge watch would fault
+/// (from [`STUCK_PITCHES`] to the watch's pitches of model travel): it rises in proportion to
+/// the reference, slowly where pulses are sparse and there is time, fast where the watch is
+/// quick, so a healthy shaft carrying material the model does not know starts before the watch
+/// faults it.
+pub const PUSH_SPAN_DUTY: f32 = 0.12;
 /// The shaft counts as stuck once the plant model has turned this many pitches since the last
 /// edge without a new one (a shaft following the model would have given one).
 pub const STUCK_PITCHES: f32 = 1.2;
@@ -105,6 +113,7 @@ pub struct LoopInput {
 pub struct LoopConstants {
     dt_s: f32,
     duty_per_rad_s: f32,
+    pair_runaway_above_rad_s: f32,
     friction_duty: f32,
     model_alpha: f32,
     kp_per_wc: f32,
@@ -112,12 +121,22 @@ pub struct LoopConstants {
     bandwidth_rad_s: f32,
     per_pulse_bw_times_pulses_per_rad: f32,
     filter_weight: f32,
-    push_per_tick: f32,
+    push_per_rad_tick: f32,
     kick_excess: f32,
     kick_gain_per_tick: f32,
     stuck_angle_rad: f32,
     duty_limit: f32,
     slew_per_tick: f32,
+}
+
+/// The model speed above which a bridge stuck on may stay below the single-interval runaway
+/// threshold (`RUNAWAY_RATIO m + RUNAWAY_MARGIN`, controller) because the identified model's
+/// full-duty speed `(1 - friction_duty) V / volts_per_rad_s` is within reach of it (80 % of it:
+/// material poured in since commissioning lowers the true one). Above it the controller also
+/// judges the last two intervals together.
+const fn pair_runaway_above_rad_s(axis: &AxisConfig, supply_v: f32) -> f32 {
+    let full = (1.0 - axis.model.friction_duty) * supply_v / axis.model.volts_per_rad_s;
+    (PAIR_RUNAWAY_ARMED_SHARE * full - RUNAWAY_MARGIN_RAD_S) / RUNAWAY_RATIO
 }
 
 impl LoopConstants {
@@ -128,6 +147,7 @@ impl LoopConstants {
         Self {
             dt_s,
             duty_per_rad_s: axis.model.volts_per_rad_s / supply_v,
+            pair_runaway_above_rad_s: pair_runaway_above_rad_s(axis, supply_v),
             friction_duty: axis.model.friction_duty,
             // Backward-Euler step of the first-order plant model, precomputed.
             model_alpha: dt_s / (axis.model.time_constant_s + dt_s),
@@ -136,11 +156,10 @@ impl LoopConstants {
             bandwidth_rad_s: axis.bandwidth_rad_s,
             per_pulse_bw_times_pulses_per_rad: axis.per_pulse_bandwidth * pulses_per_rad,
             filter_weight: w,
-            push_per_tick: if axis.model.breakaway_duty > axis.model.friction_duty {
-                BEYOND_KICK_PUSH_PER_S * dt_s
-            } else {
-                BREAKAWAY_PUSH_PER_S * dt_s
-            },
+            // Per tick and per rad/s of reference: the model covers the push's pitches in
+            // `pitches / (r pulses_per_rad)` seconds.
+            push_per_rad_tick: PUSH_SPAN_DUTY * dt_s * pulses_per_rad
+                / (WATCH_PITCHES - STUCK_PITCHES),
             kick_excess: if axis.model.breakaway_duty > axis.model.friction_duty {
                 axis.model.breakaway_duty - axis.model.friction_duty
             } else {
@@ -190,6 +209,12 @@ impl LoopConstants {
     /// Duty per rad/s of the identified model (`volts_per_rad_s / V`).
     pub fn duty_per_rad_s(&self) -> f32 {
         self.duty_per_rad_s
+    }
+
+    /// Model speed above which the two-interval runaway rule is armed, rad/s (see
+    /// [`pair_runaway_above_rad_s`]).
+    pub fn pair_runaway_above_rad_s(&self) -> f32 {
+        self.pair_runaway_above_rad_s
     }
 
     /// Steady-state duty of the model at `r` rad/s (signed).
@@ -274,12 +299,14 @@ impl SpeedLoop {
         // stick again at once.
         let first_edge = !input.at_rest && !self.moved;
         if first_edge || (input.measurement_valid && self.push != 0.0) {
-            // Stiction is gone once the shaft slides: only what the push found beyond it is
-            // load.
-            let beyond = self.push - k.kick_level(r_abs);
-            if beyond > 0.0 {
-                self.integral += PUSH_KEPT * beyond;
-            }
+            // What started the shaft (the kick, or the push beyond it) held stiction and
+            // whatever load the model does not know; half of it stays.
+            let found = if first_edge {
+                self.push.max(k.kick_level(r_abs))
+            } else {
+                self.push
+            };
+            self.integral += PUSH_KEPT * found;
             self.push = 0.0;
         }
         if !input.at_rest {
@@ -317,7 +344,7 @@ impl SpeedLoop {
             if self.push < kick_level {
                 self.push = kick_level;
             }
-            self.push += k.push_per_tick;
+            self.push += k.push_per_rad_tick * r_abs;
         }
         // The stall bound is only active with a valid measurement.
         if ev.bound_active && input.feedback {

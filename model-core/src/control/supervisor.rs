@@ -70,6 +70,27 @@ pub fn fault_code(f: Option<Fault>) -> u8 {
 /// tooth's offset (a tenth of a pitch at most) or one missing pulse never faults a healthy shaft.
 pub const WATCH_PITCHES: f32 = 2.6;
 
+/// An edge interval faster than this many times the plant model's speed (plus the margin) is a
+/// runaway: tooth offsets (up to 10 % on one interval), a 10 % overshoot and the breakaway of a
+/// stiff shaft at the lowest speed stay inside.
+pub const RUNAWAY_RATIO: f32 = 1.2;
+/// See [`RUNAWAY_RATIO`], rad/s.
+pub const RUNAWAY_MARGIN_RAD_S: f32 = 0.3;
+/// Near the top speed, where full duty (a bridge stuck on) drives the shaft to less than
+/// [`RUNAWAY_RATIO`] allows, the last two edge intervals together faster than this many times
+/// the model's speed (plus the margin), at a steady reference, are a runaway too: tooth offsets
+/// shorten two neighbouring intervals by at most 5 %. Only there: at lower speeds a start from
+/// rest overshoots more than this long after its reference is steady.
+pub const PAIR_RUNAWAY_RATIO: f32 = 1.1;
+/// The pair rule is armed when the single-interval threshold exceeds this share of the model's
+/// full-duty speed (material poured in since commissioning lowers the true one).
+pub const PAIR_RUNAWAY_ARMED_SHARE: f32 = 0.8;
+/// See [`PAIR_RUNAWAY_RATIO`], rad/s.
+pub const PAIR_RUNAWAY_MARGIN_RAD_S: f32 = 0.1;
+/// Seconds of steady reference before [`PAIR_RUNAWAY_RATIO`] applies (the model has settled and
+/// the two intervals do not lag a ramp).
+pub const PAIR_RUNAWAY_STEADY_S: f32 = 1.0;
+
 /// The sensor-lost watch of one axis: time spent driving above the stall duty without an edge,
 /// and how far the shaft should have turned meanwhile.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

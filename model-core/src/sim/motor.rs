@@ -55,6 +55,11 @@ impl MotorParams {
         }
     }
 
+    /// Duty whose torque equals stiction at supply `supply_v`: `R Ts / (k V)`.
+    pub fn ideal_breakaway_duty(&self, supply_v: f32) -> f32 {
+        self.resistance_ohm * self.stiction_nm / (self.torque_constant * supply_v)
+    }
+
     /// Steady-state model the controller identifies: `(volts_per_rad_s, friction_duty,
     /// time_constant_s)` at supply `supply_v` (ignoring stiction and inductance).
     pub fn ideal_model(&self, supply_v: f32) -> (f32, f32, f32) {

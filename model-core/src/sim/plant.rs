@@ -127,6 +127,15 @@ impl PlantParams {
             substeps: 4,
         }
     }
+
+    /// The precession duty that cancels a unit spin acceleration, duty s^2/rad: the reaction
+    /// `coupling J2 dw2/dt` over the precession motor's torque per duty `k1 V / R1` (what
+    /// commissioning measures as `MotorModel::reaction_duty_s2_per_rad`).
+    pub fn ideal_reaction_duty_s2_per_rad(&self) -> f32 {
+        let p = &self.axes[0].motor;
+        self.coupling * self.axes[1].motor.inertia_kg_m2 * p.resistance_ohm
+            / (p.torque_constant * self.supply_v)
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
