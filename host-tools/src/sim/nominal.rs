@@ -245,7 +245,7 @@ pub(super) fn commission_report(seed: u32) -> CommissionJson {
         })
         .collect();
     CommissionJson {
-        state: format!("{state:?}"),
+        state: crate::words::controller_state(state).to_string(),
         duration_s: cl.rig.time_s() as f32,
         axes,
     }
@@ -309,10 +309,24 @@ pub(super) fn trace(seed: u32, plant: Option<u32>, from_file: Option<rig_file::R
     let ctrl = Controller::new(cfg).expect("valid");
     let mut cl = ClosedLoop::new(Plant::new(rig, rig_seed), ctrl);
     let state = cl.commission(300.0);
-    eprintln!(
-        "commissioning: {state:?}, identified {:?}",
-        cl.ctrl.identified()
-    );
+    eprintln!("commissioning: {}", crate::words::controller_state(state));
+    for (name, id) in ["precession", "spin"].iter().zip(cl.ctrl.identified()) {
+        match id {
+            Some(id) => {
+                let m = id.model;
+                eprintln!(
+                    "  {name}: {:.4} V s/rad, friction duty {:.4}, time constant {:.4} s, \
+                     breakaway duty {:.4}, reaction {:.5} duty s^2/rad",
+                    m.volts_per_rad_s,
+                    m.friction_duty,
+                    m.time_constant_s,
+                    m.breakaway_duty,
+                    m.reaction_duty_s2_per_rad
+                );
+            }
+            None => eprintln!("  {name}: not identified"),
+        }
+    }
     let now = cl.rig.time_s() as f32;
     for (a, l) in cl.rig.params_mut().axes.iter_mut().zip(load) {
         a.faults.load_step_from_s = now;
