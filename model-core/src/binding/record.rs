@@ -1,8 +1,8 @@
 //! The layout of the record persisted in flash: the wire parameters (wire order), then per axis
 //! the motor model in force (identified by commissioning, or nominal): back-EMF constant,
-//! friction duty, time constant, breakaway duty, reaction duty, as f32 bit patterns; then one word whose bit `i` says that
-//! axis `i`'s model was identified by commissioning (so the flag survives a reset with the
-//! model it describes). The flash format around it (slots, version, CRC) is the firmware's
+//! friction duty, time constant, breakaway duty, reaction duty, as f32 bit patterns; then one
+//! word whose bit `i` says that axis `i`'s model was identified by commissioning (so the flag
+//! survives a reset with the model it describes). The flash format around it (slots, version, CRC) is the firmware's
 //! parameter log.
 
 use super::AXES;

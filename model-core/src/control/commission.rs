@@ -16,9 +16,9 @@
 //! 4. *Reaction* (after the precession's high step, which keeps running): the spin's duty
 //!    ramps from zero to its own high duty over [`REACTION_RAMP_S`] (a step's reaction can stall
 //!    a light rod under a heavy bowl; the lost angle does not depend on the profile). Its
-//!    acceleration reacts on the rod and the precession loses an angle; once both have settled, a line fitted as in the steps gives the precession's
-//!    angle, and the lost angle against the high step's line (at the instant of the spin step)
-//!    measures the reaction. Then the spin's duty ramps down the same way while the precession
+//!    acceleration reacts on the rod and the precession loses an angle; once both have
+//!    settled, a line fitted as in the steps gives the precession's angle, and its gap to the
+//!    high step's line (at the middle of the spin's ramp) measures the reaction. Then the spin's duty ramps down the same way while the precession
 //!    holds its duty (a coasting light rod would be driven over its speed limit by a heavy
 //!    bowl's slowing down), and both coast.
 //!
@@ -167,10 +167,6 @@ pub struct Identified {
     pub low_speed_rad_s: f32,
     /// Steady speed at the high duty, rad/s.
     pub high_speed_rad_s: f32,
-    /// Duty at which the shaft broke away from rest: the search's duty at the first edge, an
-    /// upper bound (the duty kept rising while the shaft travelled to the edge, up to a pitch;
-    /// edges alone cannot tell how far).
-    pub breakaway_duty: f32,
 }
 
 /// The identification routine's state (driven by the controller's tick).
@@ -462,7 +458,6 @@ impl Commissioning {
             model,
             low_speed_rad_s: w_l,
             high_speed_rad_s: w_h,
-            breakaway_duty: self.breakaway_duty,
         })
     }
 }

@@ -55,7 +55,9 @@ pub struct MotorModel {
     pub friction_duty: f32,
     /// Mechanical time constant of the duty-to-speed step response, s.
     pub time_constant_s: f32,
-    /// Duty that started the shaft from rest (stiction; fraction of full duty). At or below
+    /// Duty that started the shaft from rest (stiction; fraction of full duty): the breakaway
+    /// search's duty at the first edge, an upper bound (the duty kept rising while the shaft
+    /// travelled to the edge, up to a pitch; edges alone cannot tell how far). At or below
     /// `friction_duty` (the nominal model) the loop knows no stiction and starts without a
     /// kick.
     pub breakaway_duty: f32,

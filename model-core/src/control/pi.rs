@@ -68,7 +68,7 @@ pub const PUSH_SPAN_DUTY: f32 = 0.12;
 /// The shaft counts as stuck once the plant model has turned this many pitches since the last
 /// edge without a new one (a shaft following the model would have given one).
 pub const STUCK_PITCHES: f32 = 1.2;
-/// Share of the push beyond the kick's level the integral keeps once the shaft moves.
+/// Share of what started the shaft (the push, or the kick) the integral keeps once it moves.
 pub const PUSH_KEPT: f32 = 0.5;
 
 /// State of one axis's loop.
