@@ -151,7 +151,7 @@ impl Real for f64 {
     }
     #[inline]
     fn sqrt(self) -> Self {
-        libm::sqrt(self)
+        sqrt_f64(self)
     }
     #[inline]
     fn exp(self) -> Self {
@@ -311,6 +311,24 @@ fn sqrt_f32(x: f32) -> f32 {
     #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
     {
         libm::sqrtf(x)
+    }
+}
+
+/// `sqrt` in f64, correctly rounded. On x86-64 through SSE2's packed square root, one lane
+/// used: the compiler sees a square root it may widen into SIMD lanes (the flat batch form),
+/// where libm's x86 `sqrt` is an opaque `sqrtsd` in inline assembly that it cannot.
+#[inline]
+fn sqrt_f64(x: f64) -> f64 {
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+    {
+        use core::arch::x86_64::{_mm_cvtsd_f64, _mm_set_sd, _mm_sqrt_pd};
+        // SAFETY: SSE2, all these need, is enabled in this build (the cfg above); they touch
+        // no memory.
+        unsafe { _mm_cvtsd_f64(_mm_sqrt_pd(_mm_set_sd(x))) }
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+    {
+        libm::sqrt(x)
     }
 }
 

@@ -23,6 +23,7 @@
 
 mod coriolis;
 mod flat;
+mod flat_batch;
 mod inverse;
 mod phi;
 pub mod rolling;
@@ -381,20 +382,18 @@ pub fn residence_time_s<T: Real>(scene: &Scene<T>, model: Model) -> Result<T, Sc
 }
 
 /// [`residence_time_s`] of every scene of `scenes`, in order, into `out` (as many answers as
-/// both have). The same answers bit for bit, at a higher throughput on the host for the
-/// Coriolis model, whose root searches it interleaves (a batch of scenes, `bowl predict
-/// --batch`).
+/// both have). The same answers bit for bit, at a higher throughput on the host: the flat
+/// model's arithmetic runs in SIMD lanes, the Coriolis model's root searches interleave (a
+/// batch of scenes, `bowl predict --batch`). Inlined so that a caller compiled for wider SIMD
+/// gets the flat lanes at that width.
+#[inline(always)]
 pub fn residence_times_s<T: Real>(
     scenes: &[Scene<T>],
     model: Model,
     out: &mut [Result<T, SceneError>],
 ) {
     match model {
-        Model::Flat => {
-            for (scene, answer) in scenes.iter().zip(out.iter_mut()) {
-                *answer = residence_time_s(scene, Model::Flat);
-            }
-        }
+        Model::Flat => flat_batch::times_s(scenes, out),
         Model::Coriolis => coriolis::times_s(scenes, out),
     }
 }

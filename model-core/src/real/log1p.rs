@@ -91,7 +91,9 @@ pub fn ln_1p_in_domain_f64(y: f64) -> f64 {
     let ix = u
         .to_bits()
         .wrapping_add(0x3ff0_0000_0000_0000 - 0x3fe6_a09e_0000_0000);
-    let k = ((ix >> 52) as i64 - 0x3ff) as f64;
+    // The exponent as f64 through the bits of 2^52 + e (exact for e < 2^52): no integer to
+    // float conversion, which SIMD lanes of f64 lack before AVX-512.
+    let k = f64::from_bits((ix >> 52) | 0x4330_0000_0000_0000) - (4_503_599_627_370_496.0 + 1023.0);
     let f = f64::from_bits((ix & 0x000f_ffff_ffff_ffff).wrapping_add(0x3fe6_a09e_0000_0000)) - 1.0;
     let s = f / (2.0 + f);
     let z = s * s;
