@@ -104,6 +104,42 @@ fn sixteen_bit_timer_wraps_every_65_ms_yet_one_second_periods_measure_right() {
     assert!(((v as f64) - 0.5).abs() < 1e-3, "estimate {v}");
 }
 
+/// A stop: the reference ramps to 0 (not steady) while the shaft coasts, then rests at 0 and
+/// the caller says "steady" again before the next edge. The reading keeps falling under the
+/// one-pitch bound; it must not jump to the two-pitch bound (the demo's spin chart once rose
+/// from 0.7 to 1.3 rad/s there).
+#[test]
+fn the_reading_never_rises_between_edges_when_the_reference_turns_steady() {
+    let e = edges_at(2.0, 12, 3.0);
+    let mut f = Feed::new(12, 32);
+    let running = f.run(3.0, &e);
+    assert!((running - 2.0).abs() < 0.05);
+    let last_edge = *e.last().unwrap();
+    let pitch = std::f64::consts::TAU / 12.0;
+    f.steady = false;
+    let mut prev = f.run(0.4, &[]);
+    f.steady = true;
+    for _ in 0..30 {
+        let v = f.run(0.05, &[]);
+        assert!(
+            v <= prev + 1e-6,
+            "the reading rose from {prev} to {v} without an edge"
+        );
+        let one_pitch = pitch / (f.t_s - last_edge);
+        assert!(
+            (v as f64) <= one_pitch * 1.001,
+            "{v} above the one-pitch bound {one_pitch}"
+        );
+        prev = v;
+    }
+    // The next edge measures again, and at steady speed the bound allows two pitches again.
+    let period = pitch / 2.0;
+    let t0 = f.t_s;
+    let resumed: Vec<f64> = (1..40).map(|k| t0 + k as f64 * period).collect();
+    let v = f.run(39.0 * period - 0.01, &resumed);
+    assert!((v - 2.0).abs() < 0.05, "after edges resume: {v}");
+}
+
 #[test]
 fn a_stopped_shaft_decays_then_reads_exactly_zero() {
     // Steady: the bound allows two pitches (one missing pulse); otherwise one.

@@ -122,6 +122,10 @@ pub struct PulseSpeedEstimator {
     speed_filt: f32,
     speed: f32,
     bound_active: bool,
+    /// Pitches the stall bound allows since the last edge: 2 or 1 as the caller says the speed
+    /// is steady or not, but never rising between edges (a reference that comes to rest at 0
+    /// turns "steady" while the shaft coasts, and the reading must not jump up then).
+    bound_pitches: u32,
     restart_at: Option<u32>,
     closed_at: Option<u32>,
     closed_span: u32,
@@ -166,6 +170,7 @@ impl PulseSpeedEstimator {
             speed_filt: 0.0,
             speed: 0.0,
             bound_active: false,
+            bound_pitches: 1,
             restart_at: None,
             closed_at: None,
             closed_span: 0,
@@ -215,7 +220,11 @@ impl PulseSpeedEstimator {
         }
         self.clock = self.clock.wrapping_add(span);
         self.prev_now = now;
-        self.speed = self.bounded_speed(if steady { 2 } else { 1 });
+        // 2 since the last edge only while steady throughout (an edge sets 2).
+        if !steady {
+            self.bound_pitches = 1;
+        }
+        self.speed = self.bounded_speed(self.bound_pitches);
         self.speed
     }
 
@@ -264,6 +273,7 @@ impl PulseSpeedEstimator {
         }
         self.accepted = self.accepted.wrapping_add(1);
         self.last_edge = at;
+        self.bound_pitches = 2;
         self.prev_interval = self.last_interval;
         self.last_interval = dt / pulses;
         self.win_pulses += pulses;
@@ -299,7 +309,8 @@ impl PulseSpeedEstimator {
     }
 
     /// `pitches`: how many pitches the shaft may have turned since the last edge (2 at steady
-    /// speed, where one missing pulse must not halve the reading; 1 otherwise).
+    /// speed, where one missing pulse must not halve the reading; 1 otherwise; see
+    /// `bound_pitches`).
     fn bounded_speed(&mut self, pitches: u32) -> f32 {
         self.bound_active = false;
         if !self.has_edge {
