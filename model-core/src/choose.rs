@@ -8,15 +8,18 @@
 //!    tolerance is a tenth of that, clamped to `[64 epsilon, 0.1]`: computing `T` to 1e-12 when
 //!    mu is known to 20 % is waste.
 //! 2. **Model.** The Coriolis term's effect `|T_coriolis - T_flat| / T_flat` is computed (closed
-//!    forms for a constant speed; loose DP54 runs of both models on the actual omega(t)
-//!    otherwise). Below the tolerance the flat model is enough.
+//!    forms for a constant speed; for a varying one the pilot's Coriolis `T` against a flat run
+//!    whose error is within 1/32 of the tolerance). Within the tolerance, with room left for
+//!    the method, the flat model is enough.
 //! 3. **Method.** Constant speed: the closed form (exact to rounding, cheapest). Time-varying
-//!    speed: each integrator is calibrated on the scene: a run's error is measured against a
-//!    tight DP54 reference, its step (or tolerance) rescaled by the method's order to a quarter
-//!    of the tolerance, the rescaled run measured again (halving until it meets the tolerance
-//!    at that setting *and* at half of it, so a lucky cancellation does not pass), and the one
-//!    with the fewest right-hand-side evaluations wins. Explicit Euler is not a candidate:
-//!    semi-implicit Euler has the same order and cost per step and no stability limit.
+//!    speed: RK4 at the longest step whose error the pilot (`pilot.rs`: RK4 at `h`, `h/2`, `h/4`,
+//!    `h/8` from the release time, where the error follows `C h^p`) predicts within half of
+//!    what the model leaves of the tolerance; DP5(4), calibrated by tolerances ten apart, where
+//!    RK4 would need more steps than the cap or the speed has kinks (a logged trace). No search
+//!    against a tight reference: RK4 was the cheapest plan meeting the tolerance on every scene
+//!    of `bowl chart chooser`'s grid, and the step the pilot predicts costs at most 1.24x the
+//!    brute force's cheapest there. Explicit and semi-implicit Euler are not candidates
+//!    (order 1, more expensive per evaluation on both cost tables).
 
 use crate::Real;
 use crate::ode::{self, Limits, Method, OdeError, OdeOutcome, OmegaProfile};
@@ -72,12 +75,18 @@ pub struct Choice<T> {
     pub spread_rel: Option<T>,
     /// `|T_coriolis - T_flat| / T_flat`, computed.
     pub coriolis_effect_rel: T,
-    /// The plan's error, measured against a tight reference (0 for the closed form: rounding).
-    pub measured_error_rel: T,
+    /// The plan's relative error as predicted by the pilot runs (0 for the closed form:
+    /// rounding; for the closed form at the mean speed, its difference from the pilot's `T`).
+    pub estimated_error_rel: T,
     /// Right-hand-side evaluations the plan costs (0 for the closed form).
     pub rhs_evaluations: u32,
     /// The plan's measured cost on the target of `T` (f64: host ns; f32: M4F instructions).
     pub predicted_cost: f64,
+    /// `T` as the chooser estimated it on the way, s (the closed forms' for a constant speed,
+    /// the pilot's extrapolation for a varying one).
+    pub time_estimate_s: T,
+    /// Right-hand-side evaluations the choice itself ran (0 for a constant speed).
+    pub choosing_evaluations: u32,
 }
 
 /// Why no choice was made.
@@ -247,19 +256,22 @@ pub fn choose_constant_for<T: Real>(
             (Some(spread_rel), tolerance_from(spread_rel))
         }
     };
+    let (model, time_estimate_s) = if effect <= tolerance {
+        (Model::Flat, tf)
+    } else {
+        (Model::Coriolis, tc)
+    };
     Ok(Choice {
-        model: if effect <= tolerance {
-            Model::Flat
-        } else {
-            Model::Coriolis
-        },
+        model,
         plan: Plan::ClosedForm,
         tolerance_rel: tolerance,
         spread_rel,
         coriolis_effect_rel: effect,
-        measured_error_rel: T::ZERO,
+        estimated_error_rel: T::ZERO,
         rhs_evaluations: 0,
         predicted_cost: plan_cost(&Plan::<T>::ClosedForm, 0, Target::for_precision::<T>()),
+        time_estimate_s,
+        choosing_evaluations: 0,
     })
 }
 
@@ -299,185 +311,226 @@ pub fn choose_varying<T: Real, P: OmegaProfile<T>>(
     choose_varying_for(scene, &Need::Uncertainty(*knowledge), profile)
 }
 
-/// Chooses for a time-varying bowl speed (`scene.omega_rad_s` is ignored): an integrator,
-/// calibrated on this scene and profile (see the module docs).
+/// Chooses for a time-varying bowl speed (`scene.omega_rad_s` is ignored): RK4 at the longest
+/// step whose error a pilot predicts within half the tolerance (see the module docs and
+/// `pilot.rs`); DP5(4) where RK4 would need more steps than the cap.
 pub fn choose_varying_for<T: Real, P: OmegaProfile<T>>(
     scene: &Scene<T>,
     need: &Need<T>,
     profile: &P,
 ) -> Result<Choice<T>, ChooseError> {
+    choose_varying_with_margin(scene, need, profile).map(|(choice, _)| choice)
+}
+
+/// [`choose_varying_for`], and a bound on the relative error of its `time_estimate_s` (the
+/// pilot's finest run's estimated error: the extrapolation is better still).
+pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
+    scene: &Scene<T>,
+    need: &Need<T>,
+    profile: &P,
+) -> Result<(Choice<T>, T), ChooseError> {
     scene.validate_except_omega().map_err(ChooseError::Scene)?;
     check_need(need)?;
     let limits = Limits::for_scene(scene, profile);
-    let ref_tol = (T::from_f64(1e-12)).max(T::from_f64(16.0) * T::EPSILON);
-    let loose = T::from_f64(1e-7).max(T::from_f64(64.0) * T::EPSILON);
-    // Coriolis effect and spread from loose DP54 runs on the actual profile.
-    let (tf, _) = run(scene, Model::Flat, profile, dp(loose, scene), limits)?;
-    let (tc, _) = run(scene, Model::Coriolis, profile, dp(loose, scene), limits)?;
-    if !tc.is_finite() || !tf.is_finite() {
-        return Err(ChooseError::DoesNotLeave);
-    }
-    if tf <= T::ZERO {
-        return Ok(Choice {
+    let target = Target::for_precision::<T>();
+    let w_max = profile.max_omega_rad_s().max(T::EPSILON);
+    // The coarsest pilot step: well inside RK4's stability limit (2.785 / |l2|; |l2| <= 1.5
+    // k omega here).
+    let step_cap = T::from_f64(1.5) / w_max;
+    if scene.ri_m >= scene.rim_radius_m {
+        let at_rim = Choice {
             model: Model::Flat,
             plan: Plan::ClosedForm,
             tolerance_rel: tolerance_from(T::ZERO),
             spread_rel: Some(T::ZERO),
             coriolis_effect_rel: T::ZERO,
-            measured_error_rel: T::ZERO,
+            estimated_error_rel: T::ZERO,
             rhs_evaluations: 0,
-            predicted_cost: plan_cost(&Plan::<T>::ClosedForm, 0, Target::for_precision::<T>()),
-        });
+            predicted_cost: plan_cost(&Plan::<T>::ClosedForm, 0, target),
+            time_estimate_s: T::ZERO,
+            choosing_evaluations: 0,
+        };
+        return Ok((at_rim, T::ZERO));
     }
-    let effect = (tc - tf).abs() / tf;
+    // A smooth speed: RK4's error model. One with kinks: DP5(4) to a millionth first (the
+    // spread and the Coriolis effect need T far better than the tolerance they set), then to
+    // the method's budget below.
+    let smooth = profile.is_smooth();
+    // RK4 where its error settles into C h^p; otherwise (no such regime found) DP5(4). Returns
+    // the pilot and every evaluation it took, a failed RK4 pilot's included.
+    let pilot_of = |model: Model, budget: T| -> Result<(pilot::Pilot<T>, u32), ChooseError> {
+        let mut spent = 0;
+        if smooth {
+            match pilot::rk4(scene, model, profile, limits, step_cap) {
+                Ok(found) => return Ok((found, found.evaluations)),
+                Err(evals) => spent = evals,
+            }
+        }
+        let found = pilot::dp54(scene, model, profile, limits, budget)?;
+        Ok((found, spent.saturating_add(found.evaluations)))
+    };
+    let first_budget = T::from_f64(1e-6).max(T::from_f64(64.0) * T::EPSILON);
+    let (coriolis, mut choosing) = pilot_of(Model::Coriolis, first_budget)?;
+    let tc = coriolis.time_s;
     let (spread_rel, tolerance) = match need {
         Need::Tolerance(t) => (None, clamp_tolerance(*t)),
         Need::Uncertainty(knowledge) => {
-            let mut times = [T::ZERO; 8];
-            let up = T::ONE + knowledge.omega_rel;
-            let down = (T::ONE - knowledge.omega_rel).max(T::ZERO);
-            for (i, (slot, s)) in times
-                .iter_mut()
-                .zip(perturbations(scene, knowledge).iter())
-                .enumerate()
-            {
-                // omega's uncertainty scales the whole profile (entries 6 and 7).
-                let factor = match i {
-                    6 => down,
-                    7 => up,
-                    _ => T::ONE,
-                };
-                let scaled = ScaledProfile {
-                    inner: profile,
-                    factor,
-                };
-                *slot = run(s, Model::Coriolis, &scaled, dp(loose, scene), limits)
-                    .map(|r| r.0)
-                    .unwrap_or(T::INFINITY);
+            // The parameters at the ends of their ranges, at twice the pilot's finest step;
+            // where the spread comes out within 100x of the runs' own error there, once more
+            // at the step the pilot predicts within a hundredth of it.
+            let mut setting = coriolis.step_s * T::TWO;
+            let mut spread_rel = T::ZERO;
+            for _ in 0..2 {
+                let (found, evals) = spread_at(
+                    scene,
+                    knowledge,
+                    profile,
+                    coriolis.method(setting, scene),
+                    limits,
+                );
+                choosing = choosing.saturating_add(evals);
+                spread_rel = found;
+                let noise = coriolis.error_at(setting);
+                if found.is_nan() || found >= T::from_f64(100.0) * noise {
+                    break;
+                }
+                setting = coriolis.step_for(found * T::from_f64(0.01));
             }
-            let spread_rel = spread(tc, &times);
             (Some(spread_rel), tolerance_from(spread_rel))
         }
     };
-    let model = if effect <= tolerance {
+    // The flat model at the step the pilot predicts within 1/32 of the tolerance: the effect
+    // is then known to that.
+    let flat_step = coriolis.step_for(tolerance * T::from_f64(1.0 / 32.0));
+    let flat_error = coriolis.error_at(flat_step);
+    let (tf, evals) = run(
+        scene,
+        Model::Flat,
+        profile,
+        coriolis.method(flat_step, scene),
+        limits,
+    )?;
+    choosing = choosing.saturating_add(evals);
+    if !tf.is_finite() {
+        return Err(ChooseError::DoesNotLeave);
+    }
+    let effect = (tc - tf).abs() / tf;
+    // The method's predicted error is kept within half of what the model leaves of the
+    // tolerance (the prediction may be off by up to 2x). The flat model leaves the tolerance
+    // less its effect (with both runs' errors added): it is taken while that is at least a
+    // quarter of the tolerance, so its plan costs at most 2^(1/4) more than the Coriolis one.
+    let effect_bound = effect + flat_error + coriolis.error_rel;
+    let model = if effect_bound <= tolerance * T::from_f64(0.75) {
         Model::Flat
     } else {
         Model::Coriolis
     };
-    let (t_ref, _) = run(scene, model, profile, dp(ref_tol, scene), limits)?;
-    let err_of = |t: T| (t - t_ref).abs() / t_ref;
-    let w_max = profile.max_omega_rad_s().max(T::EPSILON);
-
-    // Ranked by measured cost on the target, not by evaluations.
-    let target = Target::for_precision::<T>();
-    let mut best: Option<(Method<T>, T, u32, f64)> = None;
-    let mut consider = |method: Method<T>, err: T, evals: u32| {
-        let cost = plan_cost(&Plan::Integrate(method), evals, target);
-        if err <= tolerance && best.is_none_or(|(_, _, _, c)| cost < c) {
-            best = Some((method, err, evals, cost));
-        }
+    let method_budget = if model == Model::Flat {
+        (tolerance - effect_bound) * T::HALF
+    } else {
+        tolerance * T::HALF
     };
-    // Fixed-step methods: calibrate at h0, rescale by the order, verify, halve until it holds.
-    type Make<T> = fn(T) -> Method<T>;
-    let fixed: [(Make<T>, f64); 2] = [
-        (|h| Method::Rk4 { step_s: h }, 4.0),
-        (|h| Method::SemiImplicitEuler { step_s: h }, 1.0),
-    ];
-    let quarter = tolerance * T::from_f64(0.25);
-    // A setting is taken when it meets the tolerance and so does the next finer one: a lucky
-    // cancellation of errors at one setting (it happens with the kink of a spin-up from rest)
-    // does not survive refining. Returns the setting's T and evaluations.
-    let robust = |method: Method<T>, finer: Method<T>| -> Option<(T, u32)> {
-        let (t, evals) = run(scene, model, profile, method, limits).ok()?;
-        let (t2, _) = run(scene, model, profile, finer, limits).ok()?;
-        (err_of(t) <= tolerance && err_of(t2) <= tolerance).then_some((t, evals))
+    let pilot = if model == Model::Flat || !smooth {
+        let (own, evals) = pilot_of(model, method_budget)?;
+        choosing = choosing.saturating_add(evals);
+        own
+    } else {
+        coriolis
     };
-    let grow_step = T::from_f64(core::f64::consts::SQRT_2.sqrt());
-    let grow_rtol = T::from_f64(1.778_279_410_038_923);
-    // Stay well inside RK4's stability limit (2.785 / |l2|; |l2| <= 1.5 k omega here).
-    let step_cap = T::from_f64(1.5) / w_max;
-    for (make, order) in fixed {
-        let h0 = T::from_f64(0.1) / w_max;
-        let Ok((t0, _)) = run(scene, model, profile, make(h0), limits) else {
-            continue;
-        };
-        let e0 = err_of(t0);
-        let mut h = if e0 > T::ZERO {
-            h0 * (quarter / e0).ln().exp_times(1.0 / order)
-        } else {
-            h0
-        };
-        h = h.min(step_cap);
-        for _ in 0..8 {
-            // Skip plans that would need more steps than the cap allows.
-            if t_ref / h > T::from_f64(limits.max_steps as f64) {
-                break;
-            }
-            if let Some((t, evals)) = robust(make(h), make(h * T::HALF)) {
-                // Then the longest step that is robust too, of the twelve 2^(1/4) apart above
-                // it (up to 8x, within the stability margin): the calibration aimed at a
-                // quarter of the tolerance, and the error is not monotonic in the step (the
-                // kink of a spin-up, the event's interpolation).
-                let (mut best_h, mut best) = (h, (t, evals));
-                let mut longer = h;
-                for _ in 0..12 {
-                    longer = (longer * grow_step).min(step_cap);
-                    if let Some(found) = robust(make(longer), make(longer * T::HALF)) {
-                        (best_h, best) = (longer, found);
-                    }
-                    if longer >= step_cap {
-                        break;
-                    }
-                }
-                consider(make(best_h), err_of(best.0), best.1);
-                break;
-            }
-            h *= T::HALF;
-        }
-    }
-    // DP54: its global error is roughly proportional to rtol; rescale, verify, halve.
-    let mut rtol = tolerance;
-    for _ in 0..12 {
-        if rtol < ref_tol {
-            break;
-        }
-        if let Some((t, evals)) = robust(dp(rtol, scene), dp(rtol * T::HALF, scene)) {
-            // Then the loosest robust tolerance of the twelve 10^(1/4) apart above it (up to
-            // 1000x, at most 0.1).
-            let (mut best_rtol, mut best) = (rtol, (t, evals));
-            let mut looser = rtol;
-            for _ in 0..12 {
-                looser = (looser * grow_rtol).min(T::from_f64(0.1));
-                if let Some(found) = robust(dp(looser, scene), dp(looser * T::HALF, scene)) {
-                    (best_rtol, best) = (looser, found);
-                }
-                if looser >= T::from_f64(0.1) {
-                    break;
-                }
-            }
-            consider(dp(best_rtol, scene), err_of(best.0), best.1);
-            break;
-        }
-        match run(scene, model, profile, dp(rtol, scene), limits) {
-            Ok((t, _)) => {
-                let e = err_of(t);
-                let factor = (tolerance * T::HALF / e).min(T::HALF);
-                rtol *= if factor > T::ZERO { factor } else { T::HALF };
-            }
-            Err(_) => rtol *= T::HALF,
-        }
-    }
-    let (method, err, evals, cost) = best.ok_or(ChooseError::NoMethodMeetsTolerance)?;
-    Ok(Choice {
+    let h = pilot.step_for(method_budget);
+    let stiff_rate = ode::stiff_rate_per_s(scene, model, w_max);
+    let t_start = ode::start_time_s(scene, profile, stiff_rate, limits).unwrap_or(T::ZERO);
+    // Steps to the rim: the span over the step, rounded up.
+    let span = ((pilot.time_s - t_start) / h).to_f64().max(0.0);
+    let whole = span as u64;
+    let steps = if (whole as f64) < span {
+        whole + 1
+    } else {
+        whole
+    };
+    let (plan, evals, estimated, pilot) = if pilot.kind == pilot::Kind::Dp54 {
+        (
+            Plan::Integrate(pilot.method(h, scene)),
+            pilot.plan_evaluations,
+            pilot.error_rel,
+            pilot,
+        )
+    } else if steps <= u64::from(limits.max_steps) {
+        // RK4: four evaluations a step and one where the rim is crossed.
+        let evals = u32::try_from(steps.saturating_mul(4).saturating_add(1)).unwrap_or(u32::MAX);
+        (
+            Plan::Integrate(Method::Rk4 { step_s: h }),
+            evals,
+            pilot.error_at(h),
+            pilot,
+        )
+    } else {
+        // More RK4 steps than the cap: DP5(4), calibrated to the budget.
+        let own = pilot::dp54(scene, model, profile, limits, method_budget)?;
+        choosing = choosing.saturating_add(own.evaluations);
+        (
+            Plan::Integrate(own.method(own.step_s, scene)),
+            own.plan_evaluations,
+            own.error_rel,
+            own,
+        )
+    };
+    let choice = Choice {
         model,
-        plan: Plan::Integrate(method),
+        plan,
         tolerance_rel: tolerance,
         spread_rel,
         coriolis_effect_rel: effect,
-        measured_error_rel: err,
+        estimated_error_rel: estimated,
         rhs_evaluations: evals,
-        predicted_cost: cost,
-    })
+        predicted_cost: plan_cost(&plan, evals, target),
+        time_estimate_s: pilot.time_s,
+        choosing_evaluations: choosing,
+    };
+    Ok((choice, pilot.error_rel))
+}
+
+/// The spread of `T` over the parameters' uncertainty (see [`spread`]) from runs of `method`
+/// on the Coriolis model, the nominal scene's included (so that the runs' common error
+/// cancels), and the evaluations they took.
+fn spread_at<T: Real, P: OmegaProfile<T>>(
+    scene: &Scene<T>,
+    knowledge: &Knowledge<T>,
+    profile: &P,
+    method: Method<T>,
+    limits: Limits<T>,
+) -> (T, u32) {
+    let (nominal, mut evaluations) = match run(scene, Model::Coriolis, profile, method, limits) {
+        Ok(found) => found,
+        Err(_) => return (T::INFINITY, 0),
+    };
+    let mut times = [T::ZERO; 8];
+    let up = T::ONE + knowledge.omega_rel;
+    let down = (T::ONE - knowledge.omega_rel).max(T::ZERO);
+    for (i, (slot, s)) in times
+        .iter_mut()
+        .zip(perturbations(scene, knowledge).iter())
+        .enumerate()
+    {
+        // omega's uncertainty scales the whole profile (entries 6 and 7).
+        let factor = match i {
+            6 => down,
+            7 => up,
+            _ => T::ONE,
+        };
+        let scaled = ScaledProfile {
+            inner: profile,
+            factor,
+        };
+        *slot = match run(s, Model::Coriolis, &scaled, method, limits) {
+            Ok((t, evals)) => {
+                evaluations = evaluations.saturating_add(evals);
+                t
+            }
+            Err(_) => T::INFINITY,
+        };
+    }
+    (spread(nominal, &times), evaluations)
 }
 
 /// A profile scaled by a constant factor (omega's relative uncertainty).
@@ -496,20 +549,16 @@ impl<T: Real, P: OmegaProfile<T>> OmegaProfile<T> for ScaledProfile<'_, T, P> {
     fn is_constant(&self) -> bool {
         self.inner.is_constant()
     }
-}
-
-/// `exp(ln_x * p)`: a power from a logarithm already taken.
-trait ExpTimes {
-    fn exp_times(self, p: f64) -> Self;
-}
-
-impl<T: Real> ExpTimes for T {
-    fn exp_times(self, p: f64) -> Self {
-        (self * T::from_f64(p)).exp()
+    fn is_smooth(&self) -> bool {
+        self.inner.is_smooth()
+    }
+    fn next_kink_after_s(&self, t_s: T) -> Option<T> {
+        self.inner.next_kink_after_s(t_s)
     }
 }
 
 pub mod cost;
+mod pilot;
 mod trace;
 
 pub use cost::{MethodCost, Target, plan_cost};

@@ -355,8 +355,21 @@ pub fn run(args: &Args) -> Result<()> {
         Which::Scipy(a) => scipy_charts(a),
         Which::Costs(a) => costs::write(&a.csv, &a.out),
         Which::Chooser(out) => {
-            let (f, t) = chooser::chart()?;
-            write_all(out, &f, &t)
+            let (f, cost, t) = chooser::chart()?;
+            write_all(out, &f, &t)?;
+            // What choosing costs, beside it: FILE-cost.svg and .png.
+            if !out.csv_only {
+                let stem = out.out.file_stem().map_or_else(
+                    || "chooser".to_string(),
+                    |s| s.to_string_lossy().into_owned(),
+                );
+                let svg = out.out.with_file_name(format!("{stem}-cost.svg"));
+                let png = svg.with_extension("png");
+                cost.write_svg(&svg)?;
+                cost.write_png(&png)?;
+                report(&[&svg, &png]);
+            }
+            Ok(())
         }
         Which::Log(a) => {
             let written = log::draw(&a.csv, &a.out)?;

@@ -7,6 +7,7 @@
 use anyhow::{Result, anyhow, bail};
 use model_core::choose::{Choice, ChooseError, Knowledge, Need, Plan};
 use model_core::ode::Method;
+use model_core::particle::Model;
 
 use super::{model_name, words};
 
@@ -124,14 +125,20 @@ pub fn describe(c: &Choice<f64>, need: &Need<f64>) -> String {
         ),
         _ => format!("the tolerance {} asked for", percent(c.tolerance_rel)),
     };
-    let why = if c.coriolis_effect_rel <= c.tolerance_rel {
+    let why = if c.model == Model::Flat {
         format!(
             "the Coriolis term changes T by {}, within {tolerance}",
             percent(c.coriolis_effect_rel)
         )
-    } else {
+    } else if c.coriolis_effect_rel > c.tolerance_rel {
         format!(
             "the Coriolis term changes T by {}, more than {tolerance}",
+            percent(c.coriolis_effect_rel)
+        )
+    } else {
+        format!(
+            "the Coriolis term changes T by {}, within {tolerance} but more than the half of it \
+             left once the integrator's own error is budgeted",
             percent(c.coriolis_effect_rel)
         )
     };
@@ -142,9 +149,9 @@ pub fn describe(c: &Choice<f64>, need: &Need<f64>) -> String {
     );
     if !matches!(c.plan, Plan::ClosedForm) {
         out += &format!(
-            "\n  its error against a tight DP5(4) over the speed: {:.2e} ({} right-hand-side \
-             evaluations)",
-            c.measured_error_rel, c.rhs_evaluations
+            "\n  its error as the pilot runs predict it: {:.2e} ({} right-hand-side evaluations; \
+             choosing ran {})",
+            c.estimated_error_rel, c.rhs_evaluations, c.choosing_evaluations
         );
     }
     out += &format!(
@@ -194,15 +201,16 @@ pub fn json(c: &Choice<f64>) -> serde_json::Value {
         "spread_rel": c.spread_rel.filter(|s| s.is_finite()),
         "coriolis_effect_rel": c.coriolis_effect_rel,
         "coriolis_below_uncertainty": coriolis_below_uncertainty(c),
-        "measured_error_rel": c.measured_error_rel,
+        "estimated_error_rel": c.estimated_error_rel,
         "rhs_evaluations": c.rhs_evaluations,
+        "choosing_evaluations": c.choosing_evaluations,
         "predicted_cost_ns": c.predicted_cost,
         "reason": describe_reason(c),
     })
 }
 
 fn describe_reason(c: &Choice<f64>) -> String {
-    if c.coriolis_effect_rel <= c.tolerance_rel {
+    if c.model == Model::Flat {
         "the Coriolis term is within the tolerance".into()
     } else {
         "the Coriolis term exceeds the tolerance".into()

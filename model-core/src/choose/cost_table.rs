@@ -2,22 +2,22 @@
 // from the measurements in docs/charts/work-precision.csv (paper scene, both models). Do not edit.
 
 /// closed: host ns, f64, fastest batch; fitted to 2 rows.
-pub const HOST_CLOSED: MethodCost = MethodCost { per_call: 114.8, per_eval: 0.00 };
+pub const HOST_CLOSED: MethodCost = MethodCost { per_call: 65.9, per_eval: 0.00 };
 /// euler: host ns, f64, fastest batch; fitted to 24 rows.
-pub const HOST_EULER: MethodCost = MethodCost { per_call: 329.3, per_eval: 7.85 };
+pub const HOST_EULER: MethodCost = MethodCost { per_call: 233.2, per_eval: 5.83 };
 /// semi-implicit-euler: host ns, f64, fastest batch; fitted to 24 rows.
-pub const HOST_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 312.8, per_eval: 12.11 };
+pub const HOST_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 225.5, per_eval: 9.13 };
 /// rk4: host ns, f64, fastest batch; fitted to 22 rows.
-pub const HOST_RK4: MethodCost = MethodCost { per_call: 381.1, per_eval: 5.72 };
+pub const HOST_RK4: MethodCost = MethodCost { per_call: 264.5, per_eval: 4.47 };
 /// dp54: host ns, f64, fastest batch; fitted to 22 rows.
-pub const HOST_DP54: MethodCost = MethodCost { per_call: 672.3, per_eval: 19.65 };
+pub const HOST_DP54: MethodCost = MethodCost { per_call: 536.1, per_eval: 15.22 };
 /// closed: Cortex-M4F instructions, f32 libm, QEMU; fitted to 2 rows.
-pub const MCU_CLOSED: MethodCost = MethodCost { per_call: 388.0, per_eval: 0.00 };
+pub const MCU_CLOSED: MethodCost = MethodCost { per_call: 389.0, per_eval: 0.00 };
 /// euler: Cortex-M4F instructions, f32 libm, QEMU; fitted to 4 rows.
-pub const MCU_EULER: MethodCost = MethodCost { per_call: 866.2, per_eval: 57.06 };
+pub const MCU_EULER: MethodCost = MethodCost { per_call: 901.2, per_eval: 58.06 };
 /// semi-implicit-euler: Cortex-M4F instructions, f32 libm, QEMU; fitted to 4 rows.
-pub const MCU_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 1090.2, per_eval: 64.29 };
+pub const MCU_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 1125.2, per_eval: 65.29 };
 /// rk4: Cortex-M4F instructions, f32 libm, QEMU; fitted to 10 rows.
-pub const MCU_RK4: MethodCost = MethodCost { per_call: 1087.9, per_eval: 25.63 };
+pub const MCU_RK4: MethodCost = MethodCost { per_call: 1123.7, per_eval: 25.88 };
 /// dp54: Cortex-M4F instructions, f32 libm, QEMU; fitted to 10 rows.
-pub const MCU_DP54: MethodCost = MethodCost { per_call: 1708.4, per_eval: 72.53 };
+pub const MCU_DP54: MethodCost = MethodCost { per_call: 1743.4, per_eval: 73.53 };

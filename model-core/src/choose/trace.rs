@@ -9,9 +9,9 @@
 //! at that mean; within the tolerance the closed form wins, otherwise the integrator the
 //! varying-speed chooser calibrated.
 
-use super::{Choice, ChooseError, Need, Plan, choose_varying_for, dp, run};
+use super::{Choice, ChooseError, Need, Plan, choose_varying_with_margin};
 use crate::Real;
-use crate::ode::{Limits, OmegaProfile};
+use crate::ode::OmegaProfile;
 use crate::particle::{self, Scene};
 
 /// A bowl speed sampled in time, linear between samples and held after the last one.
@@ -91,6 +91,25 @@ impl<T: Real> OmegaProfile<T> for SampledOmega<'_, T> {
     fn max_omega_rad_s(&self) -> T {
         self.max_rad_s
     }
+    fn is_smooth(&self) -> bool {
+        // Linear between samples: a kink at every sample.
+        false
+    }
+    fn next_kink_after_s(&self, t_s: T) -> Option<T> {
+        // The first sample beyond t_s by more than rounding (so no step shrinks to nothing).
+        let beyond = t_s + T::from_f64(16.0) * T::EPSILON * (t_s.abs() + T::ONE);
+        let ts = self.times_s;
+        let (mut lo, mut hi) = (0, ts.len());
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            if ts[mid] <= beyond {
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        ts.get(lo).copied()
+    }
 }
 
 /// The mean of omega(t) over `[0, t_end_s]` (composite Simpson, 1,024 intervals), rad/s.
@@ -111,22 +130,20 @@ pub fn mean_omega_rad_s<T: Real, P: OmegaProfile<T>>(profile: &P, t_end_s: T) ->
 
 /// Chooses for a logged speed trace: the closed form at the mean speed over the residence
 /// time if it meets the tolerance there, otherwise the integrator [`choose_varying_for`]
-/// calibrated on the trace. `measured_error_rel` is the chosen plan's error against a tight
-/// DP5(4) over the trace.
+/// picks. The closed form is judged against the pilot's `T` (`time_estimate_s`), whose own
+/// estimated error is added to the difference; `estimated_error_rel` is that difference.
 pub fn choose_trace<T: Real, P: OmegaProfile<T>>(
     scene: &Scene<T>,
     need: &Need<T>,
     profile: &P,
 ) -> Result<Choice<T>, ChooseError> {
-    let integrated = choose_varying_for(scene, need, profile)?;
+    let (integrated, margin_rel) = choose_varying_with_margin(scene, need, profile)?;
     if integrated.plan == Plan::ClosedForm {
         // The particle starts at the rim: nothing to integrate.
         return Ok(integrated);
     }
-    let limits = Limits::for_scene(scene, profile);
-    let ref_tol = (T::from_f64(1e-12)).max(T::from_f64(16.0) * T::EPSILON);
-    let (t_ref, _) = run(scene, integrated.model, profile, dp(ref_tol, scene), limits)?;
-    let mean = mean_omega_rad_s(profile, t_ref);
+    let t_pilot = integrated.time_estimate_s;
+    let mean = mean_omega_rad_s(profile, t_pilot);
     let at_mean = Scene {
         omega_rad_s: mean,
         ..*scene
@@ -136,11 +153,13 @@ pub fn choose_trace<T: Real, P: OmegaProfile<T>>(
         .map(|o| o.residence_time_s())
         .filter(|t| t.is_finite());
     match closed {
-        Some(t) if (t - t_ref).abs() <= integrated.tolerance_rel * t_ref => {
+        Some(t)
+            if (t - t_pilot).abs() + margin_rel * t_pilot <= integrated.tolerance_rel * t_pilot =>
+        {
             let plan = Plan::ClosedFormAtMeanSpeed { omega_rad_s: mean };
             Ok(Choice {
                 plan,
-                measured_error_rel: (t - t_ref).abs() / t_ref,
+                estimated_error_rel: (t - t_pilot).abs() / t_pilot,
                 rhs_evaluations: 0,
                 predicted_cost: super::plan_cost(&plan, 0, super::Target::for_precision::<T>()),
                 ..integrated

@@ -100,12 +100,13 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
     atol: T,
     stiff_rate: T,
     limits: Limits<T>,
+    t_start: T,
 ) -> Result<Report<T>, OdeError> {
     if !(rtol > T::ZERO && rtol.is_finite() && atol > T::ZERO && atol.is_finite()) {
         return Err(OdeError::InvalidStep);
     }
     let rim = scene.rim_radius_m;
-    let (mut t, mut r, mut v) = (T::ZERO, scene.ri_m, T::ZERO);
+    let (mut t, mut r, mut v) = (t_start, scene.ri_m, T::ZERO);
     // Initial step: a fifth of the tolerance's fifth root in units of the fastest time scale.
     let mut h = if stiff_rate > T::ZERO {
         T::from_f64(0.2) * rtol.ln().exp_scaled(0.2) / stiff_rate
@@ -132,6 +133,16 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
             return Err(OdeError::StepLimit);
         }
         steps += 1;
+        // A step never crosses a kink of the speed (a logged trace's samples): it ends on it,
+        // so every step's error estimate sees a smooth right-hand side.
+        let proposed = h;
+        let clipped = match rhs.profile.next_kink_after_s(t) {
+            Some(kink) if t + h > kink => {
+                h = kink - t;
+                true
+            }
+            _ => false,
+        };
         let mut kr = [T::ZERO; 7];
         let mut kv = [T::ZERO; 7];
         (kr[0], kv[0]) = k1;
@@ -184,7 +195,9 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
             r = r1;
             v = v1;
             k1 = k7;
-            h = (h * factor).min(limits.horizon_s);
+            // After a step shortened to a kink, the controller goes on from what it proposed.
+            let next = h * factor;
+            h = if clipped { next.max(proposed) } else { next }.min(limits.horizon_s);
         } else {
             rejected += 1;
             h *= factor.min(T::ONE);

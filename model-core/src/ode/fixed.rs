@@ -33,6 +33,7 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
     h: T,
     stiff_rate: T,
     limits: Limits<T>,
+    t_start: T,
 ) -> Result<Report<T>, OdeError> {
     if !(h > T::ZERO && h.is_finite()) {
         return Err(OdeError::InvalidStep);
@@ -47,7 +48,7 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
     let mut steps: u32 = 0;
     while steps < limits.max_steps {
         // t from the step count, not a running sum, so round-off does not accumulate.
-        let t = h * T::from_f64(steps as f64);
+        let t = t_start + h * T::from_f64(steps as f64);
         if t >= limits.horizon_s {
             return Ok(Report {
                 outcome: OdeOutcome::NotLeftBy {

@@ -5,7 +5,8 @@
 //! `r'' = k2 (r omega(t)^2 - mu g - c 2 mu omega(t) r')` with `c = 1` for [`Model::Coriolis`]
 //! and 0 for [`Model::Flat`], `r(0) = ri`, `r'(0) = 0`. Static friction holds a particle at rest
 //! while `r omega^2 <= mu g` (the closed forms' "never leaves"; the ODE alone would drag it
-//! inward, which is unphysical), so the right-hand side is 0 there.
+//! inward, which is unphysical), so the right-hand side is 0 there; a run starts at the release
+//! time, where the hold lets go, so that no step straddles that kink (release.rs).
 //!
 //! Methods ([`Method`]): explicit Euler, semi-implicit Euler, RK4 (fixed step, event located by
 //! cubic Hermite interpolation) and adaptive Dormand-Prince 5(4) (event located on its dense
@@ -20,7 +21,10 @@
 mod dp54;
 mod event;
 mod fixed;
+mod release;
 pub mod system;
+
+pub use release::scan_first_time_above;
 
 use crate::Real;
 use crate::particle::{Model, Scene, SceneError};
@@ -37,6 +41,26 @@ pub trait OmegaProfile<T> {
     fn is_constant(&self) -> bool {
         false
     }
+    /// True if omega has continuous derivatives (a fixed-step method keeps its order on it);
+    /// false for a logged trace, linear between samples.
+    fn is_smooth(&self) -> bool {
+        true
+    }
+    /// The first time after `t_s` where omega's derivative jumps (a logged trace's next
+    /// sample), `None` if there is none: the adaptive method ends a step there.
+    fn next_kink_after_s(&self, _t_s: T) -> Option<T> {
+        None
+    }
+    /// The first time in `[0, horizon_s]` at which omega is above `threshold_rad_s`, `None` if
+    /// it never is: where static friction lets a particle go. By default a scan at
+    /// `scan_step_s` and bisection ([`scan_first_time_above`]); a profile with a closed form
+    /// gives it exactly.
+    fn first_time_above_s(&self, threshold_rad_s: T, horizon_s: T, scan_step_s: T) -> Option<T>
+    where
+        T: Real,
+    {
+        scan_first_time_above(self, threshold_rad_s, horizon_s, scan_step_s)
+    }
 }
 
 /// A constant speed.
@@ -52,6 +76,9 @@ impl<T: Real> OmegaProfile<T> for ConstantOmega<T> {
     }
     fn is_constant(&self) -> bool {
         true
+    }
+    fn first_time_above_s(&self, threshold_rad_s: T, _horizon_s: T, _scan_step_s: T) -> Option<T> {
+        (self.0 > threshold_rad_s).then_some(T::ZERO)
     }
 }
 
@@ -74,6 +101,22 @@ impl<T: Real> OmegaProfile<T> for SpinUp<T> {
     }
     fn max_omega_rad_s(&self) -> T {
         self.start_rad_s.max(self.final_rad_s)
+    }
+    /// `t = tau ln((final - start) / (final - threshold))` on the way up; never on the way
+    /// down from at or below it.
+    fn first_time_above_s(&self, threshold_rad_s: T, horizon_s: T, scan_step_s: T) -> Option<T> {
+        let (start, end, tau) = (self.start_rad_s, self.final_rad_s, self.time_constant_s);
+        if start > threshold_rad_s {
+            return Some(T::ZERO);
+        }
+        if end.is_nan() || end <= threshold_rad_s {
+            return None;
+        }
+        if !(tau > T::ZERO && tau.is_finite()) {
+            return scan_first_time_above(self, threshold_rad_s, horizon_s, scan_step_s);
+        }
+        let t = tau * ((end - start) / (end - threshold_rad_s)).ln();
+        (t <= horizon_s).then_some(t.max(T::ZERO))
     }
 }
 
@@ -294,13 +337,13 @@ pub fn integrate<T: Real, P: OmegaProfile<T>>(
     if profile.is_constant() && scene.ri_m * w0 * w0 <= rhs.mu_g {
         return Ok(done(OdeOutcome::NeverLeaves));
     }
-    // Fastest decay rate |l2| at the fastest speed: k omega (s + k mu) for Coriolis.
-    let k = scene.k2.sqrt();
-    let m = match model {
-        Model::Flat => T::ZERO,
-        Model::Coriolis => k * scene.mu,
+    let stiff_rate = stiff_rate_per_s(scene, model, w_max);
+    let Some(t_start) = start_time_s(scene, profile, stiff_rate, limits) else {
+        return Ok(done(OdeOutcome::NotLeftBy {
+            horizon_s: limits.horizon_s,
+            radius_m: scene.ri_m,
+        }));
     };
-    let stiff_rate = k * w_max * ((T::ONE + m * m).sqrt() + m);
     match method {
         Method::Euler { step_s } => fixed::run(
             &mut rhs,
@@ -309,6 +352,7 @@ pub fn integrate<T: Real, P: OmegaProfile<T>>(
             step_s,
             stiff_rate,
             limits,
+            t_start,
         ),
         Method::SemiImplicitEuler { step_s } => fixed::run(
             &mut rhs,
@@ -317,6 +361,7 @@ pub fn integrate<T: Real, P: OmegaProfile<T>>(
             step_s,
             stiff_rate,
             limits,
+            t_start,
         ),
         Method::Rk4 { step_s } => fixed::run(
             &mut rhs,
@@ -325,9 +370,42 @@ pub fn integrate<T: Real, P: OmegaProfile<T>>(
             step_s,
             stiff_rate,
             limits,
+            t_start,
         ),
-        Method::Dp54 { rtol, atol } => dp54::run(&mut rhs, scene, rtol, atol, stiff_rate, limits),
+        Method::Dp54 { rtol, atol } => {
+            dp54::run(&mut rhs, scene, rtol, atol, stiff_rate, limits, t_start)
+        }
     }
+}
+
+/// The fastest decay rate `|l2|` at the fastest speed `w_max`, 1/s: `k omega (s + k mu)` for
+/// the Coriolis model, `k omega` for the flat one (docs/model.md, Stability).
+pub(crate) fn stiff_rate_per_s<T: Real>(scene: &Scene<T>, model: Model, w_max: T) -> T {
+    let k = scene.k2.sqrt();
+    let m = match model {
+        Model::Flat => T::ZERO,
+        Model::Coriolis => k * scene.mu,
+    };
+    k * w_max * ((T::ONE + m * m).sqrt() + m)
+}
+
+/// Where [`integrate`] starts: static friction holds the particle at `ri` until the push first
+/// exceeds it, and the run starts there, where the solution is smooth (release.rs); `None`
+/// when that is beyond the horizon. The scan for the crossing looks every tenth of the fastest
+/// time scale (`stiff_rate`, 1/s); a closed-form profile needs no scan.
+pub(crate) fn start_time_s<T: Real, P: OmegaProfile<T>>(
+    scene: &Scene<T>,
+    profile: &P,
+    stiff_rate: T,
+    limits: Limits<T>,
+) -> Option<T> {
+    let scan_step = if stiff_rate > T::ZERO {
+        T::from_f64(0.1) / stiff_rate
+    } else {
+        limits.horizon_s * T::from_f64(1e-3)
+    };
+    let mu_g = scene.mu * scene.g_m_s2;
+    release::release_time_s(profile, scene.ri_m, mu_g, limits.horizon_s, scan_step)
 }
 
 /// [`integrate`] at the scene's own constant speed with [`Limits::for_scene`].

@@ -206,8 +206,7 @@ fn spin_up_dp54_and_rk4_agree() {
 
 #[test]
 fn spin_up_from_rest_unsticks_then_leaves() {
-    // From rest the particle is held until r omega(t)^2 = mu g: a kink in r'' there, which
-    // costs the fixed-step method its order; DP54's error control steps over it.
+    // From rest the particle is held until r omega(t)^2 = mu g; both methods start there.
     let s = scene(0.0, 0.029, 0.05);
     let profile = SpinUp {
         start_rad_s: 0.0,
@@ -237,6 +236,89 @@ fn spin_up_from_rest_unsticks_then_leaves() {
     let w_th = (0.029f64 * 9.81 / 0.05).sqrt();
     let t_unstick = -0.4 * (1.0 - w_th / 3.6).ln();
     assert!(t_dp > t_unstick);
+}
+
+/// From rest the particle is held until `ri omega(t)^2 = mu g`; integrating from that release
+/// time keeps RK4 at its order on a spin-up: the error falls by 2^4 = 16 per halving of the
+/// step (between 12 and 20 here), on scenes where stepping across the hold's kink gave ratios
+/// anywhere from below 1 to above 100. Against an independent reference: the DP5(4) at rtol
+/// 1e-13, whose own error is far below the finest RK4's.
+#[test]
+fn rk4_keeps_its_order_on_a_spin_up_from_rest() {
+    for (w_end, tau, mu, ri) in [
+        (3.0, 0.1, 0.005, 0.05),
+        (3.6, 0.4, 0.029, 0.05),
+        (6.0, 2.0, 0.1, 0.08),
+    ] {
+        let s = scene(0.0, mu, ri);
+        let profile = SpinUp {
+            start_rad_s: 0.0,
+            final_rad_s: w_end,
+            time_constant_s: tau,
+        };
+        let limits = Limits::for_scene(&s, &profile);
+        let (t_ref, _, _) = exit(integrate(
+            &s,
+            Model::Coriolis,
+            &profile,
+            Method::Dp54 {
+                rtol: 1e-13,
+                atol: 1e-15,
+            },
+            limits,
+        ));
+        let err = |h: f64| {
+            let (t, _, _) = exit(integrate(
+                &s,
+                Model::Coriolis,
+                &profile,
+                Method::Rk4 { step_s: h },
+                limits,
+            ));
+            (t - t_ref).abs() / t_ref
+        };
+        let h0 = 0.2 / w_end;
+        let errors: [f64; 3] = core::array::from_fn(|k| err(h0 / f64::from(1u32 << k)));
+        for pair in errors.windows(2) {
+            let ratio = pair[0] / pair[1];
+            assert!(
+                (12.0..20.0).contains(&ratio),
+                "w {w_end} tau {tau}: errors {errors:?}"
+            );
+        }
+    }
+}
+
+/// The scan and bisection every profile gets by default finds the crossing the spin-up's
+/// closed form gives, to rounding; a speed that never crosses gives none, and one already
+/// above gives 0.
+#[test]
+fn the_scanned_release_time_is_the_closed_form() {
+    let up = SpinUp {
+        start_rad_s: 0.5,
+        final_rad_s: 3.0,
+        time_constant_s: 0.7,
+    };
+    let closed = up.first_time_above_s(1.7, 100.0, 0.05).unwrap();
+    let want = 0.7 * (2.5f64 / 1.3).ln();
+    assert!((closed - want).abs() < 1e-14, "{closed} vs {want}");
+    let scanned = crate::ode::scan_first_time_above(&up, 1.7, 100.0, 0.05).unwrap();
+    assert!((scanned - want).abs() < 1e-14, "{scanned} vs {want}");
+    assert_eq!(
+        crate::ode::scan_first_time_above(&up, 3.5, 100.0, 0.05),
+        None
+    );
+    assert_eq!(up.first_time_above_s(3.5, 100.0, 0.05), None);
+    assert_eq!(
+        crate::ode::scan_first_time_above(&up, 0.2, 100.0, 0.05),
+        Some(0.0)
+    );
+    // Beyond the horizon: none.
+    assert_eq!(up.first_time_above_s(2.99, 1.0, 0.05), None);
+    assert_eq!(
+        crate::ode::scan_first_time_above(&up, 2.99, 1.0, 0.05),
+        None
+    );
 }
 
 #[test]
