@@ -10,6 +10,7 @@ mod batch;
 mod choice;
 mod ode;
 mod rolling;
+mod target;
 mod throughput;
 mod trace;
 mod words;
@@ -99,6 +100,10 @@ pub struct Args {
     /// Instead of the residence time: the bowl speed that gives this residence time, s.
     #[arg(long)]
     target_time_s: Option<f64>,
+    /// The chooser: where the chosen plan runs: host (f64, priced in ns) or mcu (the
+    /// Cortex-M4F: f32, priced in instructions).
+    #[arg(long, value_enum, default_value_t = target::RunsOn::Host)]
+    target: target::RunsOn,
     /// Print JSON instead of text.
     #[arg(long)]
     json: bool,
@@ -195,7 +200,14 @@ pub fn run(args: &Args) -> Result<()> {
                  --model and --method (give --tolerance or --uncertainty instead)"
             );
         }
-        return trace::run(&scene, path, args.release_at_ms, &need, args.json);
+        return trace::run(
+            &scene,
+            path,
+            args.release_at_ms,
+            &need,
+            args.target,
+            args.json,
+        );
     }
     words::check(&scene)?;
     const BOTH: &[Model] = &[Model::Flat, Model::Coriolis];
@@ -205,7 +217,7 @@ pub fn run(args: &Args) -> Result<()> {
         ModelChoice::Coriolis => &[Model::Coriolis],
         ModelChoice::Both => BOTH,
         ModelChoice::Auto if args.target_time_s.is_some() => BOTH,
-        ModelChoice::Auto => match model_core::choose::choose_constant_for(&scene, &need) {
+        ModelChoice::Auto => match target::constant(&scene, &need, args.target) {
             Ok(c) => {
                 chosen = Some(c);
                 match c.model {
@@ -237,7 +249,7 @@ pub fn run(args: &Args) -> Result<()> {
             .collect();
         let mut v = serde_json::json!({ "scene": json_scene(&scene), "results": results });
         if let (Some(c), Some(obj)) = (&chosen, v.as_object_mut()) {
-            obj.insert("choice".into(), choice::json(c));
+            obj.insert("choice".into(), choice::json(c, args.target));
         }
         println!("{v}");
     } else {
@@ -245,7 +257,7 @@ pub fn run(args: &Args) -> Result<()> {
         if let Some(c) = &chosen {
             println!(
                 "{}\n  (--model flat, coriolis or both to override)",
-                choice::describe(c, &need)
+                choice::describe(c, &need, args.target)
             );
         }
         for (m, p) in &rows {

@@ -605,3 +605,59 @@ fn a_logged_speed_trace_is_predicted_within_the_tolerance() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("leave out --model"));
     let _ = std::fs::remove_file(spin_up);
 }
+
+/// `--target mcu`: the chooser decides in f32 and prices on the Cortex-M4F table; a tolerance
+/// below what f32 holds is raised to 64 of its rounding units, and says so; a trace still gets
+/// a plan that meets the tolerance.
+#[test]
+fn the_chooser_prices_for_the_mcu_in_f32() {
+    use model_core::choose::{Plan, Target, plan_cost};
+    let host = json(&["predict", "--tolerance", "1e-6", "--json"]);
+    let mcu = json(&[
+        "predict",
+        "--tolerance",
+        "1e-6",
+        "--target",
+        "mcu",
+        "--json",
+    ]);
+    assert_eq!(host["choice"]["target"], "host");
+    assert_eq!(host["choice"]["predicted_cost_unit"], "ns");
+    assert_eq!(mcu["choice"]["target"], "mcu");
+    assert_eq!(mcu["choice"]["predicted_cost_unit"], "instructions");
+    let floor = f64::from(64.0 * f32::EPSILON);
+    let tol = mcu["choice"]["tolerance_rel"].as_f64().unwrap();
+    assert!((tol - floor).abs() < 1e-12, "{tol} vs {floor}");
+    assert_eq!(host["choice"]["tolerance_rel"].as_f64().unwrap(), 1e-6);
+    let cost = mcu["choice"]["predicted_cost"].as_f64().unwrap();
+    assert_eq!(cost, plan_cost(&Plan::<f32>::ClosedForm, 0, Target::Mcu));
+    let text =
+        String::from_utf8(bowl(&["predict", "--tolerance", "1e-6", "--target", "mcu"]).stdout)
+            .unwrap();
+    assert!(
+        text.contains("raised to 64 rounding units") && text.contains("Cortex-M4F"),
+        "{text}"
+    );
+    // A spin-up trace for the MCU at 1e-4: a plan that meets it on the logged samples.
+    let rise = |t: f64| 3.0 + (0.5 - 3.0) * (-t / 0.3).exp();
+    let path = temp("mcu-spin-up.csv");
+    write_trace(&path, 3.0, rise);
+    let v = json(&[
+        "predict",
+        "--omega-trace",
+        path.to_str().unwrap(),
+        "--tolerance",
+        "1e-4",
+        "--target",
+        "mcu",
+        "--json",
+    ]);
+    let _ = std::fs::remove_file(&path);
+    assert_eq!(v["choice"]["target"], "mcu", "{v}");
+    let samples: Vec<f64> = (0..=150)
+        .map(|i| (rise(i as f64 * 0.02) * 1000.0).round() / 1000.0)
+        .collect();
+    let want = reference_time(&samples, v["choice"]["model"] == "coriolis");
+    let got = v["residence_time_s"].as_f64().unwrap();
+    assert!((got - want).abs() <= 1e-4 * want, "{got} vs {want}: {v}");
+}

@@ -369,7 +369,8 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
         let found = pilot::dp54(scene, model, profile, limits, budget)?;
         Ok((found, spent.saturating_add(found.evaluations)))
     };
-    let first_budget = T::from_f64(1e-6).max(T::from_f64(64.0) * T::EPSILON);
+    // A millionth, or what the precision can verify (f32: 3e-5).
+    let first_budget = T::from_f64(1e-6).max(T::from_f64(256.0) * T::EPSILON);
     let (coriolis, mut choosing) = pilot_of(Model::Coriolis, first_budget)?;
     let tc = coriolis.time_s;
     let (spread_rel, tolerance) = match need {

