@@ -303,14 +303,7 @@ fn f64_closed_forms_within_4_eps_times_the_reference_condition() {
 
 #[test]
 fn f32_closed_forms_within_4_eps_times_the_reference_condition() {
-    let (n, worst) = check::<f32>(|s| Scene {
-        omega_rad_s: s.omega_rad_s as f32,
-        mu: s.mu as f32,
-        g_m_s2: s.g_m_s2 as f32,
-        k2: s.k2 as f32,
-        ri_m: s.ri_m as f32,
-        rim_radius_m: s.rim_radius_m as f32,
-    });
+    let (n, worst) = check::<f32>(|s| s.to_f32());
     println!("f32: {n} leaving cases, worst error = {worst:.3} eps x condition");
     assert!(n > 150);
 }

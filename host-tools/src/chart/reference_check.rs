@@ -75,14 +75,7 @@ fn closed_forms_within_four_cond_eps_of_the_reference() {
             );
             checked += 1;
 
-            let s32 = Scene::<f32> {
-                omega_rad_s: s.omega_rad_s as f32,
-                mu: s.mu as f32,
-                g_m_s2: s.g_m_s2 as f32,
-                k2: s.k2 as f32,
-                ri_m: s.ri_m as f32,
-                rim_radius_m: s.rim_radius_m as f32,
-            };
+            let s32 = s.to_f32();
             let r32 = RefScene {
                 omega_rad_s: f64::from(s32.omega_rad_s),
                 mu: f64::from(s32.mu),

@@ -32,17 +32,6 @@ impl RunsOn {
     }
 }
 
-fn narrow_scene(s: &Scene<f64>) -> Scene<f32> {
-    Scene {
-        omega_rad_s: s.omega_rad_s as f32,
-        mu: s.mu as f32,
-        g_m_s2: s.g_m_s2 as f32,
-        k2: s.k2 as f32,
-        ri_m: s.ri_m as f32,
-        rim_radius_m: s.rim_radius_m as f32,
-    }
-}
-
 fn narrow_need(n: &Need<f64>) -> Need<f32> {
     match *n {
         Need::Tolerance(t) => Need::Tolerance(t as f32),
@@ -101,7 +90,7 @@ pub fn constant(
 ) -> Result<Choice<f64>, ChooseError> {
     match runs_on {
         RunsOn::Host => choose_constant_for(scene, need),
-        RunsOn::Mcu => choose_constant_for(&narrow_scene(scene), &narrow_need(need)).map(widen),
+        RunsOn::Mcu => choose_constant_for(&scene.to_f32(), &narrow_need(need)).map(widen),
     }
 }
 
@@ -129,7 +118,7 @@ pub fn trace(
             let times: Vec<f32> = times_s.iter().map(|&t| t as f32).collect();
             let omegas: Vec<f32> = omega_rad_s.iter().map(|&w| w as f32).collect();
             let narrow = SampledOmega::new(&times, &omegas).map_err(TraceChoiceError::Trace)?;
-            choose_trace(&narrow_scene(scene), &narrow_need(need), &narrow)
+            choose_trace(&scene.to_f32(), &narrow_need(need), &narrow)
                 .map(widen)
                 .map_err(TraceChoiceError::Choose)
         }

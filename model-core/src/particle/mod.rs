@@ -219,6 +219,20 @@ impl<T: Real> Scene<T> {
     }
 }
 
+impl Scene<f64> {
+    /// The scene rounded to f32, as the Cortex-M4F holds it.
+    pub const fn to_f32(&self) -> Scene<f32> {
+        Scene {
+            omega_rad_s: self.omega_rad_s as f32,
+            mu: self.mu as f32,
+            g_m_s2: self.g_m_s2 as f32,
+            k2: self.k2 as f32,
+            ri_m: self.ri_m as f32,
+            rim_radius_m: self.rim_radius_m as f32,
+        }
+    }
+}
+
 /// The model's solution in one shape: with `u = l1 t` (`l1 = c1 omega`),
 /// `r(t) = ri + (ri - a) F(u)`, `F(u) = A (e^u - 1) + B (e^{-q u} - 1)`, `A = B q`, `A + B = 1`.
 ///

@@ -156,14 +156,7 @@ fn scene_f64(i: usize) -> Scene<f64> {
 
 /// The scene rounded to f32, as the target sees it.
 pub(crate) const fn to_f32(s: &Scene<f64>) -> Scene<f32> {
-    Scene {
-        omega_rad_s: s.omega_rad_s as f32,
-        mu: s.mu as f32,
-        g_m_s2: s.g_m_s2 as f32,
-        k2: s.k2 as f32,
-        ri_m: s.ri_m as f32,
-        rim_radius_m: s.rim_radius_m as f32,
-    }
+    s.to_f32()
 }
 
 /// The f32 scene read back in f64, so the reference solves exactly the f32 inputs.
