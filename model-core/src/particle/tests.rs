@@ -605,9 +605,7 @@ proptest! {
     /// errors included, in f64 and f32, whatever the mix of scenes in its lanes.
     #[test]
     fn batch_answers_are_the_one_scene_answers(scenes in prop::collection::vec(batch_scene(), 0..23)) {
-        let narrow: Vec<Scene<f32>> = scenes.iter().map(|s| Scene {
-            omega_rad_s: s.omega_rad_s as f32, mu: s.mu as f32, g_m_s2: s.g_m_s2 as f32,
-            k2: s.k2 as f32, ri_m: s.ri_m as f32, rim_radius_m: s.rim_radius_m as f32 }).collect();
+        let narrow: Vec<Scene<f32>> = scenes.iter().map(Scene::to_f32).collect();
         for model in [Model::Flat, Model::Coriolis] {
             let mut out = vec![Ok(-1.0); scenes.len()];
             residence_times_s(&scenes, model, &mut out);

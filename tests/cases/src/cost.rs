@@ -57,7 +57,7 @@ pub const fn scene(i: usize) -> Scene<f64> {
 
 /// The scene rounded to f32, as the target sees it.
 pub const fn scene_f32(i: usize) -> Scene<f32> {
-    crate::particle::to_f32(&scene(i))
+    scene(i).to_f32()
 }
 
 const fn model(coriolis: bool) -> Model {

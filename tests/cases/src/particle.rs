@@ -154,11 +154,6 @@ fn scene_f64(i: usize) -> Scene<f64> {
     }
 }
 
-/// The scene rounded to f32, as the target sees it.
-pub(crate) const fn to_f32(s: &Scene<f64>) -> Scene<f32> {
-    s.to_f32()
-}
-
 /// The f32 scene read back in f64, so the reference solves exactly the f32 inputs.
 fn widened(s: &Scene<f32>) -> Scene<f64> {
     Scene {
@@ -234,7 +229,7 @@ const F32_TOL: f64 = 2e-6;
 
 fn flat_time_vs_acosh() -> Result<(), Failure> {
     for i in 0..GRID {
-        let s = to_f32(&scene_f64(i));
+        let s = scene_f64(i).to_f32();
         let (t, v, c) = leaves_f32(residence(&s, Model::Flat))?;
         let w = widened(&s);
         let want = flat_ref(&w);
@@ -263,7 +258,7 @@ fn flat_time_vs_acosh() -> Result<(), Failure> {
 
 fn coriolis_time_vs_bisection() -> Result<(), Failure> {
     for i in 0..GRID {
-        let s = to_f32(&scene_f64(i));
+        let s = scene_f64(i).to_f32();
         let (t, _, c) = leaves_f32(residence(&s, Model::Coriolis))?;
         let want = coriolis_ref(&widened(&s));
         close(
@@ -288,7 +283,7 @@ fn inverse_round_trips() -> Result<(), Failure> {
             (Model::Coriolis, coriolis_ref),
         ] {
             let target = reference(&s64) as f32;
-            let s = to_f32(&s64);
+            let s = s64.to_f32();
             let w =
                 omega_for_residence_time(&s, model, target).map_err(|_| err("inverse errored"))?;
             let back = reference(&Scene {
