@@ -50,10 +50,11 @@ fn the_small_family_commissions_and_steps_within_the_targets() {
 #[test]
 fn the_small_family_holds_half_a_rad_s_without_fault() {
     // 0 -> 0.5 rad/s (12 pulses/rev: about a pulse a second): no fault on a healthy plant, every
-    // axis within 5 % (revolution-averaged) by 11 s, and no limit cycle: what remains is the
-    // eccentric load's once-per-revolution share, at most 5.5 % RMS on these plants. The target
-    // is 10 s; p01's spin takes 10.8 s (its first pitch overshoots 40 % while the push finds
-    // the material it carries, and the revolution-averaged judgement holds that for 6 s).
+    // axis within 5 % (revolution-averaged) by 10 s, the target, and no limit cycle: what
+    // remains is the eccentric load's once-per-revolution share, at most 5.5 % RMS on these
+    // plants. The slowest is p01's spin, 8.8 s: its first pitch overshoots 40 % while the push
+    // finds the material it carries, and the revolution-averaged judgement holds that for 6 s.
+    // (Before the crawl window read the load, it took 10.8 s.)
     let v = json(&[
         "sim",
         "family",
@@ -69,7 +70,7 @@ fn the_small_family_holds_half_a_rad_s_without_fault() {
         for axis in ["precession", "spin"] {
             let a = &p["axes"][axis];
             let settling = a["settling_s"].as_f64().expect("settled");
-            assert!(settling <= 11.0, "{} {axis}: {a}", p["name"]);
+            assert!(settling <= 10.0, "{} {axis}: {a}", p["name"]);
             assert!(
                 a["ripple_pct"].as_f64().unwrap() <= 5.5,
                 "{} {axis}: {a}",

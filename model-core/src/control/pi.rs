@@ -48,6 +48,12 @@
 //!   was found beyond the kick left loaded shafts crawling below 0.2 rad/s until the watch
 //!   faulted them (2 to 6 healthy plants per 60-plant family); keeping half the kick costs
 //!   overshoot on an unloaded shaft (35 % on the nominal rig at 0.5 rad/s).
+//! - The crawl's reading: a loaded shaft may crawl between its first and second edge, and the
+//!   push rises again. When that window closes with the push on, its mean speed against the
+//!   mean duty that drove it reads the load the model does not know, and the integral takes
+//!   it at once. Fed to the loop as an error instead, the crawl's low mean wound the integral
+//!   up while the push had already started the shaft: 15..25 % too fast for 5 s on loaded
+//!   spin axes, which at a pulse a second the loop corrects only slowly.
 //!
 //! Both only start a shaft from rest: once the loop has seen it move, a shaft that goes quiet is
 //! not pushed (a dead sensor on a turning shaft would otherwise run it away before the
@@ -85,6 +91,7 @@ pub struct SpeedLoop {
     push: f32,
     moved: bool,
     kick_rad_s: f32,
+    push_sum: f32,
 }
 
 /// Inputs of one loop step.
@@ -244,6 +251,7 @@ impl SpeedLoop {
         push: 0.0,
         moved: false,
         kick_rad_s: 0.0,
+        push_sum: 0.0,
     };
 
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
@@ -277,6 +285,16 @@ impl SpeedLoop {
             let sample = model_mean - input.direction * w.raw_speed_rad_s;
             if self.have_error {
                 self.error += k.filter_weight * (sample - self.error);
+            } else if self.push != 0.0 {
+                // The first window after a crawl (no error then: no measurement) closed while
+                // the push was on: the shaft slid through it under a known mean duty at a
+                // measured mean speed, which reads the load the model does not know
+                // (`d = ff(w) + load`, the plant's lag being short against a window). Through
+                // the crawl the duty was the feedforward, the integral and the push: the load
+                // is the integral, the push's mean, and the duty of the speed the model
+                // expected but did not get. That is what the integral must hold; the push has
+                // done its work, and the error starts afresh with the next window.
+                self.take_crawl_load(k, w.span_s, sample, input.direction);
             } else {
                 self.error = sample;
                 self.have_error = true;
@@ -293,21 +311,16 @@ impl SpeedLoop {
             self.error = 0.0;
             e = 0.0;
         }
-        // The first edge from rest, or the first measurement after a crawl: the push held
-        // stiction and whatever load the model does not know; half of it stays in the integral
-        // (the loop corrects the rest either way), so a loaded shaft at low speed does not
-        // stick again at once.
+        // The first edge from rest: what started the shaft (the kick, or the push beyond it)
+        // held stiction and whatever load the model does not know; half of it stays in the
+        // integral (the loop corrects the rest either way), so a loaded shaft at low speed does
+        // not stick again at once. (The first measurement after a crawl reads the load itself,
+        // above.)
         let first_edge = !input.at_rest && !self.moved;
-        if first_edge || (input.measurement_valid && self.push != 0.0) {
-            // What started the shaft (the kick, or the push beyond it) held stiction and
-            // whatever load the model does not know; half of it stays.
-            let found = if first_edge {
-                self.push.max(k.kick_level(r_abs))
-            } else {
-                self.push
-            };
-            self.integral += PUSH_KEPT * found;
+        if first_edge {
+            self.integral += PUSH_KEPT * self.push.max(k.kick_level(r_abs));
             self.push = 0.0;
+            self.push_sum = 0.0;
         }
         if !input.at_rest {
             self.moved = true;
@@ -345,6 +358,7 @@ impl SpeedLoop {
                 self.push = kick_level;
             }
             self.push += k.push_per_rad_tick * r_abs;
+            self.push_sum += self.push;
         }
         // The stall bound is only active with a valid measurement.
         if ev.bound_active && input.feedback {
@@ -380,6 +394,18 @@ impl SpeedLoop {
         }
         self.duty = next;
         next
+    }
+
+    /// The integral takes the load read from a crawl window of `span_s` seconds whose model
+    /// mean exceeded the measured mean by `sample` rad/s; the push ends. Rare (once per start
+    /// of a loaded shaft), so kept out of the tick's common path.
+    #[cold]
+    #[inline(never)]
+    fn take_crawl_load(&mut self, k: &LoopConstants, span_s: f32, sample: f32, direction: f32) {
+        let mean_push = self.push_sum * k.dt_s / span_s;
+        self.integral += mean_push * direction + sample * k.duty_per_rad_s;
+        self.push_sum = 0.0;
+        self.push = 0.0;
     }
 
     /// The plant model's speed (the reference through the identified lag), rad/s.
