@@ -60,6 +60,12 @@ pub trait Real:
     fn sqrt(self) -> Self;
     /// e^x.
     fn exp(self) -> Self;
+    /// e^x for `|x| <= 700`, with no branch where a type has such a path (f64: the batch
+    /// closed form's SIMD lanes); outside that range the value is meaningless.
+    #[inline]
+    fn exp_in_domain(self) -> Self {
+        self.exp()
+    }
     /// e^x - 1, accurate near 0.
     fn exp_m1(self) -> Self;
     /// Natural logarithm.
@@ -156,6 +162,10 @@ impl Real for f64 {
     #[inline]
     fn exp(self) -> Self {
         exp::exp_f64(self)
+    }
+    #[inline]
+    fn exp_in_domain(self) -> Self {
+        exp::exp_in_domain_f64(self)
     }
     #[inline]
     fn exp_m1(self) -> Self {

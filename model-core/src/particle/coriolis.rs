@@ -11,7 +11,7 @@ const MAX_NEWTON: u32 = 40;
 
 /// Below this `m/s` the start that is first order in `m` is used; above it the
 /// curvature-matched one.
-const PERTURBATIVE_M: f64 = 0.25;
+pub(crate) const PERTURBATIVE_M: f64 = 0.25;
 
 /// The start of the iteration for `F(u) = x`.
 ///
@@ -175,10 +175,32 @@ fn local_root<T: Real>(
     delta: T,
     half_curv: T,
 ) -> Option<T> {
+    let LocalRoot { root, found } = local_root_parts(shape, e, u, g, delta, half_curv);
+    if found { Some(root) } else { None }
+}
+
+/// What [`local_root_parts`] found.
+pub(crate) struct LocalRoot<T> {
+    /// The first accepted root (meaningless unless `found`).
+    pub root: T,
+    /// A root was accepted.
+    pub found: bool,
+}
+
+/// [`local_root`] with no branch, for the batch's SIMD lanes as well (`coriolis_batch`): all
+/// three Newton corrections are computed and the first accepted one kept (the ones after it
+/// do not change it), and the test that `delta` is small enough is folded into `found`.
+#[inline(always)]
+pub(crate) fn local_root_parts<T: Real>(
+    shape: &Shape<T>,
+    e: &ShapeAt<T>,
+    u: T,
+    g: T,
+    delta: T,
+    half_curv: T,
+) -> LocalRoot<T> {
     let (q, a) = (shape.q, shape.a_coef);
-    if (delta * q.max(T::ONE)).abs() > T::HALF {
-        return None;
-    }
+    let near = (delta * q.max(T::ONE)).abs() <= T::HALF;
     let q2 = q * q;
     let f4 = a * (e.grow + q2 * e.decay);
     let f5 = a * (e.grow - q2 * q * e.decay);
@@ -189,6 +211,10 @@ fn local_root<T: Real>(
     let c5 = f5 * T::from_f64(1.0 / 120.0);
     let quarter_ulp = T::from_f64(0.25) * T::EPSILON;
     let mut d = delta;
+    let mut found = LocalRoot {
+        root: T::ZERO,
+        found: false,
+    };
     for _ in 0..3 {
         let r = g + d * (e.fp + d * (c2 + d * (c3 + d * (c4 + d * c5))));
         let dr = e.fp
@@ -201,11 +227,15 @@ fn local_root<T: Real>(
         let d3 = d * d * d;
         let remainder = f6 * d3 * d3 * T::from_f64(2.0 / 720.0);
         let limit = quarter_ulp * root;
-        if (half_curv * c * c).abs() <= limit && remainder <= limit * e.fp {
-            return Some(root);
+        let accept =
+            !found.found & ((half_curv * c * c).abs() <= limit) & (remainder <= limit * e.fp);
+        if accept {
+            found.root = root;
         }
+        found.found |= accept;
     }
-    None
+    found.found &= near;
+    found
 }
 
 /// The root of `F(u) = x` for `x > 1/eps` (and for an `x` that overflows, e.g. a subnormal

@@ -22,6 +22,7 @@
 //! reachable and then gives [`Outcome::NeverLeaves`].
 
 mod coriolis;
+mod coriolis_batch;
 mod flat;
 mod flat_batch;
 mod inverse;
@@ -408,7 +409,9 @@ pub fn residence_times_s<T: Real>(
 ) {
     match model {
         Model::Flat => flat_batch::times_s(scenes, out),
-        Model::Coriolis => coriolis::times_s(scenes, out),
+        // The lanes follow the f64 search (f32 takes no expansion step, see `coriolis`).
+        Model::Coriolis if T::is_single_precision() => coriolis::times_s(scenes, out),
+        Model::Coriolis => coriolis_batch::times_s(scenes, out),
     }
 }
 
