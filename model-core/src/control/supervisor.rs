@@ -68,7 +68,10 @@ pub fn fault_code(f: Option<Fault>) -> u8 {
 /// Pitches the plant model turns without an edge before the watch faults: below three, so a
 /// fault comes within three expected pulse periods from the last edge; above two, so one
 /// tooth's offset (a tenth of a pitch at most) or one missing pulse never faults a healthy shaft.
-pub const WATCH_PITCHES: f32 = 2.6;
+/// 2.8 rather than 2.6: a stiff shaft carrying material the model does not know breaks away
+/// only when the push has found that load, and its first edge can come most of a pitch later
+/// (docs/control.md, "Faults").
+pub const WATCH_PITCHES: f32 = 2.8;
 
 /// An edge interval faster than this many times the plant model's speed (plus the margin) is a
 /// runaway: tooth offsets (up to 10 % on one interval), a 10 % overshoot and the breakaway of a
