@@ -6,7 +6,7 @@ use super::{
 };
 use crate::Real;
 
-/// Iterations allowed; it needs 1 or 2 on the rig's scenes (in f64 mostly 1, see [`local_root`]).
+/// Iterations allowed; it needs 1 or 2 on the rig's scenes (in f64 mostly 1, see [`local_root_parts`]).
 const MAX_NEWTON: u32 = 40;
 
 /// Below this `m/s` the start that is first order in `m` is used; above it the
@@ -56,7 +56,7 @@ fn start<T: Real>(shape: &Shape<T>, x: T) -> (T, T) {
 /// Far from the root (`d F'' / F'` not small) it takes Newton's step; where `F` is a factor off
 /// `x` with `u > 1`, `F` behaves like `A e^u` and we step by `ln(x / F)` (`F <= A e^u`,
 /// docs/model.md §4's `ln((1 + x) / A)` bound). In f64, where Halley's step is not yet within
-/// rounding, the expansion of `F` at the same point usually is ([`local_root`]): one evaluation
+/// rounding, the expansion of `F` at the same point usually is ([`local_root_parts`]): one evaluation
 /// instead of two on the batch's scenes. An iteration that has not converged is an error, never
 /// a result.
 pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneError> {
@@ -144,7 +144,8 @@ impl<T: Real> Search<T> {
         // polynomial's code alone costs some 17 Cortex-M4F instructions a call: f64 only.
         if halley
             && !T::is_single_precision()
-            && let Some(root) = local_root(shape, &e, u, f - x, next - u, half_curv)
+            && let LocalRoot { root, found: true } =
+                local_root_parts(shape, &e, u, f - x, next - u, half_curv)
             && root >= self.lower
             && root <= self.upper
         {
@@ -157,28 +158,6 @@ impl<T: Real> Search<T> {
     }
 }
 
-/// The root from `F`'s Taylor expansion at `u` to fifth order, where that is within rounding of
-/// the root: `None` otherwise (the search then evaluates `F` again at Halley's point).
-///
-/// Every derivative of `F` comes from the two exponentials of the evaluation at `u`
-/// (`F^(n) = A (e^u + (-1)^n q^(n-1) e^{-q u})`), so where Halley's step alone is not yet
-/// within rounding (a start off by more than about `eps^(1/3)`, the rig's larger `mu`) the
-/// polynomial takes the place of a second evaluation: Newton on it from Halley's point
-/// (`delta`), `g = F(u) - x`, `half_curv = F'' / (2 F')`. Accepted when Newton's last
-/// correction `c` leaves an error `F'' c^2 / (2 F')` and the expansion's remainder `F^(6) delta^6 / 720 / F'` (bounded with
-/// `F^(6)` at `u` doubled, for `q |delta| <= 1/2`) both below a quarter of an ulp of the root.
-fn local_root<T: Real>(
-    shape: &Shape<T>,
-    e: &ShapeAt<T>,
-    u: T,
-    g: T,
-    delta: T,
-    half_curv: T,
-) -> Option<T> {
-    let LocalRoot { root, found } = local_root_parts(shape, e, u, g, delta, half_curv);
-    if found { Some(root) } else { None }
-}
-
 /// What [`local_root_parts`] found.
 pub(crate) struct LocalRoot<T> {
     /// The first accepted root (meaningless unless `found`).
@@ -187,9 +166,20 @@ pub(crate) struct LocalRoot<T> {
     pub found: bool,
 }
 
-/// [`local_root`] with no branch, for the batch's SIMD lanes as well (`coriolis_batch`): all
-/// three Newton corrections are computed and the first accepted one kept (the ones after it
-/// do not change it), and the test that `delta` is small enough is folded into `found`.
+/// The root from `F`'s Taylor expansion at `u` to fifth order, where that is within rounding of
+/// the root (`found`; otherwise the search evaluates `F` again at Halley's point).
+///
+/// Every derivative of `F` comes from the two exponentials of the evaluation at `u`
+/// (`F^(n) = A (e^u + (-1)^n q^(n-1) e^{-q u})`), so where Halley's step alone is not yet
+/// within rounding (a start off by more than about `eps^(1/3)`, the rig's larger `mu`) the
+/// polynomial takes the place of a second evaluation: Newton on it from Halley's point
+/// (`delta`), `g = F(u) - x`, `half_curv = F'' / (2 F')`. Accepted when Newton's last
+/// correction `c` leaves an error `F'' c^2 / (2 F')` and the expansion's remainder `F^(6) delta^6 / 720 / F'` (bounded with
+/// `F^(6)` at `u` doubled, for `q |delta| <= 1/2`) both below a quarter of an ulp of the root.
+///
+/// No branch, for the batch's SIMD lanes as well (`coriolis_batch`): all three Newton
+/// corrections are computed and the first accepted one kept (the ones after it do not change
+/// it), and the test that `delta` is small enough is folded into `found`.
 #[inline(always)]
 pub(crate) fn local_root_parts<T: Real>(
     shape: &Shape<T>,

@@ -297,9 +297,16 @@ impl<T: Real> Shape<T> {
     /// exponentials.
     #[inline]
     pub(crate) fn eval_parts(&self, u: T) -> ShapeAt<T> {
-        let (pa, ea) = phi_expm1(u);
+        self.eval_parts_by(u, phi_expm1)
+    }
+
+    /// [`Self::eval_parts`] with `phi` for `(phi(z), expm1(z))` (the batch's lanes compute it
+    /// without a branch).
+    #[inline(always)]
+    pub(crate) fn eval_parts_by(&self, u: T, phi: impl Fn(T) -> (T, T)) -> ShapeAt<T> {
+        let (pa, ea) = phi(u);
         let qu = self.q * u;
-        let (pb, eb) = phi_expm1(-qu);
+        let (pb, eb) = phi(-qu);
         // For q u >= 1, B phi(-q u) = B expm1(-q u) + A u (as B q = A): no B * (q u) overflow.
         let b_term = if qu < T::ONE {
             self.b_coef * pb
