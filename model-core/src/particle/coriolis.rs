@@ -6,7 +6,8 @@ use super::{
 };
 use crate::Real;
 
-/// Iterations allowed; it needs 1 or 2 on the rig's scenes (in f64 mostly 1, see [`local_root_parts`]).
+/// Iterations allowed; it needs 1 or 2 on the rig's scenes (in f64 mostly 1, see
+/// [`local_root_parts`]).
 const MAX_NEWTON: u32 = 40;
 
 /// Below this `m/s` the start that is first order in `m` is used; above it the
@@ -56,9 +57,9 @@ fn start<T: Real>(shape: &Shape<T>, x: T) -> (T, T) {
 /// Far from the root (`d F'' / F'` not small) it takes Newton's step; where `F` is a factor off
 /// `x` with `u > 1`, `F` behaves like `A e^u` and we step by `ln(x / F)` (`F <= A e^u`,
 /// docs/model.md §4's `ln((1 + x) / A)` bound). In f64, where Halley's step is not yet within
-/// rounding, the expansion of `F` at the same point usually is ([`local_root_parts`]): one evaluation
-/// instead of two on the batch's scenes. An iteration that has not converged is an error, never
-/// a result.
+/// rounding, the expansion of `F` at the same point usually is ([`local_root_parts`]): one
+/// evaluation instead of two on the batch's scenes. An iteration that has not converged is an
+/// error, never a result.
 pub(crate) fn solve_u<T: Real>(shape: &Shape<T>, x: T) -> Result<(T, T), SceneError> {
     let mut search = Search::new(shape, x);
     loop {
