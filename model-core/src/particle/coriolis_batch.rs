@@ -71,14 +71,7 @@ fn lanes<T: Real>(group: &[Scene<T>], out: &mut [Result<T, SceneError>]) -> usiz
         let a = scene.mu * scene.g_m_s2 / omega / omega;
         let k = scene.k2.sqrt();
         let m = k * scene.mu;
-        let s = (T::ONE + m * m).sqrt();
-        let sm = s + m;
-        let shape = Shape {
-            c1: k / sm,
-            a_coef: T::HALF * (T::ONE + m / s),
-            b_coef: T::HALF / (s * sm),
-            q: sm * sm,
-        };
+        let shape = Shape::coriolis(k, m, (T::ONE + m * m).sqrt());
         let den = scene.ri_m - a;
         let rise = scene.rim_radius_m - scene.ri_m;
         let x = rise / den;

@@ -268,19 +268,27 @@ impl<T: Real> Shape<T> {
                     let inv = T::ONE / m;
                     m * (T::ONE + inv * inv).sqrt()
                 };
-                let sm = s + m;
-                let shape = Self {
-                    c1: k / sm,
-                    a_coef: T::HALF * (T::ONE + m / s),
-                    b_coef: T::HALF / (s * sm),
-                    q: sm * sm,
-                };
+                let shape = Self::coriolis(k, m, s);
                 if shape.q.is_finite() && shape.c1 > T::ZERO && shape.b_coef > T::ZERO {
                     Ok(shape)
                 } else {
                     Err(SceneError::OutOfRange)
                 }
             }
+        }
+    }
+
+    /// The Coriolis model's shape from `k`, `m = k mu` and `s = sqrt(1 + m^2)` (docs/model.md
+    /// §3's corrected A and B): `c1 = k / (s + m)`, `A = (1 + m / s) / 2`,
+    /// `B = 1 / (2 s (s + m))`, `q = (s + m)^2`.
+    #[inline(always)]
+    pub(crate) fn coriolis(k: T, m: T, s: T) -> Self {
+        let sm = s + m;
+        Self {
+            c1: k / sm,
+            a_coef: T::HALF * (T::ONE + m / s),
+            b_coef: T::HALF / (s * sm),
+            q: sm * sm,
         }
     }
 
