@@ -110,18 +110,23 @@ pub fn chart(rigs: &[Rig], target: f32, file: &str) -> (Figure, Table) {
         x_scale: Scale::Linear,
         y_scale: Scale::Linear,
         series,
-        vlines: vec![
-            VLine {
-                x: 5.0,
-                label: " 5 % (95 % of axes)".into(),
-                color: 7,
-            },
-            VLine {
-                x: 10.0,
-                label: " 10 % (every axis)".into(),
-                color: 6,
-            },
-        ],
+        // The overshoot targets belong to the 3 rad/s step; the low-speed one has none.
+        vlines: if target < 1.0 {
+            Vec::new()
+        } else {
+            vec![
+                VLine {
+                    x: 5.0,
+                    label: " 5 % (95 % of axes)".into(),
+                    color: 7,
+                },
+                VLine {
+                    x: 10.0,
+                    label: " 10 % (every axis)".into(),
+                    color: 6,
+                },
+            ]
+        },
         notes: vec![
             format!(
                 "{} plants, {} commissioned, {} false faults",
