@@ -205,6 +205,7 @@ pub fn run(args: &Args) -> Result<()> {
             path,
             args.release_at_ms,
             &need,
+            choice::states_omega(args.uncertainty.as_deref())?,
             args.target,
             args.json,
         );

@@ -606,6 +606,73 @@ fn a_logged_speed_trace_is_predicted_within_the_tolerance() {
     let _ = std::fs::remove_file(spin_up);
 }
 
+/// A trace's own measurement uncertainty takes the place of the default 1 % on omega: a
+/// settled trace alternating +-40 mrad/s (each sample 80 mrad/s off its neighbours' line,
+/// which independent noise of RMS 80 / sqrt(1.5) mrad/s would be on average) is known to
+/// (0.5 + 80 / sqrt(1.5)) mrad/s over 3 rad/s, and that widens T's spread against the same
+/// trace with `--uncertainty omega=0` by what the closed form says the speed's uncertainty
+/// moves T; a stated omega is kept.
+#[test]
+fn a_traces_own_measurement_enters_the_tolerance() {
+    let noisy = temp("noisy.csv");
+    write_trace(&noisy, 3.0, |t| {
+        let i = (t / 0.02).round() as i64;
+        3.0 + if i % 2 == 0 { 0.04 } else { -0.04 }
+    });
+    let spec = |extra: &[&str]| {
+        let mut a = vec![
+            "predict",
+            "--omega-trace",
+            noisy.to_str().unwrap(),
+            "--json",
+        ];
+        a.extend_from_slice(extra);
+        json(&a)
+    };
+    let by_default = spec(&[]);
+    let m = &by_default["trace"]["measurement"];
+    assert_eq!(m["used_as_omega_uncertainty"], true, "{by_default}");
+    let scatter = 0.08 / 1.5f64.sqrt();
+    assert!(
+        (m["scatter_rad_s"].as_f64().unwrap() - scatter).abs() < 1e-9,
+        "{m}"
+    );
+    let want = (0.0005 + scatter) / 3.0;
+    assert!((m["relative"].as_f64().unwrap() - want).abs() < 1e-6, "{m}");
+    let without = spec(&["--uncertainty", "omega=0"]);
+    assert_eq!(
+        without["trace"]["measurement"]["used_as_omega_uncertainty"],
+        false
+    );
+    let spread = |v: &serde_json::Value| v["choice"]["spread_rel"].as_f64().unwrap();
+    // The spread's omega term, from the closed form (the trace is settled at 3 rad/s): the
+    // larger change of T with the speed at either end of its range.
+    let t_at = |w: f64| {
+        let scene = model_core::particle::Scene {
+            omega_rad_s: w,
+            mu: 0.029,
+            g_m_s2: 9.81,
+            k2: 5.0 / 7.0,
+            ri_m: 0.05,
+            rim_radius_m: 0.1,
+        };
+        model_core::particle::residence(&scene, model_core::particle::Model::Coriolis)
+            .unwrap()
+            .residence_time_s()
+    };
+    let term = [1.0 - want, 1.0 + want]
+        .map(|f| (t_at(3.0 * f) - t_at(3.0)).abs() / t_at(3.0))
+        .into_iter()
+        .fold(0.0, f64::max);
+    let added = spread(&by_default) - spread(&without);
+    assert!((added - term).abs() <= 0.05 * term, "{added} vs {term}");
+    let text =
+        String::from_utf8(bowl(&["predict", "--omega-trace", noisy.to_str().unwrap()]).stdout)
+            .unwrap();
+    assert!(text.contains("that is omega's uncertainty below"), "{text}");
+    let _ = std::fs::remove_file(noisy);
+}
+
 /// `--target mcu`: the chooser decides in f32 and prices on the Cortex-M4F table; a tolerance
 /// below what f32 holds is raised to 64 of its rounding units, and says so; a trace still gets
 /// a plan that meets the tolerance.

@@ -564,7 +564,10 @@ mod trace;
 
 pub use cost::{MethodCost, Target, plan_cost};
 
-pub use trace::{SampledOmega, TraceError, choose_trace, mean_omega_rad_s};
+pub use trace::{
+    LOGGED_SPEED_RESOLUTION_RAD_S, SampledOmega, TraceError, TraceMeasurement, choose_trace,
+    mean_omega_rad_s, residence_estimate_s,
+};
 
 #[cfg(test)]
 mod tests;

@@ -21,7 +21,21 @@ pub const DEFAULT_KNOWLEDGE: Knowledge<f64> = Knowledge {
 
 /// `--uncertainty mu=REL,radius_m=M,omega=REL` (keys left out keep their defaults).
 pub fn parse_uncertainty(spec: &str) -> Result<Knowledge<f64>> {
+    parse_uncertainty_keys(spec).map(|(k, _)| k)
+}
+
+/// True when `--uncertainty` states the speed's uncertainty itself (`omega=`); otherwise a
+/// logged trace's own measurement takes the default's place.
+pub fn states_omega(uncertainty: Option<&str>) -> Result<bool> {
+    uncertainty.map_or(Ok(false), |spec| {
+        parse_uncertainty_keys(spec).map(|(_, omega)| omega)
+    })
+}
+
+/// [`parse_uncertainty`], and whether `omega` was among the keys.
+fn parse_uncertainty_keys(spec: &str) -> Result<(Knowledge<f64>, bool)> {
     let mut k = DEFAULT_KNOWLEDGE;
+    let mut omega_given = false;
     for part in spec.split(',').map(str::trim).filter(|p| !p.is_empty()) {
         let (key, value) = part.split_once('=').ok_or_else(|| {
             anyhow!("--uncertainty: `{part}` is not KEY=VALUE (keys: mu, radius_m, omega)")
@@ -36,14 +50,17 @@ pub fn parse_uncertainty(spec: &str) -> Result<Knowledge<f64>> {
         match key.trim() {
             "mu" => k.mu_rel = x,
             "radius_m" => k.radius_m = x,
-            "omega" => k.omega_rel = x,
+            "omega" => {
+                k.omega_rel = x;
+                omega_given = true;
+            }
             other => bail!(
                 "--uncertainty: unknown key `{other}` (keys: mu (relative), radius_m (m), \
                  omega (relative))"
             ),
         }
     }
-    Ok(k)
+    Ok((k, omega_given))
 }
 
 /// What the answer must meet, from the flags.
@@ -245,6 +262,9 @@ mod tests {
     fn uncertainty_specs_parse_and_bad_ones_are_named() {
         let k = parse_uncertainty("mu=0.1, omega=0.02").unwrap();
         assert_eq!((k.mu_rel, k.radius_m, k.omega_rel), (0.1, 0.001, 0.02));
+        assert!(states_omega(Some("mu=0.1, omega=0.02")).unwrap());
+        assert!(!states_omega(Some("mu=0.1")).unwrap());
+        assert!(!states_omega(None).unwrap());
         let e = parse_uncertainty("rpm=3").unwrap_err().to_string();
         assert!(e.contains("unknown key `rpm`"), "{e}");
         let e = parse_uncertainty("mu=-1").unwrap_err().to_string();

@@ -82,10 +82,11 @@ pub fn run(
     path: &Path,
     release_ms: Option<f64>,
     need: &model_core::choose::Need<f64>,
+    omega_stated: bool,
     runs_on: super::target::RunsOn,
     json: bool,
 ) -> Result<()> {
-    use model_core::choose::{Plan, SampledOmega, TraceError};
+    use model_core::choose::{LOGGED_SPEED_RESOLUTION_RAD_S, Need, Plan, SampledOmega, TraceError};
     use model_core::ode::{self, Limits, OdeOutcome};
     use model_core::particle;
 
@@ -104,9 +105,26 @@ pub fn run(
             path.display()
         ),
     })?;
+    // The speed the particle saw is known as well as the trace measured it: that, not the
+    // loop's default 1 %, is omega's uncertainty unless --uncertainty states one.
+    // Judged over twice the first estimate of the residence time (the whole trace without
+    // one).
+    let window_s = model_core::choose::residence_estimate_s(scene, &profile)
+        .map_or(f64::INFINITY, |t| 2.0 * t);
+    let measured = profile.measurement(LOGGED_SPEED_RESOLUTION_RAD_S, window_s);
+    let measured_is_used = matches!(need, Need::Uncertainty(_)) && !omega_stated;
+    let need = match *need {
+        Need::Uncertainty(k) if measured_is_used => {
+            Need::Uncertainty(model_core::choose::Knowledge {
+                omega_rel: measured.relative,
+                ..k
+            })
+        }
+        other => other,
+    };
     let choice = super::target::trace(
         scene,
-        need,
+        &need,
         &profile,
         &trace.times_s,
         &trace.omega_rad_s,
@@ -158,6 +176,12 @@ pub fn run(
             (lo.min(w), hi.max(w))
         });
     let covered_s = trace.times_s.last().copied().unwrap_or(0.0);
+    // Past the trace's end the whole trace was judged.
+    let window_s = if window_s < covered_s {
+        window_s
+    } else {
+        f64::INFINITY
+    };
     if json {
         println!(
             "{}",
@@ -166,6 +190,14 @@ pub fn run(
                     "file": path.display().to_string(), "samples": trace.times_s.len(),
                     "release_device_ms": trace.release_ms, "covers_s": covered_s,
                     "omega_min_rad_s": lo, "omega_max_rad_s": hi,
+                    "measurement": {
+                        "rounding_rad_s": measured.rounding_rad_s,
+                        "scatter_rad_s": measured.scatter_rad_s,
+                        "mean_rad_s": measured.mean_rad_s,
+                        "relative": measured.relative,
+                        "used_as_omega_uncertainty": measured_is_used,
+                        "judged_over_s": window_s.min(covered_s),
+                    },
                 },
                 "choice": super::choice::json(&choice, runs_on),
                 "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
@@ -179,7 +211,11 @@ pub fn run(
             trace.times_s.len(),
             trace.release_ms
         );
-        println!("{}", super::choice::describe(&choice, need, runs_on));
+        println!(
+            "{}",
+            measurement_words(&measured, window_s, measured_is_used, &need, omega_stated)
+        );
+        println!("{}", super::choice::describe(&choice, &need, runs_on));
         if time_s.is_finite() {
             println!(
                 "{:<8} leaves after T = {time_s:.9} s",
@@ -193,4 +229,39 @@ pub fn run(
         }
     }
     Ok(())
+}
+
+/// How well the trace knows the speed, and what the chooser made of it.
+fn measurement_words(
+    m: &model_core::choose::TraceMeasurement<f64>,
+    judged_over_s: f64,
+    used: bool,
+    need: &model_core::choose::Need<f64>,
+    omega_stated: bool,
+) -> String {
+    use model_core::choose::Need;
+    let over = if judged_over_s.is_finite() {
+        format!("over its first {judged_over_s:.3} s (twice a first estimate of T)")
+    } else {
+        "over the whole trace (no first estimate of T: the particle waits for the speed)".into()
+    };
+    let known = format!(
+        "{over} the trace knows the speed to +-{:.3} % of its mean {:.3} rad/s (+-{:.1} mrad/s logged to whole mrad/s, \
+         {:.2} mrad/s RMS scatter about its neighbours' line)",
+        100.0 * m.relative,
+        m.mean_rad_s,
+        1e3 * m.rounding_rad_s,
+        1e3 * m.scatter_rad_s
+    );
+    match need {
+        _ if used => format!("{known}: that is omega's uncertainty below"),
+        Need::Uncertainty(_) if omega_stated => {
+            format!("{known}; --uncertainty states omega's instead")
+        }
+        Need::Tolerance(t) if *t < 0.1 * m.relative => format!(
+            "{known}: T is computed to the tolerance on the trace as logged, but a tolerance \
+             below a tenth of that is finer than the speed the particle saw is known"
+        ),
+        _ => known,
+    }
 }

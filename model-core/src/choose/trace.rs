@@ -112,6 +112,109 @@ impl<T: Real> OmegaProfile<T> for SampledOmega<'_, T> {
     }
 }
 
+/// The wire's bowl speed is whole mrad/s (`Telemetry::bowl_mrad_s`): a logged sample is within
+/// half of that of the speed the rig measured, rad/s.
+pub const LOGGED_SPEED_RESOLUTION_RAD_S: f64 = 1e-3;
+
+/// How well a logged trace knows the bowl speed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TraceMeasurement<T> {
+    /// Half the logged resolution, rad/s.
+    pub rounding_rad_s: T,
+    /// RMS scatter of the samples about the straight line through their neighbours, rad/s.
+    pub scatter_rad_s: T,
+    /// Time-weighted mean speed of the trace, rad/s.
+    pub mean_rad_s: T,
+    /// `(rounding + scatter) / mean`, at most 1: the relative uncertainty of the speed the
+    /// particle saw, as far as the trace itself can tell.
+    pub relative: T,
+}
+
+impl<T: Real> SampledOmega<'_, T> {
+    /// The trace's own measurement uncertainty over `[0, until_s]` (the residence time: the
+    /// speed after the particle left does not matter; at least three samples are used), the
+    /// samples logged to `resolution_rad_s`.
+    ///
+    /// The scatter is measured on the trace: each inner sample's distance from the straight
+    /// line through its two neighbours, whose RMS is `sqrt(1 + a^2 + b^2)` (`a + b = 1`, the
+    /// neighbours' weights) times the noise of independent samples; that factor is divided
+    /// out. A real ripple or a bend of the speed counts as scatter too (an upper bound: the
+    /// trace cannot tell its own noise from a speed that varies faster than it samples).
+    pub fn measurement(&self, resolution_rad_s: T, until_s: T) -> TraceMeasurement<T> {
+        let within = self.times_s.iter().take_while(|&&t| t <= until_s).count();
+        let used = within.max(3).min(self.times_s.len());
+        let (ts, ws) = (&self.times_s[..used], &self.omega_rad_s[..used]);
+        let rounding_rad_s = resolution_rad_s.abs() * T::HALF;
+        let (mut sum_sq, mut inner) = (T::ZERO, 0u32);
+        for i in 1..ts.len().saturating_sub(1) {
+            let span = ts[i + 1] - ts[i - 1];
+            let b = (ts[i] - ts[i - 1]) / span;
+            let a = T::ONE - b;
+            let line = ws[i - 1] * a + ws[i + 1] * b;
+            let off = (ws[i] - line) / (T::ONE + a * a + b * b).sqrt();
+            sum_sq += off * off;
+            inner += 1;
+        }
+        let scatter_rad_s = if inner > 0 {
+            (sum_sq / T::from_f64(f64::from(inner))).sqrt()
+        } else {
+            T::ZERO
+        };
+        // Trapezoids between samples; one sample is its own mean.
+        let duration = ts[ts.len() - 1] - ts[0];
+        let mean_rad_s = if duration > T::ZERO {
+            let mut area = T::ZERO;
+            for i in 1..ts.len() {
+                area += (ws[i] + ws[i - 1]) * T::HALF * (ts[i] - ts[i - 1]);
+            }
+            area / duration
+        } else {
+            ws[0]
+        };
+        let uncertain = rounding_rad_s + scatter_rad_s;
+        let relative = if uncertain >= mean_rad_s || !(uncertain / mean_rad_s).is_finite() {
+            T::ONE
+        } else {
+            uncertain / mean_rad_s
+        };
+        TraceMeasurement {
+            rounding_rad_s,
+            scatter_rad_s,
+            mean_rad_s,
+            relative,
+        }
+    }
+}
+
+/// A first estimate of the residence time on a varying speed, s: the flat closed form at the
+/// mean speed over the time it gives, iterated from the trace's top speed (a few closed forms,
+/// no integration). `None` when it does not settle within a few percent or the particle does
+/// not leave; it only sets the window over which a trace's measurement is judged.
+pub fn residence_estimate_s<T: Real, P: OmegaProfile<T>>(
+    scene: &Scene<T>,
+    profile: &P,
+) -> Option<T> {
+    let flat_at = |omega_rad_s: T| {
+        let at = Scene {
+            omega_rad_s,
+            ..*scene
+        };
+        particle::residence(&at, particle::Model::Flat)
+            .ok()
+            .map(|o| o.residence_time_s())
+            .filter(|t| t.is_finite())
+    };
+    let mut t = flat_at(profile.max_omega_rad_s())?;
+    for _ in 0..8 {
+        let next = flat_at(mean_omega_rad_s(profile, t))?;
+        if (next - t).abs() <= T::from_f64(0.02) * t {
+            return Some(next);
+        }
+        t = next;
+    }
+    None
+}
+
 /// The mean of omega(t) over `[0, t_end_s]` (composite Simpson, 1,024 intervals), rad/s.
 pub fn mean_omega_rad_s<T: Real, P: OmegaProfile<T>>(profile: &P, t_end_s: T) -> T {
     if t_end_s.is_nan() || t_end_s <= T::ZERO || !t_end_s.is_finite() {
