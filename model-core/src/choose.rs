@@ -8,17 +8,19 @@
 //!    tolerance is a tenth of that, clamped to `[64 epsilon, 0.1]`: computing `T` to 1e-12 when
 //!    mu is known to 20 % is waste.
 //! 2. **Model.** The Coriolis term's effect `|T_coriolis - T_flat| / T_flat` is computed (closed
-//!    forms for a constant speed; for a varying one the pilot's Coriolis `T` against a flat run
-//!    whose error is within 1/32 of the tolerance). Within the tolerance, with room left for
-//!    the method, the flat model is enough.
+//!    forms for a constant speed; for a varying one the pilot's Coriolis `T` against the flat
+//!    model at the pilot's two coarsest steps, extrapolated, and where that does not settle it,
+//!    a flat run whose error is within 1/32 of the tolerance). Within the tolerance, with room
+//!    left for the method, the flat model is enough.
 //! 3. **Method.** Constant speed: the closed form (exact to rounding, cheapest). Time-varying
 //!    speed: RK4 at the longest step whose error the pilot (`pilot.rs`: RK4 at `h`, `h/2`, `h/4`,
-//!    `h/8` from the release time, where the error follows `C h^p`) predicts within half of
+//!    `h/8` from the release time, `h` resolving both `1/omega` and the speed's own time
+//!    scale, where the error follows `C h^p`) predicts within half of
 //!    what the model leaves of the tolerance; DP5(4), calibrated by tolerances ten apart, where
 //!    RK4 would need more steps than the cap or the speed has kinks (a logged trace). No search
 //!    against a tight reference: RK4 was the cheapest plan meeting the tolerance on every scene
 //!    of `bowl chart chooser`'s grid, and the step the pilot predicts costs at most 1.24x the
-//!    brute force's cheapest there. Explicit and semi-implicit Euler are not candidates
+//!    brute force's cheapest there (docs/model.md, the chooser). Explicit and semi-implicit Euler are not candidates
 //!    (order 1, more expensive per evaluation on both cost tables).
 
 use crate::Real;
@@ -335,8 +337,9 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
     let target = Target::for_precision::<T>();
     let w_max = profile.max_omega_rad_s().max(T::EPSILON);
     // The coarsest pilot step: well inside RK4's stability limit (2.785 / |l2|; |l2| <= 1.5
-    // k omega here).
-    let step_cap = T::from_f64(1.5) / w_max;
+    // k omega here), and no longer than the speed's own time scale (a spin-up faster than
+    // 1/omega sets RK4's error by its derivatives; a pilot blind to them found a false C h^p).
+    let step_cap = (T::from_f64(1.5) / w_max).min(profile.time_scale_s());
     if scene.ri_m >= scene.rim_radius_m {
         let at_rim = Choice {
             model: Model::Flat,
@@ -372,7 +375,6 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
     // A millionth, or what the precision can verify (f32: 3e-5).
     let first_budget = T::from_f64(1e-6).max(T::from_f64(256.0) * T::EPSILON);
     let (coriolis, mut choosing) = pilot_of(Model::Coriolis, first_budget)?;
-    let tc = coriolis.time_s;
     let (spread_rel, tolerance) = match need {
         Need::Tolerance(t) => (None, clamp_tolerance(*t)),
         Need::Uncertainty(knowledge) => {
@@ -400,27 +402,14 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
             (Some(spread_rel), tolerance_from(spread_rel))
         }
     };
-    // The flat model at the step the pilot predicts within 1/32 of the tolerance: the effect
-    // is then known to that.
-    let flat_step = coriolis.step_for(tolerance * T::from_f64(1.0 / 32.0));
-    let flat_error = coriolis.error_at(flat_step);
-    let (tf, evals) = run(
-        scene,
-        Model::Flat,
-        profile,
-        coriolis.method(flat_step, scene),
-        limits,
-    )?;
+    // The flat model's effect: first from a cheap probe, else from a flat run at the step the
+    // pilot predicts within 1/32 of the tolerance.
+    let (effect, effect_bound, evals) = flat_effect(scene, profile, limits, &coriolis, tolerance)?;
     choosing = choosing.saturating_add(evals);
-    if !tf.is_finite() {
-        return Err(ChooseError::DoesNotLeave);
-    }
-    let effect = (tc - tf).abs() / tf;
     // The method's predicted error is kept within half of what the model leaves of the
     // tolerance (the prediction may be off by up to 2x). The flat model leaves the tolerance
     // less its effect (with both runs' errors added): it is taken while that is at least a
     // quarter of the tolerance, so its plan costs at most 2^(1/4) more than the Coriolis one.
-    let effect_bound = effect + flat_error + coriolis.error_rel;
     let model = if effect_bound <= tolerance * T::from_f64(0.75) {
         Model::Flat
     } else {
@@ -491,6 +480,75 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
     Ok((choice, pilot.error_rel))
 }
 
+/// The Coriolis term's effect on `T` (`|T_coriolis - T_flat| / T_flat`), an upper bound on it
+/// with both runs' errors added, and the evaluations it took.
+///
+/// Where the Coriolis model is needed the effect is usually far above the tolerance (about 1 %
+/// on the rig's scenes), and a precise flat run (its error within 1/32 of the tolerance, twice
+/// the evaluations of the plan) only confirms it. So a probe goes first: the flat model at the
+/// pilot's two coarsest steps, `h` and `h/2` (3/15 of the pilot), its error at `h/2` taken
+/// from their difference at the pilot's order (Richardson) and doubled, both extrapolated
+/// `T` compared. When even the effect less both errors exceeds what the flat model could
+/// use (3/4 of the tolerance), the Coriolis model is settled. Otherwise, and where the precise
+/// run would cost less than the probe (loose tolerances, where the plan is a few coarse
+/// steps), the precise run decides.
+fn flat_effect<T: Real, P: OmegaProfile<T>>(
+    scene: &Scene<T>,
+    profile: &P,
+    limits: Limits<T>,
+    coriolis: &pilot::Pilot<T>,
+    tolerance: T,
+) -> Result<(T, T, u32), ChooseError> {
+    let tc = coriolis.time_s;
+    let flat_step = coriolis.step_for(tolerance * T::from_f64(1.0 / 32.0));
+    let coarse = coriolis.coarsest_step_s;
+    let mut spent = 0u32;
+    // The probe costs 1.5 runs at `h`; the precise run `h / flat_step` of them.
+    if coriolis.kind == pilot::Kind::Rk4 && flat_step * T::from_f64(1.5) < coarse {
+        let (t_h, e1) = run(
+            scene,
+            Model::Flat,
+            profile,
+            Method::Rk4 { step_s: coarse },
+            limits,
+        )?;
+        let half = coarse * T::HALF;
+        let (t_half, e2) = run(
+            scene,
+            Model::Flat,
+            profile,
+            Method::Rk4 { step_s: half },
+            limits,
+        )?;
+        spent = e1.saturating_add(e2);
+        if t_h.is_finite() && t_half.is_finite() {
+            let excess = T::from_f64(15.0);
+            let correction = (t_h - t_half) / excess;
+            let tf = t_half - correction;
+            let flat_error = T::TWO * correction.abs() / tf;
+            let effect = (tc - tf).abs() / tf;
+            let lower = effect - flat_error - coriolis.error_rel;
+            if tf > T::ZERO && lower > tolerance * T::from_f64(0.75) {
+                return Ok((effect, effect + flat_error + coriolis.error_rel, spent));
+            }
+        }
+    }
+    let flat_error = coriolis.error_at(flat_step);
+    let (tf, evals) = run(
+        scene,
+        Model::Flat,
+        profile,
+        coriolis.method(flat_step, scene),
+        limits,
+    )?;
+    spent = spent.saturating_add(evals);
+    if !tf.is_finite() {
+        return Err(ChooseError::DoesNotLeave);
+    }
+    let effect = (tc - tf).abs() / tf;
+    Ok((effect, effect + flat_error + coriolis.error_rel, spent))
+}
+
 /// The spread of `T` over the parameters' uncertainty (see [`spread`]) from runs of `method`
 /// on the Coriolis model, the nominal scene's included (so that the runs' common error
 /// cancels), and the evaluations they took.
@@ -555,6 +613,9 @@ impl<T: Real, P: OmegaProfile<T>> OmegaProfile<T> for ScaledProfile<'_, T, P> {
     }
     fn next_kink_after_s(&self, t_s: T) -> Option<T> {
         self.inner.next_kink_after_s(t_s)
+    }
+    fn time_scale_s(&self) -> T {
+        self.inner.time_scale_s()
     }
 }
 

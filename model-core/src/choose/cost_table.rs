@@ -2,22 +2,22 @@
 // from the measurements in docs/charts/work-precision.csv (paper scene, both models). Do not edit.
 
 /// closed: host ns, f64, fastest batch; fitted to 2 rows.
-pub const HOST_CLOSED: MethodCost = MethodCost { per_call: 65.9, per_eval: 0.00 };
+pub const HOST_CLOSED: MethodCost = MethodCost { per_call: 73.3, per_eval: 0.00 };
 /// euler: host ns, f64, fastest batch; fitted to 24 rows.
-pub const HOST_EULER: MethodCost = MethodCost { per_call: 233.2, per_eval: 5.83 };
+pub const HOST_EULER: MethodCost = MethodCost { per_call: 3.0, per_eval: 6.82 };
 /// semi-implicit-euler: host ns, f64, fastest batch; fitted to 24 rows.
-pub const HOST_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 225.5, per_eval: 9.13 };
+pub const HOST_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 0.0, per_eval: 9.99 };
 /// rk4: host ns, f64, fastest batch; fitted to 22 rows.
-pub const HOST_RK4: MethodCost = MethodCost { per_call: 264.5, per_eval: 4.47 };
+pub const HOST_RK4: MethodCost = MethodCost { per_call: 86.0, per_eval: 4.94 };
 /// dp54: host ns, f64, fastest batch; fitted to 22 rows.
-pub const HOST_DP54: MethodCost = MethodCost { per_call: 536.1, per_eval: 15.22 };
+pub const HOST_DP54: MethodCost = MethodCost { per_call: 71.4, per_eval: 16.05 };
 /// closed: Cortex-M4F instructions, f32 libm, QEMU; fitted to 2 rows.
-pub const MCU_CLOSED: MethodCost = MethodCost { per_call: 389.0, per_eval: 0.00 };
+pub const MCU_CLOSED: MethodCost = MethodCost { per_call: 373.0, per_eval: 0.00 };
 /// euler: Cortex-M4F instructions, f32 libm, QEMU; fitted to 4 rows.
-pub const MCU_EULER: MethodCost = MethodCost { per_call: 901.2, per_eval: 58.06 };
+pub const MCU_EULER: MethodCost = MethodCost { per_call: 508.2, per_eval: 61.92 };
 /// semi-implicit-euler: Cortex-M4F instructions, f32 libm, QEMU; fitted to 4 rows.
-pub const MCU_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 1125.2, per_eval: 65.29 };
+pub const MCU_SEMI_IMPLICIT_EULER: MethodCost = MethodCost { per_call: 495.5, per_eval: 68.95 };
 /// rk4: Cortex-M4F instructions, f32 libm, QEMU; fitted to 10 rows.
-pub const MCU_RK4: MethodCost = MethodCost { per_call: 1123.7, per_eval: 25.88 };
+pub const MCU_RK4: MethodCost = MethodCost { per_call: 631.2, per_eval: 27.25 };
 /// dp54: Cortex-M4F instructions, f32 libm, QEMU; fitted to 10 rows.
-pub const MCU_DP54: MethodCost = MethodCost { per_call: 1743.4, per_eval: 73.53 };
+pub const MCU_DP54: MethodCost = MethodCost { per_call: 762.0, per_eval: 76.41 };

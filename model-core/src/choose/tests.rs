@@ -350,7 +350,8 @@ fn the_first_estimate_of_t_is_a_closed_form_at_a_mean_speed() {
 /// coarsest step from which every finer one meets the tolerance is the cheapest dependable
 /// RK4 plan (RK4 was the cheapest method on every scene of `bowl chart chooser`). The chosen
 /// plan must meet the tolerance, cost at most 1.25x that plan on the same table, and choosing
-/// must take fewer than 1,000 right-hand-side evaluations (737 at most on the chart's grid).
+/// must take fewer than 400 right-hand-side evaluations (290 at most on the chart's grid; 737
+/// before the flat model was probed at the pilot's coarsest steps).
 #[test]
 fn the_chosen_step_is_within_a_quarter_of_the_cheapest_and_choosing_is_bounded() {
     for (start, end, tau, mu) in [
@@ -396,7 +397,7 @@ fn the_chosen_step_is_within_a_quarter_of_the_cheapest_and_choosing_is_bounded()
             );
             let ratio = c.predicted_cost / cheapest;
             assert!(ratio <= 1.25, "{c:?}: {ratio:.3}x the cheapest");
-            assert!(c.choosing_evaluations < 1000, "{c:?}");
+            assert!(c.choosing_evaluations < 400, "{c:?}");
         }
     }
 }
@@ -435,4 +436,68 @@ proptest::proptest! {
             proptest::prop_assert!(m.scatter_rad_s.is_finite(), "{m:?}");
         }
     }
+}
+
+/// The tolerance on random spin-ups, each plan run against DP5(4) at rtol 1e-13: 4,000 scenes
+/// (mu 0.002 to 0.2, from rest or a random start to 1.5 to 8 rad/s, tau 0.05 to 5 s, ri 0.01
+/// to 0.095 m, tolerances 1e-2 to 1e-8; those that leave, about 3,200). The prediction can be
+/// off by more than the plan's 2x margin: 2 of them miss, by at most 6 % (before the crossing
+/// was located to `O(h^6)` and the pilot resolved the spin-up's time constant: 12 of 1,587 by
+/// up to 1.75x). Held at that level.
+#[test]
+fn random_spin_ups_meet_their_tolerance_but_for_rare_near_misses() {
+    let mut state = 987654321u64;
+    let mut uniform = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut scenes, mut misses, mut worst) = (0, 0, 0.0f64);
+    for _ in 0..4000 {
+        let mu = 0.002 * 100f64.powf(uniform());
+        let final_rad_s = 1.5 + 6.5 * uniform();
+        let start_rad_s = if uniform() < 0.5 {
+            0.0
+        } else {
+            final_rad_s * uniform()
+        };
+        let profile = SpinUp {
+            start_rad_s,
+            final_rad_s,
+            time_constant_s: 0.05 * 100f64.powf(uniform()),
+        };
+        let s = scene(final_rad_s, mu, 0.01 + 0.085 * uniform());
+        let tolerance = 10f64.powf(-2.0 - 6.0 * uniform());
+        let Ok(c) = choose_varying_for(&s, &Need::Tolerance(tolerance), &profile) else {
+            continue;
+        };
+        let Plan::Integrate(method) = c.plan else {
+            continue;
+        };
+        let limits = ode::Limits::for_scene(&s, &profile);
+        let time = |m| match ode::integrate(&s, c.model, &profile, m, limits)
+            .unwrap()
+            .outcome
+        {
+            ode::OdeOutcome::Leaves {
+                residence_time_s, ..
+            } => residence_time_s,
+            _ => f64::NAN,
+        };
+        let reference = time(ode::Method::Dp54 {
+            rtol: 1e-13,
+            atol: 1e-18,
+        });
+        let over = (time(method) - reference).abs() / reference / c.tolerance_rel;
+        assert!(over.is_finite(), "{c:?}");
+        scenes += 1;
+        misses += usize::from(over > 1.0);
+        worst = worst.max(over);
+    }
+    assert!(scenes > 3000, "{scenes}");
+    assert!(
+        misses <= 2 && worst <= 1.1,
+        "{misses} of {scenes}, worst {worst}"
+    );
 }

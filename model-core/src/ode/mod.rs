@@ -9,7 +9,7 @@
 //! time, where the hold lets go, so that no step straddles that kink (release.rs).
 //!
 //! Methods ([`Method`]): explicit Euler, semi-implicit Euler, RK4 (fixed step, event located by
-//! cubic Hermite interpolation) and adaptive Dormand-Prince 5(4) (event located on its dense
+//! quintic Hermite interpolation) and adaptive Dormand-Prince 5(4) (event located on its dense
 //! output). Every run reports the right-hand-side evaluations and steps, refuses a step beyond
 //! the method's stability limit instead of returning a wrong number, and stops at a step cap.
 //!
@@ -45,6 +45,15 @@ pub trait OmegaProfile<T> {
     /// false for a logged trace, linear between samples.
     fn is_smooth(&self) -> bool {
         true
+    }
+    /// The shortest time over which omega changes by a large part of itself, s (a spin-up's
+    /// time constant; infinite if unknown or constant): a step must resolve it for the error
+    /// to follow `C h^4` (the chooser's pilot starts no coarser).
+    fn time_scale_s(&self) -> T
+    where
+        T: Real,
+    {
+        T::INFINITY
     }
     /// The first time after `t_s` where omega's derivative jumps (a logged trace's next
     /// sample), `None` if there is none: the adaptive method ends a step there.
@@ -101,6 +110,16 @@ impl<T: Real> OmegaProfile<T> for SpinUp<T> {
     }
     fn max_omega_rad_s(&self) -> T {
         self.start_rad_s.max(self.final_rad_s)
+    }
+    fn time_scale_s(&self) -> T {
+        if self.start_rad_s == self.final_rad_s
+            || self.time_constant_s.is_nan()
+            || self.time_constant_s <= T::ZERO
+        {
+            T::INFINITY
+        } else {
+            self.time_constant_s
+        }
     }
     /// `t = tau ln((final - start) / (final - threshold))` on the way up; never on the way
     /// down from at or below it.
