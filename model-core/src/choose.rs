@@ -486,7 +486,7 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
 /// Where the Coriolis model is needed the effect is usually far above the tolerance (about 1 %
 /// on the rig's scenes), and a precise flat run (its error within 1/32 of the tolerance, twice
 /// the evaluations of the plan) only confirms it. So a probe goes first: the flat model at the
-/// pilot's two coarsest steps, `h` and `h/2` (3/15 of the pilot), its error at `h/2` taken
+/// pilot's two coarsest steps, `h` and `h/2` (a fifth of the pilot), its error at `h/2` taken
 /// from their difference at the pilot's order (Richardson) and doubled, both extrapolated
 /// `T` compared. When even the effect less both errors exceeds what the flat model could
 /// use (3/4 of the tolerance), the Coriolis model is settled. Otherwise, and where the precise
@@ -503,23 +503,12 @@ fn flat_effect<T: Real, P: OmegaProfile<T>>(
     let flat_step = coriolis.step_for(tolerance * T::from_f64(1.0 / 32.0));
     let coarse = coriolis.coarsest_step_s;
     let mut spent = 0u32;
-    // The probe costs 1.5 runs at `h`; the precise run `h / flat_step` of them.
-    if coriolis.kind == pilot::Kind::Rk4 && flat_step * T::from_f64(1.5) < coarse {
-        let (t_h, e1) = run(
-            scene,
-            Model::Flat,
-            profile,
-            Method::Rk4 { step_s: coarse },
-            limits,
-        )?;
+    // The probe costs three runs at `h` (one at `h`, one at `h/2`); the precise run
+    // `h / flat_step` of them.
+    if coriolis.kind == pilot::Kind::Rk4 && flat_step * T::from_f64(3.0) < coarse {
+        let flat_at = |step_s| run(scene, Model::Flat, profile, Method::Rk4 { step_s }, limits);
         let half = coarse * T::HALF;
-        let (t_half, e2) = run(
-            scene,
-            Model::Flat,
-            profile,
-            Method::Rk4 { step_s: half },
-            limits,
-        )?;
+        let ((t_h, e1), (t_half, e2)) = (flat_at(coarse)?, flat_at(half)?);
         spent = e1.saturating_add(e2);
         if t_h.is_finite() && t_half.is_finite() {
             let excess = T::from_f64(15.0);

@@ -107,8 +107,8 @@ pub fn run(
     })?;
     // The speed the particle saw is known as well as the trace measured it: that, not the
     // loop's default 1 %, is omega's uncertainty unless --uncertainty states one.
-    // Judged over twice the first estimate of the residence time (the whole trace without
-    // one).
+    // Judged over twice a first estimate of the residence time (the whole trace without one
+    // or beyond its end).
     let window_s = model_core::choose::residence_estimate_s(scene, &profile)
         .map_or(f64::INFINITY, |t| 2.0 * t);
     let measured = profile.measurement(LOGGED_SPEED_RESOLUTION_RAD_S, window_s);
@@ -243,11 +243,11 @@ fn measurement_words(
     let over = if judged_over_s.is_finite() {
         format!("over its first {judged_over_s:.3} s (twice a first estimate of T)")
     } else {
-        "over the whole trace (no first estimate of T: the particle waits for the speed)".into()
+        "over the whole trace".into()
     };
     let known = format!(
-        "{over} the trace knows the speed to +-{:.3} % of its mean {:.3} rad/s (+-{:.1} mrad/s logged to whole mrad/s, \
-         {:.2} mrad/s RMS scatter about its neighbours' line)",
+        "{over} the trace knows the speed to +-{:.3} % of its mean {:.3} rad/s (+-{:.1} \
+         mrad/s logged to whole mrad/s, {:.2} mrad/s RMS scatter about its neighbours' line)",
         100.0 * m.relative,
         m.mean_rad_s,
         1e3 * m.rounding_rad_s,

@@ -9,7 +9,7 @@
 //! (Richardson), the extrapolated `T` is better still, and the step that meets a tolerance
 //! follows from `C h^p`, never coarser than `h` (the coarsest step the ratios vouch for).
 //! Otherwise every step is halved and one finer run added. On `bowl chart chooser`'s grid the
-//! pilot and the rest of the choice took 170 to 290 right-hand-side evaluations, where the
+//! pilot and the rest of the choice took 165 to 290 right-hand-side evaluations, where the
 //! search it replaces ran a tight DP5(4) reference and dozens of candidate plans. A speed with
 //! kinks (a logged trace) has no such regime: [`dp54`] calibrates DP5(4) instead.
 
