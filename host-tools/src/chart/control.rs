@@ -102,7 +102,9 @@ pub fn settling_points(extent: Extent, seed: u32) -> Vec<SettlingPoint> {
 pub fn pulse_limit_knee(cfg: &ControllerConfig, speed_rad_s: f32) -> f64 {
     // The spin axis, whose settling is the later one.
     let a = &cfg.axes[1];
-    let pulses_per_s_per_rev = f64::from(speed_rad_s) / std::f64::consts::TAU;
+    // The schedule holds its value above its top speed (`pi::SCHEDULE_TOP_RAD_S`).
+    let scheduled_at = speed_rad_s.min(model_core::control::pi::SCHEDULE_TOP_RAD_S);
+    let pulses_per_s_per_rev = f64::from(scheduled_at) / std::f64::consts::TAU;
     f64::from(a.bandwidth_rad_s) / (f64::from(a.per_pulse_bandwidth) * pulses_per_s_per_rev)
 }
 
@@ -211,7 +213,7 @@ pub fn settling_chart(points: &[SettlingPoint]) -> (Figure, Table) {
             "0.5 s); seed 1; the simulator's true speed.".into(),
             format!("Left of N = {knee:.0} the loop bandwidth is"),
             format!(
-                "{} x pulse rate (the schedule): the pulse",
+                "{} x pulse rate at <= 2.1 rad/s (the schedule): the pulse",
                 cfg.axes[1].per_pulse_bandwidth
             ),
             format!(

@@ -502,11 +502,11 @@ impl Controller {
         &self.cfg
     }
 
-    /// The speed loop's gains on `axis` at its full bandwidth (the schedule lowers both in
+    /// The speed loop's gains on `axis` at its bandwidth ceiling (the schedule lowers both in
     /// proportion at sparse pulses): `(kp, ki)` in duty per rad/s and duty per rad.
     pub fn loop_gains(&self, axis: usize) -> Option<(f32, f32)> {
         let k = &self.axes.get(axis)?.k;
-        let wc = self.cfg.axes.get(axis)?.bandwidth_rad_s;
+        let wc = super::pi::bandwidth_ceiling_rad_s(self.cfg.axes.get(axis)?);
         Some((k.kp(wc), k.ki_per_s(wc)))
     }
 

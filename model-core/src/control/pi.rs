@@ -19,8 +19,10 @@
 //! The plant from duty to speed is `K / (tau s + 1)` with `K = V / volts_per_rad_s`. The PI zero
 //! cancels the pole (`Ti = tau`) and `Kp = wc tau / K`, `Ki = wc / K` give a first-order closed
 //! loop of bandwidth `wc`. `wc = min(bandwidth, per_pulse_bandwidth * pulse_rate)`, with the pulse
-//! rate at the reference speed: sparse pulses sample the speed slowly, and a loop faster than
-//! about a fifth of the sample rate rings or limit-cycles (see docs/control.md's stability map).
+//! rate at the reference speed up to [`SCHEDULE_TOP_RAD_S`]: sparse pulses sample the speed
+//! slowly, and a loop faster than about a fifth of the sample rate rings or limit-cycles (see
+//! docs/control.md's stability map); above that speed a loop as fast as the revolution chases
+//! the wheel's once-per-revolution pattern.
 //!
 //! # Anti-windup, bumpless changes, zero setpoint
 //! The integral stores its *output* (duty), so changing `Ki` never moves the duty; when `Kp`
@@ -152,6 +154,30 @@ const fn pair_runaway_above_rad_s(axis: &AxisConfig, supply_v: f32) -> f32 {
     (PAIR_RUNAWAY_ARMED_SHARE * full - RUNAWAY_MARGIN_RAD_S) / RUNAWAY_RATIO
 }
 
+/// The speed above which the gain schedule stops raising the loop's bandwidth with the pulse
+/// rate, rad/s. The tooth map leaves the wheel's once-per-revolution pattern visible (it cannot
+/// be told from an eccentric load, teeth.rs), so the loop sees it as a speed error at the
+/// revolution frequency; a loop as fast as the revolution (the schedule gives `0.95 omega` on
+/// 12 teeth) chases it. Measured on the 60-plant family and six unseen ones at 3 rad/s, 12
+/// teeth: scheduled up to 3 rad/s (2.9 rad/s of bandwidth) the true speed rippled up to 2.06 %;
+/// held from 2.1 rad/s on (2.0 rad/s of bandwidth), 1.84 % at most, overshoot and 3 s settling
+/// unchanged or better. The pattern shrinks as the teeth multiply (as `N^-1.5` for random
+/// offsets) while the bandwidth held grows with them: at 60 teeth it (10 rad/s) lies above the
+/// configured ceiling, and those loops are unchanged.
+pub const SCHEDULE_TOP_RAD_S: f32 = 2.1;
+
+/// The loop's bandwidth ceiling on `axis`: the configured one, or the schedule's value at
+/// [`SCHEDULE_TOP_RAD_S`] where that is lower.
+pub const fn bandwidth_ceiling_rad_s(axis: &AxisConfig) -> f32 {
+    let pulses_per_rad = axis.pulses_per_rev as f32 / core::f32::consts::TAU;
+    let at_top = axis.per_pulse_bandwidth * pulses_per_rad * SCHEDULE_TOP_RAD_S;
+    if at_top < axis.bandwidth_rad_s {
+        at_top
+    } else {
+        axis.bandwidth_rad_s
+    }
+}
+
 impl LoopConstants {
     /// Constants for `axis` at tick period `dt_s` and supply `supply_v`.
     pub const fn new(axis: &AxisConfig, dt_s: f32, supply_v: f32) -> Self {
@@ -166,7 +192,7 @@ impl LoopConstants {
             model_alpha: dt_s / (axis.model.time_constant_s + dt_s),
             kp_per_wc: axis.model.time_constant_s * axis.model.volts_per_rad_s / supply_v,
             ki_dt_per_wc: dt_s * axis.model.volts_per_rad_s / supply_v,
-            bandwidth_rad_s: axis.bandwidth_rad_s,
+            bandwidth_rad_s: bandwidth_ceiling_rad_s(axis),
             per_pulse_bw_times_pulses_per_rad: axis.per_pulse_bandwidth * pulses_per_rad,
             filter_weight: w,
             // Per tick and per rad/s of reference: the model covers the push's pitches in

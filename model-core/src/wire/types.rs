@@ -268,9 +268,10 @@ pub struct AxisModel {
     pub friction_ppm: u32,
     /// Mechanical time constant, microseconds.
     pub time_constant_us: u32,
-    /// Proportional gain at the full loop bandwidth, duty ppm per rad/s of speed error.
+    /// Proportional gain at the loop's bandwidth ceiling (`control::pi::bandwidth_ceiling_rad_s`),
+    /// duty ppm per rad/s of speed error.
     pub kp_ppm_per_rad_s: u32,
-    /// Integral gain at the full loop bandwidth, duty ppm per rad of accumulated speed error.
+    /// Integral gain at the same bandwidth, duty ppm per rad of accumulated speed error.
     pub ki_ppm_per_rad: u32,
 }
 

@@ -248,7 +248,11 @@ fn models_report_the_models_and_gains_in_force() {
         assert_eq!(f64::from(a.friction_ppm), ppm(m.friction_duty));
         assert_eq!(f64::from(a.time_constant_us), ppm(m.time_constant_s));
         let ke_v = f64::from(m.volts_per_rad_s) / f64::from(cfg.supply_v);
-        let wc = f64::from(c.bandwidth_rad_s);
+        // The ceiling: the configured bandwidth, or the per-pulse schedule at 2.1 rad/s.
+        let at_top = f64::from(c.per_pulse_bandwidth) * f64::from(c.pulses_per_rev)
+            / std::f64::consts::TAU
+            * 2.1;
+        let wc = f64::from(c.bandwidth_rad_s).min(at_top);
         let kp = f64::from(m.time_constant_s) * ke_v * wc * 1e6;
         let ki = ke_v * wc * 1e6;
         assert!((f64::from(a.kp_ppm_per_rad_s) - kp).abs() <= 1e-5 * kp + 1.0);
