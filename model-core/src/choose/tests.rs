@@ -291,14 +291,10 @@ fn a_traces_measurement_uncertainty_is_its_rounding_and_scatter() {
     assert!((m.relative - 0.5e-3 / m.mean_rad_s).abs() < 1e-15, "{m:?}");
     // Noise uniform in +-a: RMS a / sqrt(3).
     let a = 0.03;
-    let mut state = 12345u64;
+    let mut uniform = crate::particle::tests::uniform_stream(12345);
     let (_, mut noisy) = sampled(|_| 3.0);
     for w in noisy.iter_mut() {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        let u = (state >> 11) as f64 / (1u64 << 53) as f64;
-        *w += a * (2.0 * u - 1.0);
+        *w += a * (2.0 * uniform() - 1.0);
     }
     let trace = SampledOmega::new(&ts, &noisy).unwrap();
     let m = trace.measurement(1e-3, f64::INFINITY);
@@ -446,13 +442,7 @@ proptest::proptest! {
 /// up to 1.75x). Held at that level.
 #[test]
 fn random_spin_ups_meet_their_tolerance_but_for_rare_near_misses() {
-    let mut state = 987654321u64;
-    let mut uniform = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = crate::particle::tests::uniform_stream(987_654_321);
     let (mut scenes, mut misses, mut worst) = (0, 0, 0.0f64);
     for _ in 0..4000 {
         let mu = 0.002 * 100f64.powf(uniform());

@@ -105,11 +105,10 @@ mod tests {
     use super::*;
 
     /// Crossings inside a step, as RK4 hands them over (r, h v at both ends): the root is the
-    /// one plain bisection finds (100 halvings, independent of Newton) to within what rounding of
-    /// `r` moves it, and Newton gets there
-    /// in a few evaluations. Before the convergence test came first, a converged Newton step
-    /// that landed on the bracket's end was taken for leaving it: 34 and 51 iterations of
-    /// bisection on two of these.
+    /// one plain bisection finds (100 halvings, independent of Newton) to within what rounding
+    /// of `r` moves it, and Newton gets there in a few evaluations. Before the convergence test
+    /// came first, a converged Newton step that landed on the bracket's end was taken for
+    /// leaving it: 34 and 51 iterations of bisection on two of these.
     #[test]
     fn the_crossing_is_found_in_a_few_newton_steps() {
         for (r0, v0, r1, v1, h) in [

@@ -96,9 +96,9 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
         if r1 >= rim {
             let t1 = t + h;
             let (_, a1) = rhs.eval(t1, r1, v1)?;
-            let (h2, a0h, a1h) = (h * h, a0, a1);
+            let h2 = h * h;
             let theta = locate(
-                |th| hermite5(r, h * v, h2 * a0h, r1, h * v1, h2 * a1h, th),
+                |th| hermite5(r, h * v, h2 * a0, r1, h * v1, h2 * a1, th),
                 rim,
             );
             let (v_exit, _) = hermite(v, h * a0, v1, h * a1, theta);

@@ -151,13 +151,7 @@ mod tests {
     /// aside.)
     #[test]
     fn the_rigs_scenes_are_answered_by_the_lanes() {
-        let mut seed = 12345u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::particle::tests::uniform_stream(12345);
         let mut answered = 0;
         let groups = 200;
         for _ in 0..groups {

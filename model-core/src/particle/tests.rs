@@ -4,6 +4,18 @@
 use super::*;
 use proptest::prelude::*;
 
+/// Uniform numbers in [0, 1) from a 64-bit LCG seeded with `seed`: reproducible random
+/// scenes for the chooser's and the Coriolis batch's tests.
+pub(crate) fn uniform_stream(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// A test scene: Earth gravity, a rolling sphere (k2 = 5/7); also used by the ode and choose tests.
 pub(crate) fn scene(omega: f64, mu: f64, ri: f64, rim: f64) -> Scene<f64> {
     Scene {
