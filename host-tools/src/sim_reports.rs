@@ -277,6 +277,10 @@ pub struct FaultOutcome {
     pub bound_s: f64,
     /// Highest true speed of the faulted axis between injection and detection, rad/s.
     pub peak_speed_rad_s: f64,
+    /// True speed of the faulted axis in the tick that saw its first edge after the injection,
+    /// rad/s: no rule judging edges can stop the motor sooner, so a peak at this speed is the
+    /// sensor's limit, not the controller's. None when no edge came before detection.
+    pub first_edge_speed_rad_s: Option<f64>,
     /// Both duties were zero in the tick the fault latched.
     pub pwm_zero: bool,
     /// Still latched, duties zero, one second later.
@@ -401,11 +405,20 @@ fn inject(mut cl: ClosedLoop, what: Injected, axis: usize, bound_s: f64) -> Faul
     let mut detected = None;
     let mut pwm_zero = false;
     let mut peak: f64 = 0.0;
+    let mut first_edge_speed = None;
     let limit = (3.0 * bound_s + 2.0) as f32;
     let ticks = (limit / cl.dt_s()) as u32;
-    for _ in 0..ticks {
+    for tick in 0..ticks {
         if heartbeat {
             cl.ctrl.host_heartbeat();
+        }
+        // The first tick's edges came before the injection.
+        if tick > 0
+            && detected.is_none()
+            && first_edge_speed.is_none()
+            && !cl.rig.edges(axis).is_empty()
+        {
+            first_edge_speed = Some(cl.rig.speed_rad_s(axis).abs() as f64);
         }
         let duties = cl.tick();
         if detected.is_none() {
@@ -429,6 +442,7 @@ fn inject(mut cl: ClosedLoop, what: Injected, axis: usize, bound_s: f64) -> Faul
         detected_s: detected,
         bound_s,
         peak_speed_rad_s: peak,
+        first_edge_speed_rad_s: first_edge_speed,
         pwm_zero,
         latched,
     }

@@ -355,3 +355,39 @@ fn speeds_below_what_the_pulses_can_measure_are_refused() {
     );
     assert!(cl.ctrl.set_motor_speeds(1.6, 1.6).is_ok());
 }
+
+#[test]
+fn a_bridge_stuck_on_near_the_top_speed_is_caught_by_the_duty_below_the_model() {
+    // A supply at which full duty drives the spin only 8 % above a 3 rad/s setpoint: one or
+    // two early intervals cannot tell that from tooth offsets, but the loop lowers its duty
+    // against the excess speed while the shaft keeps it.
+    let mut rig = rig_with_pulses(12);
+    let spin = rig.axes[1].motor;
+    let (volts_per_rad_s, _, _) = spin.ideal_model(12.0);
+    let top_rad_s = 3.24;
+    rig.supply_v =
+        top_rad_s * volts_per_rad_s + spin.resistance_ohm * spin.coulomb_nm / spin.torque_constant;
+    let mut cl = running_loop(rig, |c| c.supply_v = rig.supply_v);
+    cl.ctrl.set_motor_speeds(1.0, 3.0).unwrap();
+    cl.ctrl.start().unwrap();
+    cl.run(8.0, |c| assert_eq!(c.ctrl.fault(), None, "a healthy shaft faulted"));
+    assert_eq!(cl.ctrl.state(), State::Running);
+    let t0 = cl.rig.time_s() as f32;
+    cl.rig.params_mut().axes[1].faults.bridge_stuck_from_s = t0;
+    let mut peak = 0.0f32;
+    let mut detected = None;
+    for k in 0..3_000 {
+        let d = cl.tick();
+        peak = peak.max(cl.rig.speed_rad_s(1));
+        if cl.ctrl.fault().is_some() {
+            assert_eq!(d, [0.0, 0.0], "duties not zero in the fault tick");
+            detected = Some((k + 1) as f32 * cl.dt_s());
+            break;
+        }
+    }
+    assert_eq!(cl.ctrl.fault(), Some(Fault::Overspeed(1)));
+    let t = detected.unwrap();
+    // Measured 0.67 s (never without the duty rule).
+    assert!(t < 1.0, "detected after {t} s");
+    assert!(peak < 1.1 * 3.0, "peak {peak} rad/s");
+}

@@ -17,8 +17,8 @@ use super::config::{ConfigError, ControllerConfig};
 use super::pi::LoopInput;
 use super::planner::{InverseFailure, ResidenceForBowlSpeed, SetpointPlanner};
 use super::supervisor::{
-    Fault, PAIR_RUNAWAY_MARGIN_RAD_S, PAIR_RUNAWAY_RATIO, PAIR_RUNAWAY_STEADY_S,
-    RUNAWAY_MARGIN_RAD_S, RUNAWAY_RATIO, State, fault_code,
+    DRIVEN_BELOW_MODEL_DUTY, Fault, PAIR_RUNAWAY_MARGIN_RAD_S, PAIR_RUNAWAY_RATIO,
+    PAIR_RUNAWAY_STEADY_S, RUNAWAY_MARGIN_RAD_S, RUNAWAY_RATIO, State, fault_code,
 };
 use crate::bowl::{MotorSpeeds, combined_speed_from_trig};
 
@@ -134,13 +134,16 @@ const fn decouple_duty_per_rad_s(cfg: &ControllerConfig) -> f32 {
     }
 }
 
-/// The two-interval runaway rule (see [`PAIR_RUNAWAY_RATIO`]), once armed near the top speed;
-/// out of line: it runs only on edges near the top speed and keeps the tick's common path short.
+/// The runaway rules near the top speed, where full duty takes the shaft too little above its
+/// reference for one interval to show it: the two-interval rule (see [`PAIR_RUNAWAY_RATIO`]) and
+/// the duty fallen below the model (see [`DRIVEN_BELOW_MODEL_DUTY`]). Out of line: they run only
+/// on edges near the top speed and keep the tick's common path short.
 #[cold]
 #[inline(never)]
-fn pair_runaway(a: &AxisState, model_rad_s: f32, steady_s: f32) -> bool {
-    steady_s > PAIR_RUNAWAY_STEADY_S
-        && a.est.pair_speed_rad_s() > PAIR_RUNAWAY_RATIO * model_rad_s + PAIR_RUNAWAY_MARGIN_RAD_S
+fn near_top_runaway(a: &AxisState, model_rad_s: f32, steady_s: f32) -> bool {
+    (steady_s > PAIR_RUNAWAY_STEADY_S
+        && a.est.pair_speed_rad_s() > PAIR_RUNAWAY_RATIO * model_rad_s + PAIR_RUNAWAY_MARGIN_RAD_S)
+        || a.duty * a.direction < a.k.steady_duty(model_rad_s) - DRIVEN_BELOW_MODEL_DUTY
 }
 
 impl Controller {
@@ -221,7 +224,8 @@ impl Controller {
             let runaway = self.reached && seen[i] && {
                 let model = a.speed_loop.model_rad_s().abs();
                 a.est.edge_speed_rad_s() > RUNAWAY_RATIO * model + RUNAWAY_MARGIN_RAD_S
-                    || (model > a.k.pair_runaway_above_rad_s() && pair_runaway(a, model, steady[i]))
+                    || (model > a.k.pair_runaway_above_rad_s()
+                        && near_top_runaway(a, model, steady[i]))
             };
             if speed > self.cfg.axes[i].overspeed_rad_s || runaway {
                 self.latch(Fault::Overspeed(i as u8));
