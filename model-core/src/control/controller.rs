@@ -18,7 +18,9 @@ use super::pi::LoopInput;
 use super::planner::{InverseFailure, ResidenceForBowlSpeed, SetpointPlanner};
 use super::supervisor::{
     DRIVEN_BELOW_MODEL_DUTY, Fault, PAIR_RUNAWAY_MARGIN_RAD_S, PAIR_RUNAWAY_RATIO,
-    PAIR_RUNAWAY_STEADY_S, RUNAWAY_MARGIN_RAD_S, RUNAWAY_RATIO, State, fault_code,
+    PAIR_RUNAWAY_STEADY_S, REVOLUTION_RUNAWAY_DUTY, REVOLUTION_RUNAWAY_MARGIN_RAD_S,
+    REVOLUTION_RUNAWAY_RATIO, RUNAWAY_MARGIN_RAD_S, RUNAWAY_RATIO, SETTLED_AFTER_S, State,
+    fault_code,
 };
 use crate::bowl::{MotorSpeeds, combined_speed_from_trig};
 
@@ -135,8 +137,9 @@ const fn decouple_duty_per_rad_s(cfg: &ControllerConfig) -> f32 {
 }
 
 /// The runaway rules near the top speed, where full duty takes the shaft too little above its
-/// reference for one interval to show it: the two-interval rule (see [`PAIR_RUNAWAY_RATIO`]) and
-/// the duty fallen below the model (see [`DRIVEN_BELOW_MODEL_DUTY`]). Out of line: they run only
+/// reference for one interval to show it: the two-interval rule (see [`PAIR_RUNAWAY_RATIO`]),
+/// the whole revolution's mean (see [`REVOLUTION_RUNAWAY_RATIO`]) and the duty fallen below the
+/// model (see [`DRIVEN_BELOW_MODEL_DUTY`]). Out of line: they run only
 /// on edges near the top speed and keep the tick's common path short.
 #[cold]
 #[inline(never)]
@@ -144,6 +147,15 @@ fn near_top_runaway(a: &AxisState, model_rad_s: f32, steady_s: f32) -> bool {
     (steady_s > PAIR_RUNAWAY_STEADY_S
         && a.est.pair_speed_rad_s() > PAIR_RUNAWAY_RATIO * model_rad_s + PAIR_RUNAWAY_MARGIN_RAD_S)
         || a.duty * a.direction < a.k.steady_duty(model_rad_s) - DRIVEN_BELOW_MODEL_DUTY
+        || (a.duty * a.direction < a.k.steady_duty(model_rad_s) - REVOLUTION_RUNAWAY_DUTY
+            && revolution_runaway(a.est.revolution_speed_rad_s(), model_rad_s, steady_s))
+}
+
+/// The whole-revolution rule (see [`REVOLUTION_RUNAWAY_RATIO`]): only once the last revolution
+/// began after the loop had settled.
+fn revolution_runaway(revolution_rad_s: f32, model_rad_s: f32, steady_s: f32) -> bool {
+    revolution_rad_s > REVOLUTION_RUNAWAY_RATIO * model_rad_s + REVOLUTION_RUNAWAY_MARGIN_RAD_S
+        && steady_s > SETTLED_AFTER_S + core::f32::consts::TAU / revolution_rad_s
 }
 
 impl Controller {

@@ -388,6 +388,15 @@ impl PulseSpeedEstimator {
             0.0
         }
     }
+    /// Mean speed over the last whole revolution, rad/s (0 until the tooth map's chain spans a
+    /// revolution at a steady reference): neither tooth offsets nor a once-per-revolution load
+    /// move it, so a small lasting excess shows in it.
+    pub fn revolution_speed_rad_s(&self) -> f32 {
+        match self.teeth.revolution_ticks() {
+            Some(t) => core::f32::consts::TAU * self.ticks_per_s / t as f32,
+            None => 0.0,
+        }
+    }
     /// True when no edge has come since the shaft last stopped (or ever).
     pub fn at_rest(&self) -> bool {
         !self.has_edge

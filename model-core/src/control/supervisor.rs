@@ -90,6 +90,25 @@ pub const PAIR_RUNAWAY_RATIO: f32 = 1.1;
 pub const PAIR_RUNAWAY_ARMED_SHARE: f32 = 0.8;
 /// See [`PAIR_RUNAWAY_RATIO`], rad/s.
 pub const PAIR_RUNAWAY_MARGIN_RAD_S: f32 = 0.1;
+/// Near the top speed, the mean speed over the last whole revolution faster than this many
+/// times the model's speed (plus the margin) is a runaway too: tooth offsets and a
+/// once-per-revolution load cancel over a revolution, and a settled loop holds its mean on the
+/// model, so a few per mille is evidence. On the seven 60-plant families (family-60, seeds 3 to
+/// 8) at 0.2, 0.5, 1 and 3 rad/s no healthy shaft's revolution ran above 1.0025 x model +
+/// 0.0025 rad/s once settled (7 of 420 did above 1 x model); twice that is the rule. A bridge
+/// stuck on that full duty takes 9 % above its reference adds 0.7 % per interval.
+pub const REVOLUTION_RUNAWAY_RATIO: f32 = 1.005;
+/// See [`REVOLUTION_RUNAWAY_RATIO`], rad/s.
+pub const REVOLUTION_RUNAWAY_MARGIN_RAD_S: f32 = 0.005;
+/// The revolution rule also needs the duty this far below what the identified model needs:
+/// a shaft that sped up because material left the bowl ran as fast for a revolution, but its
+/// loop holds it on more duty than the model (the load's share still coming down), while a
+/// bridge stuck on drives the loop's duty below the model.
+pub const REVOLUTION_RUNAWAY_DUTY: f32 = 0.01;
+/// Seconds of steady reference after which a loop has settled (the 2 % settling target): a
+/// revolution judged by [`REVOLUTION_RUNAWAY_RATIO`] must begin after it.
+pub const SETTLED_AFTER_S: f32 = 3.0;
+
 /// A shaft that holds its reference on this much less duty than the identified model needs is
 /// driven by something else (a bridge stuck on whose full duty takes it only a little above
 /// the reference, below what [`PAIR_RUNAWAY_RATIO`] can tell from tooth offsets): the loop

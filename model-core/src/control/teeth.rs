@@ -223,6 +223,16 @@ impl ToothMap {
         pitches
     }
 
+    /// The last whole revolution's length, ticks, once the chain of learned gaps spans one
+    /// (at a steady reference); tooth offsets and a once-per-revolution load cancel in it.
+    pub fn revolution_ticks(&self) -> Option<u32> {
+        if self.teeth >= 2 && self.chain == self.teeth && self.revolution_ticks > 0 {
+            Some(self.revolution_ticks)
+        } else {
+            None
+        }
+    }
+
     /// Learns from the oldest waiting gap (the estimator calls this in ticks without an edge).
     pub fn learn_pending(&mut self) {
         let n = self.teeth as usize;
@@ -364,6 +374,28 @@ mod tests {
             "{rms_learned} vs {rms_plain}"
         );
         assert!(map.revolutions_learned() >= 10);
+    }
+
+    #[test]
+    fn the_revolution_is_the_last_whole_turn_of_gaps() {
+        let e = offsets();
+        let mut map = ToothMap::new(12, 1e6);
+        let mut index = 0;
+        let mut last = [0u32; 12];
+        for k in 0..30u32 {
+            index = (index + 1) % 12;
+            // Slowing down: each gap 1 % longer than the one before.
+            let dt = (gap_ticks(&e, index) as f64 * 1.01f64.powi(k as i32)).round() as u32;
+            last[k as usize % 12] = dt;
+            map.edge(dt, 1, true);
+            map.learn_pending();
+            let want = (k >= 11).then(|| last.iter().sum::<u32>());
+            assert_eq!(map.revolution_ticks(), want, "edge {k}");
+        }
+        // A break in the chain (an edge not learned from) starts the revolution afresh.
+        map.edge(1000, 1, false);
+        map.learn_pending();
+        assert_eq!(map.revolution_ticks(), None);
     }
 
     #[test]
