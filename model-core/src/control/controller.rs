@@ -139,15 +139,17 @@ const fn decouple_duty_per_rad_s(cfg: &ControllerConfig) -> f32 {
 /// The runaway rules near the top speed, where full duty takes the shaft too little above its
 /// reference for one interval to show it: the two-interval rule (see [`PAIR_RUNAWAY_RATIO`]),
 /// the whole revolution's mean (see [`REVOLUTION_RUNAWAY_RATIO`]) and the duty fallen below the
-/// model (see [`DRIVEN_BELOW_MODEL_DUTY`]). Out of line: they run only
-/// on edges near the top speed and keep the tick's common path short.
+/// model (see [`DRIVEN_BELOW_MODEL_DUTY`]). Out of line: they run only on edges near the top
+/// speed and keep the tick's common path short.
 #[cold]
 #[inline(never)]
 fn near_top_runaway(a: &AxisState, model_rad_s: f32, steady_s: f32) -> bool {
+    // `model_rad_s` > 0 here: the feedforward of the shaft's direction, made positive.
+    let duty_below_model = a.k.feedforward(model_rad_s) - a.duty * a.direction;
     (steady_s > PAIR_RUNAWAY_STEADY_S
         && a.est.pair_speed_rad_s() > PAIR_RUNAWAY_RATIO * model_rad_s + PAIR_RUNAWAY_MARGIN_RAD_S)
-        || a.duty * a.direction < a.k.steady_duty(model_rad_s) - DRIVEN_BELOW_MODEL_DUTY
-        || (a.duty * a.direction < a.k.steady_duty(model_rad_s) - REVOLUTION_RUNAWAY_DUTY
+        || duty_below_model > DRIVEN_BELOW_MODEL_DUTY
+        || (duty_below_model > REVOLUTION_RUNAWAY_DUTY
             && revolution_runaway(a.est.revolution_speed_rad_s(), model_rad_s, steady_s))
 }
 

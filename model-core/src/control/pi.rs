@@ -149,13 +149,6 @@ pub struct LoopConstants {
 /// full-duty speed `(1 - friction_duty) V / volts_per_rad_s` is within reach of it (80 % of it:
 /// material poured in since commissioning lowers the true one). Above it the controller also
 /// judges the last two intervals together.
-impl LoopConstants {
-    /// The duty the identified model needs to hold `speed_rad_s` (>= 0) at steady state.
-    pub fn steady_duty(&self, speed_rad_s: f32) -> f32 {
-        self.friction_duty + speed_rad_s * self.duty_per_rad_s
-    }
-}
-
 const fn pair_runaway_above_rad_s(axis: &AxisConfig, supply_v: f32) -> f32 {
     let full = (1.0 - axis.model.friction_duty) * supply_v / axis.model.volts_per_rad_s;
     (PAIR_RUNAWAY_ARMED_SHARE * full - RUNAWAY_MARGIN_RAD_S) / RUNAWAY_RATIO
