@@ -1,5 +1,6 @@
 //! A closed pipe is not a crash: `bowl sim sweep | head -1` and `bowl monitor PORT | head -2`
-//! end the way Unix tools do (SIGPIPE, or quietly), never with a panic. A run that cannot be
+//! end the way Unix tools do (SIGPIPE, or quietly), never with a panic; `bowl chart` writes
+//! every file all the same. A run that cannot be
 //! measured (`sim step --pulses-per-rev 0`) is refused with the flag, the value and the range.
 
 mod common;
@@ -67,4 +68,40 @@ fn a_step_with_no_pulses_is_refused_in_plain_words() {
     assert_eq!(out.status.code(), Some(2), "a usage error");
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("'0'") && err.contains("1..=65535"), "{err}");
+}
+
+#[test]
+fn a_chart_into_a_closed_pipe_still_writes_every_file() {
+    // The files are the product: a reader gone before the first "wrote" line must not stop
+    // the svg, png and csv from being written.
+    let dir = std::env::temp_dir().join(format!("bowl-closed-pipe-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("radial.svg");
+    let mut child = Command::new(BOWL)
+        .args(["chart", "radial", "--out", svg.to_str().unwrap()])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let status = wait_within(&mut child, Duration::from_secs(60), "bowl chart radial");
+    let mut err = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    assert_eq!(status.code(), Some(0), "{status:?}: {err}");
+    for ext in ["svg", "png", "csv"] {
+        let f = svg.with_extension(ext);
+        assert!(
+            std::fs::metadata(&f).is_ok_and(|m| m.len() > 0),
+            "{} not written",
+            f.display()
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -317,13 +317,13 @@ pub fn chart() -> Result<(Figure, Figure, Table)> {
             "near the tolerance), the step from C h^p".into(),
         ],
     };
-    println!(
+    super::say(&format!(
         "chooser: {n} scenes, worst cost ratio {worst:.3} ({within} within 1.25x), against the \
          dependable cheapest {worst_dependable:.3} ({within_dependable} within 1.25x), tolerance \
          missed {misses} times; choosing took {choosing_median:.1}x the plan's time (median), \
          {choosing_worst:.1}x worst; it paid for itself in one run on {pays_in_one} of {n} \
          scenes against DP5(4) at a tenth of the tolerance (runs to pay: median \
          {payback_median:.2}, worst {payback_worst:.2})"
-    );
+    ));
     Ok((fig, cost, table))
 }

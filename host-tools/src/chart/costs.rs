@@ -135,7 +135,7 @@ pub fn table_source(csv_path: &Path) -> Result<String> {
 pub fn write(csv_path: &Path, out: &Path) -> Result<()> {
     let text = table_source(csv_path)?;
     std::fs::write(out, text).with_context(|| format!("cannot write {}", out.display()))?;
-    println!("wrote {}", out.display());
+    super::say(&format!("wrote {}", out.display()));
     Ok(())
 }
 

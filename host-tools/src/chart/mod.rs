@@ -244,16 +244,16 @@ fn work_precision(args: &WorkPrecision) -> Result<()> {
     let points = workprec::measure(budget, &qemu, &args.families)?;
     let table = workprec::table(&points);
     // A compact view of the main scene for the terminal (the CSV has everything).
-    println!("paper scene, Coriolis model:");
-    println!(
+    say("paper scene, Coriolis model:");
+    say(&format!(
         "{:<40} {:>10} {:>8} {:>12} {:>10}",
         "method", "rel.error", "RHS", "host ns", "M4F instr"
-    );
+    ));
     for p in points
         .iter()
         .filter(|p| p.scene == "paper" && p.model == Model::Coriolis)
     {
-        println!(
+        say(&format!(
             "{:<40} {:>10} {:>8} {:>12.1} {:>10}",
             p.method.key(),
             p.rel_error
@@ -263,7 +263,7 @@ fn work_precision(args: &WorkPrecision) -> Result<()> {
                 .map_or_else(|| "-".into(), |n| n.to_string()),
             p.host_ns,
             p.qemu.map_or_else(|| "-".into(), |c| c.mean.to_string()),
-        );
+        ));
     }
     let main = workprec::figure(&points, "paper", Model::Coriolis, CostAxis::HostNs);
     write_all(&args.out, &main, &table)?;
@@ -332,12 +332,36 @@ fn write_all(out: &Out, fig: &plot::Figure, table: &table::Table) -> Result<()> 
 
 fn report(paths: &[&Path]) {
     for p in paths {
-        println!("wrote {}", p.display());
+        say(&format!("wrote {}", p.display()));
+    }
+}
+
+/// One line to standard output for the reader's information. The files are a chart's product:
+/// a reader that went away (`bowl chart ... | head -1`) must not stop the ones still to be
+/// written, so a closed pipe only ends what is said ([`run`] ignores SIGPIPE).
+pub(crate) fn say(line: &str) {
+    use std::io::Write;
+    if let Err(e) = writeln!(std::io::stdout(), "{line}")
+        && e.kind() != std::io::ErrorKind::BrokenPipe
+    {
+        eprintln!("warning: writing to standard output: {e}");
+    }
+}
+
+/// Writes to a closed pipe fail (and [`say`] lets them) instead of ending the process.
+fn ignore_sigpipe() {
+    #[cfg(unix)]
+    {
+        use nix::sys::signal::{SigHandler, Signal, signal};
+        // SAFETY: SIG_IGN installs no handler of ours; every write of `bowl chart` to standard
+        // output goes through `say`, which expects the error.
+        let _ = unsafe { signal(Signal::SIGPIPE, SigHandler::SigIgn) };
     }
 }
 
 /// Runs `bowl chart ...`.
 pub fn run(args: &Args) -> Result<()> {
+    ignore_sigpipe();
     match &args.which {
         Which::WorkPrecision(wp) => work_precision(wp),
         Which::Radial(out) => {
