@@ -36,19 +36,25 @@ fn ends_quietly_when_the_reader_goes(args: &[&str], lines: usize) {
         Duration::from_secs(30),
         "bowl after its reader left",
     );
-    let mut err = String::new();
+    let err = stderr_of(&mut child);
+    assert!(
+        status.signal() == Some(nix::libc::SIGPIPE) || status.code() == Some(0),
+        "{args:?}: {status:?}: {err}"
+    );
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+}
+
+/// All `child` wrote to its standard error.
+fn stderr_of(child: &mut std::process::Child) -> String {
     use std::io::Read;
+    let mut err = String::new();
     child
         .stderr
         .take()
         .unwrap()
         .read_to_string(&mut err)
         .unwrap();
-    assert!(
-        status.signal() == Some(nix::libc::SIGPIPE) || status.code() == Some(0),
-        "{args:?}: {status:?}: {err}"
-    );
-    assert!(!err.contains("panicked"), "{args:?}: {err}");
+    err
 }
 
 #[test]
@@ -86,14 +92,7 @@ fn a_chart_into_a_closed_pipe_still_writes_every_file() {
         .unwrap();
     drop(child.stdout.take());
     let status = wait_within(&mut child, Duration::from_secs(60), "bowl chart radial");
-    let mut err = String::new();
-    use std::io::Read;
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
+    let err = stderr_of(&mut child);
     assert_eq!(status.code(), Some(0), "{status:?}: {err}");
     for ext in ["svg", "png", "csv"] {
         let f = svg.with_extension(ext);
