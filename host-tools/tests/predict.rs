@@ -585,12 +585,16 @@ fn a_logged_speed_trace_is_predicted_within_the_tolerance() {
     let (v, got, want) = trace_prediction("steady.csv", ripple, "1e-3");
     assert_eq!(v["choice"]["method"], "closed", "{v}");
     assert!((got - want).abs() <= 1e-3 * want, "{got} vs {want}");
+    assert_eq!(v["residence_time_from_choosing"], false, "{v}");
     // A spin-up from 0.5 to 3 rad/s: the particle waits for the speed, then leaves while it
     // still rises; an integrator over the trace is needed for 1e-5.
     let rise = |t: f64| 3.0 + (0.5 - 3.0) * (-t / 0.3).exp();
     let (v, got, want) = trace_prediction("spin-up.csv", rise, "1e-5");
     assert_ne!(v["choice"]["method"], "closed", "{v}");
     assert!((got - want).abs() <= 1e-5 * want, "{got} vs {want}: {v}");
+    // The pilot's finer DP5(4) run answered: the plan was not run again.
+    assert_eq!(v["choice"]["method"], "dp54", "{v}");
+    assert_eq!(v["residence_time_from_choosing"], true, "{v}");
     let spin_up = temp("spin-up.csv");
     write_trace(&spin_up, 3.0, rise);
     // --model with a trace is refused in words.

@@ -89,6 +89,11 @@ pub struct Choice<T> {
     pub time_estimate_s: T,
     /// Right-hand-side evaluations the choice itself ran (0 for a constant speed).
     pub choosing_evaluations: u32,
+    /// `T` the choice already computed, s, within the plan's budget: where the plan is a DP5(4)
+    /// run the pilot made, the pilot's finer run (a tenth of the plan's `rtol`, its difference
+    /// from the plan's within the budget) is this, and running the plan again adds nothing.
+    /// `None` where the plan must run.
+    pub answer_s: Option<T>,
 }
 
 /// Why no choice was made.
@@ -274,6 +279,7 @@ pub fn choose_constant_for<T: Real>(
         predicted_cost: plan_cost(&Plan::<T>::ClosedForm, 0, Target::for_precision::<T>()),
         time_estimate_s,
         choosing_evaluations: 0,
+        answer_s: None,
     })
 }
 
@@ -352,6 +358,7 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
             predicted_cost: plan_cost(&Plan::<T>::ClosedForm, 0, target),
             time_estimate_s: T::ZERO,
             choosing_evaluations: 0,
+            answer_s: None,
         };
         return Ok((at_rim, T::ZERO));
     }
@@ -476,6 +483,7 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
         predicted_cost: plan_cost(&plan, evals, target),
         time_estimate_s: pilot.time_s,
         choosing_evaluations: choosing,
+        answer_s: (pilot.kind == pilot::Kind::Dp54).then_some(pilot.time_s),
     };
     Ok((choice, pilot.error_rel))
 }

@@ -79,6 +79,7 @@ fn widen(c: Choice<f32>) -> Choice<f64> {
         predicted_cost: c.predicted_cost,
         time_estimate_s: f64::from(c.time_estimate_s),
         choosing_evaluations: c.choosing_evaluations,
+        answer_s: c.answer_s.map(f64::from),
     }
 }
 

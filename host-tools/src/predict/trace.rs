@@ -144,6 +144,12 @@ pub fn run(
             path.display()
         ),
     })?;
+    // The pilot's finer run (f64, on the host) is at least as accurate as the plan: no run of
+    // the plan's own.
+    let answered = match runs_on {
+        super::target::RunsOn::Host => choice.answer_s,
+        super::target::RunsOn::Mcu => None,
+    };
     let time_s = match choice.plan {
         Plan::ClosedForm => 0.0,
         Plan::ClosedFormAtMeanSpeed { omega_rad_s } => {
@@ -155,19 +161,22 @@ pub fn run(
                 .map_err(|e| anyhow!(super::words::scene(e)))?
                 .residence_time_s()
         }
-        Plan::Integrate(method) => {
-            let limits = Limits::for_scene(scene, &profile);
-            match ode::integrate(scene, choice.model, &profile, method, limits)
-                .map_err(|e| anyhow!(super::words::ode(e)))?
-                .outcome
-            {
-                OdeOutcome::Leaves {
-                    residence_time_s, ..
-                } => residence_time_s,
-                OdeOutcome::AlreadyAtRim { .. } => 0.0,
-                _ => f64::INFINITY,
+        Plan::Integrate(method) => match answered {
+            Some(t) => t,
+            None => {
+                let limits = Limits::for_scene(scene, &profile);
+                match ode::integrate(scene, choice.model, &profile, method, limits)
+                    .map_err(|e| anyhow!(super::words::ode(e)))?
+                    .outcome
+                {
+                    OdeOutcome::Leaves {
+                        residence_time_s, ..
+                    } => residence_time_s,
+                    OdeOutcome::AlreadyAtRim { .. } => 0.0,
+                    _ => f64::INFINITY,
+                }
             }
-        }
+        },
     };
     let (lo, hi) = trace
         .omega_rad_s
@@ -201,6 +210,7 @@ pub fn run(
                 },
                 "choice": super::choice::json(&choice, runs_on),
                 "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
+                "residence_time_from_choosing": answered.is_some() && matches!(choice.plan, Plan::Integrate(_)),
             })
         );
     } else {
@@ -216,6 +226,12 @@ pub fn run(
             measurement_words(&measured, window_s, measured_is_used, &need, omega_stated)
         );
         println!("{}", super::choice::describe(&choice, &need, runs_on));
+        if answered.is_some() && matches!(choice.plan, Plan::Integrate(_)) {
+            println!(
+                "  T below comes from the choosing runs (their DP5(4) run at a tenth of the plan's \
+                 rtol): the plan needed no run of its own"
+            );
+        }
         if time_s.is_finite() {
             println!(
                 "{:<8} leaves after T = {time_s:.9} s",

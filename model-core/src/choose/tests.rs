@@ -119,6 +119,8 @@ fn spin_up_plan_meets_its_tolerance_when_run() {
             .unwrap()
             .0;
         let (t, evals) = run(&s, c.model, &profile, method, limits).unwrap();
+        // RK4's plan is run: the pilot's extrapolation does not answer for it.
+        assert_eq!(c.answer_s, None);
         let err = (t - truth).abs() / truth;
         assert!(err <= 2.0 * c.tolerance_rel, "{c:?}: error {err:e}");
         assert_eq!(evals, c.rhs_evaluations);
@@ -218,6 +220,12 @@ fn a_spin_up_trace_needs_an_integrator_that_meets_the_tolerance() {
     let truth = run(&s, c.model, &trace, dp(1e-12, &s), limits).unwrap().0;
     let (t, _) = run(&s, c.model, &trace, method, limits).unwrap();
     assert!((t - truth).abs() <= 1e-4 * truth, "{c:?}: {t} vs {truth}");
+    // The pilot's finer run answers within the tolerance too, without running the plan again.
+    let answer = c.answer_s.unwrap();
+    assert!(
+        (answer - truth).abs() <= 1e-4 * truth,
+        "{answer} vs plan {t}, truth {truth}"
+    );
     // The closed form at the mean speed would miss: that is why it was not chosen.
     let mean = mean_omega_rad_s(&trace, truth);
     let t_mean = particle::residence(

@@ -265,6 +265,7 @@ pub fn choose_trace<T: Real, P: OmegaProfile<T>>(
                 estimated_error_rel: (t - t_pilot).abs() / t_pilot,
                 rhs_evaluations: 0,
                 predicted_cost: super::plan_cost(&plan, 0, super::Target::for_precision::<T>()),
+                answer_s: None,
                 ..integrated
             })
         }
