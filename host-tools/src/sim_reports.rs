@@ -413,18 +413,13 @@ fn inject(mut cl: ClosedLoop, what: Injected, axis: usize, bound_s: f64) -> Faul
             cl.ctrl.host_heartbeat();
         }
         // The first tick's edges came before the injection.
-        if tick > 0
-            && detected.is_none()
-            && first_edge_speed.is_none()
-            && !cl.rig.edges(axis).is_empty()
-        {
+        if tick > 0 && first_edge_speed.is_none() && !cl.rig.edges(axis).is_empty() {
             first_edge_speed = Some(cl.rig.speed_rad_s(axis).abs() as f64);
         }
         let duties = cl.tick();
-        if detected.is_none() {
-            peak = peak.max(cl.rig.speed_rad_s(axis).abs() as f64);
-        }
-        if detected.is_none() && cl.ctrl.fault().is_some() {
+        // Until detection: the loop ends there.
+        peak = peak.max(cl.rig.speed_rad_s(axis).abs() as f64);
+        if cl.ctrl.fault().is_some() {
             detected = Some(cl.rig.time_s() - t0);
             pwm_zero = duties == [0.0; 2];
             break;

@@ -15,13 +15,13 @@
 //! 3. **Method.** Constant speed: the closed form (exact to rounding, cheapest). Time-varying
 //!    speed: RK4 at the longest step whose error the pilot (`pilot.rs`: RK4 at `h`, `h/2`, `h/4`,
 //!    `h/8` from the release time, `h` resolving both `1/omega` and the speed's own time
-//!    scale, where the error follows `C h^p`) predicts within half of
-//!    what the model leaves of the tolerance; DP5(4), calibrated by tolerances ten apart, where
+//!    scale, where the error follows `C h^p`) predicts within half of what the model leaves of
+//!    the tolerance; DP5(4), calibrated by tolerances ten apart, where
 //!    RK4 would need more steps than the cap or the speed has kinks (a logged trace). No search
 //!    against a tight reference: RK4 was the cheapest plan meeting the tolerance on every scene
 //!    of `bowl chart chooser`'s grid, and the step the pilot predicts costs at most 1.24x the
-//!    brute force's cheapest there (docs/model.md, the chooser). Explicit and semi-implicit Euler are not candidates
-//!    (order 1, more expensive per evaluation on both cost tables).
+//!    brute force's cheapest there (docs/model.md, the chooser). Explicit and semi-implicit
+//!    Euler are not candidates (order 1, more expensive per evaluation on both cost tables).
 
 use crate::Real;
 use crate::ode::{self, Limits, Method, OdeError, OdeOutcome, OmegaProfile};
@@ -495,7 +495,7 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
 /// on the rig's scenes), and a precise flat run (its error within 1/32 of the tolerance, twice
 /// the evaluations of the plan) only confirms it. So a probe goes first: the flat model at the
 /// pilot's two coarsest steps, `h` and `h/2` (a fifth of the pilot), its error at `h/2` taken
-/// from their difference at the pilot's order (Richardson) and doubled, both extrapolated
+/// from their difference at RK4's order 4 (Richardson) and doubled, both extrapolated
 /// `T` compared. When even the effect less both errors exceeds what the flat model could
 /// use (3/4 of the tolerance), the Coriolis model is settled. Otherwise, and where the precise
 /// run would cost less than the probe (loose tolerances, where the plan is a few coarse

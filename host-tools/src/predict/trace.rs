@@ -144,8 +144,8 @@ pub fn run(
             path.display()
         ),
     })?;
-    // The pilot's finer run (f64, on the host) is at least as accurate as the plan: no run of
-    // the plan's own.
+    // Where the plan is a DP5(4) run the pilot made, the pilot's finer one (f64, on the host)
+    // answers within the plan's budget: the plan needs no run of its own.
     let answered = match runs_on {
         super::target::RunsOn::Host => choice.answer_s,
         super::target::RunsOn::Mcu => None,
@@ -210,7 +210,7 @@ pub fn run(
                 },
                 "choice": super::choice::json(&choice, runs_on),
                 "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
-                "residence_time_from_choosing": answered.is_some() && matches!(choice.plan, Plan::Integrate(_)),
+                "residence_time_from_choosing": answered.is_some(),
             })
         );
     } else {
@@ -226,7 +226,7 @@ pub fn run(
             measurement_words(&measured, window_s, measured_is_used, &need, omega_stated)
         );
         println!("{}", super::choice::describe(&choice, &need, runs_on));
-        if answered.is_some() && matches!(choice.plan, Plan::Integrate(_)) {
+        if answered.is_some() {
             println!(
                 "  T below comes from the choosing runs (their DP5(4) run at a tenth of the plan's \
                  rtol): the plan needed no run of its own"
