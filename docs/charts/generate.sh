@@ -24,6 +24,10 @@ bowl=target/release/bowl
 "$bowl" chart work-precision --out docs/charts/work-precision.svg "${qemu[@]}"
 # The chooser's cost table, fitted to those measurements (model-core/src/choose/cost_table.rs).
 "$bowl" chart costs --csv docs/charts/work-precision.csv --out model-core/src/choose/cost_table.rs
+# The chooser's error table over spin-ups (model-core/src/choose/error_table.bin, ~7 s), then
+# the tools rebuilt on both tables before the chooser is charted.
+"$bowl" chart error-table --out model-core/src/choose/error_table.bin
+cargo build --release -q -p host-tools
 "$bowl" chart chooser --out docs/charts/chooser.svg
 for c in radial velocity residence stability; do
   "$bowl" chart "$c" --out "docs/charts/$c.svg"

@@ -10,6 +10,7 @@ mod batch;
 mod choice;
 mod ode;
 mod rolling;
+mod spin_up;
 mod target;
 mod throughput;
 mod trace;
@@ -88,6 +89,15 @@ pub struct Args {
     /// With --omega-trace: the device time of the release, ms (default: the log's first row).
     #[arg(long, requires = "omega_trace")]
     release_at_ms: Option<f64>,
+    /// A spin-up, as a tuned speed loop drives it: the bowl starts at this speed, rad/s, and
+    /// approaches --omega-rad-s with --time-constant-s; the particle is released at t = 0.
+    /// The chooser picks the model and the integrator (from its precomputed error table when
+    /// --tolerance is given).
+    #[arg(long, requires = "time_constant_s", conflicts_with = "omega_trace")]
+    spin_up_from_rad_s: Option<f64>,
+    /// With --spin-up-from-rad-s: the spin-up's time constant, s.
+    #[arg(long, requires = "spin_up_from_rad_s")]
+    time_constant_s: Option<f64>,
     /// Method: closed form or one of the integrators.
     #[arg(long, value_enum, default_value_t = MethodChoice::Closed)]
     method: MethodChoice,
@@ -209,6 +219,15 @@ pub fn run(args: &Args) -> Result<()> {
             args.target,
             args.json,
         );
+    }
+    if let (Some(start), Some(tau)) = (args.spin_up_from_rad_s, args.time_constant_s) {
+        if args.model != ModelChoice::Auto || args.method != MethodChoice::Closed {
+            anyhow::bail!(
+                "--spin-up-from-rad-s lets the chooser pick the model and the method: leave out \
+                 --model and --method (give --tolerance or --uncertainty instead)"
+            );
+        }
+        return spin_up::run(&scene, start, tau, &need, args.target, args.json);
     }
     words::check(&scene)?;
     const BOTH: &[Model] = &[Model::Flat, Model::Coriolis];

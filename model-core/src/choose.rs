@@ -12,7 +12,12 @@
 //!    model at the pilot's two coarsest steps, extrapolated, and where that does not settle it,
 //!    a flat run whose error is within 1/32 of the tolerance). Within the tolerance, with room
 //!    left for the method, the flat model is enough.
-//! 3. **Method.** Constant speed: the closed form (exact to rounding, cheapest). Time-varying
+//! 3. **Method.** Constant speed: the closed form (exact to rounding, cheapest). A first-order
+//!    spin-up with a stated tolerance (f64): RK4 at the longest step whose error the
+//!    precomputed table (`table.rs`: RK4's error constant, the Coriolis effect and `T` measured
+//!    once over the spin-up's dimensionless features) predicts within half the tolerance, with
+//!    no run at all; on `bowl chart chooser`'s grid that choice costs 0.3x the plan it picks
+//!    and at most 1.232x the cheapest plan. Otherwise, time-varying
 //!    speed: RK4 at the longest step whose error the pilot (`pilot.rs`: RK4 at `h`, `h/2`, `h/4`,
 //!    `h/8` from the release time, `h` resolving both `1/omega` and the speed's own time
 //!    scale, where the error follows `C h^p`) predicts within half of what the model leaves of
@@ -26,6 +31,7 @@
 use crate::Real;
 use crate::ode::{self, Limits, Method, OdeError, OdeOutcome, OmegaProfile};
 use crate::particle::{self, Model, Outcome, Scene, SceneError};
+use spread::{perturbations, spread, spread_at};
 
 /// How well the scene's parameters are known.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,15 +83,17 @@ pub struct Choice<T> {
     pub spread_rel: Option<T>,
     /// `|T_coriolis - T_flat| / T_flat`, computed.
     pub coriolis_effect_rel: T,
-    /// The plan's relative error as predicted by the pilot runs (0 for the closed form:
-    /// rounding; for the closed form at the mean speed, its difference from the pilot's `T`).
+    /// The plan's relative error as predicted by the pilot runs or the table (0 for the closed
+    /// form: rounding; for the closed form at the mean speed, its difference from the pilot's
+    /// `T`).
     pub estimated_error_rel: T,
-    /// Right-hand-side evaluations the plan costs (0 for the closed form).
+    /// Right-hand-side evaluations the plan costs (0 for the closed form; from the table, counted
+    /// from the `T` it reads, within 25 %).
     pub rhs_evaluations: u32,
     /// The plan's measured cost on the target of `T` (f64: host ns; f32: M4F instructions).
     pub predicted_cost: f64,
     /// `T` as the chooser estimated it on the way, s (the closed forms' for a constant speed,
-    /// the pilot's extrapolation for a varying one).
+    /// the table's reading, within 25 %, or the pilot's extrapolation for a varying one).
     pub time_estimate_s: T,
     /// Right-hand-side evaluations the choice itself ran (0 for a constant speed).
     pub choosing_evaluations: u32,
@@ -94,6 +102,39 @@ pub struct Choice<T> {
     /// from the plan's within the budget) is this, and running the plan again adds nothing.
     /// `None` where the plan must run.
     pub answer_s: Option<T>,
+    /// What the choice was made from.
+    pub source: Source,
+}
+
+/// What a choice was made from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Source {
+    /// The two closed forms (a constant speed).
+    ClosedForms,
+    /// The precomputed error table (a first-order spin-up with a stated tolerance): no run.
+    Table,
+    /// Pilot runs of the scene itself.
+    PilotRuns,
+}
+
+impl Source {
+    /// In plain words, for `bowl predict`.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Source::ClosedForms => "from the two closed forms",
+            Source::Table => "from the precomputed error table, without running the scene",
+            Source::PilotRuns => "from pilot runs of the scene",
+        }
+    }
+
+    /// The JSON name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Source::ClosedForms => "closed-forms",
+            Source::Table => "table",
+            Source::PilotRuns => "pilot-runs",
+        }
+    }
 }
 
 /// Why no choice was made.
@@ -135,56 +176,6 @@ fn check_need<T: Real>(need: &Need<T>) -> Result<(), ChooseError> {
 fn clamp_tolerance<T: Real>(tolerance: T) -> T {
     let floor = T::from_f64(64.0) * T::EPSILON;
     tolerance.max(floor).min(T::from_f64(0.1))
-}
-
-/// The perturbed scenes: each parameter at both ends of its range, the others nominal.
-fn perturbations<T: Real>(s: &Scene<T>, k: &Knowledge<T>) -> [Scene<T>; 8] {
-    let lo = |x: T, rel: T| (x * (T::ONE - rel)).max(T::ZERO);
-    [
-        Scene {
-            mu: lo(s.mu, k.mu_rel),
-            ..*s
-        },
-        Scene {
-            mu: s.mu * (T::ONE + k.mu_rel),
-            ..*s
-        },
-        Scene {
-            ri_m: (s.ri_m - k.radius_m).max(T::ZERO),
-            ..*s
-        },
-        Scene {
-            ri_m: s.ri_m + k.radius_m,
-            ..*s
-        },
-        Scene {
-            rim_radius_m: (s.rim_radius_m - k.radius_m).max(T::ZERO),
-            ..*s
-        },
-        Scene {
-            rim_radius_m: s.rim_radius_m + k.radius_m,
-            ..*s
-        },
-        Scene {
-            omega_rad_s: lo(s.omega_rad_s, k.omega_rel),
-            ..*s
-        },
-        Scene {
-            omega_rad_s: s.omega_rad_s * (T::ONE + k.omega_rel),
-            ..*s
-        },
-    ]
-}
-
-/// Sum over parameters of the larger relative change of `T` at either end of its range.
-fn spread<T: Real>(nominal: T, times: &[T; 8]) -> T {
-    let mut sum = T::ZERO;
-    for pair in times.chunks(2) {
-        let d0 = (pair[0] - nominal).abs();
-        let d1 = (pair[1] - nominal).abs();
-        sum += d0.max(d1) / nominal;
-    }
-    if sum.is_finite() { sum } else { T::INFINITY }
 }
 
 fn tolerance_from<T: Real>(spread: T) -> T {
@@ -280,6 +271,7 @@ pub fn choose_constant_for<T: Real>(
         time_estimate_s,
         choosing_evaluations: 0,
         answer_s: None,
+        source: Source::ClosedForms,
     })
 }
 
@@ -337,6 +329,17 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
     need: &Need<T>,
     profile: &P,
 ) -> Result<(Choice<T>, T), ChooseError> {
+    choose_varying_reading(scene, need, profile, true)
+}
+
+/// [`choose_varying_with_margin`]; with `read_table` false the pilot chooses even where the
+/// table could (the tests hold both to the tolerance).
+pub(crate) fn choose_varying_reading<T: Real, P: OmegaProfile<T>>(
+    scene: &Scene<T>,
+    need: &Need<T>,
+    profile: &P,
+    read_table: bool,
+) -> Result<(Choice<T>, T), ChooseError> {
     scene.validate_except_omega().map_err(ChooseError::Scene)?;
     check_need(need)?;
     let limits = Limits::for_scene(scene, profile);
@@ -359,8 +362,21 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
             time_estimate_s: T::ZERO,
             choosing_evaluations: 0,
             answer_s: None,
+            source: Source::ClosedForms,
         };
         return Ok((at_rim, T::ZERO));
+    }
+    // A first-order spin-up with a stated tolerance, inside the table: no run (f64 only: the
+    // table holds truncation errors, and f32 adds a rounding error the table does not know).
+    if let (Need::Tolerance(t), Some(speed), true) = (
+        need,
+        profile.spin_up(),
+        read_table && T::EPSILON.to_f64() < 1e-12,
+    ) {
+        let tolerance = clamp_tolerance(*t);
+        if let Some(choice) = table::choice(scene, &speed, tolerance, step_cap, limits) {
+            return Ok((choice, T::from_f64(table::TIME_READING_ERROR_REL)));
+        }
     }
     // A smooth speed: RK4's error model. One with kinks: DP5(4) to a millionth first (the
     // spread and the Coriolis effect need T far better than the tolerance they set), then to
@@ -484,6 +500,7 @@ pub(crate) fn choose_varying_with_margin<T: Real, P: OmegaProfile<T>>(
         time_estimate_s: pilot.time_s,
         choosing_evaluations: choosing,
         answer_s: (pilot.kind == pilot::Kind::Dp54).then_some(pilot.time_s),
+        source: Source::PilotRuns,
     };
     Ok((choice, pilot.error_rel))
 }
@@ -546,78 +563,10 @@ fn flat_effect<T: Real, P: OmegaProfile<T>>(
     Ok((effect, effect + flat_error + coriolis.error_rel, spent))
 }
 
-/// The spread of `T` over the parameters' uncertainty (see [`spread`]) from runs of `method`
-/// on the Coriolis model, the nominal scene's included (so that the runs' common error
-/// cancels), and the evaluations they took.
-fn spread_at<T: Real, P: OmegaProfile<T>>(
-    scene: &Scene<T>,
-    knowledge: &Knowledge<T>,
-    profile: &P,
-    method: Method<T>,
-    limits: Limits<T>,
-) -> (T, u32) {
-    let (nominal, mut evaluations) = match run(scene, Model::Coriolis, profile, method, limits) {
-        Ok(found) => found,
-        Err(_) => return (T::INFINITY, 0),
-    };
-    let mut times = [T::ZERO; 8];
-    let up = T::ONE + knowledge.omega_rel;
-    let down = (T::ONE - knowledge.omega_rel).max(T::ZERO);
-    for (i, (slot, s)) in times
-        .iter_mut()
-        .zip(perturbations(scene, knowledge).iter())
-        .enumerate()
-    {
-        // omega's uncertainty scales the whole profile (entries 6 and 7).
-        let factor = match i {
-            6 => down,
-            7 => up,
-            _ => T::ONE,
-        };
-        let scaled = ScaledProfile {
-            inner: profile,
-            factor,
-        };
-        *slot = match run(s, Model::Coriolis, &scaled, method, limits) {
-            Ok((t, evals)) => {
-                evaluations = evaluations.saturating_add(evals);
-                t
-            }
-            Err(_) => T::INFINITY,
-        };
-    }
-    (spread(nominal, &times), evaluations)
-}
-
-/// A profile scaled by a constant factor (omega's relative uncertainty).
-struct ScaledProfile<'a, T, P> {
-    inner: &'a P,
-    factor: T,
-}
-
-impl<T: Real, P: OmegaProfile<T>> OmegaProfile<T> for ScaledProfile<'_, T, P> {
-    fn omega_rad_s(&self, t_s: T) -> T {
-        self.inner.omega_rad_s(t_s) * self.factor
-    }
-    fn max_omega_rad_s(&self) -> T {
-        self.inner.max_omega_rad_s() * self.factor
-    }
-    fn is_constant(&self) -> bool {
-        self.inner.is_constant()
-    }
-    fn is_smooth(&self) -> bool {
-        self.inner.is_smooth()
-    }
-    fn next_kink_after_s(&self, t_s: T) -> Option<T> {
-        self.inner.next_kink_after_s(t_s)
-    }
-    fn time_scale_s(&self) -> T {
-        self.inner.time_scale_s()
-    }
-}
-
 pub mod cost;
 mod pilot;
+mod spread;
+pub mod table;
 mod trace;
 
 pub use cost::{MethodCost, Target, plan_cost};

@@ -11,6 +11,7 @@ use clap::Subcommand;
 pub mod chooser;
 pub mod control;
 pub mod costs;
+pub mod error_table;
 pub mod family;
 pub mod figures;
 pub mod log;
@@ -73,6 +74,17 @@ enum Which {
     /// The chooser's plans against the cheapest plan meeting the same tolerance, by brute force
     /// on a grid of spin-up scenes (cost ratio per scene; CSV with the plans).
     Chooser(Out),
+    /// The chooser's error table (bytes for model-core): RK4's error constant, the Coriolis
+    /// effect and T over a spin-up's dimensionless features, each against a tight DP5(4).
+    ErrorTable(ErrorTableArgs),
+}
+
+/// Options of `bowl chart error-table`.
+#[derive(clap::Args)]
+struct ErrorTableArgs {
+    /// The file to write (model-core/src/choose/error_table.bin).
+    #[arg(long)]
+    out: PathBuf,
 }
 
 /// Options of `bowl chart costs`.
@@ -378,6 +390,7 @@ pub fn run(args: &Args) -> Result<()> {
         }
         Which::Scipy(a) => scipy_charts(a),
         Which::Costs(a) => costs::write(&a.csv, &a.out),
+        Which::ErrorTable(a) => error_table::write(&a.out),
         Which::Chooser(out) => {
             let (f, cost, t) = chooser::chart()?;
             write_all(out, &f, &t)?;

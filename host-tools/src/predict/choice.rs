@@ -5,7 +5,7 @@
 //! resistance is a fit known to about 20 %, the radii to a millimetre, the speed loop holds 1 %).
 
 use anyhow::{Result, anyhow, bail};
-use model_core::choose::{Choice, ChooseError, Knowledge, Need, Plan};
+use model_core::choose::{Choice, ChooseError, Knowledge, Need, Plan, Source};
 use model_core::ode::Method;
 use model_core::particle::Model;
 
@@ -179,12 +179,17 @@ pub fn describe(c: &Choice<f64>, need: &Need<f64>, runs_on: RunsOn) -> String {
         plan_words(&c.plan)
     );
     if !matches!(c.plan, Plan::ClosedForm) {
+        let predicted_by = match c.source {
+            Source::Table => "the precomputed error table predicts it",
+            Source::PilotRuns | Source::ClosedForms => "the pilot runs predict it",
+        };
         out += &format!(
-            "\n  its error as the pilot runs predict it: {:.2e} ({} right-hand-side evaluations; \
+            "\n  its error as {predicted_by}: {:.2e} ({} right-hand-side evaluations; \
              choosing ran {})",
             c.estimated_error_rel, c.rhs_evaluations, c.choosing_evaluations
         );
     }
+    out += &format!("\n  chosen {}", c.source.describe());
     out += &format!(
         "\n  predicted cost {:.0} {} {} (measured table: docs/model.md, the chooser)",
         c.predicted_cost,
@@ -239,6 +244,7 @@ pub fn json(c: &Choice<f64>, runs_on: RunsOn) -> serde_json::Value {
         "estimated_error_rel": c.estimated_error_rel,
         "rhs_evaluations": c.rhs_evaluations,
         "choosing_evaluations": c.choosing_evaluations,
+        "source": c.source.name(),
         "target": match runs_on { RunsOn::Host => "host", RunsOn::Mcu => "mcu" },
         "predicted_cost": c.predicted_cost,
         "predicted_cost_unit": runs_on.target().unit(),

@@ -7,9 +7,9 @@
 
 use model_core::choose::{
     Choice, ChooseError, Knowledge, Need, Plan, SampledOmega, Target, TraceError,
-    choose_constant_for, choose_trace,
+    choose_constant_for, choose_trace, choose_varying_for,
 };
-use model_core::ode::Method;
+use model_core::ode::{Method, SpinUp};
 use model_core::particle::Scene;
 
 /// Where the chosen plan runs.
@@ -80,6 +80,7 @@ fn widen(c: Choice<f32>) -> Choice<f64> {
         time_estimate_s: f64::from(c.time_estimate_s),
         choosing_evaluations: c.choosing_evaluations,
         answer_s: c.answer_s.map(f64::from),
+        source: c.source,
     }
 }
 
@@ -92,6 +93,26 @@ pub fn constant(
     match runs_on {
         RunsOn::Host => choose_constant_for(scene, need),
         RunsOn::Mcu => choose_constant_for(&scene.to_f32(), &narrow_need(need)).map(widen),
+    }
+}
+
+/// The chooser for a first-order spin-up, for `runs_on`.
+pub fn spin_up(
+    scene: &Scene<f64>,
+    need: &Need<f64>,
+    speed: &SpinUp<f64>,
+    runs_on: RunsOn,
+) -> Result<Choice<f64>, ChooseError> {
+    match runs_on {
+        RunsOn::Host => choose_varying_for(scene, need, speed),
+        RunsOn::Mcu => {
+            let narrow = SpinUp {
+                start_rad_s: speed.start_rad_s as f32,
+                final_rad_s: speed.final_rad_s as f32,
+                time_constant_s: speed.time_constant_s as f32,
+            };
+            choose_varying_for(&scene.to_f32(), &narrow_need(need), &narrow).map(widen)
+        }
     }
 }
 

@@ -352,10 +352,11 @@ fn the_first_estimate_of_t_is_a_closed_form_at_a_mean_speed() {
 /// The chooser's optimality and its own cost, against an independent brute force: RK4 steps
 /// 2^(1/8) apart from the stability margin down, each against a DP5(4) at rtol 1e-13; the
 /// coarsest step from which every finer one meets the tolerance is the cheapest dependable
-/// RK4 plan (RK4 was the cheapest method on every scene of `bowl chart chooser`). The chosen
-/// plan must meet the tolerance, cost at most 1.25x that plan on the same table, and choosing
-/// must take fewer than 400 right-hand-side evaluations (290 at most on the chart's grid; 737
-/// before the flat model was probed at the pilot's coarsest steps).
+/// RK4 plan (RK4 was the cheapest method on every scene of `bowl chart chooser`). The plan read
+/// from the table and the pilot's plan must each meet the tolerance and cost at most 1.25x
+/// that plan on the same table (priced at the evaluations the plan ran); the table runs
+/// nothing, the pilot fewer than 400 right-hand-side evaluations (290 at most on the chart's
+/// grid; 737 before the flat model was probed at the pilot's coarsest steps).
 #[test]
 fn the_chosen_step_is_within_a_quarter_of_the_cheapest_and_choosing_is_bounded() {
     for (start, end, tau, mu) in [
@@ -382,7 +383,14 @@ fn the_chosen_step_is_within_a_quarter_of_the_cheapest_and_choosing_is_bounded()
             };
             let (err, evals) = err_of(method);
             assert!(err <= tolerance, "{c:?}: error {err:e}");
-            assert_eq!(evals, c.rhs_evaluations, "{c:?}");
+            // The table's count comes from the T it reads (within 25 %), the pilot's from
+            // the T it ran.
+            assert_eq!(c.source, Source::Table, "{c:?}");
+            let counted = f64::from(c.rhs_evaluations);
+            assert!(
+                (counted - f64::from(evals)).abs() <= 0.25 * f64::from(evals) + 4.0,
+                "{c:?}: {evals} evaluations"
+            );
             let steps: [f64; 64] =
                 core::array::from_fn(|k| 1.5 / end * 2f64.powf(-(k as f64) / 8.0));
             let runs = steps.map(|h| err_of(Method::Rk4 { step_s: h }));
@@ -399,9 +407,26 @@ fn the_chosen_step_is_within_a_quarter_of_the_cheapest_and_choosing_is_bounded()
                 runs[first_dependable].1,
                 Target::Host,
             );
-            let ratio = c.predicted_cost / cheapest;
+            let chosen = plan_cost(&c.plan, evals, Target::Host);
+            let ratio = chosen / cheapest;
             assert!(ratio <= 1.25, "{c:?}: {ratio:.3}x the cheapest");
-            assert!(c.choosing_evaluations < 400, "{c:?}");
+            assert_eq!(c.choosing_evaluations, 0, "{c:?}");
+            // The pilot, asked for the same scene, meets the same bounds with fewer than 400
+            // evaluations of its own (290 at most on the chart's grid).
+            let (p, _) =
+                choose_varying_reading(&s, &Need::Tolerance(tolerance), &profile, false).unwrap();
+            let Plan::Integrate(by_pilot) = p.plan else {
+                panic!("{p:?}")
+            };
+            let (err, evals) = err_of(by_pilot);
+            assert!(err <= tolerance, "{p:?}: error {err:e}");
+            assert_eq!(evals, p.rhs_evaluations, "{p:?}");
+            let ratio = plan_cost(&p.plan, evals, Target::Host) / cheapest;
+            assert!(ratio <= 1.25, "{p:?}: {ratio:.3}x the cheapest");
+            assert!(
+                p.choosing_evaluations > 0 && p.choosing_evaluations < 400,
+                "{p:?}"
+            );
         }
     }
 }
@@ -444,14 +469,19 @@ proptest::proptest! {
 
 /// The tolerance on random spin-ups, each plan run against DP5(4) at rtol 1e-13: 4,000 scenes
 /// (mu 0.002 to 0.2, from rest or a random start to 1.5 to 8 rad/s, tau 0.05 to 5 s, ri 0.01
-/// to 0.095 m, tolerances 1e-2 to 1e-8; those that leave, about 3,200). The prediction can be
-/// off by more than the plan's 2x margin: 2 of them miss, by at most 6 % (before the crossing
-/// was located to `O(h^6)` and the pilot resolved the spin-up's time constant: 12 of 1,587 by
-/// up to 1.75x). Held at that level.
+/// to 0.095 m, tolerances 1e-2 to 1e-8; those that leave, about 3,200), each chosen twice:
+/// from the table and by the pilot. The table covers nearly all of them and its plans meet
+/// the tolerance (28,675 such scenes in a scratch run: none missed, worst 0.87 of it). The
+/// pilot's prediction can be off by more than the plan's 2x margin: 2 of them miss, by at most
+/// 6 % (before the crossing was located to `O(h^6)` and the pilot resolved the spin-up's time
+/// constant: 12 of 1,587 by up to 1.75x). Each held at its level.
 #[test]
-fn random_spin_ups_meet_their_tolerance_but_for_rare_near_misses() {
+fn random_spin_ups_meet_their_tolerance_from_the_table_and_but_for_rare_near_misses_by_the_pilot() {
     let mut uniform = crate::particle::tests::uniform_stream(987_654_321);
-    let (mut scenes, mut misses, mut worst) = (0, 0, 0.0f64);
+    let (mut scenes, mut read) = (0, 0);
+    // Misses and the worst error over the tolerance: the table's, the pilot's.
+    let mut misses = [0usize; 2];
+    let mut worst = [0.0f64; 2];
     for _ in 0..4000 {
         let mu = 0.002 * 100f64.powf(uniform());
         let final_rad_s = 1.5 + 6.5 * uniform();
@@ -467,14 +497,13 @@ fn random_spin_ups_meet_their_tolerance_but_for_rare_near_misses() {
         };
         let s = scene(final_rad_s, mu, 0.01 + 0.085 * uniform());
         let tolerance = 10f64.powf(-2.0 - 6.0 * uniform());
-        let Ok(c) = choose_varying_for(&s, &Need::Tolerance(tolerance), &profile) else {
+        let need = Need::Tolerance(tolerance);
+        let Ok((c, _)) = choose_varying_reading(&s, &need, &profile, true) else {
             continue;
         };
-        let Plan::Integrate(method) = c.plan else {
-            continue;
-        };
+        let (p, _) = choose_varying_reading(&s, &need, &profile, false).unwrap();
         let limits = ode::Limits::for_scene(&s, &profile);
-        let time = |m| match ode::integrate(&s, c.model, &profile, m, limits)
+        let time = |m, model| match ode::integrate(&s, model, &profile, m, limits)
             .unwrap()
             .outcome
         {
@@ -483,19 +512,39 @@ fn random_spin_ups_meet_their_tolerance_but_for_rare_near_misses() {
             } => residence_time_s,
             _ => f64::NAN,
         };
-        let reference = time(ode::Method::Dp54 {
+        let reference = ode::Method::Dp54 {
             rtol: 1e-13,
             atol: 1e-18,
-        });
-        let over = (time(method) - reference).abs() / reference / c.tolerance_rel;
-        assert!(over.is_finite(), "{c:?}");
+        };
         scenes += 1;
-        misses += usize::from(over > 1.0);
-        worst = worst.max(over);
+        for (k, choice) in [c, p].iter().enumerate() {
+            let Plan::Integrate(method) = choice.plan else {
+                panic!("{choice:?}")
+            };
+            let truth = time(reference, choice.model);
+            let over = (time(method, choice.model) - truth).abs() / truth / choice.tolerance_rel;
+            assert!(over.is_finite(), "{choice:?}");
+            misses[k] += usize::from(over > 1.0);
+            worst[k] = worst[k].max(over);
+        }
+        read += usize::from(c.source == Source::Table);
+        assert_eq!(p.source, Source::PilotRuns);
     }
     assert!(scenes > 3000, "{scenes}");
     assert!(
-        misses <= 2 && worst <= 1.1,
-        "{misses} of {scenes}, worst {worst}"
+        read * 100 > scenes * 95,
+        "the table read {read} of {scenes}"
+    );
+    assert!(
+        misses[0] == 0 && worst[0] <= 0.95,
+        "the table: {} of {scenes} missed, worst {}",
+        misses[0],
+        worst[0]
+    );
+    assert!(
+        misses[1] <= 2 && worst[1] <= 1.1,
+        "the pilot: {} of {scenes} missed, worst {}",
+        misses[1],
+        worst[1]
     );
 }

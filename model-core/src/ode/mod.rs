@@ -55,6 +55,11 @@ pub trait OmegaProfile<T> {
     {
         T::INFINITY
     }
+    /// The profile as a first-order spin-up, where it is one (the chooser's precomputed table
+    /// covers those); `None` otherwise.
+    fn spin_up(&self) -> Option<SpinUp<T>> {
+        None
+    }
     /// The first time after `t_s` where omega's derivative jumps (a logged trace's next
     /// sample), `None` if there is none: the adaptive method ends a step there.
     fn next_kink_after_s(&self, _t_s: T) -> Option<T> {
@@ -120,6 +125,9 @@ impl<T: Real> OmegaProfile<T> for SpinUp<T> {
         } else {
             self.time_constant_s
         }
+    }
+    fn spin_up(&self) -> Option<SpinUp<T>> {
+        Some(*self)
     }
     /// `t = tau ln((final - start) / (final - threshold))` on the way up; never on the way
     /// down from at or below it.

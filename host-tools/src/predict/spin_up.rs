@@ -1,0 +1,100 @@
+//! `bowl predict --spin-up-from-rad-s W0 --time-constant-s TAU`: the residence time while the
+//! bowl spins up from `W0` to `--omega-rad-s` as a tuned speed loop drives it,
+//! `omega(t) = omega + (W0 - omega) e^{-t / TAU}`, the particle released at t = 0. The chooser
+//! picks the model and the integrator; with `--tolerance` on the host it reads them from its
+//! precomputed error table without running the scene (`model_core::choose::table`).
+
+use anyhow::{Result, anyhow, bail};
+use model_core::choose::Plan;
+use model_core::ode::{self, Limits, OdeOutcome, SpinUp};
+use model_core::particle::Scene;
+
+use super::target::RunsOn;
+
+/// Runs `bowl predict --spin-up-from-rad-s`.
+pub fn run(
+    scene: &Scene<f64>,
+    start_rad_s: f64,
+    time_constant_s: f64,
+    need: &model_core::choose::Need<f64>,
+    runs_on: RunsOn,
+    json: bool,
+) -> Result<()> {
+    if !(start_rad_s.is_finite() && start_rad_s >= 0.0) {
+        bail!("--spin-up-from-rad-s {start_rad_s}: the start speed must be zero or positive");
+    }
+    if !(time_constant_s.is_finite() && time_constant_s > 0.0) {
+        bail!(
+            "--time-constant-s {time_constant_s}: the spin-up's time constant must be a \
+             positive number of seconds"
+        );
+    }
+    if !(scene.omega_rad_s.is_finite() && scene.omega_rad_s > 0.0) {
+        bail!(
+            "--omega-rad-s {}: the speed the spin-up approaches must be positive",
+            scene.omega_rad_s
+        );
+    }
+    scene
+        .validate_except_omega()
+        .map_err(|e| anyhow!(super::words::scene(e)))?;
+    let speed = SpinUp {
+        start_rad_s,
+        final_rad_s: scene.omega_rad_s,
+        time_constant_s,
+    };
+    let choice = super::target::spin_up(scene, need, &speed, runs_on)
+        .map_err(|e| anyhow!(super::choice::error_words(e)))?;
+    let time_s = match choice.plan {
+        Plan::ClosedForm => 0.0,
+        Plan::ClosedFormAtMeanSpeed { .. } => bail!(
+            "the chooser answered a spin-up with a closed form at a mean speed, which only a \
+             logged trace asks for: please report this scene"
+        ),
+        Plan::Integrate(method) => {
+            let limits = Limits::for_scene(scene, &speed);
+            match ode::integrate(scene, choice.model, &speed, method, limits)
+                .map_err(|e| anyhow!(super::words::ode(e)))?
+                .outcome
+            {
+                OdeOutcome::Leaves {
+                    residence_time_s, ..
+                } => residence_time_s,
+                OdeOutcome::AlreadyAtRim { .. } => 0.0,
+                _ => f64::INFINITY,
+            }
+        }
+    };
+    if json {
+        println!(
+            "{}",
+            serde_json::json!({
+                "spin_up": {
+                    "start_rad_s": start_rad_s, "final_rad_s": scene.omega_rad_s,
+                    "time_constant_s": time_constant_s,
+                },
+                "choice": super::choice::json(&choice, runs_on),
+                "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
+            })
+        );
+    } else {
+        println!(
+            "spin-up: from {start_rad_s} to {} rad/s with time constant {time_constant_s} s, \
+             the particle released at t = 0; mu {}, ri {} m, R {} m",
+            scene.omega_rad_s, scene.mu, scene.ri_m, scene.rim_radius_m
+        );
+        println!("{}", super::choice::describe(&choice, need, runs_on));
+        if time_s.is_finite() {
+            println!(
+                "{:<8} leaves after T = {time_s:.9} s",
+                super::model_name(choice.model)
+            );
+        } else {
+            println!(
+                "{:<8} NEVER LEAVES within the run's horizon",
+                super::model_name(choice.model)
+            );
+        }
+    }
+    Ok(())
+}

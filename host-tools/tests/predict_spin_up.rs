@@ -1,0 +1,147 @@
+//! `bowl predict --spin-up-from-rad-s W0 --time-constant-s TAU`: the chooser on a first-order
+//! spin-up, from its precomputed error table when a tolerance is stated, each answer against
+//! the tests' own independent RK4 reference.
+
+mod common;
+
+use std::process::{Command, Output};
+
+fn bowl(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bowl"))
+        .args(args)
+        .env_remove("RUST_BACKTRACE")
+        .env_remove("RUST_LIB_BACKTRACE")
+        .output()
+        .expect("run bowl")
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = bowl(args);
+    assert!(
+        out.status.success(),
+        "bowl {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid JSON")
+}
+
+/// The reference T of the Coriolis model (or the flat one) for a spin-up from `start` to
+/// `end` rad/s with time constant `tau`, mu 0.029, ri 0.05 m, R 0.1 m.
+fn reference(start: f64, end: f64, tau: f64, coriolis: bool) -> f64 {
+    let omega = |t: f64| end + (start - end) * (-t / tau).exp();
+    common::reference_residence_s(omega, 0.029, 0.05, 0.1, coriolis)
+}
+
+#[test]
+fn a_spin_up_with_a_tolerance_is_read_from_the_table_and_meets_it() {
+    for (start, end, tau, tolerance) in [
+        (0.0, 3.0, 0.3, 1e-5),
+        (1.0, 3.0, 2.0, 1e-6),
+        (0.0, 6.0, 0.5, 1e-4),
+    ] {
+        let args = [
+            "predict",
+            "--omega-rad-s",
+            &end.to_string(),
+            "--spin-up-from-rad-s",
+            &start.to_string(),
+            "--time-constant-s",
+            &tau.to_string(),
+            "--tolerance",
+            &tolerance.to_string(),
+            "--json",
+        ];
+        let v = json(&args);
+        let choice = &v["choice"];
+        assert_eq!(choice["source"], "table", "{v}");
+        assert_eq!(choice["choosing_evaluations"], 0, "{v}");
+        assert_eq!(choice["method"], "rk4", "{v}");
+        let coriolis = choice["model"] == "coriolis";
+        let want = reference(start, end, tau, coriolis);
+        let got = v["residence_time_s"].as_f64().unwrap();
+        assert!(
+            (got - want).abs() <= tolerance * want,
+            "{args:?}: T {got} against {want}"
+        );
+        // The model answers for the Coriolis term within the tolerance too.
+        let truth = reference(start, end, tau, true);
+        assert!((got - truth).abs() <= tolerance * truth, "{v}");
+        // The text says where the choice came from.
+        let text = bowl(&args[..args.len() - 1]);
+        let text = String::from_utf8_lossy(&text.stdout);
+        assert!(
+            text.contains("chosen from the precomputed error table, without running the scene"),
+            "{text}"
+        );
+    }
+}
+
+#[test]
+fn without_a_stated_tolerance_or_for_the_mcu_the_pilot_chooses() {
+    let base = [
+        "predict",
+        "--spin-up-from-rad-s",
+        "0",
+        "--time-constant-s",
+        "0.3",
+        "--json",
+    ];
+    let v = json(&base);
+    assert_eq!(v["choice"]["source"], "pilot-runs", "{v}");
+    let tolerance = v["choice"]["tolerance_rel"].as_f64().unwrap();
+    let got = v["residence_time_s"].as_f64().unwrap();
+    let truth = reference(0.0, 3.0, 0.3, true);
+    assert!((got - truth).abs() <= tolerance * truth, "{v}");
+    let mut mcu = base.to_vec();
+    mcu.extend(["--tolerance", "1e-4", "--target", "mcu"]);
+    let v = json(&mcu);
+    assert_eq!(v["choice"]["source"], "pilot-runs", "{v}");
+    assert!(
+        v["choice"]["choosing_evaluations"].as_u64().unwrap() > 0,
+        "{v}"
+    );
+}
+
+#[test]
+fn bad_spin_ups_are_named_in_plain_words() {
+    for (args, words) in [
+        (
+            vec!["--spin-up-from-rad-s", "1", "--time-constant-s", "0"],
+            "--time-constant-s 0: the spin-up's time constant must be a positive number",
+        ),
+        (
+            vec!["--spin-up-from-rad-s=-1", "--time-constant-s", "0.3"],
+            "--spin-up-from-rad-s -1: the start speed must be zero or positive",
+        ),
+        (
+            vec![
+                "--spin-up-from-rad-s",
+                "1",
+                "--time-constant-s",
+                "0.3",
+                "--omega-rad-s",
+                "0",
+            ],
+            "--omega-rad-s 0: the speed the spin-up approaches must be positive",
+        ),
+        (
+            vec![
+                "--spin-up-from-rad-s",
+                "1",
+                "--time-constant-s",
+                "0.3",
+                "--model",
+                "flat",
+            ],
+            "--spin-up-from-rad-s lets the chooser pick the model and the method",
+        ),
+    ] {
+        let mut all = vec!["predict"];
+        all.extend(args);
+        let out = bowl(&all);
+        assert!(!out.status.success(), "{all:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(words), "{all:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}

@@ -1,0 +1,124 @@
+//! The table's encoding, its dimensionless scaling and its reach, each against values computed
+//! here independently.
+
+use super::*;
+use crate::ode::SpinUp;
+extern crate std;
+
+#[test]
+fn a_byte_stores_its_value_rounded_up_by_less_than_a_twentieth_of_a_decade() {
+    let step = libm::pow(10.0, 1.0 / 20.0);
+    for k in 0..2000 {
+        let v = libm::pow(10.0, -8.9 + 12.0 * f64::from(k) / 2000.0);
+        let stored = DECODED[usize::from(encode(v))];
+        assert!(stored >= v * (1.0 - 1e-12), "{v:e} -> {stored:e}");
+        assert!(stored <= v * step * (1.0 + 1e-12), "{v:e} -> {stored:e}");
+        let nearest = DECODED[usize::from(encode_nearest(v))];
+        assert!(
+            (nearest / v).ln().abs() <= 0.5 * step.ln() + 1e-12,
+            "{v:e} -> {nearest:e}"
+        );
+    }
+    // Below the floor: the floor (an error constant read high is safe); beyond the top, NaN,
+    // infinite or negative: not measured.
+    assert_eq!(encode(1e-12), 1);
+    for bad in [1e6, f64::NAN, f64::INFINITY, -1.0] {
+        assert_eq!(encode(bad), 0, "{bad}");
+    }
+}
+
+/// A grid point, put back into metres and seconds (R = 0.1 m, omega_f = 3 rad/s), reads the
+/// error constant its byte holds, and that constant is the one measured on the scene in
+/// those units: RK4's largest error over the same steps against a DP5(4) at 1e-13, within
+/// the byte's rounding.
+#[test]
+fn a_grid_point_in_metres_and_seconds_reads_what_its_scene_measures() {
+    let (rim_m, w_f) = (0.1, 3.0);
+    let mut checked = 0;
+    for point in (0..POINTS).step_by(2357) {
+        let (unit, speed) = scene_at(point);
+        let scene = Scene {
+            omega_rad_s: w_f,
+            mu: unit.mu,
+            g_m_s2: unit.g_m_s2 * rim_m * w_f * w_f,
+            k2: K2,
+            ri_m: unit.ri_m * rim_m,
+            rim_radius_m: rim_m,
+        };
+        let speed = SpinUp {
+            start_rad_s: speed.start_rad_s * w_f,
+            final_rad_s: w_f,
+            time_constant_s: speed.time_constant_s / w_f,
+        };
+        let Some(reading) = read(&scene, &speed) else {
+            continue;
+        };
+        let reference = residence_s(
+            &scene,
+            Model::Coriolis,
+            &speed,
+            Method::Dp54 {
+                rtol: 1e-13,
+                atol: 1e-18,
+            },
+        );
+        let coarsest = (1.5 / w_f).min(speed.time_constant_s);
+        let mut measured = 0.0f64;
+        for level in 0..=STEP_LEVELS {
+            let h = coarsest * libm::pow(2.0, -f64::from(level) / 4.0);
+            let t = residence_s(&scene, Model::Coriolis, &speed, Method::Rk4 { step_s: h });
+            measured = measured.max(((t - reference) / reference).abs() / libm::pow(h * w_f, 4.0));
+        }
+        let ratio = reading.coriolis_constant / measured;
+        assert!(
+            (1.0 - 1e-6..=1.13).contains(&ratio),
+            "point {point}: read {:e}, measured {measured:e}",
+            reading.coriolis_constant
+        );
+        let t_ratio = reading.time_s / reference;
+        assert!(
+            (0.94..=1.06).contains(&t_ratio),
+            "point {point}: T {t_ratio}"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 40, "{checked}");
+}
+
+#[test]
+fn scenes_the_table_does_not_hold_have_no_reading() {
+    let scene = Scene {
+        omega_rad_s: 3.0,
+        mu: 0.029,
+        g_m_s2: 9.81,
+        k2: K2,
+        ri_m: 0.05,
+        rim_radius_m: 0.1,
+    };
+    let speed = SpinUp {
+        start_rad_s: 0.0,
+        final_rad_s: 3.0,
+        time_constant_s: 0.3,
+    };
+    assert!(read(&scene, &speed).is_some());
+    let hollow = Scene { k2: 0.6, ..scene };
+    let slowing = SpinUp {
+        start_rad_s: 4.0,
+        ..speed
+    };
+    let held = Scene { mu: 0.2, ..scene };
+    let frictionless = Scene { mu: 0.0, ..scene };
+    let forever = SpinUp {
+        time_constant_s: 1e6,
+        ..speed
+    };
+    for (s, p) in [
+        (hollow, speed),
+        (scene, slowing),
+        (held, speed),
+        (frictionless, speed),
+        (scene, forever),
+    ] {
+        assert_eq!(read(&s, &p), None, "{s:?} {p:?}");
+    }
+}
