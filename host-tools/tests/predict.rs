@@ -4,26 +4,9 @@
 mod common;
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn bowl(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bowl"))
-        .args(args)
-        .env_remove("RUST_BACKTRACE")
-        .env_remove("RUST_LIB_BACKTRACE")
-        .output()
-        .expect("run bowl")
-}
-
-fn json(args: &[&str]) -> serde_json::Value {
-    let out = bowl(args);
-    assert!(
-        out.status.success(),
-        "bowl {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("valid JSON")
-}
+use common::{bowl, json};
 
 /// Flat residence time by the textbook formula, `acosh((R - a)/(ri - a)) / (k omega)`.
 fn flat_time(w: f64, mu: f64, ri: f64, rim: f64) -> f64 {

@@ -4,26 +4,7 @@
 
 mod common;
 
-use std::process::{Command, Output};
-
-fn bowl(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bowl"))
-        .args(args)
-        .env_remove("RUST_BACKTRACE")
-        .env_remove("RUST_LIB_BACKTRACE")
-        .output()
-        .expect("run bowl")
-}
-
-fn json(args: &[&str]) -> serde_json::Value {
-    let out = bowl(args);
-    assert!(
-        out.status.success(),
-        "bowl {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("valid JSON")
-}
+use common::{bowl, json};
 
 /// The reference T of the Coriolis model (or the flat one) for a spin-up from `start` to
 /// `end` rad/s with time constant `tau`, mu 0.029, ri 0.05 m, R 0.1 m.

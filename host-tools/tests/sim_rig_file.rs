@@ -4,23 +4,12 @@
 
 mod common;
 
-use common::bowl;
-use serde_json::Value;
+use common::{bowl, json};
 
 const SMALL: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../tests/rigs/family-small.toml"
 );
-
-fn json(args: &[&str]) -> Value {
-    let out = bowl(args);
-    assert!(
-        out.status.success(),
-        "bowl {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
 
 #[test]
 fn the_small_family_commissions_and_steps_within_the_targets() {

@@ -81,7 +81,7 @@ pub struct Choice<T> {
     /// Relative spread of `T` over the parameters' uncertainty (infinite if some parameter
     /// set within it never leaves); `None` when the tolerance was given instead.
     pub spread_rel: Option<T>,
-    /// `|T_coriolis - T_flat| / T_flat`, computed.
+    /// `|T_coriolis - T_flat| / T_flat`, computed (or read from the table, where it chose).
     pub coriolis_effect_rel: T,
     /// The plan's relative error as predicted by the pilot runs or the table (0 for the closed
     /// form: rounding; for the closed form at the mean speed, its difference from the pilot's

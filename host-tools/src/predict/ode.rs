@@ -202,3 +202,33 @@ impl StepCheck {
         })
     }
 }
+
+/// `T` of a chosen plan over a varying speed, s: 0 for a particle already at the rim, infinite
+/// when it does not leave within the run's horizon.
+pub fn plan_time_s<P: model_core::ode::OmegaProfile<f64>>(
+    scene: &Scene<f64>,
+    model: Model,
+    profile: &P,
+    method: Method<f64>,
+) -> Result<f64> {
+    let limits = ode::Limits::for_scene(scene, profile);
+    let report = ode::integrate(scene, model, profile, method, limits)
+        .map_err(|e| anyhow!(super::words::ode(e)))?;
+    Ok(match report.outcome {
+        OdeOutcome::Leaves {
+            residence_time_s, ..
+        } => residence_time_s,
+        OdeOutcome::AlreadyAtRim { .. } => 0.0,
+        _ => f64::INFINITY,
+    })
+}
+
+/// The line `bowl predict` prints for a chosen plan's `T`.
+pub fn plan_time_line(model: Model, time_s: f64) -> String {
+    let name = super::model_name(model);
+    if time_s.is_finite() {
+        format!("{name:<8} leaves after T = {time_s:.9} s")
+    } else {
+        format!("{name:<8} NEVER LEAVES within the run's horizon")
+    }
+}

@@ -6,7 +6,7 @@
 
 use anyhow::{Result, anyhow, bail};
 use model_core::choose::Plan;
-use model_core::ode::{self, Limits, OdeOutcome, SpinUp};
+use model_core::ode::SpinUp;
 use model_core::particle::Scene;
 
 use super::target::RunsOn;
@@ -51,19 +51,7 @@ pub fn run(
             "the chooser answered a spin-up with a closed form at a mean speed, which only a \
              logged trace asks for: please report this scene"
         ),
-        Plan::Integrate(method) => {
-            let limits = Limits::for_scene(scene, &speed);
-            match ode::integrate(scene, choice.model, &speed, method, limits)
-                .map_err(|e| anyhow!(super::words::ode(e)))?
-                .outcome
-            {
-                OdeOutcome::Leaves {
-                    residence_time_s, ..
-                } => residence_time_s,
-                OdeOutcome::AlreadyAtRim { .. } => 0.0,
-                _ => f64::INFINITY,
-            }
-        }
+        Plan::Integrate(method) => super::ode::plan_time_s(scene, choice.model, &speed, method)?,
     };
     if json {
         println!(
@@ -84,17 +72,7 @@ pub fn run(
             scene.omega_rad_s, scene.mu, scene.ri_m, scene.rim_radius_m
         );
         println!("{}", super::choice::describe(&choice, need, runs_on));
-        if time_s.is_finite() {
-            println!(
-                "{:<8} leaves after T = {time_s:.9} s",
-                super::model_name(choice.model)
-            );
-        } else {
-            println!(
-                "{:<8} NEVER LEAVES within the run's horizon",
-                super::model_name(choice.model)
-            );
-        }
+        println!("{}", super::ode::plan_time_line(choice.model, time_s));
     }
     Ok(())
 }

@@ -87,7 +87,6 @@ pub fn run(
     json: bool,
 ) -> Result<()> {
     use model_core::choose::{LOGGED_SPEED_RESOLUTION_RAD_S, Need, Plan, SampledOmega, TraceError};
-    use model_core::ode::{self, Limits, OdeOutcome};
     use model_core::particle;
 
     scene
@@ -163,19 +162,7 @@ pub fn run(
         }
         Plan::Integrate(method) => match answered {
             Some(t) => t,
-            None => {
-                let limits = Limits::for_scene(scene, &profile);
-                match ode::integrate(scene, choice.model, &profile, method, limits)
-                    .map_err(|e| anyhow!(super::words::ode(e)))?
-                    .outcome
-                {
-                    OdeOutcome::Leaves {
-                        residence_time_s, ..
-                    } => residence_time_s,
-                    OdeOutcome::AlreadyAtRim { .. } => 0.0,
-                    _ => f64::INFINITY,
-                }
-            }
+            None => super::ode::plan_time_s(scene, choice.model, &profile, method)?,
         },
     };
     let (lo, hi) = trace
@@ -232,17 +219,7 @@ pub fn run(
                  rtol): the plan needed no run of its own"
             );
         }
-        if time_s.is_finite() {
-            println!(
-                "{:<8} leaves after T = {time_s:.9} s",
-                super::model_name(choice.model)
-            );
-        } else {
-            println!(
-                "{:<8} NEVER LEAVES within the run's horizon",
-                super::model_name(choice.model)
-            );
-        }
+        println!("{}", super::ode::plan_time_line(choice.model, time_s));
     }
     Ok(())
 }

@@ -54,7 +54,23 @@ impl Drop for Sim {
 
 /// Runs `bowl ARGS` to its end and returns what it printed.
 pub fn bowl(args: &[&str]) -> Output {
-    Command::new(BOWL).args(args).output().expect("bowl runs")
+    Command::new(BOWL)
+        .args(args)
+        .env_remove("RUST_BACKTRACE")
+        .env_remove("RUST_LIB_BACKTRACE")
+        .output()
+        .expect("bowl runs")
+}
+
+/// `bowl ARGS`, which must succeed, its standard output parsed as one JSON document.
+pub fn json(args: &[&str]) -> serde_json::Value {
+    let out = bowl(args);
+    assert!(
+        out.status.success(),
+        "bowl {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid JSON")
 }
 
 /// Standard output as text.

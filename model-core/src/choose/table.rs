@@ -228,8 +228,9 @@ fn error_constant(scene: &Scene<f64>, model: Model, speed: &SpinUp<f64>, referen
 }
 
 /// Measures grid point `point` of the five-dimensional grid: the bytes of the Coriolis error
-/// constant, the effect and `T omega_f`, and (where the damping index is 0, which the flat
-/// model's grid shares) the flat error constant.
+/// constant, the effect per unit of damping and the release-to-rim time (times `omega_f`, 1
+/// here), and (where the damping index is 0, which the flat model's grid shares) the flat
+/// error constant.
 pub fn measure(point: usize) -> ([u8; 3], Option<u8>) {
     let (scene, speed) = scene_at(point);
     let reference = Method::Dp54 {
