@@ -122,3 +122,54 @@ fn scenes_the_table_does_not_hold_have_no_reading() {
         assert_eq!(read(&s, &p), None, "{s:?} {p:?}");
     }
 }
+
+/// Any finite number, extremes included.
+fn any_finite() -> impl proptest::strategy::Strategy<Value = f64> {
+    use proptest::prelude::*;
+    prop_oneof![
+        0.0f64..10.0,
+        (-300.0f64..300.0).prop_map(|e| libm::pow(10.0, e)),
+        Just(0.0),
+        Just(f64::MIN_POSITIVE),
+        Just(f64::MAX),
+    ]
+}
+
+/// Mostly within the rig's range (so that many scenes lie inside the table), else any finite
+/// number.
+fn rig_or_any(low: f64, high: f64) -> impl proptest::strategy::Strategy<Value = f64> {
+    use proptest::prelude::*;
+    prop_oneof![3 => low..high, 1 => any_finite()]
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2000))]
+    /// Any finite scene and spin-up, however extreme: reading the table never panics, and what
+    /// it reads, and the plan it gives, are finite and positive.
+    #[test]
+    fn any_finite_spin_up_reads_finite_values_or_none(
+        mu in rig_or_any(0.001, 0.2), g in rig_or_any(1.0, 20.0), ri in rig_or_any(0.01, 0.1),
+        rim in rig_or_any(0.09, 0.11), start in rig_or_any(0.0, 3.0), end in rig_or_any(1.0, 8.0),
+        tau in rig_or_any(0.05, 5.0),
+        tolerance in 1e-12f64..0.1,
+    ) {
+        let scene = Scene { omega_rad_s: end, mu, g_m_s2: g, k2: K2, ri_m: ri, rim_radius_m: rim };
+        let speed = SpinUp { start_rad_s: start, final_rad_s: end, time_constant_s: tau };
+        if let Some(r) = read(&scene, &speed) {
+            for v in [r.coriolis_constant, r.flat_constant, r.effect_rel, r.time_s] {
+                proptest::prop_assert!(v.is_finite() && v > 0.0, "{r:?}");
+            }
+            proptest::prop_assert!(r.release_s.is_finite() && r.release_s >= 0.0, "{r:?}");
+        }
+        let limits = Limits::for_scene(&scene, &speed);
+        let cap = (1.5 / end.max(f64::MIN_POSITIVE)).min(tau);
+        if let Some(c) = choice(&scene, &speed, tolerance, cap, limits) {
+            let Plan::Integrate(Method::Rk4 { step_s }) = c.plan else {
+                proptest::prop_assert!(false, "{c:?}");
+                unreachable!()
+            };
+            proptest::prop_assert!(step_s.is_finite() && step_s > 0.0 && step_s <= cap, "{c:?}");
+            proptest::prop_assert!(c.rhs_evaluations >= 5 && c.predicted_cost.is_finite(), "{c:?}");
+        }
+    }
+}
