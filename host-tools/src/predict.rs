@@ -93,7 +93,11 @@ pub struct Args {
     /// approaches --omega-rad-s with --time-constant-s; the particle is released at t = 0.
     /// The chooser picks the model and the integrator (from its precomputed error table when
     /// --tolerance is given).
-    #[arg(long, requires = "time_constant_s", conflicts_with = "omega_trace")]
+    #[arg(
+        long,
+        requires = "time_constant_s",
+        conflicts_with_all = ["omega_trace", "batch", "target_time_s"]
+    )]
     spin_up_from_rad_s: Option<f64>,
     /// With --spin-up-from-rad-s: the spin-up's time constant, s.
     #[arg(long, requires = "spin_up_from_rad_s")]
@@ -188,6 +192,14 @@ pub fn predict(
 
 /// Runs `bowl predict`.
 pub fn run(args: &Args) -> Result<()> {
+    if args.spin_up_from_rad_s.is_some()
+        && (args.model != ModelChoice::Auto || args.method != MethodChoice::Closed)
+    {
+        anyhow::bail!(
+            "--spin-up-from-rad-s lets the chooser pick the model and the method: leave out \
+             --model and --method (give --tolerance or --uncertainty instead)"
+        );
+    }
     if args.model == ModelChoice::Rolling {
         return rolling::run(args, &args.rolling);
     }
@@ -221,12 +233,6 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     if let (Some(start), Some(tau)) = (args.spin_up_from_rad_s, args.time_constant_s) {
-        if args.model != ModelChoice::Auto || args.method != MethodChoice::Closed {
-            anyhow::bail!(
-                "--spin-up-from-rad-s lets the chooser pick the model and the method: leave out \
-                 --model and --method (give --tolerance or --uncertainty instead)"
-            );
-        }
         return spin_up::run(&scene, start, tau, &need, args.target, args.json);
     }
     words::check(&scene)?;

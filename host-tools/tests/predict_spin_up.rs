@@ -116,6 +116,28 @@ fn bad_spin_ups_are_named_in_plain_words() {
             ],
             "--spin-up-from-rad-s lets the chooser pick the model and the method",
         ),
+        (
+            vec![
+                "--spin-up-from-rad-s",
+                "1",
+                "--time-constant-s",
+                "0.3",
+                "--model",
+                "rolling",
+            ],
+            "--spin-up-from-rad-s lets the chooser pick the model and the method",
+        ),
+        (
+            vec![
+                "--spin-up-from-rad-s",
+                "1",
+                "--time-constant-s",
+                "0.3",
+                "--target-time-s",
+                "1",
+            ],
+            "cannot be used with",
+        ),
     ] {
         let mut all = vec!["predict"];
         all.extend(args);
