@@ -120,7 +120,7 @@ pub const BYTES: usize = 3 * POINTS + FLAT_POINTS;
 const LOG_FLOOR: f64 = -9.0;
 const STEPS_PER_DECADE: f64 = 20.0;
 
-/// The byte that stores `v` (see [`LOG_FLOOR`]).
+/// The byte that stores `v`: `1 + ceil((log10 v + 9) * 20)`, 0 for "not measured".
 pub fn encode(v: f64) -> u8 {
     if !(v.is_finite() && v >= 0.0) {
         return 0;

@@ -232,8 +232,8 @@ pub fn mean_omega_rad_s<T: Real, P: OmegaProfile<T>>(profile: &P, t_end_s: T) ->
 }
 
 /// Chooses for a logged speed trace: the closed form at the mean speed over the residence
-/// time if it meets the tolerance there, otherwise the integrator [`choose_varying_for`]
-/// picks. The closed form is judged against the pilot's `T` (`time_estimate_s`), whose own
+/// time if it meets the tolerance there, otherwise the integrator
+/// [`choose_varying_for`](super::choose_varying_for) picks. The closed form is judged against the pilot's `T` (`time_estimate_s`), whose own
 /// estimated error is added to the difference; `estimated_error_rel` is that difference.
 pub fn choose_trace<T: Real, P: OmegaProfile<T>>(
     scene: &Scene<T>,

@@ -250,8 +250,8 @@ impl LoopConstants {
         self.duty_per_rad_s
     }
 
-    /// Model speed above which the two-interval runaway rule is armed, rad/s (see
-    /// [`pair_runaway_above_rad_s`]).
+    /// Model speed above which the two-interval runaway rule is armed, rad/s (the free
+    /// function of the same name in this module says how it is set).
     pub fn pair_runaway_above_rad_s(&self) -> f32 {
         self.pair_runaway_above_rad_s
     }

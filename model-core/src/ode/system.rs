@@ -1,6 +1,6 @@
 //! The project's integrators for a system of `N` first-order equations `y' = f(t, y)` (the
 //! rolling granule of [`crate::particle::rolling`]): adaptive Dormand-Prince 5(4) with its dense
-//! output (the same tableau and step control as the radial model's, [`super::dp54`]) and classical
+//! output (the same tableau and step control as the radial model's, `ode/dp54.rs`) and classical
 //! RK4 at a fixed step with cubic Hermite interpolation. Both stop at the first zero of an event
 //! function (the rim), located on the interpolant, so `T` keeps the method's order; a check
 //! after every accepted step can end the run early (lift-off, slip, a held granule).
