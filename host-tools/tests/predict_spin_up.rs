@@ -85,62 +85,36 @@ fn without_a_stated_tolerance_or_for_the_mcu_the_pilot_chooses() {
 
 #[test]
 fn bad_spin_ups_are_named_in_plain_words() {
-    for (args, words) in [
+    // A valid spin-up (from 1 rad/s, time constant 0.3 s) unless the case overrides it.
+    const SPIN_UP: [&str; 4] = ["--spin-up-from-rad-s", "1", "--time-constant-s", "0.3"];
+    let must_choose = "--spin-up-from-rad-s lets the chooser pick the model and the method";
+    for (spin_up, extra, words) in [
         (
             vec!["--spin-up-from-rad-s", "1", "--time-constant-s", "0"],
+            vec![],
             "--time-constant-s 0: the spin-up's time constant must be a positive number",
         ),
         (
             vec!["--spin-up-from-rad-s=-1", "--time-constant-s", "0.3"],
+            vec![],
             "--spin-up-from-rad-s -1: the start speed must be zero or positive",
         ),
         (
-            vec![
-                "--spin-up-from-rad-s",
-                "1",
-                "--time-constant-s",
-                "0.3",
-                "--omega-rad-s",
-                "0",
-            ],
+            SPIN_UP.to_vec(),
+            vec!["--omega-rad-s", "0"],
             "--omega-rad-s 0: the speed the spin-up approaches must be positive",
         ),
+        (SPIN_UP.to_vec(), vec!["--model", "flat"], must_choose),
+        (SPIN_UP.to_vec(), vec!["--model", "rolling"], must_choose),
         (
-            vec![
-                "--spin-up-from-rad-s",
-                "1",
-                "--time-constant-s",
-                "0.3",
-                "--model",
-                "flat",
-            ],
-            "--spin-up-from-rad-s lets the chooser pick the model and the method",
-        ),
-        (
-            vec![
-                "--spin-up-from-rad-s",
-                "1",
-                "--time-constant-s",
-                "0.3",
-                "--model",
-                "rolling",
-            ],
-            "--spin-up-from-rad-s lets the chooser pick the model and the method",
-        ),
-        (
-            vec![
-                "--spin-up-from-rad-s",
-                "1",
-                "--time-constant-s",
-                "0.3",
-                "--target-time-s",
-                "1",
-            ],
+            SPIN_UP.to_vec(),
+            vec!["--target-time-s", "1"],
             "cannot be used with",
         ),
     ] {
         let mut all = vec!["predict"];
-        all.extend(args);
+        all.extend(spin_up);
+        all.extend(extra);
         let out = bowl(&all);
         assert!(!out.status.success(), "{all:?}");
         let err = String::from_utf8_lossy(&out.stderr);
