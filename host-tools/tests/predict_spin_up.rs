@@ -58,7 +58,7 @@ fn a_spin_up_with_a_tolerance_is_read_from_the_table_and_meets_it() {
 }
 
 #[test]
-fn without_a_stated_tolerance_or_for_the_mcu_the_pilot_chooses() {
+fn a_derived_tolerance_runs_only_the_spread_and_the_mcu_runs_the_pilot() {
     let base = [
         "predict",
         "--spin-up-from-rad-s",
@@ -67,12 +67,34 @@ fn without_a_stated_tolerance_or_for_the_mcu_the_pilot_chooses() {
         "0.3",
         "--json",
     ];
+    // The tolerance from the parameters' uncertainty (the default): the spread's runs, then
+    // the method from the table.
     let v = json(&base);
-    assert_eq!(v["choice"]["source"], "pilot-runs", "{v}");
-    let tolerance = v["choice"]["tolerance_rel"].as_f64().unwrap();
+    let choice = &v["choice"];
+    assert_eq!(choice["source"], "table", "{v}");
+    assert!(choice["choosing_evaluations"].as_u64().unwrap() > 0, "{v}");
+    let spread = choice["spread_rel"].as_f64().unwrap();
+    let tolerance = choice["tolerance_rel"].as_f64().unwrap();
+    assert!((tolerance - 0.1 * spread).abs() <= 1e-12, "{v}");
     let got = v["residence_time_s"].as_f64().unwrap();
     let truth = reference(0.0, 3.0, 0.3, true);
     assert!((got - truth).abs() <= tolerance * truth, "{v}");
+    // The spread by the tests' own reference: mu 20 % either way moves T by most of it.
+    let mu_moves = [0.8, 1.2].map(|f| {
+        let omega = |t: f64| 3.0 * (1.0 - (-t / 0.3).exp());
+        (common::reference_residence_s(omega, 0.029 * f, 0.05, 0.1, true) - truth).abs() / truth
+    });
+    let mu_part = mu_moves[0].max(mu_moves[1]);
+    assert!(
+        mu_part > 0.5 * spread && mu_part < spread,
+        "{mu_part} of {spread}"
+    );
+    let text = bowl(&base[..base.len() - 1]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        text.contains("chosen from the precomputed error table (the runs were the spread's"),
+        "{text}"
+    );
     let mut mcu = base.to_vec();
     mcu.extend(["--tolerance", "1e-4", "--target", "mcu"]);
     let v = json(&mcu);

@@ -13,11 +13,12 @@
 //!    a flat run whose error is within 1/32 of the tolerance). Within the tolerance, with room
 //!    left for the method, the flat model is enough.
 //! 3. **Method.** Constant speed: the closed form (exact to rounding, cheapest). A first-order
-//!    spin-up with a stated tolerance (f64): RK4 at the longest step whose error the
-//!    precomputed table (`table.rs`: RK4's error constant, the Coriolis effect and `T` measured
-//!    once over the spin-up's dimensionless features) predicts within half the tolerance, with
-//!    no run at all; on `bowl chart chooser`'s grid that choice costs 0.3x the plan it picks
-//!    and at most 1.232x the cheapest plan. Otherwise, time-varying
+//!    spin-up (f64): RK4 at the longest step whose error the precomputed table (`table.rs`:
+//!    RK4's error constant, the Coriolis effect and `T` measured once over the spin-up's
+//!    dimensionless features) predicts within half the tolerance, with no run at all for a
+//!    stated tolerance (a derived one runs the spread's scenes only); on `bowl chart
+//!    chooser`'s grid that choice costs 0.3x the plan it picks and at most 1.232x the cheapest
+//!    plan. Otherwise, time-varying
 //!    speed: RK4 at the longest step whose error the pilot (`pilot.rs`: RK4 at `h`, `h/2`, `h/4`,
 //!    `h/8` from the release time, `h` resolving both `1/omega` and the speed's own time
 //!    scale, where the error follows `C h^p`) predicts within half of what the model leaves of
@@ -111,7 +112,8 @@ pub struct Choice<T> {
 pub enum Source {
     /// The two closed forms (a constant speed).
     ClosedForms,
-    /// The precomputed error table (a first-order spin-up with a stated tolerance): no run.
+    /// The precomputed error table (a first-order spin-up): no run but, for a tolerance derived
+    /// from the parameters' uncertainty, the spread's.
     Table,
     /// Pilot runs of the scene itself.
     PilotRuns,
@@ -122,7 +124,7 @@ impl Source {
     pub fn describe(self) -> &'static str {
         match self {
             Source::ClosedForms => "from the two closed forms",
-            Source::Table => "from the precomputed error table, without running the scene",
+            Source::Table => "from the precomputed error table",
             Source::PilotRuns => "from pilot runs of the scene",
         }
     }

@@ -190,6 +190,13 @@ pub fn describe(c: &Choice<f64>, need: &Need<f64>, runs_on: RunsOn) -> String {
         );
     }
     out += &format!("\n  chosen {}", c.source.describe());
+    if c.source == Source::Table {
+        out += if c.choosing_evaluations == 0 {
+            ", without running the scene"
+        } else {
+            " (the runs were the spread's, for the tolerance)"
+        };
+    }
     out += &format!(
         "\n  predicted cost {:.0} {} {} (measured table: docs/model.md, the chooser)",
         c.predicted_cost,

@@ -403,6 +403,23 @@ pub(crate) fn read<T: Real>(scene: &Scene<T>, speed: &SpinUp<T>) -> Option<Readi
     })
 }
 
+/// RK4's longest step, up to `step_cap`, whose error in the Coriolis model's `T` the table
+/// reads within `error_rel`, s; `None` where the table has no reading.
+pub(crate) fn step_for<T: Real>(
+    scene: &Scene<T>,
+    speed: &ode::SpinUp<T>,
+    error_rel: f64,
+    step_cap: T,
+) -> Option<f64> {
+    let reading = read(scene, speed)?;
+    let w_f = speed.final_rad_s.to_f64();
+    Some(
+        step_cap
+            .to_f64()
+            .min(libm::sqrt(libm::sqrt(error_rel / reading.coriolis_constant)) / w_f),
+    )
+}
+
 /// The choice read from the table, `None` where the table has no
 /// reading or the plan would need more steps than the cap. The effect is read with its
 /// interpolation margin ([`EFFECT_READING_MARGIN`]); the step is RK4's longest, up to

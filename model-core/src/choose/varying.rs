@@ -76,17 +76,14 @@ pub(crate) fn choose_varying_reading<T: Real, P: OmegaProfile<T>>(
         };
         return Ok((at_rim, T::ZERO));
     }
-    // A first-order spin-up with a stated tolerance, inside the table: no run (f64 only: the
-    // table holds truncation errors, and f32 adds a rounding error the table does not know).
-    if let (Need::Tolerance(t), Some(speed), true) = (
-        need,
-        profile.spin_up(),
-        read_table && T::EPSILON.to_f64() < 1e-12,
-    ) {
-        let tolerance = clamp_tolerance(*t);
-        if let Some(choice) = table::choice(scene, &speed, tolerance, step_cap, limits) {
-            return Ok((choice, T::from_f64(table::TIME_READING_ERROR_REL)));
-        }
+    // A first-order spin-up inside the table (f64 only: the table holds truncation errors,
+    // and f32 adds a rounding error the table does not know): the method with no run; a
+    // tolerance derived from the parameters' uncertainty needs the spread's runs, at a step
+    // the table reads.
+    if let (Some(speed), true) = (profile.spin_up(), read_table && T::EPSILON.to_f64() < 1e-12)
+        && let Some(found) = from_table(scene, need, profile, &speed, step_cap, limits)
+    {
+        return Ok((found, T::from_f64(table::TIME_READING_ERROR_REL)));
     }
     // A smooth speed: RK4's error model. One with kinks: DP5(4) to a millionth first (the
     // spread and the Coriolis effect need T far better than the tolerance they set), then to
@@ -271,4 +268,51 @@ fn flat_effect<T: Real, P: OmegaProfile<T>>(
     }
     let effect = (tc - tf).abs() / tf;
     Ok((effect, effect + flat_error + coriolis.error_rel, spent))
+}
+
+/// The spread runs' own error, relative, at the step the table reads for them: a spread of
+/// `T` (a few percent at least, where the tolerance comes from it) is then far above it.
+const SPREAD_RUN_ERROR_REL: f64 = 1e-4;
+
+/// The choice from the error table (`table.rs`), `None` where it has no reading. A stated
+/// tolerance runs nothing; a derived one runs the spread's nine scenes with RK4 at the step
+/// whose error the table reads within [`SPREAD_RUN_ERROR_REL`], and once more within a
+/// hundredth of the spread found where that is not 100 times the runs' error.
+fn from_table<T: Real, P: OmegaProfile<T>>(
+    scene: &Scene<T>,
+    need: &Need<T>,
+    profile: &P,
+    speed: &ode::SpinUp<T>,
+    step_cap: T,
+    limits: Limits<T>,
+) -> Option<Choice<T>> {
+    let (spread_rel, tolerance, spent) = match need {
+        Need::Tolerance(t) => (None, clamp_tolerance(*t), 0),
+        Need::Uncertainty(knowledge) => {
+            // Where the spread comes out within 100x of the runs' error, once more with runs
+            // within a hundredth of it (taken as found, as the pilot's second pass is).
+            let mut step_s = table::step_for(scene, speed, SPREAD_RUN_ERROR_REL, step_cap)?;
+            let (mut spent, mut pass) = (0u32, 0);
+            let found = loop {
+                let method = Method::Rk4 {
+                    step_s: T::from_f64(step_s),
+                };
+                let (spread, evals) = spread_at(scene, knowledge, profile, method, limits);
+                spent = spent.saturating_add(evals);
+                if pass == 1 || spread >= T::from_f64(100.0 * SPREAD_RUN_ERROR_REL) {
+                    break spread;
+                }
+                let run_error = (spread.to_f64() * 0.01).max(1e-13);
+                step_s = table::step_for(scene, speed, run_error, step_cap)?;
+                pass += 1;
+            };
+            (Some(found), tolerance_from(found), spent)
+        }
+    };
+    let choice = table::choice(scene, speed, tolerance, step_cap, limits)?;
+    Some(Choice {
+        spread_rel,
+        choosing_evaluations: spent,
+        ..choice
+    })
 }
