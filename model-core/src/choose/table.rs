@@ -371,12 +371,13 @@ pub(crate) fn read<T: Real>(scene: &Scene<T>, speed: &SpinUp<T>) -> Option<Readi
     if q >= 1.0 {
         return None;
     }
+    let damping = 2.0 * K2 * mu;
     let features = [
         start / w_f,
         libm::log10(w_f * tau),
         libm::log10(q / (1.0 - q)),
         ri / rim,
-        libm::log10(2.0 * K2 * mu),
+        libm::log10(damping),
     ];
     let axes = [
         START_RATIO,
@@ -397,41 +398,37 @@ pub(crate) fn read<T: Real>(scene: &Scene<T>, speed: &SpinUp<T>) -> Option<Readi
     Some(Reading {
         coriolis_constant: corners.value(coriolis, false)?,
         flat_constant: corners.value(flat, true)?,
-        effect_rel: corners.value(effect, false)? * 2.0 * K2 * mu,
+        effect_rel: corners.value(effect, false)? * damping,
         time_s: released_s + corners.value(time, false)? / w_f,
         release_s: released_s,
     })
 }
 
-/// RK4's longest step, up to `step_cap`, whose error in the Coriolis model's `T` the table
-/// reads within `error_rel`, s; `None` where the table has no reading.
-pub(crate) fn step_for<T: Real>(
-    scene: &Scene<T>,
-    speed: &ode::SpinUp<T>,
-    error_rel: f64,
-    step_cap: T,
-) -> Option<f64> {
-    let reading = read(scene, speed)?;
-    let w_f = speed.final_rad_s.to_f64();
-    Some(
-        step_cap
-            .to_f64()
-            .min(libm::sqrt(libm::sqrt(error_rel / reading.coriolis_constant)) / w_f),
-    )
+/// RK4's longest step, up to `step_cap`, s, whose relative error `constant (h omega_f)^4` is
+/// within `error_rel`.
+fn step_within(constant: f64, error_rel: f64, w_f: f64, step_cap: f64) -> f64 {
+    step_cap.min(libm::sqrt(libm::sqrt(error_rel / constant)) / w_f)
 }
 
-/// The choice read from the table, `None` where the table has no
-/// reading or the plan would need more steps than the cap. The effect is read with its
-/// interpolation margin ([`EFFECT_READING_MARGIN`]); the step is RK4's longest, up to
-/// `step_cap`, whose error `C (h omega_f)^4` is within the same budget as the pilot's plan.
+impl Reading {
+    /// RK4's longest step, up to `step_cap`, s, whose error in the Coriolis model's `T` this
+    /// reading puts within `error_rel` (`w_f`: the spin-up's final speed, rad/s).
+    pub(crate) fn coriolis_step_s(&self, error_rel: f64, w_f: f64, step_cap: f64) -> f64 {
+        step_within(self.coriolis_constant, error_rel, w_f, step_cap)
+    }
+}
+
+/// The choice from a reading of the table, `None` where the plan would need more steps than
+/// the cap. The effect is read with its interpolation margin ([`EFFECT_READING_MARGIN`]); the
+/// step is RK4's longest, up to `step_cap`, whose error `C (h omega_f)^4` is within the same
+/// budget as the pilot's plan.
 pub(crate) fn choice<T: Real>(
-    scene: &Scene<T>,
+    reading: &Reading,
     speed: &ode::SpinUp<T>,
     tolerance: T,
     step_cap: T,
     limits: Limits<T>,
 ) -> Option<Choice<T>> {
-    let reading = read(scene, speed)?;
     let tol = tolerance.to_f64();
     let effect_bound = reading.effect_rel * EFFECT_READING_MARGIN;
     let (model, budget, constant, time_s) = if effect_bound <= 0.75 * tol {
@@ -451,9 +448,7 @@ pub(crate) fn choice<T: Real>(
         )
     };
     let w_f = speed.final_rad_s.to_f64();
-    let h = step_cap
-        .to_f64()
-        .min(libm::sqrt(libm::sqrt(budget / constant)) / w_f);
+    let h = step_within(constant, budget, w_f, step_cap.to_f64());
     let steps = libm::ceil(((time_s - reading.release_s) / h).max(1.0));
     if !(h > 0.0 && steps <= f64::from(limits.max_steps)) {
         return None;

@@ -163,7 +163,7 @@ proptest::proptest! {
         }
         let limits = Limits::for_scene(&scene, &speed);
         let cap = (1.5 / end.max(f64::MIN_POSITIVE)).min(tau);
-        if let Some(c) = choice(&scene, &speed, tolerance, cap, limits) {
+        if let Some(c) = read(&scene, &speed).and_then(|r| choice(&r, &speed, tolerance, cap, limits)) {
             let Plan::Integrate(Method::Rk4 { step_s }) = c.plan else {
                 proptest::prop_assert!(false, "{c:?}");
                 unreachable!()

@@ -286,12 +286,14 @@ fn from_table<T: Real, P: OmegaProfile<T>>(
     step_cap: T,
     limits: Limits<T>,
 ) -> Option<Choice<T>> {
+    let reading = table::read(scene, speed)?;
+    let (w_f, cap) = (speed.final_rad_s.to_f64(), step_cap.to_f64());
     let (spread_rel, tolerance, spent) = match need {
         Need::Tolerance(t) => (None, clamp_tolerance(*t), 0),
         Need::Uncertainty(knowledge) => {
             // Where the spread comes out within 100x of the runs' error, once more with runs
             // within a hundredth of it (taken as found, as the pilot's second pass is).
-            let mut step_s = table::step_for(scene, speed, SPREAD_RUN_ERROR_REL, step_cap)?;
+            let mut step_s = reading.coriolis_step_s(SPREAD_RUN_ERROR_REL, w_f, cap);
             let (mut spent, mut pass) = (0u32, 0);
             let found = loop {
                 let method = Method::Rk4 {
@@ -303,13 +305,13 @@ fn from_table<T: Real, P: OmegaProfile<T>>(
                     break spread;
                 }
                 let run_error = (spread.to_f64() * 0.01).max(1e-13);
-                step_s = table::step_for(scene, speed, run_error, step_cap)?;
+                step_s = reading.coriolis_step_s(run_error, w_f, cap);
                 pass += 1;
             };
             (Some(found), tolerance_from(found), spent)
         }
     };
-    let choice = table::choice(scene, speed, tolerance, step_cap, limits)?;
+    let choice = table::choice(&reading, speed, tolerance, step_cap, limits)?;
     Some(Choice {
         spread_rel,
         choosing_evaluations: spent,
