@@ -89,7 +89,8 @@ fn ask(port: &mut Link, ids: &mut Ids, words: &[&str]) -> Result<Option<Frame>> 
     let words: Vec<String> = words.iter().map(|w| w.to_string()).collect();
     let line = command_line(id, &words)
         .map_err(|r| anyhow::anyhow!("{} was refused locally ({})", words.join(" "), r.token()))?;
-    Ok(transact(port, id, &line, ANSWER_TIMEOUT)?)
+    // No answer is `None` here: the caller says what was asked and stops.
+    Ok(transact(port, id, &line, ANSWER_TIMEOUT)?.ok())
 }
 
 /// How commissioning ended.
@@ -225,11 +226,7 @@ pub fn run(args: &Args) -> Result<i32> {
         bail!("--timeout-s must be between 0 and 86400");
     }
     let mut port = Link::open(&args.port, args.baud)?;
-    let seed = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.subsec_nanos())
-        .unwrap_or(0);
-    let mut ids = Ids((seed % 60_000) as u16);
+    let mut ids = Ids(crate::link::fresh_id());
     let mut report = Report {
         result: "ok",
         seconds: 0.0,

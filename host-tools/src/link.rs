@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 use model_core::wire::{Command, Decoder, Frame, decode_frame};
 
 use crate::serial::{LinkError, Port, ReadOutcome};
+pub use crate::unreadable::{LineTap, UnreadableAnswer};
 
 #[cfg(unix)]
 pub(crate) type Stream = std::os::unix::net::UnixStream;
@@ -121,39 +122,108 @@ pub fn answers_kind(command: &Command, frame: &Frame) -> bool {
     }
 }
 
+/// A request id for the first command of a process: the wall clock in milliseconds, mod 2^16
+/// (one turn in 65.5 s). The rig takes a command with the id and words of one of its recent
+/// commands, up to 60 s old, for a copy and does not carry it out again (docs/protocol.md), so
+/// ids must not come back within 60 s: from the clock, each process starts past the ids of
+/// the ones before it and counts up from there (a process sends far fewer than one command a
+/// millisecond). `u16::MAX` is left to the monitor's heartbeat.
+pub fn fresh_id() -> u16 {
+    let ms = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_millis())
+        .unwrap_or(0);
+    match (ms % 65_536) as u16 {
+        u16::MAX => 0,
+        id => id,
+    }
+}
+
 /// How long one attempt waits before the command is sent again with the same id (the rig carries
 /// a resend out once). The rig answers within a few ms; a damaged answer is never repaired.
 pub const RESEND_EVERY: Duration = Duration::from_millis(200);
 
+/// What came from the rig while a command waited in vain for its answer: enough to say whether
+/// the line is dead, noisy, or alive but not answering.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Unanswered {
+    /// Frames that arrived intact (telemetry, other tools' answers).
+    pub frames_ok: u64,
+    /// Frames that arrived damaged.
+    pub frames_corrupt: u64,
+    /// How many times the command was sent (the first time and the resends).
+    pub sent: u32,
+}
+
+impl Unanswered {
+    /// What to try, in words.
+    pub fn advice(&self) -> String {
+        let seen = format!(
+            "sent {} times; meanwhile {} frames arrived intact and {} damaged",
+            self.sent, self.frames_ok, self.frames_corrupt
+        );
+        let todo = if self.frames_corrupt > 0 {
+            "the line is noisy: give it longer (`--timeout-ms 5000` resends every 200 ms until \
+             then), check the cable, its ground and the baud rate (`--baud`); `bowl monitor PORT` \
+             shows the frame counters"
+        } else if self.frames_ok == 0 {
+            "nothing came from the port at all: is the rig powered, is this its port (`bowl \
+             ports`), is the baud rate right (`--baud`)?"
+        } else {
+            "the rig is sending but did not answer: give it longer (`--timeout-ms 5000`); \
+             `bowl monitor PORT` shows its state and the frame counters"
+        };
+        format!("{seen}; {todo}")
+    }
+}
+
 /// Sends the command `line` (request `id`) and waits for its answer: the frame with this id and
 /// the kind the command gets. Old input is discarded first; when no answer comes within
-/// [`RESEND_EVERY`], the same line is sent again, until `timeout` has passed.
+/// [`RESEND_EVERY`], the same line is sent again, until `timeout` has passed. `Ok(Err(..))`
+/// when nothing answered (with what came instead); an error when the link failed
+/// ([`LinkError`]) or the answer could not be read ([`UnreadableAnswer`]).
 pub fn transact(
     link: &mut Link,
     id: u16,
     line: &[u8],
     timeout: Duration,
-) -> Result<Option<Frame>, LinkError> {
+) -> anyhow::Result<Result<Frame, Unanswered>> {
     let command = match decode_frame(line) {
         Ok(Frame::Command { command, .. }) => command,
-        _ => return Err(LinkError("not a command line (a bug in bowl)".into())),
+        _ => anyhow::bail!("not a command line (a bug in bowl)"),
     };
     let end = Instant::now() + timeout;
     let mut buf = [0u8; 4096];
+    let mut unanswered = Unanswered::default();
     while let Some(left) = end.checked_duration_since(Instant::now()) {
         link.discard_input();
         link.write_all(line)?;
+        unanswered.sent += 1;
         let deadline = Instant::now() + left.min(RESEND_EVERY);
         let mut decoder = Decoder::new();
+        let mut tap = LineTap::default();
         while let Some(left) = deadline.checked_duration_since(Instant::now()) {
             match link.read(&mut buf, left.min(Duration::from_millis(50)))? {
                 ReadOutcome::Data(n) => {
                     for &b in &buf[..n] {
-                        if let Some(Ok(frame)) = decoder.push(b)
-                            && frame.answer_id() == Some(id)
-                            && answers_kind(&command, &frame)
-                        {
-                            return Ok(Some(frame));
+                        tap.push(b);
+                        match decoder.push(b) {
+                            Some(Ok(frame))
+                                if frame.answer_id() == Some(id)
+                                    && answers_kind(&command, &frame) =>
+                            {
+                                return Ok(Ok(frame));
+                            }
+                            Some(Ok(_)) => unanswered.frames_ok += 1,
+                            Some(Err(e)) => {
+                                if let Some(u) = tap.unreadable_answer(e)
+                                    && u.id == id
+                                {
+                                    return Err(u.into());
+                                }
+                                unanswered.frames_corrupt += 1;
+                            }
+                            None => {}
                         }
                     }
                 }
@@ -161,12 +231,13 @@ pub fn transact(
                 ReadOutcome::Gone => {
                     return Err(LinkError(
                         "the link went away while waiting for the answer".into(),
-                    ));
+                    )
+                    .into());
                 }
             }
         }
     }
-    Ok(None)
+    Ok(Err(unanswered))
 }
 
 #[cfg(all(test, unix))]
@@ -198,6 +269,7 @@ mod tests {
                 reset_count: 1,
                 uptime_ms,
                 telemetry_hz: 50,
+                flags: 0,
             },
         }
     }
@@ -240,7 +312,7 @@ mod tests {
         });
         let line = command_line(77, &["status".into()]).unwrap();
         let got = transact(&mut link, 77, &line, Duration::from_millis(1000)).unwrap();
-        assert_eq!(got, Some(status(77)));
+        assert_eq!(got, Ok(status(77)));
         drop(link);
         assert_eq!(rig.join().unwrap().len(), 1, "answered at the first try");
     }
@@ -257,7 +329,7 @@ mod tests {
         });
         let line = command_line(9, &["start".into()]).unwrap();
         let got = transact(&mut link, 9, &line, Duration::from_millis(1000)).unwrap();
-        assert_eq!(got, Some(Frame::Ack { id: 9 }));
+        assert_eq!(got, Ok(Frame::Ack { id: 9 }));
         drop(link);
         let seen = rig.join().unwrap();
         assert_eq!(seen.len(), 2);
@@ -271,10 +343,71 @@ mod tests {
         let line = command_line(5, &["stop".into()]).unwrap();
         let started = Instant::now();
         let got = transact(&mut link, 5, &line, Duration::from_millis(600)).unwrap();
-        assert_eq!(got, None);
+        let silence = got.unwrap_err();
+        assert_eq!(
+            (silence.sent, silence.frames_ok, silence.frames_corrupt),
+            (3, 0, 0)
+        );
+        assert!(silence.advice().contains("nothing came from the port"));
         assert!(started.elapsed() >= Duration::from_millis(600));
         drop(link);
         assert_eq!(rig.join().unwrap().len(), 3, "sent every 200 ms");
+    }
+
+    /// A raw line with a correct CRC.
+    fn raw(payload: &str) -> Vec<u8> {
+        let crc = model_core::wire::crc::crc32(payload.as_bytes());
+        format!("${payload}*{crc:08X}\r\n").into_bytes()
+    }
+
+    #[test]
+    fn an_answer_bowl_cannot_read_is_reported_as_what_it_is() {
+        for (answer, says) in [
+            ("R1,5,BOGUS", "a word or a field this bowl does not know"),
+            ("A2,5", "in protocol version 2 (this bowl speaks version 1)"),
+            ("X1,5", "a kind of frame this bowl does not know ('X')"),
+        ] {
+            // Another request's unreadable answer first: not ours, not taken.
+            let (mut link, rig) = scripted(Vec::new(), move |_, _| {
+                let mut out = raw("R1,6,BOGUS");
+                out.extend(raw(answer));
+                out
+            });
+            let line = command_line(5, &["stop".into()]).unwrap();
+            let started = Instant::now();
+            let err = transact(&mut link, 5, &line, Duration::from_millis(1000)).unwrap_err();
+            assert!(
+                started.elapsed() < Duration::from_millis(500),
+                "not a timeout"
+            );
+            let text = err.to_string();
+            assert!(text.contains("request 5"), "{text}");
+            assert!(text.contains(says), "{text}");
+            assert!(
+                text.contains(&format!("`${answer}*")),
+                "the line as it came: {text}"
+            );
+            assert!(err.downcast_ref::<UnreadableAnswer>().is_some());
+            drop(link);
+            rig.join().unwrap();
+        }
+        // A damaged line (CRC wrong) is no answer at all: the PC resends and times out.
+        let (mut link, rig) = scripted(Vec::new(), |_, _| b"$R1,5,BOGUS*00000000\r\n".to_vec());
+        let line = command_line(5, &["stop".into()]).unwrap();
+        let got = transact(&mut link, 5, &line, Duration::from_millis(400)).unwrap();
+        let noisy = got.unwrap_err();
+        assert!(
+            (1..=u64::from(noisy.sent)).contains(&noisy.frames_corrupt),
+            "{noisy:?}"
+        );
+        assert!(
+            noisy.advice().contains("the line is noisy"),
+            "{}",
+            noisy.advice()
+        );
+        assert!(noisy.advice().contains("--timeout-ms"));
+        drop(link);
+        rig.join().unwrap();
     }
 
     #[test]

@@ -6,6 +6,7 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 mod chart;
+mod command_words;
 mod commission;
 #[cfg(unix)]
 mod demo;
@@ -28,6 +29,7 @@ mod sim_reports;
 mod sim_world;
 mod simulated_backend;
 mod telemetry_csv;
+mod unreadable;
 mod virtual_rig;
 mod words;
 

@@ -14,6 +14,7 @@ use model_core::control::{BowlSpeedForResidence, Controller, ControllerConfig, I
 use model_core::particle::{Model, Scene, omega_for_residence_time};
 use model_core::wire::{Frame, ParamId, ParamValues, Reason, Status};
 
+use crate::command_words::integer_in;
 use crate::link::{Link, transact};
 use crate::send::command_line;
 use crate::words;
@@ -57,23 +58,21 @@ pub fn particulars(
     }
 }
 
-/// `set NAME VALUE` out of range: the parameter's own range from the table, or, if the value
-/// is inside it, the rule that ties it to the others.
-fn set_range(words: &[String]) -> Option<String> {
+/// `set NAME VALUE` refused: not an integer, or outside the parameter's own range from the
+/// table, or, if the value is inside it, the rule that ties it to the others.
+pub(crate) fn set_range(words: &[String]) -> Option<String> {
     let name = words.get(1)?.to_ascii_uppercase();
     let id = ParamId::ALL.into_iter().find(|p| p.token() == name)?;
     let (lo, hi) = id.range();
     let unit = id.unit();
-    match words.get(2)?.parse::<i64>() {
-        Ok(v) if v < i64::from(lo) || v > i64::from(hi) => Some(format!(
-            "{name} = {v} {unit} is outside its range {lo}..={hi} {unit}"
+    let value = words.get(2)?;
+    match integer_in(value, &name, i64::from(lo), i64::from(hi), unit) {
+        Some(why) => Some(why),
+        None => Some(format!(
+            "{name} = {value} {unit} is inside its own range ({lo}..={hi}) but not with the \
+             other parameters (the start radius must lie inside the rim, the loop settings must \
+             fit the motors): see `bowl send PORT params`"
         )),
-        Ok(v) => Some(format!(
-            "{name} = {v} {unit} is inside its own range ({lo}..={hi}) but not with the other \
-             parameters (the start radius must lie inside the rim, the loop settings must fit \
-             the motors): see `bowl send PORT params`"
-        )),
-        Err(_) => None,
     }
 }
 
@@ -223,7 +222,7 @@ fn ask(link: &mut Link, id: u16, word: &str, timeout: Duration) -> Option<Frame>
     // Far from the refused command's id, so a script's next id is never this question's.
     let query_id = id ^ 0x8000;
     let line = command_line(query_id, &[word.to_string()]).ok()?;
-    transact(link, query_id, &line, timeout).ok().flatten()
+    transact(link, query_id, &line, timeout).ok()?.ok()
 }
 
 fn ask_status(link: &mut Link, id: u16, timeout: Duration) -> Option<Status> {
@@ -254,7 +253,10 @@ mod tests {
         let (lo, hi) = ParamId::MuPpm.range();
         let text = set_range(&w(&format!("set MU_PPM {}", i64::from(hi) + 1))).unwrap();
         assert!(text.contains(&format!("{lo}..={hi}")), "{text}");
-        assert!(text.starts_with("MU_PPM = "), "{text}");
+        assert!(
+            text.starts_with(&format!("MU_PPM {} ppm", i64::from(hi) + 1)),
+            "{text}"
+        );
     }
 
     #[test]

@@ -89,8 +89,13 @@ impl Relay {
                     Ok(n) => {
                         for &b in &buf[..n] {
                             c.line.push(b);
-                            if b == b'\n' {
-                                lines.push(std::mem::take(&mut c.line));
+                            if b == b'\r' || b == b'\n' {
+                                // A line ends at CR, LF or CRLF, as on the rig. A line end
+                                // alone (the LF of a CRLF) goes nowhere: the rig needs none.
+                                let line = std::mem::take(&mut c.line);
+                                if line.len() > 1 {
+                                    lines.push(line);
+                                }
                             } else if c.line.len() > LINE_MAX {
                                 c.line.clear();
                             }

@@ -6,7 +6,7 @@ use std::io::{BufWriter, Read, Write};
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use model_core::wire::{DecodeStats, Decoder, Frame};
 use serde_json::json;
 
@@ -62,6 +62,12 @@ const CHUNK_BYTES: usize = 1 << 16;
 pub fn run(args: &Args) -> Result<()> {
     let mut file =
         File::open(&args.file).with_context(|| format!("cannot read {}", args.file.display()))?;
+    if args.file.is_dir() {
+        bail!(
+            "cannot read {}: it is a directory, not a capture",
+            args.file.display()
+        );
+    }
     let mut csv = match &args.csv {
         Some(path) => {
             let mut w = BufWriter::new(
@@ -132,5 +138,27 @@ pub fn run(args: &Args) -> Result<()> {
         0.0
     });
     println!("{out}");
+    // Nothing decoded: not a capture of the rig's output (or one the line ruined). Said, and a
+    // failure, so a script does not go on with zero frames.
+    if stats.frames_ok == 0 {
+        let file = args.file.display();
+        if stats.bytes == 0 {
+            bail!("{file} is empty: a capture holds the bytes the rig sent");
+        }
+        let damaged = if stats.frames_corrupt > 0 {
+            format!(
+                "; {} frame candidates, every one damaged (a wrong baud rate or a broken line?)",
+                stats.frames_corrupt
+            )
+        } else {
+            String::new()
+        };
+        bail!(
+            "{file} is not a capture of the rig's output: none of its {} bytes forms a frame{damaged}. \
+             A capture is the raw bytes from the rig's serial port, as `bowl serve --capture` or a \
+             serial logger writes them",
+            stats.bytes
+        );
+    }
     Ok(())
 }

@@ -5,8 +5,11 @@ use std::time::Duration;
 
 use anyhow::Result;
 use model_core::wire::crc::crc32;
-use model_core::wire::{Frame, FrameError, PROTOCOL_VERSION, ParamId, Reason, decode_frame};
+use model_core::wire::{
+    Command, Frame, FrameError, PROTOCOL_VERSION, ParamId, Reason, decode_frame,
+};
 
+use crate::command_words;
 use crate::exit_code;
 use crate::link::{Link, transact};
 use crate::refusal;
@@ -19,8 +22,8 @@ pub struct Args {
     port: String,
     /// The command and its arguments, e.g. `speed 1800 2100`, `rtime cori 2500`, `start`, `stop`,
     /// `clear`, `set MU_PPM 29000`, `status`, `params`, `models`, `commission`, `inject sensor2`
-    /// (see docs/protocol.md).
-    #[arg(required = true, num_args = 1..)]
+    /// (see docs/protocol.md). A negative number is a value, judged by the protocol's rules.
+    #[arg(required = true, num_args = 1.., allow_negative_numbers = true)]
     command: Vec<String>,
     /// Baud rate.
     #[arg(long, default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(50..=12_000_000))]
@@ -28,13 +31,15 @@ pub struct Args {
     /// Request id echoed by the rig (default: derived from the clock).
     #[arg(long)]
     id: Option<u16>,
-    /// How long to wait for the answer, ms.
-    #[arg(long, default_value_t = 1000)]
+    /// How long to wait for the answer, ms (1..=60000: the rig remembers a command for 60 s to
+    /// know its copies, so resends must end before that).
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u64).range(1..=60_000))]
     timeout_ms: u64,
 }
 
-/// Builds the command line `$C1,id,WORDS...*CRC\n` and checks it with the shared decoder, so a
-/// command the rig would refuse as malformed or out of range never leaves the PC.
+/// Builds the command line `$C1,id,WORDS...*CRC\r\n` and checks it with the shared decoder and
+/// the protocol's rules, so a command the rig would refuse as malformed or out of range whatever
+/// its settings never leaves the PC (a speed below 0: every SPEED_MAX is at least 0).
 pub fn command_line(id: u16, words: &[String]) -> Result<Vec<u8>, Reason> {
     let mut payload = format!("C{PROTOCOL_VERSION},{id}");
     for w in words {
@@ -43,8 +48,17 @@ pub fn command_line(id: u16, words: &[String]) -> Result<Vec<u8>, Reason> {
             payload.push_str(&part.to_ascii_uppercase());
         }
     }
-    let line = format!("${payload}*{:08X}\n", crc32(payload.as_bytes())).into_bytes();
+    // CRLF, as every frame ends: the rig takes CR, LF or CRLF.
+    let line = format!("${payload}*{:08X}\r\n", crc32(payload.as_bytes())).into_bytes();
     match decode_frame(&line) {
+        Ok(Frame::Command {
+            command:
+                Command::SetSpeeds {
+                    precession_mrad_s,
+                    spin_mrad_s,
+                },
+            ..
+        }) if precession_mrad_s < 0 || spin_mrad_s < 0 => Err(Reason::Range),
         Ok(Frame::Command { .. }) => Ok(line),
         Err(FrameError::BadCommand { reason, .. }) => Err(reason),
         _ => Err(Reason::Malformed),
@@ -68,6 +82,26 @@ pub fn explain(reason: Reason) -> &'static str {
     }
 }
 
+/// The STATUS flags in words, each after "; " (empty when none is set).
+fn status_flag_words(flags: u8) -> String {
+    use model_core::wire::status_flags as f;
+    [
+        (
+            f::PARAMS_DEFAULTS,
+            "booted on default parameters: no valid record in flash",
+        ),
+        (f::PARAMS_SAVE_FAILED, "the last parameter save failed"),
+        (
+            f::CLOCK_FALLBACK,
+            "running on the internal oscillator: the crystal did not start",
+        ),
+    ]
+    .iter()
+    .filter(|(bit, _)| flags & bit != 0)
+    .map(|(_, w)| format!("; {w}"))
+    .collect()
+}
+
 /// A one-line description of an answer frame.
 pub fn describe(frame: &Frame) -> String {
     match frame {
@@ -80,16 +114,18 @@ pub fn describe(frame: &Frame) -> String {
             )
         }
         Frame::Status { id, status: s } => format!(
-            "status (id {id}): state={} fault={} reset_cause={} reset_count={} uptime_ms={} telemetry_hz={} ({}; {}; last reset: {})",
+            "status (id {id}): state={} fault={} reset_cause={} reset_count={} uptime_ms={} telemetry_hz={} flags={} ({}; {}; last reset: {}{})",
             words::state_token(s.state),
             words::fault_token(s.fault),
             words::reset_cause_token(s.reset_cause),
             s.reset_count,
             s.uptime_ms,
             s.telemetry_hz,
+            s.flags,
             words::state(s.state),
             words::fault(s.fault),
             words::reset_cause(s.reset_cause),
+            status_flag_words(s.flags),
         ),
         Frame::Params { id, values } => {
             let mut out = format!("params (id {id}):");
@@ -145,32 +181,24 @@ pub fn describe(frame: &Frame) -> String {
 
 /// Runs `bowl send`; returns the process exit status.
 pub fn run(args: &Args) -> Result<i32> {
-    let id = args.id.unwrap_or_else(|| {
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map(|d| d.subsec_nanos())
-            .unwrap_or(0);
-        (nanos % 65_521) as u16
-    });
+    let id = args.id.unwrap_or_else(crate::link::fresh_id);
     let line = match command_line(id, &args.command) {
         Ok(line) => line,
         Err(reason) => {
+            // A command line that cannot be right on any rig: a usage error, said in words.
             println!(
                 "rejected locally: {} - {} (not sent)",
                 reason.token(),
                 explain(reason)
             );
-            if let Some(why) = refusal::particulars(None, id, &args.command, reason, Duration::ZERO)
-            {
-                println!("  {why}");
-            }
-            return Ok(exit_code::REFUSED);
+            println!("  {}", command_words::local_refusal(&args.command, reason));
+            return Ok(exit_code::USAGE);
         }
     };
     let mut link = Link::open(&args.port, args.baud)?;
     let timeout = Duration::from_millis(args.timeout_ms);
     match transact(&mut link, id, &line, timeout)? {
-        Some(frame) => {
+        Ok(frame) => {
             println!("{}", describe(&frame));
             if let Frame::Reject { reason, .. } = frame
                 && let Some(why) =
@@ -184,10 +212,11 @@ pub fn run(args: &Args) -> Result<i32> {
                 exit_code::OK
             })
         }
-        None => {
+        Err(unanswered) => {
             println!(
-                "timeout: no answer to id {id} within {} ms",
-                args.timeout_ms
+                "timeout: no answer to id {id} within {} ms ({})",
+                args.timeout_ms,
+                unanswered.advice()
             );
             Ok(exit_code::TIMEOUT)
         }

@@ -117,11 +117,22 @@ impl LogReader {
     /// Opens `path` and reads its header.
     pub fn open(path: &std::path::Path) -> Result<Self> {
         use anyhow::Context as _;
+        // A directory opens like a file on Unix and fails only at the first read, without
+        // its name: said here, with it.
+        if path.is_dir() {
+            anyhow::bail!(
+                "{} is a directory, not a telemetry log (a CSV file)",
+                path.display()
+            );
+        }
         let mut reader = csv::ReaderBuilder::new()
             .flexible(true)
             .from_path(path)
             .with_context(|| format!("cannot open {}", path.display()))?;
-        let header = reader.headers()?.clone();
+        let header = reader
+            .headers()
+            .with_context(|| format!("cannot read the header of {}", path.display()))?
+            .clone();
         Ok(Self {
             reader,
             header,

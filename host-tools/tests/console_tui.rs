@@ -80,8 +80,9 @@ fn a_person_sees_the_rig_commands_it_and_quits() {
             "LINK OK",
             "precession w1",
             "spin w2",
-            "device time (s)",
-            "speed (rad/s)",
+            "precession w1 rad/s: set, measured",
+            "spin w2 rad/s: set, measured",
+            "20 s",
             "set rad/s",
             "measured rad/s",
             "state idle",
@@ -108,7 +109,7 @@ fn a_person_sees_the_rig_commands_it_and_quits() {
             .success()
     );
     let small = tmux.wait_for(
-        &["device time (s)", "speed (rad/s)", "measured rad/s"],
+        &["precession w1 rad/s: set, measured", "measured rad/s"],
         "after a resize",
     );
     assert!(
@@ -121,11 +122,17 @@ fn a_person_sees_the_rig_commands_it_and_quits() {
     tmux.wait_for(&["PAUSED"], "the pause key");
     tmux.keys(&["p"]);
 
-    // A fault cannot be missed.
+    // A fault cannot be missed, and its line is wrapped, not cut, in 90 columns: its end says
+    // what to do.
     tmux.keys(&[":", "inject sensor1", "Enter"]);
-    tmux.wait_for(
+    let fault = tmux.wait_for(
         &["FAULT ", "the rig stopped the motors"],
         "the fault banner",
+    );
+    let flat: String = fault.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        flat.contains("Type `:clear` once the cause is fixed"),
+        "the whole fault line:\n{fault}"
     );
 
     // The link dies: said so, and the values are no longer shown as current.
@@ -141,5 +148,72 @@ fn a_person_sees_the_rig_commands_it_and_quits() {
     assert!(
         !screen.contains("device time (s)"),
         "terminal restored:\n{screen}"
+    );
+}
+
+/// Telemetry that stops while the port stays open (`SET TELEM_HZ 0`, typed with Tab completion):
+/// the banner says "no telemetry for N s" instead of LINK OK, the values turn grey and say so,
+/// the log gets a "no telemetry" row; when frames come again (the command brought back with
+/// Up and edited) LINK OK returns and the log says after how long.
+#[test]
+fn telemetry_that_stops_is_said_and_marked_in_the_log() {
+    let sim = Sim::start(&[]);
+    let dir = common::temp_dir("tui-stale");
+    let log = dir.join("run.csv");
+    let tmux = Tmux::start(
+        "tui-stale",
+        &format!(
+            "{BOWL} monitor {} --log {} ; sleep 30",
+            sim.path,
+            log.display()
+        ),
+    );
+    tmux.wait_for(&["LINK OK", "state idle"], "the dashboard");
+    // Tab completes the command and the parameter name.
+    tmux.keys(&[":", "st"]);
+    tmux.keys(&["Tab"]);
+    tmux.wait_for(
+        &["command> st_", "Tab: start status stop"],
+        "the candidates for st",
+    );
+    tmux.keys(&["BSpace", "BSpace", "se", "Tab", "tel", "Tab"]);
+    tmux.wait_for(&["command> set TELEM_HZ _"], "completed to set TELEM_HZ");
+    tmux.keys(&["0", "Enter"]);
+    let quiet = tmux.wait_for(
+        &[
+            "set TELEM_HZ 0 -> ok (id",
+            "no telemetry for",
+            "last values before the telemetry stopped",
+            "fault: unknown (no current telemetry)",
+        ],
+        "the stale state",
+    );
+    assert!(
+        !quiet.contains("LINK OK"),
+        "LINK OK while nothing comes:\n{quiet}"
+    );
+    // Up brings the command back; edit it and send: telemetry comes again.
+    tmux.keys(&[":", "Up"]);
+    tmux.wait_for(&["command> set TELEM_HZ 0_"], "the history");
+    tmux.keys(&["BSpace", "50", "Enter"]);
+    tmux.wait_for(
+        &["LINK OK", "telemetry again after", "no fault"],
+        "telemetry back",
+    );
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["\"frames_ok\""], "the counters after quitting");
+    let text = std::fs::read_to_string(&log).unwrap();
+    let events: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.rsplit(',').next())
+        .filter(|e| !e.is_empty() && *e != "event")
+        .collect();
+    let stop = events.iter().position(|e| *e == "no telemetry");
+    let again = events
+        .iter()
+        .position(|e| e.starts_with("telemetry again after"));
+    assert!(
+        stop.is_some() && again > stop,
+        "the gap is marked in the log: {events:?}"
     );
 }

@@ -53,7 +53,7 @@ fn parameter_out_of_its_range_is_refused_locally_with_the_range() {
         &(i64::from(hi) + 1).to_string(),
     ]);
     let text = stdout(&out);
-    assert_eq!(out.status.code(), Some(1), "{text}");
+    assert_eq!(out.status.code(), Some(2), "a usage error: {text}");
     assert!(text.contains("rejected locally"), "{text}");
     assert!(
         text.contains(&format!("is outside its range {lo}..={hi}")),

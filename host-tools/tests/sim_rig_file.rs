@@ -156,3 +156,67 @@ fn step_runs_on_a_rig_file() {
     assert_eq!(v["fault_code"], 0);
     assert!(v["worst"]["overshoot_pct"].as_f64().unwrap() <= 5.0, "{v}");
 }
+
+/// A step down while running (`--from-rad-s`): the plants settle at 3 rad/s, then slow to 1
+/// rad/s without a fault (slowing down faulted healthy plants before the missing-pulse
+/// inference asked the plant model), and the JSON carries the transition's fields.
+#[test]
+fn the_small_family_slows_down_without_fault() {
+    let v = json(&[
+        "sim",
+        "family",
+        "--rig-file",
+        SMALL,
+        "--from-rad-s",
+        "3",
+        "--target-rad-s",
+        "1",
+        "--json",
+    ]);
+    assert_eq!(v["from_rad_s"], 3.0, "{v}");
+    assert_eq!(v["target_rad_s"], 1.0, "{v}");
+    for p in v["plants"].as_array().unwrap() {
+        assert_eq!(p["false_fault"], false, "{p}");
+        for axis in ["precession", "spin"] {
+            let a = &p["axes"][axis];
+            // Past the target in the step's direction: below 1 rad/s, as % of it.
+            let overshoot = a["overshoot_pct"].as_f64().unwrap();
+            assert!(
+                (0.0..=10.0).contains(&overshoot),
+                "{} {axis}: {a}",
+                p["name"]
+            );
+            let s2 = a["settling_2pct_s"].as_f64();
+            let s5 = a["settling_5pct_s"].as_f64().expect("settled in 5 %");
+            assert!(s5 <= 3.0, "{} {axis}: {a}", p["name"]);
+            // The wider band is reached no later than the narrower one.
+            assert!(s2.is_none_or(|s2| s5 <= s2), "{} {axis}: {a}", p["name"]);
+            assert_eq!(a["settling_s"], a["settling_2pct_s"], "{a}");
+        }
+    }
+    assert_eq!(v["summary"]["false_faults"], 0);
+}
+
+/// `--from-rad-s` is judged like any speed, in words; and a "step" to the same speed is no step.
+#[test]
+fn a_transition_from_an_impossible_speed_is_refused_in_words() {
+    for (from, want) in [
+        ("-1", "--from-rad-s -1 is outside 0 to"),
+        ("99", "--from-rad-s 99 is outside 0 to"),
+        ("3", "equals --target-rad-s"),
+    ] {
+        let out = bowl(&[
+            "sim",
+            "family",
+            "--rig-file",
+            SMALL,
+            "--from-rad-s",
+            from,
+            "--target-rad-s",
+            "3",
+        ]);
+        assert!(!out.status.success(), "{from}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(want), "{from}: {err}");
+    }
+}

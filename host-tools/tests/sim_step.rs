@@ -57,3 +57,25 @@ fn sixty_pulses_per_rev_settles_within_one_second() {
     assert_eq!(v["fault_code"], 0);
     assert!(f(&v["worst"], "settling_time_s") <= 1.0, "{v}");
 }
+
+/// The nominal rig slows from 3 to 1 rad/s (`--from-rad-s`, `--json`): no fault, within the
+/// step-down targets of docs/control.md.
+#[test]
+fn nominal_slow_down_meets_the_targets() {
+    let v = json(&[
+        "sim",
+        "step",
+        "--from-rad-s",
+        "3",
+        "--target-rad-s",
+        "1",
+        "--json",
+    ]);
+    assert_eq!(v["from_rad_s"], 3.0, "{v}");
+    assert_eq!(v["fault_code"], 0, "{v}");
+    for axis in v["axes"].as_array().unwrap() {
+        assert!(f(axis, "overshoot_pct") <= 5.0, "{axis}");
+        assert!(f(axis, "settling_time_s") <= 3.0, "{axis}");
+        assert!(f(axis, "steady_state_error_pct") <= 1.0, "{axis}");
+    }
+}

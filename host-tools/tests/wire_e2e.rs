@@ -80,12 +80,12 @@ fn send_and_monitor_against_the_virtual_rig() {
     let too_fast = bowl(&["send", p, "speed", "9000", "2100"]);
     assert_eq!(too_fast.status.code(), Some(1));
     assert!(stdout(&too_fast).contains("RANGE"), "{}", stdout(&too_fast));
-    // Outside the wire range: refused before it is sent.
+    // Outside the wire range: refused before it is sent, a usage error (2).
     let local = bowl(&["send", p, "set", "TEETH1", "0"]);
-    assert_eq!(local.status.code(), Some(1));
+    assert_eq!(local.status.code(), Some(2));
     assert!(stdout(&local).contains("rejected locally"));
     let unknown = bowl(&["send", p, "set", "NO_SUCH", "1"]);
-    assert_eq!(unknown.status.code(), Some(1));
+    assert_eq!(unknown.status.code(), Some(2));
 
     // The rejected command changed nothing: the setpoints are still 1800/2100.
     let params = bowl(&["send", p, "params"]);

@@ -11,6 +11,7 @@ use proptest::prelude::*;
 #[derive(Default)]
 struct Recorder {
     calls: Vec<String>,
+    heartbeats: u32,
     speed_max: i32,
     now_ms: u32,
 }
@@ -72,6 +73,32 @@ impl Backend for Recorder {
             _ => id.range().0,
         }
     }
+    fn heartbeat(&mut self) {
+        self.heartbeats += 1;
+    }
+}
+
+/// Every command that arrives intact shows the host is there, whatever its answer: queries,
+/// refusals (by the decoder or the device), copies, PING. A damaged line does not.
+#[test]
+fn every_intact_command_counts_as_host_presence() {
+    let (mut rig, mut d) = rig_and_device();
+    let mut input = Vec::new();
+    for p in [
+        "C1,1,STATUS",
+        "C1,2,PARAMS",
+        "C1,3,SPEED,1800,5001",
+        "C1,4,FLY",
+        "C1,5,START",
+        "C1,5,START",
+        "C1,6,PING",
+    ] {
+        input.extend(line(p));
+    }
+    assert_eq!(answers(&mut d, &mut rig, &input).len(), 7);
+    assert_eq!(rig.heartbeats, 7);
+    answers(&mut d, &mut rig, b"$C1,7,PING*00000000\r\n");
+    assert_eq!(rig.heartbeats, 7, "a damaged line is not the host");
 }
 
 fn answers(device: &mut Device, rig: &mut Recorder, input: &[u8]) -> Vec<Frame> {
@@ -245,9 +272,120 @@ fn a_resent_command_runs_once_and_is_answered_again() {
         other => panic!("{other:?}"),
     };
     assert_eq!((uptime(&s1), uptime(&s2)), (0, 500));
-    // After another command, an old id with the same words runs again (only the last is kept).
-    answers(&mut d, &mut rig, &line("C1,40,START"));
-    assert_eq!(rig.calls, vec!["start", "clear", "start", "stop", "start"]);
+    // After other commands, a late copy of an old one is answered again, not run again.
+    let late = answers(&mut d, &mut rig, &line("C1,40,START"));
+    assert_eq!(late, vec![Frame::Ack { id: 40 }]);
+    assert_eq!(rig.calls, vec!["start", "clear", "start", "stop"]);
+}
+
+/// The case: SPEED id 600, SPEED id 601, then a late copy of 600. The copy gets 600's
+/// answer and the setpoints stay at 601's.
+#[test]
+fn a_late_copy_of_an_old_speed_is_answered_and_not_run() {
+    let (mut rig, mut d) = rig_and_device();
+    let mut input = line("C1,600,SPEED,1800,2100");
+    input.extend(line("C1,601,SPEED,1000,1000"));
+    input.extend(line("C1,600,SPEED,1800,2100"));
+    let got = answers(&mut d, &mut rig, &input);
+    let ack = |id| Frame::Ack { id };
+    assert_eq!(got, vec![ack(600), ack(601), ack(600)]);
+    assert_eq!(rig.calls, vec!["speeds 1800 2100", "speeds 1000 1000"]);
+    // A refused one is remembered with its refusal: the copy is refused again, never run.
+    let mut input = line("C1,602,SPEED,1800,5001");
+    input.extend(line("C1,603,STOP"));
+    input.extend(line("C1,602,SPEED,1800,5001"));
+    let got = answers(&mut d, &mut rig, &input);
+    let range = Frame::Reject {
+        id: 602,
+        reason: Reason::Range,
+    };
+    assert_eq!(got, vec![range, ack(603), range]);
+    assert_eq!(rig.calls.last().map(String::as_str), Some("stop"));
+}
+
+/// START id 700, STOP id 701, then a late copy of START 700: the rig stays stopped. The same
+/// holds with the copy behind 15 other commands; behind 16 the window has moved on (the PC never
+/// resends that long: it resends for at most its timeout).
+#[test]
+fn a_late_start_after_stop_does_not_restart() {
+    let (mut rig, mut d) = rig_and_device();
+    let mut input = line("C1,700,START");
+    input.extend(line("C1,701,STOP"));
+    input.extend(line("C1,700,START"));
+    let got = answers(&mut d, &mut rig, &input);
+    assert_eq!(
+        got,
+        vec![
+            Frame::Ack { id: 700 },
+            Frame::Ack { id: 701 },
+            Frame::Ack { id: 700 }
+        ]
+    );
+    assert_eq!(rig.calls, vec!["start", "stop"]);
+    // 14 more commands: START 700 is now 16 commands back, still in the window.
+    for id in 702..716 {
+        answers(
+            &mut d,
+            &mut rig,
+            &line(&format!("C1,{id},SET,TEETH1,{}", id - 690)),
+        );
+    }
+    answers(&mut d, &mut rig, &line("C1,700,START"));
+    assert_eq!(rig.calls.iter().filter(|c| *c == "start").count(), 1);
+    // One more pushes it out: the same id and words are now a new request.
+    answers(&mut d, &mut rig, &line("C1,716,SET,TEETH1,30"));
+    answers(&mut d, &mut rig, &line("C1,700,START"));
+    assert_eq!(rig.calls.iter().filter(|c| *c == "start").count(), 2);
+}
+
+/// A remembered command answers its copies for `RESEND_HORIZON_MS` of device time (the clock
+/// `poll_telemetry` is given); after that the same id and words are a new request (ids repeat).
+#[test]
+fn a_remembered_command_ages_out_after_the_resend_horizon() {
+    use model_core::wire::device::RESEND_HORIZON_MS;
+    let (mut rig, mut d) = rig_and_device();
+    let mut buf = [0u8; MAX_FRAME_LEN];
+    d.poll_telemetry(&rig, 1_000, &mut buf);
+    answers(&mut d, &mut rig, &line("C1,5,START"));
+    d.poll_telemetry(&rig, 1_000 + RESEND_HORIZON_MS, &mut buf);
+    answers(&mut d, &mut rig, &line("C1,5,START"));
+    assert_eq!(rig.calls, vec!["start"], "a copy within the horizon");
+    d.poll_telemetry(&rig, 1_001 + RESEND_HORIZON_MS, &mut buf);
+    answers(&mut d, &mut rig, &line("C1,5,START"));
+    assert_eq!(rig.calls, vec!["start", "start"], "a new request after it");
+}
+
+/// The case: 30 s at 50 Hz, then `SET TELEM_HZ 20`: frames go on at once, every 50 ms,
+/// numbered on from where they were (before the fix the rig fell silent for 30 s).
+#[test]
+fn telemetry_goes_on_at_the_new_rate_after_set_telem_hz() {
+    let (mut rig, mut d) = rig_and_device();
+    let mut buf = [0u8; MAX_FRAME_LEN];
+    let mut sent = Vec::new();
+    for ms in 0..40_000u32 {
+        rig.now_ms = ms;
+        if ms == 30_000 {
+            let got = answers(&mut d, &mut rig, &line("C1,9,SET,TELEM_HZ,20"));
+            assert_eq!(got, vec![Frame::Ack { id: 9 }]);
+        }
+        if let Some(n) = d.poll_telemetry(&rig, ms, &mut buf) {
+            match decode_frame(&buf[..n]) {
+                Ok(Frame::Telemetry(t)) => sent.push((t.time_ms, t.seq)),
+                other => panic!("{other:?}"),
+            }
+        }
+    }
+    let after: Vec<_> = sent.iter().filter(|(t, _)| *t >= 30_000).collect();
+    assert_eq!(
+        after.first().map(|f| f.0),
+        Some(30_000),
+        "the first frame at once"
+    );
+    assert_eq!(after.len(), 200, "10 s at 20 Hz");
+    assert!(after.windows(2).all(|w| w[1].0 - w[0].0 == 50));
+    // The sequence numbers go on without a gap: nothing looks lost to the PC.
+    assert!(sent.windows(2).all(|w| w[1].1 == w[0].1 + 1));
+    assert_eq!(sent.len(), 1500 + 200);
 }
 
 #[test]
@@ -287,7 +425,8 @@ proptest! {
     fn arbitrary_input_gets_valid_answers(bytes in proptest::collection::vec(any::<u8>(), 0..2000)) {
         let (mut rig, mut d) = rig_and_device();
         let got = answers(&mut d, &mut rig, &bytes);
-        let newlines = bytes.iter().filter(|&&b| b == b'\n').count();
+        // A line ends at `\n` or `\r` (a `\r\n` is one end, so this bound is loose there).
+        let newlines = bytes.iter().filter(|&&b| b == b'\n' || b == b'\r').count();
         prop_assert!(got.len() <= newlines);
     }
 

@@ -2,9 +2,12 @@
 file so that what the firmware saves survives resets and emulator runs.
 
 NOR semantics: programming only clears bits (the new value is `old & written`), a sector
-erase sets all of it to 0xFF. Both stall the CPU for their typical duration (word program
-16 us, 128 KiB sector erase 1 s: RM0383 / the F411 datasheet, t_PROG and t_ERASE128KB), which
-the machine models by letting time run with the CPU stopped.
+erase sets all of it to 0xFF. Both stall the CPU (the machine lets time run with the CPU
+stopped) for the STM32F411 datasheet's durations ("Flash memory programming" table): word
+program t_PROG 16 us typical; 128 KiB sector erase t_ERASE128KB by the program/erase
+parallelism FLASH_CR.PSIZE at the STRT write: x8 2 s typical / 4 s maximum, x16 1.3 / 2.6 s,
+x32 1 / 2 s. embassy-stm32 0.6's blocking erase leaves PSIZE as it finds it (x8 after reset,
+x32 after one of its writes). `Machine(flash_timing="max")` uses the maxima.
 
 A power cut can be scheduled at the N-th program or erase step: that step is left half done
 (an erase clears only the sector's first half, a program leaves the word's odd bits as they
@@ -21,7 +24,10 @@ BACKED_SIZE = 0x6_0000
 SECTOR_BASES = {5: 0x0802_0000, 6: 0x0804_0000, 7: 0x0806_0000}
 SECTOR_SIZE = 0x2_0000
 PROGRAM_NS = 16_000
-ERASE_NS = 1_000_000_000
+# t_ERASE128KB, ns, by PSIZE (0 = x8, 1 = x16, 2 = x32, 3 = x64, which needs an external VPP
+# and is taken as x32 here): (typical, maximum).
+ERASE_128K_NS = {0: (2_000_000_000, 4_000_000_000), 1: (1_300_000_000, 2_600_000_000),
+                 2: (1_000_000_000, 2_000_000_000), 3: (1_000_000_000, 2_000_000_000)}
 
 ACR, KEYR, OPTKEYR, SR, CR, OPTCR = range(0, 0x18, 4)
 PG, SER, STRT, LOCK = 1, 2, 1 << 16, 1 << 31
@@ -68,8 +74,9 @@ class FlashInterface(QlPeripheral):
             self.cr = value & ~STRT
             if value & STRT and value & SER:
                 sector = (value >> 3) & 0xF
+                psize = (value >> 8) & 3
                 try:
-                    self.store.erase(sector, self.machine)
+                    self.store.erase(sector, self.machine, psize)
                 except PowerCut:
                     self.machine.cut_power()
                     return
@@ -116,7 +123,7 @@ class FlashStore:
         self.log.append(what)
         return self.cut_at is not None and self.steps == self.cut_at
 
-    def erase(self, sector: int, machine):
+    def erase(self, sector: int, machine, psize: int = 0):
         if sector not in SECTOR_BASES:
             return  # image sectors: the firmware has no business there; leave them
         start = SECTOR_BASES[sector] - BACKED_BASE
@@ -126,7 +133,8 @@ class FlashStore:
             raise PowerCut
         self.data[start:start + SECTOR_SIZE] = b"\xff" * SECTOR_SIZE
         self.flush()
-        machine.stall(ERASE_NS)
+        typical, maximum = ERASE_128K_NS[psize]
+        machine.stall(maximum if machine.flash_timing == "max" else typical)
 
     def program(self, offset: int, size: int, value: int, machine):
         old = int.from_bytes(self.data[offset:offset + size], "little")

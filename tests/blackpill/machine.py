@@ -23,15 +23,17 @@ from clock_tree import HSE_HZ, ClockTree
 from dma import Dma
 from exti import Exti
 from flash import BACKED_BASE, BACKED_SIZE, FlashInterface, FlashStore
-from iwdg import Iwdg
+from iwdg import LSI_HZ, Iwdg
 from nvic import Nvic
+from pins import PwmPinWatch
 from plant import DIR_PINS, SOLENOID_PIN
 from rtt import RttReader
 from timers import Timer
 from usart import Usart
 
 SLICE_NS = 20_000
-# The image sits in sectors 0..4 (memory.x); 5..7 are the flash model's.
+# memory.x allows the image sectors 0..5 (256 KiB); tests/run holds it to 96 KiB, inside
+# sectors 0..4 (128 KiB), so sector 5 can sit behind the flash model with 6 and 7.
 CODE_FLASH_SIZE = BACKED_BASE - 0x0800_0000
 
 IRQ_TIM1_UP, IRQ_TIM1_CC, IRQ_TIM2, IRQ_TIM5 = 25, 27, 28, 50
@@ -44,6 +46,10 @@ IRQ_DMA1_STREAM = {5: 16, 6: 17}
 DMA1_ROUTES = {(5, 4): ("usart2", "rx"), (6, 4): ("usart2", "tx")}
 
 THUMB_WFE, THUMB_SEV = b"\x20\xbf", b"\x40\xbf"
+# The Black Pill's blue LED: PC13, lit when low.
+LED_PIN = 13
+# RCC_CR's crystal ready flag (RM0383 6.3.1).
+HSERDY = 1 << 17
 DIR_MASK = sum(1 << pin for pin in DIR_PINS)
 
 # RCC_CSR reset flags (RM0383 6.3.21).
@@ -135,6 +141,13 @@ class Board:
         self.dir_pins = self.gpiob.instance.ODR & DIR_MASK
         self.solenoid_on = False
         self.gpiob.hook_write(self._gpiob_written, intercept=QL_INTERCEPT.EXIT)
+        # The PWM pins after every write that can change them (GPIOA's mode, TIM1's outputs).
+        self.pwm_pins = PwmPinWatch(m, ql.hw.gpioa, self.tim1)
+        ql.hw.gpioa.hook_write(self.pwm_pins.check, intercept=QL_INTERCEPT.EXIT)
+        self.tim1.on_write = self.pwm_pins.check
+        # The status LED on PC13 (active low): each change, as (time ns, lit).
+        self.led_lit = False
+        ql.hw.gpioc.hook_write(self._gpioc_written, intercept=QL_INTERCEPT.EXIT)
 
         for addr in m.wfe_sites:
             self.uc.hook_add(UC_HOOK_CODE, self._on_wfe, begin=addr, end=addr)
@@ -177,6 +190,12 @@ class Board:
                 self.m.dir_changes += 1
             if changed & (1 << pin) and self.tim1.pwm_fraction(axis) > 0.0:
                 self.m.dir_violations.append((self.m.now_ns, axis, self.tim1.pwm_fraction(axis)))
+
+    def _gpioc_written(self, gpio, access, offset, size, value):
+        lit = not gpio.instance.ODR & (1 << LED_PIN)
+        if lit != self.led_lit:
+            self.led_lit = lit
+            self.m.led_changes.append((self.m.now_ns, lit))
 
     def _on_wfe(self, uc, address, size, user_data):
         # Stop before the instruction (unicorn 2.0.1 would fault on it); `resume_after_wfe`
@@ -229,6 +248,10 @@ class Board:
             p.sync()
         for p in self.stepping:
             p.step()
+        if not self.m.hse_hz:
+            # No crystal on this board: qiling's RCC sets HSERDY with HSEON; a dead oscillator
+            # never does.
+            self.rcc.instance.CR &= ~HSERDY
 
     def next_event_ns(self):
         times = [t for t in (p.next_event_ns() for p in self.clocked) if t is not None]
@@ -237,10 +260,15 @@ class Board:
 
 class Machine:
     def __init__(self, elf: str, flash_path: str, plant=None, link=None, defmt_print=None,
-                 log_dir=None, realtime=False, hse_hz=HSE_HZ):
+                 log_dir=None, realtime=False, hse_hz=HSE_HZ, lsi_hz=LSI_HZ,
+                 flash_timing="typical"):
         self.elf = elf
-        # The crystal on the emulated board (the Black Pill's is 25 MHz).
+        # The crystal on the emulated board (the Black Pill's is 25 MHz; 0: none, or dead).
         self.hse_hz = hse_hz
+        # The LSI's frequency (iwdg.py: 17 to 47 kHz on silicon) and the flash's durations
+        # ("typical" or "max": flash.py).
+        self.lsi_hz = lsi_hz
+        self.flash_timing = flash_timing
         self.store = FlashStore(flash_path)
         self.plant = plant
         self.link = link
@@ -253,6 +281,10 @@ class Machine:
         self.in_dma = False
         self.held = None  # (every_ns, hold_ns, next_ns): the CPU held periodically
         self.dir_violations = []
+        # Each moment a PWM pin that TIM1 drove was left floating: (time ns, axis, state).
+        self.pwm_pin_floats = []
+        # The status LED's changes (time ns, lit), across resets.
+        self.led_changes = []
         self.dir_changes = 0
         self.resets = []
         self.interrupts = 0

@@ -15,10 +15,14 @@ from pty_link import PtyLink
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-ELF = os.path.join(ROOT, "target/thumbv7em-none-eabihf/release/firmware")
-PLANT_LIB = os.path.join(ROOT, "target/debug/libplant_ffi.so")
-BOWL = os.path.join(ROOT, "target/debug/bowl")
-LOGS = os.path.join(ROOT, "target/test-logs")
+# Cargo's target directory, as cargo finds it (`CARGO_TARGET_DIR`, else target/ at the root):
+# the image, the plant library and `bowl` the same build left there.
+TARGET = os.environ.get("CARGO_TARGET_DIR") or os.path.join(ROOT, "target")
+# BLACKPILL_ELF runs another image (e.g. an older build, to see a test fail on it).
+ELF = os.environ.get("BLACKPILL_ELF") or os.path.join(TARGET, "thumbv7em-none-eabihf/release/firmware")
+PLANT_LIB = os.path.join(TARGET, "debug/libplant_ffi.so")
+BOWL = os.path.join(TARGET, "debug/bowl")
+LOGS = os.path.join(TARGET, "test-logs")
 DEFMT_PRINT = os.environ.get("DEFMT_PRINT", "defmt-print")
 # The emulation runs below real time with the loop closed: give answers room.
 ANSWER_TIMEOUT_MS = 8000
@@ -26,10 +30,11 @@ ANSWER_TIMEOUT_MS = 8000
 
 class Session:
     def __init__(self, flash_path: str, realtime: bool = True, seed: int = 1, hse_hz=None,
-                 rig_file=None):
+                 rig_file=None, **board):
+        """`board`: the Machine's other settings (lsi_hz, flash_timing)."""
         self.plant = RigPlant(PLANT_LIB, seed, rig_file)
         self.link = PtyLink()
-        extra = {} if hse_hz is None else {"hse_hz": hse_hz}
+        extra = dict(board) if hse_hz is None else {"hse_hz": hse_hz, **board}
         self.machine = Machine(ELF, flash_path, plant=self.plant, link=self.link,
                                defmt_print=DEFMT_PRINT, log_dir=LOGS, realtime=realtime, **extra)
         self.actions = queue.Queue()

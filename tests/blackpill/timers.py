@@ -1,7 +1,8 @@
 """STM32F4 TIM1/TIM2/TIM5 (RM0383 sections 12-13): an up-counter derived from the RCC clock
 tree, prescaler/auto-reload/compare preload taking effect at update events, compare and
 capture flags with overcapture, the update flag, DIER-gated interrupt lines, and for the
-advanced timer the main output enable (BDTR.MOE) that gates the PWM outputs.
+advanced timer the main output enable (BDTR.MOE) that gates the PWM outputs, with what each
+output does then (`output_state`: driven to its idle level, or released to float, per OSSI).
 
 The counter is evaluated lazily from the machine's clock: `sync` brings the flags up to the
 current time, and `next_event_ns` tells the machine when the next enabled interrupt is due so
@@ -14,7 +15,7 @@ from qiling.hw.peripheral import QlPeripheral
 CR1, CR2, SMCR, DIER, SR, EGR, CCMR1, CCMR2, CCER, CNT, PSC, ARR, RCR = range(0, 0x34, 4)
 CCR_BASE, BDTR = 0x34, 0x44
 CEN, URS, ARPE = 1 << 0, 1 << 2, 1 << 7
-MOE = 1 << 15
+MOE, OSSR, OSSI = 1 << 15, 1 << 11, 1 << 10
 UIF = 1
 
 
@@ -40,6 +41,8 @@ class Timer(QlPeripheral):
         # The counter's position is `cnt` at `anchor_ns` plus the ticks since.
         self.anchor_ns = 0
         self.updates = 0
+        # Called after every register write (the board watches its output pins with it).
+        self.on_write = None
 
     # --- time base -------------------------------------------------------------------
     def tick_hz(self) -> float:
@@ -170,6 +173,31 @@ class Timer(QlPeripheral):
             frac = 1.0 - frac
         return frac
 
+    def output_state(self, ch: int) -> str:
+        """What the timer does with channel `ch`'s output (RM0383, TIM1's table "Output control
+        bits for complementary OCx and OCxN channels with break feature"): "pwm" (switching),
+        "low" or "high" (driven steadily), or "released" (not driven by the timer: the pin
+        floats unless its GPIO pull holds it).
+        - MOE = 0, OSSI = 0: released, whatever CCxE says (the issue's floating PA8/PA9).
+        - MOE = 0, OSSI = 1, CCxE or CCxNE set: driven to the idle level OISx (TIMx_CR2).
+        - MOE = 1 (or a general-purpose timer), CCxE = 0: released, unless OSSR = 1 and the
+          complementary output CCxNE is enabled (then driven inactive, CCxP).
+        - MOE = 1, CCxE = 1: OCxREF xor CCxP: the PWM."""
+        self.sync()
+        ccer = self.regs[CCER] >> (4 * ch)
+        cce, ccp, ccne = ccer & 1, ccer & 2, ccer & 4
+        bdtr = self.regs[BDTR]
+        if self.advanced and not bdtr & MOE:
+            if not bdtr & OSSI or not (cce or ccne):
+                return "released"
+            return "high" if self.regs[CR2] & (1 << (8 + 2 * ch)) else "low"
+        if not cce:
+            if self.advanced and ccne and bdtr & OSSR:
+                return "high" if ccp else "low"
+            return "released"
+        frac = self.pwm_fraction(ch)
+        return "low" if frac == 0.0 else "high" if frac == 1.0 else "pwm"
+
     # --- registers ---------------------------------------------------------------------
     def read(self, offset: int, size: int) -> int:
         self.sync()
@@ -217,6 +245,8 @@ class Timer(QlPeripheral):
                 self.anchor_ns = self.machine.now_ns
         elif offset in self.regs:
             self.regs[offset] = value
+        if self.on_write is not None:
+            self.on_write()
 
     @property
     def region(self):

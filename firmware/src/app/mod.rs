@@ -10,6 +10,7 @@
 //! - [`params`]: parameters persisted in flash (version + CRC-32, append-only records).
 //! - [`persist`]: the loop that saves changed parameters and reports lost capture edges.
 //! - [`reset`]: reset cause and a reset counter that survives resets in uninitialised RAM.
+//! - [`led`]: the status LED's pattern for each state (idle, driving, fault, link lost).
 //! - [`motors`]: the pair of motor outputs and the all-off path used by faults and panics.
 //! - [`tasks`]: capture, control tick, link (telemetry + commands), supervisor.
 
@@ -17,6 +18,7 @@ pub mod binding;
 pub mod edges;
 pub mod gates;
 pub mod hal;
+pub mod led;
 pub mod motors;
 pub mod params;
 pub mod persist;

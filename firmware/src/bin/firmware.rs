@@ -2,10 +2,12 @@
 //!
 //! Boot: read the reset cause and count the reset, bring the outputs up *off*, load the
 //! parameters from flash, then run the tasks: control tick (1 kHz), host link (commands,
-//! answers, telemetry over USART2 with DMA), supervisor (watchdog, parameter persistence) and a
-//! heartbeat LED, and the release solenoid. Pulse capture and the exit light gate are the TIM2
-//! interrupt, the release button EXTI0. Pin map: `firmware::blackpill` and docs/wiring.md.
-//! Flash and run: `cargo flash` (probe-rs; defmt logs over RTT).
+//! answers, telemetry over USART2 with DMA), supervisor (watchdog, parameter persistence), the
+//! status LED (a pattern per state: `firmware::app::led`), and the release solenoid. Pulse
+//! capture and the exit light gate are the TIM2 interrupt, the release button EXTI0. Pin map:
+//! `firmware::blackpill` and docs/wiring.md. A crystal that does not start leaves the board on
+//! the HSI (`firmware::blackpill::clocks`), reported in the log, on the LED and in STATUS.
+//! Flash and run: `cargo flash-rig` (probe-rs; defmt logs over RTT).
 #![no_std]
 #![no_main]
 
@@ -32,6 +34,7 @@ use firmware::app::binding::{
     ControllerBackend, DeviceCore, PERSISTED_COUNT, default_persisted, split_persisted,
 };
 use firmware::app::hal::Watchdog;
+use firmware::app::led::{self, LedMode};
 use firmware::app::motors::Motors;
 use firmware::app::params::ParamLog;
 use firmware::app::persist::{PERSIST_PERIOD, Persistence};
@@ -39,13 +42,13 @@ use firmware::app::reset;
 use firmware::app::slot::Slot;
 use firmware::app::tasks::{self, Heartbeat, SharedCore};
 use firmware::blackpill::capture::{self, Tim2Clock};
-use firmware::blackpill::clocks;
+use firmware::blackpill::clocks::{self, ClockSource};
 use firmware::blackpill::flash_region::ParamSector;
 use firmware::blackpill::gates::{self, BoardGates, ReleaseButton};
 use firmware::blackpill::motor_pwm::{self, PWM_HZ, PwmMotor};
 use firmware::blackpill::reset_cause::{self, ResetFlag};
 use model_core::control::ControllerConfig;
-use model_core::wire::{Hello, ResetCause};
+use model_core::wire::{Hello, ResetCause, status_flags};
 
 bind_interrupts!(struct Irqs {
     USART2 => usart::InterruptHandler<USART2>;
@@ -79,6 +82,8 @@ fn wire_cause(flag: ResetFlag) -> ResetCause {
         ResetFlag::IndependentWatchdog => ResetCause::IndependentWatchdog,
         ResetFlag::WindowWatchdog => ResetCause::WindowWatchdog,
         ResetFlag::Software => ResetCause::Software,
+        // The protocol's Pin is "the NRST pin (reset button, debugger)".
+        ResetFlag::Debugger => ResetCause::Pin,
         ResetFlag::LowPower => ResetCause::LowPower,
         ResetFlag::PowerOn => ResetCause::PowerOn,
         ResetFlag::Pin => ResetCause::Pin,
@@ -91,7 +96,11 @@ async fn main(spawner: Spawner) {
     // Before anything else: the flags are cleared here, the counter lives in .uninit RAM.
     let flag = reset_cause::take();
     let resets = reset::count_this_boot();
-    let p = embassy_stm32::init(clocks::config());
+    // The crystal gets a bounded start-up time; without it the board runs on the HSI instead
+    // of hanging in embassy's HSE wait. Until `init` the PWM pins are inputs, as in reset:
+    // the bridge's pull-downs hold the motors off (docs/wiring.md).
+    let clock = clocks::start_crystal();
+    let p = embassy_stm32::init(clocks::config(clock));
 
     // Outputs first, off: PWM compare 0, direction low.
     let pwm = SimplePwm::new(
@@ -125,6 +134,11 @@ async fn main(spawner: Spawner) {
         "boot: reset cause {}, resets since power-on {}",
         flag, resets
     );
+    if clock == ClockSource::InternalFallback {
+        warn!(
+            "clock: the 25 MHz crystal did not start; running on the internal 16 MHz oscillator (HSI), timing within the HSI's tolerance only"
+        );
+    }
 
     // Parameters: the newest valid record, or the defaults (and why).
     let log = PARAM_LOG
@@ -132,6 +146,12 @@ async fn main(spawner: Spawner) {
             p.FLASH,
         ))))
         .unwrap_or_else(|| halt("parameter log slot"));
+    // What STATUS tells the PC about this board (`flags`): the log alone reaches no one
+    // once the probe is gone.
+    let mut flags = 0;
+    if clock == ClockSource::InternalFallback {
+        flags |= status_flags::CLOCK_FALLBACK;
+    }
     let stored = match log.load::<PERSISTED_COUNT>() {
         Ok(v) => {
             info!("params: loaded from flash");
@@ -139,6 +159,7 @@ async fn main(spawner: Spawner) {
         }
         Err(e) => {
             warn!("params: {}, using defaults", e);
+            flags |= status_flags::PARAMS_DEFAULTS;
             default_persisted()
         }
     };
@@ -146,7 +167,7 @@ async fn main(spawner: Spawner) {
         reset_cause: wire_cause(flag),
         reset_count: resets as u16,
     };
-    let (rig, outcome) = ControllerBackend::new(
+    let (mut rig, outcome) = ControllerBackend::new(
         ControllerConfig::nominal(),
         stored,
         hello,
@@ -154,7 +175,9 @@ async fn main(spawner: Spawner) {
     );
     if let Err(r) = outcome {
         warn!("params: stored values rejected ({}), using defaults", r);
+        flags |= status_flags::PARAMS_DEFAULTS;
     }
+    rig.update_status_flags(flags, 0);
     let core = CORE
         .put(Mutex::new(RefCell::new(DeviceCore::new(rig))))
         .unwrap_or_else(|| halt("core slot"));
@@ -177,7 +200,7 @@ async fn main(spawner: Spawner) {
     spawn(spawner, control_task(core, motors, capture));
     spawn(spawner, link_task(core, rx, tx));
     spawn(spawner, supervisor_task(Iwdg(iwdg), core, log));
-    spawn(spawner, heartbeat_task(led));
+    spawn(spawner, led_task(led, core, clock));
     spawn(spawner, solenoid_task(solenoid, button));
     info!("running");
 }
@@ -196,7 +219,7 @@ fn spawn<S>(
 fn halt(what: &str) -> ! {
     motor_pwm::emergency_off();
     error!("startup failed: {}", what);
-    cortex_m::peripheral::SCB::sys_reset()
+    reset_cause::software_reset()
 }
 
 #[embassy_executor::task]
@@ -247,15 +270,20 @@ async fn supervisor_task(
                     lost[0], lost[1]
                 );
             }
+            let save_failed = status_flags::PARAMS_SAVE_FAILED;
             match report.saved {
                 Some(Ok(record)) => {
+                    core.lock(|c| c.borrow_mut().backend.update_status_flags(0, save_failed));
                     let r = split_persisted(&record);
                     info!(
                         "params: saved; motor models {} / {}, identified {}",
                         r.models[0], r.models[1], r.identified
                     );
                 }
-                Some(Err(e)) => error!("params: save failed: {}", e),
+                Some(Err(e)) => {
+                    core.lock(|c| c.borrow_mut().backend.update_status_flags(save_failed, 0));
+                    error!("params: save failed: {}", e);
+                }
                 None => {}
             }
         }
@@ -269,12 +297,23 @@ async fn solenoid_task(solenoid: Output<'static>, _button: ReleaseButton) {
     gates::run_solenoid(solenoid).await
 }
 
+/// The status LED (PC13, active low): the pattern of the controller's state, and the clock
+/// warning when running on the HSI. It only reads the state: a stuck LED task changes nothing
+/// else, and a stuck executor leaves the LED frozen (the watchdog resets the MCU then).
 #[embassy_executor::task]
-async fn heartbeat_task(mut led: Output<'static>) {
-    let mut ticker = Ticker::every(Duration::from_millis(500));
+async fn led_task(mut led: Output<'static>, core: &'static Core, clock: ClockSource) {
+    let fallback = clock == ClockSource::InternalFallback;
+    let mut ticker = Ticker::every(Duration::from_millis(led::STEP_MS.into()));
     loop {
         ticker.next().await;
-        led.toggle();
+        let mode = core.lock(|c| {
+            let c = c.borrow();
+            let ctrl = c.backend.controller();
+            LedMode::of(ctrl.state(), ctrl.fault())
+        });
+        let now_ms = embassy_time::Instant::now().as_millis() as u32;
+        let on = led::lit(mode, fallback, now_ms);
+        led.set_level(if on { Level::Low } else { Level::High });
     }
 }
 
@@ -288,12 +327,12 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
         Some(l) => error!("panic at {}:{}", l.file(), l.line()),
         None => error!("panic"),
     }
-    cortex_m::peripheral::SCB::sys_reset()
+    reset_cause::software_reset()
 }
 
 #[exception]
 unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
     motor_pwm::emergency_off();
     error!("hard fault at pc {=u32:#010x}", frame.pc());
-    cortex_m::peripheral::SCB::sys_reset()
+    reset_cause::software_reset()
 }

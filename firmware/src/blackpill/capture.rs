@@ -103,7 +103,14 @@ fn TIM2() {
             if sr.ccof(i) {
                 // Another edge came and went before we read this one.
                 queue.count_lost(1);
-                tim.sr().modify(|w| w.set_ccof(i, false));
+                // TIMx_SR's flags are rc_w0 (RM0383): writing 1 leaves a flag alone, writing 0
+                // clears it. A read-modify-write would write 0 to every flag that rose since
+                // the read above (another channel's capture flag, an edge lost with it), so
+                // write ones everywhere but this one over-capture flag (as ST's HAL does).
+                tim.sr().write(|w| {
+                    w.0 = u32::MAX;
+                    w.set_ccof(i, false);
+                });
             }
         }
     }

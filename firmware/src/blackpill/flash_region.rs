@@ -53,9 +53,10 @@ impl FlashRegion for ParamSector {
             return Err(FlashError::OutOfBounds);
         }
         let start = REGION_OFFSET + sector * Self::SECTOR_SIZE;
-        // A 128 KiB sector erase takes 1 to 4 s (RM0383: t_ERASE128KB), with the CPU stalled
-        // on flash reads. The watchdog (250 ms) would reset the MCU half way: stretch it to its
-        // maximum for the erase, then put it back. Only called with the motors off.
+        // A 128 KiB sector erase takes 2 s typical, 4 s at most at the x8 parallelism embassy
+        // leaves after reset (1 to 2 s at x32: the datasheet's t_ERASE128KB), with the CPU
+        // stalled on flash reads. The watchdog (250 ms) would reset the MCU half way: stretch
+        // it to its maximum for the erase, then put it back. Only called with the motors off.
         let saved = stretch_watchdog();
         let result = self
             .flash
@@ -69,8 +70,9 @@ impl FlashRegion for ParamSector {
 const IWDG_KEY_RELOAD: u16 = 0xAAAA;
 const IWDG_KEY_UNLOCK: u16 = 0x5555;
 
-/// Sets the IWDG to its longest timeout (prescaler 256, reload 4095: about 32 s on the 32 kHz
-/// LSI) and reloads it; returns the previous (prescaler, reload) registers.
+/// Sets the IWDG to its longest timeout (prescaler 256, reload 4095: 32.8 s on the typical
+/// 32 kHz LSI, 22.3 s at the datasheet's fastest 47 kHz, still five times the 4 s worst-case
+/// erase) and reloads it; returns the previous (prescaler, reload) registers.
 fn stretch_watchdog() -> (u8, u16) {
     use embassy_stm32::pac::iwdg::vals::{Key, Pr};
     let iwdg = embassy_stm32::pac::IWDG;

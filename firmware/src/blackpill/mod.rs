@@ -14,12 +14,13 @@
 //! | Release solenoid driver      | PB5  | GPIO out, high = energised                   |
 //! | Host link TX                 | PA2  | USART2_TX, DMA1 stream 6                      |
 //! | Host link RX                 | PA3  | USART2_RX, DMA1 stream 5 (circular)           |
-//! | Heartbeat LED (active low)   | PC13 | GPIO out                                     |
+//! | Status LED (active low)      | PC13 | GPIO out, a pattern per state (`app::led`)   |
 //! | Debug probe                  | PA13/PA14 | SWDIO/SWCLK, defmt over RTT            |
 //!
 //! Timers: TIM1 PWM, TIM2 capture (both sensors on one 32-bit counter, so their timestamps and
 //! the controller's `now` share one time base), TIM5 embassy's time driver. The IWDG resets the
-//! MCU if the control tick stops; parameters live in flash sector 7 (0x0806_0000, 128 KiB).
+//! MCU if the control tick stops; parameters live in flash
+//! sectors 6 and 7 (0x0804_0000..0x0808_0000, 2 x 128 KiB; `memory.x` ends the image at 256 KiB).
 
 pub mod capture;
 pub mod clocks;

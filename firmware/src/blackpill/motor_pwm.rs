@@ -2,8 +2,12 @@
 //!
 //! A PWM/DIR H-bridge input pair: PWM low = outputs off. The bridge inputs have pull-downs
 //! (docs/wiring.md), so the motors are also off while the MCU is in reset or unprogrammed.
+//!
+//! Off state: TIM1 keeps driving PA8/PA9 low when its main output is disabled (OSSI = 1,
+//! OISx = 0, CCxP = 0), so after a fault the pins do not depend on the pull-downs.
 
 use embassy_stm32::gpio::{Level, Output};
+use embassy_stm32::pac::timer::vals::{Ossi, Ossr};
 use embassy_stm32::peripherals::TIM1;
 use embassy_stm32::timer::Channel;
 use embassy_stm32::timer::simple_pwm::SimplePwmChannel;
@@ -30,6 +34,8 @@ impl PwmMotor {
         direction: Output<'static>,
     ) -> Self {
         channel.set_duty_cycle_fully_off();
+        // Before the channel's output is enabled: from here on a fault (MOE = 0) drives it low.
+        drive_off_state();
         channel.enable();
         Self {
             channel,
@@ -87,14 +93,34 @@ impl MotorOutput for PwmMotor {
     }
 }
 
+/// TIM1's off-state selection (RM0383, TIMx_BDTR, and the TIM1 table "Output control bits for
+/// complementary OCx and OCxN channels with break feature"): with OSSI = 0 (the reset value,
+/// and what embassy leaves) clearing MOE *releases* the pins: not driven by the timer, they
+/// float and only the bridge's pull-downs hold them low. With OSSI = 1 and CCxE = 1 the timer
+/// keeps the output enabled at its idle level OISx (0 here: TIM1_CR2 untouched), i.e. driven
+/// low. OSSR = 1 does the same with MOE = 1 for a channel whose CCxE is cleared while its
+/// complementary output is enabled; no CHxN pin is used today, it keeps a later complementary
+/// wiring driven too. Idempotent; no lock, no driver state.
+pub fn drive_off_state() {
+    embassy_stm32::pac::TIM1.bdtr().modify(|w| {
+        w.set_ossi(Ossi::IDLE_LEVEL);
+        w.set_ossr(Ossr::IDLE_LEVEL);
+    });
+}
+
 /// Both PWM outputs to zero and TIM1's main output off, by raw register writes: no lock, no
 /// driver state, safe to call from the panic and fault handlers at any moment.
 pub fn emergency_off() {
     let tim1 = embassy_stm32::pac::TIM1;
+    // MOE off first, in the same write as OSSI = 1: the outputs go to their idle level (driven
+    // low, OISx = 0) at once, not released to float, whatever ran (or did not run) before.
+    tim1.bdtr().modify(|w| {
+        w.set_ossi(Ossi::IDLE_LEVEL);
+        w.set_ossr(Ossr::IDLE_LEVEL);
+        w.set_moe(false);
+    });
     tim1.ccr(0)
         .write_value(embassy_stm32::pac::timer::regs::Ccr1ch(0));
     tim1.ccr(1)
         .write_value(embassy_stm32::pac::timer::regs::Ccr1ch(0));
-    // MOE off: the outputs go to their idle level (low, OISx = 0) at once.
-    tim1.bdtr().modify(|w| w.set_moe(false));
 }

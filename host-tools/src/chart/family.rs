@@ -1,5 +1,6 @@
 //! `bowl chart family`: overshoot against settling time of every axis of a family of plants (a
-//! rig or family file), each commissioned and stepped from rest, with the targets marked.
+//! rig or family file), each commissioned and stepped from rest or from a running speed, with the
+//! targets marked.
 
 use super::plot::{Figure, Mark, Scale, Series, VLine};
 use super::table::Table;
@@ -12,9 +13,9 @@ fn never_s(target: f32) -> f64 {
 }
 
 /// Runs the family (on all cores) and draws it.
-pub fn chart(rigs: &[Rig], target: f32, file: &str) -> (Figure, Table) {
+pub fn chart(rigs: &[Rig], from: f32, target: f32, file: &str) -> (Figure, Table) {
     let plants: Vec<PlantStep> =
-        crate::sim::parallel(rigs, |r| sim_reports::family_plant(r, target));
+        crate::sim::parallel(rigs, |r| sim_reports::family_plant(r, from, target));
     let mut table = Table::new(&[
         "plant",
         "axis",
@@ -104,9 +105,10 @@ pub fn chart(rigs: &[Rig], target: f32, file: &str) -> (Figure, Table) {
         });
     }
     let fig = Figure {
-        title: format!("Overshoot and settling, 0 -> {target} rad/s, every axis of {file}"),
-        x_label: "overshoot of the true speed, % of the setpoint".into(),
-        y_label: format!("{band} % settling (speed averaged over a revolution), s"),
+        title: format!("Overshoot and settling, {from} -> {target} rad/s, every axis of {file}"),
+        x_label: "overshoot of the true speed (past the target, in the step's direction), % of the target"
+            .into(),
+        y_label: format!("{band} % settling (speed averaged over a revolution, at most 1 s), s"),
         x_scale: Scale::Linear,
         y_scale: Scale::Linear,
         series,

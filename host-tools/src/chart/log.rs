@@ -154,7 +154,7 @@ fn figure(rows: &[Row], axis: usize, file: &str, wall_clock: bool) -> Figure {
                 vlines.push(VLine {
                     x: *t_s,
                     label: what.clone(),
-                    color: if what == "link lost" {
+                    color: if what == "link lost" || what == "no telemetry" {
                         FAULT_COLOUR
                     } else {
                         EVENT_COLOUR

@@ -54,7 +54,8 @@ enum Which {
     Settling(ControlArgs),
     /// Limit cycle of the 0.5 rad/s hold against the per-pulse gain, with and without the schedule.
     ControlStability(ControlArgs),
-    /// Overshoot against settling of every axis of a rig or family file (0 -> target step).
+    /// Overshoot against settling of every axis of a rig or family file (a step from rest, or from
+    /// --from-rad-s, to the target).
     Family(FamilyArgs),
     /// Rolling model: residence time against bowl speed beside the paper's (cf. paper Fig. 7).
     RollingResidence(RollingResidenceArgs),
@@ -140,6 +141,9 @@ struct FamilyArgs {
     /// Step target, rad/s.
     #[arg(long, default_value_t = 3.0)]
     target_rad_s: f32,
+    /// Both axes settle at this speed first, then step to the target (0 = from rest), rad/s.
+    #[arg(long, default_value_t = 0.0)]
+    from_rad_s: f32,
 }
 
 /// Options of the control charts (`settling`, `control-stability`).
@@ -447,7 +451,7 @@ pub fn run(args: &Args) -> Result<()> {
                 .rig_file
                 .file_name()
                 .map_or(String::new(), |n| n.to_string_lossy().into_owned());
-            let (f, t) = family::chart(&rigs, a.target_rad_s, &name);
+            let (f, t) = family::chart(&rigs, a.from_rad_s, a.target_rad_s, &name);
             write_all(&a.out, &f, &t)
         }
     }

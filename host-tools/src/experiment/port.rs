@@ -18,7 +18,7 @@ use model_core::wire::{
 
 use super::ReleaseRig;
 use super::simulated::Release;
-use crate::link::{Link, RESEND_EVERY, answers_kind};
+use crate::link::{LineTap, Link, RESEND_EVERY, answers_kind};
 use crate::send::command_line;
 use crate::serial::ReadOutcome;
 
@@ -39,6 +39,8 @@ const PING_EVERY: Duration = Duration::from_secs(1);
 pub struct PortRig {
     link: Link,
     decoder: Decoder,
+    /// The raw line beside the decoder, to show an answer it cannot read.
+    tap: LineTap,
     next_id: u16,
     latest: Option<Telemetry>,
     /// Telemetry since the last [`PortRig::take_telemetry`].
@@ -59,7 +61,8 @@ impl PortRig {
         let mut rig = Self {
             link,
             decoder: Decoder::new(),
-            next_id: (std::process::id() as u16).wrapping_mul(31),
+            tap: LineTap::default(),
+            next_id: crate::link::fresh_id(),
             latest: None,
             fresh: Vec::new(),
             events: VecDeque::new(),
@@ -94,6 +97,7 @@ impl PortRig {
         };
         let mut answer = None;
         for &b in &buf[..n] {
+            self.tap.push(b);
             match self.decoder.push(b) {
                 Some(Ok(Frame::Telemetry(t))) => {
                     self.latest = Some(t);
@@ -108,7 +112,15 @@ impl PortRig {
                         answer = Some(frame);
                     }
                 }
-                _ => {}
+                // Our answer, intact but unreadable here: said as it is, not waited out.
+                Some(Err(e)) => {
+                    if let (Some(u), Some((id, _))) = (self.tap.unreadable_answer(e), want)
+                        && u.id == id
+                    {
+                        return Err(u.into());
+                    }
+                }
+                None => {}
             }
         }
         Ok(answer)

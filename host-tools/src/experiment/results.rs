@@ -96,6 +96,13 @@ impl Writer {
 
 /// Reads a results file: the rows with their line numbers (header = line 1).
 pub fn read(path: &Path) -> Result<Vec<(usize, Row)>> {
+    // A directory opens like a file on Unix and reads as empty: said, with its name.
+    if path.is_dir() {
+        anyhow::bail!(
+            "{} is a directory, not a results file (the CSV `bowl experiment --out` writes)",
+            path.display()
+        );
+    }
     let mut reader = csv::Reader::from_path(path)
         .with_context(|| format!("cannot read the results file {}", path.display()))?;
     let mut rows = Vec::new();
@@ -115,10 +122,14 @@ pub fn read(path: &Path) -> Result<Vec<(usize, Row)>> {
 
 /// Reads a trace file (`t_s,bowl_rad_s`).
 pub fn read_trace(path: &Path) -> Result<Vec<(f64, f64)>> {
-    let mut reader = csv::Reader::from_path(path)?;
+    let what = || format!("cannot read the speed trace {}", path.display());
+    if path.is_dir() {
+        anyhow::bail!("{}: it is a directory", what());
+    }
+    let mut reader = csv::Reader::from_path(path).with_context(what)?;
     let mut out = Vec::new();
     for rec in reader.deserialize::<(f64, f64)>() {
-        out.push(rec?);
+        out.push(rec.with_context(what)?);
     }
     Ok(out)
 }

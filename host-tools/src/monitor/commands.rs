@@ -5,7 +5,8 @@ use std::time::{Duration, Instant};
 
 use model_core::wire::{Command, Frame, decode_frame};
 
-use crate::link::{RESEND_EVERY, answers_kind};
+use crate::command_words::local_refusal;
+use crate::link::{RESEND_EVERY, UnreadableAnswer, answers_kind};
 use crate::refusal::particulars;
 use crate::send::{command_line, describe, explain};
 
@@ -29,13 +30,10 @@ pub struct Commands {
 
 impl Commands {
     pub fn new() -> Self {
-        // Ids from the clock, so two monitors in a row do not reuse each other's.
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map(|d| d.subsec_nanos())
-            .unwrap_or(0);
+        // Ids from the clock, so no tool before this one used them within the rig's memory of
+        // recent commands (a late copy of theirs must not look like ours, nor ours like theirs).
         Self {
-            next_id: (nanos % 60_000) as u16 + 1,
+            next_id: crate::link::fresh_id(),
             pending: Vec::new(),
         }
     }
@@ -47,13 +45,18 @@ impl Commands {
             return Err("type a command, e.g. `status`, `speed 1800 2100`, `start`".into());
         }
         let id = self.next_id;
-        self.next_id = self.next_id.wrapping_add(1).max(1);
+        // u16::MAX is the heartbeat's.
+        self.next_id = match self.next_id.wrapping_add(1) {
+            u16::MAX => 0,
+            n => n,
+        };
         let line = command_line(id, &words).map_err(|r| {
-            let mut why = format!("`{text}` not sent: {} - {}", r.token(), explain(r));
-            if let Some(more) = particulars(None, id, &words, r, Duration::ZERO) {
-                why.push_str(&format!(" ({more})"));
-            }
-            why
+            format!(
+                "`{text}` not sent: {} - {} ({})",
+                r.token(),
+                explain(r),
+                local_refusal(&words, r)
+            )
         })?;
         let Ok(Frame::Command { command, .. }) = decode_frame(&line) else {
             return Err(format!("`{text}` not sent: not a command"));
@@ -86,6 +89,15 @@ impl Commands {
             }
         }
         Some(text)
+    }
+
+    /// An intact answer this bowl cannot read: the text to show (with the command it answers,
+    /// which is then no longer waited for, if it is ours).
+    pub fn on_unreadable(&mut self, answer: &UnreadableAnswer) -> String {
+        match self.pending.iter().position(|p| p.id == answer.id) {
+            Some(i) => format!("{} -> {answer}", self.pending.remove(i).words),
+            None => answer.to_string(),
+        }
     }
 
     /// Lines to send again (same id) and texts for commands that got no answer at all.

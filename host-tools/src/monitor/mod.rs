@@ -7,8 +7,10 @@
 //! into the monitor itself (the UI's command line, or stdin lines in plain mode).
 
 mod commands;
+mod line_edit;
 mod tui;
 mod view;
+mod wrap;
 
 pub(crate) use view::View;
 
@@ -21,9 +23,10 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant, SystemTime};
 
 use anyhow::{Context, Result};
-use model_core::wire::{Decoder, Frame};
+use model_core::wire::{Decoder, Frame, FrameError};
 use serde_json::json;
 
+use crate::link::LineTap;
 use crate::relay::Relay;
 use crate::replay::stats_json;
 use crate::serial::{Port, ReadOutcome};
@@ -108,6 +111,8 @@ pub fn run(args: &Args) -> Result<()> {
         .seconds
         .map(|s| started + Duration::from_secs_f64(s.max(0.0)));
     let mut decoder = Decoder::new();
+    let mut tap = LineTap::default();
+    let mut other_version_said = false;
     let mut view = View::new();
     let mut commands = Commands::new();
     let mut port = Some(first);
@@ -127,6 +132,8 @@ pub fn run(args: &Args) -> Result<()> {
     let mut next_redraw = Instant::now();
     let mut next_plain = Instant::now() + Duration::from_secs(1);
     let mut buf = [0u8; 4096];
+    // An open gap in the telemetry: since when nothing came, and the frame count then.
+    let mut gap: Option<(Instant, u64)> = None;
 
     while deadline.is_none_or(|d| Instant::now() < d) && !interrupted.load(Ordering::SeqCst) {
         if port.is_none() && last_open_try.elapsed() >= REOPEN_EVERY {
@@ -161,8 +168,30 @@ pub fn run(args: &Args) -> Result<()> {
                 for &b in &buf[..n] {
                     // Damaged frames are counted by the decoder (corrupt, oversize, truncated).
                     let restarts = decoder.stats().restarts;
-                    let Some(Ok(frame)) = decoder.push(b) else {
-                        continue;
+                    tap.push(b);
+                    let frame = match decoder.push(b) {
+                        Some(Ok(frame)) => frame,
+                        Some(Err(e)) => {
+                            // Intact but unreadable here (another version, an unknown word):
+                            // shown as it came, never taken for silence.
+                            if let Some(u) = tap.unreadable_answer(e) {
+                                view.event(plain, commands.on_unreadable(&u));
+                            } else if e == FrameError::UnsupportedVersion && !other_version_said {
+                                // Telemetry in another protocol version: every frame would
+                                // count as malformed with no word why. Said once.
+                                other_version_said = true;
+                                view.event(
+                                    plain,
+                                    format!(
+                                        "the rig sends another protocol version than this \
+                                         bowl reads (1): `{}`; update whichever is older",
+                                        tap.text()
+                                    ),
+                                );
+                            }
+                            continue;
+                        }
+                        None => continue,
                     };
                     if decoder.stats().restarts > restarts {
                         link_event(&mut log, decoder.stats().restarts, "device restart")?;
@@ -198,6 +227,34 @@ pub fn run(args: &Args) -> Result<()> {
                 view.event(plain, format!("port {} lost; reopening", args.port));
                 link_event(&mut log, decoder.stats().restarts, "link lost")?;
             }
+        }
+        // Telemetry overdue, and back: said on the screen and marked in the log (so a chart of
+        // the log breaks its lines across the gap).
+        match gap {
+            None => {
+                if let Some(quiet) = view.silence(Instant::now()) {
+                    gap = Some((Instant::now() - quiet, view.telemetry_frames));
+                    view.event(
+                        plain,
+                        format!(
+                            "no telemetry for {:.1} s: the port is open but the rig sends no \
+                             frames (TELEM_HZ 0? a reset? a loose cable?); the values shown are old",
+                            quiet.as_secs_f64()
+                        ),
+                    );
+                    link_event(&mut log, decoder.stats().restarts, "no telemetry")?;
+                }
+            }
+            Some((from, frames)) if view.telemetry_frames > frames => {
+                gap = None;
+                let text = format!(
+                    "telemetry again after {:.1} s",
+                    from.elapsed().as_secs_f64()
+                );
+                view.event(plain, text.clone());
+                link_event(&mut log, decoder.stats().restarts, &text)?;
+            }
+            Some(_) => {}
         }
         let mut outgoing = relay.as_mut().map(Relay::poll).unwrap_or_default();
         let mut typed_now: Vec<String> = typed.iter().flat_map(|rx| rx.try_iter()).collect();

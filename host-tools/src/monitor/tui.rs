@@ -1,11 +1,12 @@
 //! The monitor's terminal UI (ratatui + crossterm): live charts of set and measured speed per
 //! axis against device time, the latest values, link and fault banners, counters, events and a
-//! command line. Keys: `:` starts a command (Enter sends, Esc drops it), `p` or space pauses the
-//! charts, `q` or Ctrl-C quits. The terminal is restored on every way out.
+//! command line. Keys: `:` starts a command (Enter sends, Esc drops it, Up/Down bring back
+//! earlier ones, Tab completes), `p` or space pauses the charts, `q` or Ctrl-C quits. The
+//! terminal is restored on every way out.
 
 use std::collections::VecDeque;
 use std::io::Stdout;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::Result;
 use crossterm::event::{self, Event, KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
@@ -21,7 +22,9 @@ use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Axis, Block, Borders, Chart, Dataset, GraphType, Paragraph};
 
+use super::line_edit::LineEdit;
 use super::view::{View, residence_text};
+use super::wrap::{pack, wrap};
 
 /// Seconds of device time the charts show.
 const WINDOW_S: f64 = 20.0;
@@ -65,8 +68,10 @@ pub struct Tui {
     terminal: Terminal<CrosstermBackend<Stdout>>,
     history: History,
     paused: bool,
-    /// The command being typed, when the command line is open.
-    input: Option<String>,
+    /// Whether the command line is open.
+    typing: bool,
+    /// The command line's text and history.
+    line: LineEdit,
 }
 
 impl Tui {
@@ -80,7 +85,8 @@ impl Tui {
                 axes: [VecDeque::new(), VecDeque::new()],
             },
             paused: false,
-            input: None,
+            typing: false,
+            line: LineEdit::default(),
         })
     }
 
@@ -109,44 +115,75 @@ impl Tui {
         if key.modifiers.contains(KeyModifiers::CONTROL) && key.code == KeyCode::Char('c') {
             return Action::Quit;
         }
-        match (&mut self.input, key.code) {
-            (Some(text), KeyCode::Enter) => {
-                let text = std::mem::take(text);
-                self.input = None;
-                return Action::Send(text);
+        let line = &mut self.line;
+        match (self.typing, key.code) {
+            (true, KeyCode::Enter) => {
+                self.typing = false;
+                return Action::Send(line.take());
             }
-            (Some(_), KeyCode::Esc) => self.input = None,
-            (Some(text), KeyCode::Backspace) => {
-                text.pop();
+            (true, KeyCode::Esc) => self.typing = false,
+            (true, KeyCode::Backspace) => line.backspace(),
+            (true, KeyCode::Up) => line.older(),
+            (true, KeyCode::Down) => line.newer(),
+            (true, KeyCode::Tab) => line.complete(),
+            (true, KeyCode::Char(c)) => line.push(c),
+            (true, _) => {}
+            (false, KeyCode::Char('q')) => return Action::Quit,
+            (false, KeyCode::Char('p') | KeyCode::Char(' ')) => self.paused = !self.paused,
+            (false, KeyCode::Char(':') | KeyCode::Enter) => {
+                self.typing = true;
+                line.open();
             }
-            (Some(text), KeyCode::Char(c)) => text.push(c),
-            (Some(_), _) => {}
-            (None, KeyCode::Char('q')) => return Action::Quit,
-            (None, KeyCode::Char('p') | KeyCode::Char(' ')) => self.paused = !self.paused,
-            (None, KeyCode::Char(':') | KeyCode::Enter) => self.input = Some(String::new()),
-            (None, _) => {}
+            // Up opens the command line on the last command, as in a shell.
+            (false, KeyCode::Up) => {
+                self.typing = true;
+                line.open();
+                line.older();
+            }
+            (false, _) => {}
         }
         Action::None
     }
 
     pub fn draw(&mut self, port: &str, view: &View, decoder: &Decoder, tools: usize) -> Result<()> {
-        let (history, paused, input) = (&self.history, self.paused, &self.input);
+        let (history, paused) = (&self.history, self.paused);
+        let input = self.typing.then_some(&self.line);
+        let silence = view.silence(Instant::now());
         self.terminal.draw(|f| {
+            let width = usize::from(f.area().width).max(20);
+            // The fault line and the events are wrapped to the width, never cut: the end of a
+            // fault line says what to do.
+            let (fault_text, fault_style) = fault_line(view, silence.is_some());
+            let fault_rows = wrap(&fault_text, width);
+            // The newest event whole (up to EVENT_ROWS_MAX rows), then older ones while they fit.
+            let newest = view.events.back().map_or(0, |e| wrap(e, width).len());
+            let event_space = newest.clamp(EVENT_ROWS, EVENT_ROWS_MAX);
+            let mut event_rows = Vec::new();
+            for e in view.events.iter().rev() {
+                let mut lines = wrap(e, width);
+                if event_rows.len() + lines.len() > event_space && !event_rows.is_empty() {
+                    break;
+                }
+                lines.truncate(event_space);
+                event_rows.extend(lines);
+            }
+            let banner_rows = banner(port, view, silence, paused, tools, width);
             let rows = Layout::vertical([
-                Constraint::Length(1),
-                Constraint::Length(1),
+                Constraint::Length(banner_rows.len() as u16),
+                Constraint::Length(fault_rows.len() as u16),
                 Constraint::Min(8),
                 Constraint::Length(5),
                 Constraint::Length(1),
-                Constraint::Length(4),
+                Constraint::Length(event_space as u16 + 1),
                 Constraint::Length(1),
             ])
             .split(f.area());
-            f.render_widget(banner(port, view, paused, tools), rows[0]);
-            f.render_widget(fault_line(view), rows[1]);
+            f.render_widget(Paragraph::new(banner_rows), rows[0]);
+            let fault_lines: Vec<Line> = fault_rows.into_iter().map(Line::from).collect();
+            f.render_widget(Paragraph::new(fault_lines).style(fault_style), rows[1]);
             let charts = Layout::horizontal([Constraint::Ratio(1, 2), Constraint::Ratio(1, 2)])
                 .split(rows[2]);
-            let live = view.connected && view.latest.is_some();
+            let live = view.connected && silence.is_none() && view.latest.is_some();
             for (i, (name, area)) in ["precession w1", "spin w2"]
                 .iter()
                 .zip(charts.iter())
@@ -154,30 +191,29 @@ impl Tui {
             {
                 speed_chart(f, *area, name, &history.axes[i], live);
             }
-            f.render_widget(values(view), rows[3]);
+            f.render_widget(values(view, live), rows[3]);
             f.render_widget(
                 Paragraph::new(view.counters(decoder)).style(Style::default().fg(Color::Cyan)),
                 rows[4],
             );
-            let events: Vec<Line> = view
-                .events
-                .iter()
-                .rev()
-                .take(4)
-                .map(|e| Line::from(e.as_str()))
-                .collect();
+            let events: Vec<Line> = event_rows.into_iter().map(Line::from).collect();
             f.render_widget(
                 Paragraph::new(events)
                     .block(Block::default().borders(Borders::TOP).title("events")),
                 rows[5],
             );
             let prompt = match input {
-                Some(text) => Line::from(vec![
+                Some(line) => Line::from(vec![
                     Span::styled("command> ", Style::default().fg(Color::Yellow)),
-                    Span::raw(text.as_str()),
+                    Span::raw(line.text.as_str()),
                     Span::styled("_", Style::default().add_modifier(Modifier::SLOW_BLINK)),
                     Span::styled(
-                        "   Enter send · Esc cancel",
+                        if line.candidates.is_empty() {
+                            "   Enter send · Esc cancel · Up/Down earlier · Tab complete"
+                                .to_string()
+                        } else {
+                            format!("   Tab: {}", line.candidates.join(" "))
+                        },
                         Style::default().fg(Color::DarkGray),
                     ),
                 ]),
@@ -201,7 +237,14 @@ impl Drop for Tui {
 }
 
 /// The top line: port, link, rig state and fault, each impossible to miss when it matters.
-fn banner<'a>(port: &'a str, view: &View, paused: bool, tools: usize) -> Paragraph<'a> {
+fn banner<'a>(
+    port: &'a str,
+    view: &View,
+    silence: Option<Duration>,
+    paused: bool,
+    tools: usize,
+    width: usize,
+) -> Vec<Line<'a>> {
     let alarm = Style::default()
         .fg(Color::White)
         .bg(Color::Red)
@@ -210,7 +253,16 @@ fn banner<'a>(port: &'a str, view: &View, paused: bool, tools: usize) -> Paragra
         format!(" bowl monitor {port} "),
         Style::default().add_modifier(Modifier::BOLD),
     )];
-    if view.connected {
+    if let Some(quiet) = silence.filter(|_| view.connected) {
+        // The port is open but nothing comes: LINK OK would be a lie.
+        spans.push(Span::styled(
+            format!(
+                " no telemetry for {:.0} s - the values below are old ",
+                quiet.as_secs_f64()
+            ),
+            alarm,
+        ));
+    } else if view.connected {
         spans.push(Span::styled(
             " LINK OK ",
             Style::default().fg(Color::Black).bg(Color::Green),
@@ -221,7 +273,7 @@ fn banner<'a>(port: &'a str, view: &View, paused: bool, tools: usize) -> Paragra
             alarm,
         ));
     }
-    if let Some(t) = view.latest.filter(|_| view.connected) {
+    if let Some(t) = view.latest.filter(|_| view.connected && silence.is_none()) {
         spans.push(Span::raw(format!(
             "  state {}  ",
             crate::words::state(t.state)
@@ -236,26 +288,34 @@ fn banner<'a>(port: &'a str, view: &View, paused: bool, tools: usize) -> Paragra
     if tools > 0 {
         spans.push(Span::raw(format!("  {tools} tool(s) connected")));
     }
-    Paragraph::new(Line::from(spans))
+    pack(spans, width)
 }
 
-/// A whole red line while the rig reports a fault (the motors are off until `clear`).
-fn fault_line(view: &View) -> Paragraph<'static> {
-    match view.latest.filter(|_| view.connected) {
-        Some(t) if t.fault != FaultCode::None => Paragraph::new(format!(
-            " FAULT {}: the rig stopped the motors. {}. Type `:clear` once the cause is fixed",
-            t.fault.code(),
-            crate::words::fault(t.fault)
-        ))
-        .style(
+/// How many rows the events get (the newest first, each wrapped) ...
+const EVENT_ROWS: usize = 4;
+/// ... and at most, for a long newest event (a refusal that lists every parameter name).
+const EVENT_ROWS_MAX: usize = 8;
+
+/// The fault line's text and style: red while the rig reports a fault (the motors are off until
+/// `clear`), unknown while no current telemetry comes (`stale`: overdue).
+fn fault_line(view: &View, stale: bool) -> (String, Style) {
+    match view.latest.filter(|_| view.connected && !stale) {
+        Some(t) if t.fault != FaultCode::None => (
+            format!(
+                " FAULT {}: the rig stopped the motors. {}. Type `:clear` once the cause is fixed",
+                t.fault.code(),
+                crate::words::fault(t.fault)
+            ),
             Style::default()
                 .fg(Color::White)
                 .bg(Color::Red)
                 .add_modifier(Modifier::BOLD),
         ),
-        Some(_) => Paragraph::new(" no fault").style(Style::default().fg(Color::Green)),
-        None => Paragraph::new(" fault: unknown (no current telemetry)")
-            .style(Style::default().fg(Color::DarkGray)),
+        Some(_) => (" no fault".into(), Style::default().fg(Color::Green)),
+        None => (
+            " fault: unknown (no current telemetry)".into(),
+            Style::default().fg(Color::DarkGray),
+        ),
     }
 }
 
@@ -294,37 +354,39 @@ fn speed_chart(
             .data(&measured),
     ];
     let label = |v: f64| Span::raw(format!("{v:.2}"));
+    // What the lines are and the units go in the frame's title: a legend or an axis title
+    // inside the plot would be drawn over the newest samples at the right edge.
+    let title = Line::from(vec![
+        Span::raw(format!(" {name} rad/s: ")),
+        Span::styled("set", Style::default().fg(dim(Color::Yellow))),
+        Span::raw(", "),
+        Span::styled("measured", Style::default().fg(dim(Color::Cyan))),
+        Span::raw(" "),
+    ]);
     let chart = Chart::new(datasets)
-        .block(
-            Block::default()
-                .borders(Borders::ALL)
-                .title(format!(" {name} ")),
-        )
-        .x_axis(
-            Axis::default()
-                .title("device time (s)")
-                .bounds([t_start, t_end])
-                .labels([
-                    Span::raw(format!("{t_start:.0}")),
-                    Span::raw(format!("{:.0}", (t_start + t_end) / 2.0)),
-                    Span::raw(format!("{t_end:.0}")),
-                ]),
-        )
-        .y_axis(
-            Axis::default()
-                .title("speed (rad/s)")
-                .bounds([y0, y1])
-                .labels([label(y0), label((y0 + y1) / 2.0), label(y1)]),
-        );
+        .block(Block::default().borders(Borders::ALL).title(title))
+        .legend_position(None)
+        .x_axis(Axis::default().bounds([t_start, t_end]).labels([
+            Span::raw(format!("{t_start:.0}")),
+            Span::raw(format!("{:.0}", (t_start + t_end) / 2.0)),
+            // The unit on the last label, below the axis (device time, s).
+            Span::raw(format!("{t_end:.0} s")),
+        ]))
+        .y_axis(Axis::default().bounds([y0, y1]).labels([
+            label(y0),
+            label((y0 + y1) / 2.0),
+            label(y1),
+        ]));
     f.render_widget(chart, area);
 }
 
-/// The latest values; grey when the link is lost (they are then the last known, not current).
-fn values(view: &View) -> Paragraph<'static> {
+/// The latest values; grey when they are not current (`live` false: the link is lost or no
+/// telemetry came for a while: they are then the last known).
+fn values(view: &View, live: bool) -> Paragraph<'static> {
     let Some(t) = view.latest else {
         return Paragraph::new("no telemetry yet");
     };
-    let style = if view.connected {
+    let style = if live {
         Style::default()
     } else {
         Style::default()
@@ -357,6 +419,8 @@ fn values(view: &View) -> Paragraph<'static> {
     )));
     if !view.connected {
         lines.push(Line::from("(last values before the link was lost)"));
+    } else if !live {
+        lines.push(Line::from("(last values before the telemetry stopped)"));
     }
     Paragraph::new(lines).style(style)
 }

@@ -5,6 +5,7 @@
 #![cfg_attr(not(unix), allow(dead_code, unused_imports))]
 
 use std::collections::VecDeque;
+use std::time::{Duration, Instant};
 
 use model_core::wire::{Decoder, Frame, Hello, Residence, Telemetry};
 
@@ -91,7 +92,20 @@ pub(crate) struct View {
     pub(crate) reconnects: u64,
     pub(crate) connected: bool,
     pub(crate) logged_rows: u64,
+    /// When the latest telemetry frame arrived (or the port was opened, before the first).
+    heard_at: Instant,
+    /// Device time between the last two telemetry frames, ms (0 until two have come).
+    period_ms: u32,
+    /// Telemetry frames taken in.
+    pub(crate) telemetry_frames: u64,
 }
+
+/// Telemetry is overdue after this many frame periods without a frame ...
+const STALE_PERIODS: u32 = 3;
+/// ... and never sooner than this: a USB serial adapter delivers in bursts of up to ~20 ms and
+/// a busy PC can pause the monitor for a few tenths of a second, which must not read as a rig
+/// gone quiet at 50 frames/s.
+const STALE_FLOOR: Duration = Duration::from_millis(500);
 
 impl View {
     pub(crate) fn new() -> Self {
@@ -109,13 +123,41 @@ impl View {
             reconnects: 0,
             connected: false,
             logged_rows: 0,
+            heard_at: Instant::now(),
+            period_ms: 0,
+            telemetry_frames: 0,
         }
+    }
+
+    /// How long no telemetry has arrived, once that is longer than [`STALE_PERIODS`] frame
+    /// periods (at least [`STALE_FLOOR`]; before the period is known, 1 s): then LINK OK would
+    /// be a lie, the values are old. `None` while frames arrive, and while the port is lost
+    /// (that is said already).
+    pub(crate) fn silence(&self, now: Instant) -> Option<Duration> {
+        let quiet = now.saturating_duration_since(self.heard_at);
+        let limit = match self.period_ms {
+            0 => Duration::from_secs(1),
+            ms => (Duration::from_millis(u64::from(ms)) * STALE_PERIODS).max(STALE_FLOOR),
+        };
+        (self.connected && quiet > limit).then_some(quiet)
     }
 
     /// Takes in one decoded frame (the CSV log is the caller's).
     pub(crate) fn on_frame(&mut self, plain: bool, frame: &Frame) {
         match frame {
-            Frame::Telemetry(t) => self.latest = Some(*t),
+            Frame::Telemetry(t) => {
+                if let Some(last) = self.latest {
+                    // The period the rig sends at now (it changes with TELEM_HZ); a jump of
+                    // more than 10 s is a gap or a restart, not a period.
+                    let dt = t.time_ms.wrapping_sub(last.time_ms);
+                    if (1..=10_000).contains(&dt) && t.seq == last.seq.wrapping_add(1) {
+                        self.period_ms = dt;
+                    }
+                }
+                self.latest = Some(*t);
+                self.heard_at = Instant::now();
+                self.telemetry_frames += 1;
+            }
             Frame::Hello(h) => {
                 self.hello = Some(*h);
                 self.event(
@@ -133,6 +175,10 @@ impl View {
 
     pub(crate) fn set_connected(&mut self, connected: bool) {
         self.connected = connected;
+        if connected {
+            // A port just (re)opened: silence is counted from now.
+            self.heard_at = Instant::now();
+        }
     }
 
     pub(crate) fn event(&mut self, plain: bool, text: String) {
@@ -189,6 +235,13 @@ impl View {
         if !self.connected {
             // The old values would read as current: say the link is down instead.
             return format!("LINK LOST: no values | {}", self.counters(d));
+        }
+        if let Some(quiet) = self.silence(Instant::now()) {
+            return format!(
+                "NO TELEMETRY for {:.1} s: no values | {}",
+                quiet.as_secs_f64(),
+                self.counters(d)
+            );
         }
         format!("{values} | {}", self.counters(d))
     }

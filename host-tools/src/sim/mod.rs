@@ -101,8 +101,14 @@ pub(crate) struct StepArgs {
     #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u16).range(1..))]
     pulses_per_rev: u16,
     /// Step target, rad/s.
-    #[arg(long, default_value_t = 3.0)]
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
     target_rad_s: f32,
+    /// Both axes first run at this speed, then step to --target-rad-s (0 = from rest), rad/s.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    from_rad_s: f32,
+    /// JSON output (the only format; accepted for symmetry with the other reports).
+    #[arg(long)]
+    json: bool,
     /// Feedforward only (feedback off): shows what the loop adds.
     #[arg(long)]
     no_feedback: bool,
@@ -141,8 +147,12 @@ pub(crate) struct FamilyArgs {
     #[arg(long)]
     rig_file: Option<std::path::PathBuf>,
     /// Step target with --rig-file, rad/s.
-    #[arg(long, default_value_t = 3.0)]
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
     target_rad_s: f32,
+    /// With --rig-file: both axes first settle at this speed, then step to --target-rad-s
+    /// (0 = from rest), rad/s.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    from_rad_s: f32,
     /// JSON output (the only format; accepted for symmetry).
     #[arg(long)]
     json: bool,
@@ -167,6 +177,8 @@ pub(crate) struct StabilityArgs {
 pub(crate) fn run(what: &What) -> Result<()> {
     match what {
         What::Step(a) if a.rig_file.is_some() => {
+            check_speed(a.target_rad_s, "--target-rad-s")?;
+            check_from(a.from_rad_s, a.target_rad_s)?;
             let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
             let rigs = rig_file::load(path)?;
             if rigs.len() != 1 {
@@ -183,14 +195,16 @@ pub(crate) fn run(what: &What) -> Result<()> {
                 rig.params.axes[1].load_step_nm,
             ];
             let out = StepJson {
-                scenario: "rig file, both axes 0 -> target, commissioned first, true speed",
+                scenario: "rig file, both axes from --from-rad-s (0 = rest) to the target, commissioned first, true speed",
                 pulses_per_rev: rig.params.axes[1].sensor.pulses_per_rev,
+                from_rad_s: a.from_rad_s,
                 target_rad_s: a.target_rad_s,
                 feedback: !a.no_feedback,
                 outcome: step_run_with(
                     rig.params,
                     cfg,
                     rig.seed,
+                    a.from_rad_s,
                     a.target_rad_s,
                     !a.no_feedback,
                     load,
@@ -202,11 +216,22 @@ pub(crate) fn run(what: &What) -> Result<()> {
         What::Family(a) if a.rig_file.is_some() => {
             let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
             check_speed(a.target_rad_s, "--target-rad-s")?;
+            check_from(a.from_rad_s, a.target_rad_s)?;
             let rigs = rig_file::load(path)?;
             check_lowest(&rigs, a.target_rad_s, "--target-rad-s")?;
-            let plants = parallel(&rigs, |r| sim_reports::family_plant(r, a.target_rad_s));
+            if a.from_rad_s > 0.0 {
+                check_lowest(&rigs, a.from_rad_s, "--from-rad-s")?;
+            }
+            let plants = parallel(&rigs, |r| {
+                sim_reports::family_plant(r, a.from_rad_s, a.target_rad_s)
+            });
             let summary = sim_reports::summary(&plants);
-            let out = serde_json::json!({ "plants": plants, "summary": summary });
+            let out = serde_json::json!({
+                "from_rad_s": a.from_rad_s,
+                "target_rad_s": a.target_rad_s,
+                "plants": plants,
+                "summary": summary,
+            });
             println!("{}", serde_json::to_string_pretty(&out)?);
         }
         What::Faults(a) => {
@@ -219,6 +244,8 @@ pub(crate) fn run(what: &What) -> Result<()> {
         }
         What::MakeFamily(a) => print!("{}", family_file::family_toml(a.seed, a.plants)),
         What::Step(a) => {
+            check_speed(a.target_rad_s, "--target-rad-s")?;
+            check_from(a.from_rad_s, a.target_rad_s)?;
             let mut rig = rig_with_pulses(a.pulses_per_rev);
             if let Some(r) = a.ripple_nm {
                 for ax in &mut rig.axes {
@@ -238,14 +265,16 @@ pub(crate) fn run(what: &What) -> Result<()> {
                 }
             }
             let out = StepJson {
-                scenario: "nominal rig, both axes 0 -> target, commissioned first, true speed",
+                scenario: "nominal rig, both axes from --from-rad-s (0 = rest) to the target, commissioned first, true speed",
                 pulses_per_rev: a.pulses_per_rev,
+                from_rad_s: a.from_rad_s,
                 target_rad_s: a.target_rad_s,
                 feedback: !a.no_feedback,
                 outcome: step_run_with(
                     rig,
                     cfg,
                     a.common.seed,
+                    a.from_rad_s,
                     a.target_rad_s,
                     !a.no_feedback,
                     [0.0; 2],
@@ -304,6 +333,20 @@ fn check_step(o: &StepOutcome) -> Result<()> {
             "the run faulted (fault code {}, see docs/protocol.md): the figures above are not a step \
              response",
             o.fault_code
+        );
+    }
+    Ok(())
+}
+
+/// `--from-rad-s`: 0 (from rest) or a speed in the controller's range, not the target itself.
+fn check_from(from: f32, target: f32) -> Result<()> {
+    if from == 0.0 {
+        return Ok(());
+    }
+    check_speed(from, "--from-rad-s")?;
+    if from == target {
+        bail!(
+            "--from-rad-s {from} equals --target-rad-s: there is no step; give a different speed or 0 (from rest)"
         );
     }
     Ok(())

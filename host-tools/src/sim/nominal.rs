@@ -14,7 +14,8 @@ use crate::sim_reports;
 pub struct AxisFigures {
     /// 10-90 % rise time, s.
     pub rise_time_s: f32,
-    /// Overshoot, percent of the target.
+    /// Overshoot: the largest excursion past the target in the step's direction, percent of
+    /// the target.
     pub overshoot_pct: f32,
     /// 2 % settling time, s.
     pub settling_time_s: f32,
@@ -49,23 +50,35 @@ pub struct StepOutcome {
     pub commissioned: bool,
 }
 
-/// Commissions, then steps both axes (see `model_core::sim::experiments::commissioned_step`).
+/// Commissions, runs both axes at `from` (0 = rest), then steps them to `target` (see
+/// `model_core::sim::experiments::commissioned_transition`).
+#[allow(clippy::too_many_arguments)]
 pub fn step_run_with(
     rig: PlantParams,
     cfg: ControllerConfig,
     seed: u32,
+    from: f32,
     target: f32,
     feedback: bool,
     load_after_commissioning_nm: [f32; 2],
 ) -> StepOutcome {
-    outcome_json(experiments::commissioned_step(
+    let o = experiments::commissioned_transition(
         rig,
         cfg,
         seed,
+        from,
         target,
         feedback,
         load_after_commissioning_nm,
-    ))
+    );
+    let mut out = outcome_json(o);
+    // The model's overshoot is a fraction of the change; the report's is % of the target.
+    let scale = ((target - from) / target).abs();
+    for a in out.axes.iter_mut() {
+        a.overshoot_pct *= scale;
+    }
+    out.worst = worst_of(&out.axes);
+    out
 }
 
 pub(super) fn outcome_json(o: experiments::StepOutcome) -> StepOutcome {
@@ -86,6 +99,7 @@ pub(super) fn step_run(rig: PlantParams, seed: u32, target: f32, feedback: bool)
         rig,
         ControllerConfig::nominal(),
         seed,
+        0.0,
         target,
         feedback,
         [0.0; 2],
@@ -126,6 +140,8 @@ pub struct StepJson {
     pub scenario: &'static str,
     /// Pulses per revolution.
     pub pulses_per_rev: u16,
+    /// Speed both axes held before the step, rad/s (0 = from rest).
+    pub from_rad_s: f32,
     /// Target, rad/s.
     pub target_rad_s: f32,
     /// Feedback on.

@@ -110,6 +110,8 @@ pub struct ControllerBackend<I: Injector> {
     saved_identified: [bool; AXES],
     /// Axes whose model in force came identified from the stored record.
     stored_identified: [bool; AXES],
+    /// Board conditions for STATUS (`wire::status_flags`), set by the board.
+    status_flags: u8,
     injector: I,
 }
 
@@ -147,6 +149,7 @@ impl<I: Injector> ControllerBackend<I> {
             saved_models: [cfg.axes[0].model, cfg.axes[1].model],
             saved_identified: stored_identified,
             stored_identified,
+            status_flags: 0,
             injector,
         };
         (rig, outcome)
@@ -165,6 +168,11 @@ impl<I: Injector> ControllerBackend<I> {
             now[0].is_some() || self.stored_identified[0],
             now[1].is_some() || self.stored_identified[1],
         ]
+    }
+
+    /// Sets and clears board conditions STATUS reports (`wire::status_flags` bits).
+    pub fn update_status_flags(&mut self, set: u8, clear: u8) {
+        self.status_flags = (self.status_flags & !clear) | set;
     }
 
     /// The controller (diagnostics).
@@ -272,6 +280,10 @@ impl<I: Injector> Backend for ControllerBackend<I> {
 
     fn reset_info(&self) -> Hello {
         self.hello
+    }
+
+    fn status_flags(&self) -> u8 {
+        self.status_flags
     }
 
     fn set_speeds(&mut self, precession_mrad_s: i16, spin_mrad_s: i16) -> Result<(), Reason> {

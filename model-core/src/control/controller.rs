@@ -229,7 +229,16 @@ impl Controller {
         for i in 0..2 {
             let a = &mut self.axes[i];
             let before = a.est.accepted_edges();
-            let speed = a.est.tick(now_ticks, edges[i], steady[i] > 0.5, |_, _| {});
+            // Steady as the shaft shows it, not only by the reference's age: the reference
+            // unchanged for half a second *and* the measurement within 10 % of the plant model
+            // the loop runs. A shaft still slowing towards a new, lower reference is not steady,
+            // and its long intervals are not missing pulses.
+            let model = a.speed_loop.model_rad_s().abs();
+            let steady_i = steady[i] > 0.5
+                && a.est.is_valid()
+                && (a.measured.abs() - model).abs() <= 0.1 * model;
+            a.est.expect_speed_rad_s(model);
+            let speed = a.est.tick(now_ticks, edges[i], steady_i, |_, _| {});
             seen[i] = a.est.accepted_edges() != before;
             a.measured = a.direction * speed;
             // Runaway (a bridge stuck on): once both axes have reached their references, an

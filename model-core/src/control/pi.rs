@@ -100,6 +100,11 @@ pub struct SpeedLoop {
     moved: bool,
     kick_rad_s: f32,
     push_sum: f32,
+    /// The model has been above the reference (the reference came down) since the start of
+    /// the newest window: that window's "too fast" is the slowing down, not a load.
+    slowing: bool,
+    /// Seconds since the model was last more than 2 % above the reference's magnitude.
+    model_down_quiet_s: f32,
 }
 
 /// Inputs of one loop step.
@@ -284,6 +289,8 @@ impl SpeedLoop {
         moved: false,
         kick_rad_s: 0.0,
         push_sum: 0.0,
+        slowing: false,
+        model_down_quiet_s: 0.0,
     };
 
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
@@ -300,6 +307,21 @@ impl SpeedLoop {
         let rp = self.model_rad_s;
         self.model_angle_rad += rp * k.dt_s;
         let ev = input.events;
+        // Slowing down: the model above the reference. Its windows, and every window that
+        // began before the model came down to the reference, compare a shaft that decelerates
+        // as its inertia lets it with a model that may decelerate faster; their "too fast" is
+        // not a load the integral should hold.
+        if rp.abs() > 1.02 * r_abs {
+            self.slowing = true;
+            self.model_down_quiet_s = 0.0;
+        } else {
+            self.model_down_quiet_s += k.dt_s;
+        }
+        if let Some(w) = ev.closed
+            && w.ago_s + w.span_s < self.model_down_quiet_s
+        {
+            self.slowing = false;
+        }
         if let Some(ago) = ev.restarted_s_ago {
             self.model_angle_rad = rp * ago;
             self.window_open = true;
@@ -413,7 +435,18 @@ impl SpeedLoop {
         let ff = (k.friction_duty + self.push + kick) * input.direction
             + r * k.duty_per_rad_s
             + input.extra_duty;
-        let candidate_i = self.integral + ki_dt * e;
+        // A "too fast" error is not integrated while the shaft slows down to a lower reference
+        // (see `slowing`) nor while the stall bound is active (the shaft is slowing between
+        // edges and nothing says it is still faster than the model: the error held from the
+        // last window is stale). Integrated for the seconds a window lasts at low speed, the
+        // deceleration's error wound the duty below friction and the shaft stalled (4 -> 0.2
+        // rad/s: 2 of 60 healthy plants faulted). It still acts proportionally.
+        let e_int = if (ev.bound_active || self.slowing) && e * input.direction < 0.0 {
+            0.0
+        } else {
+            e
+        };
+        let candidate_i = self.integral + ki_dt * e_int;
         let unlimited = ff + kp * e + candidate_i;
         let lim = k.duty_limit;
         let next = self.duty + clamp(clamp(unlimited, lim) - self.duty, k.slew_per_tick);

@@ -2,7 +2,7 @@
 //! QEMU cases: the commissioned 0 -> target step, the seeded family of perturbed plants, and
 //! the low-speed hold.
 
-use super::harness::{ClosedLoop, StepMetrics, StepReport};
+use super::harness::{ClosedLoop, SETTLING_BAND, StepMetrics, StepReport};
 use super::plant::{Plant, PlantParams};
 use super::prng::Prng;
 use crate::control::{Controller, ControllerConfig, Fault, State};
@@ -52,8 +52,36 @@ pub fn true_model_config(rig: &PlantParams) -> ControllerConfig {
 /// speed for [`STEP_RUN_S`].
 pub fn commissioned_step(
     rig: PlantParams,
+    cfg: ControllerConfig,
+    seed: u32,
+    target_rad_s: f32,
+    feedback: bool,
+    load_after_commissioning_nm: [f32; 2],
+) -> StepOutcome {
+    commissioned_transition(
+        rig,
+        cfg,
+        seed,
+        0.0,
+        target_rad_s,
+        feedback,
+        load_after_commissioning_nm,
+    )
+}
+
+/// How long both axes run at the starting speed of a transition before the step, s: the
+/// from-rest step's whole run, so the loop has settled there (and its integral holds the load).
+pub const HOLD_BEFORE_STEP_S: f32 = STEP_RUN_S;
+
+/// [`commissioned_step`] from `from_rad_s` instead of rest: both axes run at `from_rad_s` for
+/// [`HOLD_BEFORE_STEP_S`] (longer at low speed: three revolutions at least), then the setpoint
+/// changes to `target_rad_s` while running and the true speed is measured for [`STEP_RUN_S`]
+/// (overshoot and rise as fractions of the change). `from_rad_s == 0` is the step from rest.
+pub fn commissioned_transition(
+    rig: PlantParams,
     mut cfg: ControllerConfig,
     seed: u32,
+    from_rad_s: f32,
     target_rad_s: f32,
     feedback: bool,
     load_after_commissioning_nm: [f32; 2],
@@ -76,15 +104,25 @@ pub fn commissioned_step(
         a.faults.load_step_from_s = now;
         a.faults.load_step_nm = load;
     }
-    let mut m = [
-        StepMetrics::new(target_rad_s, STEADY_FROM_S),
-        StepMetrics::new(target_rad_s, STEADY_FROM_S),
-    ];
+    let metrics = || StepMetrics::between(from_rad_s, target_rad_s, SETTLING_BAND, STEADY_FROM_S);
+    let mut m = [metrics(), metrics()];
     let mut fault = cl.ctrl.fault();
-    if commissioned
-        && cl.ctrl.set_motor_speeds(target_rad_s, target_rad_s).is_ok()
-        && cl.ctrl.start().is_ok()
-    {
+    let mut ready = commissioned;
+    if ready && from_rad_s != 0.0 {
+        ready = cl.ctrl.set_motor_speeds(from_rad_s, from_rad_s).is_ok() && cl.ctrl.start().is_ok();
+        let hold = HOLD_BEFORE_STEP_S.max(3.0 * core::f32::consts::TAU / from_rad_s.abs());
+        cl.run(hold, |c| {
+            if fault.is_none() {
+                fault = c.ctrl.fault();
+            }
+        });
+        ready &= fault.is_none();
+    }
+    let started = |c: &mut ClosedLoop| {
+        c.ctrl.set_motor_speeds(target_rad_s, target_rad_s).is_ok()
+            && (from_rad_s != 0.0 || c.ctrl.start().is_ok())
+    };
+    if ready && started(&mut cl) {
         let dt = cl.dt_s();
         let mut t = 0.0f32;
         cl.run(STEP_RUN_S, |c| {

@@ -8,7 +8,7 @@ use super::{
     MODEL_FIELD_MAX, MotorTelemetry, PARAM_COUNT, ParamId, ParamValues, Reason, ResetCause,
     Residence, ResidenceModel, Status, Telemetry,
 };
-use super::{FRAME_END, FRAME_START, PROTOCOL_VERSION};
+use super::{FRAME_END, FRAME_START, LINE_END_CR, PROTOCOL_VERSION};
 
 /// Why a line was not accepted as a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -182,6 +182,7 @@ fn status(f: &mut Fields<'_>) -> Result<Status, FieldError> {
         reset_count: u16_field(f)?,
         uptime_ms: u32_field(f)?,
         telemetry_hz: param_value(f, ParamId::TelemetryHz)? as u8,
+        flags: f.int(0, u8::MAX.into())? as u8,
     })
 }
 
@@ -287,7 +288,8 @@ pub fn parse_command_line(line: &[u8]) -> Result<Frame, FrameError> {
     })
 }
 
-/// The payload of a line whose trailer and CRC check out.
+/// The payload of a line whose trailer and CRC check out (the `\r` of a `\r\n` line end, if
+/// the caller left it on, is not part of the line).
 fn checked_payload(line: &[u8]) -> Result<&[u8], FrameError> {
     let line = match line.split_last() {
         Some((b'\r', rest)) => rest,
@@ -393,10 +395,11 @@ fn parse_payload(payload: &[u8]) -> Result<Frame, FrameError> {
     Ok(frame)
 }
 
-/// Decodes one complete frame `$...\n` (for tests and one-shot use).
+/// Decodes one complete frame `$...` ending in `\r\n`, `\n` or `\r` (for tests and one-shot
+/// use).
 pub fn decode_frame(bytes: &[u8]) -> Result<Frame, FrameError> {
     match bytes {
-        [FRAME_START, line @ .., FRAME_END] => parse_line(line),
+        [FRAME_START, line @ .., FRAME_END | LINE_END_CR] => parse_line(line),
         _ => Err(FrameError::BadTrailer),
     }
 }

@@ -30,6 +30,10 @@ pub trait Backend {
     fn telemetry(&self) -> Telemetry;
     /// Why and how often the device has reset.
     fn reset_info(&self) -> Hello;
+    /// Board conditions for STATUS (`status_flags` bits); none by default.
+    fn status_flags(&self) -> u8 {
+        0
+    }
     /// New motor setpoints, mrad/s; [`Device`] has already checked each against 0..=its SPEED_MAX.
     fn set_speeds(&mut self, precession_mrad_s: i16, spin_mrad_s: i16) -> Result<(), Reason>;
     /// Choose the setpoints whose predicted residence time is `time_ms`; says which model
@@ -50,7 +54,9 @@ pub trait Backend {
     fn set_param(&mut self, id: ParamId, value: i32) -> Result<(), Reason>;
     /// The current value of a parameter (never asked for [`ParamId::TelemetryHz`]).
     fn param(&self, id: ParamId) -> i32;
-    /// A heartbeat from the PC (every command counts as one too; this is for PING).
+    /// The PC is there: called for every command that arrives intact (its CRC checks out),
+    /// before it is answered, whatever the answer (a query, a refusal, a copy, PING). Feeds the
+    /// host-silence watch (`LINK_TIMEOUT_MS`).
     fn heartbeat(&mut self) {}
     /// Start the motor identification routine.
     fn commission(&mut self) -> Result<(), Reason> {
@@ -85,10 +91,76 @@ pub struct Device {
     frames_scheduled: u32,
     schedule_start_ms: Option<u32>,
     encode_failures: u32,
-    /// The last command that changed something, its id and its answer: a resend with the same
-    /// id and the same command (the PC lost the answer) gets the same answer again, not carried
-    /// out twice.
-    last: Option<(u16, Command, Frame)>,
+    /// The last [`RECENT_COMMANDS`] commands that change something, with their answers: a copy
+    /// of one of them (a resend after a lost answer, or a late duplicate) is answered from here
+    /// and never carried out again. A ring: `next_recent` is the slot the next one overwrites.
+    recent: [Option<Recent>; RECENT_COMMANDS],
+    next_recent: usize,
+    /// The device time of the latest [`Device::poll_telemetry`] call, ms: the clock that ages
+    /// the remembered commands.
+    now_ms: u32,
+}
+
+/// How many recent commands (those that change something) the rig remembers with their
+/// answers. The PC resends every 200 ms for at most 60 s, so in practice its copies find their
+/// original here even when other tools send commands in between.
+pub const RECENT_COMMANDS: usize = 16;
+
+/// How long a remembered command answers its copies, ms of device time. A copy older than this
+/// is taken for a new request: the PC's ids repeat (16 bits), and a new command that happens to
+/// reuse an old id with the same words must still be carried out. `bowl` resends for at most
+/// 60 s (`--timeout-ms` is capped there) and numbers its requests so that no id repeats within
+/// this horizon.
+pub const RESEND_HORIZON_MS: u32 = 60_000;
+
+/// One remembered command: what it was and what the rig answered (the answers of commands that
+/// change something: ack, reject or RTIME's choice; kept small, 16 of them live on the MCU).
+#[derive(Clone, Copy)]
+struct Recent {
+    id: u16,
+    command: Command,
+    outcome: Outcome,
+    at_ms: u32,
+}
+
+#[derive(Clone, Copy)]
+enum Outcome {
+    Ack,
+    Reject(Reason),
+    ResidenceSet(ResidenceChoice),
+}
+
+impl Outcome {
+    fn of(answer: &Frame) -> Option<Outcome> {
+        match *answer {
+            Frame::Ack { .. } => Some(Outcome::Ack),
+            Frame::Reject { reason, .. } => Some(Outcome::Reject(reason)),
+            Frame::ResidenceSet {
+                model,
+                precession_mrad_s,
+                spin_mrad_s,
+                ..
+            } => Some(Outcome::ResidenceSet(ResidenceChoice {
+                model,
+                precession_mrad_s,
+                spin_mrad_s,
+            })),
+            _ => None,
+        }
+    }
+
+    fn answer(self, id: u16) -> Frame {
+        match self {
+            Outcome::Ack => Frame::Ack { id },
+            Outcome::Reject(reason) => Frame::Reject { id, reason },
+            Outcome::ResidenceSet(c) => Frame::ResidenceSet {
+                id,
+                model: c.model,
+                precession_mrad_s: c.precession_mrad_s,
+                spin_mrad_s: c.spin_mrad_s,
+            },
+        }
+    }
 }
 
 /// The default telemetry rate, frames per second.
@@ -110,7 +182,9 @@ impl Device {
             frames_scheduled: 0,
             schedule_start_ms: None,
             encode_failures: 0,
-            last: None,
+            recent: [None; RECENT_COMMANDS],
+            next_recent: 0,
+            now_ms: 0,
         }
     }
 
@@ -149,8 +223,14 @@ impl Device {
         let mut out = [0u8; MAX_FRAME_LEN];
         for &b in bytes {
             let answer = match self.decoder.push_command(b) {
-                Some(Ok(Frame::Command { id, command })) => self.answer(backend, id, command),
-                Some(Err(FrameError::BadCommand { id, reason })) => Frame::Reject { id, reason },
+                Some(Ok(Frame::Command { id, command })) => {
+                    backend.heartbeat();
+                    self.answer(backend, id, command)
+                }
+                Some(Err(FrameError::BadCommand { id, reason })) => {
+                    backend.heartbeat();
+                    Frame::Reject { id, reason }
+                }
                 // Not a command, or damaged beyond reading an id: the PC times out and retries.
                 _ => continue,
             };
@@ -172,25 +252,51 @@ impl Device {
         }
     }
 
-    /// The answer to a command from the PC: carried out once per request id. A command that
-    /// repeats the previous one's id and words is a resend after a lost answer, and gets the
-    /// same answer again without running twice. Queries (STATUS, PARAMS, MODELS, PING) change
-    /// nothing and are always answered afresh.
+    /// The answer to a command from the PC: carried out once per request id. A command with the
+    /// id and the words of one of the last [`RECENT_COMMANDS`] (sent within
+    /// [`RESEND_HORIZON_MS`]) is a copy of it: a resend after a lost answer, or a late duplicate
+    /// that arrives after newer commands. It gets the original answer again and is never carried
+    /// out a second time, so a late copy cannot undo what came after it. Queries (STATUS,
+    /// PARAMS, MODELS, PING) change nothing and are always answered afresh.
     pub fn answer<B: Backend>(&mut self, backend: &mut B, id: u16, command: Command) -> Frame {
         let query = matches!(
             command,
             Command::GetStatus | Command::GetParams | Command::GetModels | Command::Ping
         );
-        if let Some((last_id, last_command, answer)) = self.last
-            && !query
-            && last_id == id
-            && last_command == command
-        {
-            return answer;
+        if query {
+            return self.execute(backend, id, command);
+        }
+        let now = self.now_ms;
+        let copy_of = self.recent.iter().flatten().find(|r| {
+            r.id == id && r.command == command && now.wrapping_sub(r.at_ms) <= RESEND_HORIZON_MS
+        });
+        if let Some(original) = copy_of {
+            return original.outcome.answer(id);
         }
         let answer = self.execute(backend, id, command);
-        if !query {
-            self.last = Some((id, command, answer));
+        if let Some(outcome) = Outcome::of(&answer) {
+            // The same id with other words is a new request that reused an id: it replaces the
+            // old entry, so one id never stands for two answers.
+            let slot = match self
+                .recent
+                .iter()
+                .position(|r| r.is_some_and(|r| r.id == id))
+            {
+                Some(i) => i,
+                None => {
+                    let i = self.next_recent;
+                    self.next_recent = (i + 1) % RECENT_COMMANDS;
+                    i
+                }
+            };
+            if let Some(entry) = self.recent.get_mut(slot) {
+                *entry = Some(Recent {
+                    id,
+                    command,
+                    outcome,
+                    at_ms: now,
+                });
+            }
         }
         answer
     }
@@ -249,6 +355,7 @@ impl Device {
                         reset_count: reset.reset_count,
                         uptime_ms: t.time_ms,
                         telemetry_hz: self.telemetry_hz,
+                        flags: backend.status_flags(),
                     },
                 };
             }
@@ -259,10 +366,8 @@ impl Device {
                 };
             }
             Command::Inject(what) => backend.inject(what),
-            Command::Ping => {
-                backend.heartbeat();
-                Ok(())
-            }
+            // The host was heard when the command arrived (`receive`).
+            Command::Ping => Ok(()),
             Command::Commission => backend.commission(),
             Command::Release => backend.release(),
             Command::GetModels => match backend.models() {
@@ -293,20 +398,27 @@ impl Device {
         match u8::try_from(hz) {
             Ok(hz) if i32::from(hz) <= max => {
                 self.telemetry_hz = hz;
+                // A new schedule: its clock and its frame count start again together (the old
+                // count against a fresh clock would hold telemetry back for as long as the rig
+                // had been sending).
                 self.schedule_start_ms = None;
+                self.frames_scheduled = 0;
                 Ok(())
             }
             _ => Err(Reason::Range),
         }
     }
 
-    /// Builds the telemetry frame if one is due at `now_ms` (call at least once per period).
+    /// Builds the telemetry frame if one is due at `now_ms`. Call it at least once per period,
+    /// and also while telemetry is off: `now_ms` is the device's clock for the window of recent
+    /// commands too.
     pub fn poll_telemetry<B: Backend>(
         &mut self,
         backend: &B,
         now_ms: u32,
         out: &mut [u8; MAX_FRAME_LEN],
     ) -> Option<usize> {
+        self.now_ms = now_ms;
         if self.telemetry_hz == 0 {
             return None;
         }

@@ -5,7 +5,7 @@ use super::{
     AxisModel, Command, DUTY_MAX_BP, Frame, MODEL_FIELD_MAX, MotorTelemetry, PARAM_COUNT, ParamId,
     RESIDENCE_MAX_MS, Residence, Telemetry,
 };
-use super::{FRAME_END, FRAME_START, MAX_FRAME_LEN, PROTOCOL_VERSION};
+use super::{FRAME_END, FRAME_START, LINE_END_CR, MAX_FRAME_LEN, PROTOCOL_VERSION};
 
 /// Why a frame could not be encoded. Nothing was written that could be mistaken for a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -178,6 +178,7 @@ fn body(out: &mut Out<'_>, frame: &Frame) {
             out.int(status.reset_count.into());
             out.int(status.uptime_ms.into());
             out.int(status.telemetry_hz.into());
+            out.int(status.flags.into());
         }
         Frame::Params { id, values } => {
             out.int((*id).into());
@@ -260,7 +261,7 @@ pub fn kind_letter(frame: &Frame) -> u8 {
 /// Writes `frame` as one line into `buf` and returns its length in bytes.
 ///
 /// The line is `$`, the kind letter, the protocol version, the fields (each after a `,`),
-/// `*`, the CRC-32 of everything between `$` and `*` as 8 upper-case hex digits, and `\n`.
+/// `*`, the CRC-32 of everything between `$` and `*` as 8 upper-case hex digits, and `\r\n`.
 pub fn encode(frame: &Frame, buf: &mut [u8]) -> Result<usize, EncodeError> {
     if !fields_in_range(frame) {
         return Err(EncodeError::FieldOutOfRange);
@@ -279,6 +280,7 @@ pub fn encode(frame: &Frame, buf: &mut [u8]) -> Result<usize, EncodeError> {
     for shift in (0..8).rev() {
         out.byte(hex_upper(crc >> (shift * 4)));
     }
+    out.byte(LINE_END_CR);
     out.byte(FRAME_END);
     if out.overflow || out.len > MAX_FRAME_LEN {
         return Err(EncodeError::BufferTooSmall);

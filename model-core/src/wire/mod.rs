@@ -2,10 +2,10 @@
 //! firmware and the host tools. The specification with worked examples is `docs/protocol.md`.
 //!
 //! A frame is `$`, a kind letter, the protocol version digit, comma-separated fields, `*`, the
-//! CRC-32 of the bytes between `$` and `*` in 8 upper-case hex digits, and `\n`:
+//! CRC-32 of the bytes between `$` and `*` in 8 upper-case hex digits, and `\r\n`:
 //!
 //! ```text
-//! $T1,123456,6172,2,0,1800,1796,4521,315,2100,2101,5230,367,3381,2345,2410*9B4507F3\n
+//! $T1,123456,6172,2,0,1800,1796,4521,315,2100,2101,5230,367,3381,2345,2410*9B4507F3\r\n
 //! ```
 //!
 //! Numbers are scaled integers (no float formatting on the MCU). The longest telemetry frame is
@@ -36,15 +36,21 @@ pub const PROTOCOL_VERSION: u8 = 1;
 /// The first byte of every frame.
 pub const FRAME_START: u8 = b'$';
 
-/// The last byte of every frame.
+/// The last byte of every frame. Frames are sent with `\r` before it (`\r\n`, so every
+/// serial console shows one line per frame); a line may also end at a lone `\r` (Enter typed
+/// in a console) or a lone `\n`.
 pub const FRAME_END: u8 = b'\n';
+
+/// The carriage return that comes before [`FRAME_END`] in every frame sent, and ends a line on
+/// its own too.
+pub const LINE_END_CR: u8 = b'\r';
 
 /// The longest frame, `$` to `\n` included (a PARAMS answer is the longest kind). The decoder
 /// drops longer lines as oversize.
 pub const MAX_FRAME_LEN: usize = 256;
 
-/// The longest telemetry frame: every field at its widest.
-pub const MAX_TELEMETRY_LEN: usize = 110;
+/// The longest telemetry frame: every field at its widest, `\r\n` included.
+pub const MAX_TELEMETRY_LEN: usize = 111;
 
 /// The default link: 115 200 baud, 8N1 (10 bits a byte).
 pub const DEFAULT_BAUD: u32 = 115_200;

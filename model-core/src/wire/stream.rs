@@ -2,7 +2,7 @@
 //! each line to [`super::decode`] and keeps the statistics (frames good, corrupt, missing).
 
 use super::decode::{FrameError, parse_command_line, parse_line};
-use super::{FRAME_END, FRAME_START, Frame, MAX_FRAME_LEN};
+use super::{FRAME_END, FRAME_START, Frame, LINE_END_CR, MAX_FRAME_LEN};
 
 /// Counters of a [`Decoder`]. Every byte fed is either in a good frame or in `bytes_skipped`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -50,6 +50,10 @@ pub const REORDER_FRAMES: u16 = 16;
 ///
 /// Resynchronisation: a frame starts at every `$`. A `$` inside a frame drops the partial frame
 /// and starts a new one, so a damaged end-of-line costs only its own frame, never the next.
+///
+/// Line ends: `\r`, `\n` or `\r\n` end a line (the rig sends `\r\n` so any serial console shows
+/// one line per frame; a console sends `\r` on Enter). The `\n` of a `\r\n` belongs to the line
+/// it ends: it is neither a second line end nor noise.
 #[derive(Clone)]
 pub struct Decoder {
     buf: [u8; MAX_FRAME_LEN],
@@ -62,6 +66,9 @@ pub struct Decoder {
     period_ms: u32,
     /// Corrupt candidates since the newest accepted telemetry frame.
     corrupt_in_gap: u64,
+    /// The last line ended at a `\r` (and was accepted: `Some(true)`): a `\n` right after it
+    /// completes that line end.
+    cr_ended: Option<bool>,
 }
 
 impl Default for Decoder {
@@ -94,6 +101,7 @@ impl Decoder {
             last: None,
             period_ms: 0,
             corrupt_in_gap: 0,
+            cr_ended: None,
         }
     }
 
@@ -119,6 +127,16 @@ impl Decoder {
         byte: u8,
         parse: impl FnOnce(&[u8]) -> Result<Frame, FrameError>,
     ) -> Option<Result<Frame, FrameError>> {
+        if let Some(accepted) = self.cr_ended.take()
+            && byte == FRAME_END
+        {
+            // The `\n` of a `\r\n`: a byte of the line it ends (skipped if that line was).
+            self.stats.bytes += 1;
+            if !accepted {
+                self.stats.bytes_skipped += 1;
+            }
+            return None;
+        }
         self.stats.bytes += 1;
         if !self.in_frame {
             if byte == FRAME_START {
@@ -130,10 +148,14 @@ impl Decoder {
             return None;
         }
         match byte {
-            FRAME_END => {
+            FRAME_END | LINE_END_CR => {
                 self.in_frame = false;
                 let result = parse(self.buf.get(..self.len).unwrap_or(&[]));
-                Some(self.account(result))
+                let result = self.account(result);
+                if byte == LINE_END_CR {
+                    self.cr_ended = Some(result.is_ok());
+                }
+                Some(result)
             }
             FRAME_START => {
                 // Drop the partial frame (its `$` and body), start again at this `$`.
@@ -142,7 +164,7 @@ impl Decoder {
                 self.len = 0;
                 Some(Err(FrameError::Truncated))
             }
-            b'\r' | 0x20..=0x7E => {
+            0x20..=0x7E => {
                 if let Some(slot) = self.buf.get_mut(self.len) {
                     *slot = byte;
                     self.len += 1;
@@ -181,7 +203,9 @@ impl Decoder {
         mut on_frame: impl FnMut(Result<Frame, FrameError>, &DecodeStats),
     ) {
         while !bytes.is_empty() {
-            if !self.in_frame {
+            if self.cr_ended.is_some() {
+                // The byte after a `\r` line end: only the byte-wise path knows a `\n` there.
+            } else if !self.in_frame {
                 // Line noise: skip to the next `$`.
                 let noise = bytes
                     .iter()

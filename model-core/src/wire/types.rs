@@ -187,6 +187,19 @@ pub struct Status {
     pub uptime_ms: u32,
     /// Telemetry rate, frames per second (0 = off).
     pub telemetry_hz: u8,
+    /// Board conditions the PC should know about, one bit each ([`status_flags`]); 0 = none.
+    pub flags: u8,
+}
+
+/// The bits of [`Status::flags`] (a rig without such conditions, e.g. the virtual one, sends 0).
+pub mod status_flags {
+    /// This boot started from the default parameters and motor models: the parameter flash
+    /// held no valid record (empty, corrupt, another layout) or its values were refused.
+    pub const PARAMS_DEFAULTS: u8 = 1 << 0;
+    /// The last parameter save failed (flash keeps the record before it).
+    pub const PARAMS_SAVE_FAILED: u8 = 1 << 1;
+    /// The board runs on its internal RC oscillator: the crystal did not start.
+    pub const CLOCK_FALLBACK: u8 = 1 << 2;
 }
 
 /// A fault the simulated or emulated rig can be told to produce (real hardware rejects it with

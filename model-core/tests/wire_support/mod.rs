@@ -136,9 +136,10 @@ pub fn frame() -> impl Strategy<Value = Frame> {
             reset_cause(),
             any::<u16>(),
             any::<u32>(),
-            0u8..=50
+            0u8..=50,
+            any::<u8>()
         )
-            .prop_map(|(id, state, fault, reset_cause, reset_count, uptime_ms, hz)| {
+            .prop_map(|(id, state, fault, reset_cause, reset_count, uptime_ms, hz, flags)| {
                 Frame::Status {
                     id,
                     status: Status {
@@ -148,6 +149,7 @@ pub fn frame() -> impl Strategy<Value = Frame> {
                         reset_count,
                         uptime_ms,
                         telemetry_hz: hz,
+                        flags,
                     },
                 }
             }),

@@ -39,7 +39,7 @@ pub static BENCHES: &[Bench] = &[Bench {
     name: "control::tick_both_axes_f32",
     inputs: 12_000,
     run: bench_tick,
-    budget_instructions: Some(1200),
+    budget_instructions: Some(4000),
 }];
 
 fn fail(what: &'static str) -> Failure {

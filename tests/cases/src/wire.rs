@@ -41,9 +41,9 @@ pub static BENCHES: &[Bench] = &[
     },
 ];
 
-/// The first telemetry example of docs/protocol.md.
+/// The first telemetry example of docs/protocol.md, with the `\r\n` every frame ends with.
 const EXAMPLE: &[u8] =
-    b"$T1,123456,6172,3,0,1800,1796,4521,315,2100,2101,5230,367,3381,2345,2410*86D01424\n";
+    b"$T1,123456,6172,3,0,1800,1796,4521,315,2100,2101,5230,367,3381,2345,2410*86D01424\r\n";
 
 /// What the doc says the example means: "123.456 s after reset, frame 6172, running, no fault;
 /// precession set 1.800 rad/s, measured 1.796, duty 45.21 %, 315 pulses; spin set 2.100, measured
@@ -98,8 +98,8 @@ fn doc_example() -> Result<(), Failure> {
 fn resync() -> Result<(), Failure> {
     let mut d = Decoder::new();
     let mut ok = 0u32;
-    // Noise, the example with its `\n` lost, then the example intact.
-    let first = EXAMPLE.get(..EXAMPLE.len() - 1).unwrap_or(&[]);
+    // Noise, the example with its `\r\n` lost, then the example intact.
+    let first = EXAMPLE.get(..EXAMPLE.len() - 2).unwrap_or(&[]);
     for part in [&b"\x00\xffnoise"[..], first, EXAMPLE] {
         d.push_slice(part, |r, _| ok += u32::from(r.is_ok()));
     }
