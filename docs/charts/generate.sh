@@ -37,6 +37,9 @@ done
 "$bowl" chart control-stability --out docs/charts/control-stability.svg
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --out docs/charts/control-family.svg
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --target-rad-s 0.5 --out docs/charts/control-family-low.svg
+# Slowing down while running (docs/control.md, "Transitions").
+"$bowl" chart family --rig-file tests/rigs/family-60.toml --from-rad-s 3 --target-rad-s 1 --out docs/charts/control-family-down.svg
+"$bowl" chart family --rig-file tests/rigs/family-60.toml --from-rad-s 3 --target-rad-s 0.5 --out docs/charts/control-family-down-low.svg
 # The rolling model of the tilted, precessing bowl (docs/model.md section 9).
 mkdir -p docs/charts/rolling
 "$bowl" chart rolling-residence --out docs/charts/rolling/residence-60.svg
@@ -46,3 +49,8 @@ mkdir -p docs/charts/rolling
 "$bowl" chart rolling-hierarchy --mu 0.001 --out docs/charts/rolling/hierarchy-mu0.001.svg
 "$bowl" chart rolling-hierarchy --mu 0.1 --out docs/charts/rolling/hierarchy-mu0.1.svg
 "$bowl" chart rolling-work-precision --out docs/charts/rolling/work-precision.svg
+# The granule in the real bowl: sliding, the wall and its lip (docs/model.md section 10).
+mkdir -p docs/charts/bowl
+"$bowl" chart bowl-residence --out docs/charts/bowl/residence-60.svg
+"$bowl" chart bowl-residence --axes-angle-deg 30 --out docs/charts/bowl/residence-30.svg
+"$bowl" chart bowl-regimes --out docs/charts/bowl/regimes.svg

@@ -220,3 +220,56 @@ fn a_transition_from_an_impossible_speed_is_refused_in_words() {
         assert!(err.contains(want), "{from}: {err}");
     }
 }
+
+/// A spin that cannot reach 4 rad/s (tests/rigs/saturated-spin.toml) runs saturated there with
+/// no runaway fault, and slows to 2 rad/s when asked.
+#[test]
+fn a_saturated_axis_at_the_top_speed_is_no_runaway() {
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/rigs/saturated-spin.toml"
+    );
+    let v = json(&[
+        "sim",
+        "family",
+        "--rig-file",
+        file,
+        "--from-rad-s",
+        "4",
+        "--target-rad-s",
+        "2",
+        "--json",
+    ]);
+    let p = &v["plants"][0];
+    assert_eq!(p["commissioning"], "ok", "{p}");
+    assert_eq!(p["false_fault"], false, "{p}");
+    assert!(
+        p["axes"]["spin"]["settling_2pct_s"].as_f64().is_some(),
+        "{p}"
+    );
+}
+
+/// Slowing from 3 to 0.5 rad/s (12 pulses a revolution: about a pulse a second there): no fault,
+/// every axis within 5 % by 10 s, the low-speed target.
+#[test]
+fn the_small_family_slows_to_half_a_rad_s_without_fault() {
+    let v = json(&[
+        "sim",
+        "family",
+        "--rig-file",
+        SMALL,
+        "--from-rad-s",
+        "3",
+        "--target-rad-s",
+        "0.5",
+        "--json",
+    ]);
+    for p in v["plants"].as_array().unwrap() {
+        assert_eq!(p["false_fault"], false, "{p}");
+        for axis in ["precession", "spin"] {
+            let a = &p["axes"][axis];
+            let s5 = a["settling_5pct_s"].as_f64().expect("settled in 5 %");
+            assert!(s5 <= 10.0, "{} {axis}: {a}", p["name"]);
+        }
+    }
+}

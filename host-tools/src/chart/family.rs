@@ -108,7 +108,11 @@ pub fn chart(rigs: &[Rig], from: f32, target: f32, file: &str) -> (Figure, Table
         title: format!("Overshoot and settling, {from} -> {target} rad/s, every axis of {file}"),
         x_label: "overshoot of the true speed (past the target, in the step's direction), % of the target"
             .into(),
-        y_label: format!("{band} % settling (speed averaged over a revolution, at most 1 s), s"),
+        y_label: if target < 1.0 {
+            format!("{band} % settling (speed averaged over a revolution), s")
+        } else {
+            format!("{band} % settling (speed averaged over a revolution, at most 1 s), s")
+        },
         x_scale: Scale::Linear,
         y_scale: Scale::Linear,
         series,

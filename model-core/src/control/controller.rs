@@ -145,7 +145,11 @@ const fn decouple_duty_per_rad_s(cfg: &ControllerConfig) -> f32 {
 #[inline(never)]
 fn near_top_runaway(a: &AxisState, model_rad_s: f32, steady_s: f32) -> bool {
     // `model_rad_s` > 0 here: the feedforward of the shaft's direction, made positive.
-    let duty_below_model = a.k.feedforward(model_rad_s) - a.duty * a.direction;
+    // The model's duty, but no more than the bridge can give: a shaft whose model asks for more
+    // than the duty limit (a heavy plant near the top speed) runs saturated, short of its
+    // reference, and that is no runaway (4 rad/s faulted a healthy plant of an unseen family).
+    let model_duty = a.k.feedforward(model_rad_s).min(a.k.duty_limit());
+    let duty_below_model = model_duty - a.duty * a.direction;
     (steady_s > PAIR_RUNAWAY_STEADY_S
         && a.est.pair_speed_rad_s() > PAIR_RUNAWAY_RATIO * model_rad_s + PAIR_RUNAWAY_MARGIN_RAD_S)
         || duty_below_model > DRIVEN_BELOW_MODEL_DUTY

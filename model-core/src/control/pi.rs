@@ -261,6 +261,11 @@ impl LoopConstants {
         self.pair_runaway_above_rad_s
     }
 
+    /// The largest duty the loop gives, in magnitude.
+    pub fn duty_limit(&self) -> f32 {
+        self.duty_limit
+    }
+
     /// Steady-state duty of the model at `r` rad/s (signed).
     #[inline]
     pub fn feedforward(&self, r: f32) -> f32 {
