@@ -7,6 +7,7 @@ use anyhow::{Result, anyhow};
 use model_core::particle::{self, Model, Outcome, Scene};
 
 mod batch;
+mod bowl;
 mod choice;
 mod ode;
 mod rolling;
@@ -14,6 +15,7 @@ mod spin_up;
 mod target;
 mod throughput;
 mod trace;
+mod validity;
 mod words;
 
 pub use rolling::words as rolling_words;
@@ -34,6 +36,10 @@ pub enum ModelChoice {
     /// The granule rolling on the tilted, precessing bowl (docs/model.md §9): needs
     /// --precession-rad-s, --spin-rad-s and --axes-angle-deg.
     Rolling,
+    /// The granule rolling or sliding in the real bowl, wall and lip included (docs/model.md
+    /// §10): the rolling model's flags and --sliding-mu, --wall-angle-deg, --wall-height-m,
+    /// --fillet-radius-m, --restitution, --max-time-s.
+    Bowl,
 }
 
 /// How to compute the residence time.
@@ -134,6 +140,9 @@ pub struct Args {
     /// The rolling model's own flags.
     #[command(flatten)]
     rolling: rolling::RollingArgs,
+    /// The bowl model's own flags.
+    #[command(flatten)]
+    bowl: bowl::BowlArgs,
 }
 
 /// One computed result, whatever the method.
@@ -203,6 +212,9 @@ pub fn run(args: &Args) -> Result<()> {
     if args.model == ModelChoice::Rolling {
         return rolling::run(args, &args.rolling);
     }
+    if args.model == ModelChoice::Bowl {
+        return bowl::run(args, &args.rolling, &args.bowl);
+    }
     if let (Some(input), Some(output)) = (&args.batch, &args.out) {
         return batch::run(input, output, args);
     }
@@ -230,10 +242,19 @@ pub fn run(args: &Args) -> Result<()> {
             choice::states_omega(args.uncertainty.as_deref())?,
             args.target,
             args.json,
+            args.rolling.sliding_mu(),
         );
     }
     if let (Some(start), Some(tau)) = (args.spin_up_from_rad_s, args.time_constant_s) {
-        return spin_up::run(&scene, start, tau, &need, args.target, args.json);
+        return spin_up::run(
+            &scene,
+            start,
+            tau,
+            &need,
+            args.target,
+            args.json,
+            args.rolling.sliding_mu(),
+        );
     }
     words::check(&scene)?;
     const BOTH: &[Model] = &[Model::Flat, Model::Coriolis];
@@ -256,6 +277,7 @@ pub fn run(args: &Args) -> Result<()> {
             Err(e) => anyhow::bail!(choice::error_words(e)),
         },
         ModelChoice::Rolling => return rolling::run(args, &args.rolling),
+        ModelChoice::Bowl => return bowl::run(args, &args.rolling, &args.bowl),
     };
     if let Some(target) = args.target_time_s {
         return run_inverse(&scene, models, target, args.json);
@@ -268,10 +290,20 @@ pub fn run(args: &Args) -> Result<()> {
         }
         rows.push((model, p));
     }
+    let sliding_mu = args.rolling.sliding_mu();
+    let validity: Vec<_> = rows
+        .iter()
+        .map(|(_, p)| validity::paper(&scene, &p.outcome, sliding_mu))
+        .collect();
     if args.json {
         let results: Vec<_> = rows
             .iter()
-            .map(|(m, p)| json_result(*m, args.method, p))
+            .zip(&validity)
+            .map(|((m, p), v)| {
+                let mut r = json_result(*m, args.method, p);
+                v.add_to(&mut r);
+                r
+            })
             .collect();
         let mut v = serde_json::json!({ "scene": json_scene(&scene), "results": results });
         if let (Some(c), Some(obj)) = (&chosen, v.as_object_mut()) {
@@ -279,6 +311,11 @@ pub fn run(args: &Args) -> Result<()> {
         }
         println!("{v}");
     } else {
+        for ((m, _), v) in rows.iter().zip(&validity) {
+            if let Some(line) = v.text_line() {
+                println!("{} model {line}", model_name(*m));
+            }
+        }
         println!("{}", describe_scene(&scene));
         if let Some(c) = &chosen {
             println!(

@@ -14,6 +14,9 @@ use serde::Deserialize;
 use std::path::Path;
 use toml::Spanned;
 
+mod bowl;
+pub use bowl::BowlGeometry;
+
 /// One rig from a file: its name, the plant and the seed of its tooth offsets and jitter.
 #[derive(Debug, Clone)]
 pub struct Rig {
@@ -26,6 +29,8 @@ pub struct Rig {
     /// The `[particle]` table: the hidden truth of the simulated granules (`bowl experiment`),
     /// if the file has one.
     pub particle: Option<ParticleParams>,
+    /// The `[bowl]` table: the bowl's shape and tilt (`bowl predict --model bowl`), if any.
+    pub bowl: Option<BowlGeometry>,
 }
 
 type Num = Option<Spanned<f64>>;
@@ -72,6 +77,7 @@ struct RigToml {
     precession: Option<AxisToml>,
     spin: Option<AxisToml>,
     particle: Option<ParticleToml>,
+    bowl: Option<bowl::BowlToml>,
 }
 
 #[derive(Deserialize)]
@@ -130,6 +136,7 @@ pub fn parse(text: &str, file: &str, default_name: &str) -> Result<Vec<Rig>> {
             params: check.rig(t)?,
             seed: check.get(&t.seed, "seed", 0.0, u32::MAX as f64, 1.0)? as u32,
             particle: t.particle.as_ref().map(|p| check.particle(p)).transpose()?,
+            bowl: t.bowl.as_ref().map(|b| check.bowl(b)).transpose()?,
             name,
         });
     }

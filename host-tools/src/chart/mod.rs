@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Subcommand;
 
+pub mod bowl;
 pub mod chooser;
 pub mod control;
 pub mod costs;
@@ -59,6 +60,10 @@ enum Which {
     Family(FamilyArgs),
     /// Rolling model: residence time against bowl speed beside the paper's (cf. paper Fig. 7).
     RollingResidence(RollingResidenceArgs),
+    /// Bowl model: residence time against bowl speed for each bowl shape (docs/model.md §10).
+    BowlResidence(RollingResidenceArgs),
+    /// Bowl model: sliding and leaving against the tilt at 2 rad/s (the regime map).
+    BowlRegimes(Out),
     /// Rolling model: the twelve releases' paths on the bowl bottom.
     RollingPaths(Out),
     /// Rolling model: each simpler member's difference from the full model (the hierarchy map).
@@ -420,6 +425,14 @@ pub fn run(args: &Args) -> Result<()> {
         Which::RollingResidence(a) => {
             let (f, t) = rolling::residence(a.axes_angle_deg)?;
             write_all(&a.out, &f, &t)
+        }
+        Which::BowlResidence(a) => {
+            let (f, t) = bowl::residence(a.axes_angle_deg)?;
+            write_all(&a.out, &f, &t)
+        }
+        Which::BowlRegimes(out) => {
+            let (f, t) = bowl::regimes(2.0)?;
+            write_all(out, &f, &t)
         }
         Which::RollingPaths(out) => {
             let (f, t) = rolling::trajectories()?;

@@ -10,17 +10,18 @@ use model_core::particle::rolling::{
 };
 use serde_json::json;
 
-use super::{Args, MethodChoice};
+use super::{Args, MethodChoice, validity};
 
 /// Flags of the rolling model (the shared ones: `--mu` is its rolling resistance, `--ri-m`,
 /// `--rim-radius-m`, `--g`, `--k2`, `--method`, `--tol`, `--step-s`, `--json`).
 #[derive(clap::Args, Debug, Clone)]
 pub struct RollingArgs {
     /// Rolling model: precession speed w1 of the bowl's axis about the vertical, rad/s.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     precession_rad_s: Option<f64>,
-    /// Rolling model: spin speed w2 of the bowl about its own axis, rad/s.
-    #[arg(long)]
+    /// Rolling model: spin speed w2 of the bowl about its own axis, rad/s (negative: the
+    /// other way, e.g. --spin-rad-s -2.7).
+    #[arg(long, allow_negative_numbers = true)]
     spin_rad_s: Option<f64>,
     /// Rolling model: angle between the bowl's axis and the vertical, degrees (paper Eq. 2).
     #[arg(long)]
@@ -51,6 +52,51 @@ pub struct RollingArgs {
     /// the mean over the releases.
     #[arg(long)]
     each_release: bool,
+}
+
+impl RollingArgs {
+    /// The contact's sliding coefficient (every model judges its rolling against it).
+    pub fn sliding_mu(&self) -> f64 {
+        self.sliding_mu
+    }
+
+    /// `--release-azimuth-deg` as given.
+    pub fn release_azimuth_deg(&self) -> &str {
+        &self.release_azimuth_deg
+    }
+
+    /// The tilted bowl's scene from the flags (the rolling and the bowl model share it), and
+    /// the tilt in degrees; `model` names the model in the words of a missing flag.
+    pub fn scene(
+        &self,
+        args: &Args,
+        model: &str,
+        default_tilt_deg: Option<f64>,
+    ) -> Result<(RollingScene<f64>, f64)> {
+        let tilt = self.axes_angle_deg.or(default_tilt_deg);
+        let (Some(w1), Some(w2), Some(th_deg)) = (self.precession_rad_s, self.spin_rad_s, tilt)
+        else {
+            bail!(
+                "the {model} model needs --precession-rad-s, --spin-rad-s and --axes-angle-deg \
+                 (the two motor speeds and the tilt of the bowl's axis)"
+            );
+        };
+        let scene = RollingScene {
+            precession_rad_s: w1,
+            spin_rad_s: w2,
+            axes_angle_rad: th_deg.to_radians(),
+            rolling_resistance: args.mu,
+            sliding_friction: self.sliding_mu,
+            g_m_s2: args.g,
+            k2: args.k2,
+            particle_radius_m: self.particle_radius_m,
+            rod_length_m: self.rod_length_m,
+            ri_m: args.ri_m,
+            rim_radius_m: args.rim_radius_m,
+        };
+        scene.validate().map_err(|e| anyhow::anyhow!(words(e)))?;
+        Ok((scene, th_deg))
+    }
 }
 
 pub fn words(e: RollingError) -> String {
@@ -218,17 +264,28 @@ pub fn run(args: &Args, r: &RollingArgs) -> Result<()> {
     if r.release_azimuth_deg.trim() == "all" {
         let sum = rolling::residence_over_azimuths(&scene, method)
             .map_err(|e| anyhow::anyhow!(words(e)))?;
+        let validity = validity::rolling(
+            sum.slid,
+            sum.lifted,
+            AZIMUTHS_DEG.len() as u32,
+            sum.max_friction_ratio,
+            r.sliding_mu,
+        );
         if args.json {
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&json!({
-                    "model": "rolling", "release_azimuths_deg": AZIMUTHS_DEG,
-                    "residence_time_mean_s": sum.mean_s, "residence_time_min_s": sum.min_s,
-                    "residence_time_max_s": sum.max_s, "releases_leaving": sum.left,
-                    "releases_sliding": sum.slid, "rhs_evaluations": sum.evaluations,
-                }))?
-            );
+            let mut v = json!({
+                "model": "rolling", "release_azimuths_deg": AZIMUTHS_DEG,
+                "residence_time_mean_s": sum.mean_s, "residence_time_min_s": sum.min_s,
+                "residence_time_max_s": sum.max_s, "releases_leaving": sum.left,
+                "releases_sliding": sum.slid, "releases_lifting_off": sum.lifted,
+                "max_friction_ratio": sum.max_friction_ratio,
+                "rhs_evaluations": sum.evaluations,
+            });
+            validity.add_to(&mut v);
+            println!("{}", serde_json::to_string_pretty(&v)?);
         } else {
+            if let Some(line) = validity.text_line() {
+                println!("{line}");
+            }
             println!("{head}");
             match (sum.mean_s, sum.min_s, sum.max_s) {
                 (Some(m), Some(lo), Some(hi)) => println!(
@@ -249,13 +306,32 @@ pub fn run(args: &Args, r: &RollingArgs) -> Result<()> {
     })?;
     let report = rolling::residence(&scene, beta_deg.to_radians(), method)
         .map_err(|e| anyhow::anyhow!(words(e)))?;
+    let validity = match report.outcome {
+        RollingOutcome::Leaves {
+            max_friction_ratio,
+            first_slip_s,
+            ..
+        } => validity::rolling(
+            u32::from(first_slip_s.is_some()),
+            0,
+            1,
+            max_friction_ratio,
+            r.sliding_mu,
+        ),
+        RollingOutcome::LiftsOff { .. } => validity::rolling(0, 1, 1, 0.0, r.sliding_mu),
+        _ => validity::Validity::valid(),
+    };
     if args.json {
         let mut v = outcome_json(&report.outcome);
+        validity.add_to(&mut v);
         v["model"] = json!("rolling");
         v["release_azimuth_deg"] = json!(beta_deg);
         v["rhs_evaluations"] = json!(report.evaluations);
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
+        if let Some(line) = validity.text_line() {
+            println!("{line}");
+        }
         println!("{head}");
         println!(
             "release at {beta_deg} deg: {}",

@@ -19,6 +19,7 @@ pub fn run(
     need: &model_core::choose::Need<f64>,
     runs_on: RunsOn,
     json: bool,
+    sliding_mu: f64,
 ) -> Result<()> {
     if !(start_rad_s.is_finite() && start_rad_s >= 0.0) {
         bail!("--spin-up-from-rad-s {start_rad_s}: the start speed must be zero or positive");
@@ -53,19 +54,23 @@ pub fn run(
         ),
         Plan::Integrate(method) => super::ode::plan_time_s(scene, choice.model, &speed, method)?,
     };
+    let top = start_rad_s.max(scene.omega_rad_s);
+    let validity = super::validity::paper_up_to(scene, choice.model, top, sliding_mu);
     if json {
-        println!(
-            "{}",
-            serde_json::json!({
-                "spin_up": {
-                    "start_rad_s": start_rad_s, "final_rad_s": scene.omega_rad_s,
-                    "time_constant_s": time_constant_s,
-                },
-                "choice": super::choice::json(&choice, runs_on),
-                "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
-            })
-        );
+        let mut v = serde_json::json!({
+            "spin_up": {
+                "start_rad_s": start_rad_s, "final_rad_s": scene.omega_rad_s,
+                "time_constant_s": time_constant_s,
+            },
+            "choice": super::choice::json(&choice, runs_on),
+            "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
+        });
+        validity.add_to(&mut v);
+        println!("{v}");
     } else {
+        if let Some(line) = validity.text_line() {
+            println!("{line}");
+        }
         println!(
             "spin-up: from {start_rad_s} to {} rad/s with time constant {time_constant_s} s, \
              the particle released at t = 0; mu {}, ri {} m, R {} m",

@@ -76,7 +76,9 @@ pub fn read(path: &Path, release_ms: Option<f64>) -> Result<Trace> {
 }
 
 /// Runs `bowl predict --omega-trace`: the chooser picks the model and the method for the
-/// trace, and the chosen plan computes the residence time.
+/// trace, and the chosen plan computes the residence time; `sliding_mu` judges whether the
+/// paper's rolling holds up to the trace's top speed.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     scene: &model_core::particle::Scene<f64>,
     path: &Path,
@@ -85,6 +87,7 @@ pub fn run(
     omega_stated: bool,
     runs_on: super::target::RunsOn,
     json: bool,
+    sliding_mu: f64,
 ) -> Result<()> {
     use model_core::choose::{LOGGED_SPEED_RESOLUTION_RAD_S, Need, Plan, SampledOmega, TraceError};
     use model_core::particle;
@@ -178,29 +181,32 @@ pub fn run(
     } else {
         f64::INFINITY
     };
+    let validity = super::validity::paper_up_to(scene, choice.model, hi, sliding_mu);
     if json {
-        println!(
-            "{}",
-            serde_json::json!({
-                "trace": {
-                    "file": path.display().to_string(), "samples": trace.times_s.len(),
-                    "release_device_ms": trace.release_ms, "covers_s": covered_s,
-                    "omega_min_rad_s": lo, "omega_max_rad_s": hi,
-                    "measurement": {
-                        "rounding_rad_s": measured.rounding_rad_s,
-                        "scatter_rad_s": measured.scatter_rad_s,
-                        "mean_rad_s": measured.mean_rad_s,
-                        "relative": measured.relative,
-                        "used_as_omega_uncertainty": measured_is_used,
-                        "judged_over_s": window_s.min(covered_s),
-                    },
+        let mut v = serde_json::json!({
+            "trace": {
+                "file": path.display().to_string(), "samples": trace.times_s.len(),
+                "release_device_ms": trace.release_ms, "covers_s": covered_s,
+                "omega_min_rad_s": lo, "omega_max_rad_s": hi,
+                "measurement": {
+                    "rounding_rad_s": measured.rounding_rad_s,
+                    "scatter_rad_s": measured.scatter_rad_s,
+                    "mean_rad_s": measured.mean_rad_s,
+                    "relative": measured.relative,
+                    "used_as_omega_uncertainty": measured_is_used,
+                    "judged_over_s": window_s.min(covered_s),
                 },
-                "choice": super::choice::json(&choice, runs_on),
-                "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
-                "residence_time_from_choosing": answered.is_some(),
-            })
-        );
+            },
+            "choice": super::choice::json(&choice, runs_on),
+            "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
+            "residence_time_from_choosing": answered.is_some(),
+        });
+        validity.add_to(&mut v);
+        println!("{v}");
     } else {
+        if let Some(line) = validity.text_line() {
+            println!("{line}");
+        }
         println!(
             "trace: {}, {} samples from device time {} ms over {covered_s:.3} s, bowl speed \
              {lo:.3} to {hi:.3} rad/s (held at the last sample after that)",

@@ -93,7 +93,7 @@ fn finite<T: Real, const N: usize>(y: &[T; N]) -> bool {
 /// state there.
 fn event_in_step<T: Real, const N: usize>(
     component: impl Fn(usize, T) -> (T, T),
-    event: EventFn<T, N>,
+    event: &impl Fn(T, &[T; N], T, &[T; N]) -> (T, T),
     t: T,
     h: T,
 ) -> (T, [T; N]) {
@@ -108,7 +108,7 @@ fn event_in_step<T: Real, const N: usize>(
     let theta = locate(
         |th| {
             let (v, d) = at(th);
-            event(&v, &d)
+            event(t + th * h, &v, h, &d)
         },
         T::ZERO,
     );
@@ -120,13 +120,70 @@ fn event_in_step<T: Real, const N: usize>(
 /// typical size times `rtol` where it may pass through zero); `h0` the first step.
 #[allow(clippy::too_many_arguments)]
 pub fn dp54<T: Real, const N: usize, S>(
-    mut f: impl FnMut(T, &[T; N]) -> [T; N],
+    f: impl FnMut(T, &[T; N]) -> [T; N],
     t0: T,
     y0: [T; N],
     rtol: T,
     atol: [T; N],
     h0: T,
     event: EventFn<T, N>,
+    check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
+    limits: SystemLimits<T>,
+) -> Result<Run<T, N, S>, SystemError> {
+    let event = |_: T, y: &[T; N], _: T, dy: &[T; N]| event(y, dy);
+    dp54_with(f, t0, y0, rtol, atol, h0, &event, check, limits)
+}
+
+/// [`dp54`] with an event that depends on the time and on the caller's data (a mode switch of
+/// the granule: the friction it needs reaching what the contact gives, its slip reversing),
+/// given by its value alone; the crossing is located on the dense output as the rim's is, with
+/// the slope by a central difference along the interpolant (Newton is safeguarded by
+/// bisection, so an approximate slope costs iterations, not accuracy).
+#[allow(clippy::too_many_arguments)]
+pub fn dp54_timed<T: Real, const N: usize, S>(
+    f: impl FnMut(T, &[T; N]) -> [T; N],
+    t0: T,
+    y0: [T; N],
+    rtol: T,
+    atol: [T; N],
+    h0: T,
+    event: impl Fn(T, &[T; N]) -> T,
+    check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
+    limits: SystemLimits<T>,
+) -> Result<Run<T, N, S>, SystemError> {
+    let event = timed(event);
+    dp54_with(f, t0, y0, rtol, atol, h0, &event, check, limits)
+}
+
+/// A value-only event as `(g, g')` along `(dt, dy)` (per unit theta of a step): the slope by a
+/// central difference over `sqrt(eps)` of the step.
+fn timed<T: Real, const N: usize>(
+    g: impl Fn(T, &[T; N]) -> T,
+) -> impl Fn(T, &[T; N], T, &[T; N]) -> (T, T) {
+    move |t: T, y: &[T; N], dt: T, dy: &[T; N]| {
+        let value = g(t, y);
+        let e = T::EPSILON.sqrt();
+        let shifted = |sign: T| {
+            let mut ys = *y;
+            for i in 0..N {
+                ys[i] += sign * e * dy[i];
+            }
+            g(t + sign * e * dt, &ys)
+        };
+        let slope = (shifted(T::ONE) - shifted(-T::ONE)) / (T::TWO * e);
+        (value, slope)
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn dp54_with<T: Real, const N: usize, S>(
+    mut f: impl FnMut(T, &[T; N]) -> [T; N],
+    t0: T,
+    y0: [T; N],
+    rtol: T,
+    atol: [T; N],
+    h0: T,
+    event: &impl Fn(T, &[T; N], T, &[T; N]) -> (T, T),
     mut check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
     limits: SystemLimits<T>,
 ) -> Result<Run<T, N, S>, SystemError> {
@@ -189,7 +246,7 @@ pub fn dp54<T: Real, const N: usize, S>(
             h *= factor.min(T::ONE);
             continue;
         }
-        let (g1, _) = event(&y1, &[T::ZERO; N]);
+        let (g1, _) = event(t + h, &y1, T::ZERO, &[T::ZERO; N]);
         if g1 >= T::ZERO {
             let dense: [Dense<T>; N] = core::array::from_fn(|i| {
                 let hk: [T; 7] = core::array::from_fn(|s| h * k[s][i]);
@@ -220,11 +277,38 @@ pub fn dp54<T: Real, const N: usize, S>(
 /// Classical RK4 at the fixed step `h` from `(t0, y0)`, the event located on the cubic Hermite
 /// interpolant of each component (its slopes are the right-hand sides at the step's ends).
 pub fn rk4<T: Real, const N: usize, S>(
-    mut f: impl FnMut(T, &[T; N]) -> [T; N],
+    f: impl FnMut(T, &[T; N]) -> [T; N],
     t0: T,
     y0: [T; N],
     h: T,
     event: EventFn<T, N>,
+    check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
+    limits: SystemLimits<T>,
+) -> Result<Run<T, N, S>, SystemError> {
+    let event = |_: T, y: &[T; N], _: T, dy: &[T; N]| event(y, dy);
+    rk4_with(f, t0, y0, h, &event, check, limits)
+}
+
+/// [`rk4`] with a value-only event that depends on the time (as [`dp54_timed`]).
+pub fn rk4_timed<T: Real, const N: usize, S>(
+    f: impl FnMut(T, &[T; N]) -> [T; N],
+    t0: T,
+    y0: [T; N],
+    h: T,
+    event: impl Fn(T, &[T; N]) -> T,
+    check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
+    limits: SystemLimits<T>,
+) -> Result<Run<T, N, S>, SystemError> {
+    let event = timed(event);
+    rk4_with(f, t0, y0, h, &event, check, limits)
+}
+
+fn rk4_with<T: Real, const N: usize, S>(
+    mut f: impl FnMut(T, &[T; N]) -> [T; N],
+    t0: T,
+    y0: [T; N],
+    h: T,
+    event: &impl Fn(T, &[T; N], T, &[T; N]) -> (T, T),
     mut check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
     limits: SystemLimits<T>,
 ) -> Result<Run<T, N, S>, SystemError> {
@@ -263,7 +347,7 @@ pub fn rk4<T: Real, const N: usize, S>(
         if !finite(&y1) {
             return Err(SystemError::NotFinite);
         }
-        let (g1, _) = event(&y1, &[T::ZERO; N]);
+        let (g1, _) = event(t + h, &y1, T::ZERO, &[T::ZERO; N]);
         if g1 >= T::ZERO {
             let (te, ye) = event_in_step(
                 |i, th| hermite(y[i], h * k1[i], y1[i], h * k1_next[i], th),

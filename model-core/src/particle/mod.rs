@@ -21,6 +21,7 @@
 //! paper's own "correction factor" 0.029 (docs/model.md §5, "The parameter problem"); 0.4 stays
 //! reachable and then gives [`Outcome::NeverLeaves`].
 
+pub mod bowl;
 mod coriolis;
 mod coriolis_batch;
 mod flat;

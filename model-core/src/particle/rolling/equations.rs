@@ -43,19 +43,26 @@ pub struct Forces<T> {
     pub normal_m_s2: T,
     /// In-plane friction force per unit mass needed to roll, `|f_t|/m`, m/s^2.
     pub friction_m_s2: T,
+    /// That friction as a vector in the bottom's plane, `f_t/m`, m/s^2 (a granule that starts
+    /// to slide slips against it).
+    pub friction_xy_m_s2: [T; 2],
     /// At rest and held by the resistance: `|D| <= mu_r N/m`.
     pub held: bool,
 }
 
-/// Vectors of the bowl frame at time `t`.
-struct Frame<T> {
-    omega: [T; 3],
-    alpha: [T; 3],
-    gravity: [T; 3],
-    carrier: [T; 3],
+/// Vectors of the bowl frame at time `t` (shared with the sliding granule's equations).
+pub(crate) struct Frame<T> {
+    /// The frame's angular velocity `Omega`, rad/s.
+    pub(crate) omega: [T; 3],
+    /// Its angular acceleration `alpha`, rad/s^2.
+    pub(crate) alpha: [T; 3],
+    /// Gravity `gB`, m/s^2.
+    pub(crate) gravity: [T; 3],
+    /// The bowl centre's acceleration `A_O`, m/s^2.
+    pub(crate) carrier: [T; 3],
 }
 
-fn frame<T: Real>(s: &RollingScene<T>, t: T) -> Frame<T> {
+pub(crate) fn frame<T: Real>(s: &RollingScene<T>, t: T) -> Frame<T> {
     let psi = s.spin_rad_s * t;
     let (sp, cp) = (psi.sin(), psi.cos());
     let (st, ct) = (s.axes_angle_rad.sin(), s.axes_angle_rad.cos());
@@ -71,7 +78,7 @@ fn frame<T: Real>(s: &RollingScene<T>, t: T) -> Frame<T> {
     }
 }
 
-fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
+pub(crate) fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -134,6 +141,7 @@ pub fn forces<T: Real>(s: &RollingScene<T>, t: T, y: &State<T>) -> Forces<T> {
         derivative: [ux, uy, dux, duy, dsig],
         normal_m_s2: normal,
         friction_m_s2: (ft[0] * ft[0] + ft[1] * ft[1]).sqrt(),
+        friction_xy_m_s2: ft,
         held,
     }
 }

@@ -13,6 +13,8 @@
 
 pub mod equations;
 pub mod hierarchy;
+pub mod modes;
+pub mod slide;
 
 use core::ops::ControlFlow;
 
@@ -126,7 +128,7 @@ impl<T: Real> RollingScene<T> {
 
     /// Whether the forces in the bowl's frame are constant in time (no precession, or a
     /// precession about the bowl's own axis with the bowl on it): then a held granule stays.
-    fn stationary(&self) -> bool {
+    pub(crate) fn stationary(&self) -> bool {
         self.precession_rad_s == T::ZERO
             || (self.axes_angle_rad == T::ZERO && self.rod_length_m == T::ZERO)
     }
@@ -370,6 +372,10 @@ pub struct AzimuthSummary<T> {
     pub left: u32,
     /// How many of those slid on the way (rolling needed more friction than there is).
     pub slid: u32,
+    /// How many lifted off the bottom (the normal force reached zero): the model ends there.
+    pub lifted: u32,
+    /// The largest friction ratio `|f_t| / N` rolling needed over the releases that left.
+    pub max_friction_ratio: T,
     /// Right-hand-side evaluations of all 12.
     pub evaluations: u32,
 }
@@ -399,17 +405,21 @@ pub fn over_azimuths_within<T: Real>(
 ) -> Result<AzimuthSummary<T>, RollingError> {
     let mut sum = T::ZERO;
     let (mut min_s, mut max_s): (Option<T>, Option<T>) = (None, None);
-    let (mut left, mut slid, mut evaluations) = (0u32, 0u32, 0u32);
+    let (mut left, mut slid, mut lifted, mut evaluations) = (0u32, 0u32, 0u32, 0u32);
+    let mut max_ratio = T::ZERO;
     for deg in AZIMUTHS_DEG {
         let beta = T::from_f64(deg.to_radians());
         let report = residence_within(scene, beta, method, limits)?;
         evaluations = evaluations.saturating_add(report.evaluations);
+        lifted += u32::from(matches!(report.outcome, RollingOutcome::LiftsOff { .. }));
         if let RollingOutcome::Leaves {
             residence_time_s: t,
             first_slip_s,
+            max_friction_ratio,
             ..
         } = report.outcome
         {
+            max_ratio = max_ratio.max(max_friction_ratio);
             sum += t;
             left += 1;
             slid += u32::from(first_slip_s.is_some());
@@ -423,6 +433,8 @@ pub fn over_azimuths_within<T: Real>(
         max_s,
         left,
         slid,
+        lifted,
+        max_friction_ratio: max_ratio,
         evaluations,
     })
 }
@@ -468,5 +480,7 @@ pub fn at_rest_threshold_m_s<T: Real>() -> T {
     T::from_f64(AT_REST_M_S)
 }
 
+#[cfg(test)]
+mod modes_tests;
 #[cfg(test)]
 mod tests;

@@ -1,0 +1,365 @@
+//! `bowl predict --model bowl`: the granule in the real bowl (model-core `particle::bowl`,
+//! docs/model.md §10): rolling or sliding on the flat bottom, the fillet and the wall, until
+//! its centre passes the lip's radius, for one, several or the twelve release azimuths.
+
+use anyhow::{Result, bail};
+use model_core::ode::system::SystemLimits;
+use model_core::particle::bowl::{self, BowlError, BowlOutcome, BowlReport, BowlShape};
+use model_core::particle::rolling::{AZIMUTHS_DEG, MAX_STEPS, RollingMethod};
+use serde_json::{Value, json};
+
+use super::validity::Validity;
+use super::{Args, MethodChoice, rolling};
+
+/// The bowl model's own flags (the scene's are the rolling model's; `--mu` is the rolling
+/// resistance, `--sliding-mu` the contact's sliding coefficient).
+#[derive(clap::Args, Debug, Clone)]
+pub struct BowlArgs {
+    /// Bowl model: the wall's angle from the bottom plane, degrees (90 = vertical; default 90
+    /// or the rig file's).
+    #[arg(long, allow_negative_numbers = true)]
+    wall_angle_deg: Option<f64>,
+    /// Bowl model: the wall's height above the bottom, m (0 = a bare rim at --rim-radius-m;
+    /// default 0 or the rig file's).
+    #[arg(long, allow_negative_numbers = true)]
+    wall_height_m: Option<f64>,
+    /// Bowl model: the fillet's radius between bottom and wall, m (0 = a sharp corner; default
+    /// 0 or the rig file's).
+    #[arg(long, allow_negative_numbers = true)]
+    fillet_radius_m: Option<f64>,
+    /// Bowl model: coefficient of restitution of the impact with a sharp corner's wall
+    /// (default 0.5 or the rig file's).
+    #[arg(long, allow_negative_numbers = true)]
+    restitution: Option<f64>,
+    /// Bowl model: follow each release this long, s; still inside then, it has not left.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 10.0)]
+    max_time_s: f64,
+    /// Bowl model: the bowl from a rig file's [bowl] table (docs/rigs/nominal.toml): its wall
+    /// keys unless given as flags, its tilt unless --axes-angle-deg is given, and its bottom
+    /// and granule radii in place of --rim-radius-m and --particle-radius-m.
+    #[arg(long, value_name = "RIG.toml")]
+    rig_file: Option<std::path::PathBuf>,
+}
+
+/// The wall flags with the rig file's `[bowl]` table (or the defaults) under them.
+struct Wall {
+    angle_deg: f64,
+    height_m: f64,
+    fillet_m: f64,
+    restitution: f64,
+}
+
+impl BowlArgs {
+    fn wall(&self, table: Option<&rig_file::BowlGeometry>) -> Wall {
+        let pick =
+            |flag: Option<f64>, from: Option<f64>, default: f64| flag.or(from).unwrap_or(default);
+        Wall {
+            angle_deg: pick(self.wall_angle_deg, table.map(|t| t.wall_angle_deg), 90.0),
+            height_m: pick(self.wall_height_m, table.map(|t| t.wall_height_m), 0.0),
+            fillet_m: pick(self.fillet_radius_m, table.map(|t| t.fillet_radius_m), 0.0),
+            restitution: pick(self.restitution, table.map(|t| t.restitution), 0.5),
+        }
+    }
+}
+
+fn words(e: BowlError) -> String {
+    match e {
+        BowlError::Scene(e) => rolling::words(e),
+        BowlError::InvalidWallAngle => {
+            "--wall-angle-deg must be above 0 and at most 90 degrees (90 = a vertical wall)".into()
+        }
+        BowlError::InvalidWallHeight => "--wall-height-m must be 0 or more (0 = a bare rim)".into(),
+        BowlError::InvalidFillet => {
+            "--fillet-radius-m must be 0 or more (0 = a sharp corner)".into()
+        }
+        BowlError::FilletReachesRelease => "the fillet between bottom and wall reaches in to the \
+             release radius: give a smaller --fillet-radius-m or --ri-m (the granule starts on \
+             the flat bottom)"
+            .into(),
+        BowlError::InvalidRestitution => "--restitution must lie between 0 and 1".into(),
+        BowlError::InvalidHorizon => "--max-time-s must be a positive number of seconds".into(),
+    }
+}
+
+/// `all`, one azimuth or a comma-separated list, degrees.
+fn azimuths(text: &str) -> Result<Vec<f64>> {
+    if text.trim() == "all" {
+        return Ok(AZIMUTHS_DEG.to_vec());
+    }
+    text.split(',')
+        .map(|p| {
+            let v: f64 = p.trim().parse().map_err(|_| {
+                anyhow::anyhow!(
+                    "--release-azimuth-deg {text:?}: {p:?} is not a number of degrees (give \
+                     `all`, one number, or numbers separated by commas)"
+                )
+            })?;
+            if !v.is_finite() {
+                bail!("--release-azimuth-deg must be finite numbers of degrees, not {p:?}");
+            }
+            Ok(v)
+        })
+        .collect()
+}
+
+/// Each mode's share of the time a release spent in the bowl.
+fn regime(r: &BowlReport<f64>) -> Value {
+    if r.outcome == BowlOutcome::Held {
+        return json!({"held": 1.0});
+    }
+    let total = r.regime.roll_s + r.regime.slide_s + r.held_s;
+    let mut m = serde_json::Map::new();
+    if total > 0.0 {
+        for (name, t) in [
+            ("roll", r.regime.roll_s),
+            ("slide", r.regime.slide_s),
+            ("held", r.held_s),
+        ] {
+            if t > 0.0 {
+                m.insert(name.into(), json!(t / total));
+            }
+        }
+    }
+    Value::Object(m)
+}
+
+fn outcome_name(o: &BowlOutcome<f64>) -> &'static str {
+    match o {
+        BowlOutcome::Leaves { .. } => "leaves",
+        BowlOutcome::Held => "held",
+        BowlOutcome::LiftsOff { .. } => "lifts_off",
+        BowlOutcome::Inside { .. } => "inside",
+    }
+}
+
+/// Runs `bowl predict --model bowl`.
+pub fn run(args: &Args, r: &rolling::RollingArgs, b: &BowlArgs) -> Result<()> {
+    if args.target_time_s.is_some() || args.batch.is_some() {
+        bail!("--target-time-s and --batch are for the flat and Coriolis models, not the bowl");
+    }
+    let table = match &b.rig_file {
+        Some(path) => {
+            let rigs = rig_file::load(path)?;
+            let Some(t) = rigs.first().and_then(|rig| rig.bowl) else {
+                bail!(
+                    "the rig file {} has no [bowl] table (its keys: docs/rigs/nominal.toml)",
+                    path.display()
+                );
+            };
+            Some(t)
+        }
+        None => None,
+    };
+    let (mut scene, th_deg) = r.scene(args, "bowl", table.map(|t| t.axes_angle_deg))?;
+    if let Some(t) = &table {
+        scene.rim_radius_m = t.rim_radius_m;
+        scene.particle_radius_m = t.particle_radius_m;
+        scene.validate().map_err(|e| {
+            anyhow::anyhow!("with the rig file's [bowl] table: {}", rolling::words(e))
+        })?;
+    }
+    let wall = b.wall(table.as_ref());
+    let method = match args.method {
+        MethodChoice::Closed | MethodChoice::Dp54 => RollingMethod::Dp54 { rtol: args.tol },
+        MethodChoice::Rk4 => RollingMethod::Rk4 {
+            step_s: args.step_s.unwrap_or(1e-4),
+        },
+        other => {
+            bail!("--method {other:?} is not offered for the bowl model: use dp54 (default) or rk4")
+        }
+    };
+    for (v, flag) in [
+        (wall.angle_deg, "--wall-angle-deg"),
+        (wall.height_m, "--wall-height-m"),
+        (wall.fillet_m, "--fillet-radius-m"),
+        (wall.restitution, "--restitution"),
+        (b.max_time_s, "--max-time-s"),
+    ] {
+        if !v.is_finite() {
+            bail!("{flag} must be a finite number, not {v}");
+        }
+    }
+    let shape = BowlShape {
+        wall_angle_rad: wall.angle_deg.to_radians(),
+        wall_height_m: wall.height_m,
+        fillet_radius_m: wall.fillet_m,
+        restitution: wall.restitution,
+    };
+    shape
+        .validate(&scene)
+        .map_err(|e| anyhow::anyhow!(words(e)))?;
+    let limits = SystemLimits {
+        horizon_s: b.max_time_s,
+        max_steps: MAX_STEPS,
+    };
+    let betas = azimuths(r.release_azimuth_deg())?;
+    let mut rows = Vec::new();
+    // A release the integrator gives up on (the step cap, e.g. a granule chattering at the
+    // stick threshold in a corner) is reported as such; the others still count.
+    let mut gave_up = Vec::new();
+    for &deg in &betas {
+        match bowl::residence(&scene, &shape, deg.to_radians(), method, limits) {
+            Ok(rep) => rows.push((deg, rep)),
+            Err(
+                e @ BowlError::Scene(model_core::particle::rolling::RollingError::Integration(_)),
+            ) => {
+                gave_up.push((deg, words(e)));
+            }
+            Err(e) => bail!("release at {deg} deg: {}", words(e)),
+        }
+    }
+    let times: Vec<f64> = rows
+        .iter()
+        .filter_map(|(_, rep)| match rep.outcome {
+            BowlOutcome::Leaves {
+                residence_time_s, ..
+            } => Some(residence_time_s),
+            _ => None,
+        })
+        .collect();
+    let mean = (!times.is_empty()).then(|| times.iter().sum::<f64>() / times.len() as f64);
+    let min = times.iter().copied().reduce(f64::min);
+    let max = times.iter().copied().reduce(f64::max);
+    let lifted = rows
+        .iter()
+        .filter(|(_, rep)| matches!(rep.outcome, BowlOutcome::LiftsOff { .. }))
+        .count();
+    let releases = betas.len();
+    let mut why = Vec::new();
+    if lifted > 0 {
+        why.push(format!(
+            "the granule's normal force reaches zero in {lifted} of {releases} releases (it \
+             would fly): flight is not modelled, so those releases have no residence time"
+        ));
+    }
+    if !gave_up.is_empty() {
+        why.push(format!(
+            "the integration gave up on {} of {releases} releases ({}), so they have no \
+             residence time; a shorter --max-time-s or a looser --tol may get through",
+            gave_up.len(),
+            gave_up[0].1
+        ));
+    }
+    let validity = if why.is_empty() {
+        Validity::valid()
+    } else {
+        Validity(Some(why.join("; ")))
+    };
+    let alpha = wall.angle_deg.to_radians();
+    let lip = if wall.height_m > 0.0 {
+        scene.rim_radius_m + wall.height_m * alpha.cos() / alpha.sin()
+    } else {
+        scene.rim_radius_m
+    };
+    let evaluations: u64 = rows.iter().map(|(_, rep)| u64::from(rep.evaluations)).sum();
+    if args.json {
+        let mut per: Vec<(f64, Value)> = rows
+            .iter()
+            .map(|(deg, rep)| {
+                let (t, v) = match rep.outcome {
+                    BowlOutcome::Leaves {
+                        residence_time_s,
+                        exit_speed_m_s,
+                    } => (Some(residence_time_s), Some(exit_speed_m_s)),
+                    _ => (None, None),
+                };
+                (
+                    *deg,
+                    json!({
+                        "azimuth_deg": deg, "left": t.is_some(), "residence_time_s": t,
+                        "regime": regime(rep), "outcome": outcome_name(&rep.outcome),
+                        "exit_speed_relative_m_s": v, "on_wall_s": rep.on_wall_s,
+                        "switches": rep.switches, "rhs_evaluations": rep.evaluations,
+                    }),
+                )
+            })
+            .collect();
+        for (deg, why) in &gave_up {
+            per.push((
+                *deg,
+                json!({
+                    "azimuth_deg": deg, "left": false, "residence_time_s": null,
+                    "regime": {}, "outcome": "gave_up", "error": why,
+                }),
+            ));
+        }
+        // In the order the azimuths were given.
+        per.sort_by_key(|(deg, _)| betas.iter().position(|b| b == deg));
+        let per: Vec<Value> = per.into_iter().map(|(_, v)| v).collect();
+        let mut v = json!({
+            "model": "bowl",
+            "residence_time_mean_s": mean, "residence_time_min_s": min,
+            "residence_time_max_s": max, "releases": releases,
+            "releases_leaving": times.len(), "per_release": per,
+            "bowl": {
+                "rim_radius_m": scene.rim_radius_m, "wall_angle_deg": wall.angle_deg,
+                "wall_height_m": wall.height_m, "fillet_radius_m": wall.fillet_m,
+                "lip_radius_m": lip, "restitution": wall.restitution,
+                "axes_angle_deg": th_deg, "particle_radius_m": scene.particle_radius_m,
+                "from_rig_file": b.rig_file.as_ref().map(|p| p.display().to_string()),
+            },
+            "max_time_s": b.max_time_s, "rhs_evaluations": evaluations,
+        });
+        validity.add_to(&mut v);
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    if let Some(line) = validity.text_line() {
+        println!("{line}");
+    }
+    println!(
+        "bowl model: w1 {} rad/s, w2 {} rad/s, tilt {th_deg} deg, mu_r {}, mu_s {}, a {} m, ri {} m; \
+         bottom R {} m, wall {} deg, {} m high, fillet {} m, lip at {lip:.4} m, e {}",
+        scene.precession_rad_s,
+        scene.spin_rad_s,
+        scene.rolling_resistance,
+        scene.sliding_friction,
+        scene.particle_radius_m,
+        scene.ri_m,
+        scene.rim_radius_m,
+        wall.angle_deg,
+        wall.height_m,
+        wall.fillet_m,
+        wall.restitution
+    );
+    if let Some(p) = &b.rig_file {
+        println!(
+            "  (bowl, tilt and granule radius from {}'s [bowl] table; flags given override its wall)",
+            p.display()
+        );
+    }
+    for (deg, rep) in &rows {
+        let what = match rep.outcome {
+            BowlOutcome::Leaves {
+                residence_time_s,
+                exit_speed_m_s,
+            } => format!(
+                "leaves over the lip after T = {residence_time_s:.6} s at {exit_speed_m_s:.4} m/s"
+            ),
+            BowlOutcome::Held => "held at rest where it was released".into(),
+            BowlOutcome::LiftsOff { time_s } => {
+                format!("lifts off at t = {time_s:.4} s (flight is not modelled)")
+            }
+            BowlOutcome::Inside { horizon_s } if rep.held_s > 0.0 => {
+                format!("held by the wall: still inside after {horizon_s} s")
+            }
+            BowlOutcome::Inside { horizon_s } => format!("still inside after {horizon_s} s"),
+        };
+        println!("release at {deg} deg: {what}; regime {}", regime(rep));
+    }
+    for (deg, why) in &gave_up {
+        println!("release at {deg} deg: no answer: {why}");
+    }
+    match (mean, min, max) {
+        (Some(m), Some(lo), Some(hi)) => println!(
+            "over {releases} releases: {} leave, T mean {m:.6} s, min {lo:.6} s, max {hi:.6} s",
+            times.len()
+        ),
+        _ => println!(
+            "none of the {} releases leaves within {} s",
+            rows.len(),
+            b.max_time_s
+        ),
+    }
+    Ok(())
+}

@@ -1,0 +1,52 @@
+//! `bowl chart bowl-regimes`: the regime map's CSV against the closed forms it must show.
+
+mod common;
+
+use common::{bowl, temp_dir};
+
+/// At 2 rad/s on a bare rim the granule slides from the tilt where rolling down the incline
+/// needs more than mu_s: `(1 - k2) tan th > 0.4`, th > 54.5 deg (the rotation shifts it a
+/// little): none at 45 deg, all at 60 deg and above; a vertical 20 mm wall with a sharp corner
+/// lets no release out at any tilt; the bare rim lets every release out.
+#[test]
+fn the_regime_map_shows_the_sliding_threshold_and_the_held_granules() {
+    let d = temp_dir("chart-bowl-regimes");
+    let out = d.join("r.svg");
+    let o = bowl(&[
+        "chart",
+        "bowl-regimes",
+        "--csv-only",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(d.join("r.csv")).unwrap();
+    let mut checked = 0;
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let (shape, tilt, slide, leaving): (&str, f64, f64, f64) = (
+            f[0],
+            f[1].parse().unwrap(),
+            f[2].parse().unwrap(),
+            f[4].parse().unwrap(),
+        );
+        match shape {
+            "bare rim" => {
+                assert_eq!(leaving, 1.0, "{line}");
+                if tilt <= 45.0 {
+                    assert!(slide < 0.01, "{line}");
+                }
+                if tilt >= 60.0 {
+                    assert!(slide > 0.99, "{line}");
+                }
+                checked += 1;
+            }
+            "vertical wall 20 mm" => {
+                assert_eq!(leaving, 0.0, "{line}");
+                checked += 1;
+            }
+            _ => {}
+        }
+    }
+    assert_eq!(checked, 32);
+}

@@ -1,0 +1,314 @@
+//! The granule on the bowl's wall: a sphere rolling or sliding on a surface of revolution about
+//! the bowl's axis, in the tilted, precessing bowl frame (docs/model.md §10). The paper has no
+//! wall (its model ends at the rim radius R on a flat bottom); a real bowl's wall decides
+//! whether and when the granule leaves.
+//!
+//! **Geometry.** The centre of a sphere of radius `a` touching the surface runs on the surface
+//! offset by `a`; for the bowl (flat bottom, a fillet of radius `F` into a cone at `alpha` from
+//! the bottom plane) the centre's meridian, by arc length `s` from where the fillet starts
+//! (radius `rho_b = R - F tan(alpha/2)`), is an arc of radius `F - a` about the fillet's centre
+//! turning by `alpha`, then a straight line at `alpha` (the cone offset by `a`) up to where the
+//! contact reaches the wall's top edge, then an arc of radius `a` about that edge (the granule
+//! pivots over the lip); it has left when its centre passes the lip radius `R + H cot alpha`,
+//! i.e. is over the edge. A granule whose normal force vanishes on that pivot flies off the
+//! lip outwards: that counts as leaving there.
+//!
+//! **Dynamics** (one set for every surface; on the flat bottom it is [`super::super::rolling`]'s
+//! equations, a test holds them equal there). Centre `q`, its velocity `u` relative to the bowl,
+//! `n` the surface normal towards the centre, `s = a w` the spin relative to the bowl:
+//!
+//! ```text
+//! b      = gB - A_O - alpha x q - Omega x (Omega x q) - 2 Omega x u     (per unit mass)
+//! N/m    = -u . dn/dt - b . n                     keeps the centre on its surface
+//! c      = -a alpha - Omega x s
+//! roll:  f/m = (1 - k2) (-b_t + P_t(c x n + s x dn/dt)) - k2 mu_r (N/m) u/|u|
+//!        (d/dt of the no-slip condition u = s x n; the resistance is a torque mu_r a N)
+//! slide: f/m = -mu_s (N/m) v_c/|v_c|,  v_c = u - s x n
+//! du/dt = b + (N/m) n + f/m;   ds/dt = -(k2/(1 - k2)) n x (f/m + [roll] mu_r (N/m) u/|u|) + c
+//! ```
+//!
+//! State `[s, ex, ey, sdot, phidot, sx, sy, sz]`: `(ex, ey)` is the horizontal unit vector
+//! from the axis to the centre (no angle, so no trigonometry in the right-hand side), with
+//! `d(ex, ey)/dt = phidot (-ey, ex)`; `s`'s rate is `u . T` with `T` the meridian's tangent.
+
+use super::super::rolling::RollingScene;
+use super::super::rolling::equations::{AT_REST_M_S, cross, frame};
+use crate::Real;
+
+/// The wall state `[s, ex, ey, sdot, phidot, sx, sy, sz]`.
+pub type WallState<T> = [T; 8];
+
+/// The centre's meridian on the wall: a fillet arc of radius `rc = F - a` turning by
+/// `alpha`, then the offset cone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Meridian<T> {
+    /// Radius where the bottom ends and the fillet starts, m.
+    pub rho_b_m: T,
+    /// Height of the centre on the bottom (`a`), m.
+    pub z0_m: T,
+    /// Radius of the centre's arc, `F - a`, m.
+    pub arc_radius_m: T,
+    /// The wall's angle from the bottom plane, rad.
+    pub alpha_rad: T,
+    /// The lip radius the centre must pass to leave, m.
+    pub lip_m: T,
+    /// Arc length where the contact reaches the lip's edge (the wall's top), m: beyond it the
+    /// granule pivots about the edge, its centre on a circle of radius `pivot_m` about it.
+    pub top_s: T,
+    /// The pivot's radius (the granule's, at least a micrometre of the rim so that a point
+    /// granule still has a finite curvature there), m.
+    pub pivot_m: T,
+}
+
+/// A point of the meridian: `(rho, z)`, its unit tangent `(rho', z')` and its derivative
+/// `(rho'', z'')` by arc length.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Point<T> {
+    /// Radius and height, m.
+    pub pos: [T; 2],
+    /// Unit tangent.
+    pub tangent: [T; 2],
+    /// Curvature vector, 1/m.
+    pub bend: [T; 2],
+}
+
+impl<T: Real> Meridian<T> {
+    fn arc_length(&self) -> T {
+        self.arc_radius_m * self.alpha_rad
+    }
+
+    /// The meridian at arc length `s` (below 0 the bottom continued, so that an integrator's
+    /// stage just past the edge stays defined).
+    pub fn at(&self, s: T) -> Point<T> {
+        let rc = self.arc_radius_m;
+        if s <= T::ZERO {
+            return Point {
+                pos: [self.rho_b_m + s, self.z0_m],
+                tangent: [T::ONE, T::ZERO],
+                bend: [T::ZERO, T::ZERO],
+            };
+        }
+        let len = self.arc_length();
+        if s < len {
+            let th = s / rc;
+            let (st, ct) = (th.sin(), th.cos());
+            return Point {
+                pos: [self.rho_b_m + rc * st, self.z0_m + rc * (T::ONE - ct)],
+                tangent: [ct, st],
+                bend: [-st / rc, ct / rc],
+            };
+        }
+        let (sa, ca) = (self.alpha_rad.sin(), self.alpha_rad.cos());
+        let d = s.min(self.top_s) - len;
+        let cone = [
+            self.rho_b_m + rc * sa + d * ca,
+            self.z0_m + rc * (T::ONE - ca) + d * sa,
+        ];
+        if s <= self.top_s {
+            return Point {
+                pos: cone,
+                tangent: [ca, sa],
+                bend: [T::ZERO, T::ZERO],
+            };
+        }
+        // Over the edge: the centre turns about it (convex), the tangent's angle falling from
+        // alpha at 1/pivot per metre.
+        let pv = self.pivot_m;
+        let th = self.alpha_rad - (s - self.top_s) / pv;
+        let (st, ct) = (th.sin(), th.cos());
+        let edge = [cone[0] + pv * sa, cone[1] - pv * ca];
+        Point {
+            pos: [edge[0] - pv * st, edge[1] + pv * ct],
+            tangent: [ct, st],
+            bend: [st / pv, -ct / pv],
+        }
+    }
+
+    /// Whether arc length `s` is on the pivot over the lip's edge.
+    pub fn over_edge(&self, s: T) -> bool {
+        s > self.top_s
+    }
+}
+
+/// How the contact acts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Contact<T> {
+    /// No slip; rolling resistance.
+    Roll,
+    /// Slipping; the friction opposes the slip, or this direction (a unit tangent vector)
+    /// while the slip is below the rest threshold or has turned against it.
+    Slide([T; 3]),
+}
+
+/// Everything the wall's equations give at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WallForces<T> {
+    /// The state's time derivative.
+    pub derivative: WallState<T>,
+    /// Normal force per unit mass, m/s^2.
+    pub normal_m_s2: T,
+    /// The friction rolling would need without resistance, per unit mass, m/s^2.
+    pub needed_m_s2: [T; 3],
+    /// The contact point's slip velocity, m/s.
+    pub slip_m_s: [T; 3],
+    /// The centre's radius from the bowl's axis, m.
+    pub rho_m: T,
+    /// The centre's velocity relative to the bowl, m/s.
+    pub velocity_m_s: [T; 3],
+}
+
+fn dot<T: Real>(a: &[T; 3], b: &[T; 3]) -> T {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn tangential<T: Real>(v: &[T; 3], n: &[T; 3]) -> [T; 3] {
+    let k = dot(v, n);
+    [v[0] - k * n[0], v[1] - k * n[1], v[2] - k * n[2]]
+}
+
+/// The right-hand side on the wall.
+pub fn wall_forces<T: Real>(
+    sc: &RollingScene<T>,
+    m: &Meridian<T>,
+    t: T,
+    y: &WallState<T>,
+    contact: Contact<T>,
+) -> WallForces<T> {
+    let [s, ex0, ey0, sd, pd, sx, sy, sz] = *y;
+    // The azimuth's unit vector, renormalised against the integrator's drift.
+    let en = (ex0 * ex0 + ey0 * ey0).sqrt().max(T::EPSILON);
+    let (ex, ey) = (ex0 / en, ey0 / en);
+    let p = m.at(s);
+    let [rho, z] = p.pos;
+    let [rp, zp] = p.tangent;
+    let [rpp, zpp] = p.bend;
+    let e_phi = [-ey, ex, T::ZERO];
+    let tan = [rp * ex, rp * ey, zp];
+    let n = [-zp * ex, -zp * ey, rp];
+    let q = [rho * ex, rho * ey, z];
+    let u = [
+        sd * tan[0] + rho * pd * e_phi[0],
+        sd * tan[1] + rho * pd * e_phi[1],
+        sd * tan[2],
+    ];
+    // dn/dt = (-z'' e_rho + rho'' e3) sdot - z' phidot e_phi.
+    let ndot = [
+        -zpp * sd * ex - zp * pd * e_phi[0],
+        -zpp * sd * ey - zp * pd * e_phi[1],
+        rpp * sd,
+    ];
+    let f = frame(sc, t);
+    let o = f.omega;
+    let oq = cross(&o, &q);
+    let ooq = cross(&o, &oq);
+    let aq = cross(&f.alpha, &q);
+    let ou = cross(&o, &u);
+    let b: [T; 3] =
+        core::array::from_fn(|i| f.gravity[i] - f.carrier[i] - aq[i] - ooq[i] - T::TWO * ou[i]);
+    let normal = -dot(&u, &ndot) - dot(&b, &n);
+    let sig = [sx, sy, sz];
+    let os = cross(&o, &sig);
+    let a = sc.particle_radius_m;
+    let c: [T; 3] = core::array::from_fn(|i| -a * f.alpha[i] - os[i]);
+    let cn = cross(&c, &n);
+    let snd = cross(&sig, &ndot);
+    let q_t = tangential(&[cn[0] + snd[0], cn[1] + snd[1], cn[2] + snd[2]], &n);
+    let b_t = tangential(&b, &n);
+    let k2 = sc.k2;
+    let one_m = T::ONE - k2;
+    let needed: [T; 3] = core::array::from_fn(|i| one_m * (q_t[i] - b_t[i]));
+    let sn = cross(&sig, &n);
+    let slip: [T; 3] = core::array::from_fn(|i| u[i] - sn[i]);
+    let n_pos = normal.max(T::ZERO);
+    let speed = dot(&u, &u).sqrt();
+    // The friction, and the resistance's part of the torque (rolling only).
+    let (fm, resist) = match contact {
+        Contact::Roll => {
+            let r = sc.rolling_resistance * n_pos;
+            let dir = if speed > T::from_f64(AT_REST_M_S) {
+                [u[0] / speed, u[1] / speed, u[2] / speed]
+            } else {
+                // At rest: the resistance opposes where it would start to move (and holds
+                // it while it can: then nothing moves).
+                let acc: [T; 3] = core::array::from_fn(|i| needed[i] + b_t[i]);
+                let an = dot(&acc, &acc).sqrt();
+                if an <= k2 * r || an == T::ZERO {
+                    [T::ZERO; 3]
+                } else {
+                    [acc[0] / an, acc[1] / an, acc[2] / an]
+                }
+            };
+            let held = speed <= T::from_f64(AT_REST_M_S) && dir == [T::ZERO; 3];
+            if held {
+                // Held at rest: the contact gives exactly what keeps it there.
+                (core::array::from_fn(|i| -b_t[i]), [T::ZERO; 3])
+            } else {
+                let fm: [T; 3] = core::array::from_fn(|i| needed[i] - k2 * r * dir[i]);
+                (fm, core::array::from_fn(|i| r * dir[i]))
+            }
+        }
+        Contact::Slide(d) => {
+            let sl = dot(&slip, &slip).sqrt();
+            let dir = if sl > T::from_f64(AT_REST_M_S) && dot(&slip, &d) > T::ZERO {
+                [slip[0] / sl, slip[1] / sl, slip[2] / sl]
+            } else {
+                d
+            };
+            let k = sc.sliding_friction * n_pos;
+            ([-k * dir[0], -k * dir[1], -k * dir[2]], [T::ZERO; 3])
+        }
+    };
+    let acc: [T; 3] = core::array::from_fn(|i| b[i] + normal * n[i] + fm[i]);
+    let torque_force: [T; 3] = core::array::from_fn(|i| fm[i] + resist[i]);
+    let nf = cross(&n, &torque_force);
+    let ratio = k2 / one_m;
+    let dsig: [T; 3] = core::array::from_fn(|i| -ratio * nf[i] + c[i]);
+    // Back to the coordinates: s'' = du/dt . T + rho rho' phidot^2, phi'' = (du/dt . e_phi -
+    // 2 rho' sdot phidot) / rho.
+    let sdd = dot(&acc, &tan) + rho * rp * pd * pd;
+    let pdd = (dot(&acc, &e_phi) - T::TWO * rp * sd * pd) / rho;
+    WallForces {
+        derivative: [sd, -pd * ey, pd * ex, sdd, pdd, dsig[0], dsig[1], dsig[2]],
+        normal_m_s2: normal,
+        needed_m_s2: needed,
+        slip_m_s: slip,
+        rho_m: rho,
+        velocity_m_s: u,
+    }
+}
+
+/// A state on the bottom `[x, y, ux, uy, sx, sy, sz]` at the fillet's start radius as a wall
+/// state (`s = 0`).
+pub fn onto_wall<T: Real>(m: &Meridian<T>, y: &[T; 7]) -> WallState<T> {
+    let rho = (y[0] * y[0] + y[1] * y[1]).sqrt().max(T::EPSILON);
+    let (ex, ey) = (y[0] / rho, y[1] / rho);
+    let radial = y[2] * ex + y[3] * ey;
+    let around = -y[2] * ey + y[3] * ex;
+    [
+        T::ZERO,
+        ex,
+        ey,
+        radial,
+        around / m.rho_b_m,
+        y[4],
+        y[5],
+        y[6],
+    ]
+}
+
+/// A wall state back at the fillet's start (`s = 0`) as a state on the bottom.
+pub fn onto_bottom<T: Real>(m: &Meridian<T>, y: &WallState<T>) -> [T; 7] {
+    let en = (y[1] * y[1] + y[2] * y[2]).sqrt().max(T::EPSILON);
+    let (ex, ey) = (y[1] / en, y[2] / en);
+    let rho = m.rho_b_m;
+    let (sd, pd) = (y[3], y[4]);
+    [
+        rho * ex,
+        rho * ey,
+        sd * ex - rho * pd * ey,
+        sd * ey + rho * pd * ex,
+        y[5],
+        y[6],
+        y[7],
+    ]
+}

@@ -1,0 +1,277 @@
+//! One stay on the wall: roll and slide segments (as on the bottom, `rolling::modes`) with
+//! the wall's events, each located on the integrator's interpolant: back onto the bottom
+//! (`s` = 0), over the lip (the centre's radius reaching the lip's), lift-off (`N` = 0), and the
+//! contact's changes (rolling needing more than `mu_s N`; the slip ending).
+
+use core::cell::Cell;
+use core::ops::ControlFlow;
+
+use super::wall::{Contact, Meridian, WallState, wall_forces};
+use crate::Real;
+use crate::ode::system::{Ended, SystemError, SystemLimits};
+use crate::particle::rolling::equations::AT_REST_M_S;
+use crate::particle::rolling::modes::{Regime, fired, segment, stuck_m_s};
+use crate::particle::rolling::{RollingError, RollingMethod, RollingScene};
+
+/// How a stay on the wall ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WallEnd<T> {
+    /// Back on the bottom at this time, in this wall state (`s` = 0).
+    Bottom(T, WallState<T>),
+    /// Over the lip at this time, at this speed relative to the bowl, m/s.
+    Lip(T, T),
+    /// The normal force reached zero at this time.
+    LiftsOff(T),
+    /// Still on the wall at the horizon.
+    Horizon,
+}
+
+/// What a stay cost and how it went.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WallStay<T> {
+    /// How it ended.
+    pub end: WallEnd<T>,
+    /// Time rolling and sliding on the wall, s.
+    pub regime: Regime<T>,
+    /// Changes of contact.
+    pub switches: u32,
+    /// Right-hand sides.
+    pub evaluations: u32,
+    /// Accepted steps.
+    pub steps: u32,
+}
+
+fn norm<T: Real>(v: &[T; 3]) -> T {
+    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+}
+
+fn events<T: Real>(
+    sc: &RollingScene<T>,
+    m: &Meridian<T>,
+    t: T,
+    y: &WallState<T>,
+    contact: Contact<T>,
+    armed: bool,
+    refs: (T, T),
+) -> [T; 4] {
+    let (reference, speed_ref) = refs;
+    let f = wall_forces(sc, m, t, y, contact);
+    let rim = sc.rim_radius_m;
+    let switch = match contact {
+        Contact::Roll => (norm(&f.needed_m_s2) - sc.sliding_friction * f.normal_m_s2) / reference,
+        Contact::Slide(d) => {
+            let s = f.slip_m_s;
+            let reversed = -(s[0] * d[0] + s[1] * d[1] + s[2] * d[2]);
+            let stuck = if armed {
+                reversed.max(stuck_m_s(speed_ref) - norm(&s))
+            } else {
+                reversed
+            };
+            stuck / speed_ref
+        }
+    };
+    [
+        -y[0] / rim,
+        (f.rho_m - m.lip_m) / rim,
+        -f.normal_m_s2 / reference,
+        switch,
+    ]
+}
+
+/// The contact a wall state starts in (`must_slide` as on the bottom), or `None` if `N <= 0`.
+fn next_contact<T: Real>(
+    sc: &RollingScene<T>,
+    m: &Meridian<T>,
+    t: T,
+    y: &WallState<T>,
+    must_slide: bool,
+) -> Option<Contact<T>> {
+    let f = wall_forces(sc, m, t, y, Contact::Roll);
+    let slip = f.slip_m_s;
+    let sl = norm(&slip);
+    if sl > T::from_f64(AT_REST_M_S) {
+        return Some(Contact::Slide([slip[0] / sl, slip[1] / sl, slip[2] / sl]));
+    }
+    if f.normal_m_s2 <= T::ZERO {
+        return None;
+    }
+    let need = norm(&f.needed_m_s2);
+    if (need <= sc.sliding_friction * f.normal_m_s2 && !must_slide) || need <= T::ZERO {
+        return Some(Contact::Roll);
+    }
+    let nd = f.needed_m_s2;
+    Some(Contact::Slide([
+        -nd[0] / need,
+        -nd[1] / need,
+        -nd[2] / need,
+    ]))
+}
+
+/// Makes the slip of a wall state exactly zero (its spin's tangential part follows the
+/// translation, `s x n = u`), keeping the spin about the normal.
+fn no_slip<T: Real>(sc: &RollingScene<T>, m: &Meridian<T>, t: T, y: &WallState<T>) -> WallState<T> {
+    let f = wall_forces(sc, m, t, y, Contact::Roll);
+    let p = m.at(y[0]);
+    let en = (y[1] * y[1] + y[2] * y[2]).sqrt().max(T::EPSILON);
+    let (ex, ey) = (y[1] / en, y[2] / en);
+    let n = [-p.tangent[1] * ex, -p.tangent[1] * ey, p.tangent[0]];
+    let u = f.velocity_m_s;
+    let sig = [y[5], y[6], y[7]];
+    let along = sig[0] * n[0] + sig[1] * n[1] + sig[2] * n[2];
+    // s = n x u + (s . n) n satisfies s x n = u for u tangential.
+    let nu = [
+        n[1] * u[2] - n[2] * u[1],
+        n[2] * u[0] - n[0] * u[2],
+        n[0] * u[1] - n[1] * u[0],
+    ];
+    let mut out = *y;
+    for i in 0..3 {
+        out[5 + i] = nu[i] + along * n[i];
+    }
+    out
+}
+
+/// Follows the granule on the wall from `(t0, y0)` until it leaves the wall.
+pub fn stay<T: Real>(
+    sc: &RollingScene<T>,
+    m: &Meridian<T>,
+    t0: T,
+    y0: WallState<T>,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+    max_switches: u32,
+) -> Result<WallStay<T>, RollingError> {
+    let rim = sc.rim_radius_m;
+    let spin = sc.combined_speed_rad_s();
+    let w1l = sc.precession_rad_s * sc.precession_rad_s * sc.rod_length_m;
+    let reference = sc.g_m_s2 + spin * spin * rim + w1l + T::ONE;
+    let refs = (reference, (reference * rim).sqrt());
+    let scales = (rim, rim * spin.max(T::ONE));
+    let mut out = WallStay {
+        end: WallEnd::Horizon,
+        regime: Regime {
+            roll_s: T::ZERO,
+            slide_s: T::ZERO,
+        },
+        switches: 0,
+        evaluations: 0,
+        steps: 0,
+    };
+    let (mut t, mut y) = (t0, y0);
+    let mut must_slide = false;
+    let mut previous: Option<bool> = None;
+    loop {
+        let remaining = SystemLimits {
+            horizon_s: limits.horizon_s,
+            max_steps: limits.max_steps.saturating_sub(out.steps),
+        };
+        if remaining.max_steps == 0 || out.switches > max_switches {
+            return Err(RollingError::Integration(SystemError::StepLimit));
+        }
+        let Some(contact) = next_contact(sc, m, t, &y, must_slide) else {
+            out.end = WallEnd::LiftsOff(t);
+            return Ok(out);
+        };
+        let rolling = matches!(contact, Contact::Roll);
+        if previous.is_some_and(|p| p != rolling) {
+            out.switches += 1;
+        }
+        previous = Some(rolling);
+        if rolling {
+            y = no_slip(sc, m, t, &y);
+        }
+        let dir = Cell::new(match contact {
+            Contact::Slide(d) => d,
+            Contact::Roll => [T::ZERO; 3],
+        });
+        let armed = Cell::new(false);
+        let now = |d: [T; 3]| {
+            if rolling {
+                Contact::Roll
+            } else {
+                Contact::Slide(d)
+            }
+        };
+        let run = segment(
+            |t, y: &WallState<T>| wall_forces(sc, m, t, y, now(dir.get())).derivative,
+            t,
+            y,
+            method,
+            scales,
+            |t, y: &WallState<T>| {
+                let e = events(sc, m, t, y, now(dir.get()), armed.get(), refs);
+                e[0].max(e[1]).max(e[2]).max(e[3])
+            },
+            |t, y: &WallState<T>| {
+                if !rolling {
+                    let s = wall_forces(sc, m, t, y, now(dir.get())).slip_m_s;
+                    let sl = norm(&s);
+                    let d = dir.get();
+                    if sl > T::TWO * stuck_m_s(refs.1) {
+                        armed.set(true);
+                    }
+                    if sl > T::from_f64(AT_REST_M_S)
+                        && s[0] * d[0] + s[1] * d[1] + s[2] * d[2] > T::ZERO
+                    {
+                        dir.set([s[0] / sl, s[1] / sl, s[2] / sl]);
+                    }
+                }
+                ControlFlow::<core::convert::Infallible>::Continue(())
+            },
+            remaining,
+        )
+        .map_err(RollingError::Integration)?;
+        out.evaluations = out.evaluations.saturating_add(run.evaluations);
+        out.steps = out.steps.saturating_add(run.steps);
+        let (te, ye) = match run.ended {
+            Ended::Event { t, y } => (t, y),
+            Ended::Horizon { .. } => {
+                if rolling {
+                    out.regime.roll_s += limits.horizon_s - t;
+                } else {
+                    out.regime.slide_s += limits.horizon_s - t;
+                }
+                return Ok(out);
+            }
+            Ended::Stopped { why, .. } => match why {},
+        };
+        if rolling {
+            out.regime.roll_s += te - t;
+        } else {
+            out.regime.slide_s += te - t;
+        }
+        let e = events(sc, m, te, &ye, now(dir.get()), armed.get(), refs);
+        match fired(&e) {
+            0 => {
+                let mut back = ye;
+                back[0] = T::ZERO;
+                out.end = WallEnd::Bottom(te, back);
+                return Ok(out);
+            }
+            1 => {
+                out.end = WallEnd::Lip(
+                    te,
+                    norm(&wall_forces(sc, m, te, &ye, now(dir.get())).velocity_m_s),
+                );
+                return Ok(out);
+            }
+            2 if m.over_edge(ye[0]) => {
+                // Airborne from the lip's edge, outwards: over the lip.
+                out.end = WallEnd::Lip(
+                    te,
+                    norm(&wall_forces(sc, m, te, &ye, now(dir.get())).velocity_m_s),
+                );
+                return Ok(out);
+            }
+            2 => {
+                out.end = WallEnd::LiftsOff(te);
+                return Ok(out);
+            }
+            _ => {
+                must_slide = rolling;
+                t = te;
+                y = if rolling { ye } else { no_slip(sc, m, te, &ye) };
+            }
+        }
+    }
+}

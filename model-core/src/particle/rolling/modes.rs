@@ -1,0 +1,451 @@
+//! The granule that rolls or slides on the flat bottom of the tilted, precessing bowl
+//! (docs/model.md §10): it rolls ([`super::equations`], rolling resistance as there) while the
+//! friction rolling needs stays within `mu_s N`, and slides ([`super::slide`], Coulomb friction
+//! `mu_s N` against the slip, the spin driven by its torque) otherwise. Each change of mode is an
+//! event of the project's integrators ([`crate::ode::system`]), located on the step's
+//! interpolant like the rim, and the run restarts from there in the other mode, so no step
+//! straddles a kink of the right-hand side:
+//!
+//! * roll -> slide where `|f_t| - mu_s N` reaches zero from below; the slip then starts
+//!   against `f_t` (a friction short of `f_t` by `df` gives `dv_c/dt = -df / (m (1 - k2))`);
+//! * slide -> roll where the slip reaches zero (its component along its last direction turns
+//!   negative), if rolling then needs no more than `mu_s N`; otherwise the granule keeps sliding
+//!   against the friction rolling would need;
+//! * the rim (the centre's contact point at radius `R`) and lift-off (`N` reaching zero) in
+//!   either mode.
+
+use core::cell::Cell;
+use core::convert::Infallible;
+use core::ops::ControlFlow;
+
+use super::equations::{AT_REST_M_S, forces};
+use super::slide::{
+    SlideState, from_rolling, needed_friction_m_s2, slide_forces, slip_m_s, to_rolling,
+};
+use super::{HORIZON_S, MAX_STEPS, RollingError, RollingMethod, RollingScene, SystemLimits};
+use crate::Real;
+use crate::ode::system::{self, Ended, Run, SystemError};
+
+/// How the granule moves on the bottom.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Mode {
+    /// Rolling without slip.
+    Roll,
+    /// Sliding: the contact point slips.
+    Slide,
+}
+
+/// The time a release spent in each mode, s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Regime<T> {
+    /// Rolling, s.
+    pub roll_s: T,
+    /// Sliding, s.
+    pub slide_s: T,
+}
+
+impl<T: Real> Regime<T> {
+    /// Each mode's share of the time (0 and 0 for a release that never moved).
+    pub fn shares(&self) -> (T, T) {
+        let total = self.roll_s + self.slide_s;
+        if total > T::ZERO {
+            (self.roll_s / total, self.slide_s / total)
+        } else {
+            (T::ZERO, T::ZERO)
+        }
+    }
+}
+
+/// What happens to one granule that may roll or slide.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ModesOutcome<T> {
+    /// It reaches the rim.
+    Leaves {
+        /// Residence time `T`, s.
+        residence_time_s: T,
+        /// Speed of its centre relative to the bowl at the rim, m/s.
+        exit_speed_m_s: T,
+    },
+    /// Released at rest, held there (rolling resistance within what it can give, static
+    /// friction within `mu_s N`), and the forces never change.
+    Held,
+    /// The normal force reached zero at this time, s: it leaves the bottom.
+    LiftsOff {
+        /// s.
+        time_s: T,
+    },
+    /// Still in the bowl at the horizon, s.
+    NotLeftBy {
+        /// s.
+        horizon_s: T,
+    },
+}
+
+/// One release's outcome, the time it spent in each mode, and what it cost.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModesReport<T> {
+    /// The outcome.
+    pub outcome: ModesOutcome<T>,
+    /// Time in each mode up to the outcome, s.
+    pub regime: Regime<T>,
+    /// Changes of mode.
+    pub switches: u32,
+    /// Right-hand-side evaluations.
+    pub evaluations: u32,
+    /// Accepted steps.
+    pub steps: u32,
+    /// The state where it left or lifted off, in the sliding form (the start state otherwise):
+    /// where a bowl's wall takes over from the bottom.
+    pub end_state: SlideState<T>,
+}
+
+/// The most changes of mode one release may take: a granule at the stick-slip threshold can
+/// switch at every step; beyond this it is reported as a step limit, not followed forever.
+pub const MAX_SWITCHES: u32 = 100_000;
+
+/// One release at azimuth `beta_rad` (as [`super::residence`]: at rest in the bowl at `ri`,
+/// `(x, y) = ri (-cos beta, -sin beta)`), rolling or sliding, within [`HORIZON_S`] and
+/// [`MAX_STEPS`].
+pub fn residence_roll_or_slide<T: Real>(
+    scene: &RollingScene<T>,
+    beta_rad: T,
+    method: RollingMethod<T>,
+) -> Result<ModesReport<T>, RollingError> {
+    let limits = SystemLimits {
+        horizon_s: T::from_f64(HORIZON_S),
+        max_steps: MAX_STEPS,
+    };
+    roll_or_slide_within(scene, beta_rad, method, limits)
+}
+
+/// [`residence_roll_or_slide`] within the caller's horizon and step cap.
+pub fn roll_or_slide_within<T: Real>(
+    scene: &RollingScene<T>,
+    beta_rad: T,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+) -> Result<ModesReport<T>, RollingError> {
+    scene.validate()?;
+    if !beta_rad.is_finite() {
+        return Err(RollingError::InvalidAzimuth);
+    }
+    let y0 = [
+        -scene.ri_m * beta_rad.cos(),
+        -scene.ri_m * beta_rad.sin(),
+        T::ZERO,
+        T::ZERO,
+        T::ZERO,
+    ];
+    let start = forces(scene, T::ZERO, &y0);
+    let (ft, normal) = needed_friction_m_s2(scene, T::ZERO, &from_rolling(&y0));
+    let fits = (ft[0] * ft[0] + ft[1] * ft[1]).sqrt() <= scene.sliding_friction * normal;
+    if start.held && fits && scene.stationary() {
+        return Ok(ModesReport {
+            outcome: ModesOutcome::Held,
+            regime: Regime {
+                roll_s: T::ZERO,
+                slide_s: T::ZERO,
+            },
+            switches: 0,
+            evaluations: 1,
+            steps: 0,
+            end_state: from_rolling(&y0),
+        });
+    }
+    run_from(scene, T::ZERO, from_rolling(&y0), method, limits)
+}
+
+/// Which mode a state at `t` is in, and for a slide the direction its slip takes.
+enum Next<T> {
+    Roll([T; 5]),
+    Slide(SlideState<T>, [T; 2]),
+    LiftsOff,
+}
+
+/// `must_slide`: the roll -> slide event just fired, located where rolling needs `mu_s N` to
+/// the location's accuracy; judging again there could find it a hair below and roll on from
+/// the same instant, one step at a time.
+fn next_mode<T: Real>(
+    scene: &RollingScene<T>,
+    t: T,
+    y: &SlideState<T>,
+    must_slide: bool,
+) -> Next<T> {
+    let slip = slip_m_s(y);
+    let speed = (slip[0] * slip[0] + slip[1] * slip[1]).sqrt();
+    if speed > T::from_f64(AT_REST_M_S) {
+        return Next::Slide(*y, [slip[0] / speed, slip[1] / speed]);
+    }
+    let rolling = to_rolling(y);
+    let no_slip = from_rolling(&rolling);
+    let (ft, normal) = needed_friction_m_s2(scene, t, &no_slip);
+    if normal <= T::ZERO {
+        return Next::LiftsOff;
+    }
+    let need = (ft[0] * ft[0] + ft[1] * ft[1]).sqrt();
+    let fits = need <= scene.sliding_friction * normal;
+    if (fits && !must_slide) || need <= T::ZERO {
+        return Next::Roll(rolling);
+    }
+    // Rolling needs more than the contact gives: the slip starts against that friction.
+    Next::Slide(no_slip, [-ft[0] / need, -ft[1] / need])
+}
+
+/// The rolling state's roll -> slide, rim and lift-off events, each made dimensionless and
+/// negative inside: the run stops where the first of them reaches zero.
+fn roll_events<T: Real>(scene: &RollingScene<T>, t: T, y: &[T; 5], reference: T) -> [T; 3] {
+    let (ft, normal) = needed_friction_m_s2(scene, t, &from_rolling(y));
+    let rim = scene.rim_radius_m;
+    [
+        (y[0] * y[0] + y[1] * y[1]) / (rim * rim) - T::ONE,
+        ((ft[0] * ft[0] + ft[1] * ft[1]).sqrt() - scene.sliding_friction * normal) / reference,
+        -normal / reference,
+    ]
+}
+
+/// The slip below which a slide has ended, in units of the scene's speed: a few roundings of
+/// it, so that the end is located as exactly as the slip's zero itself (a slip that falls
+/// linearly at `mu_s g / (1 - k2)` reaches this 1e-16 s before its zero).
+const STUCK: f64 = 64.0;
+
+/// The sliding state's rim, slip-end and lift-off events (as [`roll_events`]). The slip ends
+/// where it turns against its last direction (it passes through zero in a step) or, once it
+/// has been above twice [`STUCK`] roundings (`armed`), where it falls below that: a slip
+/// that shrinks while its direction turns (the needed friction near `mu_s N`) makes the
+/// equations stiff as it vanishes (the direction turns at a rate `|f| / |v_c|`), so the steps
+/// shrink with it and it would never be reached by steps alone.
+fn slide_events<T: Real>(
+    scene: &RollingScene<T>,
+    t: T,
+    y: &SlideState<T>,
+    dir: [T; 2],
+    armed: bool,
+    refs: (T, T),
+) -> [T; 3] {
+    let (reference, speed_ref) = refs;
+    let f = slide_forces(scene, t, y, dir);
+    let rim = scene.rim_radius_m;
+    let slip = f.slip_m_s;
+    let reversed = -(slip[0] * dir[0] + slip[1] * dir[1]);
+    let stuck = if armed {
+        let speed = (slip[0] * slip[0] + slip[1] * slip[1]).sqrt();
+        reversed.max(stuck_m_s(speed_ref) - speed)
+    } else {
+        reversed
+    };
+    [
+        (y[0] * y[0] + y[1] * y[1]) / (rim * rim) - T::ONE,
+        stuck / speed_ref,
+        -f.normal_m_s2 / reference,
+    ]
+}
+
+pub(crate) fn stuck_m_s<T: Real>(speed_ref: T) -> T {
+    T::from_f64(STUCK) * T::EPSILON * speed_ref
+}
+
+pub(crate) fn max3<T: Real>(v: [T; 3]) -> T {
+    v[0].max(v[1]).max(v[2])
+}
+
+/// The event of the three that fired: the one closest to zero from below (the others are
+/// still negative where the first reaches zero).
+pub(crate) fn fired<T: Real>(v: &[T]) -> usize {
+    let mut best = 0;
+    for i in 1..v.len() {
+        if v[i] > v[best] {
+            best = i;
+        }
+    }
+    best
+}
+
+/// Integrates one mode's segment from `(t0, y0)` with the method, stopping at the first event.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn segment<T: Real, const N: usize>(
+    rhs: impl FnMut(T, &[T; N]) -> [T; N],
+    t0: T,
+    y0: [T; N],
+    method: RollingMethod<T>,
+    scales: (T, T),
+    event: impl Fn(T, &[T; N]) -> T,
+    check: impl FnMut(T, &[T; N]) -> ControlFlow<Infallible>,
+    limits: SystemLimits<T>,
+) -> Result<Run<T, N, Infallible>, SystemError> {
+    let (length, speed) = scales;
+    match method {
+        RollingMethod::Dp54 { rtol } => {
+            // Lengths, velocities and spins at their own scales (as the rolling model's runs).
+            let atol: [T; N] =
+                core::array::from_fn(|i| if i < 2 { rtol * length } else { rtol * speed });
+            let h0 = T::from_f64(1e-3) * length / speed;
+            system::dp54_timed(rhs, t0, y0, rtol, atol, h0, event, check, limits)
+        }
+        RollingMethod::Rk4 { step_s } => {
+            system::rk4_timed(rhs, t0, y0, step_s, event, check, limits)
+        }
+    }
+}
+
+/// The run from a state at `t0` in the sliding form (a rolling state has no slip), whatever
+/// its mode; the modes and their events as the module says.
+pub(crate) fn run_from<T: Real>(
+    scene: &RollingScene<T>,
+    t0: T,
+    y0: SlideState<T>,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+) -> Result<ModesReport<T>, RollingError> {
+    let rim = scene.rim_radius_m;
+    let spin = scene.combined_speed_rad_s();
+    let w1l = scene.precession_rad_s * scene.precession_rad_s * scene.rod_length_m;
+    // Scales that make the events dimensionless: accelerations and speeds of the scene.
+    let reference = scene.g_m_s2 + spin * spin * rim + w1l + T::ONE;
+    let refs = (reference, (reference * rim).sqrt());
+    let scales = (rim, rim * spin.max(T::ONE));
+    let mut report = ModesReport {
+        outcome: ModesOutcome::NotLeftBy {
+            horizon_s: limits.horizon_s,
+        },
+        regime: Regime {
+            roll_s: T::ZERO,
+            slide_s: T::ZERO,
+        },
+        switches: 0,
+        evaluations: 0,
+        steps: 0,
+        end_state: y0,
+    };
+    let (mut t, mut y) = (t0, y0);
+    let mut previous: Option<Mode> = None;
+    let mut must_slide = false;
+    loop {
+        let remaining = SystemLimits {
+            horizon_s: limits.horizon_s,
+            max_steps: limits.max_steps.saturating_sub(report.steps),
+        };
+        if remaining.max_steps == 0 || report.switches > MAX_SWITCHES {
+            return Err(RollingError::Integration(SystemError::StepLimit));
+        }
+        let next = next_mode(scene, t, &y, must_slide);
+        let mode = match next {
+            Next::Roll(_) => Some(Mode::Roll),
+            Next::Slide(..) => Some(Mode::Slide),
+            Next::LiftsOff => None,
+        };
+        if previous.is_some() && mode.is_some() && previous != mode {
+            report.switches += 1;
+        }
+        previous = mode;
+        let (ended, which) = match next {
+            Next::LiftsOff => {
+                report.outcome = ModesOutcome::LiftsOff { time_s: t };
+                return Ok(report);
+            }
+            Next::Roll(yr) => {
+                let run = segment(
+                    |t, y: &[T; 5]| forces(scene, t, y).derivative,
+                    t,
+                    yr,
+                    method,
+                    scales,
+                    |t, y: &[T; 5]| max3(roll_events(scene, t, y, reference)),
+                    |_, _| ControlFlow::Continue(()),
+                    remaining,
+                )
+                .map_err(RollingError::Integration)?;
+                report.evaluations = report.evaluations.saturating_add(run.evaluations);
+                report.steps = report.steps.saturating_add(run.steps);
+                match run.ended {
+                    Ended::Event { t: te, y: ye } => {
+                        let which = fired(&roll_events(scene, te, &ye, reference));
+                        report.regime.roll_s += te - t;
+                        ((te, from_rolling(&ye), ye[2], ye[3]), which)
+                    }
+                    Ended::Horizon { .. } => {
+                        report.regime.roll_s += limits.horizon_s - t;
+                        return Ok(report);
+                    }
+                    Ended::Stopped { why, .. } => match why {},
+                }
+            }
+            Next::Slide(ys, dir0) => {
+                let dir = Cell::new(dir0);
+                let slip0 = slip_m_s(&ys);
+                let stuck = stuck_m_s(refs.1);
+                let armed = Cell::new(
+                    slip0[0] * slip0[0] + slip0[1] * slip0[1] > T::from_f64(4.0) * stuck * stuck,
+                );
+                let run = segment(
+                    |t, y: &SlideState<T>| slide_forces(scene, t, y, dir.get()).derivative,
+                    t,
+                    ys,
+                    method,
+                    scales,
+                    |t, y: &SlideState<T>| {
+                        max3(slide_events(scene, t, y, dir.get(), armed.get(), refs))
+                    },
+                    |_, y: &SlideState<T>| {
+                        // The slip's direction for the next step (the friction opposes it).
+                        let s = slip_m_s(y);
+                        let d = dir.get();
+                        let speed = (s[0] * s[0] + s[1] * s[1]).sqrt();
+                        if speed > T::TWO * stuck {
+                            armed.set(true);
+                        }
+                        if speed > T::from_f64(AT_REST_M_S) && s[0] * d[0] + s[1] * d[1] > T::ZERO {
+                            dir.set([s[0] / speed, s[1] / speed]);
+                        }
+                        ControlFlow::Continue(())
+                    },
+                    remaining,
+                )
+                .map_err(RollingError::Integration)?;
+                report.evaluations = report.evaluations.saturating_add(run.evaluations);
+                report.steps = report.steps.saturating_add(run.steps);
+                match run.ended {
+                    Ended::Event { t: te, y: ye } => {
+                        let events = slide_events(scene, te, &ye, dir.get(), armed.get(), refs);
+                        report.regime.slide_s += te - t;
+                        let mut ye = ye;
+                        if fired(&events) == 1 {
+                            // The slip is zero here to the location's accuracy: make it
+                            // exactly so (rolling), keeping the translation.
+                            ye[4] = -ye[3];
+                            ye[5] = ye[2];
+                        }
+                        ((te, ye, ye[2], ye[3]), fired(&events))
+                    }
+                    Ended::Horizon { .. } => {
+                        report.regime.slide_s += limits.horizon_s - t;
+                        return Ok(report);
+                    }
+                    Ended::Stopped { why, .. } => match why {},
+                }
+            }
+        };
+        let (te, ye, ux, uy) = ended;
+        if which != 1 {
+            report.end_state = ye;
+        }
+        match which {
+            0 => {
+                report.outcome = ModesOutcome::Leaves {
+                    residence_time_s: te - t0,
+                    exit_speed_m_s: (ux * ux + uy * uy).sqrt(),
+                };
+                return Ok(report);
+            }
+            2 => {
+                report.outcome = ModesOutcome::LiftsOff { time_s: te };
+                return Ok(report);
+            }
+            _ => {
+                must_slide = previous == Some(Mode::Roll);
+                t = te;
+                y = ye;
+            }
+        }
+    }
+}

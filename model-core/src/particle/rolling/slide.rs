@@ -1,0 +1,133 @@
+//! The equations of motion of a sphere *sliding* on the flat bottom of the tilted, precessing
+//! bowl, in the bowl's frame (docs/model.md §10). The paper (Eq. 1, 3 to 5) has the granule roll
+//! and lets the measured sliding coefficient 0.4 act as a rolling resistance; at the rig's 60 deg
+//! tilt rolling needs more friction than 0.4 of the normal force, so the contact slips: Coulomb
+//! friction `mu_s N` acts against the slip velocity of the contact point and its torque drives
+//! the spin, which is then a free state (three components) instead of following the rolling
+//! constraint.
+//!
+//! Frame, `Omega`, `alpha`, `gB`, `A_O`, `p`, `C`, `E` and `N` as in [`super::equations`]. State
+//! `[x, y, ux, uy, sx, sy, sz]`: the contact point, the centre's velocity relative to the bowl,
+//! and `s = a w` with `w` the sphere's angular velocity relative to the bowl (m/s, so that the
+//! granule's radius `a` drops out as it does when rolling).
+//!
+//! ```text
+//! v_c   = u - s x n = (ux - sy, uy + sx)                 slip of the contact point on the bowl
+//! f/m   = -mu_s (N/m) v_c/|v_c|                           Coulomb, against the slip
+//! du/dt = (gB - A_O - E - C - 2 Omega x u)_xy + f/m       Newton in the rotating frame
+//! ds/dt = -(k2/(1 - k2)) n x f/m - a alpha - Omega x s    Euler: I dw_abs/dt = -a n x f,
+//!                                                          dw_abs/dt = dw/dt + alpha + Omega x w
+//! ```
+//!
+//! `m a^2 / I = k2 / (1 - k2)` turns the torque into the spin's rate. Rolling is the special
+//! case `v_c = 0` with `f` the friction [`super::equations::forces`] says rolling needs; a test
+//! holds the two sets of equations to each other there. A change of the friction by `df`
+//! changes `dv_c/dt` by `df / (m (1 - k2))` in every direction, so a granule whose rolling
+//! needs more than `mu_s N` slips against that needed friction, and a slip that reaches zero
+//! stays rolling exactly when rolling then needs no more than `mu_s N` (`super::modes`).
+
+use super::RollingScene;
+use super::equations::{AT_REST_M_S, cross, frame};
+use crate::Real;
+
+/// The sliding state: `[x, y, ux, uy, sx, sy, sz]`, m and m/s.
+pub type SlideState<T> = [T; 7];
+
+/// Everything the sliding equations give at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlideForces<T> {
+    /// The state's time derivative.
+    pub derivative: SlideState<T>,
+    /// Normal force per unit mass, m/s^2 (the granule lifts off where it is <= 0).
+    pub normal_m_s2: T,
+    /// The contact point's slip velocity relative to the bowl, m/s.
+    pub slip_m_s: [T; 2],
+}
+
+/// The slip velocity of a sliding state, m/s.
+pub fn slip_m_s<T: Real>(y: &SlideState<T>) -> [T; 2] {
+    [y[2] - y[5], y[3] + y[4]]
+}
+
+/// The right-hand side of the sliding granule at `(t, y)`. `slip_dir` is the unit direction the
+/// slip had at the last accepted step (or, at the start of a slide, the direction it starts
+/// in): the friction acts against it wherever the slip is below [`AT_REST_M_S`] or has turned
+/// against it, so the right-hand side stays continuous through the step in which the slip
+/// reaches zero, and the integrator's interpolant locates that instant (`super::modes`).
+pub fn slide_forces<T: Real>(
+    s: &RollingScene<T>,
+    t: T,
+    y: &SlideState<T>,
+    slip_dir: [T; 2],
+) -> SlideForces<T> {
+    let [x, yy, ux, uy, sx, sy, sz] = *y;
+    let f = frame(s, t);
+    let o = f.omega;
+    let a = s.particle_radius_m;
+    let p = [x, yy, a];
+    let o_dot_p = o[0] * p[0] + o[1] * p[1] + o[2] * p[2];
+    let o2 = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
+    let c = [
+        o[0] * o_dot_p - o2 * p[0],
+        o[1] * o_dot_p - o2 * p[1],
+        o[2] * o_dot_p - o2 * p[2],
+    ];
+    let e = cross(&f.alpha, &p);
+    // The same normal force as rolling (docs/model.md §9): it does not depend on the spin.
+    let normal = -f.gravity[2] + f.carrier[2] + e[2] + c[2] + T::TWO * (o[0] * uy - o[1] * ux);
+    let slip = slip_m_s(y);
+    let speed = (slip[0] * slip[0] + slip[1] * slip[1]).sqrt();
+    let along = slip[0] * slip_dir[0] + slip[1] * slip_dir[1];
+    let dir = if speed > T::from_f64(AT_REST_M_S) && along > T::ZERO {
+        [slip[0] / speed, slip[1] / speed]
+    } else {
+        slip_dir
+    };
+    let fric = s.sliding_friction * normal.max(T::ZERO);
+    let fm = [-fric * dir[0], -fric * dir[1]];
+    let ou = cross(&o, &[ux, uy, T::ZERO]);
+    let dux = f.gravity[0] - f.carrier[0] - e[0] - c[0] - T::TWO * ou[0] + fm[0];
+    let duy = f.gravity[1] - f.carrier[1] - e[1] - c[1] - T::TWO * ou[1] + fm[1];
+    // ds/dt = -(k2/(1-k2)) n x f/m - a alpha - Omega x s, with n x f = (-fy, fx, 0).
+    let ratio = s.k2 / (T::ONE - s.k2);
+    let os = cross(&o, &[sx, sy, sz]);
+    let dsx = ratio * fm[1] - a * f.alpha[0] - os[0];
+    let dsy = -ratio * fm[0] - a * f.alpha[1] - os[1];
+    let dsz = -a * f.alpha[2] - os[2];
+    SlideForces {
+        derivative: [ux, uy, dux, duy, dsx, dsy, dsz],
+        normal_m_s2: normal,
+        slip_m_s: slip,
+    }
+}
+
+/// A rolling state `[x, y, ux, uy, sig]` as a sliding one: rolling means no slip, so
+/// `s x n = u`, i.e. `sx = -uy`, `sy = ux`, and the spin about the axis is `sig`.
+pub fn from_rolling<T: Real>(y: &[T; 5]) -> SlideState<T> {
+    [y[0], y[1], y[2], y[3], -y[3], y[2], y[4]]
+}
+
+/// A sliding state whose slip has reached zero as a rolling one.
+pub fn to_rolling<T: Real>(y: &SlideState<T>) -> [T; 5] {
+    [y[0], y[1], y[2], y[3], y[6]]
+}
+
+/// The friction per unit mass a granule without slip at `(t, y)` needs to keep from slipping,
+/// m/s^2, and the normal force per unit mass: `-(1 - k2) A` with `A` the slip's acceleration
+/// when no friction acts (`dv_c/dt = A + f / (m (1 - k2))`). Without rolling resistance this
+/// is the rolling model's `f_t`; with it, it leaves out the resistance, which the sliding
+/// contact does not have, so that a slide starts exactly where these equations make the slip
+/// grow, along `A`.
+pub fn needed_friction_m_s2<T: Real>(s: &RollingScene<T>, t: T, y: &SlideState<T>) -> ([T; 2], T) {
+    let free = RollingScene {
+        sliding_friction: T::ZERO,
+        ..*s
+    };
+    let f = slide_forces(&free, t, y, [T::ZERO, T::ZERO]);
+    let d = f.derivative;
+    let scale = -(T::ONE - s.k2);
+    (
+        [scale * (d[2] - d[5]), scale * (d[3] + d[4])],
+        f.normal_m_s2,
+    )
+}
