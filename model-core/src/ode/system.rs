@@ -134,30 +134,13 @@ pub fn dp54<T: Real, const N: usize, S>(
     dp54_with(f, t0, y0, rtol, atol, h0, &event, check, limits)
 }
 
-/// [`dp54`] with an event that depends on the time and on the caller's data (a mode switch of
-/// the granule: the friction it needs reaching what the contact gives, its slip reversing),
-/// given by its value alone; the crossing is located on the dense output as the rim's is, with
-/// the slope by a central difference along the interpolant (Newton is safeguarded by
-/// bisection, so an approximate slope costs iterations, not accuracy).
-#[allow(clippy::too_many_arguments)]
-pub fn dp54_timed<T: Real, const N: usize, S>(
-    f: impl FnMut(T, &[T; N]) -> [T; N],
-    t0: T,
-    y0: [T; N],
-    rtol: T,
-    atol: [T; N],
-    h0: T,
-    event: impl Fn(T, &[T; N]) -> T,
-    check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
-    limits: SystemLimits<T>,
-) -> Result<Run<T, N, S>, SystemError> {
-    let event = timed(event);
-    dp54_with(f, t0, y0, rtol, atol, h0, &event, check, limits)
-}
-
-/// A value-only event as `(g, g')` along `(dt, dy)` (per unit theta of a step): the slope by a
-/// central difference over `sqrt(eps)` of the step.
-fn timed<T: Real, const N: usize>(
+/// A value-only event as `(g, g')` along `(dt, dy)` (per unit theta of a step), for
+/// [`dp54_with`] and [`rk4_with`]: an event that depends on the time and on the caller's data (a
+/// mode switch of the granule: the friction it needs reaching what the contact gives, its slip
+/// reversing), given by its value alone; the crossing is located on the interpolant as the
+/// rim's is, with the slope by a central difference over `sqrt(eps)` of the step (Newton is
+/// safeguarded by bisection, so an approximate slope costs iterations, not accuracy).
+pub(crate) fn timed<T: Real, const N: usize>(
     g: impl Fn(T, &[T; N]) -> T,
 ) -> impl Fn(T, &[T; N], T, &[T; N]) -> (T, T) {
     move |t: T, y: &[T; N], dt: T, dy: &[T; N]| {
@@ -175,8 +158,9 @@ fn timed<T: Real, const N: usize>(
     }
 }
 
+/// [`dp54`] with an event of the time, the state and the step's direction (as [`timed`] makes).
 #[allow(clippy::too_many_arguments)]
-fn dp54_with<T: Real, const N: usize, S>(
+pub(crate) fn dp54_with<T: Real, const N: usize, S>(
     mut f: impl FnMut(T, &[T; N]) -> [T; N],
     t0: T,
     y0: [T; N],
@@ -289,21 +273,8 @@ pub fn rk4<T: Real, const N: usize, S>(
     rk4_with(f, t0, y0, h, &event, check, limits)
 }
 
-/// [`rk4`] with a value-only event that depends on the time (as [`dp54_timed`]).
-pub fn rk4_timed<T: Real, const N: usize, S>(
-    f: impl FnMut(T, &[T; N]) -> [T; N],
-    t0: T,
-    y0: [T; N],
-    h: T,
-    event: impl Fn(T, &[T; N]) -> T,
-    check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
-    limits: SystemLimits<T>,
-) -> Result<Run<T, N, S>, SystemError> {
-    let event = timed(event);
-    rk4_with(f, t0, y0, h, &event, check, limits)
-}
-
-fn rk4_with<T: Real, const N: usize, S>(
+/// [`rk4`] with an event of the time, the state and the step's direction (as [`timed`] makes).
+pub(crate) fn rk4_with<T: Real, const N: usize, S>(
     mut f: impl FnMut(T, &[T; N]) -> [T; N],
     t0: T,
     y0: [T; N],

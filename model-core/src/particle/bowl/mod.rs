@@ -18,7 +18,7 @@ pub mod wall_run;
 
 use crate::Real;
 use crate::ode::system::{SystemError, SystemLimits};
-use crate::particle::rolling::modes::{MAX_SWITCHES, ModesOutcome, Regime, run_from};
+use crate::particle::rolling::modes::{MAX_SWITCHES, ModesOutcome, Regime, Tally, run_from};
 use crate::particle::rolling::{RollingError, RollingMethod, RollingScene};
 use wall::{Meridian, onto_bottom, onto_wall};
 use wall_run::{WallEnd, stay};
@@ -65,29 +65,8 @@ pub enum BowlError {
     InvalidHorizon,
 }
 
-/// What happens to one granule in the bowl.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum BowlOutcome<T> {
-    /// Its centre passes the lip's radius.
-    Leaves {
-        /// Residence time, s.
-        residence_time_s: T,
-        /// Speed relative to the bowl there, m/s.
-        exit_speed_m_s: T,
-    },
-    /// Released at rest, held there, and the forces never change.
-    Held,
-    /// Its normal force reached zero at this time, s (flight is not modelled).
-    LiftsOff {
-        /// s.
-        time_s: T,
-    },
-    /// Still in the bowl at the horizon (held by the wall, or slower), s.
-    Inside {
-        /// s.
-        horizon_s: T,
-    },
-}
+/// What happens to one granule in the bowl: as on the bottom alone.
+pub type BowlOutcome<T> = ModesOutcome<T>;
 
 /// One release in the bowl.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,6 +85,17 @@ pub struct BowlReport<T> {
     pub evaluations: u32,
     /// Accepted steps.
     pub steps: u32,
+}
+
+impl<T: Real> BowlReport<T> {
+    /// Adds a stay's time in each mode, changes and cost.
+    fn add(&mut self, stay: &Tally<T>) {
+        self.regime.roll_s += stay.regime.roll_s;
+        self.regime.slide_s += stay.regime.slide_s;
+        self.switches = self.switches.saturating_add(stay.switches);
+        self.evaluations = self.evaluations.saturating_add(stay.evaluations);
+        self.steps = self.steps.saturating_add(stay.steps);
+    }
 }
 
 impl<T: Real> BowlShape<T> {
@@ -231,25 +221,18 @@ pub fn residence<T: Real>(
     let mut on_bottom = first;
     let mut t = T::ZERO;
     loop {
-        report.regime.roll_s += on_bottom.regime.roll_s;
-        report.regime.slide_s += on_bottom.regime.slide_s;
-        report.switches = report.switches.saturating_add(on_bottom.switches);
-        report.evaluations = report.evaluations.saturating_add(on_bottom.evaluations);
-        report.steps = report.steps.saturating_add(on_bottom.steps);
+        report.add(&on_bottom.tally);
         let (te, exit_speed) = match on_bottom.outcome {
             ModesOutcome::Leaves {
                 residence_time_s,
                 exit_speed_m_s,
             } => (t + residence_time_s, exit_speed_m_s),
-            ModesOutcome::Held => {
-                report.outcome = BowlOutcome::Held;
+            // Still on the bottom at the horizon: the report's outcome already says so.
+            ModesOutcome::Inside { .. } => return Ok(report),
+            held_or_lifted => {
+                report.outcome = held_or_lifted;
                 return Ok(report);
             }
-            ModesOutcome::LiftsOff { time_s } => {
-                report.outcome = BowlOutcome::LiftsOff { time_s };
-                return Ok(report);
-            }
-            ModesOutcome::NotLeftBy { .. } => return Ok(report),
         };
         let Some(m) = meridian else {
             report.outcome = BowlOutcome::Leaves {
@@ -305,12 +288,8 @@ pub fn residence<T: Real>(
         }
         let w =
             stay(sc, &m, te, entry, method, remaining, MAX_SWITCHES).map_err(BowlError::Scene)?;
-        report.regime.roll_s += w.regime.roll_s;
-        report.regime.slide_s += w.regime.slide_s;
-        report.on_wall_s += w.regime.roll_s + w.regime.slide_s;
-        report.switches = report.switches.saturating_add(w.switches);
-        report.evaluations = report.evaluations.saturating_add(w.evaluations);
-        report.steps = report.steps.saturating_add(w.steps);
+        report.add(&w.tally);
+        report.on_wall_s += w.tally.regime.roll_s + w.tally.regime.slide_s;
         match w.end {
             WallEnd::Lip(tl, speed) => {
                 report.outcome = BowlOutcome::Leaves {

@@ -209,7 +209,7 @@ fn a_bare_rim_is_the_flat_disc() {
             panic!("{bowl:?}")
         };
         assert_eq!(t, residence_time_s);
-        assert_eq!(bowl.regime, flat.regime);
+        assert_eq!(bowl.regime, flat.tally.regime);
         assert_eq!(bowl.on_wall_s, 0.0);
     }
 }

@@ -8,9 +8,11 @@ use core::ops::ControlFlow;
 
 use super::wall::{Contact, Meridian, WallState, wall_forces};
 use crate::Real;
-use crate::ode::system::{Ended, SystemError, SystemLimits};
+use crate::ode::system::SystemLimits;
 use crate::particle::rolling::equations::AT_REST_M_S;
-use crate::particle::rolling::modes::{Regime, fired, segment, stuck_m_s};
+use crate::particle::rolling::modes::{
+    Mode, Tally, fired, follow_slip, scene_scales, segment, stuck_m_s,
+};
 use crate::particle::rolling::{RollingError, RollingMethod, RollingScene};
 
 /// How a stay on the wall ended.
@@ -31,14 +33,8 @@ pub enum WallEnd<T> {
 pub struct WallStay<T> {
     /// How it ended.
     pub end: WallEnd<T>,
-    /// Time rolling and sliding on the wall, s.
-    pub regime: Regime<T>,
-    /// Changes of contact.
-    pub switches: u32,
-    /// Right-hand sides.
-    pub evaluations: u32,
-    /// Accepted steps.
-    pub steps: u32,
+    /// Time rolling and sliding on the wall, changes of contact, cost.
+    pub tally: Tally<T>,
 }
 
 fn norm<T: Real>(v: &[T; 3]) -> T {
@@ -141,42 +137,23 @@ pub fn stay<T: Real>(
     limits: SystemLimits<T>,
     max_switches: u32,
 ) -> Result<WallStay<T>, RollingError> {
-    let rim = sc.rim_radius_m;
-    let spin = sc.combined_speed_rad_s();
-    let w1l = sc.precession_rad_s * sc.precession_rad_s * sc.rod_length_m;
-    let reference = sc.g_m_s2 + spin * spin * rim + w1l + T::ONE;
-    let refs = (reference, (reference * rim).sqrt());
-    let scales = (rim, rim * spin.max(T::ONE));
+    let (refs, scales) = scene_scales(sc);
     let mut out = WallStay {
         end: WallEnd::Horizon,
-        regime: Regime {
-            roll_s: T::ZERO,
-            slide_s: T::ZERO,
-        },
-        switches: 0,
-        evaluations: 0,
-        steps: 0,
+        tally: Tally::new(),
     };
     let (mut t, mut y) = (t0, y0);
     let mut must_slide = false;
-    let mut previous: Option<bool> = None;
+    let mut previous: Option<Mode> = None;
     loop {
-        let remaining = SystemLimits {
-            horizon_s: limits.horizon_s,
-            max_steps: limits.max_steps.saturating_sub(out.steps),
-        };
-        if remaining.max_steps == 0 || out.switches > max_switches {
-            return Err(RollingError::Integration(SystemError::StepLimit));
-        }
+        let remaining = out.tally.remaining(limits, max_switches)?;
         let Some(contact) = next_contact(sc, m, t, &y, must_slide) else {
             out.end = WallEnd::LiftsOff(t);
             return Ok(out);
         };
         let rolling = matches!(contact, Contact::Roll);
-        if previous.is_some_and(|p| p != rolling) {
-            out.switches += 1;
-        }
-        previous = Some(rolling);
+        let mode = if rolling { Mode::Roll } else { Mode::Slide };
+        out.tally.enter(&mut previous, mode);
         if rolling {
             y = no_slip(sc, m, t, &y);
         }
@@ -192,10 +169,11 @@ pub fn stay<T: Real>(
                 Contact::Slide(d)
             }
         };
-        let run = segment(
+        let Some((te, ye)) = segment(
+            &mut out.tally,
+            mode,
             |t, y: &WallState<T>| wall_forces(sc, m, t, y, now(dir.get())).derivative,
-            t,
-            y,
+            (t, y),
             method,
             scales,
             |t, y: &WallState<T>| {
@@ -205,41 +183,15 @@ pub fn stay<T: Real>(
             |t, y: &WallState<T>| {
                 if !rolling {
                     let s = wall_forces(sc, m, t, y, now(dir.get())).slip_m_s;
-                    let sl = norm(&s);
-                    let d = dir.get();
-                    if sl > T::TWO * stuck_m_s(refs.1) {
-                        armed.set(true);
-                    }
-                    if sl > T::from_f64(AT_REST_M_S)
-                        && s[0] * d[0] + s[1] * d[1] + s[2] * d[2] > T::ZERO
-                    {
-                        dir.set([s[0] / sl, s[1] / sl, s[2] / sl]);
-                    }
+                    follow_slip(&s, &dir, &armed, stuck_m_s(refs.1));
                 }
-                ControlFlow::<core::convert::Infallible>::Continue(())
+                ControlFlow::Continue(())
             },
             remaining,
-        )
-        .map_err(RollingError::Integration)?;
-        out.evaluations = out.evaluations.saturating_add(run.evaluations);
-        out.steps = out.steps.saturating_add(run.steps);
-        let (te, ye) = match run.ended {
-            Ended::Event { t, y } => (t, y),
-            Ended::Horizon { .. } => {
-                if rolling {
-                    out.regime.roll_s += limits.horizon_s - t;
-                } else {
-                    out.regime.slide_s += limits.horizon_s - t;
-                }
-                return Ok(out);
-            }
-            Ended::Stopped { why, .. } => match why {},
+        )?
+        else {
+            return Ok(out);
         };
-        if rolling {
-            out.regime.roll_s += te - t;
-        } else {
-            out.regime.slide_s += te - t;
-        }
         let e = events(sc, m, te, &ye, now(dir.get()), armed.get(), refs);
         match fired(&e) {
             0 => {

@@ -86,13 +86,20 @@ pub(crate) fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
     ]
 }
 
-/// The right-hand side and the contact forces at `(t, y)`.
-pub fn forces<T: Real>(s: &RollingScene<T>, t: T, y: &State<T>) -> Forces<T> {
-    let [x, yy, ux, uy, sig] = *y;
+/// What the frame does to a granule at the contact point `(x, y)` moving at `(ux, uy)` relative
+/// to the bowl, whether it rolls or slides (the sliding equations share it): the frame at `t`,
+/// `C = Omega (Omega . p) - |Omega|^2 p` and `E = alpha x p` at the centre `p = (x, y, a)`, and
+/// the normal force per unit mass `N/m = g cos th + A_Oz + E_z + C_z + 2 (Ox uy - Oy ux)`, which
+/// does not depend on the spin, so rolling and sliding have the same (docs/model.md §9).
+pub(crate) fn at_contact<T: Real>(
+    s: &RollingScene<T>,
+    t: T,
+    xy: [T; 2],
+    u: [T; 2],
+) -> (Frame<T>, [T; 3], [T; 3], T) {
     let f = frame(s, t);
     let o = f.omega;
-    let a = s.particle_radius_m;
-    let p = [x, yy, a];
+    let p = [xy[0], xy[1], s.particle_radius_m];
     let o_dot_p = o[0] * p[0] + o[1] * p[1] + o[2] * p[2];
     let o2 = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
     let c = [
@@ -102,7 +109,16 @@ pub fn forces<T: Real>(s: &RollingScene<T>, t: T, y: &State<T>) -> Forces<T> {
     ];
     let e = cross(&f.alpha, &p);
     let g_cos = -f.gravity[2];
-    let normal = g_cos + f.carrier[2] + e[2] + c[2] + T::TWO * (o[0] * uy - o[1] * ux);
+    let normal = g_cos + f.carrier[2] + e[2] + c[2] + T::TWO * (o[0] * u[1] - o[1] * u[0]);
+    (f, c, e, normal)
+}
+
+/// The right-hand side and the contact forces at `(t, y)`.
+pub fn forces<T: Real>(s: &RollingScene<T>, t: T, y: &State<T>) -> Forces<T> {
+    let [x, yy, ux, uy, sig] = *y;
+    let (f, c, e, normal) = at_contact(s, t, [x, yy], [ux, uy]);
+    let o = f.omega;
+    let a = s.particle_radius_m;
     let k2 = s.k2;
     let spin_coupling = (T::ONE - k2) / k2;
     let d = [

@@ -228,6 +228,34 @@ pub const HORIZON_S: f64 = 60.0;
 /// Step cap of one release.
 pub const MAX_STEPS: u32 = 2_000_000;
 
+/// The limits of a release: [`HORIZON_S`] and [`MAX_STEPS`].
+pub(crate) fn default_limits<T: Real>() -> SystemLimits<T> {
+    SystemLimits {
+        horizon_s: T::from_f64(HORIZON_S),
+        max_steps: MAX_STEPS,
+    }
+}
+
+/// The release at azimuth `beta_rad` (measured from the downhill direction at `t = 0`, which is
+/// `-e1`, turning towards `-e2`), once the scene and the azimuth are checked:
+/// `(x, y) = ri (-cos beta, -sin beta)`, at rest in the bowl.
+pub(crate) fn release<T: Real>(
+    scene: &RollingScene<T>,
+    beta_rad: T,
+) -> Result<State<T>, RollingError> {
+    scene.validate()?;
+    if !beta_rad.is_finite() {
+        return Err(RollingError::InvalidAzimuth);
+    }
+    Ok([
+        -scene.ri_m * beta_rad.cos(),
+        -scene.ri_m * beta_rad.sin(),
+        T::ZERO,
+        T::ZERO,
+        T::ZERO,
+    ])
+}
+
 /// The rim in the state scaled by `1/R`: `|(x, y)|^2 - 1` and its derivative along `dy`.
 fn rim_event<T: Real>(y: &State<T>, dy: &State<T>) -> (T, T) {
     (
@@ -236,19 +264,13 @@ fn rim_event<T: Real>(y: &State<T>, dy: &State<T>) -> (T, T) {
     )
 }
 
-/// One release at azimuth `beta_rad` (measured from the downhill direction at `t = 0`, which is
-/// `-e1`, turning towards `-e2`): `(x, y) = ri (-cos beta, -sin beta)`, at rest in the bowl.
-/// Gives up after [`HORIZON_S`] and [`MAX_STEPS`].
+/// One release at azimuth `beta_rad` (as [`release`] places it). Gives up after [`HORIZON_S`] and [`MAX_STEPS`].
 pub fn residence<T: Real>(
     scene: &RollingScene<T>,
     beta_rad: T,
     method: RollingMethod<T>,
 ) -> Result<RollingReport<T>, RollingError> {
-    let limits = SystemLimits {
-        horizon_s: T::from_f64(HORIZON_S),
-        max_steps: MAX_STEPS,
-    };
-    residence_within(scene, beta_rad, method, limits)
+    residence_within(scene, beta_rad, method, default_limits())
 }
 
 /// [`residence`] within the caller's horizon and step cap (a fit that only needs to know that
@@ -260,19 +282,9 @@ pub fn residence_within<T: Real>(
     method: RollingMethod<T>,
     limits: SystemLimits<T>,
 ) -> Result<RollingReport<T>, RollingError> {
-    scene.validate()?;
-    if !beta_rad.is_finite() {
-        return Err(RollingError::InvalidAzimuth);
-    }
+    let y0 = release(scene, beta_rad)?;
     // Lengths in units of R: the event is then |r|^2 - 1 = 0 with a fixed target.
     let rim = scene.rim_radius_m;
-    let y0: State<T> = [
-        -scene.ri_m * beta_rad.cos(),
-        -scene.ri_m * beta_rad.sin(),
-        T::ZERO,
-        T::ZERO,
-        T::ZERO,
-    ];
     let start = forces(scene, T::ZERO, &y0);
     if start.held && scene.stationary() {
         return Ok(RollingReport {
@@ -390,11 +402,7 @@ pub fn residence_over_azimuths<T: Real>(
     scene: &RollingScene<T>,
     method: RollingMethod<T>,
 ) -> Result<AzimuthSummary<T>, RollingError> {
-    let limits = SystemLimits {
-        horizon_s: T::from_f64(HORIZON_S),
-        max_steps: MAX_STEPS,
-    };
-    over_azimuths_within(scene, method, limits)
+    over_azimuths_within(scene, method, default_limits())
 }
 
 /// [`residence_over_azimuths`] within the caller's horizon and step cap per release.

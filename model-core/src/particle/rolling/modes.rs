@@ -22,9 +22,9 @@ use super::equations::{AT_REST_M_S, forces};
 use super::slide::{
     SlideState, from_rolling, needed_friction_m_s2, slide_forces, slip_m_s, to_rolling,
 };
-use super::{HORIZON_S, MAX_STEPS, RollingError, RollingMethod, RollingScene, SystemLimits};
+use super::{RollingError, RollingMethod, RollingScene, SystemLimits, default_limits, release};
 use crate::Real;
-use crate::ode::system::{self, Ended, Run, SystemError};
+use crate::ode::system::{self, Ended, SystemError};
 
 /// How the granule moves on the bottom.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -57,37 +57,38 @@ impl<T: Real> Regime<T> {
     }
 }
 
-/// What happens to one granule that may roll or slide.
+/// What happens to one granule that may roll or slide, on the bottom alone or in a bowl with a
+/// wall (`bowl::BowlOutcome` is this one).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ModesOutcome<T> {
-    /// It reaches the rim.
+    /// It reaches the rim (in a bowl with a wall: its centre passes the lip's radius).
     Leaves {
         /// Residence time `T`, s.
         residence_time_s: T,
-        /// Speed of its centre relative to the bowl at the rim, m/s.
+        /// Speed of its centre relative to the bowl there, m/s.
         exit_speed_m_s: T,
     },
     /// Released at rest, held there (rolling resistance within what it can give, static
     /// friction within `mu_s N`), and the forces never change.
     Held,
-    /// The normal force reached zero at this time, s: it leaves the bottom.
+    /// The normal force reached zero at this time, s: it leaves the surface (flight is not
+    /// modelled).
     LiftsOff {
         /// s.
         time_s: T,
     },
-    /// Still in the bowl at the horizon, s.
-    NotLeftBy {
+    /// Still in the bowl at the horizon (in a bowl with a wall: held by the wall, or slower), s.
+    Inside {
         /// s.
         horizon_s: T,
     },
 }
 
-/// One release's outcome, the time it spent in each mode, and what it cost.
+/// The time a run of segments spent in each mode, its changes of mode, and what it cost (on the
+/// bottom here, on the wall in `bowl::wall_run`).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ModesReport<T> {
-    /// The outcome.
-    pub outcome: ModesOutcome<T>,
-    /// Time in each mode up to the outcome, s.
+pub struct Tally<T> {
+    /// Time in each mode, s.
     pub regime: Regime<T>,
     /// Changes of mode.
     pub switches: u32,
@@ -95,6 +96,63 @@ pub struct ModesReport<T> {
     pub evaluations: u32,
     /// Accepted steps.
     pub steps: u32,
+}
+
+impl<T: Real> Tally<T> {
+    /// Nothing spent yet.
+    pub(crate) fn new() -> Self {
+        Self {
+            regime: Regime {
+                roll_s: T::ZERO,
+                slide_s: T::ZERO,
+            },
+            switches: 0,
+            evaluations: 0,
+            steps: 0,
+        }
+    }
+
+    /// The limits left for the next segment: the caller's horizon and the steps not yet taken;
+    /// a step limit once the steps or `max_switches` changes of mode are spent.
+    pub(crate) fn remaining(
+        &self,
+        limits: SystemLimits<T>,
+        max_switches: u32,
+    ) -> Result<SystemLimits<T>, RollingError> {
+        let remaining = SystemLimits {
+            horizon_s: limits.horizon_s,
+            max_steps: limits.max_steps.saturating_sub(self.steps),
+        };
+        if remaining.max_steps == 0 || self.switches > max_switches {
+            return Err(RollingError::Integration(SystemError::StepLimit));
+        }
+        Ok(remaining)
+    }
+
+    /// Counts a change of mode when `mode` is not the `previous` segment's, and remembers it.
+    pub(crate) fn enter(&mut self, previous: &mut Option<Mode>, mode: Mode) {
+        if previous.is_some_and(|p| p != mode) {
+            self.switches += 1;
+        }
+        *previous = Some(mode);
+    }
+
+    /// Adds `dt` to the time in `mode`.
+    fn spend(&mut self, mode: Mode, dt: T) {
+        match mode {
+            Mode::Roll => self.regime.roll_s += dt,
+            Mode::Slide => self.regime.slide_s += dt,
+        }
+    }
+}
+
+/// One release's outcome, the time it spent in each mode, and what it cost.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModesReport<T> {
+    /// The outcome.
+    pub outcome: ModesOutcome<T>,
+    /// Time in each mode up to the outcome, changes of mode, cost.
+    pub tally: Tally<T>,
     /// The state where it left or lifted off, in the sliding form (the start state otherwise):
     /// where a bowl's wall takes over from the bottom.
     pub end_state: SlideState<T>,
@@ -105,18 +163,14 @@ pub struct ModesReport<T> {
 pub const MAX_SWITCHES: u32 = 100_000;
 
 /// One release at azimuth `beta_rad` (as [`super::residence`]: at rest in the bowl at `ri`,
-/// `(x, y) = ri (-cos beta, -sin beta)`), rolling or sliding, within [`HORIZON_S`] and
-/// [`MAX_STEPS`].
+/// `(x, y) = ri (-cos beta, -sin beta)`), rolling or sliding, within [`super::HORIZON_S`] and
+/// [`super::MAX_STEPS`].
 pub fn residence_roll_or_slide<T: Real>(
     scene: &RollingScene<T>,
     beta_rad: T,
     method: RollingMethod<T>,
 ) -> Result<ModesReport<T>, RollingError> {
-    let limits = SystemLimits {
-        horizon_s: T::from_f64(HORIZON_S),
-        max_steps: MAX_STEPS,
-    };
-    roll_or_slide_within(scene, beta_rad, method, limits)
+    roll_or_slide_within(scene, beta_rad, method, default_limits())
 }
 
 /// [`residence_roll_or_slide`] within the caller's horizon and step cap.
@@ -126,30 +180,17 @@ pub fn roll_or_slide_within<T: Real>(
     method: RollingMethod<T>,
     limits: SystemLimits<T>,
 ) -> Result<ModesReport<T>, RollingError> {
-    scene.validate()?;
-    if !beta_rad.is_finite() {
-        return Err(RollingError::InvalidAzimuth);
-    }
-    let y0 = [
-        -scene.ri_m * beta_rad.cos(),
-        -scene.ri_m * beta_rad.sin(),
-        T::ZERO,
-        T::ZERO,
-        T::ZERO,
-    ];
+    let y0 = release(scene, beta_rad)?;
     let start = forces(scene, T::ZERO, &y0);
     let (ft, normal) = needed_friction_m_s2(scene, T::ZERO, &from_rolling(&y0));
     let fits = (ft[0] * ft[0] + ft[1] * ft[1]).sqrt() <= scene.sliding_friction * normal;
     if start.held && fits && scene.stationary() {
         return Ok(ModesReport {
             outcome: ModesOutcome::Held,
-            regime: Regime {
-                roll_s: T::ZERO,
-                slide_s: T::ZERO,
+            tally: Tally {
+                evaluations: 1,
+                ..Tally::new()
             },
-            switches: 0,
-            evaluations: 1,
-            steps: 0,
             end_state: from_rolling(&y0),
         });
     }
@@ -261,30 +302,84 @@ pub(crate) fn fired<T: Real>(v: &[T]) -> usize {
     best
 }
 
-/// Integrates one mode's segment from `(t0, y0)` with the method, stopping at the first event.
+/// Scales of a scene: `refs`, the acceleration and speed that make the events dimensionless,
+/// and `scales`, the length and speed of the integrator's tolerances (see [`segment`]).
+pub(crate) fn scene_scales<T: Real>(scene: &RollingScene<T>) -> ((T, T), (T, T)) {
+    let rim = scene.rim_radius_m;
+    let spin = scene.combined_speed_rad_s();
+    let w1l = scene.precession_rad_s * scene.precession_rad_s * scene.rod_length_m;
+    // Scales that make the events dimensionless: accelerations and speeds of the scene.
+    let reference = scene.g_m_s2 + spin * spin * rim + w1l + T::ONE;
+    let refs = (reference, (reference * rim).sqrt());
+    (refs, (rim, rim * spin.max(T::ONE)))
+}
+
+fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
+    a.iter().zip(b).fold(T::ZERO, |acc, (x, y)| acc + *x * *y)
+}
+
+/// After an accepted step of a slide with the slip `s` (`stuck`: [`stuck_m_s`]): arms the
+/// slip-end event once the slip has been above twice `stuck`, and turns the friction's
+/// direction `dir` to the slip's for the next step while it still goes along `dir` (the
+/// friction opposes it).
+pub(crate) fn follow_slip<T: Real, const N: usize>(
+    s: &[T; N],
+    dir: &Cell<[T; N]>,
+    armed: &Cell<bool>,
+    stuck: T,
+) {
+    let d = dir.get();
+    let speed = dot(s, s).sqrt();
+    if speed > T::TWO * stuck {
+        armed.set(true);
+    }
+    if speed > T::from_f64(AT_REST_M_S) && dot(s, &d) > T::ZERO {
+        dir.set(core::array::from_fn(|i| s[i] / speed));
+    }
+}
+
+/// Integrates one segment in `mode` from `(t0, y0)` with the method, stopping at the first
+/// event, and adds its cost and its time to `tally`: the event's time and state, or `None` at
+/// the horizon.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn segment<T: Real, const N: usize>(
+    tally: &mut Tally<T>,
+    mode: Mode,
     rhs: impl FnMut(T, &[T; N]) -> [T; N],
-    t0: T,
-    y0: [T; N],
+    (t0, y0): (T, [T; N]),
     method: RollingMethod<T>,
     scales: (T, T),
     event: impl Fn(T, &[T; N]) -> T,
     check: impl FnMut(T, &[T; N]) -> ControlFlow<Infallible>,
     limits: SystemLimits<T>,
-) -> Result<Run<T, N, Infallible>, SystemError> {
+) -> Result<Option<(T, [T; N])>, RollingError> {
     let (length, speed) = scales;
-    match method {
+    let event = system::timed(event);
+    let run = match method {
         RollingMethod::Dp54 { rtol } => {
             // Lengths, velocities and spins at their own scales (as the rolling model's runs).
             let atol: [T; N] =
                 core::array::from_fn(|i| if i < 2 { rtol * length } else { rtol * speed });
             let h0 = T::from_f64(1e-3) * length / speed;
-            system::dp54_timed(rhs, t0, y0, rtol, atol, h0, event, check, limits)
+            system::dp54_with(rhs, t0, y0, rtol, atol, h0, &event, check, limits)
         }
         RollingMethod::Rk4 { step_s } => {
-            system::rk4_timed(rhs, t0, y0, step_s, event, check, limits)
+            system::rk4_with(rhs, t0, y0, step_s, &event, check, limits)
         }
+    }
+    .map_err(RollingError::Integration)?;
+    tally.evaluations = tally.evaluations.saturating_add(run.evaluations);
+    tally.steps = tally.steps.saturating_add(run.steps);
+    match run.ended {
+        Ended::Event { t, y } => {
+            tally.spend(mode, t - t0);
+            Ok(Some((t, y)))
+        }
+        Ended::Horizon { .. } => {
+            tally.spend(mode, limits.horizon_s - t0);
+            Ok(None)
+        }
+        Ended::Stopped { why, .. } => match why {},
     }
 }
 
@@ -297,132 +392,80 @@ pub(crate) fn run_from<T: Real>(
     method: RollingMethod<T>,
     limits: SystemLimits<T>,
 ) -> Result<ModesReport<T>, RollingError> {
-    let rim = scene.rim_radius_m;
-    let spin = scene.combined_speed_rad_s();
-    let w1l = scene.precession_rad_s * scene.precession_rad_s * scene.rod_length_m;
-    // Scales that make the events dimensionless: accelerations and speeds of the scene.
-    let reference = scene.g_m_s2 + spin * spin * rim + w1l + T::ONE;
-    let refs = (reference, (reference * rim).sqrt());
-    let scales = (rim, rim * spin.max(T::ONE));
+    let (refs, scales) = scene_scales(scene);
+    let reference = refs.0;
     let mut report = ModesReport {
-        outcome: ModesOutcome::NotLeftBy {
+        outcome: ModesOutcome::Inside {
             horizon_s: limits.horizon_s,
         },
-        regime: Regime {
-            roll_s: T::ZERO,
-            slide_s: T::ZERO,
-        },
-        switches: 0,
-        evaluations: 0,
-        steps: 0,
+        tally: Tally::new(),
         end_state: y0,
     };
     let (mut t, mut y) = (t0, y0);
     let mut previous: Option<Mode> = None;
     let mut must_slide = false;
     loop {
-        let remaining = SystemLimits {
-            horizon_s: limits.horizon_s,
-            max_steps: limits.max_steps.saturating_sub(report.steps),
-        };
-        if remaining.max_steps == 0 || report.switches > MAX_SWITCHES {
-            return Err(RollingError::Integration(SystemError::StepLimit));
-        }
-        let next = next_mode(scene, t, &y, must_slide);
-        let mode = match next {
-            Next::Roll(_) => Some(Mode::Roll),
-            Next::Slide(..) => Some(Mode::Slide),
-            Next::LiftsOff => None,
-        };
-        if previous.is_some() && mode.is_some() && previous != mode {
-            report.switches += 1;
-        }
-        previous = mode;
-        let (ended, which) = match next {
+        let remaining = report.tally.remaining(limits, MAX_SWITCHES)?;
+        let (ended, which) = match next_mode(scene, t, &y, must_slide) {
             Next::LiftsOff => {
                 report.outcome = ModesOutcome::LiftsOff { time_s: t };
                 return Ok(report);
             }
             Next::Roll(yr) => {
-                let run = segment(
+                report.tally.enter(&mut previous, Mode::Roll);
+                let Some((te, ye)) = segment(
+                    &mut report.tally,
+                    Mode::Roll,
                     |t, y: &[T; 5]| forces(scene, t, y).derivative,
-                    t,
-                    yr,
+                    (t, yr),
                     method,
                     scales,
                     |t, y: &[T; 5]| max3(roll_events(scene, t, y, reference)),
                     |_, _| ControlFlow::Continue(()),
                     remaining,
-                )
-                .map_err(RollingError::Integration)?;
-                report.evaluations = report.evaluations.saturating_add(run.evaluations);
-                report.steps = report.steps.saturating_add(run.steps);
-                match run.ended {
-                    Ended::Event { t: te, y: ye } => {
-                        let which = fired(&roll_events(scene, te, &ye, reference));
-                        report.regime.roll_s += te - t;
-                        ((te, from_rolling(&ye), ye[2], ye[3]), which)
-                    }
-                    Ended::Horizon { .. } => {
-                        report.regime.roll_s += limits.horizon_s - t;
-                        return Ok(report);
-                    }
-                    Ended::Stopped { why, .. } => match why {},
-                }
+                )?
+                else {
+                    return Ok(report);
+                };
+                let which = fired(&roll_events(scene, te, &ye, reference));
+                ((te, from_rolling(&ye), ye[2], ye[3]), which)
             }
             Next::Slide(ys, dir0) => {
+                report.tally.enter(&mut previous, Mode::Slide);
                 let dir = Cell::new(dir0);
                 let slip0 = slip_m_s(&ys);
                 let stuck = stuck_m_s(refs.1);
                 let armed = Cell::new(
                     slip0[0] * slip0[0] + slip0[1] * slip0[1] > T::from_f64(4.0) * stuck * stuck,
                 );
-                let run = segment(
+                let Some((te, ye)) = segment(
+                    &mut report.tally,
+                    Mode::Slide,
                     |t, y: &SlideState<T>| slide_forces(scene, t, y, dir.get()).derivative,
-                    t,
-                    ys,
+                    (t, ys),
                     method,
                     scales,
                     |t, y: &SlideState<T>| {
                         max3(slide_events(scene, t, y, dir.get(), armed.get(), refs))
                     },
                     |_, y: &SlideState<T>| {
-                        // The slip's direction for the next step (the friction opposes it).
-                        let s = slip_m_s(y);
-                        let d = dir.get();
-                        let speed = (s[0] * s[0] + s[1] * s[1]).sqrt();
-                        if speed > T::TWO * stuck {
-                            armed.set(true);
-                        }
-                        if speed > T::from_f64(AT_REST_M_S) && s[0] * d[0] + s[1] * d[1] > T::ZERO {
-                            dir.set([s[0] / speed, s[1] / speed]);
-                        }
+                        follow_slip(&slip_m_s(y), &dir, &armed, stuck);
                         ControlFlow::Continue(())
                     },
                     remaining,
-                )
-                .map_err(RollingError::Integration)?;
-                report.evaluations = report.evaluations.saturating_add(run.evaluations);
-                report.steps = report.steps.saturating_add(run.steps);
-                match run.ended {
-                    Ended::Event { t: te, y: ye } => {
-                        let events = slide_events(scene, te, &ye, dir.get(), armed.get(), refs);
-                        report.regime.slide_s += te - t;
-                        let mut ye = ye;
-                        if fired(&events) == 1 {
-                            // The slip is zero here to the location's accuracy: make it
-                            // exactly so (rolling), keeping the translation.
-                            ye[4] = -ye[3];
-                            ye[5] = ye[2];
-                        }
-                        ((te, ye, ye[2], ye[3]), fired(&events))
-                    }
-                    Ended::Horizon { .. } => {
-                        report.regime.slide_s += limits.horizon_s - t;
-                        return Ok(report);
-                    }
-                    Ended::Stopped { why, .. } => match why {},
+                )?
+                else {
+                    return Ok(report);
+                };
+                let events = slide_events(scene, te, &ye, dir.get(), armed.get(), refs);
+                let mut ye = ye;
+                if fired(&events) == 1 {
+                    // The slip is zero here to the location's accuracy: make it
+                    // exactly so (rolling), keeping the translation.
+                    ye[4] = -ye[3];
+                    ye[5] = ye[2];
                 }
+                ((te, ye, ye[2], ye[3]), fired(&events))
             }
         };
         let (te, ye, ux, uy) = ended;

@@ -110,7 +110,7 @@ fn sliding_down_an_incline_matches_its_closed_form() {
                 ((t - closed) / closed).abs() < 1e-9,
                 "{th_deg} {beta_deg}: {t} vs {closed}"
             );
-            assert_eq!(r.regime.roll_s, 0.0, "slides from release to rim");
+            assert_eq!(r.tally.regime.roll_s, 0.0, "slides from release to rim");
             // RK4 is exact on constant acceleration, and the cubic Hermite locates the rim on
             // the parabola: the same T to rounding.
             let rk4 =
@@ -119,8 +119,8 @@ fn sliding_down_an_incline_matches_its_closed_form() {
                 ((time(&rk4) - closed) / closed).abs() < 1e-9,
                 "rk4: {rk4:?}"
             );
-            assert!((r.regime.slide_s - t).abs() < 1e-12);
-            assert_eq!(r.switches, 0);
+            assert!((r.tally.regime.slide_s - t).abs() < 1e-12);
+            assert_eq!(r.tally.switches, 0);
         }
     }
 }
@@ -152,7 +152,7 @@ fn rolling_down_an_incline_matches_its_closed_form() {
             let r = residence_roll_or_slide(&s, beta, FINE).unwrap();
             let t = time(&r);
             assert!(((t - closed) / closed).abs() < 1e-9, "{t} vs {closed}");
-            assert_eq!(r.regime.slide_s, 0.0);
+            assert_eq!(r.tally.regime.slide_s, 0.0);
         }
     }
 }
@@ -180,7 +180,7 @@ fn turntable_limits_match_their_closed_forms() {
         let r = residence_roll_or_slide(&rolls, 0.3, FINE).unwrap();
         let closed = disc_residence_s(omega, 5.0 / 7.0, 0.05, 0.1).unwrap();
         assert!(((time(&r) - closed) / closed).abs() < 1e-9, "{omega}");
-        assert_eq!(r.regime.slide_s, 0.0);
+        assert_eq!(r.tally.regime.slide_s, 0.0);
         let slides = RollingScene {
             sliding_friction: 0.0,
             ..base
@@ -191,7 +191,7 @@ fn turntable_limits_match_their_closed_forms() {
             ((time(&r) - closed) / closed).abs() < 1e-9,
             "{omega}: {r:?}"
         );
-        assert_eq!(r.regime.roll_s, 0.0);
+        assert_eq!(r.tally.regime.roll_s, 0.0);
     }
 }
 
@@ -219,13 +219,16 @@ fn a_thrown_granule_rolls_after_its_slip_is_gone() {
             max_steps: 100_000,
         };
         let r = run_from(&s, 0.0, y0, FINE, limits).unwrap();
-        assert!(((r.regime.slide_s - t_star) / t_star).abs() < 1e-9, "{r:?}");
+        assert!(
+            ((r.tally.regime.slide_s - t_star) / t_star).abs() < 1e-9,
+            "{r:?}"
+        );
         assert!(((time(&r) - closed) / closed).abs() < 1e-9, "{r:?}");
         let ModesOutcome::Leaves { exit_speed_m_s, .. } = r.outcome else {
             unreachable!()
         };
         assert!((exit_speed_m_s - k2 * u0).abs() < 1e-9, "{exit_speed_m_s}");
-        assert_eq!(r.switches, 1);
+        assert_eq!(r.tally.switches, 1);
     }
 }
 
@@ -235,7 +238,7 @@ fn mean_over_azimuths(s: &RollingScene<f64>) -> (f64, f64) {
         let r = residence_roll_or_slide(s, deg.to_radians(), RollingMethod::Dp54 { rtol: 1e-9 })
             .unwrap();
         sum += time(&r);
-        slide += r.regime.slide_s;
+        slide += r.tally.regime.slide_s;
     }
     (sum / 12.0, slide / sum)
 }
@@ -294,7 +297,7 @@ proptest::proptest! {
         let limits = SystemLimits { horizon_s: 0.5, max_steps: 20_000 };
         if let Ok(r) = super::modes::roll_or_slide_within(&s, beta, method, limits) {
             let ok = |v: f64| v.is_finite() && (0.0..=0.5 + 1e-9).contains(&v);
-            proptest::prop_assert!(ok(r.regime.roll_s) && ok(r.regime.slide_s), "{r:?}");
+            proptest::prop_assert!(ok(r.tally.regime.roll_s) && ok(r.tally.regime.slide_s), "{r:?}");
             match r.outcome {
                 ModesOutcome::Leaves { residence_time_s, exit_speed_m_s } => {
                     proptest::prop_assert!(ok(residence_time_s) && exit_speed_m_s.is_finite());

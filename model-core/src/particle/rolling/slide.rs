@@ -27,7 +27,7 @@
 //! stays rolling exactly when rolling then needs no more than `mu_s N` (`super::modes`).
 
 use super::RollingScene;
-use super::equations::{AT_REST_M_S, cross, frame};
+use super::equations::{AT_REST_M_S, at_contact, cross};
 use crate::Real;
 
 /// The sliding state: `[x, y, ux, uy, sx, sy, sz]`, m and m/s.
@@ -61,20 +61,10 @@ pub fn slide_forces<T: Real>(
     slip_dir: [T; 2],
 ) -> SlideForces<T> {
     let [x, yy, ux, uy, sx, sy, sz] = *y;
-    let f = frame(s, t);
+    // The same normal force as rolling (docs/model.md §9): it does not depend on the spin.
+    let (f, c, e, normal) = at_contact(s, t, [x, yy], [ux, uy]);
     let o = f.omega;
     let a = s.particle_radius_m;
-    let p = [x, yy, a];
-    let o_dot_p = o[0] * p[0] + o[1] * p[1] + o[2] * p[2];
-    let o2 = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
-    let c = [
-        o[0] * o_dot_p - o2 * p[0],
-        o[1] * o_dot_p - o2 * p[1],
-        o[2] * o_dot_p - o2 * p[2],
-    ];
-    let e = cross(&f.alpha, &p);
-    // The same normal force as rolling (docs/model.md §9): it does not depend on the spin.
-    let normal = -f.gravity[2] + f.carrier[2] + e[2] + c[2] + T::TWO * (o[0] * uy - o[1] * ux);
     let slip = slip_m_s(y);
     let speed = (slip[0] * slip[0] + slip[1] * slip[1]).sqrt();
     let along = slip[0] * slip_dir[0] + slip[1] * slip_dir[1];
