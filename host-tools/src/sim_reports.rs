@@ -102,9 +102,9 @@ struct Record {
     angle: Vec<[f64; 2]>,
 }
 
-/// Figures of axis `i` of `rec` for a step from `from` to `sp` with a `band` (fraction)
-/// settling band.
-fn figures(rec: &Record, i: usize, from: f64, sp: f64, band: f64) -> AxisStep {
+/// Figures of axis `i` of `rec` for a step from `from` to `sp` (`settling_s` in the band
+/// [`band_for`] gives the target).
+fn figures(rec: &Record, i: usize, from: f64, sp: f64) -> AxisStep {
     let n = rec.speed.len();
     // Past the target in the step's direction: above it going up, below it going down.
     let direction = if sp < from { -1.0 } else { 1.0 };
@@ -114,8 +114,13 @@ fn figures(rec: &Record, i: usize, from: f64, sp: f64, band: f64) -> AxisStep {
         .map(|w| (w[i] as f64 - sp) * direction)
         .fold(f64::MIN, f64::max);
     let overshoot_pct = (100.0 * excess / sp).max(0.0);
-    let settling = |band: f64| settling_in_band(rec, i, sp, band);
-    let settling_s = settling(band);
+    let settling_2pct_s = settling_in_band(rec, i, sp, 0.02);
+    let settling_5pct_s = settling_in_band(rec, i, sp, 0.05);
+    let settling_s = if band_for(sp as f32) > 0.02 {
+        settling_5pct_s
+    } else {
+        settling_2pct_s
+    };
     let rev_s = TAU / sp;
     // Ripple over the whole revolutions at the end of the run that follow settling (at least one).
     let rev_ticks = ((rev_s / rec.dt_s) as usize).clamp(1, n);
@@ -128,8 +133,8 @@ fn figures(rec: &Record, i: usize, from: f64, sp: f64, band: f64) -> AxisStep {
     AxisStep {
         overshoot_pct,
         settling_s,
-        settling_2pct_s: settling(0.02),
-        settling_5pct_s: settling(0.05),
+        settling_2pct_s,
+        settling_5pct_s,
         ripple_pct: 100.0 * var.sqrt() / sp,
     }
 }
@@ -239,7 +244,7 @@ fn settle_at(cl: &mut ClosedLoop, speed: f32) -> bool {
 /// Runs a commissioned loop (material poured in) at `from` on both axes until settled there
 /// (from rest when `from` is 0), then steps both axes to `target`; records the true speed from
 /// the step on.
-fn step(mut cl: ClosedLoop, from: f32, target: f32, band: f64) -> (Axes<AxisStep>, bool) {
+fn step(mut cl: ClosedLoop, from: f32, target: f32) -> (Axes<AxisStep>, bool) {
     pour_material(&mut cl);
     let mut fault = false;
     if from > 0.0 {
@@ -262,8 +267,8 @@ fn step(mut cl: ClosedLoop, from: f32, target: f32, band: f64) -> (Axes<AxisStep
     let (from, sp) = (from as f64, target as f64);
     (
         Axes {
-            precession: figures(&rec, 0, from, sp, band),
-            spin: figures(&rec, 1, from, sp, band),
+            precession: figures(&rec, 0, from, sp),
+            spin: figures(&rec, 1, from, sp),
         },
         fault,
     )
@@ -285,7 +290,7 @@ pub fn family_plant(rig: &Rig, from: f32, target: f32) -> PlantStep {
             axes: None,
         },
         Ok(cl) => {
-            let (axes, fault) = step(cl, from, target, band_for(target));
+            let (axes, fault) = step(cl, from, target);
             PlantStep {
                 name: rig.name.clone(),
                 commissioning: "ok".into(),

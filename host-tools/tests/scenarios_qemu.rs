@@ -23,7 +23,7 @@ use std::time::Instant;
 use bowl_emulator::board::Board;
 use bowl_emulator::splitter::Splitter;
 use bowl_emulator::{image, qemu};
-use common::{BOWL, bowl, temp_dir};
+use common::{BOWL, temp_dir};
 use scenario::Scenario;
 
 /// `done`, or the rejection's wire token, from what `bowl send` said and its exit code.
@@ -112,18 +112,7 @@ fn run_on_board(
     let capture = dir.join("capture.bin");
     let csv = dir.join("telemetry.csv");
     std::fs::write(&capture, &*raw.lock().unwrap()).unwrap();
-    let out = bowl(&[
-        "replay",
-        capture.to_str().unwrap(),
-        "--csv",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "bowl replay of the board's output: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let mut rows = scenario::telemetry_rows(&csv);
+    let mut rows = scenario::replay_rows(&capture, &csv, "the board's output");
     scenario::rebase(s, &mut rows, &sent);
     (rows, answers, sent)
 }

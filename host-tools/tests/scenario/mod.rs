@@ -212,6 +212,23 @@ pub fn answers(capture: &[u8], count: usize) -> Vec<Answer> {
 }
 
 /// The telemetry rows of a `bowl replay --csv` file (event rows left out).
+/// Decodes a raw capture of the rig's output with `bowl replay --csv` into `csv` and reads
+/// its telemetry rows (one place for both runners; `what` names the run in a failure).
+pub fn replay_rows(capture: &Path, csv: &Path, what: &str) -> Vec<Row> {
+    let out = super::common::bowl(&[
+        "replay",
+        capture.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "bowl replay of {what}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    telemetry_rows(csv)
+}
+
 pub fn telemetry_rows(csv: &Path) -> Vec<Row> {
     let mut reader = csv::ReaderBuilder::new()
         .flexible(true)

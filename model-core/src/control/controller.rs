@@ -249,7 +249,6 @@ impl Controller {
             // edge that came far sooner than the plant model expects faults at once, without
             // waiting for the filtered speed to reach the absolute limit.
             let runaway = self.reached && seen[i] && {
-                let model = a.speed_loop.model_rad_s().abs();
                 a.est.edge_speed_rad_s() > RUNAWAY_RATIO * model + RUNAWAY_MARGIN_RAD_S
                     || (model > a.k.pair_runaway_above_rad_s()
                         && near_top_runaway(a, model, steady[i]))
