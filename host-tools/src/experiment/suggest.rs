@@ -22,6 +22,7 @@ const GRID: usize = 40;
 
 fn run_at(p: &ParticleParams, w: f64) -> Run {
     Run {
+        row: 0,
         condition: 0,
         residence_s: 1.0,
         mean_rad_s: w,

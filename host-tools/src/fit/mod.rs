@@ -6,6 +6,9 @@
 pub mod charts;
 pub mod joint;
 pub mod models;
+mod report;
+pub use report::run;
+pub mod robust;
 pub mod stats;
 
 use std::path::{Path, PathBuf};
@@ -88,6 +91,8 @@ pub struct ModelFit {
     /// The best `mu` is the search's upper limit (the largest at which every run still
     /// leaves): the model does not describe these runs, whatever its interval says.
     pub at_limit: bool,
+    /// Why the model cannot reproduce the runs (never preferred then); `None`: it can.
+    pub cannot_reproduce: Option<String>,
 }
 
 /// The whole fit.
@@ -97,6 +102,8 @@ pub struct Fit {
     pub runs: Vec<Run>,
     /// Runs left out.
     pub excluded: Vec<Excluded>,
+    /// Runs left out as outliers.
+    pub outliers: Vec<robust::Outlier>,
     /// One per candidate, in [`CANDIDATES`] order.
     pub models: Vec<ModelFit>,
     /// `flat`, `coriolis` or `undecided`.
@@ -117,9 +124,23 @@ pub fn load(path: &Path) -> Result<(Vec<Run>, Vec<Excluded>)> {
             });
             continue;
         }
-        let Some(t) = row.residence_s.filter(|t| t.is_finite() && *t > 0.0) else {
-            exclude("no exit gate event (residence time missing)".into());
-            continue;
+        let t = match row.residence_s {
+            None => {
+                exclude("no exit gate event (residence time missing)".into());
+                continue;
+            }
+            Some(t) if t.is_nan() => {
+                exclude("residence time is not a number (NaN)".into());
+                continue;
+            }
+            Some(t) if t <= 0.0 => {
+                exclude(format!(
+                    "residence time {t} s: a release takes a positive time (the exit gate fires \
+                     after the release gate)"
+                ));
+                continue;
+            }
+            Some(t) => t,
         };
         let geometry_ok = row.release_radius_m >= 0.0
             && row.rim_radius_m > row.release_radius_m
@@ -149,6 +170,7 @@ pub fn load(path: &Path) -> Result<(Vec<Run>, Vec<Excluded>)> {
             Method::Integrated
         };
         runs.push(Run {
+            row: line,
             condition: row.condition,
             residence_s: t,
             mean_rad_s: mean,
@@ -207,6 +229,7 @@ pub fn fit_model(runs: &[Run], candidate: Candidate, fit_k2: bool) -> ModelFit {
                 errors_pct,
                 k2: K2::Fitted(j.k2, j.k2_ci95),
                 at_limit: at_limit(j.mu, ceiling),
+                cannot_reproduce: None,
             }
         }
         Err(e) => ModelFit {
@@ -261,13 +284,17 @@ fn fit_mu(runs: &[Run], candidate: Candidate) -> ModelFit {
         errors_pct,
         k2: K2::Given,
         at_limit: at_limit(mu, ceiling),
+        cannot_reproduce: None,
     }
 }
 
 /// The model whose AIC is lower than every other's by more than [`AIC_DECISIVE`], else
-/// "undecided".
+/// "undecided". A model that cannot reproduce the runs takes no part.
 fn preferred_by_aic(models: &[ModelFit]) -> &'static str {
-    let mut by_aic: Vec<&ModelFit> = models.iter().filter(|m| m.aic.is_finite()).collect();
+    let mut by_aic: Vec<&ModelFit> = models
+        .iter()
+        .filter(|m| m.aic.is_finite() && m.cannot_reproduce.is_none())
+        .collect();
     by_aic.sort_by(|a, b| a.aic.total_cmp(&b.aic));
     match by_aic.as_slice() {
         [best] => best.candidate.name,
@@ -289,22 +316,32 @@ pub fn fit_candidates(
     candidates: &[Candidate],
     fit_k2: bool,
 ) -> Result<Fit> {
+    if let Some(why) = robust::impossible(&runs) {
+        bail!("{why}");
+    }
+    let (runs, outliers) = robust::screen(runs);
     if runs.len() < 3 {
         bail!(
-            "{} usable runs ({} excluded): the fit needs at least 3 (two parameters, mu and the \
+            "{} usable runs ({} excluded, {} outliers): the fit needs at least 3 (two parameters, mu and the \
              timing noise, and one degree of freedom for the interval)",
             runs.len(),
-            excluded.len()
+            excluded.len(),
+            outliers.len()
         );
     }
-    let models: Vec<ModelFit> = candidates
+    let mut models: Vec<ModelFit> = candidates
         .iter()
         .map(|&c| fit_model(&runs, c, fit_k2))
         .collect();
+    let marks = robust::cannot_reproduce(&models);
+    for (m, why) in models.iter_mut().zip(marks) {
+        m.cannot_reproduce = why;
+    }
     let preferred = preferred_by_aic(&models);
     Ok(Fit {
         runs,
         excluded,
+        outliers,
         models,
         preferred,
     })
@@ -331,6 +368,9 @@ pub fn to_json(fit: &Fit) -> serde_json::Value {
         if m.at_limit {
             model["at_search_limit"] = json!(true);
         }
+        if let Some(why) = &m.cannot_reproduce {
+            model["cannot_reproduce"] = json!(why);
+        }
         models.insert(m.candidate.name.into(), model);
     }
     json!({
@@ -338,6 +378,7 @@ pub fn to_json(fit: &Fit) -> serde_json::Value {
         "preferred": fit.preferred,
         "runs": fit.runs.len(),
         "excluded": fit.excluded,
+        "outliers": fit.outliers,
     })
 }
 
@@ -385,91 +426,6 @@ pub fn condition_table(fit: &Fit) -> crate::chart::table::Table {
         table.row(row);
     }
     table
-}
-
-/// `bowl fit`.
-pub fn run(args: &Args) -> Result<()> {
-    if !(args.axes_angle_deg.is_finite() && (0.0..90.0).contains(&args.axes_angle_deg)) {
-        anyhow::bail!(
-            "--axes-angle-deg {} is not a tilt the rig can have: give 0 to below 90 degrees",
-            args.axes_angle_deg
-        );
-    }
-    let (mut runs, excluded) = load(&args.results)?;
-    for r in &mut runs {
-        r.axes_angle_rad = args.axes_angle_deg.to_radians();
-    }
-    let fit = fit(runs, excluded, args.fit_k2)?;
-    if !args.no_charts {
-        let dir = args.charts.clone().unwrap_or_else(|| {
-            let stem = args
-                .results
-                .file_stem()
-                .map_or("results".into(), |s| s.to_string_lossy());
-            args.results
-                .parent()
-                .unwrap_or(Path::new("."))
-                .join(format!("{stem}_fit"))
-        });
-        charts::write(&fit, &dir)?;
-        if !args.json {
-            println!("charts and table: {}", dir.display());
-        }
-    }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&to_json(&fit))?);
-        return Ok(());
-    }
-    let integrated = fit
-        .runs
-        .iter()
-        .filter(|r| r.method == Method::Integrated)
-        .count();
-    println!(
-        "{} runs ({} by the closed form at the mean speed, {} integrated over the speed trace), {} excluded",
-        fit.runs.len(),
-        fit.runs.len() - integrated,
-        integrated,
-        fit.excluded.len()
-    );
-    for e in &fit.excluded {
-        println!("  excluded line {}: {}", e.row, e.reason);
-    }
-    println!("model      mu        95 % interval          rms error %   AIC");
-    for m in &fit.models {
-        println!(
-            "{:<10} {:.5}  [{:.5}, {:.5}]   {:>8.2}   {:>10.2}",
-            m.candidate.name, m.mu, m.mu_ci95.0, m.mu_ci95.1, m.rms_error_pct, m.aic
-        );
-        match &m.k2 {
-            K2::Given => {}
-            K2::Fitted(k2, ci) => println!("{:<10} k2 {:.4}  [{:.4}, {:.4}]", "", k2, ci.0, ci.1),
-            K2::NotFitted(why) => println!("{:<10} k2 not fitted: {why}", ""),
-        }
-        if m.at_limit {
-            println!(
-                "{:<10} its best mu is the largest at which every run still leaves: this model \
-                 does not describe these runs",
-                ""
-            );
-        }
-    }
-    println!(
-        "preferred: {} (a model is preferred when its AIC is lower by more than {AIC_DECISIVE})",
-        fit.preferred
-    );
-    if let Some(m) = fit
-        .models
-        .iter()
-        .find(|m| m.candidate.name == fit.preferred)
-    {
-        println!(
-            "apply to the rig: bowl send PORT set MU_PPM {:.0}",
-            (m.mu * 1e6).round()
-        );
-    }
-    print!("{}", condition_table(&fit).to_csv());
-    Ok(())
 }
 
 #[cfg(test)]

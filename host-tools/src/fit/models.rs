@@ -76,6 +76,8 @@ pub enum Method {
 /// One usable run.
 #[derive(Debug, Clone)]
 pub struct Run {
+    /// Line of the results file (header = 1); 0 for a run not read from a file.
+    pub row: usize,
     /// Plan condition.
     pub condition: usize,
     /// Measured residence time, s.

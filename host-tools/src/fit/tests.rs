@@ -37,6 +37,7 @@ pub(super) fn synthetic_runs(
     for (c, &w) in speeds.iter().enumerate() {
         for _ in 0..per_speed {
             let mut run = Run {
+                row: 0,
                 condition: c + 1,
                 residence_s: 0.0,
                 mean_rad_s: w,
@@ -262,6 +263,7 @@ fn drifting_speed_uses_the_integrator() {
             .unwrap();
             let kept: Vec<(f64, f64)> = trace.into_iter().filter(|p| p.0 <= truth).collect();
             runs.push(Run {
+                row: 0,
                 condition: c + 1,
                 residence_s: truth + 0.002 * gaussian(&mut rng),
                 mean_rad_s: kept.iter().map(|p| p.1).sum::<f64>() / kept.len() as f64,
@@ -332,6 +334,7 @@ fn rolling_truth_is_recognised() {
     for (c, &w) in [1.0, 2.2, 3.6].iter().enumerate() {
         for _ in 0..2 {
             let mut run = Run {
+                row: 0,
                 condition: c + 1,
                 residence_s: 0.0,
                 mean_rad_s: w,
