@@ -137,6 +137,10 @@ pub struct Args {
     /// alone, ns per scene on one thread and on every core; JSON on standard output).
     #[arg(long, requires = "batch")]
     throughput: bool,
+    /// Batch mode: write every row, with a `status` column (`ok` or why the row was refused),
+    /// instead of nothing when a row is refused; the exit status is still 1 if any row was.
+    #[arg(long, requires = "batch")]
+    keep_going: bool,
     /// The rolling model's own flags.
     #[command(flatten)]
     rolling: rolling::RollingArgs,

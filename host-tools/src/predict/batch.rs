@@ -15,6 +15,13 @@
 //! scene the rig refuses such as a start at or beyond the rim) is reported on stderr with its
 //! line number and reason; then nothing is written (the output is built in a temporary file
 //! beside OUT and renamed over it only when every row succeeded) and the exit status is 1.
+//! With `--keep-going` every row is written, with a last column `status`: `ok` or the refusal
+//! in words (its result fields empty), and the exit status is 1 if any row was refused.
+//!
+//! Line numbers count LF, CRLF and lone CR line ends alike (the header is line 1). A column
+//! named twice, or a column that is neither an input nor a label (`label`, `id`, `note`, or a
+//! name starting `label_` or `note_`, carried through unchanged), refuses the file by name: a
+//! misspelt `Mu` would otherwise leave `mu` missing or, worse, read from the wrong copy.
 
 use std::path::{Path, PathBuf};
 
@@ -54,8 +61,38 @@ struct Columns {
     k2: Option<usize>,
 }
 
+/// The input columns.
+const INPUTS: [&str; 7] = ["model", "w_rad_s", "mu", "ri_m", "R_m", "g", "k2"];
+
+/// Whether a column is a label carried through unchanged.
+fn is_label(name: &str) -> bool {
+    matches!(name, "label" | "id" | "note")
+        || name.starts_with("label_")
+        || name.starts_with("note_")
+}
+
 impl Columns {
     fn find(header: &csv::StringRecord) -> Result<Self> {
+        for (i, h) in header.iter().enumerate() {
+            let h = h.trim();
+            if let Some(j) = header.iter().take(i).position(|o| o.trim() == h) {
+                bail!(
+                    "column `{h}` appears twice (columns {} and {}): say which one is meant by \
+                     removing or renaming the other",
+                    j + 1,
+                    i + 1
+                );
+            }
+            if !INPUTS.contains(&h) && !is_label(h) {
+                bail!(
+                    "column {} `{h}` is not a column of the batch: inputs are {} (g and k2 \
+                     optional); labels carried through are label, id, note or a name starting \
+                     label_ or note_ (rename it, or remove it)",
+                    i + 1,
+                    INPUTS.join(",")
+                );
+            }
+        }
         let pos = |name: &str| header.iter().position(|h| h.trim() == name);
         let need = |name: &str| {
             pos(name).ok_or_else(|| {
@@ -172,12 +209,47 @@ impl Drop for Partial {
     }
 }
 
+/// Start offsets of the lines of `bytes`: LF, CRLF and lone CR each end one line.
+fn line_starts(bytes: &[u8]) -> Vec<u64> {
+    let mut starts = vec![0];
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'\r' if bytes.get(i + 1) == Some(&b'\n') => {
+                i += 1;
+                starts.push(i as u64 + 1);
+            }
+            b'\r' | b'\n' => starts.push(i as u64 + 1),
+            _ => {}
+        }
+        i += 1;
+    }
+    starts
+}
+
+/// Where a record read from `offset` begins: the csv reader's position can sit on the line
+/// end before it (the LF of a CRLF) or on blank lines it skips.
+fn record_start(bytes: &[u8], offset: u64) -> u64 {
+    let skipped = bytes
+        .iter()
+        .skip(offset as usize)
+        .take_while(|b| matches!(b, b'\r' | b'\n'))
+        .count();
+    offset + skipped as u64
+}
+
+/// The line (from 1) holding byte `offset`.
+fn line_of(starts: &[u64], offset: u64) -> usize {
+    starts.partition_point(|&s| s <= offset)
+}
+
 /// Runs `bowl predict --batch INPUT --out OUTPUT`.
 pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
+    let bytes = std::fs::read(input).with_context(|| format!("cannot open {}", input.display()))?;
+    let starts = line_starts(&bytes);
     let mut reader = csv::ReaderBuilder::new()
         .flexible(true)
-        .from_path(input)
-        .with_context(|| format!("cannot open {}", input.display()))?;
+        .from_reader(bytes.as_slice());
     let header = reader
         .headers()
         .with_context(|| format!("{}: cannot read the header row", input.display()))?
@@ -199,19 +271,26 @@ pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
     for c in RESULT_COLUMNS {
         out_header.push_field(c);
     }
+    if args.keep_going {
+        out_header.push_field("status");
+    }
     writer.write_record(&out_header)?;
     let (mut failed, mut rows) = (0usize, 0usize);
     let mut scenes = Vec::new();
-    for (index, record) in reader.records().enumerate() {
+    let mut record = csv::StringRecord::new();
+    loop {
+        // Line numbers as a user sees them: the header is line 1, whatever ends the lines.
+        let (row, byte) = match reader.read_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => (Ok(record.clone()), record.position().map(|p| p.byte())),
+            Err(e) => (Err(anyhow!("{e}")), e.position().map(|p| p.byte())),
+        };
+        let line = line_of(
+            &starts,
+            record_start(&bytes, byte.unwrap_or(reader.position().byte())),
+        );
         rows += 1;
-        // Line numbers as a user sees them: the header is line 1. (For rows with embedded
-        // newlines the csv reader's own position is the truth.)
-        let line = record
-            .as_ref()
-            .ok()
-            .and_then(|r| r.position().map(|p| p.line()))
-            .unwrap_or(index as u64 + 2);
-        let result = record.map_err(|e| anyhow!("{e}")).and_then(|row| {
+        let result = row.and_then(|row| {
             let (model, scene) = parse_row(&row, &cols, header.len())?;
             let p = predict(&scene, model, args.method, args.step_s, args.tol)?;
             if args.throughput {
@@ -220,7 +299,7 @@ pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
             Ok((row, p))
         });
         match result {
-            Ok((row, p)) if failed == 0 => {
+            Ok((row, p)) if failed == 0 || args.keep_going => {
                 let mut out = row.clone();
                 let mut fields = result_fields(&p.outcome);
                 if let Some(w) = p.check.as_ref().and_then(super::ode::StepCheck::warning) {
@@ -234,19 +313,34 @@ pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
                 for f in fields {
                     out.push_field(&f);
                 }
+                if args.keep_going {
+                    out.push_field("ok");
+                }
                 writer.write_record(&out)?;
             }
             Ok(_) => {}
             Err(e) => {
                 failed += 1;
                 eprintln!("{}: line {line}: {e:#}", input.display());
+                if args.keep_going {
+                    // The row as read, cut or padded to the header's width, results empty.
+                    let mut out = csv::StringRecord::new();
+                    for i in 0..header.len() {
+                        out.push_field(record.get(i).unwrap_or(""));
+                    }
+                    for _ in RESULT_COLUMNS {
+                        out.push_field("");
+                    }
+                    out.push_field(&format!("refused: {e:#}"));
+                    writer.write_record(&out)?;
+                }
             }
         }
     }
-    if failed > 0 {
+    if failed > 0 && !args.keep_going {
         bail!(
             "{failed} of {rows} row(s) of {} failed (see above): {} not written; fix the rows \
-             and run again",
+             and run again, or give --keep-going to write every row with its status",
             input.display(),
             output.display()
         );
@@ -257,8 +351,35 @@ pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
         .with_context(|| format!("cannot write {}", output.display()))?;
     let mut partial = partial;
     partial.kept = true;
+    if failed > 0 {
+        bail!(
+            "{failed} of {rows} row(s) of {} refused (see above and their status column): the \
+             other {} written to {}",
+            input.display(),
+            rows - failed,
+            output.display()
+        );
+    }
     if args.throughput {
         println!("{}", super::throughput::measure(&scenes));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_end_at_lf_crlf_and_cr() {
+        for text in ["a\nb\nc\n", "a\r\nb\r\nc\r\n", "a\rb\rc\r"] {
+            let starts = line_starts(text.as_bytes());
+            let c = text.find('c').unwrap() as u64;
+            assert_eq!(line_of(&starts, 0), 1, "{text:?}");
+            assert_eq!(line_of(&starts, c), 3, "{text:?}");
+            // From just after b's first line end (a CRLF's LF, or a blank line) to c.
+            let after_b = text.find('b').unwrap() as u64 + 2;
+            assert_eq!(line_of(&starts, record_start(text.as_bytes(), after_b)), 3);
+        }
+    }
 }
