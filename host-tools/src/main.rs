@@ -3,7 +3,7 @@
 use std::process::ExitCode;
 
 use anyhow::Result;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod chart;
 mod command_words;
@@ -78,7 +78,10 @@ enum Command {
 
 fn main() -> ExitCode {
     restore_default_sigpipe();
-    let cli = match Cli::try_parse() {
+    let cli = match negative_numbers(Cli::command())
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m))
+    {
         Ok(cli) => cli,
         Err(e) => {
             // --help and --version end here too, on standard output and with success.
@@ -103,6 +106,20 @@ fn main() -> ExitCode {
         }
     };
     ExitCode::from(u8::try_from(code).unwrap_or(1))
+}
+
+/// Every command takes negative numbers as values (`--omega-rad-s -3`, `--spin-rad-s -2.7`):
+/// each command then judges the value in words by its own limits, instead of clap taking it for
+/// an unknown flag.
+fn negative_numbers(command: clap::Command) -> clap::Command {
+    let command = command.allow_negative_numbers(true);
+    let names: Vec<String> = command
+        .get_subcommands()
+        .map(|s| s.get_name().to_string())
+        .collect();
+    names
+        .iter()
+        .fold(command, |c, name| c.mut_subcommand(name, negative_numbers))
 }
 
 /// `bowl ... | head`: when the reader goes away, end quietly the way Unix tools do (the default

@@ -66,7 +66,7 @@ fn every_answer_says_whether_its_model_holds() {
         "90",
     ])));
     assert_eq!(v["valid"], false, "{v}");
-    let lift = rig_rolling(&["--json", "--rod-length-m", "0.5", "--sliding-mu", "0.8"]);
+    let lift = rig_rolling(&["--json", "--rod-offset-m", "0.5", "--sliding-mu", "0.8"]);
     let mut lift = strs(&lift);
     lift[4] = "4";
     let v = json(&lift);

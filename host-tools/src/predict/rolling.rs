@@ -29,9 +29,12 @@ pub struct RollingArgs {
     /// Rolling model: granule radius a, m.
     #[arg(long, default_value_t = 0.003)]
     particle_radius_m: f64,
-    /// Rolling model: distance L of the bowl's centre from the precession axis, m.
-    #[arg(long, default_value_t = 0.0)]
-    rod_length_m: f64,
+    /// Rolling model: the rod's horizontal offset L, the distance of the bowl's centre from the
+    /// precession axis, m. Not the rod's length: a rod of length l at angle th from the
+    /// vertical gives L = l sin(th) (l overstates L by 15 % at 60 deg). `--rod-length-m` is
+    /// this flag's old name, kept as an alias.
+    #[arg(long, visible_alias = "rod-length-m", default_value_t = 0.0)]
+    rod_offset_m: f64,
     /// Rolling model: release azimuth from the downhill direction, degrees, or `all` (mean, min
     /// and max over 0, 30, ..., 330).
     #[arg(long, default_value = "all")]
@@ -90,7 +93,7 @@ impl RollingArgs {
             g_m_s2: args.g,
             k2: args.k2,
             particle_radius_m: self.particle_radius_m,
-            rod_length_m: self.rod_length_m,
+            rod_length_m: self.rod_offset_m,
             ri_m: args.ri_m,
             rim_radius_m: args.rim_radius_m,
         };
@@ -113,7 +116,11 @@ pub fn words(e: RollingError) -> String {
             "--k2 must lie between 0 and 1 (5/7 for a solid sphere, 3/5 for a hollow one)".into()
         }
         RollingError::InvalidParticleRadius => "--particle-radius-m must be 0 or more".into(),
-        RollingError::InvalidRodLength => "--rod-length-m must be 0 or more".into(),
+        RollingError::InvalidRodLength => {
+            "--rod-offset-m (the horizontal offset L of the bowl's centre from the precession \
+             axis, m) must be 0 or more"
+                .into()
+        }
         RollingError::InvalidStartRadius => "--ri-m must be 0 or more".into(),
         RollingError::InvalidRimRadius => {
             "--rim-radius-m must be finite and larger than --ri-m (the granule starts inside the bowl)"
@@ -219,7 +226,7 @@ pub fn run(args: &Args, r: &RollingArgs) -> Result<()> {
         g_m_s2: args.g,
         k2: args.k2,
         particle_radius_m: r.particle_radius_m,
-        rod_length_m: r.rod_length_m,
+        rod_length_m: r.rod_offset_m,
         ri_m: args.ri_m,
         rim_radius_m: args.rim_radius_m,
     };
@@ -230,7 +237,7 @@ pub fn run(args: &Args, r: &RollingArgs) -> Result<()> {
         scene.combined_speed_rad_s(),
         args.mu,
         r.particle_radius_m,
-        r.rod_length_m,
+        r.rod_offset_m,
         args.ri_m,
         args.rim_radius_m
     );

@@ -27,10 +27,42 @@ pub fn scene(e: SceneError) -> String {
     }
 }
 
+/// Why a scene was refused, with the value given.
+pub fn scene_with_values(e: SceneError, s: &Scene<f64>) -> String {
+    match e {
+        SceneError::InvalidOmega => format!(
+            "--omega-rad-s {} rad/s: the paper's models take the bowl's speed as a rate of turning, \
+             0 or more (which way it turns is not one of their parameters): give 0 or a positive \
+             speed",
+            s.omega_rad_s
+        ),
+        SceneError::InvalidResistance => format!(
+            "--mu {}: the rolling resistance must be 0 or more (0.029 is the paper's)",
+            s.mu
+        ),
+        SceneError::InvalidGravity => {
+            format!("--g {}: must be 0 or more (9.81 on Earth)", s.g_m_s2)
+        }
+        SceneError::InvalidK2 => format!(
+            "--k2 {}: must lie in (0, 1] (5/7 for a solid sphere, 3/5 for a hollow one)",
+            s.k2
+        ),
+        SceneError::InvalidStartRadius => {
+            format!("--ri-m {} m: the start radius must be 0 or more", s.ri_m)
+        }
+        SceneError::InvalidRimRadius => format!(
+            "--rim-radius-m {} m: the rim radius must be 0 or more",
+            s.rim_radius_m
+        ),
+        other => scene(other),
+    }
+}
+
 /// The scene as the rig would take it: valid, and starting inside the rim (the rig refuses a
 /// start at or beyond the rim, so predicting T = 0 there would answer a question it never asks).
 pub fn check(s: &Scene<f64>) -> anyhow::Result<()> {
-    s.validate().map_err(|e| anyhow::anyhow!(scene(e)))?;
+    s.validate()
+        .map_err(|e| anyhow::anyhow!(scene_with_values(e, s)))?;
     if s.ri_m >= s.rim_radius_m {
         anyhow::bail!(
             "--ri-m {} m is not inside the rim (--rim-radius-m {} m): the granule must start \

@@ -1,0 +1,107 @@
+//! Flags that say what they mean: negative numbers taken as values (and judged in words), the
+//! rod's horizontal offset under its own name, and what holds a granule when nothing turns.
+
+mod common;
+
+use common::bowl;
+
+fn run(args: &[&str]) -> (Option<i32>, String, String) {
+    let out = bowl(args);
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_negative_speed_is_a_value_judged_in_words() {
+    let (code, _, err) = run(&["predict", "--omega-rad-s", "-3"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(!err.contains("unexpected argument"), "{err}");
+    assert!(
+        err.contains("--omega-rad-s -3 rad/s") && err.contains("0 or more"),
+        "{err}"
+    );
+    let (code, _, err) = run(&["predict", "--mu", "-0.1"]);
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains("--mu -0.1: the rolling resistance must be 0 or more"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_negative_spin_is_taken() {
+    let (code, out, err) = run(&[
+        "predict",
+        "--model",
+        "bowl",
+        "--axes-angle-deg",
+        "60",
+        "--precession-rad-s",
+        "1.2",
+        "--spin-rad-s",
+        "-2.7",
+        "--rim-radius-m",
+        "0.075",
+        "--ri-m",
+        "0.0375",
+        "--release-azimuth-deg",
+        "0",
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains("w2 -2.7 rad/s"), "{out}");
+    let (code, out, err) = run(&["kinematics", "--spin-rad-s", "-1.8"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!out.is_empty());
+}
+
+#[test]
+fn the_rods_offset_has_its_name_and_the_old_one_still_works() {
+    let scene = |flag: &str| {
+        run(&[
+            "predict",
+            "--model",
+            "rolling",
+            flag,
+            "0.1",
+            "--precession-rad-s",
+            "2.08",
+            "--spin-rad-s",
+            "2.08",
+            "--axes-angle-deg",
+            "60",
+            "--ri-m",
+            "0.075",
+            "--rim-radius-m",
+            "0.15",
+            "--release-azimuth-deg",
+            "0",
+        ])
+    };
+    let new = scene("--rod-offset-m");
+    let old = scene("--rod-length-m");
+    assert_eq!(new.0, Some(0), "{}", new.2);
+    assert!(new.1.contains("L 0.1 m"), "{}", new.1);
+    assert_eq!(new.1, old.1, "the alias gives the same answer");
+    let (_, help, _) = run(&["predict", "--help"]);
+    assert!(
+        help.contains("--rod-offset-m") && help.contains("rod-length-m"),
+        "{help}"
+    );
+    assert!(help.contains("horizontal offset L"), "{help}");
+}
+
+#[test]
+fn no_turning_and_no_friction_is_not_said_to_be_friction() {
+    let (code, out, _) = run(&["predict", "--omega-rad-s", "0", "--mu", "0"]);
+    assert_eq!(code, Some(0));
+    assert!(!out.contains("friction holds it"), "{out}");
+    assert!(
+        out.contains("the bowl is not turning") && out.contains("no friction"),
+        "{out}"
+    );
+    let (_, out, _) = run(&["predict", "--omega-rad-s", "3", "--mu", "0.5"]);
+    assert!(out.contains("friction holds it"), "{out}");
+}
