@@ -52,7 +52,12 @@ struct AxisReport {
     back_emf_v_per_rad_s: f64,
     friction_duty: f64,
     time_constant_s: f64,
-    bandwidth_rad_s: f64,
+    /// The speed loop's bandwidth, from the rig's parameters (PARAMS).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    bandwidth_rad_s: Option<f64>,
+    /// Why the bandwidth is not reported (never a bare null).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    bandwidth_unknown: Option<&'static str>,
     kp_duty_per_rad_s: f64,
     ki_duty_per_rad: f64,
 }
@@ -127,13 +132,14 @@ fn follow(port: &mut Link, ids: &mut Ids, timeout: Duration, quiet: bool) -> Res
                         last_seen = Instant::now();
                         if !quiet && last_report.elapsed() >= Duration::from_secs(1) {
                             last_report = Instant::now();
+                            // In the units of the result: rad/s and duty (a fraction of full).
                             eprintln!(
-                                "  {:5.1} s  precession {:6} mrad/s duty {:6} bp   spin {:6} mrad/s duty {:6} bp",
+                                "  {:5.1} s  precession {:7.3} rad/s duty {:+.4}   spin {:7.3} rad/s duty {:+.4}",
                                 start.elapsed().as_secs_f64(),
-                                t.precession.measured_mrad_s,
-                                t.precession.duty_bp,
-                                t.spin.measured_mrad_s,
-                                t.spin.duty_bp
+                                f64::from(t.precession.measured_mrad_s) * 1e-3,
+                                f64::from(t.precession.duty_bp) * 1e-4,
+                                f64::from(t.spin.measured_mrad_s) * 1e-3,
+                                f64::from(t.spin.duty_bp) * 1e-4
                             );
                         }
                     }
@@ -171,7 +177,10 @@ fn axis_report(
         back_emf_v_per_rad_s: si(m.back_emf_uv_per_rad_s),
         friction_duty: si(m.friction_ppm),
         time_constant_s: si(m.time_constant_us),
-        bandwidth_rad_s: params.map_or(f64::NAN, |p| f64::from(p[bw.index()]) * 1e-3),
+        bandwidth_rad_s: params.map(|p| f64::from(p[bw.index()]) * 1e-3),
+        bandwidth_unknown: params
+            .is_none()
+            .then_some("the rig did not answer PARAMS (asked 3 times)"),
         kp_duty_per_rad_s: si(m.kp_ppm_per_rad_s),
         ki_duty_per_rad: si(m.ki_ppm_per_rad),
     }
@@ -198,7 +207,7 @@ fn print(report: &Report, json: bool) -> Result<()> {
     }
     for a in &report.axes {
         println!(
-            "{:10} {}  Ke {:.4} V/(rad/s)  friction {:.4} duty  tau {:.4} s  |  bandwidth {:.3} rad/s  Kp {:.4} duty/(rad/s)  Ki {:.4} duty/rad",
+            "{:10} {}  Ke {:.4} V/(rad/s)  friction {:.4} duty  tau {:.4} s  |  bandwidth {}  Kp {:.4} duty/(rad/s)  Ki {:.4} duty/rad",
             a.axis,
             if a.identified {
                 "identified"
@@ -208,7 +217,10 @@ fn print(report: &Report, json: bool) -> Result<()> {
             a.back_emf_v_per_rad_s,
             a.friction_duty,
             a.time_constant_s,
-            a.bandwidth_rad_s,
+            a.bandwidth_rad_s.map_or_else(
+                || format!("unknown ({})", a.bandwidth_unknown.unwrap_or("")),
+                |b| format!("{b:.3} rad/s")
+            ),
             a.kp_duty_per_rad_s,
             a.ki_duty_per_rad
         );
@@ -284,10 +296,14 @@ pub fn run(args: &Args) -> Result<i32> {
         }
     };
     if code == exit_code::OK {
-        let params = match ask(&mut port, &mut ids, &["PARAMS"])? {
-            Some(Frame::Params { values, .. }) => Some(values),
-            _ => None,
-        };
+        // The JSON's bandwidth comes from here: an answer lost among telemetry is asked again.
+        let mut params = None;
+        for _ in 0..3 {
+            if let Some(Frame::Params { values, .. }) = ask(&mut port, &mut ids, &["PARAMS"])? {
+                params = Some(values);
+                break;
+            }
+        }
         match ask(&mut port, &mut ids, &["MODELS"])? {
             Some(Frame::Models { axes, .. }) => {
                 report.axes = vec![

@@ -43,8 +43,33 @@ fn commissioning_over_the_wire_identifies_the_simulated_motors() {
             ) < 1e-3,
             "{a}"
         );
-        assert!(g("bandwidth_rad_s") > 0.0, "{a}");
+        // The rig's parameter (8 rad/s nominal), never a null where the text gives a number.
+        assert_eq!(g("bandwidth_rad_s"), 8.0, "{a}");
+        assert!(a.get("bandwidth_unknown").is_none(), "{a}");
     }
+}
+
+/// The text run's progress lines are in the result's units (rad/s and duty as a fraction), and
+/// its bandwidth is the JSON's.
+#[test]
+fn progress_is_in_the_units_of_the_result() {
+    let sim = Sim::start(&["--seconds", "120"]);
+    let out = bowl(&["commission", &sim.path, "--timeout-s", "90"]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    let progress: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains(" s  precession"))
+        .collect();
+    assert!(!progress.is_empty(), "{err}");
+    for l in &progress {
+        assert!(
+            l.contains("rad/s duty") && !l.contains("mrad/s") && !l.contains(" bp"),
+            "{l}"
+        );
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.matches("bandwidth 8.000 rad/s").count(), 2, "{text}");
 }
 
 /// A rig that is running refuses COMMISSION (STATE): exit 2, and it keeps running; a rig whose

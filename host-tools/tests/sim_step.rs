@@ -79,3 +79,11 @@ fn nominal_slow_down_meets_the_targets() {
         assert!(f(axis, "steady_state_error_pct") <= 1.0, "{axis}");
     }
 }
+
+/// `--json` is taken as by every other report (the output is JSON either way).
+#[test]
+fn json_flag_is_taken() {
+    let plain = json(&["sim", "step"]);
+    let flagged = json(&["sim", "step", "--json"]);
+    assert_eq!(plain, flagged);
+}
