@@ -144,3 +144,34 @@ fn bad_spin_ups_are_named_in_plain_words() {
         assert!(!err.contains("panicked"), "{err}");
     }
 }
+
+/// A flat-model choice claims its whole error: the integrator's plus the flat model's own (the
+/// Coriolis term it leaves out), and T is within that claim of the Coriolis reference.
+#[test]
+fn a_flat_choice_claims_the_flat_models_own_error_too() {
+    let v = json(&[
+        "predict",
+        "--spin-up-from-rad-s",
+        "0",
+        "--time-constant-s",
+        "0.3",
+        "--tolerance",
+        "2e-2",
+        "--json",
+    ]);
+    let c = &v["choice"];
+    assert_eq!(c["model"], "flat", "{c}");
+    let f = |k: &str| c[k].as_f64().unwrap();
+    assert_eq!(f("model_error_rel"), f("coriolis_effect_rel"));
+    assert!(
+        (f("estimated_error_rel") - f("method_error_rel") - f("model_error_rel")).abs() < 1e-15
+    );
+    let t = v["residence_time_s"].as_f64().unwrap();
+    let truth = reference(0.0, 3.0, 0.3, true);
+    let actual = (t - truth).abs() / truth;
+    assert!(
+        actual <= f("estimated_error_rel"),
+        "actual {actual:e} vs claimed {c}"
+    );
+    assert!(actual <= f("tolerance_rel"));
+}

@@ -62,11 +62,12 @@ pub fn run(args: &Args) -> Result<()> {
         .filter(|r| r.method == Method::Integrated)
         .count();
     println!(
-        "{} runs ({} by the closed form at the mean speed, {} integrated over the speed trace), {} excluded",
+        "{} runs ({} by the closed form at the mean speed, {} integrated over the speed trace), {} excluded, {} outliers left out",
         fit.runs.len(),
         fit.runs.len() - integrated,
         integrated,
-        fit.excluded.len() + fit.outliers.len()
+        fit.excluded.len(),
+        fit.outliers.len()
     );
     for e in &fit.excluded {
         println!("  excluded line {}: {}", e.row, e.reason);

@@ -136,6 +136,23 @@ pub fn coriolis_below_uncertainty(c: &Choice<f64>) -> bool {
     c.spread_rel.is_some_and(|s| c.coriolis_effect_rel <= s)
 }
 
+/// The error the choice claims, relative: the method's (integrator or closed form), the model's
+/// own (for the flat model, the Coriolis term it leaves out), and their sum, the bound on T's
+/// error against the Coriolis model that the tolerance is about.
+pub fn claimed_error(c: &Choice<f64>) -> (f64, f64, f64) {
+    let method = if matches!(c.plan, Plan::ClosedForm) {
+        0.0
+    } else {
+        c.estimated_error_rel
+    };
+    let model = if c.model == Model::Flat {
+        c.coriolis_effect_rel
+    } else {
+        0.0
+    };
+    (method, model, method + model)
+}
+
 /// The choice and its reasons, for the text output.
 pub fn describe(c: &Choice<f64>, need: &Need<f64>, runs_on: RunsOn) -> String {
     let tolerance = match (need, c.spread_rel) {
@@ -178,15 +195,22 @@ pub fn describe(c: &Choice<f64>, need: &Need<f64>, runs_on: RunsOn) -> String {
         model_name(c.model),
         plan_words(&c.plan)
     );
+    let (method_error, model_error, total) = claimed_error(c);
     if !matches!(c.plan, Plan::ClosedForm) {
         let predicted_by = match c.source {
             Source::Table => "the precomputed error table predicts it",
             Source::PilotRuns | Source::ClosedForms => "the pilot runs predict it",
         };
         out += &format!(
-            "\n  its error as {predicted_by}: {:.2e} ({} right-hand-side evaluations; \
-             choosing ran {})",
-            c.estimated_error_rel, c.rhs_evaluations, c.choosing_evaluations
+            "\n  the method's error as {predicted_by}: {method_error:.2e} ({} right-hand-side \
+             evaluations; choosing ran {})",
+            c.rhs_evaluations, c.choosing_evaluations
+        );
+    }
+    if model_error > 0.0 {
+        out += &format!(
+            "\n  the flat model's own error (the Coriolis term it leaves out): {model_error:.2e}; \
+             error of T in all: up to {total:.2e}"
         );
     }
     out += &format!("\n  chosen {}", c.source.describe());
@@ -248,7 +272,9 @@ pub fn json(c: &Choice<f64>, runs_on: RunsOn) -> serde_json::Value {
         "spread_rel": c.spread_rel.filter(|s| s.is_finite()),
         "coriolis_effect_rel": c.coriolis_effect_rel,
         "coriolis_below_uncertainty": coriolis_below_uncertainty(c),
-        "estimated_error_rel": c.estimated_error_rel,
+        "estimated_error_rel": claimed_error(c).2,
+        "method_error_rel": claimed_error(c).0,
+        "model_error_rel": claimed_error(c).1,
         "rhs_evaluations": c.rhs_evaluations,
         "choosing_evaluations": c.choosing_evaluations,
         "source": c.source.name(),
