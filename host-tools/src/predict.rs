@@ -9,7 +9,7 @@ use model_core::particle::{self, Model, Outcome, Scene};
 mod batch;
 mod bowl;
 mod choice;
-mod ode;
+pub(crate) mod ode;
 mod rolling;
 mod spin_up;
 mod target;

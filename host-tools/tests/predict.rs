@@ -95,7 +95,7 @@ fn bad_scene_is_a_clear_error() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1));
-    assert!(err.contains("--k2 must lie in (0, 1]"), "{err}");
+    assert!(err.contains("--k2 1.5: must lie in (0, 1]"), "{err}");
     assert!(!err.contains("InvalidK2"), "no Rust names: {err}");
     // The rig refuses a start at or beyond the rim: so does predict (it answered T = 0).
     let out = bowl(&["predict", "--ri-m", "0.2", "--rim-radius-m", "0.1"]);

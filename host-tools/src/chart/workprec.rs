@@ -92,7 +92,7 @@ pub struct Method {
     /// Number type.
     pub precision: Precision,
     /// Fixed-step methods: the step as `h omega` (dimensionless); DP5(4): the tolerance
-    /// (rtol = tol, atol = tol R for r and tol omega R for r', see [`dp54_tolerances`]);
+    /// (rtol = tol, atol = tol R for r and tol omega R for r', see `crate::predict::ode::dp54`);
     /// closed forms: none.
     pub setting: Option<f64>,
 }
@@ -160,12 +160,6 @@ pub fn methods() -> Vec<Method> {
     v
 }
 
-/// DP5(4) tolerances for a scene: relative `tol`, absolute `tol R` (same for r in m and r' in
-/// m/s; r' at the rim is of order omega R, a fraction of R per second at these speeds).
-pub fn dp54_tolerances<T: Real>(tol: T, s: &Scene<T>) -> (T, T) {
-    (tol, tol * s.rim_radius_m)
-}
-
 /// The model's ODE method for `m` on scene `s` (step in seconds from `h omega`).
 fn ode_method<T: Real>(m: &Method, s: &Scene<T>) -> Option<ode::Method<T>> {
     let x = T::from_f64(m.setting?);
@@ -175,10 +169,7 @@ fn ode_method<T: Real>(m: &Method, s: &Scene<T>) -> Option<ode::Method<T>> {
         Family::Euler => ode::Method::Euler { step_s: h },
         Family::SemiImplicitEuler => ode::Method::SemiImplicitEuler { step_s: h },
         Family::Rk4 => ode::Method::Rk4 { step_s: h },
-        Family::Dp54 => {
-            let (rtol, atol) = dp54_tolerances(x, s);
-            ode::Method::Dp54 { rtol, atol }
-        }
+        Family::Dp54 => crate::predict::ode::dp54(x, s),
     })
 }
 

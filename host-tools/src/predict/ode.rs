@@ -6,6 +6,35 @@ use model_core::particle::{self, Model, Outcome, Scene};
 
 use super::{MethodChoice, Prediction};
 
+/// DP5(4) at tolerance `tol` on scene `s`: relative `tol`, absolute `tol R` (the same for r in
+/// m and r' in m/s; r' at the rim is of order omega R). The one rule for `bowl predict --method
+/// dp54 --tol`, its suggested tolerance and the work-precision chart, so one tolerance is one
+/// plan everywhere (the CLI's absolute tolerance was `tol x 1e-2` whatever the rim: 61
+/// evaluations where the chart, at `tol R` with R = 75 mm, took 55).
+pub fn dp54<T: model_core::Real>(tol: T, s: &Scene<T>) -> Method<T> {
+    Method::Dp54 {
+        rtol: tol,
+        atol: tol * s.rim_radius_m,
+    }
+}
+
+/// The integrator `method` with fixed step `step_s` or DP5(4) tolerance `tol`; `None` for the
+/// closed form.
+pub fn plan(
+    method: MethodChoice,
+    step_s: f64,
+    tol: f64,
+    scene: &Scene<f64>,
+) -> Option<Method<f64>> {
+    Some(match method {
+        MethodChoice::Euler => Method::Euler { step_s },
+        MethodChoice::SemiImplicit => Method::SemiImplicitEuler { step_s },
+        MethodChoice::Rk4 => Method::Rk4 { step_s },
+        MethodChoice::Dp54 => dp54(tol, scene),
+        MethodChoice::Closed => return None,
+    })
+}
+
 /// Integrates one scene with a numerical method. The condition number reported is the
 /// problem's (from the closed form): it does not depend on the method.
 pub fn predict(
@@ -23,16 +52,8 @@ pub fn predict(
             0.01
         }
     });
-    let m = match method {
-        MethodChoice::Euler => Method::Euler { step_s: h },
-        MethodChoice::SemiImplicit => Method::SemiImplicitEuler { step_s: h },
-        MethodChoice::Rk4 => Method::Rk4 { step_s: h },
-        MethodChoice::Dp54 => Method::Dp54 {
-            rtol: tol,
-            atol: tol * 1e-2,
-        },
-        MethodChoice::Closed => unreachable!("closed forms are handled by the caller"),
-    };
+    let m = plan(method, h, tol, scene)
+        .ok_or_else(|| anyhow!("closed forms are not integrated (a bug in bowl)"))?;
     let closed = particle::residence(scene, model).map_err(|e| anyhow!(super::words::scene(e)))?;
     let report =
         ode::integrate_constant(scene, model, m).map_err(|e| anyhow!(super::words::ode(e)))?;
@@ -142,16 +163,7 @@ fn suggest(
         _ => h * (aim / err).powf(1.0 / order),
     };
     for _ in 0..40 {
-        let m = match method {
-            MethodChoice::Euler => Method::Euler { step_s: setting },
-            MethodChoice::SemiImplicit => Method::SemiImplicitEuler { step_s: setting },
-            MethodChoice::Rk4 => Method::Rk4 { step_s: setting },
-            MethodChoice::Dp54 => Method::Dp54 {
-                rtol: setting,
-                atol: setting * 1e-2,
-            },
-            MethodChoice::Closed => return None,
-        };
+        let m = plan(method, setting, setting, scene)?;
         if meets(m) {
             return Some(setting);
         }
