@@ -1,8 +1,10 @@
 //! The second emulator: the exact Black Pill image (`cargo build --release -p firmware`) on an
 //! emulated STM32F411, run by `tests/blackpill/run_board.py` (qiling with the project's
 //! peripheral models, the simulated plant through `tests/blackpill/plant-ffi`). USART2 is served
-//! on a pseudo-terminal. The emulator's Python environment is made by `bash tests/run`
-//! (`ensure_blackpill_emulator` in tests/lib/ensure-tools.sh).
+//! on a pseudo-terminal. The emulator's Python environment, the thumb target and flip-link are
+//! installed by the one installer `bash tests/run` uses too (`ensure_blackpill_emulator` and
+//! friends in tests/lib/ensure-tools.sh): [`install`] runs it when the board is booted, so a
+//! fresh clone's `bowl demo --rig blackpill` sets itself up, with progress.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -23,6 +25,53 @@ pub fn image_path() -> PathBuf {
 /// The emulator's Python interpreter (its virtual environment under the target directory).
 pub fn python() -> PathBuf {
     workspace::root().join("target/venv-blackpill/bin/python")
+}
+
+/// The shared installer's steps the emulated board needs, as `bash tests/run` runs them.
+const INSTALL_STEPS: &str = "source tests/lib/ensure-tools.sh && ensure_thumb_target && \
+                             ensure_flip_link && ensure_blackpill_emulator";
+
+/// Installs what the emulated board needs and a fresh machine lacks (the thumb target,
+/// flip-link, the emulator's venv with its pinned qiling and unicorn, defmt-print), through the
+/// installer `bash tests/run` uses; quiet and quick when everything is there. Progress is shown
+/// (pip's own lines): the first install downloads and builds for a few minutes.
+pub fn install() -> Result<()> {
+    let fresh = !python().is_file();
+    if fresh {
+        eprintln!(
+            "the Black Pill emulator is not installed yet: installing it into {} (python3 venv, \
+             pinned qiling and unicorn from PyPI; a few minutes, once)",
+            python()
+                .parent()
+                .and_then(Path::parent)
+                .unwrap_or(Path::new(""))
+                .display()
+        );
+    }
+    let status = Command::new("bash")
+        .current_dir(workspace::root())
+        .args(["-c", INSTALL_STEPS])
+        // pip shows what it collects and builds: the progress of the long first install.
+        .env("ENSURE_VERBOSE", "1")
+        .stdin(Stdio::null())
+        .stdout(Stdio::inherit())
+        .stderr(Stdio::inherit())
+        .status()
+        .context("cannot run bash for the emulator's installer (tests/lib/ensure-tools.sh)")?;
+    if !status.success() || !python().is_file() {
+        bail!(
+            "installing the Black Pill emulator failed (tests/lib/ensure-tools.sh, output above): \
+             it needs python3 with venv and pip and access to PyPI; fix that and run again, or run \
+             the demo on the host (--rig host)"
+        );
+    }
+    if fresh {
+        eprintln!(
+            "the Black Pill emulator is installed: {}",
+            python().display()
+        );
+    }
+    Ok(())
 }
 
 /// Builds what the emulated board needs: the image and the plant library.
@@ -81,14 +130,8 @@ impl PtyBoard {
     /// caller stops it sooner). Waits 60 s at most for the pseudo-terminal.
     pub fn boot(seconds: f64) -> Result<PtyBoard> {
         let root = workspace::root();
+        install()?;
         let python = python();
-        if !python.is_file() {
-            bail!(
-                "the Black Pill emulator is not installed ({} is missing): run `bash tests/run` \
-                 once, which installs it",
-                python.display()
-            );
-        }
         build()?;
         let mut child = Command::new(&python)
             .current_dir(&root)

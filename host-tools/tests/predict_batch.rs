@@ -71,9 +71,9 @@ fn keep_going_writes_every_row_with_its_status_and_fails() {
         "{err}"
     );
     let mut rdr = csv::Reader::from_reader(written.as_bytes());
-    assert_eq!(rdr.headers().unwrap().iter().last(), Some("status"));
+    assert_eq!(rdr.headers().unwrap().iter().next_back(), Some("status"));
     let rows: Vec<csv::StringRecord> = rdr.records().map(|r| r.unwrap()).collect();
-    let status: Vec<&str> = rows.iter().map(|r| r.iter().last().unwrap()).collect();
+    let status: Vec<&str> = rows.iter().map(|r| r.iter().next_back().unwrap()).collect();
     assert_eq!(status[0], "ok");
     assert!(status[1].starts_with("refused: `w_rad_s` = \"fast\" is not a number"));
     assert!(status[2].contains("not inside the rim"), "{}", status[2]);

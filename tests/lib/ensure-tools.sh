@@ -40,14 +40,17 @@ ensure_qemu() {
 
 # The emulated Black Pill (tests/blackpill): a venv under target/ with the pinned qiling and
 # unicorn (tests/blackpill/requirements.txt), and defmt-print to decode the image's logs.
-# Sets BLACKPILL_PYTHON and DEFMT_PRINT for the caller.
+# Sets BLACKPILL_PYTHON and DEFMT_PRINT for the caller. With ENSURE_VERBOSE set (the demo and
+# `bowl-emulator`'s boot of the board: emulator/src/blackpill.rs `install`) pip shows its progress.
 ensure_blackpill_emulator() {
   local venv=target/venv-blackpill
   local req=tests/blackpill/requirements.txt
+  local pip_output=(--quiet)
+  if [ -n "${ENSURE_VERBOSE:-}" ]; then pip_output=(--progress-bar on); fi
   if ! [ -x "$venv/bin/python" ] || ! cmp -s "$req" "$venv/requirements.txt"; then
     echo "== installing the Black Pill emulator (qiling, pinned unicorn) into $venv"
     python3 -m venv "$venv" &&
-      "$venv/bin/pip" install --quiet --disable-pip-version-check -r "$req" &&
+      "$venv/bin/pip" install "${pip_output[@]}" --disable-pip-version-check -r "$req" &&
       cp "$req" "$venv/requirements.txt" || return 1
   fi
   BLACKPILL_PYTHON=$venv/bin/python
