@@ -4,9 +4,8 @@
 mod common;
 
 use std::path::PathBuf;
-use std::process::Output;
 
-use common::{bowl, json};
+use common::{bowl, json, run_batch};
 
 /// Flat residence time by the textbook formula, `acosh((R - a)/(ri - a)) / (k omega)`.
 fn flat_time(w: f64, mu: f64, ri: f64, rim: f64) -> f64 {
@@ -271,27 +270,6 @@ fn batch_rows_carry_the_results_condition_and_flags_of_single_predictions() {
     );
     let _ = std::fs::remove_file(input);
     let _ = std::fs::remove_file(output);
-}
-
-/// `bowl predict --batch` on a file holding `csv` (named after `name`), with `extra` flags:
-/// its output, the results file's text (empty if none was written), both files removed.
-fn run_batch(name: &str, csv: &str, extra: &[&str]) -> (Output, String) {
-    let input = temp(&format!("{name}.csv"));
-    let output = temp(&format!("{name}-out.csv"));
-    std::fs::write(&input, csv).unwrap();
-    let mut args = vec![
-        "predict",
-        "--batch",
-        input.to_str().unwrap(),
-        "--out",
-        output.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    let out = bowl(&args);
-    let text = std::fs::read_to_string(&output).unwrap_or_default();
-    let _ = std::fs::remove_file(input);
-    let _ = std::fs::remove_file(output);
-    (out, text)
 }
 
 #[test]

@@ -3,33 +3,14 @@
 
 mod common;
 
-use std::path::PathBuf;
 use std::process::Output;
 
-use common::bowl;
+use common::run_batch;
 
-fn temp(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("bowl-batch-{}-{name}", std::process::id()))
-}
-
-/// Runs the batch on `text` with `extra` flags: the output and the written file's text.
+/// Runs the batch on `text` with `extra` flags: the output, the written file's text, stderr.
 fn batch(name: &str, text: &str, extra: &[&str]) -> (Output, String, String) {
-    let input = temp(&format!("{name}.csv"));
-    let output = temp(&format!("{name}-out.csv"));
-    std::fs::write(&input, text).unwrap();
-    let mut args = vec![
-        "predict",
-        "--batch",
-        input.to_str().unwrap(),
-        "--out",
-        output.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    let out = bowl(&args);
-    let written = std::fs::read_to_string(&output).unwrap_or_default();
+    let (out, written) = run_batch(name, text, extra);
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    let _ = std::fs::remove_file(input);
-    let _ = std::fs::remove_file(output);
     (out, written, err)
 }
 

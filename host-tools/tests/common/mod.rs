@@ -15,6 +15,30 @@ use std::time::{Duration, Instant};
 use nix::fcntl::OFlag;
 use nix::pty::{PtyMaster, grantpt, posix_openpt, ptsname_r, unlockpt};
 
+/// `bowl predict --batch` on a file holding `csv` (named after `name` in the temporary folder),
+/// with `extra` flags: its output and the results file's text (empty if none was written), both
+/// files removed.
+pub fn run_batch(name: &str, csv: &str, extra: &[&str]) -> (Output, String) {
+    let temp =
+        |n: &str| std::env::temp_dir().join(format!("bowl-batch-{}-{n}", std::process::id()));
+    let input = temp(&format!("{name}.csv"));
+    let output = temp(&format!("{name}-out.csv"));
+    std::fs::write(&input, csv).unwrap();
+    let mut args = vec![
+        "predict",
+        "--batch",
+        input.to_str().unwrap(),
+        "--out",
+        output.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let out = bowl(&args);
+    let text = std::fs::read_to_string(&output).unwrap_or_default();
+    let _ = std::fs::remove_file(input);
+    let _ = std::fs::remove_file(output);
+    (out, text)
+}
+
 /// The `bowl` binary under test.
 pub const BOWL: &str = env!("CARGO_BIN_EXE_bowl");
 
