@@ -266,4 +266,54 @@ mod tests {
             "{marks:?}"
         );
     }
+
+    /// NaN, negative and missing-trace rows are each excluded with their line and own words.
+    #[test]
+    fn dropped_rows_say_why() {
+        use crate::experiment::results::{Row, Writer};
+        let dir = std::env::temp_dir().join(format!("bowl-fit-dropped-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("r.csv");
+        let mut w = Writer::create(&path).unwrap();
+        let trace = w.write_trace(1, &[(0.0, 4.0), (0.5, 4.0)]).unwrap();
+        let row = |run: usize, t: f64, trace_path: &str| Row {
+            run,
+            condition: 1,
+            bowl_rad_s: 4.0,
+            precession_rad_s: 2.3,
+            spin_rad_s: 2.3,
+            release_radius_m: 0.05,
+            rim_radius_m: 0.15,
+            k2: 5.0 / 7.0,
+            status: "ok".into(),
+            residence_s: Some(t),
+            trace_mean_rad_s: Some(4.0),
+            trace_sd_rad_s: Some(0.0),
+            trace_path: trace_path.into(),
+        };
+        w.push(&row(1, f64::NAN, &trace)).unwrap();
+        w.push(&row(2, -0.5, &trace)).unwrap();
+        w.push(&row(3, 0.6, "r_traces/none.csv")).unwrap();
+        w.push(&row(4, 0.6, &trace)).unwrap();
+        drop(w);
+        let (runs, excluded) = super::super::load(&path).unwrap();
+        assert_eq!(runs.len(), 1);
+        assert_eq!(runs[0].row, 5);
+        let said: Vec<(usize, &str)> = excluded
+            .iter()
+            .map(|e| (e.row, e.reason.as_str()))
+            .collect();
+        assert_eq!(said[0], (2, "residence time is not a number (NaN)"));
+        assert_eq!(said[1].0, 3);
+        assert!(
+            said[1]
+                .1
+                .starts_with("residence time -0.5 s: a release takes a positive time")
+        );
+        assert_eq!(
+            said[2],
+            (4, "speed trace r_traces/none.csv missing or empty")
+        );
+        let _ = std::fs::remove_dir_all(dir);
+    }
 }
