@@ -412,19 +412,6 @@ fn describe_scene(s: &Scene<f64>) -> String {
     )
 }
 
-/// What keeps a granule that never leaves in the bowl, in words.
-fn what_holds(scene: &Scene<f64>, equilibrium_radius_m: f64) -> String {
-    match (scene.omega_rad_s == 0.0, scene.mu == 0.0) {
-        (true, true) => "the bowl is not turning (omega 0) and there is no friction (mu 0): \
-                         nothing pushes the granule outward, so it stays where it was put"
-            .into(),
-        (true, false) => "the bowl is not turning (omega 0): nothing pushes the granule \
-                          outward, and friction keeps it where it was put"
-            .into(),
-        _ => format!("ri <= a = {equilibrium_radius_m:.6} m, friction holds it"),
-    }
-}
-
 fn describe(scene: &Scene<f64>, model: Model, method: MethodChoice, p: &Prediction) -> String {
     let head = format!("{:<8} {:<13}", model_name(model), method_name(method));
     let cost = if p.rhs_evaluations > 0 {
@@ -460,7 +447,7 @@ fn describe(scene: &Scene<f64>, model: Model, method: MethodChoice, p: &Predicti
             near_threshold,
         } => format!(
             "{head} NEVER LEAVES: {}{}",
-            what_holds(scene, equilibrium_radius_m),
+            words::what_holds(scene, equilibrium_radius_m),
             if near_threshold {
                 " (within rounding of the threshold)"
             } else {

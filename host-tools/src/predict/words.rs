@@ -74,6 +74,19 @@ pub fn check(s: &Scene<f64>) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// What keeps a granule that never leaves in the bowl, in words.
+pub fn what_holds(scene: &Scene<f64>, equilibrium_radius_m: f64) -> String {
+    match (scene.omega_rad_s == 0.0, scene.mu == 0.0) {
+        (true, true) => "the bowl is not turning (omega 0) and there is no friction (mu 0): \
+                         nothing pushes the granule outward, so it stays where it was put"
+            .into(),
+        (true, false) => "the bowl is not turning (omega 0): nothing pushes the granule \
+                          outward, and friction keeps it where it was put"
+            .into(),
+        _ => format!("ri <= a = {equilibrium_radius_m:.6} m, friction holds it"),
+    }
+}
+
 /// Why no bowl speed was found for a target.
 pub fn inverse(e: InverseError, target_s: f64) -> String {
     match e {
