@@ -184,3 +184,29 @@ impl PtyBoard {
         self.process.stop()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The installer the board runs is the shared one, and every step it names is defined there
+    /// (a renamed step would otherwise surface only on a fresh clone).
+    #[test]
+    fn the_install_steps_are_the_shared_installers() {
+        let script =
+            std::fs::read_to_string(workspace::root().join("tests/lib/ensure-tools.sh")).unwrap();
+        assert!(INSTALL_STEPS.starts_with("source tests/lib/ensure-tools.sh"));
+        for step in INSTALL_STEPS.split("&&").skip(1) {
+            let name = step.trim();
+            assert!(
+                script.contains(&format!("{name}() {{")),
+                "{name} not in ensure-tools.sh"
+            );
+        }
+        let run = std::fs::read_to_string(workspace::root().join("tests/run")).unwrap();
+        assert!(
+            run.contains("ensure_blackpill_emulator"),
+            "tests/run uses the same installer"
+        );
+    }
+}
