@@ -136,6 +136,11 @@ impl PtyBoard {
         let mut child = Command::new(&python)
             .current_dir(&root)
             .arg("tests/blackpill/run_board.py")
+            // What `build` made, wherever cargo put it (CARGO_TARGET_DIR too).
+            .arg("--elf")
+            .arg(image_path())
+            .arg("--plant-lib")
+            .arg(workspace::target_dir().join("debug/libplant_ffi.so"))
             .args(["--seconds", &seconds.ceil().to_string()])
             .args(["--defmt-print", &defmt_print(&root)])
             .arg("--control-stdin")
