@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use model_core::wire::{Command, Decoder, Frame, decode_frame};
 
-use crate::serial::{LinkError, Port, ReadOutcome};
+use crate::serial::{LinkError, Port, ReadOutcome, other_holders, shared_port_warning};
 pub use crate::unreadable::{LineTap, UnreadableAnswer};
 
 #[cfg(unix)]
@@ -60,7 +60,11 @@ impl Link {
             eprintln!("{port} is held by a running `bowl monitor`: sending through it");
             return Ok(Link::Monitor(stream));
         }
-        Port::open(port, baud).map(Link::Port)
+        let opened = Port::open(port, baud)?;
+        if let Some(warning) = shared_port_warning(port, &other_holders(port)) {
+            eprintln!("{warning}");
+        }
+        Ok(Link::Port(opened))
     }
 
     /// Reads what is there, waiting at most `timeout`.

@@ -148,6 +148,136 @@ impl Port {
     }
 }
 
+/// Another program that has the same port open.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Holder {
+    /// Its process id.
+    pub pid: u32,
+    /// Its name, as the system knows it (`picocom`, `python3`, ...).
+    pub name: String,
+}
+
+impl std::fmt::Display for Holder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} (pid {})", self.name, self.pid)
+    }
+}
+
+/// Other programs that have `path` open, as far as this system lets us see (Linux, through
+/// `/proc`; elsewhere none are found). Our exclusive open keeps later programs out, but one that
+/// opened the port before us without locking it (tio and screen without their lock, `cat`, a
+/// script) goes on reading: each byte the rig sends reaches only one of us, so frames and answers
+/// go missing at random with nothing else to show why. A program that also holds the
+/// pseudo-terminal's master side is the rig's side (a virtual rig, an emulator), not a reader.
+pub fn other_holders(path: &str) -> Vec<Holder> {
+    #[cfg(target_os = "linux")]
+    {
+        linux_holders::find(path)
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        let _ = path;
+        Vec::new()
+    }
+}
+
+/// The warning shown when [`other_holders`] found someone, in words: who, what it does to the
+/// link, what to do.
+pub fn shared_port_warning(path: &str, holders: &[Holder]) -> Option<String> {
+    if holders.is_empty() {
+        return None;
+    }
+    let who: Vec<String> = holders.iter().map(Holder::to_string).collect();
+    Some(format!(
+        "warning: {path} is also open in {}, which does not lock it: it takes some of the rig's \
+         bytes, so frames and answers will go missing. Close it; to share the rig between programs, \
+         keep one `bowl monitor` open (other `bowl` commands send through it)",
+        who.join(", ")
+    ))
+}
+
+#[cfg(target_os = "linux")]
+mod linux_holders {
+    use std::os::unix::fs::{FileTypeExt, MetadataExt};
+
+    use super::Holder;
+
+    /// The pseudo-terminal index of a `/dev/pts/N` path.
+    fn pts_index(path: &str) -> Option<u32> {
+        std::fs::canonicalize(path)
+            .ok()?
+            .to_str()?
+            .strip_prefix("/dev/pts/")?
+            .parse()
+            .ok()
+    }
+
+    /// Whether process `pid` holds the master side of pseudo-terminal `index` (its `fdinfo`
+    /// names the index of the terminal a `/dev/ptmx` descriptor opened).
+    fn holds_master(pid: &str, index: u32) -> bool {
+        let Ok(fds) = std::fs::read_dir(format!("/proc/{pid}/fd")) else {
+            return false;
+        };
+        fds.flatten().any(|fd| {
+            let target = std::fs::read_link(fd.path()).unwrap_or_default();
+            if !target.to_string_lossy().ends_with("ptmx") {
+                return false;
+            }
+            let info = std::fs::read_to_string(format!(
+                "/proc/{pid}/fdinfo/{}",
+                fd.file_name().to_string_lossy()
+            ))
+            .unwrap_or_default();
+            info.lines().any(|l| {
+                l.strip_prefix("tty-index:")
+                    .and_then(|v| v.trim().parse::<u32>().ok())
+                    == Some(index)
+            })
+        })
+    }
+
+    pub(super) fn find(path: &str) -> Vec<Holder> {
+        let Ok(device) = std::fs::metadata(path) else {
+            return Vec::new();
+        };
+        if !device.file_type().is_char_device() {
+            return Vec::new();
+        }
+        let me = std::process::id().to_string();
+        let pts = pts_index(path);
+        let Ok(procs) = std::fs::read_dir("/proc") else {
+            return Vec::new();
+        };
+        let mut found = Vec::new();
+        for entry in procs.flatten() {
+            let pid = entry.file_name().to_string_lossy().into_owned();
+            if pid == me || !pid.bytes().all(|b| b.is_ascii_digit()) {
+                continue;
+            }
+            // Other users' descriptors are not readable: those holders stay unseen.
+            let Ok(fds) = std::fs::read_dir(format!("/proc/{pid}/fd")) else {
+                continue;
+            };
+            let holds = fds.flatten().any(|fd| {
+                std::fs::metadata(fd.path()).is_ok_and(|m| {
+                    m.file_type().is_char_device() && m.rdev() == device.rdev()
+                })
+            });
+            if !holds || pts.is_some_and(|i| holds_master(&pid, i)) {
+                continue;
+            }
+            let name = std::fs::read_to_string(format!("/proc/{pid}/comm"))
+                .map(|n| n.trim().to_owned())
+                .unwrap_or_else(|_| "a program".to_owned());
+            if let Ok(pid) = pid.parse() {
+                found.push(Holder { pid, name });
+            }
+        }
+        found.sort_by_key(|h| h.pid);
+        found
+    }
+}
+
 impl Drop for Port {
     fn drop(&mut self) {
         // A terminal keeps its exclusive flag while anyone else holds it open (the virtual rig

@@ -29,7 +29,7 @@ use serde_json::json;
 use crate::link::LineTap;
 use crate::relay::Relay;
 use crate::replay::stats_json;
-use crate::serial::{Port, ReadOutcome};
+use crate::serial::{Holder, Port, ReadOutcome, other_holders, shared_port_warning};
 use crate::telemetry_csv;
 use commands::Commands;
 use tui::{Action, Tui};
@@ -87,6 +87,30 @@ fn stdin_lines() -> mpsc::Receiver<String> {
 }
 
 /// Runs `bowl monitor`.
+/// How often the monitor looks for programs that read the port beside it (a scan of `/proc`: a
+/// few milliseconds).
+const HOLDER_CHECK_EVERY: Duration = Duration::from_secs(5);
+
+/// Who else had the port open when last looked, so each change is said once.
+#[derive(Default)]
+struct SharedPort {
+    seen: Vec<Holder>,
+}
+
+impl SharedPort {
+    /// Looks again; the words to show when the set of other holders changed.
+    fn check(&mut self, port: &str) -> Option<String> {
+        let now = other_holders(port);
+        if now == self.seen {
+            return None;
+        }
+        let text = shared_port_warning(port, &now)
+            .unwrap_or_else(|| format!("{port} is no longer open in another program"));
+        self.seen = now;
+        Some(text)
+    }
+}
+
 /// Heartbeat period, well inside the rig's default link-loss timeout (3 s).
 const HEARTBEAT_EVERY: Duration = Duration::from_secs(1);
 /// The heartbeat's command id: other tools match answers by id and kind and never wait for it.
@@ -134,6 +158,8 @@ pub fn run(args: &Args) -> Result<()> {
     let mut buf = [0u8; 4096];
     // An open gap in the telemetry: since when nothing came, and the frame count then.
     let mut gap: Option<(Instant, u64)> = None;
+    let mut holders = SharedPort::default();
+    let mut next_holder_check = Instant::now();
 
     while deadline.is_none_or(|d| Instant::now() < d) && !interrupted.load(Ordering::SeqCst) {
         if port.is_none() && last_open_try.elapsed() >= REOPEN_EVERY {
@@ -255,6 +281,13 @@ pub fn run(args: &Args) -> Result<()> {
                 link_event(&mut log, decoder.stats().restarts, &text)?;
             }
             Some(_) => {}
+        }
+        if port.is_some() && Instant::now() >= next_holder_check {
+            next_holder_check = Instant::now() + HOLDER_CHECK_EVERY;
+            if let Some(text) = holders.check(&args.port) {
+                view.event(plain, text.clone());
+                link_event(&mut log, decoder.stats().restarts, &text)?;
+            }
         }
         let mut outgoing = relay.as_mut().map(Relay::poll).unwrap_or_default();
         let mut typed_now: Vec<String> = typed.iter().flat_map(|rx| rx.try_iter()).collect();
