@@ -55,6 +55,53 @@ fn thread_cpu_seconds() -> f64 {
         .unwrap_or(0.0)
 }
 
+/// Gaps in a capture's telemetry, judged as the monitor judges them live: no frame for three
+/// frame periods (at least [`GAP_FLOOR_MS`]) is a gap, marked in the CSV with the monitor's own
+/// words at the device times it began and ended, so `bowl chart log` breaks its lines there.
+#[derive(Default)]
+struct Gaps {
+    /// The last frame: boot, device time, sequence number.
+    last: Option<(u64, u32, u16)>,
+    /// The frame period, from the last two frames that followed each other with none lost.
+    period_ms: Option<u32>,
+}
+
+/// The shortest silence called a gap (the monitor's floor).
+const GAP_FLOOR_MS: u32 = 500;
+
+impl Gaps {
+    /// A telemetry frame arrived: the (device time, words) of the gap it ends, if any.
+    fn on_frame(&mut self, boot: u64, time_ms: u32, seq: u16) -> Option<[(u32, String); 2]> {
+        let last = self.last.replace((boot, time_ms, seq));
+        let (last_boot, last_ms, last_seq) = last?;
+        if last_boot != boot || time_ms < last_ms {
+            // A restart: the device clock began again; the restart is its own event.
+            self.period_ms = None;
+            return None;
+        }
+        let dt = time_ms - last_ms;
+        let gap = self
+            .period_ms
+            .filter(|&p| dt > (3 * p).max(GAP_FLOOR_MS))
+            .map(|p| {
+                [
+                    (last_ms + p, "no telemetry".to_string()),
+                    (
+                        time_ms,
+                        format!(
+                            "telemetry again after {:.1} s",
+                            f64::from(time_ms - last_ms - p) / 1000.0
+                        ),
+                    ),
+                ]
+            });
+        if seq == last_seq.wrapping_add(1) && dt > 0 {
+            self.period_ms = Some(dt);
+        }
+        gap
+    }
+}
+
 /// Read size of the streaming replay: the capture is never held whole, whatever its size.
 const CHUNK_BYTES: usize = 1 << 16;
 
@@ -79,6 +126,7 @@ pub fn run(args: &Args) -> Result<()> {
         None => None,
     };
     let mut telemetry = 0u64;
+    let mut gaps = Gaps::default();
     let mut csv_error = None;
     let started = Instant::now();
     let cpu_started = thread_cpu_seconds();
@@ -97,7 +145,13 @@ pub fn run(args: &Args) -> Result<()> {
             let written = match (r, csv.as_mut()) {
                 (Ok(Frame::Telemetry(t)), w) => {
                     telemetry += 1;
-                    w.map(|w| telemetry_csv::write_row(w, stats.restarts, &t, None))
+                    let gap = gaps.on_frame(stats.restarts, t.time_ms, t.seq);
+                    w.map(|w| {
+                        for (at_ms, what) in gap.iter().flatten() {
+                            telemetry_csv::write_device_event(w, stats.restarts, *at_ms, what)?;
+                        }
+                        telemetry_csv::write_row(w, stats.restarts, &t, None)
+                    })
                 }
                 // Gate events are logged too: nothing the rig sends is dropped.
                 (Ok(Frame::Event(e)), Some(w)) => {

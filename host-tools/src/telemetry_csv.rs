@@ -104,6 +104,22 @@ pub fn write_event(
     Ok(())
 }
 
+/// Writes an event the device's clock dates (a gap found in a capture, which holds no PC time):
+/// `boot`, the device time, the other columns empty, the event.
+pub fn write_device_event(
+    out: &mut impl Write,
+    boot: u64,
+    device_time_ms: u32,
+    event: &str,
+) -> Result<()> {
+    writeln!(
+        out,
+        "{boot},{device_time_ms}{},{event}",
+        ",".repeat(TELEMETRY_COLUMNS)
+    )?;
+    Ok(())
+}
+
 /// A telemetry log opened for reading (`bowl monitor --log`, `bowl replay --csv`, the demo's
 /// telemetry.csv): its records, and its columns found by name.
 pub struct LogReader {

@@ -281,3 +281,65 @@ fn the_monitor_says_what_it_cannot_read() {
         "said once: {text}"
     );
 }
+
+/// A capture with the telemetry paused (`SET TELEM_HZ 0` for 3 s): `replay --csv` marks the gap
+/// with the monitor's own words at the device times it began and ended, and `bowl chart log`
+/// breaks its lines there (no line drawn across data the rig never sent).
+#[test]
+fn replay_marks_a_gap_in_the_telemetry_as_the_monitor_does() {
+    let dir = temp_dir("replay-gap");
+    let capture = dir.join("cap.bin");
+    let csv = dir.join("run.csv");
+    let made = bowl(&[
+        "serve",
+        "--capture",
+        capture.to_str().unwrap(),
+        "--seconds",
+        "8",
+        "--command",
+        "0:speed,1500,1500",
+        "--command",
+        "2000:set,TELEM_HZ,0",
+        "--command",
+        "5000:set,TELEM_HZ,50",
+    ]);
+    assert!(made.status.success(), "{}", stdout(&made));
+    let replay = bowl(&[
+        "replay",
+        capture.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(replay.status.success(), "{}", stdout(&replay));
+    let rows = csv_rows(&csv);
+    let events: Vec<(u64, &str)> = rows
+        .iter()
+        .filter(|r| !r["event"].is_empty())
+        .map(|r| (r["device_time_ms"].parse().unwrap(), r["event"].as_str()))
+        .collect();
+    assert_eq!(events.len(), 2, "{events:?}");
+    let (began, ended) = (events[0], events[1]);
+    assert_eq!(began.1, "no telemetry", "{events:?}");
+    assert!((2000..=2060).contains(&began.0), "{events:?}");
+    assert!(ended.1.starts_with("telemetry again after 3.0 s"), "{events:?}");
+    assert!((5000..=5040).contains(&ended.0), "{events:?}");
+    // Telemetry rows lie outside the gap only.
+    let inside = rows
+        .iter()
+        .filter(|r| r["event"].is_empty())
+        .filter_map(|r| r["device_time_ms"].parse::<u64>().ok())
+        .filter(|t| (began.0 + 1..ended.0).contains(t))
+        .count();
+    assert_eq!(inside, 0);
+    let chart = bowl(&[
+        "chart",
+        "log",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--out",
+        dir.join("run.svg").to_str().unwrap(),
+    ]);
+    assert!(chart.status.success(), "{}", stdout(&chart));
+    let svg = std::fs::read_to_string(dir.join("run-spin.svg")).unwrap();
+    assert!(svg.contains("no telemetry"), "the gap is marked on the chart");
+}
