@@ -82,10 +82,11 @@ pub fn explain(reason: Reason) -> &'static str {
     }
 }
 
-/// The STATUS flags in words, each after "; " (empty when none is set).
-fn status_flag_words(flags: u8) -> String {
+/// The STATUS flags in words, joined by "; " (`None` when none is set): also the monitor's
+/// banner.
+pub fn status_flag_words(flags: u8) -> Option<String> {
     use model_core::wire::status_flags as f;
-    [
+    let words: Vec<&str> = [
         (
             f::PARAMS_DEFAULTS,
             "booted on default parameters: no valid record in flash",
@@ -98,8 +99,9 @@ fn status_flag_words(flags: u8) -> String {
     ]
     .iter()
     .filter(|(bit, _)| flags & bit != 0)
-    .map(|(_, w)| format!("; {w}"))
-    .collect()
+    .map(|(_, w)| *w)
+    .collect();
+    (!words.is_empty()).then(|| words.join("; "))
 }
 
 /// A one-line description of an answer frame.
@@ -125,7 +127,9 @@ pub fn describe(frame: &Frame) -> String {
             words::state(s.state),
             words::fault(s.fault),
             words::reset_cause(s.reset_cause),
-            status_flag_words(s.flags),
+            status_flag_words(s.flags)
+                .map(|w| format!("; {w}"))
+                .unwrap_or_default(),
         ),
         Frame::Params { id, values } => {
             let mut out = format!("params (id {id}):");

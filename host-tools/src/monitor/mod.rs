@@ -115,6 +115,11 @@ impl SharedPort {
 const HEARTBEAT_EVERY: Duration = Duration::from_secs(1);
 /// The heartbeat's command id: other tools match answers by id and kind and never wait for it.
 const HEARTBEAT_ID: u16 = u16::MAX;
+/// The id of the monitor's own STATUS (asked when the port opens and after each rig restart, for
+/// the board conditions only STATUS carries: the parameters' source, the clock).
+const STATUS_ID: u16 = u16::MAX - 1;
+/// Asked again this often until answered.
+const STATUS_AGAIN_EVERY: Duration = Duration::from_secs(2);
 
 pub fn run(args: &Args) -> Result<()> {
     // The UI needs a screen and a keyboard; without either it prints lines.
@@ -159,6 +164,8 @@ pub fn run(args: &Args) -> Result<()> {
     // An open gap in the telemetry: since when nothing came, and the frame count then.
     let mut gap: Option<(Instant, u64)> = None;
     let mut holders = SharedPort::default();
+    // When to ask the rig's STATUS next (None: answered).
+    let mut status_due = Some(Instant::now());
     let mut next_holder_check = Instant::now();
 
     while deadline.is_none_or(|d| Instant::now() < d) && !interrupted.load(Ordering::SeqCst) {
@@ -176,6 +183,7 @@ pub fn run(args: &Args) -> Result<()> {
                 view.set_connected(true);
                 view.reconnects += 1;
                 view.event(plain, format!("port {} reopened", args.port));
+                status_due = Some(Instant::now());
                 link_event(&mut log, decoder.stats().restarts, "port reopened")?;
             }
         }
@@ -235,6 +243,23 @@ pub fn run(args: &Args) -> Result<()> {
                         if let Some(ui) = tui.as_mut() {
                             ui.on_telemetry(t);
                         }
+                    }
+                    match &frame {
+                        Frame::Hello(_) => status_due = Some(Instant::now()),
+                        Frame::Status { id, status } if *id == STATUS_ID => {
+                            status_due = None;
+                            if view.board_flags != Some(status.flags) {
+                                view.board_flags = Some(status.flags);
+                                if let Some(words) = crate::send::status_flag_words(status.flags)
+                                {
+                                    let text = format!("the rig reports: {words}");
+                                    view.event(plain, text.clone());
+                                    link_event(&mut log, decoder.stats().restarts, &text)?;
+                                }
+                            }
+                            continue;
+                        }
+                        _ => {}
                     }
                     match commands.on_frame(&frame) {
                         Some(text) => view.event(plain, text),
@@ -311,6 +336,12 @@ pub fn run(args: &Args) -> Result<()> {
         if port.is_some() && last_heartbeat.elapsed() >= HEARTBEAT_EVERY {
             last_heartbeat = Instant::now();
             if let Ok(line) = crate::send::command_line(HEARTBEAT_ID, &["PING".to_string()]) {
+                outgoing.push(line);
+            }
+        }
+        if port.is_some() && status_due.is_some_and(|due| Instant::now() >= due) {
+            status_due = Some(Instant::now() + STATUS_AGAIN_EVERY);
+            if let Ok(line) = crate::send::command_line(STATUS_ID, &["STATUS".to_string()]) {
                 outgoing.push(line);
             }
         }

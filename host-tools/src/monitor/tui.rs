@@ -279,6 +279,18 @@ fn banner<'a>(
             crate::words::state(t.state)
         )));
     }
+    // Board conditions the rig reported (defaults instead of the saved parameters, the
+    // internal oscillator): on the banner for as long as they hold, not only as an event.
+    if let Some(words) = view
+        .board_flags
+        .and_then(crate::send::status_flag_words)
+        .filter(|_| view.connected)
+    {
+        spans.push(Span::styled(
+            format!(" board: {words} "),
+            Style::default().fg(Color::Black).bg(Color::Yellow),
+        ));
+    }
     if paused {
         spans.push(Span::styled(
             " PAUSED ",

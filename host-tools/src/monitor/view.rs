@@ -98,6 +98,8 @@ pub(crate) struct View {
     period_ms: u32,
     /// Telemetry frames taken in.
     pub(crate) telemetry_frames: u64,
+    /// The board conditions the rig's STATUS reported (`wire::status_flags` bits), once asked.
+    pub(crate) board_flags: Option<u8>,
 }
 
 /// Telemetry is overdue after this many frame periods without a frame ...
@@ -126,6 +128,7 @@ impl View {
             heard_at: Instant::now(),
             period_ms: 0,
             telemetry_frames: 0,
+            board_flags: None,
         }
     }
 
