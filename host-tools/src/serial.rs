@@ -259,9 +259,8 @@ mod linux_holders {
                 continue;
             };
             let holds = fds.flatten().any(|fd| {
-                std::fs::metadata(fd.path()).is_ok_and(|m| {
-                    m.file_type().is_char_device() && m.rdev() == device.rdev()
-                })
+                std::fs::metadata(fd.path())
+                    .is_ok_and(|m| m.file_type().is_char_device() && m.rdev() == device.rdev())
             });
             if !holds || pts.is_some_and(|i| holds_master(&pid, i)) {
                 continue;

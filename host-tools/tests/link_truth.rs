@@ -321,7 +321,10 @@ fn replay_marks_a_gap_in_the_telemetry_as_the_monitor_does() {
     let (began, ended) = (events[0], events[1]);
     assert_eq!(began.1, "no telemetry", "{events:?}");
     assert!((2000..=2060).contains(&began.0), "{events:?}");
-    assert!(ended.1.starts_with("telemetry again after 3.0 s"), "{events:?}");
+    assert!(
+        ended.1.starts_with("telemetry again after 3.0 s"),
+        "{events:?}"
+    );
     assert!((5000..=5040).contains(&ended.0), "{events:?}");
     // Telemetry rows lie outside the gap only.
     let inside = rows
@@ -341,5 +344,8 @@ fn replay_marks_a_gap_in_the_telemetry_as_the_monitor_does() {
     ]);
     assert!(chart.status.success(), "{}", stdout(&chart));
     let svg = std::fs::read_to_string(dir.join("run-spin.svg")).unwrap();
-    assert!(svg.contains("no telemetry"), "the gap is marked on the chart");
+    assert!(
+        svg.contains("no telemetry"),
+        "the gap is marked on the chart"
+    );
 }
