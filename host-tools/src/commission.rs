@@ -17,9 +17,9 @@ use model_core::wire::{
 use serde::Serialize;
 
 use crate::exit_code;
-use crate::link::{Link, transact};
-use crate::send::{command_line, explain};
-use crate::serial::ReadOutcome;
+use rig_client::lines::{command_line, explain};
+use rig_client::link::{Link, transact};
+use rig_client::serial::ReadOutcome;
 
 /// How long one command waits for its answer.
 const ANSWER_TIMEOUT: Duration = Duration::from_millis(1000);
@@ -226,7 +226,7 @@ pub fn run(args: &Args) -> Result<i32> {
         bail!("--timeout-s must be between 0 and 86400");
     }
     let mut port = Link::open(&args.port, args.baud)?;
-    let mut ids = Ids(crate::link::fresh_id());
+    let mut ids = Ids(rig_client::link::fresh_id());
     let mut report = Report {
         result: "ok",
         seconds: 0.0,
@@ -265,7 +265,7 @@ pub fn run(args: &Args) -> Result<i32> {
             report.result = "fault";
             report.fault = Some(format!(
                 "{} (code {})",
-                crate::words::fault(fault),
+                rig_client::words::fault(fault),
                 fault.code()
             ));
             exit_code::REFUSED
@@ -273,7 +273,7 @@ pub fn run(args: &Args) -> Result<i32> {
         End::OtherState(state) => {
             bail!(
                 "commissioning ended with the rig {} (another PC may have sent a command)",
-                crate::words::state(state)
+                rig_client::words::state(state)
             )
         }
         End::Timeout => {

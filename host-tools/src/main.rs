@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::{Parser, Subcommand};
 
 mod chart;
-mod command_words;
+mod cmd;
 mod commission;
 #[cfg(unix)]
 mod demo;
@@ -15,23 +15,15 @@ mod experiment;
 mod family_file;
 mod fit;
 mod kinematics;
-mod link;
 mod monitor;
 mod predict;
-mod refusal;
-mod relay;
 mod replay;
-mod send;
-mod serial;
 mod serve;
 mod sim;
 mod sim_reports;
 mod sim_world;
 mod simulated_backend;
-mod telemetry_csv;
-mod unreadable;
 mod virtual_rig;
-mod words;
 
 /// The PC side of the bowl granulation rig.
 #[derive(Parser)]
@@ -54,7 +46,7 @@ enum Command {
     /// The serial ports on this computer, with their USB descriptions.
     Ports,
     /// Send one command to the rig and print its answer.
-    Send(send::Args),
+    Send(cmd::send::Args),
     /// Run the motor identification on the rig; print the identified models and gains.
     Commission(commission::Args),
     /// Decode a raw capture of the rig's output; print statistics as JSON.
@@ -95,7 +87,7 @@ fn main() -> ExitCode {
         Err(e) if exit_code::is_closed_output(&e) => exit_code::OK,
         Err(e) => {
             eprintln!("error: {e:#}");
-            if e.chain().any(|c| c.is::<serial::LinkError>()) {
+            if e.chain().any(|c| c.is::<rig_client::serial::LinkError>()) {
                 exit_code::LINK
             } else {
                 exit_code::REFUSED
@@ -126,8 +118,8 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Chart(args) => done(chart::run(&args)),
         Command::Predict(args) => done(predict::run(&args)),
         Command::Monitor(args) => done(monitor::run(&args)),
-        Command::Ports => done(serial::run_ports()),
-        Command::Send(args) => send::run(&args),
+        Command::Ports => done(cmd::ports::run()),
+        Command::Send(args) => cmd::send::run(&args),
         Command::Commission(args) => commission::run(&args),
         Command::Replay(args) => done(replay::run(&args)),
         #[cfg(unix)]

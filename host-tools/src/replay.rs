@@ -10,7 +10,7 @@ use anyhow::{Context, Result, bail};
 use model_core::wire::{DecodeStats, Decoder, Frame};
 use serde_json::json;
 
-use crate::telemetry_csv;
+use rig_client::telemetry_csv;
 
 /// Flags of `bowl replay`.
 #[derive(clap::Args)]

@@ -22,8 +22,8 @@ use nix::pty::{PtyMaster, grantpt, posix_openpt, ptsname_r, unlockpt};
 #[cfg(unix)]
 use nix::sys::termios::{FlushArg, tcflush};
 
-use crate::send::command_line;
 use crate::virtual_rig::VirtualRig;
+use rig_client::lines::command_line;
 
 /// Flags of `bowl serve`.
 #[derive(clap::Args)]

@@ -29,7 +29,7 @@ pub fn config_for(rig: &Rig) -> ControllerConfig {
 /// Commissions `rig`; returns the closed loop (Idle, identified) or the plain reason.
 pub fn commissioned(rig: &Rig, cfg: ControllerConfig) -> Result<ClosedLoop, String> {
     let ctrl = Controller::new(cfg)
-        .map_err(|e| format!("configuration rejected: {}", crate::words::config(e)))?;
+        .map_err(|e| format!("configuration rejected: {}", rig_client::words::config(e)))?;
     let mut cl = ClosedLoop::new(Plant::new(rig.params, rig.seed), ctrl);
     match cl.commission(COMMISSION_MAX_S) {
         State::Idle => Ok(cl),
@@ -39,7 +39,7 @@ pub fn commissioned(rig: &Rig, cfg: ControllerConfig) -> Result<ClosedLoop, Stri
                 Some(f) => format!(
                     "{} during identification",
                     model_core::wire::FaultCode::from_code(i64::from(f.code()))
-                        .map_or("an unknown fault", crate::words::fault)
+                        .map_or("an unknown fault", rig_client::words::fault)
                 ),
                 None => "did not finish".to_string(),
             },

@@ -79,7 +79,7 @@ impl SimulatedBackend {
             AssemblyError::Ended(state, why) => anyhow!(
                 "commissioning on the simulated plant ended {} ({}): check the rig's motor, \
                  supply and friction values",
-                crate::words::controller_state(state),
+                rig_client::words::controller_state(state),
                 why.map_or("no reason given", |e| e.reason())
             ),
         })?;

@@ -57,7 +57,7 @@ fn iso_seconds(s: &str) -> Option<f64> {
 
 /// The rows, and whether their times are the PC's clock.
 fn read(path: &Path) -> Result<(Vec<Row>, bool)> {
-    let mut log = crate::telemetry_csv::LogReader::open(path)?;
+    let mut log = rig_client::telemetry_csv::LogReader::open(path)?;
     let col = |name: &str| log.column(name);
     let time = col("device_time_ms")?;
     let fault = col("fault")?;
@@ -248,7 +248,7 @@ mod tests {
         use std::time::{Duration, SystemTime};
         for (s, ms) in [(0u64, 0u64), (951_782_400, 5), (1_764_038_666, 123)] {
             let t = SystemTime::UNIX_EPOCH + Duration::from_millis(s * 1000 + ms);
-            let text = crate::telemetry_csv::utc(t);
+            let text = rig_client::telemetry_csv::utc(t);
             let back = iso_seconds(&text).unwrap();
             assert!(
                 (back - (s as f64 + ms as f64 / 1000.0)).abs() < 1e-6,

@@ -60,7 +60,7 @@ fn fault_reaction(
     FaultReaction {
         injected_at_s: seconds(inject.at_ms),
         fault: detected.map(|t| format!("{:?}", t.fault)),
-        fault_text: detected.map(|t| crate::words::fault(t.fault).to_string()),
+        fault_text: detected.map(|t| rig_client::words::fault(t.fault).to_string()),
         detection_s: detected.map(since),
         expected_detection_s: expected,
         motors_off_s: off.map(since),

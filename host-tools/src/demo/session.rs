@@ -12,9 +12,9 @@ use anyhow::{Context, Result, anyhow, bail};
 use model_core::wire::{DecodeStats, Decoder, Frame, Hello, Telemetry};
 
 use crate::monitor::View;
-use crate::send::{command_line, describe, explain};
-use crate::serial::{Port, ReadOutcome};
-use crate::telemetry_csv;
+use rig_client::lines::{command_line, describe, explain};
+use rig_client::serial::{Port, ReadOutcome};
+use rig_client::telemetry_csv;
 
 /// One command the script sent and what came back.
 #[derive(Debug, Clone, serde::Serialize)]

@@ -18,9 +18,9 @@ use model_core::wire::{
 
 use super::ReleaseRig;
 use super::simulated::Release;
-use crate::link::{LineTap, Link, RESEND_EVERY, answers_kind};
-use crate::send::command_line;
-use crate::serial::ReadOutcome;
+use rig_client::lines::command_line;
+use rig_client::link::{LineTap, Link, RESEND_EVERY, answers_kind};
+use rig_client::serial::ReadOutcome;
 
 /// A speed counts as settled within this fraction of its target (or 0.02 rad/s)...
 const SETTLED_BAND: f64 = 0.02;
@@ -62,7 +62,7 @@ impl PortRig {
             link,
             decoder: Decoder::new(),
             tap: LineTap::default(),
-            next_id: crate::link::fresh_id(),
+            next_id: rig_client::link::fresh_id(),
             latest: None,
             fresh: Vec::new(),
             events: VecDeque::new(),
@@ -71,7 +71,10 @@ impl PortRig {
         };
         match rig.command(&["params"])? {
             Frame::Params { values, .. } => rig.params = values,
-            other => bail!("{port}: PARAMS answered {}", crate::send::describe(&other)),
+            other => bail!(
+                "{port}: PARAMS answered {}",
+                rig_client::lines::describe(&other)
+            ),
         }
         // A faulted rig refuses every speed: say so once, before the plan starts.
         if let Frame::Status { status, .. } = rig.command(&["status"])?
@@ -80,7 +83,7 @@ impl PortRig {
             bail!(
                 "{port}: the rig is stopped by a fault ({}); check the rig, clear it with \
                  `bowl send {port} clear` and run the plan again",
-                crate::words::fault(status.fault)
+                rig_client::words::fault(status.fault)
             );
         }
         Ok(rig)
@@ -171,7 +174,7 @@ impl PortRig {
     fn fault(&mut self) -> Result<Option<String>> {
         match self.latest {
             Some(t) if t.state == DeviceState::Faulted => {
-                let words = crate::words::fault(t.fault).to_string();
+                let words = rig_client::words::fault(t.fault).to_string();
                 self.command(&["clear"])?;
                 self.latest = None;
                 Ok(Some(words))
@@ -188,7 +191,7 @@ impl PortRig {
                 "speeds {:.3}, {:.3} rad/s refused: {}",
                 targets[0],
                 targets[1],
-                crate::send::explain(reason)
+                rig_client::lines::explain(reason)
             ))));
         }
         if self.latest.is_none_or(|t| t.state != DeviceState::Running)
@@ -196,7 +199,7 @@ impl PortRig {
         {
             return Ok(Err(Release::MotorFault(format!(
                 "START refused: {}",
-                crate::send::explain(reason)
+                rig_client::lines::explain(reason)
             ))));
         }
         let started = Instant::now();
@@ -238,7 +241,7 @@ impl PortRig {
         if let Frame::Reject { reason, .. } = self.command(&["release"])? {
             let why = match reason {
                 Reason::Unsupported => "the rig has no release solenoid".to_string(),
-                other => crate::send::explain(other).to_string(),
+                other => rig_client::lines::explain(other).to_string(),
             };
             return Ok(Release::MotorFault(format!("RELEASE refused: {why}")));
         }

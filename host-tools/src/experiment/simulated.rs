@@ -118,7 +118,7 @@ impl SimulatedRig {
                 "speeds {:.3}, {:.3} rad/s refused by the controller: {}",
                 targets[0],
                 targets[1],
-                crate::words::rejection(e)
+                rig_client::words::rejection(e)
             )));
         }
         if ctrl.state() == State::Idle {

@@ -5,10 +5,10 @@ use std::time::{Duration, Instant};
 
 use model_core::wire::{Command, Frame, decode_frame};
 
-use crate::command_words::local_refusal;
-use crate::link::{RESEND_EVERY, UnreadableAnswer, answers_kind};
-use crate::refusal::particulars;
-use crate::send::{command_line, describe, explain};
+use rig_client::command_words::local_refusal;
+use rig_client::lines::{command_line, describe, explain};
+use rig_client::link::{RESEND_EVERY, UnreadableAnswer, answers_kind};
+use rig_client::refusal::particulars;
 
 /// How often a typed command is sent in all when no answer comes (1 s).
 const ATTEMPTS: u32 = 5;
@@ -33,7 +33,7 @@ impl Commands {
         // Ids from the clock, so no tool before this one used them within the rig's memory of
         // recent commands (a late copy of theirs must not look like ours, nor ours like theirs).
         Self {
-            next_id: crate::link::fresh_id(),
+            next_id: rig_client::link::fresh_id(),
             pending: Vec::new(),
         }
     }

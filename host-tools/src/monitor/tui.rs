@@ -276,7 +276,7 @@ fn banner<'a>(
     if let Some(t) = view.latest.filter(|_| view.connected && silence.is_none()) {
         spans.push(Span::raw(format!(
             "  state {}  ",
-            crate::words::state(t.state)
+            rig_client::words::state(t.state)
         )));
     }
     if paused {
@@ -304,7 +304,7 @@ fn fault_line(view: &View, stale: bool) -> (String, Style) {
             format!(
                 " FAULT {}: the rig stopped the motors. {}. Type `:clear` once the cause is fixed",
                 t.fault.code(),
-                crate::words::fault(t.fault)
+                rig_client::words::fault(t.fault)
             ),
             Style::default()
                 .fg(Color::White)

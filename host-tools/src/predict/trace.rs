@@ -18,7 +18,7 @@ pub struct Trace {
 
 /// Reads the rows of one boot from `release_ms` on (default: the log's first telemetry row).
 pub fn read(path: &Path, release_ms: Option<f64>) -> Result<Trace> {
-    let mut log = crate::telemetry_csv::LogReader::open(path)?;
+    let mut log = rig_client::telemetry_csv::LogReader::open(path)?;
     let (time, omega) = (log.column("device_time_ms")?, log.column("bowl_mrad_s")?);
     let boot_col = log.optional("boot");
     let mut trace = Trace {

@@ -181,18 +181,3 @@ pub fn list_ports() -> Result<Vec<String>, LinkError> {
         })
         .collect())
 }
-
-/// Runs `bowl ports`.
-pub fn run_ports() -> anyhow::Result<()> {
-    let ports = list_ports()?;
-    if ports.is_empty() {
-        println!(
-            "no serial ports found (plug the rig in; a virtual rig: `bowl serve --pty`, whose \
-             path it prints)"
-        );
-    }
-    for p in ports {
-        println!("{p}");
-    }
-    Ok(())
-}

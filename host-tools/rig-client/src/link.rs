@@ -247,7 +247,7 @@ mod tests {
     use model_core::wire::{DeviceState, FaultCode, ResetCause, Status, encode};
 
     use super::*;
-    use crate::send::command_line;
+    use crate::lines::command_line;
 
     fn bytes(frame: &Frame) -> Vec<u8> {
         let mut buf = [0u8; 512];

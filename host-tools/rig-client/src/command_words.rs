@@ -5,6 +5,8 @@
 
 use model_core::wire::{Command, Injection, ParamId, Reason, ResidenceModel};
 
+use crate::integer::integer_in;
+
 /// The command word `bowl` types for each command: an exhaustive match, so a new command in the
 /// wire protocol cannot be left out without a compile error.
 pub fn command_word(c: &Command) -> &'static str {
@@ -187,37 +189,20 @@ fn speed_value(arg: &str, axis: &str, limit: ParamId) -> Option<String> {
     }
 }
 
-/// Whether `arg` is an integer as the rig reads them, inside `lo..=hi`: `None` if so, else
-/// what is wrong with it.
-pub(crate) fn integer_in(arg: &str, what: &str, lo: i64, hi: i64, unit: &str) -> Option<String> {
-    match arg.parse::<i64>() {
-        Err(_) => Some(format!(
-            "{what}: `{arg}` is not an integer (a whole number of {unit}, {lo}..={hi})"
-        )),
-        Ok(v) if v < lo || v > hi => Some(format!(
-            "{what} {v} {unit} is outside its range {lo}..={hi} {unit}"
-        )),
-        Ok(v) if v.to_string() != arg => Some(format!(
-            "{what}: write `{arg}` as `{v}` (the rig reads integers without `+` or leading zeros)"
-        )),
-        Ok(_) => None,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn refused(line: &str) -> String {
         let words: Vec<String> = line.split_whitespace().map(str::to_string).collect();
-        let reason = crate::send::command_line(1, &words).expect_err(line);
+        let reason = crate::lines::command_line(1, &words).expect_err(line);
         local_refusal(&words, reason)
     }
 
     #[test]
     fn every_command_word_is_one_the_rig_takes() {
         for word in all_words() {
-            let line = crate::send::command_line(1, &[word.to_string()]);
+            let line = crate::lines::command_line(1, &[word.to_string()]);
             // The bare word may lack its arguments, but it is never an unknown command.
             assert_ne!(line.err(), Some(Reason::UnknownCommand), "{word}");
         }

@@ -14,9 +14,9 @@ use model_core::control::{BowlSpeedForResidence, Controller, ControllerConfig, I
 use model_core::particle::{Model, Scene, omega_for_residence_time};
 use model_core::wire::{Frame, ParamId, ParamValues, Reason, Status};
 
-use crate::command_words::integer_in;
+use crate::integer::integer_in;
+use crate::lines::command_line;
 use crate::link::{Link, transact};
-use crate::send::command_line;
 use crate::words;
 
 /// The particulars of a refusal of `words` (the command as typed), asking the rig what it
