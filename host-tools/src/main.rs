@@ -18,12 +18,8 @@ mod kinematics;
 mod monitor;
 mod predict;
 mod replay;
-mod serve;
 mod sim;
 mod sim_reports;
-mod sim_world;
-mod simulated_backend;
-mod virtual_rig;
 
 /// The PC side of the bowl granulation rig.
 #[derive(Parser)]
@@ -53,7 +49,7 @@ enum Command {
     Replay(replay::Args),
     /// A virtual rig (no hardware): serve it on a pseudo-terminal (--pty) or write its bytes to a
     /// file (--capture).
-    Serve(serve::Args),
+    Serve(cmd::serve::Args),
     /// Reports on the controller against the simulated plant (step, family, commission, sweep,
     /// stability, trace).
     #[command(subcommand)]
@@ -124,7 +120,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Replay(args) => done(replay::run(&args)),
         #[cfg(unix)]
         Command::Demo(args) => done(demo::run(&args)),
-        Command::Serve(args) => done(serve::run(&args)),
+        Command::Serve(args) => done(cmd::serve::run(&args)),
         Command::Sim(report) => done(sim::run(&report)),
         Command::Experiment(args) => done(experiment::run(&args)),
         Command::Fit(args) => done(fit::run(&args)),

@@ -28,8 +28,12 @@ pub fn config_for(rig: &Rig) -> ControllerConfig {
 
 /// Commissions `rig`; returns the closed loop (Idle, identified) or the plain reason.
 pub fn commissioned(rig: &Rig, cfg: ControllerConfig) -> Result<ClosedLoop, String> {
-    let ctrl = Controller::new(cfg)
-        .map_err(|e| format!("configuration rejected: {}", rig_client::words::config(e)))?;
+    let ctrl = Controller::new(cfg).map_err(|e| {
+        format!(
+            "configuration rejected: {}",
+            virtual_rig::controller_words::config(e)
+        )
+    })?;
     let mut cl = ClosedLoop::new(Plant::new(rig.params, rig.seed), ctrl);
     match cl.commission(COMMISSION_MAX_S) {
         State::Idle => Ok(cl),

@@ -2,3 +2,4 @@
 
 pub mod ports;
 pub mod send;
+pub mod serve;

@@ -1,5 +1,5 @@
 //! Releases on the simulated rig: the one plant with the controller
-//! (`crate::simulated_backend::SimulatedBackend`), and a granule that follows the rig file's
+//! (`virtual_rig::SimulatedBackend`), and a granule that follows the rig file's
 //! `[particle]` truth under the plant's true bowl speed (paper Eq. 2 from the two true shaft
 //! speeds). What the experiment records is what a real rig records: the gate times (with the
 //! gate's jitter) and the controller's *measured* speeds.
@@ -11,7 +11,7 @@ use model_core::sim::PlantParams;
 use model_core::sim::granule::ParticleParams;
 use model_core::wire::GateKind;
 
-use crate::simulated_backend::SimulatedBackend;
+use virtual_rig::SimulatedBackend;
 
 /// Speed trace sampling period, ms.
 const TRACE_PERIOD_MS: u32 = 10;
@@ -118,7 +118,7 @@ impl SimulatedRig {
                 "speeds {:.3}, {:.3} rad/s refused by the controller: {}",
                 targets[0],
                 targets[1],
-                rig_client::words::rejection(e)
+                virtual_rig::controller_words::rejection(e)
             )));
         }
         if ctrl.state() == State::Idle {

@@ -11,7 +11,7 @@
 //!   (per-pulse bandwidth) and pulse rate, with and without the pulse-rate schedule.
 //! - `bowl sim trace`: CSV trace of the step on one family plant (or the nominal rig).
 //!
-//! The virtual rig on a link (pseudo-terminal or capture file) is `bowl serve` (`crate::serve`).
+//! The virtual rig on a link (pseudo-terminal or capture file) is `bowl serve` (`virtual_rig::serve`).
 
 use anyhow::{Result, bail};
 use model_core::control::ControllerConfig;

@@ -261,7 +261,7 @@ pub(super) fn commission_report(seed: u32) -> CommissionJson {
         })
         .collect();
     CommissionJson {
-        state: rig_client::words::controller_state(state).to_string(),
+        state: virtual_rig::controller_words::controller_state(state).to_string(),
         duration_s: cl.rig.time_s() as f32,
         axes,
     }
@@ -327,7 +327,7 @@ pub(super) fn trace(seed: u32, plant: Option<u32>, from_file: Option<rig_file::R
     let state = cl.commission(300.0);
     eprintln!(
         "commissioning: {}",
-        rig_client::words::controller_state(state)
+        virtual_rig::controller_words::controller_state(state)
     );
     for (name, id) in ["precession", "spin"].iter().zip(cl.ctrl.identified()) {
         match id {

@@ -3,7 +3,7 @@
 //! binding of the controller and the particle model to the protocol that the firmware runs
 //! (`model_core::binding::ControllerBackend`).
 //!
-//! Only the simulated world is particular to it ([`SimWorld`]): injected faults sit between the
+//! Only the simulated world is particular to it ([`World`]): injected faults sit between the
 //! plant and the controller (a lost sensor withholds the plant's edges, a stalled motor gets no
 //! drive), and granules dropped by RELEASE move under the plant's true bowl speed, timed by the
 //! gates.
@@ -18,13 +18,13 @@ use model_core::sim::PlantParams;
 use model_core::sim::granule::ParticleParams;
 use model_core::wire::{Hello, ParamId, ResetCause};
 
-use crate::sim_world::SimWorld;
+use crate::world::World;
 
 /// The plant, and the controller bound to the protocol.
 #[derive(Clone)]
 pub struct SimulatedBackend {
     plant: model_core::sim::Plant,
-    rig: ControllerBackend<SimWorld>,
+    rig: ControllerBackend<World>,
     ticks: u64,
     total_ms: u64,
     now_ms: u32,
@@ -64,7 +64,7 @@ impl SimulatedBackend {
                 identified: [false; 2],
             }),
             hello,
-            SimWorld::new(particle, seed, f64::from(base.axes_angle_rad)),
+            World::new(particle, seed, f64::from(base.axes_angle_rad)),
         );
         checked.map_err(|r| anyhow!("rig parameters refused: {}", r.token()))?;
         let mut sim = Self {
@@ -79,7 +79,7 @@ impl SimulatedBackend {
             AssemblyError::Ended(state, why) => anyhow!(
                 "commissioning on the simulated plant ended {} ({}): check the rig's motor, \
                  supply and friction values",
-                rig_client::words::controller_state(state),
+                crate::controller_words::controller_state(state),
                 why.map_or("no reason given", |e| e.reason())
             ),
         })?;
@@ -89,12 +89,12 @@ impl SimulatedBackend {
     }
 
     /// The controller and particle model behind the protocol.
-    pub fn bound(&self) -> &ControllerBackend<SimWorld> {
+    pub fn bound(&self) -> &ControllerBackend<World> {
         &self.rig
     }
 
     /// The same, to hand to the protocol device.
-    pub fn bound_mut(&mut self) -> &mut ControllerBackend<SimWorld> {
+    pub fn bound_mut(&mut self) -> &mut ControllerBackend<World> {
         &mut self.rig
     }
 
@@ -140,7 +140,7 @@ impl SimulatedBackend {
     }
 
     /// The simulated world: faults, granules and gates.
-    pub fn world_mut(&mut self) -> &mut SimWorld {
+    pub fn world_mut(&mut self) -> &mut World {
         self.rig.injector_mut()
     }
 }

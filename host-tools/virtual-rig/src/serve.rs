@@ -1,4 +1,4 @@
-//! `bowl serve`: the virtual rig ([`crate::virtual_rig`]) on a transport. Either a
+//! The virtual rig ([`crate::rig`]) on a transport (`bowl serve`). Either a
 //! pseudo-terminal speaking the protocol in real time (`--pty`), or a capture file written
 //! faster than real time with exactly the bytes the rig would send (`--capture FILE --seconds S`).
 //! The demo serves its host rig with the same loop ([`serve_on_pty`]).
@@ -22,59 +22,27 @@ use nix::pty::{PtyMaster, grantpt, posix_openpt, ptsname_r, unlockpt};
 #[cfg(unix)]
 use nix::sys::termios::{FlushArg, tcflush};
 
-use crate::virtual_rig::VirtualRig;
-use rig_client::lines::command_line;
+use model_core::wire::{Command, Frame, MAX_FRAME_LEN, encode};
 
-/// Flags of `bowl serve`.
-#[derive(clap::Args)]
-pub struct Args {
-    /// Serve the virtual rig on a new pseudo-terminal; its path is printed on the first line.
-    #[arg(long, conflicts_with = "capture")]
-    pty: bool,
-    /// Also make this symlink point at the pseudo-terminal (replaced if it exists).
-    #[arg(long, requires = "pty")]
-    link: Option<PathBuf>,
-    /// Run faster than real time and write the rig's output bytes to this file.
-    #[arg(long, requires = "seconds")]
-    capture: Option<PathBuf>,
-    /// Simulated seconds to run (with --pty: stop after this many real seconds).
-    #[arg(long)]
-    seconds: Option<f64>,
-    /// Commands fed to the rig as if from the PC, `AT_MS:WORDS`, e.g. `0:speed,1800,2100`
-    /// `0:start` `5000:inject,sensor2` (repeatable; the answers appear in the output).
-    #[arg(long = "command", value_name = "AT_MS:WORDS")]
-    commands: Vec<String>,
-    /// Seed of the simulated plant's noise (and of the line noise).
-    #[arg(long, default_value_t = 1)]
-    seed: u32,
-    /// Serve this rig instead of the nominal one: a rig file (docs/rigs/*.toml, keys in
-    /// docs/rigs/nominal.toml); its own `seed` key then seeds the plant's tooth offsets and jitter,
-    /// its `[particle]` table the granules RELEASE drops. The virtual rig commissions itself on
-    /// it before it answers.
-    #[arg(long, value_name = "RIG.toml")]
-    rig_file: Option<PathBuf>,
-    /// A noisy line: this percentage of the bytes sent is replaced by a different random byte
-    /// (what the PC receives, to try the decoder and the counters; default 0).
-    #[arg(long, default_value_t = 0.0)]
-    line_noise_percent: f64,
-}
+use crate::rig::VirtualRig;
 
 /// Corrupts a fraction of the bytes on their way out (xorshift PRNG, seeded: reproducible).
-pub(crate) struct LineNoise {
+pub struct LineNoise {
     state: u64,
     threshold: u64,
 }
 
 impl LineNoise {
     /// A clean line.
-    pub(crate) fn none() -> Self {
+    pub fn none() -> Self {
         Self {
             state: 1,
             threshold: 0,
         }
     }
 
-    fn new(percent: f64, seed: u32) -> Result<Self> {
+    /// A line that corrupts `percent` % of the bytes (seeded).
+    pub fn new(percent: f64, seed: u32) -> Result<Self> {
         if !(percent.is_finite() && (0.0..=100.0).contains(&percent)) {
             bail!("--line-noise-percent must be between 0 and 100 (got {percent})");
         }
@@ -105,27 +73,11 @@ impl LineNoise {
 }
 
 /// A scheduled command: device time and the command line bytes.
-pub(crate) struct Scheduled {
-    at_ms: u32,
-    line: Vec<u8>,
-}
-
-fn parse_commands(specs: &[String]) -> Result<Vec<Scheduled>> {
-    let mut out = Vec::new();
-    for (i, spec) in specs.iter().enumerate() {
-        let (at, words) = spec
-            .split_once(':')
-            .with_context(|| format!("--command {spec}: expected AT_MS:WORDS"))?;
-        let at_ms: u32 = at
-            .parse()
-            .with_context(|| format!("--command {spec}: bad time"))?;
-        let id = u16::try_from(i + 1).unwrap_or(u16::MAX);
-        let line = command_line(id, &[words.to_string()])
-            .map_err(|r| anyhow::anyhow!("--command {spec}: rejected locally ({})", r.token()))?;
-        out.push(Scheduled { at_ms, line });
-    }
-    out.sort_by_key(|s| s.at_ms);
-    Ok(out)
+pub struct Scheduled {
+    /// Device time it is fed to the rig, ms.
+    pub at_ms: u32,
+    /// The command line, as the PC would send it.
+    pub line: Vec<u8>,
 }
 
 /// The scripted PC heartbeats like every host tool (PING once a second of device time), so the
@@ -137,72 +89,20 @@ const SCRIPT_PING_ID: u16 = 9000;
 /// The heartbeat line due at device time `now_ms`, if a script runs and one is due.
 fn script_heartbeat(scripted: bool, now_ms: u32) -> Option<Vec<u8>> {
     (scripted && now_ms > 0 && now_ms.is_multiple_of(SCRIPT_PING_EVERY_MS))
-        .then(|| command_line(SCRIPT_PING_ID, &["PING".to_string()]).ok())
+        .then(|| {
+            let mut buf = [0u8; MAX_FRAME_LEN];
+            let ping = Frame::Command {
+                id: SCRIPT_PING_ID,
+                command: Command::Ping,
+            };
+            encode(&ping, &mut buf).ok().map(|n| buf[..n].to_vec())
+        })
         .flatten()
 }
 
-/// Runs `bowl serve`.
-pub fn run(args: &Args) -> Result<()> {
-    let commands = parse_commands(&args.commands)?;
-    let noise = LineNoise::new(args.line_noise_percent, args.seed)?;
-    let new_rig = || match &args.rig_file {
-        None => VirtualRig::new(args.seed),
-        Some(path) => {
-            let rigs = rig_file::load(path)?;
-            let [rig] = rigs.as_slice() else {
-                bail!(
-                    "{} holds {} rigs ([[plant]] tables); bowl serve runs one: give a rig file \
-                     with one rig",
-                    path.display(),
-                    rigs.len()
-                );
-            };
-            VirtualRig::with_plant(rig.params, rig.particle.unwrap_or_default(), rig.seed)
-                .with_context(|| format!("the rig in {}", path.display()))
-        }
-    };
-    if let Some(path) = &args.capture {
-        let seconds = args.seconds.unwrap_or(0.0);
-        return capture(path, seconds, commands, new_rig()?, noise);
-    }
-    #[cfg(not(unix))]
-    if args.pty {
-        bail!(
-            "--pty needs a Unix system (Linux, macOS); on Windows use --capture FILE --seconds S"
-        );
-    }
-    #[cfg(unix)]
-    if args.pty {
-        let pty = Pty::open()?;
-        if let Some(link) = &args.link {
-            let _ = std::fs::remove_file(link);
-            std::os::unix::fs::symlink(&pty.path, link)
-                .with_context(|| format!("cannot link {} to {}", link.display(), pty.path))?;
-        }
-        println!("{}", pty.path);
-        std::io::stdout().flush()?;
-        let never = AtomicBool::new(false);
-        let served = serve_on_pty(
-            pty,
-            new_rig()?,
-            Pacing {
-                device_ms_per_wall_ms: 1.0,
-                stop: &never,
-                stop_after: args.seconds.map(Duration::from_secs_f64),
-                backlog: Backlog::DropWhenUnread,
-            },
-            commands,
-            noise,
-        );
-        if let Some(link) = &args.link {
-            let _ = std::fs::remove_file(link);
-        }
-        return served.map(|_| ());
-    }
-    bail!("say --pty (serve on a pseudo-terminal) or --capture FILE --seconds S (write to a file)")
-}
-
-fn capture(
+/// Runs `rig` for `seconds` of device time faster than real time and writes its output bytes
+/// (with `noise`) to `path`: `bowl serve --capture`.
+pub fn capture(
     path: &PathBuf,
     seconds: f64,
     commands: Vec<Scheduled>,
@@ -248,19 +148,19 @@ fn capture(
 
 #[cfg(unix)]
 /// A pseudo-terminal pair: the master side the rig is served on, and the slave's path.
-pub(crate) struct Pty {
+pub struct Pty {
     master: PtyMaster,
     /// Held open so the master never sees a hang-up between clients.
     slave: File,
     /// The slave's device path, for the client.
-    pub(crate) path: String,
+    pub path: String,
 }
 
 #[cfg(unix)]
 impl Pty {
     /// Opens a pair. The slave is put in raw mode so nothing is echoed or line-buffered before a
     /// client configures it.
-    pub(crate) fn open() -> Result<Pty> {
+    pub fn open() -> Result<Pty> {
         let master = posix_openpt(OFlag::O_RDWR | OFlag::O_NOCTTY | OFlag::O_NONBLOCK)
             .context("posix_openpt")?;
         grantpt(&master).context("grantpt")?;
@@ -294,7 +194,7 @@ fn make_raw(file: &File) -> Result<()> {
 
 /// What happens to output bytes nobody reads.
 #[derive(Clone, Copy, Debug)]
-pub(crate) enum Backlog {
+pub enum Backlog {
     /// Drop them, like a UART with no listener, so a client that connects later starts with
     /// fresh frames (`bowl serve`).
     DropWhenUnread,
@@ -304,15 +204,15 @@ pub(crate) enum Backlog {
 }
 
 /// How the served rig keeps time and when it stops.
-pub(crate) struct Pacing<'a> {
+pub struct Pacing<'a> {
     /// Device milliseconds per wall millisecond (1 = real time).
-    pub(crate) device_ms_per_wall_ms: f64,
+    pub device_ms_per_wall_ms: f64,
     /// Stops the loop when set.
-    pub(crate) stop: &'a AtomicBool,
+    pub stop: &'a AtomicBool,
     /// Stops the loop after this much wall time.
-    pub(crate) stop_after: Option<Duration>,
+    pub stop_after: Option<Duration>,
     /// Unread output.
-    pub(crate) backlog: Backlog,
+    pub backlog: Backlog,
 }
 
 /// What the server saw.
@@ -328,7 +228,7 @@ pub struct ServeStats {
 /// clock one millisecond at a time, reading what the client sent before each millisecond and
 /// writing what the rig answered after each pass.
 #[cfg(unix)]
-pub(crate) fn serve_on_pty(
+pub fn serve_on_pty(
     mut pty: Pty,
     mut rig: VirtualRig,
     pacing: Pacing<'_>,
@@ -427,19 +327,6 @@ mod tests {
         for bad in [-1.0, 100.5, f64::NAN] {
             let err = LineNoise::new(bad, 1).err().expect("refused").to_string();
             assert!(err.contains("between 0 and 100"), "{err}");
-        }
-    }
-
-    #[test]
-    fn scheduled_commands_run_in_time_order_and_bad_ones_are_named() {
-        let specs = ["5000:start".to_string(), "0:speed,1800,2100".to_string()];
-        let cmds = parse_commands(&specs).unwrap();
-        assert_eq!(cmds.iter().map(|c| c.at_ms).collect::<Vec<_>>(), [0, 5000]);
-        let first = String::from_utf8(cmds[0].line.clone()).unwrap();
-        assert!(first.contains("SPEED"), "{first}");
-        for bad in ["start", "soon:start"] {
-            let err = parse_commands(&[bad.to_string()]).err().expect("refused");
-            assert!(format!("{err:#}").contains(bad), "{err:#}");
         }
     }
 }

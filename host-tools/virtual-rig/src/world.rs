@@ -20,7 +20,7 @@ const EVENT_QUEUE: usize = 16;
 
 /// The simulated world around the virtual rig's controller.
 #[derive(Debug, Clone)]
-pub struct SimWorld {
+pub struct World {
     injection: Injection,
     gates: Gates,
     release_asked: bool,
@@ -29,7 +29,7 @@ pub struct SimWorld {
     pub events_lost: u32,
 }
 
-impl Injector for SimWorld {
+impl Injector for World {
     fn inject(&mut self, what: Injection) -> Result<(), Reason> {
         self.injection = what;
         Ok(())
@@ -49,7 +49,7 @@ impl Injector for SimWorld {
     }
 }
 
-impl SimWorld {
+impl World {
     /// No fault, no granule; granules drawn from `particle` with a generator seeded by `seed`,
     /// in a bowl whose axes are `axes_rad` apart.
     pub fn new(particle: ParticleParams, seed: u32, axes_rad: f64) -> Self {
@@ -121,7 +121,7 @@ mod tests {
 
     #[test]
     fn releases_are_one_at_a_time_and_timed_by_both_gates() {
-        let mut world = SimWorld::new(ParticleParams::default(), 1, core::f64::consts::FRAC_PI_2);
+        let mut world = World::new(ParticleParams::default(), 1, core::f64::consts::FRAC_PI_2);
         assert_eq!(world.gate_event(), None);
         world.release().unwrap();
         assert_eq!(world.release(), Err(Reason::State), "one granule at a time");

@@ -1,4 +1,4 @@
-//! The virtual rig: the simulated plant and the controller ([`crate::simulated_backend`]) behind
+//! The virtual rig: the simulated plant and the controller ([`crate::backend`]) behind
 //! the protocol device (`model_core::wire::device`, the same code the firmware runs), advanced one
 //! millisecond at a time. `bowl serve` ([`crate::serve`]) puts it on a pseudo-terminal or into a
 //! capture file; the demo serves it the same way.
@@ -7,17 +7,17 @@ use anyhow::Result;
 use model_core::wire::MAX_FRAME_LEN;
 use model_core::wire::device::Device;
 
-use crate::simulated_backend::SimulatedBackend;
+use crate::backend::SimulatedBackend;
 
 /// The rig plus the protocol, advanced one millisecond at a time.
-pub(crate) struct VirtualRig {
+pub struct VirtualRig {
     rig: SimulatedBackend,
     device: Device,
-    pub(crate) now_ms: u32,
+    pub now_ms: u32,
 }
 
 impl VirtualRig {
-    pub(crate) fn new(seed: u32) -> Result<Self> {
+    pub fn new(seed: u32) -> Result<Self> {
         Self::with_plant(
             model_core::sim::PlantParams::nominal(),
             model_core::sim::granule::ParticleParams::default(),
@@ -26,7 +26,7 @@ impl VirtualRig {
     }
 
     /// A virtual rig on the given plant and granules (a rig file's), commissioned on it.
-    pub(crate) fn with_plant(
+    pub fn with_plant(
         plant: model_core::sim::PlantParams,
         particle: model_core::sim::granule::ParticleParams,
         seed: u32,
@@ -39,7 +39,7 @@ impl VirtualRig {
     }
 
     /// The boot announcement.
-    pub(crate) fn boot(&mut self, out: &mut Vec<u8>) {
+    pub fn boot(&mut self, out: &mut Vec<u8>) {
         let mut buf = [0u8; MAX_FRAME_LEN];
         if let Some(n) = self.device.hello(self.rig.bound(), &mut buf) {
             out.extend_from_slice(&buf[..n]);
@@ -47,7 +47,7 @@ impl VirtualRig {
     }
 
     /// One millisecond: take the received bytes, run the plant and controller, send what is due.
-    pub(crate) fn step_1ms(&mut self, received: &[u8], out: &mut Vec<u8>) {
+    pub fn step_1ms(&mut self, received: &[u8], out: &mut Vec<u8>) {
         self.device
             .receive(self.rig.bound_mut(), received, |answer| {
                 out.extend_from_slice(answer)
