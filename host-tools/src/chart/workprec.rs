@@ -1,5 +1,5 @@
 //! `bowl chart work-precision`: achieved error in the residence time against cost, for every
-//! method and setting, on the named scenes of `bowl_test_cases::cost`.
+//! method and setting, on the named scenes of `model_core::particle::named_scenes`.
 //!
 //! Error: `|T - T_ref| / T_ref` with `T_ref` from [`super::reference`] (256-bit, independent code)
 //! evaluated at exactly the inputs the method saw (for f32 methods: the f32-rounded scene, so the
@@ -9,9 +9,9 @@
 
 use std::collections::BTreeMap;
 
-use bowl_test_cases::cost::{SCENE_NAMES, scene};
 use model_core::Real;
 use model_core::ode;
+use model_core::particle::named_scenes::{SCENE_NAMES, scene};
 use model_core::particle::{Model, Outcome, Scene, residence};
 use model_core::real::micro::{MicroF32, MicroF32HwSqrt};
 
