@@ -8,6 +8,7 @@
 //! `refusal` (a refused command in particulars), `telemetry_csv` (the CSV log).
 
 pub mod command_words;
+pub mod decode_stats;
 pub mod integer;
 pub mod lines;
 pub mod link;

@@ -153,7 +153,7 @@ pub fn summarise(
             .zip(tel.last())
             .map_or(0.0, |(a, b)| seconds(b.time_ms.wrapping_sub(a.time_ms))),
         wall_s: info.wall_s,
-        frames: crate::replay::stats_json(stats),
+        frames: rig_client::decode_stats::stats_json(stats),
         telemetry_rows: tel.len(),
         aborted: info.aborted,
         board_console: info.board_console,

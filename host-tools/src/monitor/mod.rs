@@ -26,8 +26,8 @@ use anyhow::{Context, Result};
 use model_core::wire::{Decoder, Frame, FrameError};
 use serde_json::json;
 
-use crate::replay::stats_json;
 use commands::Commands;
+use rig_client::decode_stats::stats_json;
 use rig_client::link::LineTap;
 use rig_client::relay::Relay;
 use rig_client::serial::{Port, ReadOutcome};

@@ -17,15 +17,14 @@ use anyhow::{Result, bail};
 use model_core::control::ControllerConfig;
 use model_core::sim::experiments::rig_with_pulses;
 
-use crate::{family_file, sim_reports};
-
-mod nominal;
-
-pub use nominal::*;
-use nominal::{commission_report, family, stability, sweep, trace};
+use lab::parallel::parallel;
+use lab::sim_reports::nominal::{
+    StepJson, StepOutcome, commission_report, family, stability, step_run_with, sweep, trace,
+};
+use lab::{family_file, sim_reports};
 
 #[derive(clap::Subcommand)]
-pub(crate) enum What {
+pub enum What {
     /// Step 0 -> 3 rad/s on the nominal rig; JSON.
     Step(StepArgs),
     /// The step on a seeded family of perturbed plants; JSON with worst case and median.
@@ -45,7 +44,7 @@ pub(crate) enum What {
 }
 
 #[derive(clap::Args)]
-pub(crate) struct FaultsArgs {
+pub struct FaultsArgs {
     /// Rig file or family file (TOML, see docs/rigs/nominal.toml).
     #[arg(long)]
     rig_file: std::path::PathBuf,
@@ -58,7 +57,7 @@ pub(crate) struct FaultsArgs {
 }
 
 #[derive(clap::Args)]
-pub(crate) struct MakeFamilyArgs {
+pub struct MakeFamilyArgs {
     /// Seed of the spread.
     #[arg(long, default_value_t = 1)]
     seed: u32,
@@ -68,7 +67,7 @@ pub(crate) struct MakeFamilyArgs {
 }
 
 #[derive(clap::Args)]
-pub(crate) struct TraceArgs {
+pub struct TraceArgs {
     #[command(flatten)]
     common: CommonArgs,
     /// Family plant index; without it, the nominal rig.
@@ -86,14 +85,14 @@ pub(crate) struct TraceArgs {
 }
 
 #[derive(clap::Args, Clone)]
-pub(crate) struct CommonArgs {
+pub struct CommonArgs {
     /// Seed of tooth errors, jitter and the family.
     #[arg(long, default_value_t = 1)]
     seed: u32,
 }
 
 #[derive(clap::Args)]
-pub(crate) struct StepArgs {
+pub struct StepArgs {
     #[command(flatten)]
     common: CommonArgs,
     /// Pulses per revolution of both sensors (at least 1: the controller measures speed from
@@ -131,7 +130,7 @@ pub(crate) struct StepArgs {
 }
 
 #[derive(clap::Args)]
-pub(crate) struct FamilyArgs {
+pub struct FamilyArgs {
     #[command(flatten)]
     common: CommonArgs,
     /// Number of plants (at least 50).
@@ -159,7 +158,7 @@ pub(crate) struct FamilyArgs {
 }
 
 #[derive(clap::Args)]
-pub(crate) struct StabilityArgs {
+pub struct StabilityArgs {
     #[command(flatten)]
     common: CommonArgs,
     /// Speed of the test, rad/s.
@@ -174,7 +173,7 @@ pub(crate) struct StabilityArgs {
 }
 
 /// Runs `bowl sim`.
-pub(crate) fn run(what: &What) -> Result<()> {
+pub fn run(what: &What) -> Result<()> {
     match what {
         What::Step(a) if a.rig_file.is_some() => {
             check_speed(a.target_rad_s, "--target-rad-s")?;
@@ -378,24 +377,10 @@ fn check_lowest(rigs: &[rig_file::Rig], x: f32, flag: &str) -> Result<()> {
     Ok(())
 }
 
-/// `f` over `items` on all cores, results in order; a panic in `f` is raised again here.
-pub(crate) fn parallel<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let chunk = items.len().div_ceil(threads).max(1);
-    std::thread::scope(|s| {
-        let handles: Vec<_> = items
-            .chunks(chunk)
-            .map(|c| s.spawn(|| c.iter().map(&f).collect::<Vec<R>>()))
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-            .collect()
-    })
-}
-
 #[cfg(test)]
 mod tests {
+    use lab::sim_reports::nominal::AxisFigures;
+
     use super::*;
 
     fn outcome(fault_code: u8, commissioned: bool) -> StepOutcome {

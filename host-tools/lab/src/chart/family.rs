@@ -15,7 +15,7 @@ fn never_s(target: f32) -> f64 {
 /// Runs the family (on all cores) and draws it.
 pub fn chart(rigs: &[Rig], from: f32, target: f32, file: &str) -> (Figure, Table) {
     let plants: Vec<PlantStep> =
-        crate::sim::parallel(rigs, |r| sim_reports::family_plant(r, from, target));
+        crate::parallel::parallel(rigs, |r| sim_reports::family_plant(r, from, target));
     let mut table = Table::new(&[
         "plant",
         "axis",

@@ -20,7 +20,7 @@ fn log_uniform(rng: &mut Prng, lo: f32, hi: f32) -> f32 {
 pub fn family_toml(seed: u32, plants: u32) -> String {
     let mut out = format!(
         "# {plants} plants: `bowl sim make-family --seed {seed} --plants {plants}` \
-         (spread: host-tools/src/family_file.rs)\n"
+         (spread: host-tools/lab/src/family_file.rs)\n"
     );
     let nominal = PlantParams::nominal();
     for index in 0..plants {

@@ -75,7 +75,7 @@ pub fn settling_pulse_counts(extent: Extent) -> &'static [u16] {
 
 /// Runs the commissioned step (nominal rig and controller, seed `seed`) for every pulse count.
 pub fn settling_points(extent: Extent, seed: u32) -> Vec<SettlingPoint> {
-    crate::sim::parallel(settling_pulse_counts(extent), |&n| {
+    crate::parallel::parallel(settling_pulse_counts(extent), |&n| {
         let o = experiments::commissioned_step(
             rig_with_pulses(n),
             ControllerConfig::nominal(),
@@ -287,7 +287,7 @@ pub fn hold_points(extent: Extent, seed: u32) -> Vec<HoldPoint> {
             }
         }
     }
-    crate::sim::parallel(&jobs, |&(setup, g, scheduled)| {
+    crate::parallel::parallel(&jobs, |&(setup, g, scheduled)| {
         let (r, fault) = experiments::low_speed_hold_at_rate(
             setup.tick_hz,
             seed,

@@ -81,7 +81,7 @@ pub fn step_run_with(
     out
 }
 
-pub(super) fn outcome_json(o: experiments::StepOutcome) -> StepOutcome {
+pub fn outcome_json(o: experiments::StepOutcome) -> StepOutcome {
     let axes = [
         AxisFigures::from(o.reports[0]),
         AxisFigures::from(o.reports[1]),
@@ -94,7 +94,7 @@ pub(super) fn outcome_json(o: experiments::StepOutcome) -> StepOutcome {
     }
 }
 
-pub(super) fn step_run(rig: PlantParams, seed: u32, target: f32, feedback: bool) -> StepOutcome {
+pub fn step_run(rig: PlantParams, seed: u32, target: f32, feedback: bool) -> StepOutcome {
     step_run_with(
         rig,
         ControllerConfig::nominal(),
@@ -106,7 +106,7 @@ pub(super) fn step_run(rig: PlantParams, seed: u32, target: f32, feedback: bool)
     )
 }
 
-pub(super) fn worst_of(a: &[AxisFigures]) -> AxisFigures {
+pub fn worst_of(a: &[AxisFigures]) -> AxisFigures {
     let mut w = a[0];
     for x in &a[1..] {
         w.rise_time_s = w.rise_time_s.max(x.rise_time_s);
@@ -118,7 +118,7 @@ pub(super) fn worst_of(a: &[AxisFigures]) -> AxisFigures {
     w
 }
 
-pub(super) fn median_of(a: &[AxisFigures]) -> AxisFigures {
+pub fn median_of(a: &[AxisFigures]) -> AxisFigures {
     let med = |f: fn(&AxisFigures) -> f32| {
         let mut v: Vec<f32> = a.iter().map(f).collect();
         v.sort_by(f32::total_cmp);
@@ -172,7 +172,7 @@ pub struct FamilyJson {
     pub commissioning_failures: u32,
 }
 
-pub(super) fn family(seed: u32, plants: u32, feedback: bool) -> FamilyJson {
+pub fn family(seed: u32, plants: u32, feedback: bool) -> FamilyJson {
     let outcomes: Vec<StepOutcome> = (0..plants)
         .map(|i| outcome_json(experiments::family_step(seed, i, feedback)))
         .collect();
@@ -231,7 +231,7 @@ pub struct CommissionJson {
     pub axes: Vec<Option<AxisIdentification>>,
 }
 
-pub(super) fn commission_report(seed: u32) -> CommissionJson {
+pub fn commission_report(seed: u32) -> CommissionJson {
     let rig = PlantParams::nominal();
     let ctrl = Controller::new(ControllerConfig::nominal()).expect("valid");
     let mut cl = ClosedLoop::new(Plant::new(rig, seed), ctrl);
@@ -267,7 +267,7 @@ pub(super) fn commission_report(seed: u32) -> CommissionJson {
     }
 }
 
-pub(super) fn sweep(seed: u32) {
+pub fn sweep(seed: u32) {
     println!("pulses_per_rev,settling_time_s,overshoot_pct,rms_ripple_pct,rise_time_s,fault_code");
     for n in [1u16, 2, 4, 6, 8, 12, 16, 24, 32, 48, 60, 90, 120, 180, 240] {
         let o = step_run(rig_with_pulses(n), seed, 3.0, true);
@@ -282,7 +282,7 @@ pub(super) fn sweep(seed: u32) {
     }
 }
 
-pub(super) fn stability(seed: u32, speed: f32, only: Option<u16>, tick_hz: u32) {
+pub fn stability(seed: u32, speed: f32, only: Option<u16>, tick_hz: u32) {
     println!(
         "tick_hz,pulses_per_rev,pulse_rate_hz,per_pulse_bandwidth,scheduled,half_peak_to_peak_pct,fault_code,mean_error_pct"
     );
@@ -307,7 +307,7 @@ pub(super) fn stability(seed: u32, speed: f32, only: Option<u16>, tick_hz: u32) 
     }
 }
 
-pub(super) fn trace(seed: u32, plant: Option<u32>, from_file: Option<rig_file::Rig>, target: f32) {
+pub fn trace(seed: u32, plant: Option<u32>, from_file: Option<rig_file::Rig>, target: f32) {
     let mut cfg = ControllerConfig::nominal();
     let (rig, rig_seed, load) = match plant {
         _ if from_file.is_some() => {

@@ -7,10 +7,11 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use model_core::wire::{DecodeStats, Decoder, Frame};
-use serde_json::json;
+use model_core::wire::{Decoder, Frame};
 
+use rig_client::decode_stats::stats_json;
 use rig_client::telemetry_csv;
+use serde_json::json;
 
 /// Flags of `bowl replay`.
 #[derive(clap::Args)]
@@ -20,24 +21,6 @@ pub struct Args {
     /// Write the decoded telemetry as CSV, keyed on device time.
     #[arg(long)]
     csv: Option<PathBuf>,
-}
-
-/// Statistics as one JSON object.
-pub fn stats_json(s: &DecodeStats) -> serde_json::Value {
-    json!({
-        "bytes": s.bytes,
-        "frames_ok": s.frames_ok,
-        "frames_corrupt": s.frames_corrupt,
-        "frames_missing": s.frames_missing,
-        "bytes_skipped": s.bytes_skipped,
-        "bad_crc": s.bad_crc,
-        "malformed": s.malformed,
-        "oversize": s.oversize,
-        "truncated": s.truncated,
-        "duplicates": s.duplicates,
-        "reordered": s.reordered,
-        "restarts": s.restarts,
-    })
 }
 
 /// CPU time of this thread, s (0 if the clock cannot be read).
