@@ -11,4 +11,5 @@ pub mod family_file;
 pub mod fit;
 pub mod parallel;
 pub mod predict;
+pub mod results;
 pub mod sim_reports;

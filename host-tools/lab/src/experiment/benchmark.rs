@@ -10,10 +10,10 @@ use model_core::particle::Model;
 use model_core::sim::granule::ParticleParams;
 
 use super::plan::Plan;
-use super::results::Writer;
 use super::run_plan;
 use super::simulated::SimulatedRig;
 use crate::fit;
+use crate::results::Writer;
 
 /// What one seed gave for the true model.
 struct Outcome {

@@ -6,7 +6,6 @@
 pub mod benchmark;
 pub mod plan;
 pub mod port;
-pub mod results;
 pub mod simulated;
 pub mod suggest;
 
@@ -16,7 +15,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use model_core::sim::granule::ParticleParams;
 
-use results::{Row, Writer};
+use crate::results::{self, Row, Writer};
 use simulated::{Release, SimulatedRig};
 
 /// Arguments of `bowl experiment`.
@@ -241,3 +240,6 @@ pub fn run_plan(
     }
     Ok(run_no)
 }
+
+#[cfg(test)]
+mod tests;

@@ -14,7 +14,7 @@ use anyhow::{Result, bail};
 use serde::Serialize;
 use serde_json::json;
 
-use crate::experiment::results::{self, STATUS_OK};
+use crate::results::{self, STATUS_OK};
 use models::{
     CANDIDATES, Candidate, Equation, Method, Run, STEADY_REL_SD, mu_ceiling_for, predict,
     predict_with_k2,
@@ -473,4 +473,4 @@ pub fn run(args: &Args) -> Result<()> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
