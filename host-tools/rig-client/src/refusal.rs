@@ -16,7 +16,8 @@ use model_core::wire::{Frame, ParamId, ParamValues, Reason, Status};
 
 use crate::integer::integer_in;
 use crate::lines::command_line;
-use crate::link::{Link, transact};
+use crate::link::Link;
+use crate::request::transact;
 use crate::words;
 
 /// The particulars of a refusal of `words` (the command as typed), asking the rig what it

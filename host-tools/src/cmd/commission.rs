@@ -18,7 +18,8 @@ use serde::Serialize;
 
 use crate::exit_code;
 use rig_client::lines::{command_line, explain};
-use rig_client::link::{Link, transact};
+use rig_client::link::Link;
+use rig_client::request::transact;
 use rig_client::serial::ReadOutcome;
 
 /// How long one command waits for its answer.
@@ -226,7 +227,7 @@ pub fn run(args: &Args) -> Result<i32> {
         bail!("--timeout-s must be between 0 and 86400");
     }
     let mut port = Link::open(&args.port, args.baud)?;
-    let mut ids = Ids(rig_client::link::fresh_id());
+    let mut ids = Ids(rig_client::request::fresh_id());
     let mut report = Report {
         result: "ok",
         seconds: 0.0,

@@ -7,8 +7,9 @@ use anyhow::Result;
 use model_core::wire::Frame;
 use rig_client::command_words;
 use rig_client::lines::{command_line, describe, explain};
-use rig_client::link::{Link, transact};
+use rig_client::link::Link;
 use rig_client::refusal;
+use rig_client::request::transact;
 
 use crate::exit_code;
 
@@ -36,7 +37,7 @@ pub struct Args {
 
 /// Runs `bowl send`; returns the process exit status.
 pub fn run(args: &Args) -> Result<i32> {
-    let id = args.id.unwrap_or_else(rig_client::link::fresh_id);
+    let id = args.id.unwrap_or_else(rig_client::request::fresh_id);
     let line = match command_line(id, &args.command) {
         Ok(line) => line,
         Err(reason) => {

@@ -28,10 +28,10 @@ use serde_json::json;
 
 use commands::Commands;
 use rig_client::decode_stats::stats_json;
-use rig_client::link::LineTap;
 use rig_client::relay::Relay;
 use rig_client::serial::{Port, ReadOutcome};
 use rig_client::telemetry_csv;
+use rig_client::unreadable::LineTap;
 use tui::{Action, Tui};
 
 /// Flags of `bowl monitor`.

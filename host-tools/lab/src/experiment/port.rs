@@ -5,22 +5,21 @@
 //! gate events (`E` frames: the exit's device time minus the release's, in the same boot). The
 //! speed trace is the telemetry's measured combined bowl speed from the release on.
 //!
-//! Every frame is read by one decoder loop: a command's answer is waited for there, so no gate
-//! event or telemetry frame that arrives meanwhile is lost.
+//! Every command goes through the rig client's typed [`Rig`] and its one request loop; the gate
+//! events and telemetry frames that arrive while a command waits are kept, none is lost.
 
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
 use model_core::wire::{
-    Decoder, DeviceState, Frame, GateEvent, GateKind, ParamId, ParamValues, Reason, Telemetry,
+    DeviceState, Frame, GateEvent, GateKind, ParamId, ParamValues, Reason, Telemetry,
 };
+use rig_client::lines::explain;
+use rig_client::rig::{Reply, Rig};
 
 use super::ReleaseRig;
 use super::simulated::Release;
-use rig_client::lines::command_line;
-use rig_client::link::{LineTap, Link, RESEND_EVERY, answers_kind};
-use rig_client::serial::ReadOutcome;
 
 /// A speed counts as settled within this fraction of its target (or 0.02 rad/s)...
 const SETTLED_BAND: f64 = 0.02;
@@ -37,13 +36,9 @@ const PING_EVERY: Duration = Duration::from_secs(1);
 
 /// A rig on a serial line.
 pub struct PortRig {
-    link: Link,
-    decoder: Decoder,
-    /// The raw line beside the decoder, to show an answer it cannot read.
-    tap: LineTap,
-    next_id: u16,
+    rig: Rig,
     latest: Option<Telemetry>,
-    /// Telemetry since the last [`PortRig::take_telemetry`].
+    /// Telemetry since it was last taken.
     fresh: Vec<Telemetry>,
     events: VecDeque<GateEvent>,
     last_ping: Instant,
@@ -57,28 +52,22 @@ fn param(p: &ParamValues, id: ParamId) -> f64 {
 impl PortRig {
     /// Opens the port and reads the rig's parameters (the geometry and the speed split).
     pub fn open(port: &str, baud: u32) -> Result<Self> {
-        let link = Link::open(port, baud).map_err(|e| anyhow!("{port}: {}", e.0))?;
+        let rig = Rig::open(port, baud, ANSWER_TIMEOUT).map_err(|e| anyhow!("{port}: {}", e.0))?;
         let mut rig = Self {
-            link,
-            decoder: Decoder::new(),
-            tap: LineTap::default(),
-            next_id: rig_client::link::fresh_id(),
+            rig,
             latest: None,
             fresh: Vec::new(),
             events: VecDeque::new(),
             last_ping: Instant::now(),
             params: [0; model_core::wire::PARAM_COUNT],
         };
-        match rig.command(&["params"])? {
-            Frame::Params { values, .. } => rig.params = values,
-            other => bail!(
-                "{port}: PARAMS answered {}",
-                rig_client::lines::describe(&other)
-            ),
+        match rig.command(Rig::params)? {
+            Reply::Done(values) => rig.params = values,
+            Reply::Refused(reason) => bail!("{port}: PARAMS refused: {}", explain(reason)),
         }
         // A faulted rig refuses every speed: say so once, before the plan starts.
-        if let Frame::Status { status, .. } = rig.command(&["status"])?
-            && status.state == model_core::wire::DeviceState::Faulted
+        if let Reply::Done(status) = rig.command(Rig::status)?
+            && status.state == DeviceState::Faulted
         {
             bail!(
                 "{port}: the rig is stopped by a fault ({}); check the rig, clear it with \
@@ -89,84 +78,40 @@ impl PortRig {
         Ok(rig)
     }
 
-    /// Reads what the rig sent within `wait`: telemetry and gate events are kept; returns the
-    /// answer to `id` of the kind `command` gets, if it came.
-    fn pump(&mut self, wait: Duration, want: Option<(u16, &Frame)>) -> Result<Option<Frame>> {
-        let mut buf = [0u8; 4096];
-        let n = match self.link.read(&mut buf, wait).map_err(|e| anyhow!(e.0))? {
-            ReadOutcome::Data(n) => n,
-            ReadOutcome::Timeout => return Ok(None),
-            ReadOutcome::Gone => bail!("the rig's port went away"),
-        };
-        let mut answer = None;
-        for &b in &buf[..n] {
-            self.tap.push(b);
-            match self.decoder.push(b) {
-                Some(Ok(Frame::Telemetry(t))) => {
+    /// One command through the rig client's request loop (sent again every 200 ms with the
+    /// same id, which the rig carries out once); the telemetry and gate events that arrived
+    /// meanwhile are kept.
+    fn command<T>(
+        &mut self,
+        command: impl FnOnce(&mut Rig) -> Result<Reply<T>>,
+    ) -> Result<Reply<T>> {
+        let reply = command(&mut self.rig);
+        self.sort_arrived();
+        reply
+    }
+
+    /// Telemetry and gate events from what arrived; other frames are not ours.
+    fn sort_arrived(&mut self) {
+        while let Some(frame) = self.rig.arrived.pop_front() {
+            match frame {
+                Frame::Telemetry(t) => {
                     self.latest = Some(t);
                     self.fresh.push(t);
                 }
-                Some(Ok(Frame::Event(e))) => self.events.push_back(e),
-                Some(Ok(frame)) => {
-                    if let Some((id, Frame::Command { command, .. })) = want
-                        && frame.answer_id() == Some(id)
-                        && answers_kind(command, &frame)
-                    {
-                        answer = Some(frame);
-                    }
-                }
-                // Our answer, intact but unreadable here: said as it is, not waited out.
-                Some(Err(e)) => {
-                    if let (Some(u), Some((id, _))) = (self.tap.unreadable_answer(e), want)
-                        && u.id == id
-                    {
-                        return Err(u.into());
-                    }
-                }
-                None => {}
+                Frame::Event(e) => self.events.push_back(e),
+                _ => {}
             }
         }
-        Ok(answer)
-    }
-
-    /// Sends one command and waits for its answer (sent again every 200 ms with the same id,
-    /// which the rig carries out once), reading everything else that arrives meanwhile.
-    fn command(&mut self, words: &[&str]) -> Result<Frame> {
-        self.next_id = self.next_id.wrapping_add(1);
-        let id = self.next_id;
-        let words: Vec<String> = words.iter().map(|w| w.to_string()).collect();
-        let line = command_line(id, &words)
-            .map_err(|r| anyhow!("{} refused locally ({})", words.join(" "), r.token()))?;
-        let sent = match model_core::wire::decode_frame(&line) {
-            Ok(f) => f,
-            Err(_) => bail!("{} is not a command line (a bug in bowl)", words.join(" ")),
-        };
-        let end = Instant::now() + ANSWER_TIMEOUT;
-        while Instant::now() < end {
-            self.link.write_all(&line).map_err(|e| anyhow!(e.0))?;
-            let resend = Instant::now() + RESEND_EVERY;
-            while let Some(left) = resend.checked_duration_since(Instant::now()) {
-                if let Some(answer) =
-                    self.pump(left.min(Duration::from_millis(20)), Some((id, &sent)))?
-                {
-                    return Ok(answer);
-                }
-            }
-        }
-        bail!(
-            "no answer to {} within {} s",
-            words.join(" "),
-            ANSWER_TIMEOUT.as_secs()
-        )
     }
 
     /// Reads for `wait`, keeping the link alive.
     fn listen(&mut self, wait: Duration) -> Result<()> {
         if self.last_ping.elapsed() >= PING_EVERY {
             self.last_ping = Instant::now();
-            self.command(&["ping"])?;
+            self.command(Rig::ping)?;
         }
-        self.pump(wait, None)?;
+        self.rig.listen(wait)?;
+        self.sort_arrived();
         Ok(())
     }
 
@@ -175,7 +120,7 @@ impl PortRig {
         match self.latest {
             Some(t) if t.state == DeviceState::Faulted => {
                 let words = rig_client::words::fault(t.fault).to_string();
-                self.command(&["clear"])?;
+                self.command(Rig::clear)?;
                 self.latest = None;
                 Ok(Some(words))
             }
@@ -184,22 +129,27 @@ impl PortRig {
     }
 
     fn settle_inner(&mut self, targets: [f64; 2], settle_s: f64) -> Result<Result<(), Release>> {
-        let mrad = |w: f64| format!("{}", (w * 1000.0).round() as i64);
-        let (p, s) = (mrad(targets[0]), mrad(targets[1]));
-        if let Frame::Reject { reason, .. } = self.command(&["speed", &p, &s])? {
-            return Ok(Err(Release::MotorFault(format!(
+        let mrad = |w: f64| i16::try_from((w * 1000.0).round() as i64);
+        let refused = |reason: Reason| {
+            Release::MotorFault(format!(
                 "speeds {:.3}, {:.3} rad/s refused: {}",
                 targets[0],
                 targets[1],
-                rig_client::lines::explain(reason)
-            ))));
+                explain(reason)
+            ))
+        };
+        let (Ok(p), Ok(s)) = (mrad(targets[0]), mrad(targets[1])) else {
+            return Ok(Err(refused(Reason::Range)));
+        };
+        if let Reply::Refused(reason) = self.command(|rig| rig.speed(p, s))? {
+            return Ok(Err(refused(reason)));
         }
         if self.latest.is_none_or(|t| t.state != DeviceState::Running)
-            && let Frame::Reject { reason, .. } = self.command(&["start"])?
+            && let Reply::Refused(reason) = self.command(Rig::start)?
         {
             return Ok(Err(Release::MotorFault(format!(
                 "START refused: {}",
-                rig_client::lines::explain(reason)
+                explain(reason)
             ))));
         }
         let started = Instant::now();
@@ -238,10 +188,10 @@ impl PortRig {
     fn release_inner(&mut self) -> Result<Release> {
         self.events.clear();
         self.fresh.clear();
-        if let Frame::Reject { reason, .. } = self.command(&["release"])? {
+        if let Reply::Refused(reason) = self.command(Rig::release)? {
             let why = match reason {
                 Reason::Unsupported => "the rig has no release solenoid".to_string(),
-                other => rig_client::lines::explain(other).to_string(),
+                other => explain(other).to_string(),
             };
             return Ok(Release::MotorFault(format!("RELEASE refused: {why}")));
         }
@@ -316,6 +266,6 @@ impl ReleaseRig for PortRig {
     }
 
     fn stop(&mut self) {
-        let _ = self.command(&["stop"]);
+        let _ = self.command(Rig::stop);
     }
 }
