@@ -10,16 +10,16 @@ mod batch;
 mod bowl;
 mod choice;
 mod ode;
+mod refusals;
 mod rolling;
 mod spin_up;
 mod target;
 mod throughput;
 mod trace;
 mod validity;
-mod words;
 
+pub use refusals::scene as scene_words;
 pub use rolling::words as rolling_words;
-pub use words::scene as scene_words;
 
 /// Which model(s) to evaluate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -187,7 +187,7 @@ pub fn predict(
     match method {
         MethodChoice::Closed => {
             let outcome =
-                particle::residence(scene, model).map_err(|e| anyhow!(words::scene(e)))?;
+                particle::residence(scene, model).map_err(|e| anyhow!(refusals::scene(e)))?;
             Ok(Prediction {
                 outcome,
                 rhs_evaluations: 0,
@@ -256,7 +256,7 @@ pub fn run(args: &Args) -> Result<()> {
             args.rolling.sliding_mu(),
         );
     }
-    words::check(&scene)?;
+    refusals::check(&scene)?;
     const BOTH: &[Model] = &[Model::Flat, Model::Coriolis];
     let mut chosen = None;
     let models: &[Model] = match args.model {
@@ -459,7 +459,7 @@ fn run_inverse(scene: &Scene<f64>, models: &[Model], target: f64, json: bool) ->
             anyhow!(
                 "no bowl speed for T = {target} s ({} model): {}",
                 model_name(model),
-                words::inverse(e, target)
+                refusals::inverse(e, target)
             )
         })?;
         out.push((model, w));

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, anyhow, bail};
 use model_core::particle::{Model, Outcome, Scene};
 
-use super::{Args, predict, words};
+use super::{Args, predict, refusals};
 
 /// Formats an f64 for the batch output: shortest round-trip digits, `inf`, `nan`.
 pub fn format_f64(x: f64) -> String {
@@ -109,7 +109,7 @@ fn parse_row(row: &csv::StringRecord, cols: &Columns, width: usize) -> Result<(M
         ri_m: field(cols.ri, "ri_m")?,
         rim_radius_m: field(cols.rim, "R_m")?,
     };
-    words::check(&scene)?;
+    refusals::check(&scene)?;
     Ok((model, scene))
 }
 

@@ -10,7 +10,7 @@ use model_core::ode::Method;
 use model_core::particle::Model;
 
 use super::target::RunsOn;
-use super::{model_name, words};
+use super::{model_name, refusals};
 
 /// The parameters' uncertainty used when neither `--tolerance` nor `--uncertainty` is given.
 pub const DEFAULT_KNOWLEDGE: Knowledge<f64> = Knowledge {
@@ -83,7 +83,7 @@ pub fn need(tolerance: Option<f64>, uncertainty: Option<&str>) -> Result<Need<f6
 /// Why the chooser could not choose, in plain words.
 pub fn error_words(e: ChooseError) -> String {
     match e {
-        ChooseError::Scene(s) => words::scene(s),
+        ChooseError::Scene(s) => refusals::scene(s),
         ChooseError::InvalidKnowledge => {
             "the tolerance or an uncertainty is not a finite, non-negative number".into()
         }

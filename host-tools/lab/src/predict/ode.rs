@@ -33,9 +33,10 @@ pub fn predict(
         },
         MethodChoice::Closed => unreachable!("closed forms are handled by the caller"),
     };
-    let closed = particle::residence(scene, model).map_err(|e| anyhow!(super::words::scene(e)))?;
+    let closed =
+        particle::residence(scene, model).map_err(|e| anyhow!(super::refusals::scene(e)))?;
     let report =
-        ode::integrate_constant(scene, model, m).map_err(|e| anyhow!(super::words::ode(e)))?;
+        ode::integrate_constant(scene, model, m).map_err(|e| anyhow!(super::refusals::ode(e)))?;
     let outcome = match report.outcome {
         OdeOutcome::Leaves {
             residence_time_s,
@@ -213,7 +214,7 @@ pub fn plan_time_s<P: model_core::ode::OmegaProfile<f64>>(
 ) -> Result<f64> {
     let limits = ode::Limits::for_scene(scene, profile);
     let report = ode::integrate(scene, model, profile, method, limits)
-        .map_err(|e| anyhow!(super::words::ode(e)))?;
+        .map_err(|e| anyhow!(super::refusals::ode(e)))?;
     Ok(match report.outcome {
         OdeOutcome::Leaves {
             residence_time_s, ..

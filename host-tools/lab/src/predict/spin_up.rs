@@ -38,7 +38,7 @@ pub fn run(
     }
     scene
         .validate_except_omega()
-        .map_err(|e| anyhow!(super::words::scene(e)))?;
+        .map_err(|e| anyhow!(super::refusals::scene(e)))?;
     let speed = SpinUp {
         start_rad_s,
         final_rad_s: scene.omega_rad_s,

@@ -94,7 +94,7 @@ pub fn run(
 
     scene
         .validate_except_omega()
-        .map_err(|e| anyhow!(super::words::scene(e)))?;
+        .map_err(|e| anyhow!(super::refusals::scene(e)))?;
     let trace = read(path, release_ms)?;
     let profile = SampledOmega::new(&trace.times_s, &trace.omega_rad_s).map_err(|e| match e {
         TraceError::Empty => anyhow!("{}: no speed samples", path.display()),
@@ -160,7 +160,7 @@ pub fn run(
                 ..*scene
             };
             particle::residence(&at_mean, choice.model)
-                .map_err(|e| anyhow!(super::words::scene(e)))?
+                .map_err(|e| anyhow!(super::refusals::scene(e)))?
                 .residence_time_s()
         }
         Plan::Integrate(method) => match answered {

@@ -1,4 +1,5 @@
-//! The particle model's refusals in plain words: which value, the limit, what to do.
+//! The particle model's refusals in plain words (a scene, an inverse, an integration it
+//! refused): which value, the limit, what to do.
 
 use model_core::ode::OdeError;
 use model_core::particle::{InverseError, Scene, SceneError};
