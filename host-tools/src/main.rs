@@ -24,7 +24,7 @@ enum Command {
     /// Combined bowl speed from the two motor speeds (paper Eq. 2), or the split of a target speed.
     Kinematics(cmd::kinematics::Args),
     /// Charts: work-precision (error against cost), and the paper's Figures 5-7 redrawn.
-    Chart(lab::chart::Args),
+    Chart(cmd::chart::Args),
     /// Residence time and exit velocities of a particle (paper Eq. 5-12, corrected), or a batch CSV.
     Predict(Box<lab::predict::Args>),
     /// Live view of the rig's telemetry, with CSV log and frame counters.
@@ -49,9 +49,9 @@ enum Command {
     Demo(demo::Args),
     /// Run a plan of particle releases on a simulated rig and record residence times, or
     /// suggest a plan (--suggest).
-    Experiment(lab::experiment::Args),
+    Experiment(cmd::experiment::Args),
     /// Fit the rolling resistance of each particle model to measured residence times.
-    Fit(lab::fit::Args),
+    Fit(cmd::fit::Args),
 }
 
 fn main() -> ExitCode {
@@ -101,7 +101,7 @@ fn run(cli: Cli) -> Result<i32> {
     let done = |r: Result<()>| r.map(|()| exit_code::OK);
     match cli.command {
         Command::Kinematics(args) => done(cmd::kinematics::run(&args)),
-        Command::Chart(args) => done(lab::chart::run(&args)),
+        Command::Chart(args) => done(cmd::chart::run(&args)),
         Command::Predict(args) => done(lab::predict::run(&args)),
         Command::Monitor(args) => done(monitor::run(&args)),
         Command::Ports => done(cmd::ports::run()),
@@ -112,7 +112,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Demo(args) => done(demo::run(&args)),
         Command::Serve(args) => done(cmd::serve::run(&args)),
         Command::Sim(report) => done(cmd::sim::run(&report)),
-        Command::Experiment(args) => done(lab::experiment::run(&args)),
-        Command::Fit(args) => done(lab::fit::run(&args)),
+        Command::Experiment(args) => done(cmd::experiment::run(&args)),
+        Command::Fit(args) => done(cmd::fit::run(&args)),
     }
 }

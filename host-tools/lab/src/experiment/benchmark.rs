@@ -11,7 +11,7 @@ use model_core::sim::granule::ParticleParams;
 
 use super::plan::Plan;
 use super::run_plan;
-use super::simulated::SimulatedRig;
+use super::simulated::BackendRig;
 use crate::fit;
 use crate::results::Writer;
 
@@ -44,7 +44,7 @@ pub fn run(
     for seed in 1..=seeds {
         let path = dir.join(format!("{stem}_seed{seed}.csv"));
         let started = Instant::now();
-        let mut rig = SimulatedRig::new(*plant, *particle, seed)?;
+        let mut rig = BackendRig::new(*plant, *particle, seed)?;
         let mut writer = Writer::create(&path)?;
         run_plan(&mut rig, plan, &mut writer, false)?;
         slowest_s = slowest_s.max(started.elapsed().as_secs_f64());

@@ -49,13 +49,14 @@ fn fault_words(fault: Option<Fault>) -> String {
     }
 }
 
-/// The simulated rig with its granules.
-pub struct SimulatedRig {
+/// The experiment's rig on a `SimulatedBackend` driven directly (no protocol device between):
+/// the simulated counterpart of [`super::port::PortRig`].
+pub struct BackendRig {
     backend: SimulatedBackend,
     now_ms: u32,
 }
 
-impl SimulatedRig {
+impl BackendRig {
     /// The plant, commissioned, with the given granule truth.
     pub fn new(plant: PlantParams, particle: ParticleParams, seed: u32) -> Result<Self> {
         let mut backend = SimulatedBackend::with_plant(plant, particle, seed)?;
@@ -201,7 +202,7 @@ impl SimulatedRig {
     }
 }
 
-impl super::ReleaseRig for SimulatedRig {
+impl super::ReleaseRig for BackendRig {
     fn geometry(&self) -> (f64, f64, f64) {
         let p = self.particle();
         (p.release_radius_m, p.rim_radius_m, p.k2)

@@ -4,7 +4,7 @@
 use model_core::particle::Model;
 use model_core::sim::granule::ParticleParams;
 
-use super::simulated::SimulatedRig;
+use super::simulated::BackendRig;
 use super::{plan, run_plan};
 use crate::fit::models::closed_form;
 use crate::fit::tests::{fit_paper, fitted, synthetic};
@@ -32,7 +32,7 @@ fn small_plan_on_the_simulated_rig() {
     let dir = std::env::temp_dir().join(format!("bowl-fit-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("results.csv");
-    let mut rig = SimulatedRig::new(model_core::sim::PlantParams::nominal(), particle, 5).unwrap();
+    let mut rig = BackendRig::new(model_core::sim::PlantParams::nominal(), particle, 5).unwrap();
     let mut writer = Writer::create(&out).unwrap();
     assert_eq!(run_plan(&mut rig, &plan, &mut writer, false).unwrap(), 7);
     std::fs::remove_file(dir.join("results_traces/run_0002.csv")).unwrap();
@@ -98,7 +98,7 @@ fn stalled_motor_is_excluded_with_its_reason() {
     let dir = std::env::temp_dir().join(format!("bowl-fit-stall-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("results.csv");
-    let mut rig = SimulatedRig::new(model_core::sim::PlantParams::nominal(), particle, 2).unwrap();
+    let mut rig = BackendRig::new(model_core::sim::PlantParams::nominal(), particle, 2).unwrap();
     rig.inject(model_core::wire::Injection::StallSpin).unwrap();
     let mut writer = Writer::create(&out).unwrap();
     run_plan(&mut rig, &plan, &mut writer, false).unwrap();
