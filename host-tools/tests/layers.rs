@@ -4,7 +4,8 @@
 //! - the crates depend the way the arrows point: bowl -> {lab, virtual-rig, rig-client} ->
 //!   model-core; lab may use rig-client and virtual-rig; rig-client and virtual-rig use neither
 //!   lab nor each other; nothing in the product uses the test crate;
-//! - every path ARCHITECTURE.md names exists.
+//! - every path ARCHITECTURE.md names exists;
+//! - no source file of the four crates is over 500 lines (a file with one job).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -274,4 +275,20 @@ fn every_path_architecture_md_names_exists() {
         missing.is_empty(),
         "ARCHITECTURE.md names paths that do not exist: {missing:?}"
     );
+}
+
+#[test]
+fn no_source_file_over_500_lines() {
+    let mut long = Vec::new();
+    for (_, dir) in CRATES {
+        let mut files = Vec::new();
+        rust_files(&root().join(dir), &mut files);
+        for f in files {
+            let lines = std::fs::read_to_string(&f).unwrap().lines().count();
+            if lines > 500 {
+                long.push(format!("{} ({lines} lines)", f.display()));
+            }
+        }
+    }
+    assert!(long.is_empty(), "split by job: {long:?}");
 }
