@@ -11,16 +11,12 @@
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
-use model_core::wire::{
-    AxisModel, Decoder, DeviceState, FaultCode, Frame, ParamId, ParamValues, Reason,
-};
+use model_core::wire::{AxisModel, DeviceState, FaultCode, Frame, ParamId, ParamValues, Reason};
+use rig_client::lines::explain;
+use rig_client::rig::{NoAnswer, Reply, Rig};
 use serde::Serialize;
 
 use crate::exit_code;
-use rig_client::lines::{command_line, explain};
-use rig_client::link::Link;
-use rig_client::request::transact;
-use rig_client::serial::ReadOutcome;
 
 /// How long one command waits for its answer.
 const ANSWER_TIMEOUT: Duration = Duration::from_millis(1000);
@@ -72,26 +68,16 @@ struct Report {
     axes: Vec<AxisReport>,
 }
 
-/// Request ids: one per command of this run.
-struct Ids(u16);
-
-impl Ids {
-    fn next(&mut self) -> u16 {
-        self.0 = self.0.wrapping_add(1);
-        self.0
-    }
-}
-
 /// Heartbeat period (well inside the rig's default link-loss timeout).
 const PING_EVERY: Duration = Duration::from_secs(1);
 
-fn ask(port: &mut Link, ids: &mut Ids, words: &[&str]) -> Result<Option<Frame>> {
-    let id = ids.next();
-    let words: Vec<String> = words.iter().map(|w| w.to_string()).collect();
-    let line = command_line(id, &words)
-        .map_err(|r| anyhow::anyhow!("{} was refused locally ({})", words.join(" "), r.token()))?;
-    // No answer is `None` here: the caller says what was asked and stops.
-    Ok(transact(port, id, &line, ANSWER_TIMEOUT)?.ok())
+/// The rig's reply, or `None` when no answer came (the caller says what was asked and stops).
+fn answered<T>(reply: Result<Reply<T>>) -> Result<Option<Reply<T>>> {
+    match reply {
+        Ok(r) => Ok(Some(r)),
+        Err(e) if e.downcast_ref::<NoAnswer>().is_some() => Ok(None),
+        Err(e) => Err(e),
+    }
 }
 
 /// How commissioning ended.
@@ -102,11 +88,10 @@ enum End {
     Timeout,
 }
 
-/// Follows the rig until it leaves the commissioning state.
-fn follow(port: &mut Link, ids: &mut Ids, timeout: Duration, quiet: bool) -> Result<End> {
+/// Follows the rig until it leaves the commissioning state (its telemetry, or STATUS when it
+/// sends none), through the rig client's typed [`Rig`].
+fn follow(rig: &mut Rig, timeout: Duration, quiet: bool) -> Result<End> {
     let start = Instant::now();
-    let mut decoder = Decoder::new();
-    let mut buf = [0u8; 4096];
     let mut last_seen = Instant::now();
     let mut last_report = Instant::now();
     let mut last_ping = Instant::now();
@@ -117,35 +102,31 @@ fn follow(port: &mut Link, ids: &mut Ids, timeout: Duration, quiet: bool) -> Res
         // Telemetry out is not presence: the rig's link-loss timeout needs bytes from us.
         if last_ping.elapsed() >= PING_EVERY {
             last_ping = Instant::now();
-            ask(port, ids, &["PING"])?;
+            answered(rig.ping())?;
         }
         let mut state = None;
-        match port.read(&mut buf, Duration::from_millis(50))? {
-            ReadOutcome::Data(n) => {
-                for &b in &buf[..n] {
-                    if let Some(Ok(Frame::Telemetry(t))) = decoder.push(b) {
-                        state = Some((t.state, t.fault));
-                        last_seen = Instant::now();
-                        if !quiet && last_report.elapsed() >= Duration::from_secs(1) {
-                            last_report = Instant::now();
-                            eprintln!(
-                                "  {:5.1} s  precession {:6} mrad/s duty {:6} bp   spin {:6} mrad/s duty {:6} bp",
-                                start.elapsed().as_secs_f64(),
-                                t.precession.measured_mrad_s,
-                                t.precession.duty_bp,
-                                t.spin.measured_mrad_s,
-                                t.spin.duty_bp
-                            );
-                        }
-                    }
+        rig.listen(Duration::from_millis(50))?;
+        // Telemetry (and what came while a command waited for its answer).
+        while let Some(frame) = rig.arrived.pop_front() {
+            if let Frame::Telemetry(t) = frame {
+                state = Some((t.state, t.fault));
+                last_seen = Instant::now();
+                if !quiet && last_report.elapsed() >= Duration::from_secs(1) {
+                    last_report = Instant::now();
+                    eprintln!(
+                        "  {:5.1} s  precession {:6} mrad/s duty {:6} bp   spin {:6} mrad/s duty {:6} bp",
+                        start.elapsed().as_secs_f64(),
+                        t.precession.measured_mrad_s,
+                        t.precession.duty_bp,
+                        t.spin.measured_mrad_s,
+                        t.spin.duty_bp
+                    );
                 }
             }
-            ReadOutcome::Timeout => {}
-            ReadOutcome::Gone => bail!("the port went away during commissioning"),
         }
         if state.is_none() && last_seen.elapsed() > POLL_AFTER {
             // No telemetry (TELEM_HZ 0?): ask.
-            if let Some(Frame::Status { status, .. }) = ask(port, ids, &["STATUS"])? {
+            if let Some(Reply::Done(status)) = answered(rig.status())? {
                 state = Some((status.state, status.fault));
             }
             last_seen = Instant::now();
@@ -226,8 +207,7 @@ pub fn run(args: &Args) -> Result<i32> {
     if !(args.timeout_s.is_finite() && args.timeout_s > 0.0 && args.timeout_s <= 86_400.0) {
         bail!("--timeout-s must be between 0 and 86400");
     }
-    let mut port = Link::open(&args.port, args.baud)?;
-    let mut ids = Ids(rig_client::request::fresh_id());
+    let mut rig = Rig::open(&args.port, args.baud, ANSWER_TIMEOUT)?;
     let mut report = Report {
         result: "ok",
         seconds: 0.0,
@@ -235,15 +215,16 @@ pub fn run(args: &Args) -> Result<i32> {
         reason: None,
         axes: Vec::new(),
     };
-    match ask(&mut port, &mut ids, &["COMMISSION"])? {
-        Some(Frame::Ack { .. }) => {}
-        Some(Frame::Reject { reason, .. }) => {
+    match answered(rig.commission())? {
+        // What came before the acknowledgement tells of the rig before commissioning.
+        Some(Reply::Done(())) => rig.arrived.clear(),
+        Some(Reply::Refused(reason)) => {
             report.result = "rejected";
             report.reason = Some(reason.token());
             print(&report, args.json)?;
             return Ok(exit_code::REFUSED);
         }
-        _ => {
+        None => {
             report.result = "timeout";
             print(&report, args.json)?;
             return Ok(exit_code::TIMEOUT);
@@ -253,12 +234,7 @@ pub fn run(args: &Args) -> Result<i32> {
         eprintln!("commissioning: the rig drives each motor with open-loop duty steps");
     }
     let started = Instant::now();
-    let end = follow(
-        &mut port,
-        &mut ids,
-        Duration::from_secs_f64(args.timeout_s),
-        args.json,
-    )?;
+    let end = follow(&mut rig, Duration::from_secs_f64(args.timeout_s), args.json)?;
     report.seconds = started.elapsed().as_secs_f64();
     let code = match end {
         End::Idle => exit_code::OK,
@@ -280,17 +256,17 @@ pub fn run(args: &Args) -> Result<i32> {
         End::Timeout => {
             report.result = "timeout";
             // Leave the motors off rather than half-way through a duty step.
-            let _ = ask(&mut port, &mut ids, &["STOP"]);
+            let _ = rig.stop();
             exit_code::TIMEOUT
         }
     };
     if code == exit_code::OK {
-        let params = match ask(&mut port, &mut ids, &["PARAMS"])? {
-            Some(Frame::Params { values, .. }) => Some(values),
+        let params = match answered(rig.params())? {
+            Some(Reply::Done(values)) => Some(values),
             _ => None,
         };
-        match ask(&mut port, &mut ids, &["MODELS"])? {
-            Some(Frame::Models { axes, .. }) => {
+        match answered(rig.models())? {
+            Some(Reply::Done(axes)) => {
                 report.axes = vec![
                     axis_report(
                         "precession",
@@ -301,13 +277,13 @@ pub fn run(args: &Args) -> Result<i32> {
                     axis_report("spin", &axes[1], params.as_ref(), ParamId::Bandwidth2MradS),
                 ];
             }
-            Some(Frame::Reject { reason, .. }) => {
+            Some(Reply::Refused(reason)) => {
                 eprintln!(
                     "the rig does not report its models (MODELS: {}); commissioning itself succeeded",
                     reason.token()
                 );
             }
-            _ => eprintln!("no answer to MODELS"),
+            None => eprintln!("no answer to MODELS"),
         }
     }
     print(&report, args.json)?;
