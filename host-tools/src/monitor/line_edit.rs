@@ -2,7 +2,7 @@
 //! the commands sent before, Tab completes the command word and its first argument (parameter
 //! names, residence models, injections).
 
-use crate::command_words::{all_words, first_arguments};
+use rig_client::command_words::{all_words, first_arguments};
 
 /// How many sent commands Up can bring back.
 const HISTORY_MAX: usize = 200;

@@ -2,7 +2,7 @@
 //! or one text line per second with `--plain` or when stdout is not a terminal), CSV log keyed on
 //! device time, frame counters; reopens the port after an unplug and keeps logging.
 //!
-//! It holds the port exclusively and serves a local socket ([`crate::relay`]) through which
+//! It holds the port exclusively and serves a local socket ([`rig_client::relay`]) through which
 //! `bowl send`, `bowl commission` and scripts reach the rig meanwhile. Commands can also be typed
 //! into the monitor itself (the UI's command line, or stdin lines in plain mode).
 
@@ -26,12 +26,12 @@ use anyhow::{Context, Result};
 use model_core::wire::{Decoder, Frame, FrameError};
 use serde_json::json;
 
-use crate::link::LineTap;
-use crate::relay::Relay;
-use crate::replay::stats_json;
-use crate::serial::{Holder, Port, ReadOutcome, other_holders, shared_port_warning};
-use crate::telemetry_csv;
 use commands::Commands;
+use rig_client::decode_stats::stats_json;
+use rig_client::relay::Relay;
+use rig_client::serial::{Holder, Port, ReadOutcome, other_holders, shared_port_warning};
+use rig_client::telemetry_csv;
+use rig_client::unreadable::LineTap;
 use tui::{Action, Tui};
 
 /// Flags of `bowl monitor`.
@@ -250,7 +250,7 @@ pub fn run(args: &Args) -> Result<()> {
                             status_due = None;
                             if view.board_flags != Some(status.flags) {
                                 view.board_flags = Some(status.flags);
-                                if let Some(words) = crate::send::status_flag_words(status.flags) {
+                                if let Some(words) = rig_client::lines::status_flag_words(status.flags) {
                                     let text = format!("the rig reports: {words}");
                                     view.event(plain, text.clone());
                                     link_event(&mut log, decoder.stats().restarts, &text)?;
@@ -334,13 +334,13 @@ pub fn run(args: &Args) -> Result<()> {
         // the one program holding the port, keeps the link alive while it watches.
         if port.is_some() && last_heartbeat.elapsed() >= HEARTBEAT_EVERY {
             last_heartbeat = Instant::now();
-            if let Ok(line) = crate::send::command_line(HEARTBEAT_ID, &["PING".to_string()]) {
+            if let Ok(line) = rig_client::lines::command_line(HEARTBEAT_ID, &["PING".to_string()]) {
                 outgoing.push(line);
             }
         }
         if port.is_some() && status_due.is_some_and(|due| Instant::now() >= due) {
             status_due = Some(Instant::now() + STATUS_AGAIN_EVERY);
-            if let Ok(line) = crate::send::command_line(STATUS_ID, &["STATUS".to_string()]) {
+            if let Ok(line) = rig_client::lines::command_line(STATUS_ID, &["STATUS".to_string()]) {
                 outgoing.push(line);
             }
         }

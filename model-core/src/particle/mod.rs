@@ -27,6 +27,7 @@ mod coriolis_batch;
 mod flat;
 mod flat_batch;
 mod inverse;
+pub mod named_scenes;
 mod phi;
 pub mod rolling;
 
