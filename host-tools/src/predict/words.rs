@@ -1,6 +1,6 @@
 //! The particle model's refusals in plain words: which value, the limit, what to do.
 
-use model_core::ode::OdeError;
+use model_core::particle::OdeError;
 use model_core::particle::{Input, InverseError, Scene, SceneError, magnitude_limits};
 
 /// Why a scene was refused.

@@ -29,9 +29,11 @@ mod flat;
 mod flat_batch;
 mod inverse;
 mod phi;
+pub(crate) mod radial;
 pub mod rolling;
 
 pub use inverse::{InverseError, omega_for_residence_time};
+pub use radial::{OdeError, integrate, integrate_constant};
 
 use crate::Real;
 use phi::phi_expm1;
