@@ -1,7 +1,7 @@
 //! The chooser's decisions checked against errors measured independently here.
 
 use super::*;
-use crate::ode::SpinUp;
+use crate::ode::{self, SpinUp};
 extern crate std;
 
 /// The particle tests' scene with the rim at 0.1 m.
@@ -552,7 +552,7 @@ fn random_spin_ups_meet_their_tolerance_from_the_table_and_nearly_always_by_the_
         };
         let (p, _) = choose_varying_reading(&s, &need, &profile, false).unwrap();
         let limits = ode::Limits::for_scene(&s, &profile);
-        let time = |m, model| match ode::integrate(&s, model, &profile, m, limits)
+        let time = |m, model| match particle::integrate(&s, model, &profile, m, limits)
             .unwrap()
             .outcome
         {

@@ -9,7 +9,7 @@
 
 use crate::check::Bench;
 use model_core::ode;
-use model_core::particle::{Model, Scene, residence};
+use model_core::particle::{self, Model, Scene, residence};
 use model_core::real::micro::{MicroF32, MicroF32HwSqrt};
 
 // The chart's named scenes are the model's (`bowl chart work-precision` draws them too): one
@@ -193,7 +193,7 @@ static ODE_METHODS: [ode::Method<f32>; 14] = {
 fn ode_f32<const CORIOLIS: bool, const M: usize>(_: usize) -> f32 {
     let s = core::hint::black_box(&SCENES_F32[0]);
     let m = core::hint::black_box(ODE_METHODS[M]);
-    match ode::integrate_constant(s, model(CORIOLIS), m) {
+    match particle::integrate_constant(s, model(CORIOLIS), m) {
         Ok(ode::Report {
             outcome: ode::OdeOutcome::Leaves {
                 residence_time_s, ..

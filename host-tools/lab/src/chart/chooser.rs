@@ -9,8 +9,8 @@
 
 use anyhow::Result;
 use model_core::choose::{Need, Plan, Source, Target, choose_varying_for, plan_cost};
-use model_core::ode::{self, Limits, Method, OdeOutcome, SpinUp};
-use model_core::particle::{Model, Scene};
+use model_core::ode::{Limits, Method, OdeOutcome, SpinUp};
+use model_core::particle::{self, Model, Scene};
 
 use super::plot::{Figure, Mark, Scale, Series};
 use super::table::Table;
@@ -18,7 +18,7 @@ use super::table::Table;
 /// `T` of one run, infinite when it does not leave (or fails).
 fn time(s: &Scene<f64>, m: Model, p: &SpinUp<f64>, method: Method<f64>) -> (f64, u32) {
     let limits = Limits::for_scene(s, p);
-    match ode::integrate(s, m, p, method, limits) {
+    match particle::integrate(s, m, p, method, limits) {
         Ok(r) => match r.outcome {
             OdeOutcome::Leaves {
                 residence_time_s, ..

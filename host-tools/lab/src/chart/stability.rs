@@ -10,7 +10,7 @@
 //! CSV says `refused`.
 
 use model_core::ode;
-use model_core::particle::{Model, Scene};
+use model_core::particle::{self, Model, Scene};
 
 use super::plot::{Figure, Mark, Scale, Series, VLine};
 use super::reference::{self, RefModel, RefOutcome, RefScene};
@@ -140,7 +140,8 @@ pub fn chart() -> anyhow::Result<(Figure, Table)> {
             let mut refused = Vec::new();
             for h_omega in grid() {
                 let m = method(fam, h_omega / s.omega_rad_s);
-                let (outcome, err, evals, note) = match ode::integrate_constant(s, sc.model, m) {
+                let (outcome, err, evals, note) = match particle::integrate_constant(s, sc.model, m)
+                {
                     Ok(rep) => match rep.outcome {
                         ode::OdeOutcome::Leaves {
                             residence_time_s, ..
@@ -157,7 +158,7 @@ pub fn chart() -> anyhow::Result<(Figure, Table)> {
                             format!("{other:?}"),
                         ),
                     },
-                    Err(ode::OdeError::BeyondStabilityLimit) => {
+                    Err(particle::OdeError::BeyondStabilityLimit) => {
                         ("refused", f64::NAN, None, "BeyondStabilityLimit".into())
                     }
                     Err(e) => ("error", f64::NAN, None, format!("{e:?}")),

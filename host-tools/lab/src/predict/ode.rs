@@ -36,7 +36,8 @@ pub fn predict(
     let closed =
         particle::residence(scene, model).map_err(|e| anyhow!(super::refusals::scene(e)))?;
     let report =
-        ode::integrate_constant(scene, model, m).map_err(|e| anyhow!(super::refusals::ode(e)))?;
+        particle::integrate_constant(scene, model, m)
+            .map_err(|e| anyhow!(super::refusals::ode(e)))?;
     let outcome = match report.outcome {
         OdeOutcome::Leaves {
             residence_time_s,
@@ -125,7 +126,7 @@ fn suggest(
 ) -> Option<f64> {
     let exact = particle::residence(scene, model).ok()?.residence_time_s();
     let aim = 0.5 * WARN_RELATIVE_ERROR;
-    let meets = |m: Method<f64>| match ode::integrate_constant(scene, model, m) {
+    let meets = |m: Method<f64>| match particle::integrate_constant(scene, model, m) {
         Ok(r) => match r.outcome {
             OdeOutcome::Leaves {
                 residence_time_s, ..
@@ -213,7 +214,7 @@ pub fn plan_time_s<P: model_core::ode::OmegaProfile<f64>>(
     method: Method<f64>,
 ) -> Result<f64> {
     let limits = ode::Limits::for_scene(scene, profile);
-    let report = ode::integrate(scene, model, profile, method, limits)
+    let report = particle::integrate(scene, model, profile, method, limits)
         .map_err(|e| anyhow!(super::refusals::ode(e)))?;
     Ok(match report.outcome {
         OdeOutcome::Leaves {

@@ -1,8 +1,8 @@
 //! The particle model's refusals in plain words (a scene, an inverse, an integration it
 //! refused): which value, the limit, what to do.
 
-use model_core::ode::OdeError;
-use model_core::particle::{InverseError, Scene, SceneError};
+use model_core::particle::OdeError;
+use model_core::particle::{Input, InverseError, Scene, SceneError, magnitude_limits};
 
 /// Why a scene was refused.
 pub fn scene(e: SceneError) -> String {
@@ -16,6 +16,22 @@ pub fn scene(e: SceneError) -> String {
         SceneError::InvalidStartRadius => "--ri-m must be 0 or more (the start radius, m)".into(),
         SceneError::InvalidRimRadius => "--rim-radius-m must be 0 or more (m)".into(),
         SceneError::InvalidTime => "the time must be 0 or more".into(),
+        SceneError::ExtremeMagnitude(input) => {
+            let (low, high) = magnitude_limits::<f64>();
+            let flag = match input {
+                Input::Omega => "--omega-rad-s",
+                Input::Resistance => "--mu",
+                Input::Gravity => "--g",
+                Input::K2 => "--k2",
+                Input::StartRadius => "--ri-m",
+                Input::RimRadius => "--rim-radius-m",
+            };
+            format!(
+                "{flag} is outside the magnitudes the model computes with (0, or {low:e} to \
+                 {high:e}): products of the inputs would underflow or overflow f64 and the \
+                 answer could come out the wrong way round; rescale the units (or pass 0)"
+            )
+        }
         SceneError::OutOfRange => {
             "the numbers overflow the arithmetic for this scene (absurd magnitudes): rescale the \
              units"

@@ -4,7 +4,7 @@
 
 use model_core::Real;
 use model_core::ode;
-use model_core::particle::{Model, Outcome, Scene, residence};
+use model_core::particle::{self, Model, Outcome, Scene, residence};
 use model_core::real::micro::{MicroF32, MicroF32HwSqrt};
 
 use crate::chart::figures::scene_err;
@@ -181,7 +181,7 @@ fn ode_run<T: Real>(m: &Method, s: &Scene<T>, model: Model) -> Run {
             note: "no ODE method".into(),
         };
     };
-    match ode::integrate_constant(s, model, method) {
+    match particle::integrate_constant(s, model, method) {
         Ok(rep) => {
             let (time_s, note) = match rep.outcome {
                 ode::OdeOutcome::Leaves {
@@ -323,7 +323,7 @@ fn time_in<T: Real>(method: &Method, s: &Scene<f64>, model: Model, budget: Budge
         return ns_per_call(budget, || residence(&st, model));
     }
     match ode_method(method, &st) {
-        Some(m) => ns_per_call(budget, || ode::integrate_constant(&st, model, m)),
+        Some(m) => ns_per_call(budget, || particle::integrate_constant(&st, model, m)),
         None => Timing {
             median_ns: f64::NAN,
             min_ns: f64::NAN,

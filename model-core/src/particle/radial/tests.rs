@@ -1,6 +1,7 @@
 //! Integrators against the closed forms (constant speed) and against each other (spin-up).
 
 use super::*;
+use crate::ode::SpinUp;
 use crate::particle::{self, Outcome};
 use proptest::prelude::*;
 
