@@ -9,7 +9,7 @@ use std::io::{Read, Write};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use common::{Sim, bowl, csv_rows, stdout, temp_dir};
+use common::{Sim, bowl, capture_timed, csv_rows, replay_to_csv, stdout, temp_dir};
 use model_core::wire::crc::crc32;
 use model_core::wire::{Decoder, DeviceState, Frame};
 
@@ -173,30 +173,11 @@ fn a_command_ended_by_cr_is_answered_and_every_frame_ends_in_crlf() {
 /// 20 frames/s (before the fix not one frame came in the next 30 s).
 #[test]
 fn telemetry_goes_on_at_the_new_rate_after_set_telem_hz() {
-    let dir = temp_dir("telem-hz");
-    let capture = dir.join("cap.bin");
-    let csv = dir.join("run.csv");
-    let made = bowl(&[
-        "serve",
-        "--capture",
-        capture.to_str().unwrap(),
-        "--seconds",
+    let csv = captured_csv(
+        "telem-hz",
         "40",
-        "--command",
-        "0:speed,1500,1500",
-        "--command",
-        "0:start",
-        "--command",
-        "30000:set,TELEM_HZ,20",
-    ]);
-    assert!(made.status.success(), "{}", stdout(&made));
-    let replay = bowl(&[
-        "replay",
-        capture.to_str().unwrap(),
-        "--csv",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(replay.status.success(), "{}", stdout(&replay));
+        &["0:speed,1500,1500", "0:start", "30000:set,TELEM_HZ,20"],
+    );
     let times: Vec<u64> = csv_rows(&csv)
         .iter()
         .filter_map(|r| r.get("device_time_ms")?.parse().ok())
@@ -287,30 +268,16 @@ fn the_monitor_says_what_it_cannot_read() {
 /// breaks its lines there (no line drawn across data the rig never sent).
 #[test]
 fn replay_marks_a_gap_in_the_telemetry_as_the_monitor_does() {
-    let dir = temp_dir("replay-gap");
-    let capture = dir.join("cap.bin");
-    let csv = dir.join("run.csv");
-    let made = bowl(&[
-        "serve",
-        "--capture",
-        capture.to_str().unwrap(),
-        "--seconds",
+    let csv = captured_csv(
+        "replay-gap",
         "8",
-        "--command",
-        "0:speed,1500,1500",
-        "--command",
-        "2000:set,TELEM_HZ,0",
-        "--command",
-        "5000:set,TELEM_HZ,50",
-    ]);
-    assert!(made.status.success(), "{}", stdout(&made));
-    let replay = bowl(&[
-        "replay",
-        capture.to_str().unwrap(),
-        "--csv",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(replay.status.success(), "{}", stdout(&replay));
+        &[
+            "0:speed,1500,1500",
+            "2000:set,TELEM_HZ,0",
+            "5000:set,TELEM_HZ,50",
+        ],
+    );
+    let dir = csv.parent().unwrap().to_path_buf();
     let rows = csv_rows(&csv);
     let events: Vec<(u64, &str)> = rows
         .iter()
@@ -348,4 +315,14 @@ fn replay_marks_a_gap_in_the_telemetry_as_the_monitor_does() {
         svg.contains("no telemetry"),
         "the gap is marked on the chart"
     );
+}
+
+/// A capture of `seconds` with the timed `commands`, replayed to CSV: the CSV's path (in a
+/// scratch directory named `name`).
+fn captured_csv(name: &str, seconds: &str, commands: &[&str]) -> std::path::PathBuf {
+    let dir = temp_dir(name);
+    let csv = dir.join("run.csv");
+    let replay = replay_to_csv(&capture_timed(&dir, seconds, commands), &csv);
+    assert!(replay.status.success(), "{}", stdout(&replay));
+    csv
 }

@@ -250,7 +250,9 @@ pub fn run(args: &Args) -> Result<()> {
                             status_due = None;
                             if view.board_flags != Some(status.flags) {
                                 view.board_flags = Some(status.flags);
-                                if let Some(words) = rig_client::lines::status_flag_words(status.flags) {
+                                if let Some(words) =
+                                    rig_client::lines::status_flag_words(status.flags)
+                                {
                                     let text = format!("the rig reports: {words}");
                                     view.event(plain, text.clone());
                                     link_event(&mut log, decoder.stats().restarts, &text)?;

@@ -35,9 +35,8 @@ pub fn predict(
     };
     let closed =
         particle::residence(scene, model).map_err(|e| anyhow!(super::refusals::scene(e)))?;
-    let report =
-        particle::integrate_constant(scene, model, m)
-            .map_err(|e| anyhow!(super::refusals::ode(e)))?;
+    let report = particle::integrate_constant(scene, model, m)
+        .map_err(|e| anyhow!(super::refusals::ode(e)))?;
     let outcome = match report.outcome {
         OdeOutcome::Leaves {
             residence_time_s,
