@@ -89,7 +89,7 @@ pub fn command() -> impl Strategy<Value = Command> {
         param_value(id).prop_map(move |value| Command::SetParam { id, value })
     });
     prop_oneof![
-        (any::<i16>(), any::<i16>()).prop_map(|(p, s)| Command::SetSpeeds {
+        (0..=i16::MAX, 0..=i16::MAX).prop_map(|(p, s)| Command::SetSpeeds {
             precession_mrad_s: p,
             spin_mrad_s: s
         }),
@@ -105,7 +105,9 @@ pub fn command() -> impl Strategy<Value = Command> {
         Just(Command::Commission),
         Just(Command::GetModels),
         Just(Command::Release),
-        (0..Injection::ALL.len()).prop_map(|i| Command::Inject(Injection::ALL[i])),
+        (0..Injection::ALL.len()).prop_map(|i| Command::Inject {
+            what: Injection::ALL[i]
+        }),
     ]
 }
 
