@@ -584,14 +584,14 @@ impl Command {
             .filter(|w| !w.is_empty());
         let word = words.next().ok_or(Refusal::NoCommand)?;
         let kind = CommandKind::from_word(word).ok_or(Refusal::UnknownCommand { word })?;
+        // Field by field, as the rig's decoder reads them, so both refuse a line for the same
+        // reason: a wrong value before a missing or extra one.
         let fields = kind.fields();
         let given = words.clone().count();
-        if given != fields.len() {
-            return Err(Refusal::FieldCount { kind, given });
-        }
         let mut values = [0i64; MAX_FIELDS];
         let mut param = None;
-        for (index, ((slot, field), word)) in values.iter_mut().zip(fields).zip(words).enumerate() {
+        for (index, (slot, field)) in values.iter_mut().zip(fields).enumerate() {
+            let word = words.next().ok_or(Refusal::FieldCount { kind, given })?;
             *slot = field
                 .parse(word.as_bytes(), &mut param, true)
                 .map_err(|problem| Refusal::Field {
@@ -601,6 +601,9 @@ impl Command {
                     param,
                     problem,
                 })?;
+        }
+        if words.next().is_some() {
+            return Err(Refusal::FieldCount { kind, given });
         }
         // Every value passed its field, so it fits its type.
         Command::from_values(kind, &values).ok_or(Refusal::FieldCount { kind, given })
@@ -644,8 +647,8 @@ impl Refusal<'_> {
     /// The reason the rig would give for the same line.
     pub const fn reason(&self) -> Reason {
         match self {
-            Refusal::NoCommand | Refusal::UnknownCommand { .. } => Reason::UnknownCommand,
-            Refusal::FieldCount { .. } => Reason::Malformed,
+            Refusal::UnknownCommand { .. } => Reason::UnknownCommand,
+            Refusal::NoCommand | Refusal::FieldCount { .. } => Reason::Malformed,
             Refusal::Field { problem, .. } => problem.reason(),
         }
     }
@@ -768,21 +771,23 @@ impl fmt::Display for Refusal<'_> {
                         "{what}: write `{word}` as `{v}` (the rig reads integers without `+` or \
                          leading zeros)"
                     ),
-                    FieldProblem::OutOfRange(v) if v < lo && v < 0 => {
-                        write!(
-                            f,
-                            "{what} {v} {unit} is below {lo}: it takes {lo}..={hi} {unit}"
-                        )?;
-                        if let FieldKind::Int { limit: Some(p), .. } = field.kind {
-                            write!(f, ", and at most the rig's {}", p.token())?;
-                        }
-                        f.write_str(" (a negative number is a value here, not an option)")
-                    }
                     FieldProblem::OutOfRange(v) => {
-                        write!(
-                            f,
-                            "{what} {v} {unit} is outside its range {lo}..={hi} {unit}"
-                        )
+                        match field.kind {
+                            FieldKind::Int { limit: Some(p), .. } if v < lo => write!(
+                                f,
+                                "{what} {v} {unit} is below {lo}: it takes {lo}..={hi} {unit}, \
+                                 and at most the rig's {}",
+                                p.token()
+                            )?,
+                            _ => write!(
+                                f,
+                                "{what} {v} {unit} is outside its range {lo}..={hi} {unit}"
+                            )?,
+                        }
+                        if v < 0 {
+                            f.write_str(" (a negative number is a value here, not an option)")?;
+                        }
+                        Ok(())
                     }
                     FieldProblem::UnknownChoice => {
                         write!(f, "`{word}` is not {what}: ")?;
