@@ -4,10 +4,11 @@
 
 use super::commands::{Command, CommandKind, FieldProblem, MAX_FIELDS, parse_int};
 use super::crc::crc32;
-use super::{
-    AxisModel, DeviceState, FaultCode, Frame, GateEvent, GateKind, Hello, MODEL_FIELD_MAX,
-    MotorTelemetry, PARAM_COUNT, ParamId, ParamValues, Reason, ResetCause, Residence,
-    ResidenceModel, Status, Telemetry,
+use super::frame::Frame;
+use super::params::{PARAM_COUNT, ParamId, ParamValues};
+use super::types::{
+    AxisModel, DeviceState, FaultCode, GateEvent, GateKind, Hello, MODEL_FIELD_MAX, MotorTelemetry,
+    Reason, ResetCause, Residence, ResidenceModel, Status, Telemetry,
 };
 use super::{FRAME_END, FRAME_START, LINE_END_CR, PROTOCOL_VERSION};
 

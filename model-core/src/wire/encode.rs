@@ -2,9 +2,10 @@
 
 use super::commands::{Command, FieldKind};
 use super::crc::crc32;
-use super::{
-    AxisModel, DUTY_MAX_BP, Frame, MODEL_FIELD_MAX, MotorTelemetry, PARAM_COUNT, ParamId,
-    RESIDENCE_MAX_MS, Residence, Telemetry,
+use super::frame::Frame;
+use super::params::{PARAM_COUNT, ParamId};
+use super::types::{
+    AxisModel, DUTY_MAX_BP, MODEL_FIELD_MAX, MotorTelemetry, RESIDENCE_MAX_MS, Residence, Telemetry,
 };
 use super::{FRAME_END, FRAME_START, LINE_END_CR, MAX_FRAME_LEN, PROTOCOL_VERSION};
 
