@@ -48,6 +48,7 @@ const WIRE: &[(&str, &[&str])] = &[
         &["commands", "crc", "frame", "params", "types", "wire"],
     ),
     ("stream", &["decode", "frame", "wire"]),
+    ("words", &["commands", "params", "types"]),
     (
         "device",
         &[

@@ -237,15 +237,7 @@ fn a_steady_trace_is_answered_by_the_closed_form_at_its_mean_speed() {
         (omega_rad_s - mean).abs() < 1e-4 * mean,
         "{omega_rad_s} vs {mean}"
     );
-    let t_mean = particle::residence(
-        &Scene {
-            omega_rad_s: mean,
-            ..s
-        },
-        c.model,
-    )
-    .unwrap()
-    .residence_time_s();
+    let t_mean = closed_form_at(&s, c.model, mean);
     let err = (t_mean - truth).abs() / truth;
     assert!(err <= c.tolerance_rel, "{c:?}: error {err:e}");
     assert!(
@@ -253,6 +245,13 @@ fn a_steady_trace_is_answered_by_the_closed_form_at_its_mean_speed() {
         "{c:?}: error {err:e}"
     );
     assert_eq!(c.rhs_evaluations, 0);
+}
+
+/// The closed form's residence time of `s` at constant bowl speed `omega_rad_s`.
+fn closed_form_at(s: &Scene<f64>, model: Model, omega_rad_s: f64) -> f64 {
+    particle::residence(&Scene { omega_rad_s, ..*s }, model)
+        .unwrap()
+        .residence_time_s()
 }
 
 #[test]
@@ -276,15 +275,7 @@ fn a_spin_up_trace_needs_an_integrator_that_meets_the_tolerance() {
     );
     // The closed form at the mean speed would miss: that is why it was not chosen.
     let mean = mean_omega_rad_s(&trace, truth);
-    let t_mean = particle::residence(
-        &Scene {
-            omega_rad_s: mean,
-            ..s
-        },
-        c.model,
-    )
-    .unwrap()
-    .residence_time_s();
+    let t_mean = closed_form_at(&s, c.model, mean);
     assert!((t_mean - truth).abs() > 1e-4 * truth, "{t_mean} vs {truth}");
 }
 

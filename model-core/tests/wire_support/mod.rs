@@ -4,6 +4,19 @@
 use model_core::wire::*;
 use proptest::prelude::*;
 
+/// Every frame a byte stream holds, and the decoder's counters after its end.
+pub fn decode_all(bytes: &[u8]) -> (Vec<Frame>, DecodeStats) {
+    let mut d = Decoder::new();
+    let mut frames = Vec::new();
+    d.push_slice(bytes, |r, _| {
+        if let Ok(f) = r {
+            frames.push(f)
+        }
+    });
+    d.finish();
+    (frames, *d.stats())
+}
+
 pub fn device_state() -> impl Strategy<Value = DeviceState> {
     (0i64..6).prop_map(|c| DeviceState::from_code(c).unwrap())
 }
