@@ -360,8 +360,10 @@ command_table! {
     /// Set one parameter.
     SetParam: "SET", answer Ack, refusable true, states ANY, changes true,
         example "set MU_PPM 29000",
-        meaning "set one parameter (table below): the particle scene and the loop bandwidths \
-                 any time but commissioning, the rest while idle or faulted (`STATE` otherwise)"
+        meaning "set one parameter (table below), each when its part of the rig allows: the \
+                 particle scene (`RIM_UM`, `START_UM`, `MU_PPM`, `K2_PPM`) and `TELEM_HZ` in any \
+                 state, the loop bandwidths (`BWn_MRAD_S`, `PER_PULSEn_MILLI`) in any but \
+                 commissioning, the rest while idle or faulted (`STATE` otherwise)"
     {
         /// Which parameter.
         id: ParamId = FieldKind::ParamName, "", "a parameter";
