@@ -108,18 +108,12 @@ impl Link {
     }
 }
 
-/// Whether `frame` is the kind of answer `command` gets: `S` to STATUS, `P` to PARAMS, `M` to
-/// MODELS, `W` to RTIME, `A` or `R` to the rest (and `R` to anything: a query can be refused
-/// too).
+/// Whether `frame` is the kind of answer `command` gets, as the command table says (`S` to
+/// STATUS, `P` to PARAMS, `M` to MODELS, `W` to RTIME, `A` to the rest), or `R` (anything can
+/// be refused).
 pub fn answers_kind(command: &Command, frame: &Frame) -> bool {
-    match (command, frame) {
-        (_, Frame::Reject { .. }) => true,
-        (Command::GetStatus, f) => matches!(f, Frame::Status { .. }),
-        (Command::GetParams, f) => matches!(f, Frame::Params { .. }),
-        (Command::GetModels, f) => matches!(f, Frame::Models { .. }),
-        (Command::SetResidence { .. }, f) => matches!(f, Frame::ResidenceSet { .. }),
-        (_, f) => matches!(f, Frame::Ack { .. }),
-    }
+    matches!(frame, Frame::Reject { .. })
+        || model_core::wire::encode::kind_letter(frame) == command.kind().answer().letter()
 }
 
 /// A request id for the first command of a process: the wall clock in milliseconds, mod 2^16
