@@ -48,7 +48,7 @@ const WIRE: &[(&str, &[&str])] = &[
         &["commands", "crc", "frame", "params", "types", "wire"],
     ),
     ("stream", &["decode", "frame", "wire"]),
-    ("words", &["commands", "params", "types"]),
+    ("typed", &["commands", "params", "types"]),
     (
         "device",
         &[

@@ -2,10 +2,10 @@
 //! wire (and, lower case, the word a person types), its fields (name with unit, unit, range or
 //! tokens, words for people), the answer it gets, the controller states that allow it and what
 //! it does; [`Command`], [`CommandKind`], the encoder's and the decoder's command fields,
-//! [`Command::from_words`], the refusal words ([`Refusal`]) and docs/protocol.md's command table
-//! (checked by `model-core/tests/wire_doc.rs`) are made from it (the words: [`super::words`]). To add a command, add a row
-//! (the device's `execute` and the host's callers are exhaustive `match`es, so the compiler
-//! points there).
+//! [`Command::from_words`] and the refusal words ([`Refusal`](super::Refusal), both in [`super::typed`]) and
+//! docs/protocol.md's command table (checked by `model-core/tests/wire_doc.rs`) are made from
+//! it. To add a command, add a row (the device's `execute` and the host's callers are
+//! exhaustive `match`es, so the compiler points there).
 //!
 //! A field's range is the protocol's: a value outside it is refused whatever the rig's settings
 //! (`RANGE`, never clamped), on the rig by the decoder and on the PC before sending. A field

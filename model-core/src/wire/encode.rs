@@ -56,9 +56,18 @@ impl Out<'_> {
         if v < 0 {
             self.byte(b'-');
         }
-        let mut mag = v.unsigned_abs();
+        let mut wide = v.unsigned_abs();
         let mut digits = [0u8; 20];
         let mut n = 0;
+        // Every wire value fits in 32 bits, which the MCU divides in hardware (a 64-bit
+        // division is a library call, about 100 instructions a digit); a wider value's low
+        // digits take the 64-bit way first.
+        while wide > u64::from(u32::MAX) {
+            digits[n] = b'0' + (wide % 10) as u8;
+            n += 1;
+            wide /= 10;
+        }
+        let mut mag = wide as u32;
         loop {
             digits[n] = b'0' + (mag % 10) as u8;
             n += 1;

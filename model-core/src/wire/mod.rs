@@ -15,7 +15,7 @@
 //! - [`params`]: the settable parameters, one table (token, unit, range, default);
 //! - [`commands`]: the commands, one table (token, fields with units and ranges, answer, the
 //!   states that allow it);
-//! - [`words`]: [`Command::from_words`] (the words a person types) and the refusal words;
+//! - [`typed`]: [`Command::from_words`] (the words a person types) and the refusal words;
 //! - [`frame`]: a frame in either direction;
 //! - [`encode()`] and [`decode`]: the codec and the streaming [`Decoder`];
 //! - [`device`]: the rig's side (command dispatch, telemetry pacing) over the [`device::Backend`] trait.
@@ -28,8 +28,8 @@ pub mod encode;
 pub mod frame;
 pub mod params;
 pub mod stream;
+pub mod typed;
 pub mod types;
-pub mod words;
 
 pub use commands::{
     Answer, COMMAND_COUNT, Command, CommandKind, Field, FieldKind, FieldProblem, MAX_FIELDS, States,
@@ -39,8 +39,8 @@ pub use encode::{EncodeError, encode};
 pub use frame::Frame;
 pub use params::*;
 pub use stream::{DecodeStats, Decoder, REORDER_FRAMES};
+pub use typed::Refusal;
 pub use types::*;
-pub use words::Refusal;
 
 /// The protocol version in every frame header (`$T1`): one decimal digit.
 pub const PROTOCOL_VERSION: u8 = 1;
