@@ -12,7 +12,7 @@ use model_core::bowl::MotorSpeeds;
 use model_core::control::estimator::lowest_speed_rad_s;
 use model_core::control::{BowlSpeedForResidence, Controller, ControllerConfig, InverseFailure};
 use model_core::particle::{Model, Scene, omega_for_residence_time};
-use model_core::wire::{Command, Frame, ParamId, ParamValues, Reason, Status};
+use model_core::wire::{Command, CommandKind, Frame, ParamId, ParamValues, Reason, Status};
 
 use crate::link::{Link, transact};
 use crate::send::command_line;
@@ -90,7 +90,20 @@ fn state_words(s: &Status, command: &str) -> String {
         D::Idle if command == "clear" => "there is no fault to clear".to_string(),
         _ => "see docs/protocol.md for what each state allows".to_string(),
     };
-    format!("the rig is {}: {todo}", words::state(s.state))
+    // The states the command table allows it in.
+    let allowed = CommandKind::from_word(command).map(|kind| {
+        let states: Vec<&str> = (0..=5)
+            .filter_map(D::from_code)
+            .filter(|&state| kind.states().contains(state))
+            .map(words::state_token)
+            .collect();
+        format!(" (`{command}` is taken while {})", states.join(", "))
+    });
+    format!(
+        "the rig is {}: {todo}{}",
+        words::state(s.state),
+        allowed.unwrap_or_default()
+    )
 }
 
 /// The controller's view of the rig's parameters (speed limits, sensor wheels, axes angle).
