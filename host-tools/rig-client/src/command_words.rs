@@ -1,191 +1,42 @@
-//! The commands as a person types them (`speed 1800 2100`, `set MU_PPM 29000`): their words,
-//! what each takes, and a command line refused before it is sent, said in words (which value,
-//! which limit, which names are valid). Used by `bowl send`, the monitor's command line and its
-//! Tab completion.
+//! The commands as a person types them (`speed 1800 2100`, `set MU_PPM 29000`): their words
+//! and first arguments for Tab completion, and a command line refused before it is sent, said
+//! in words. All of it follows the command table (`model_core::wire::commands`); used by
+//! `bowl send`, the monitor's command line and its Tab completion.
 
-use model_core::wire::{Command, Injection, ParamId, Reason, ResidenceModel};
+use model_core::wire::{Command, CommandKind, FieldKind, ParamId, Reason};
 
-use crate::integer::integer_in;
-
-/// The command word `bowl` types for each command: an exhaustive match, so a new command in the
-/// wire protocol cannot be left out without a compile error.
-pub fn command_word(c: &Command) -> &'static str {
-    match c {
-        Command::SetSpeeds { .. } => "speed",
-        Command::SetResidence { .. } => "rtime",
-        Command::Start => "start",
-        Command::Stop => "stop",
-        Command::ClearFault => "clear",
-        Command::SetParam { .. } => "set",
-        Command::GetStatus => "status",
-        Command::GetParams => "params",
-        Command::Inject(_) => "inject",
-        Command::Ping => "ping",
-        Command::Commission => "commission",
-        Command::GetModels => "models",
-        Command::Release => "release",
-    }
+/// Every command word, lower case (the wire token as a person types it), in the order of the
+/// command table (docs/protocol.md).
+pub fn all_words() -> Vec<String> {
+    CommandKind::ALL
+        .iter()
+        .map(|k| k.token().to_ascii_lowercase())
+        .collect()
 }
 
-/// One command of each kind, for [`command_word`] to name.
-const EVERY_COMMAND: [Command; 13] = [
-    Command::SetSpeeds {
-        precession_mrad_s: 0,
-        spin_mrad_s: 0,
-    },
-    Command::SetResidence {
-        model: ResidenceModel::Coriolis,
-        time_ms: 1,
-    },
-    Command::Start,
-    Command::Stop,
-    Command::ClearFault,
-    Command::SetParam {
-        id: ParamId::TelemetryHz,
-        value: 0,
-    },
-    Command::GetStatus,
-    Command::GetParams,
-    Command::Inject(Injection::None),
-    Command::Ping,
-    Command::Commission,
-    Command::GetModels,
-    Command::Release,
-];
-
-/// Every command word, in the order of docs/protocol.md's table.
-pub fn all_words() -> Vec<&'static str> {
-    EVERY_COMMAND.iter().map(command_word).collect()
-}
-
-/// The words that may follow `command` as its first argument, lower case.
+/// The words that may follow `command` as its first argument, lower case (from the command
+/// table: a choice's tokens, or the parameter names).
 pub fn first_arguments(command: &str) -> Vec<String> {
-    match command {
-        "set" => ParamId::ALL
+    let Some(first) = CommandKind::from_word(command).and_then(|k| k.fields().first()) else {
+        return Vec::new();
+    };
+    match first.kind {
+        FieldKind::Choice(tokens) => tokens.iter().map(|t| t.to_ascii_lowercase()).collect(),
+        FieldKind::ParamName => ParamId::ALL
             .iter()
             .map(|p| p.token().to_ascii_lowercase())
             .collect(),
-        "rtime" => vec!["cori".into(), "flat".into()],
-        "inject" => Injection::ALL
-            .iter()
-            .map(|i| i.token().to_ascii_lowercase())
-            .collect(),
-        _ => Vec::new(),
+        FieldKind::Int { .. } | FieldKind::ParamValue => Vec::new(),
     }
 }
 
-/// What `command` takes after its word, and an example.
-fn usage(command: &str) -> (usize, &'static str) {
-    match command {
-        "speed" => (
-            2,
-            "speed W1 W2: the precession and spin speeds in mrad/s, each 0..=its SPEED_MAX \
-             (e.g. `speed 1800 2100`)",
-        ),
-        "rtime" => (
-            2,
-            "rtime MODEL MS: cori or flat, then the residence time in ms, 1..=9999999 \
-             (e.g. `rtime cori 2500`)",
-        ),
-        "set" => (
-            2,
-            "set NAME VALUE: a parameter and its value, an integer in the parameter's unit \
-             (e.g. `set MU_PPM 29000`)",
-        ),
-        "inject" => (1, "inject WHAT: none, sensor1, sensor2, stall1 or stall2"),
-        _ => (0, "takes nothing after its word"),
-    }
-}
-
-/// A command line refused before it was sent (`reason`, from the shared decoder and the
-/// protocol's rules), in words: what was wrong, with which value, the limit or the valid names.
+/// A command line refused before it was sent, in words: what was wrong, with which value, the
+/// limit or the valid names (the command table's words, `model_core::wire::Refusal`). `reason`
+/// is what the local check answered; the words say more.
 pub fn local_refusal(words: &[String], reason: Reason) -> String {
-    // The words as the decoder saw them: split at spaces and commas.
-    let words: Vec<String> = words
-        .iter()
-        .flat_map(|w| w.split(','))
-        .filter(|w| !w.is_empty())
-        .map(str::to_string)
-        .collect();
-    let Some(command) = words.first().map(|w| w.to_ascii_lowercase()) else {
-        return "no command given".into();
-    };
-    let args = &words[1..];
-    if reason == Reason::UnknownCommand {
-        return format!(
-            "`{command}` is not a command; the commands: {}",
-            all_words().join(", ")
-        );
-    }
-    if reason == Reason::UnknownParam {
-        let names: Vec<&str> = ParamId::ALL.iter().map(|p| p.token()).collect();
-        return format!(
-            "`{}` is not a parameter; the parameters: {} (docs/protocol.md)",
-            args.first().map_or("", String::as_str),
-            names.join(", ")
-        );
-    }
-    let (count, usage) = usage(&command);
-    if args.len() != count {
-        return format!(
-            "`{command}` takes {count} value{} after it, got {}: {usage}",
-            if count == 1 { "" } else { "s" },
-            args.len()
-        );
-    }
-    match (command.as_str(), reason) {
-        ("speed", _) => {
-            for (arg, (axis, limit)) in args.iter().zip([
-                ("precession", ParamId::SpeedMax1MradS),
-                ("spin", ParamId::SpeedMax2MradS),
-            ]) {
-                if let Some(why) = speed_value(arg, axis, limit) {
-                    return why;
-                }
-            }
-        }
-        ("rtime", _) => {
-            if !matches!(args[0].to_ascii_lowercase().as_str(), "cori" | "flat") {
-                return format!("`{}` is not a residence model: cori or flat", args[0]);
-            }
-            if let Some(why) = integer_in(&args[1], "the residence time", 1, 9_999_999, "ms") {
-                return why;
-            }
-        }
-        ("set", _) => {
-            if let Some(why) = crate::refusal::set_range(&words) {
-                return why;
-            }
-        }
-        ("inject", _) => {
-            return format!(
-                "`{}` is not something to inject: {}",
-                args[0],
-                first_arguments("inject").join(", ")
-            );
-        }
-        _ => {}
-    }
-    format!("{}: {usage}", words.join(" "))
-}
-
-/// A speed value judged by the protocol's rule (0..=SPEED_MAX, and SPEED_MAX is at most
-/// 32 767): `None` if it passes.
-fn speed_value(arg: &str, axis: &str, limit: ParamId) -> Option<String> {
-    let max = limit.range().1;
-    match arg.parse::<i64>() {
-        Ok(v) if v < 0 => Some(format!(
-            "the {axis} speed {v} mrad/s is below 0: a speed is 0 (stopped) up to {} (at most \
-             {max} mrad/s); the motors turn one way",
-            limit.token()
-        )),
-        _ => integer_in(
-            arg,
-            &format!("the {axis} speed"),
-            0,
-            i64::from(max),
-            "mrad/s",
-        ),
+    match Command::from_words(words) {
+        Err(refusal) => refusal.to_string(),
+        Ok(_) => format!("{}: {}", words.join(" "), crate::lines::explain(reason)),
     }
 }
 
@@ -202,7 +53,7 @@ mod tests {
     #[test]
     fn every_command_word_is_one_the_rig_takes() {
         for word in all_words() {
-            let line = crate::lines::command_line(1, &[word.to_string()]);
+            let line = crate::lines::command_line(1, std::slice::from_ref(&word));
             // The bare word may lack its arguments, but it is never an unknown command.
             assert_ne!(line.err(), Some(Reason::UnknownCommand), "{word}");
         }
@@ -243,7 +94,7 @@ mod tests {
         );
         let text = refused("rtime fast 2500");
         assert!(
-            text.contains("`fast` is not a residence model: cori or flat"),
+            text.contains("`fast` is not a residence model: flat or cori"),
             "{text}"
         );
         let text = refused("inject fire");

@@ -11,7 +11,6 @@
 
 pub mod command_words;
 pub mod decode_stats;
-pub mod integer;
 pub mod lines;
 pub mod link;
 pub mod refusal;

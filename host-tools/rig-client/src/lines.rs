@@ -1,39 +1,20 @@
 //! Command lines out, answers described: the line `$C1,id,WORDS...*CRC` built from a command's
-//! words and checked by the shared decoder, a rejection reason and an answer frame in words.
+//! words by the command table, a rejection reason and an answer frame in words.
 
-use model_core::wire::crc::crc32;
-use model_core::wire::{
-    Command, Frame, FrameError, PROTOCOL_VERSION, ParamId, Reason, decode_frame,
-};
+use model_core::wire::{Command, Frame, MAX_FRAME_LEN, ParamId, Reason, encode};
 
 use crate::words;
 
-/// Builds the command line `$C1,id,WORDS...*CRC\r\n` and checks it with the shared decoder and
-/// the protocol's rules, so a command the rig would refuse as malformed or out of range whatever
-/// its settings never leaves the PC (a speed below 0: every SPEED_MAX is at least 0).
+/// Builds the command line `$C1,id,WORD,fields...*CRC\r\n` from the words a person typed,
+/// judged by the command table (`Command::from_words`), so a command the rig would refuse as
+/// malformed or out of range whatever its settings never leaves the PC (a speed below 0: every
+/// SPEED_MAX is at least 0). The words of the refusal: [`crate::command_words::local_refusal`].
 pub fn command_line(id: u16, words: &[String]) -> Result<Vec<u8>, Reason> {
-    let mut payload = format!("C{PROTOCOL_VERSION},{id}");
-    for w in words {
-        for part in w.split(',').filter(|p| !p.is_empty()) {
-            payload.push(',');
-            payload.push_str(&part.to_ascii_uppercase());
-        }
-    }
-    // CRLF, as every frame ends: the rig takes CR, LF or CRLF.
-    let line = format!("${payload}*{:08X}\r\n", crc32(payload.as_bytes())).into_bytes();
-    match decode_frame(&line) {
-        Ok(Frame::Command {
-            command:
-                Command::SetSpeeds {
-                    precession_mrad_s,
-                    spin_mrad_s,
-                },
-            ..
-        }) if precession_mrad_s < 0 || spin_mrad_s < 0 => Err(Reason::Range),
-        Ok(Frame::Command { .. }) => Ok(line),
-        Err(FrameError::BadCommand { reason, .. }) => Err(reason),
-        _ => Err(Reason::Malformed),
-    }
+    let command = Command::from_words(words).map_err(|r| r.reason())?;
+    let mut buf = [0u8; MAX_FRAME_LEN];
+    // Every field passed its range: the frame encodes (CRLF, as every frame ends).
+    let n = encode(&Frame::Command { id, command }, &mut buf).map_err(|_| Reason::Malformed)?;
+    Ok(buf[..n].to_vec())
 }
 
 /// What a rejection reason means, for people.

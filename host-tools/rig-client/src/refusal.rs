@@ -12,9 +12,8 @@ use model_core::bowl::MotorSpeeds;
 use model_core::control::estimator::lowest_speed_rad_s;
 use model_core::control::{BowlSpeedForResidence, Controller, ControllerConfig, InverseFailure};
 use model_core::particle::{Model, Scene, omega_for_residence_time};
-use model_core::wire::{Frame, ParamId, ParamValues, Reason, Status};
+use model_core::wire::{Command, CommandKind, Frame, ParamId, ParamValues, Reason, Status};
 
-use crate::integer::integer_in;
 use crate::lines::command_line;
 use crate::link::Link;
 use crate::request::transact;
@@ -59,21 +58,22 @@ pub fn particulars(
     }
 }
 
-/// `set NAME VALUE` refused: not an integer, or outside the parameter's own range from the
-/// table, or, if the value is inside it, the rule that ties it to the others.
+/// `set NAME VALUE` refused: not an integer, or outside the parameter's own range (the
+/// command table's words), or, if the value is inside it, the rule that ties it to the others.
 pub(crate) fn set_range(words: &[String]) -> Option<String> {
-    let name = words.get(1)?.to_ascii_uppercase();
-    let id = ParamId::ALL.into_iter().find(|p| p.token() == name)?;
-    let (lo, hi) = id.range();
-    let unit = id.unit();
-    let value = words.get(2)?;
-    match integer_in(value, &name, i64::from(lo), i64::from(hi), unit) {
-        Some(why) => Some(why),
-        None => Some(format!(
-            "{name} = {value} {unit} is inside its own range ({lo}..={hi}) but not with the \
-             other parameters (the start radius must lie inside the rim, the loop settings must \
-             fit the motors): see `bowl send PORT params`"
-        )),
+    match Command::from_words(words) {
+        Err(refusal) => Some(refusal.to_string()),
+        Ok(Command::SetParam { id, value }) => {
+            let (lo, hi) = id.range();
+            Some(format!(
+                "{} = {value} {} is inside its own range ({lo}..={hi}) but not with the other \
+                 parameters (the start radius must lie inside the rim, the loop settings must \
+                 fit the motors): see `bowl send PORT params`",
+                id.token(),
+                id.unit()
+            ))
+        }
+        Ok(_) => None,
     }
 }
 
@@ -91,7 +91,20 @@ fn state_words(s: &Status, command: &str) -> String {
         D::Idle if command == "clear" => "there is no fault to clear".to_string(),
         _ => "see docs/protocol.md for what each state allows".to_string(),
     };
-    format!("the rig is {}: {todo}", words::state(s.state))
+    // The states the command table allows it in.
+    let allowed = CommandKind::from_word(command).map(|kind| {
+        let states: Vec<&str> = (0..=5)
+            .filter_map(D::from_code)
+            .filter(|&state| kind.states().contains(state))
+            .map(words::state_token)
+            .collect();
+        format!(" (`{command}` is taken while {})", states.join(", "))
+    });
+    format!(
+        "the rig is {}: {todo}{}",
+        words::state(s.state),
+        allowed.unwrap_or_default()
+    )
 }
 
 /// The controller's view of the rig's parameters (speed limits, sensor wheels, axes angle).

@@ -12,7 +12,7 @@ use model_core::wire::{
 
 use crate::lines::describe;
 use crate::link::Link;
-use crate::request::{Reader, Request, Unanswered, fresh_id, request};
+use crate::request::{Reader, Request, Unanswered, fresh_id, next_id, request};
 use crate::serial::{LinkError, ReadOutcome};
 
 /// What the rig said to a command it answered.
@@ -37,8 +37,8 @@ impl std::fmt::Display for NoAnswer {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "no answer to {:?} ({})",
-            self.command,
+            "no answer to {} ({})",
+            self.command.kind().token(),
             self.unanswered.advice()
         )
     }
@@ -75,13 +75,13 @@ impl Rig {
 
     /// Sends `command` and waits for its answer frame.
     pub fn command(&mut self, command: Command) -> anyhow::Result<Frame> {
-        // u16::MAX is the monitor's heartbeat's.
-        self.next_id = match self.next_id.wrapping_add(1) {
-            u16::MAX => 0,
-            n => n,
-        };
+        self.next_id = next_id(self.next_id);
         let mut req = Request::new(self.next_id, command).map_err(|r| {
-            anyhow::anyhow!("{command:?} refused here: {}", crate::lines::explain(r))
+            anyhow::anyhow!(
+                "{} refused here: {}",
+                command.kind().token(),
+                crate::lines::explain(r)
+            )
         })?;
         let arrived = &mut self.arrived;
         match request(
@@ -122,7 +122,7 @@ impl Rig {
         match self.command(command)? {
             Frame::Reject { reason, .. } => Ok(Reply::Refused(reason)),
             Frame::Ack { .. } => Ok(Reply::Done(())),
-            other => anyhow::bail!("{command:?} answered {}", describe(&other)),
+            other => anyhow::bail!("{} answered {}", command.kind().token(), describe(&other)),
         }
     }
 
@@ -184,7 +184,7 @@ impl Rig {
 
     /// INJECT: make a simulated rig misbehave.
     pub fn inject(&mut self, what: Injection) -> anyhow::Result<Reply<()>> {
-        self.acked(Command::Inject(what))
+        self.acked(Command::Inject { what })
     }
 
     /// COMMISSION: start the motor identification.

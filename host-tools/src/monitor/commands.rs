@@ -8,7 +8,7 @@ use model_core::wire::Frame;
 use rig_client::command_words::local_refusal;
 use rig_client::lines::{command_line, describe, explain};
 use rig_client::refusal::particulars;
-use rig_client::request::{Request, fresh_id};
+use rig_client::request::{Request, fresh_id, next_id};
 use rig_client::unreadable::UnreadableAnswer;
 
 /// How often a typed command is sent in all when no answer comes (1 s).
@@ -43,11 +43,7 @@ impl Commands {
             return Err("type a command, e.g. `status`, `speed 1800 2100`, `start`".into());
         }
         let id = self.next_id;
-        // u16::MAX is the heartbeat's.
-        self.next_id = match self.next_id.wrapping_add(1) {
-            u16::MAX => 0,
-            n => n,
-        };
+        self.next_id = next_id(self.next_id);
         let line = command_line(id, &words).map_err(|r| {
             format!(
                 "`{text}` not sent: {} - {} ({})",

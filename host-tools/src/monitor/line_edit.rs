@@ -94,7 +94,7 @@ impl LineEdit {
             (n, false) => (n - 1, words[n - 1]),
         };
         let options: Vec<String> = match index {
-            0 => all_words().into_iter().map(String::from).collect(),
+            0 => all_words(),
             1 => first_arguments(&words[0].to_ascii_lowercase()),
             _ => Vec::new(),
         };

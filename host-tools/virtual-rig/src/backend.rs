@@ -9,13 +9,10 @@
 //! gates.
 
 use anyhow::{Result, anyhow};
-use model_core::binding::{
-    AssemblyError, ControllerBackend, Record, commission_on_plant, default_params, describe_bowl,
-    persisted,
-};
+use model_core::binding::{ControllerBackend, Record, default_params, persisted};
 use model_core::control::ControllerConfig;
-use model_core::sim::PlantParams;
 use model_core::sim::granule::ParticleParams;
+use model_core::sim::{AssemblyError, PlantParams, commission_on_plant};
 use model_core::wire::{Hello, ParamId, ResetCause};
 
 use crate::world::World;
@@ -50,7 +47,7 @@ impl SimulatedBackend {
         for (id, axis) in [(ParamId::Teeth1, 0), (ParamId::Teeth2, 1)] {
             params[id.index()] = i32::from(plant_params.axes[axis].sensor.pulses_per_rev);
         }
-        describe_bowl(&mut params, &particle);
+        particle.describe_bowl(&mut params);
         let hello = Hello {
             reset_cause: ResetCause::Unknown,
             reset_count: 0,

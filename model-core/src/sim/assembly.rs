@@ -1,10 +1,11 @@
-//! Commissioning on a simulated plant, as a real rig is commissioned once after assembly: the
+//! Commissioning on a simulated plant (the simulator's, so the binding the firmware links never
+//! needs the plant), as a real rig is commissioned once after assembly: the
 //! host's virtual rig and the emulated board both start with the motor models they identified
 //! on their own plant, not with the datasheet's.
 
-use super::{ControllerBackend, Injector};
+use super::Plant;
+use crate::binding::{ControllerBackend, Injector};
 use crate::control::{IdentifyError, State};
-use crate::sim::Plant;
 use crate::wire::Reason;
 use crate::wire::device::Backend;
 
