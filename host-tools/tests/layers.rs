@@ -7,6 +7,11 @@
 //! - every path ARCHITECTURE.md names exists;
 //! - no source file of the four crates is over 500 lines (a file with one job).
 
+#[path = "../../tests/support/graph.rs"]
+mod graph;
+
+use graph::{Graph, circle, rust_files};
+
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -21,17 +26,6 @@ const CRATES: [(&str, &str); 4] = [
     ("virtual-rig", "host-tools/virtual-rig/src"),
     ("lab", "host-tools/lab/src"),
 ];
-
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
-}
 
 /// The top-level module a file belongs to (`chart/plot.rs` -> `chart`), `None` for the crate
 /// root.
@@ -91,11 +85,11 @@ fn imports(code: &str) -> BTreeSet<String> {
 }
 
 /// The arrows between the top-level modules of the crate whose sources are in `src`.
-fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+fn module_graph(src: &Path) -> Graph {
     let mut files = Vec::new();
     rust_files(src, &mut files);
     let modules: BTreeSet<String> = files.iter().filter_map(|f| top_module(src, f)).collect();
-    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    let mut graph = Graph::new();
     for file in &files {
         let Some(from) = top_module(src, file) else {
             continue;
@@ -109,38 +103,6 @@ fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
         }
     }
     graph
-}
-
-/// A circle in `graph`, if there is one, as the modules along it.
-fn circle(graph: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
-    fn visit(
-        node: &str,
-        graph: &BTreeMap<String, BTreeSet<String>>,
-        path: &mut Vec<String>,
-        done: &mut BTreeSet<String>,
-    ) -> Option<Vec<String>> {
-        if let Some(at) = path.iter().position(|p| p == node) {
-            let mut c = path[at..].to_vec();
-            c.push(node.to_string());
-            return Some(c);
-        }
-        if done.contains(node) {
-            return None;
-        }
-        path.push(node.to_string());
-        for next in graph.get(node).into_iter().flatten() {
-            if let Some(c) = visit(next, graph, path, done) {
-                return Some(c);
-            }
-        }
-        path.pop();
-        done.insert(node.to_string());
-        None
-    }
-    let mut done = BTreeSet::new();
-    graph
-        .keys()
-        .find_map(|n| visit(n, graph, &mut Vec::new(), &mut done))
 }
 
 #[test]

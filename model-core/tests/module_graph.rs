@@ -4,7 +4,12 @@
 //! circle. A new import is a decision: add its direction here, and the test says whether it
 //! closes a circle.
 
-use std::collections::{BTreeMap, BTreeSet};
+#[path = "../../tests/support/graph.rs"]
+mod graph;
+
+use graph::{Graph, circle, rust_files};
+
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 /// Which top-level module may import which (`a` imports from each of its list). Read down:
@@ -52,21 +57,8 @@ const WIRE: &[(&str, &[&str])] = &[
     ),
 ];
 
-type Graph = BTreeMap<String, BTreeSet<String>>;
-
 fn src() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
-}
-
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            rust_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
 }
 
 /// The code of a file without its comments (doc links name modules too).
@@ -217,38 +209,6 @@ fn allowed(table: &[(&str, &[&str])]) -> Graph {
         .iter()
         .map(|(m, tos)| (m.to_string(), tos.iter().map(|t| t.to_string()).collect()))
         .collect()
-}
-
-/// A circle in `graph`, if there is one, as the modules along it.
-fn circle(graph: &Graph) -> Option<Vec<String>> {
-    fn visit(
-        node: &str,
-        graph: &Graph,
-        path: &mut Vec<String>,
-        done: &mut BTreeSet<String>,
-    ) -> Option<Vec<String>> {
-        if let Some(i) = path.iter().position(|p| p == node) {
-            let mut found = path[i..].to_vec();
-            found.push(node.to_string());
-            return Some(found);
-        }
-        if done.contains(node) {
-            return None;
-        }
-        path.push(node.to_string());
-        for next in graph.get(node).into_iter().flatten() {
-            if let Some(found) = visit(next, graph, path, done) {
-                return Some(found);
-            }
-        }
-        path.pop();
-        done.insert(node.to_string());
-        None
-    }
-    let mut done = BTreeSet::new();
-    graph
-        .keys()
-        .find_map(|n| visit(n, graph, &mut Vec::new(), &mut done))
 }
 
 /// Every import in `found` is allowed (or listed in `exempt`), and the allowed ones form no

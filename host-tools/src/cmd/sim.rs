@@ -91,6 +91,26 @@ pub struct CommonArgs {
     seed: u32,
 }
 
+/// The step of `sim step` and `sim family --rig-file`: from a speed (or rest) to a target.
+#[derive(clap::Args)]
+pub struct StepSpeeds {
+    /// Step target, rad/s.
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+    target_rad_s: f32,
+    /// Both axes first settle at this speed, then step to --target-rad-s (0 = from rest), rad/s.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    from_rad_s: f32,
+}
+
+impl StepSpeeds {
+    /// `(from, target)`, each judged in words.
+    fn checked(&self) -> Result<(f32, f32)> {
+        check_speed(self.target_rad_s, "--target-rad-s")?;
+        check_from(self.from_rad_s, self.target_rad_s)?;
+        Ok((self.from_rad_s, self.target_rad_s))
+    }
+}
+
 #[derive(clap::Args)]
 pub struct StepArgs {
     #[command(flatten)]
@@ -99,12 +119,8 @@ pub struct StepArgs {
     /// the pulses).
     #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u16).range(1..))]
     pulses_per_rev: u16,
-    /// Step target, rad/s.
-    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
-    target_rad_s: f32,
-    /// Both axes first run at this speed, then step to --target-rad-s (0 = from rest), rad/s.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    from_rad_s: f32,
+    #[command(flatten)]
+    step: StepSpeeds,
     /// JSON output (the only format; accepted for symmetry with the other reports).
     #[arg(long)]
     json: bool,
@@ -145,13 +161,9 @@ pub struct FamilyArgs {
     /// Run the plants of this rig or family file instead of the built-in family.
     #[arg(long)]
     rig_file: Option<std::path::PathBuf>,
-    /// Step target with --rig-file, rad/s.
-    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
-    target_rad_s: f32,
-    /// With --rig-file: both axes first settle at this speed, then step to --target-rad-s
-    /// (0 = from rest), rad/s.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    from_rad_s: f32,
+    /// With --rig-file: the step.
+    #[command(flatten)]
+    step: StepSpeeds,
     /// JSON output (the only format; accepted for symmetry).
     #[arg(long)]
     json: bool,
@@ -176,8 +188,7 @@ pub struct StabilityArgs {
 pub fn run(what: &What) -> Result<()> {
     match what {
         What::Step(a) if a.rig_file.is_some() => {
-            check_speed(a.target_rad_s, "--target-rad-s")?;
-            check_from(a.from_rad_s, a.target_rad_s)?;
+            let (from, target) = a.step.checked()?;
             let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
             let rigs = rig_file::load(path)?;
             if rigs.len() != 1 {
@@ -193,41 +204,36 @@ pub fn run(what: &What) -> Result<()> {
                 rig.params.axes[0].load_step_nm,
                 rig.params.axes[1].load_step_nm,
             ];
-            let out = StepJson {
-                scenario: "rig file, both axes from --from-rad-s (0 = rest) to the target, commissioned first, true speed",
-                pulses_per_rev: rig.params.axes[1].sensor.pulses_per_rev,
-                from_rad_s: a.from_rad_s,
-                target_rad_s: a.target_rad_s,
-                feedback: !a.no_feedback,
-                outcome: step_run_with(
-                    rig.params,
-                    cfg,
-                    rig.seed,
-                    a.from_rad_s,
-                    a.target_rad_s,
-                    !a.no_feedback,
-                    load,
-                ),
-            };
-            println!("{}", serde_json::to_string_pretty(&out)?);
-            check_step(&out.outcome)?;
+            let outcome = step_run_with(
+                rig.params,
+                cfg,
+                rig.seed,
+                from,
+                target,
+                !a.no_feedback,
+                load,
+            );
+            print_step(
+                "rig file, both axes from --from-rad-s (0 = rest) to the target, commissioned first, true speed",
+                rig.params.axes[1].sensor.pulses_per_rev,
+                (from, target),
+                !a.no_feedback,
+                outcome,
+            )?;
         }
         What::Family(a) if a.rig_file.is_some() => {
             let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
-            check_speed(a.target_rad_s, "--target-rad-s")?;
-            check_from(a.from_rad_s, a.target_rad_s)?;
+            let (from, target) = a.step.checked()?;
             let rigs = rig_file::load(path)?;
-            check_lowest(&rigs, a.target_rad_s, "--target-rad-s")?;
-            if a.from_rad_s > 0.0 {
-                check_lowest(&rigs, a.from_rad_s, "--from-rad-s")?;
+            check_lowest(&rigs, target, "--target-rad-s")?;
+            if from > 0.0 {
+                check_lowest(&rigs, from, "--from-rad-s")?;
             }
-            let plants = parallel(&rigs, |r| {
-                sim_reports::family_plant(r, a.from_rad_s, a.target_rad_s)
-            });
+            let plants = parallel(&rigs, |r| sim_reports::family_plant(r, from, target));
             let summary = sim_reports::summary(&plants);
             let out = serde_json::json!({
-                "from_rad_s": a.from_rad_s,
-                "target_rad_s": a.target_rad_s,
+                "from_rad_s": from,
+                "target_rad_s": target,
                 "plants": plants,
                 "summary": summary,
             });
@@ -243,8 +249,7 @@ pub fn run(what: &What) -> Result<()> {
         }
         What::MakeFamily(a) => print!("{}", family_file::family_toml(a.seed, a.plants)),
         What::Step(a) => {
-            check_speed(a.target_rad_s, "--target-rad-s")?;
-            check_from(a.from_rad_s, a.target_rad_s)?;
+            let (from, target) = a.step.checked()?;
             let mut rig = rig_with_pulses(a.pulses_per_rev);
             if let Some(r) = a.ripple_nm {
                 for ax in &mut rig.axes {
@@ -263,24 +268,15 @@ pub fn run(what: &What) -> Result<()> {
                     ax.accel_limit_rad_s2 = acc;
                 }
             }
-            let out = StepJson {
-                scenario: "nominal rig, both axes from --from-rad-s (0 = rest) to the target, commissioned first, true speed",
-                pulses_per_rev: a.pulses_per_rev,
-                from_rad_s: a.from_rad_s,
-                target_rad_s: a.target_rad_s,
-                feedback: !a.no_feedback,
-                outcome: step_run_with(
-                    rig,
-                    cfg,
-                    a.common.seed,
-                    a.from_rad_s,
-                    a.target_rad_s,
-                    !a.no_feedback,
-                    [0.0; 2],
-                ),
-            };
-            println!("{}", serde_json::to_string_pretty(&out)?);
-            check_step(&out.outcome)?;
+            let feedback = !a.no_feedback;
+            let outcome = step_run_with(rig, cfg, a.common.seed, from, target, feedback, [0.0; 2]);
+            print_step(
+                "nominal rig, both axes from --from-rad-s (0 = rest) to the target, commissioned first, true speed",
+                a.pulses_per_rev,
+                (from, target),
+                feedback,
+                outcome,
+            )?;
         }
         What::Family(a) => {
             if a.plants < 50 && !a.allow_small {
@@ -320,6 +316,26 @@ pub fn run(what: &What) -> Result<()> {
 }
 
 /// A step run that faulted or was never commissioned has no step figures: say so, fail.
+/// Prints a step's report as JSON, then fails if it is no step response.
+fn print_step(
+    scenario: &'static str,
+    pulses_per_rev: u16,
+    (from_rad_s, target_rad_s): (f32, f32),
+    feedback: bool,
+    outcome: StepOutcome,
+) -> Result<()> {
+    let out = StepJson {
+        scenario,
+        pulses_per_rev,
+        from_rad_s,
+        target_rad_s,
+        feedback,
+        outcome,
+    };
+    println!("{}", serde_json::to_string_pretty(&out)?);
+    check_step(&out.outcome)
+}
+
 fn check_step(o: &StepOutcome) -> Result<()> {
     if !o.commissioned {
         bail!(

@@ -7,7 +7,10 @@ use model_core::ode::system::SystemLimits;
 use model_core::particle::bowl::{self, BowlOutcome, BowlShape};
 use model_core::particle::rolling::{self, AZIMUTHS_DEG, MAX_STEPS, RollingMethod, RollingScene};
 
-use super::plot::{Figure, Mark, Scale, Series};
+/// The scene both bowl charts draw, said under their legends.
+const SCENE_NOTE: &str = "75 mm bottom, ri = R/2, mu_r 0.029, mu_s 0.4";
+
+use super::plot::{Figure, Mark, Series};
 use super::table::Table;
 
 const METHOD: RollingMethod<f64> = RollingMethod::Dp54 { rtol: 1e-9 };
@@ -100,23 +103,20 @@ pub fn residence(tilt_deg: f64) -> Result<(Figure, Table)> {
             color: i + 1,
         });
     }
-    let fig = Figure {
-        title: format!(
+    let fig = Figure::linear(
+        format!(
             "Residence time against bowl speed in the real bowl, axis tilted {tilt_deg} deg (cf. paper Fig. 7)"
         ),
-        x_label: "combined bowl speed |w1 e_z + w2 n|, rad/s (w1 = w2)".into(),
-        y_label: "mean residence time over 12 releases, s".into(),
-        x_scale: Scale::Linear,
-        y_scale: Scale::Linear,
+        "combined bowl speed |w1 e_z + w2 n|, rad/s (w1 = w2)",
+        "mean residence time over 12 releases, s",
         series,
-        vlines: vec![],
-        notes: vec![
-            "75 mm bottom, ri = R/2, mu_r 0.029, mu_s 0.4".into(),
-            "granule 3 mm; sharp corners, e 0.5".into(),
-            "gap: not all 12 releases leave in 3 s".into(),
-            "(the vertical wall holds every one)".into(),
+        &[
+            SCENE_NOTE,
+            "granule 3 mm; sharp corners, e 0.5",
+            "gap: not all 12 releases leave in 3 s",
+            "(the vertical wall holds every one)",
         ],
-    };
+    );
     Ok((fig, table))
 }
 
@@ -182,19 +182,16 @@ pub fn regimes(omega_rad_s: f64) -> Result<(Figure, Table)> {
             color: i + 1,
         });
     }
-    let fig = Figure {
-        title: format!("Regimes against the tilt at {omega_rad_s} rad/s (w1 = w2)"),
-        x_label: "angle between the vertical and the bowl's axis (paper Eq. 2), deg".into(),
-        y_label: "share".into(),
-        x_scale: Scale::Linear,
-        y_scale: Scale::Linear,
+    let fig = Figure::linear(
+        format!("Regimes against the tilt at {omega_rad_s} rad/s (w1 = w2)"),
+        "angle between the vertical and the bowl's axis (paper Eq. 2), deg",
+        "share",
         series,
-        vlines: vec![],
-        notes: vec![
-            "75 mm bottom, ri = R/2, mu_r 0.029, mu_s 0.4".into(),
-            "not sliding: rolling, or held in".into(),
-            "a corner; not leaving in 3 s: held".into(),
+        &[
+            SCENE_NOTE,
+            "not sliding: rolling, or held in",
+            "a corner; not leaving in 3 s: held",
         ],
-    };
+    );
     Ok((fig, table))
 }

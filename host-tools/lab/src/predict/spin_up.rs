@@ -56,21 +56,14 @@ pub fn run(
     };
     let top = start_rad_s.max(scene.omega_rad_s);
     let validity = super::validity::paper_up_to(scene, choice.model, top, sliding_mu);
-    if json {
-        let mut v = serde_json::json!({
-            "spin_up": {
-                "start_rad_s": start_rad_s, "final_rad_s": scene.omega_rad_s,
-                "time_constant_s": time_constant_s,
-            },
-            "choice": super::choice::json(&choice, runs_on),
-            "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
-        });
-        validity.add_to(&mut v);
-        println!("{v}");
-    } else {
-        if let Some(line) = validity.text_line() {
-            println!("{line}");
-        }
+    let head = serde_json::json!({
+        "spin_up": {
+            "start_rad_s": start_rad_s, "final_rad_s": scene.omega_rad_s,
+            "time_constant_s": time_constant_s,
+        },
+    });
+    let choice_json = super::choice::json(&choice, runs_on);
+    if validity.start_answer(json, head, choice_json, time_s) {
         println!(
             "spin-up: from {start_rad_s} to {} rad/s with time constant {time_constant_s} s, \
              the particle released at t = 0; mu {}, ri {} m, R {} m",

@@ -182,31 +182,24 @@ pub fn run(
         f64::INFINITY
     };
     let validity = super::validity::paper_up_to(scene, choice.model, hi, sliding_mu);
-    if json {
-        let mut v = serde_json::json!({
-            "trace": {
-                "file": path.display().to_string(), "samples": trace.times_s.len(),
-                "release_device_ms": trace.release_ms, "covers_s": covered_s,
-                "omega_min_rad_s": lo, "omega_max_rad_s": hi,
-                "measurement": {
-                    "rounding_rad_s": measured.rounding_rad_s,
-                    "scatter_rad_s": measured.scatter_rad_s,
-                    "mean_rad_s": measured.mean_rad_s,
-                    "relative": measured.relative,
-                    "used_as_omega_uncertainty": measured_is_used,
-                    "judged_over_s": window_s.min(covered_s),
-                },
+    let head = serde_json::json!({
+        "trace": {
+            "file": path.display().to_string(), "samples": trace.times_s.len(),
+            "release_device_ms": trace.release_ms, "covers_s": covered_s,
+            "omega_min_rad_s": lo, "omega_max_rad_s": hi,
+            "measurement": {
+                "rounding_rad_s": measured.rounding_rad_s,
+                "scatter_rad_s": measured.scatter_rad_s,
+                "mean_rad_s": measured.mean_rad_s,
+                "relative": measured.relative,
+                "used_as_omega_uncertainty": measured_is_used,
+                "judged_over_s": window_s.min(covered_s),
             },
-            "choice": super::choice::json(&choice, runs_on),
-            "residence_time_s": if time_s.is_finite() { serde_json::json!(time_s) } else { serde_json::Value::Null },
-            "residence_time_from_choosing": answered.is_some(),
-        });
-        validity.add_to(&mut v);
-        println!("{v}");
-    } else {
-        if let Some(line) = validity.text_line() {
-            println!("{line}");
-        }
+        },
+        "residence_time_from_choosing": answered.is_some(),
+    });
+    let choice_json = super::choice::json(&choice, runs_on);
+    if validity.start_answer(json, head, choice_json, time_s) {
         println!(
             "trace: {}, {} samples from device time {} ms over {covered_s:.3} s, bowl speed \
              {lo:.3} to {hi:.3} rad/s (held at the last sample after that)",

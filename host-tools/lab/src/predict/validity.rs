@@ -27,6 +27,31 @@ impl Validity {
     pub fn text_line(&self) -> Option<String> {
         self.0.as_ref().map(|r| format!("NOT VALID HERE: {r}"))
     }
+
+    /// The start of an answer at a varying speed (a spin-up, a logged trace): with `json`, `v`
+    /// with the chooser's `choice` (the JSON of `super::choice::json`), the residence time
+    /// (null when the granule never leaves) and this validity, printed, and `false`; in text,
+    /// this validity's line first, and `true`: the caller's text follows.
+    pub fn start_answer(&self, json: bool, mut v: Value, choice: Value, time_s: f64) -> bool {
+        if !json {
+            if let Some(line) = self.text_line() {
+                println!("{line}");
+            }
+            return true;
+        }
+        if let Some(obj) = v.as_object_mut() {
+            obj.insert("choice".into(), choice);
+            let time = if time_s.is_finite() {
+                json!(time_s)
+            } else {
+                Value::Null
+            };
+            obj.insert("residence_time_s".into(), time);
+        }
+        self.add_to(&mut v);
+        println!("{v}");
+        false
+    }
 }
 
 /// The rolling model over releases: it assumes the granule rolls (friction within `mu_s N`)

@@ -94,6 +94,28 @@ pub struct Figure {
     pub notes: Vec<String>,
 }
 
+impl Figure {
+    /// A figure on linear axes with no marker lines, its notes under the legend.
+    pub fn linear(
+        title: String,
+        x_label: &str,
+        y_label: &str,
+        series: Vec<Series>,
+        notes: &[&str],
+    ) -> Self {
+        Figure {
+            title,
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            x_scale: Scale::Linear,
+            y_scale: Scale::Linear,
+            series,
+            vlines: vec![],
+            notes: notes.iter().map(|n| (*n).to_string()).collect(),
+        }
+    }
+}
+
 /// Why a chart could not be drawn.
 #[derive(Debug)]
 pub enum PlotError {
