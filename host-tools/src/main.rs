@@ -5,33 +5,11 @@ use std::process::ExitCode;
 use anyhow::Result;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
-mod chart;
-mod command_words;
-mod commission;
+mod cmd;
 #[cfg(unix)]
 mod demo;
 mod exit_code;
-mod experiment;
-mod family_file;
-mod fit;
-mod kinematics;
-mod link;
 mod monitor;
-mod predict;
-mod refusal;
-mod relay;
-mod replay;
-mod send;
-mod serial;
-mod serve;
-mod sim;
-mod sim_reports;
-mod sim_world;
-mod simulated_backend;
-mod telemetry_csv;
-mod unreadable;
-mod virtual_rig;
-mod words;
 
 /// The PC side of the bowl granulation rig.
 #[derive(Parser)]
@@ -44,36 +22,36 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Combined bowl speed from the two motor speeds (paper Eq. 2), or the split of a target speed.
-    Kinematics(kinematics::Args),
+    Kinematics(cmd::kinematics::Args),
     /// Charts: work-precision (error against cost), and the paper's Figures 5-7 redrawn.
-    Chart(chart::Args),
+    Chart(cmd::chart::Args),
     /// Residence time and exit velocities of a particle (paper Eq. 5-12, corrected), or a batch CSV.
-    Predict(Box<predict::Args>),
+    Predict(Box<lab::predict::Args>),
     /// Live view of the rig's telemetry, with CSV log and frame counters.
     Monitor(monitor::Args),
     /// The serial ports on this computer, with their USB descriptions.
     Ports,
     /// Send one command to the rig and print its answer.
-    Send(send::Args),
+    Send(cmd::send::Args),
     /// Run the motor identification on the rig; print the identified models and gains.
-    Commission(commission::Args),
+    Commission(cmd::commission::Args),
     /// Decode a raw capture of the rig's output; print statistics as JSON.
-    Replay(replay::Args),
+    Replay(cmd::replay::Args),
     /// A virtual rig (no hardware): serve it on a pseudo-terminal (--pty) or write its bytes to a
     /// file (--capture).
-    Serve(serve::Args),
+    Serve(cmd::serve::Args),
     /// Reports on the controller against the simulated plant (step, family, commission, sweep,
     /// stability, trace).
     #[command(subcommand)]
-    Sim(sim::What),
+    Sim(cmd::sim::What),
     #[cfg(unix)]
     /// The rig without hardware: a simulated rig, a scripted session, the live view, a summary.
     Demo(demo::Args),
     /// Run a plan of particle releases on a simulated rig and record residence times, or
     /// suggest a plan (--suggest).
-    Experiment(experiment::Args),
+    Experiment(cmd::experiment::Args),
     /// Fit the rolling resistance of each particle model to measured residence times.
-    Fit(fit::Args),
+    Fit(cmd::fit::Args),
 }
 
 fn main() -> ExitCode {
@@ -98,7 +76,7 @@ fn main() -> ExitCode {
         Err(e) if exit_code::is_closed_output(&e) => exit_code::OK,
         Err(e) => {
             eprintln!("error: {e:#}");
-            if e.chain().any(|c| c.is::<serial::LinkError>()) {
+            if e.chain().any(|c| c.is::<rig_client::serial::LinkError>()) {
                 exit_code::LINK
             } else {
                 exit_code::REFUSED
@@ -139,19 +117,19 @@ fn restore_default_sigpipe() {
 fn run(cli: Cli) -> Result<i32> {
     let done = |r: Result<()>| r.map(|()| exit_code::OK);
     match cli.command {
-        Command::Kinematics(args) => done(kinematics::run(&args)),
-        Command::Chart(args) => done(chart::run(&args)),
-        Command::Predict(args) => done(predict::run(&args)),
+        Command::Kinematics(args) => done(cmd::kinematics::run(&args)),
+        Command::Chart(args) => done(cmd::chart::run(&args)),
+        Command::Predict(args) => done(lab::predict::run(&args)),
         Command::Monitor(args) => done(monitor::run(&args)),
-        Command::Ports => done(serial::run_ports()),
-        Command::Send(args) => send::run(&args),
-        Command::Commission(args) => commission::run(&args),
-        Command::Replay(args) => done(replay::run(&args)),
+        Command::Ports => done(cmd::ports::run()),
+        Command::Send(args) => cmd::send::run(&args),
+        Command::Commission(args) => cmd::commission::run(&args),
+        Command::Replay(args) => done(cmd::replay::run(&args)),
         #[cfg(unix)]
         Command::Demo(args) => done(demo::run(&args)),
-        Command::Serve(args) => done(serve::run(&args)),
-        Command::Sim(report) => done(sim::run(&report)),
-        Command::Experiment(args) => done(experiment::run(&args)),
-        Command::Fit(args) => done(fit::run(&args)),
+        Command::Serve(args) => done(cmd::serve::run(&args)),
+        Command::Sim(report) => done(cmd::sim::run(&report)),
+        Command::Experiment(args) => done(cmd::experiment::run(&args)),
+        Command::Fit(args) => done(cmd::fit::run(&args)),
     }
 }

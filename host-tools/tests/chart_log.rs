@@ -2,29 +2,14 @@
 
 mod common;
 
-use common::{Sim, bowl, stdout, temp_dir};
+use common::{bowl, monitor_logged, sim_timed, stdout, temp_dir};
 
 #[test]
 fn a_monitor_log_is_drawn_with_its_link_events() {
-    let sim = Sim::start(&[
-        "--seconds",
-        "10",
-        "--command",
-        "0:speed,1800,2100",
-        "--command",
-        "0:start",
-    ]);
+    let sim = sim_timed("10", &["0:speed,1800,2100", "0:start"]);
     let dir = temp_dir("chart-log");
     let log = dir.join("run.csv");
-    let mon = bowl(&[
-        "monitor",
-        &sim.path,
-        "--seconds",
-        "2",
-        "--plain",
-        "--log",
-        log.to_str().unwrap(),
-    ]);
+    let mon = monitor_logged(&sim.path, "2", &log);
     assert_eq!(mon.status.code(), Some(0), "{}", stdout(&mon));
     let out = dir.join("run.svg");
     let drawn = bowl(&[

@@ -335,3 +335,34 @@ fn a_second_monitor_is_told_the_port_is_held() {
     let _ = first.kill();
     let _ = first.wait();
 }
+
+/// A program that opened the port before us without locking it (here: this test, holding the
+/// pty open as `cat` or a script would) steals bytes at random: the monitor and `bowl send` name
+/// it. The virtual rig itself (holding the pty's master side) is not taken for one.
+#[test]
+fn a_reader_that_does_not_lock_the_port_is_named() {
+    let sim = Sim::start(&[]);
+    let alone = bowl(&["monitor", &sim.path, "--plain", "--seconds", "1"]);
+    let text = stdout(&alone);
+    assert!(alone.status.success(), "{text}");
+    assert!(!text.contains("also open in"), "no one else reads: {text}");
+
+    let _reader = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(&sim.path)
+        .expect("the pty opens");
+    let me = format!("pid {}", std::process::id());
+    let watched = bowl(&["monitor", &sim.path, "--plain", "--seconds", "1"]);
+    let text = stdout(&watched);
+    assert!(
+        text.contains("also open in") && text.contains(&me) && text.contains("does not lock it"),
+        "the monitor names the other reader ({me}): {text}"
+    );
+    let sent = bowl(&["send", &sim.path, "--timeout-ms", "3000", "ping"]);
+    let err = String::from_utf8_lossy(&sent.stderr);
+    assert!(
+        err.contains("also open in") && err.contains(&me),
+        "send names the other reader ({me}): {err}"
+    );
+}

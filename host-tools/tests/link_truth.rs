@@ -9,7 +9,7 @@ use std::io::{Read, Write};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use common::{Sim, bowl, csv_rows, stdout, temp_dir};
+use common::{Sim, bowl, capture_timed, csv_rows, replay_to_csv, stdout, temp_dir};
 use model_core::wire::crc::crc32;
 use model_core::wire::{Decoder, DeviceState, Frame};
 
@@ -173,30 +173,11 @@ fn a_command_ended_by_cr_is_answered_and_every_frame_ends_in_crlf() {
 /// 20 frames/s (before the fix not one frame came in the next 30 s).
 #[test]
 fn telemetry_goes_on_at_the_new_rate_after_set_telem_hz() {
-    let dir = temp_dir("telem-hz");
-    let capture = dir.join("cap.bin");
-    let csv = dir.join("run.csv");
-    let made = bowl(&[
-        "serve",
-        "--capture",
-        capture.to_str().unwrap(),
-        "--seconds",
+    let csv = captured_csv(
+        "telem-hz",
         "40",
-        "--command",
-        "0:speed,1500,1500",
-        "--command",
-        "0:start",
-        "--command",
-        "30000:set,TELEM_HZ,20",
-    ]);
-    assert!(made.status.success(), "{}", stdout(&made));
-    let replay = bowl(&[
-        "replay",
-        capture.to_str().unwrap(),
-        "--csv",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(replay.status.success(), "{}", stdout(&replay));
+        &["0:speed,1500,1500", "0:start", "30000:set,TELEM_HZ,20"],
+    );
     let times: Vec<u64> = csv_rows(&csv)
         .iter()
         .filter_map(|r| r.get("device_time_ms")?.parse().ok())
@@ -280,4 +261,68 @@ fn the_monitor_says_what_it_cannot_read() {
         1,
         "said once: {text}"
     );
+}
+
+/// A capture with the telemetry paused (`SET TELEM_HZ 0` for 3 s): `replay --csv` marks the gap
+/// with the monitor's own words at the device times it began and ended, and `bowl chart log`
+/// breaks its lines there (no line drawn across data the rig never sent).
+#[test]
+fn replay_marks_a_gap_in_the_telemetry_as_the_monitor_does() {
+    let csv = captured_csv(
+        "replay-gap",
+        "8",
+        &[
+            "0:speed,1500,1500",
+            "2000:set,TELEM_HZ,0",
+            "5000:set,TELEM_HZ,50",
+        ],
+    );
+    let dir = csv.parent().unwrap().to_path_buf();
+    let rows = csv_rows(&csv);
+    let events: Vec<(u64, &str)> = rows
+        .iter()
+        .filter(|r| !r["event"].is_empty())
+        .map(|r| (r["device_time_ms"].parse().unwrap(), r["event"].as_str()))
+        .collect();
+    assert_eq!(events.len(), 2, "{events:?}");
+    let (began, ended) = (events[0], events[1]);
+    assert_eq!(began.1, "no telemetry", "{events:?}");
+    assert!((2000..=2060).contains(&began.0), "{events:?}");
+    assert!(
+        ended.1.starts_with("telemetry again after 3.0 s"),
+        "{events:?}"
+    );
+    assert!((5000..=5040).contains(&ended.0), "{events:?}");
+    // Telemetry rows lie outside the gap only.
+    let inside = rows
+        .iter()
+        .filter(|r| r["event"].is_empty())
+        .filter_map(|r| r["device_time_ms"].parse::<u64>().ok())
+        .filter(|t| (began.0 + 1..ended.0).contains(t))
+        .count();
+    assert_eq!(inside, 0);
+    let chart = bowl(&[
+        "chart",
+        "log",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--out",
+        dir.join("run.svg").to_str().unwrap(),
+    ]);
+    assert!(chart.status.success(), "{}", stdout(&chart));
+    let svg = std::fs::read_to_string(dir.join("run-spin.svg")).unwrap();
+    assert!(
+        svg.contains("no telemetry"),
+        "the gap is marked on the chart"
+    );
+}
+
+/// A capture of `seconds` with the timed `commands`, replayed to CSV: the CSV's path (in a
+/// scratch directory named `name`).
+fn captured_csv(name: &str, seconds: &str, commands: &[&str]) -> std::path::PathBuf {
+    let dir = temp_dir(name);
+    let csv = dir.join("run.csv");
+    let replay = replay_to_csv(&capture_timed(&dir, seconds, commands), &csv);
+    assert!(replay.status.success(), "{}", stdout(&replay));
+    csv
 }

@@ -26,6 +26,8 @@ fn state_refusal_says_the_state_and_what_to_do() {
         text.contains("the rig is idle: there is no fault to clear"),
         "{text}"
     );
+    // The states the command table allows it in.
+    assert!(text.contains("(`clear` is taken while faulted)"), "{text}");
 }
 
 #[test]

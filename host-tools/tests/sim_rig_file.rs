@@ -162,17 +162,7 @@ fn step_runs_on_a_rig_file() {
 /// inference asked the plant model), and the JSON carries the transition's fields.
 #[test]
 fn the_small_family_slows_down_without_fault() {
-    let v = json(&[
-        "sim",
-        "family",
-        "--rig-file",
-        SMALL,
-        "--from-rad-s",
-        "3",
-        "--target-rad-s",
-        "1",
-        "--json",
-    ]);
+    let v = small_family_step("3", "1");
     assert_eq!(v["from_rad_s"], 3.0, "{v}");
     assert_eq!(v["target_rad_s"], 1.0, "{v}");
     for p in v["plants"].as_array().unwrap() {
@@ -205,16 +195,7 @@ fn a_transition_from_an_impossible_speed_is_refused_in_words() {
         ("99", "--from-rad-s 99 is outside 0 to"),
         ("3", "equals --target-rad-s"),
     ] {
-        let out = bowl(&[
-            "sim",
-            "family",
-            "--rig-file",
-            SMALL,
-            "--from-rad-s",
-            from,
-            "--target-rad-s",
-            "3",
-        ]);
+        let out = small_family_run(from, "3", &[]);
         assert!(!out.status.success(), "{from}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(want), "{from}: {err}");
@@ -253,17 +234,7 @@ fn a_saturated_axis_at_the_top_speed_is_no_runaway() {
 /// every axis within 5 % by 10 s, the low-speed target.
 #[test]
 fn the_small_family_slows_to_half_a_rad_s_without_fault() {
-    let v = json(&[
-        "sim",
-        "family",
-        "--rig-file",
-        SMALL,
-        "--from-rad-s",
-        "3",
-        "--target-rad-s",
-        "0.5",
-        "--json",
-    ]);
+    let v = small_family_step("3", "0.5");
     for p in v["plants"].as_array().unwrap() {
         assert_eq!(p["false_fault"], false, "{p}");
         for axis in ["precession", "spin"] {
@@ -272,4 +243,31 @@ fn the_small_family_slows_to_half_a_rad_s_without_fault() {
             assert!(s5 <= 10.0, "{} {axis}: {a}", p["name"]);
         }
     }
+}
+
+/// `bowl sim family --rig-file SMALL --from-rad-s FROM --target-rad-s TO EXTRA...`.
+fn small_family_run(from: &str, to: &str, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "sim",
+        "family",
+        "--rig-file",
+        SMALL,
+        "--from-rad-s",
+        from,
+        "--target-rad-s",
+        to,
+    ];
+    args.extend_from_slice(extra);
+    bowl(&args)
+}
+
+/// [`small_family_run`] with `--json`, which must succeed: its report.
+fn small_family_step(from: &str, to: &str) -> serde_json::Value {
+    let out = small_family_run(from, to, &["--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid JSON")
 }

@@ -4,11 +4,14 @@
 mod common;
 
 use std::io::Read;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::path::Path;
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{BOWL, Sim, bowl, last_json, open_pty, spawn_on_terminal, stdout, temp_dir};
+use common::{
+    BOWL, Sim, bowl, capture_timed, last_json, monitor_logged, open_pty, replay_to_csv,
+    sim_capture, spawn_on_terminal, stdout, temp_dir,
+};
 
 /// Telemetry rows of a CSV as (boot, device_time_ms); link-event rows (no device time) left out.
 fn csv_keys(path: &Path) -> Vec<(u64, u64)> {
@@ -37,26 +40,6 @@ fn csv_events(path: &Path) -> Vec<String> {
 }
 
 /// Runs `bowl serve --capture DIR/cap.bin ARGS...` (the virtual rig writing its bytes to a file)
-/// and returns the capture's path.
-fn sim_capture(dir: &Path, args: &[&str]) -> PathBuf {
-    let capture = dir.join("cap.bin");
-    let mut all = vec!["serve", "--capture", capture.to_str().unwrap()];
-    all.extend_from_slice(args);
-    let made = bowl(&all);
-    assert!(made.status.success(), "{}", stdout(&made));
-    capture
-}
-
-/// `bowl replay CAPTURE --csv CSV`.
-fn replay_to_csv(capture: &Path, csv: &Path) -> Output {
-    bowl(&[
-        "replay",
-        capture.to_str().unwrap(),
-        "--csv",
-        csv.to_str().unwrap(),
-    ])
-}
-
 /// The cells of a telemetry CSV's data rows (header skipped).
 fn csv_cells(text: &str) -> Vec<Vec<&str>> {
     text.lines()
@@ -94,15 +77,7 @@ fn send_and_monitor_against_the_virtual_rig() {
 
     let dir = temp_dir("monitor");
     let log = dir.join("log.csv");
-    let mon = bowl(&[
-        "monitor",
-        p,
-        "--seconds",
-        "2",
-        "--plain",
-        "--log",
-        log.to_str().unwrap(),
-    ]);
+    let mon = monitor_logged(p, "2", &log);
     assert_eq!(mon.status.code(), Some(0), "{}", stdout(&mon));
     let summary = last_json(&mon);
     let ok = summary["frames_ok"].as_u64().unwrap();
@@ -259,17 +234,7 @@ fn pty_sends_exactly_the_bytes_of_the_capture() {
 #[test]
 fn replay_counts_what_the_capture_holds_and_what_damage_removed() {
     let dir = temp_dir("replay");
-    let capture = sim_capture(
-        &dir,
-        &[
-            "--seconds",
-            "5",
-            "--command",
-            "0:speed,1800,2100",
-            "--command",
-            "0:start",
-        ],
-    );
+    let capture = capture_timed(&dir, "5", &["0:speed,1800,2100", "0:start"]);
     let csv = dir.join("t.csv");
     let clean = replay_to_csv(&capture, &csv);
     assert!(clean.status.success());
@@ -310,18 +275,13 @@ fn replay_counts_what_the_capture_holds_and_what_damage_removed() {
 #[test]
 fn an_injected_sensor_fault_stops_both_motors_and_is_reported() {
     let dir = temp_dir("fault");
-    let capture = sim_capture(
+    let capture = capture_timed(
         &dir,
+        "8",
         &[
-            "--seconds",
-            "8",
-            "--command",
             "0:speed,1800,2100",
-            "--command",
             "0:start",
-            "--command",
             "4000:inject,sensor2",
-            "--command",
             "7000:start",
         ],
     );
@@ -376,19 +336,11 @@ fn monitor_on_a_screen_without_a_keyboard_prints_lines() {
 #[test]
 fn a_residence_time_target_is_reached_in_closed_loop() {
     let dir = temp_dir("rtime");
-    let capture = sim_capture(
+    // The last target is unreachable: it would need a bowl speed above the motors' limit.
+    let capture = capture_timed(
         &dir,
-        &[
-            "--seconds",
-            "12",
-            "--command",
-            "0:rtime,cori,700",
-            "--command",
-            "0:start",
-            // Unreachable: would need a bowl speed above the motors' limit.
-            "--command",
-            "100:rtime,cori,20",
-        ],
+        "12",
+        &["0:rtime,cori,700", "0:start", "100:rtime,cori,20"],
     );
     let raw = String::from_utf8_lossy(&std::fs::read(&capture).unwrap()).into_owned();
     assert!(
@@ -418,15 +370,7 @@ fn monitor_counts_what_a_noisy_line_destroys() {
     let sim = Sim::start(&["--seconds", "10", "--line-noise-percent", "1"]);
     let dir = temp_dir("noisy");
     let log = dir.join("log.csv");
-    let mon = bowl(&[
-        "monitor",
-        &sim.path,
-        "--seconds",
-        "3",
-        "--plain",
-        "--log",
-        log.to_str().unwrap(),
-    ]);
+    let mon = monitor_logged(&sim.path, "3", &log);
     assert_eq!(mon.status.code(), Some(0));
     let s = last_json(&mon);
     let ok = s["frames_ok"].as_u64().unwrap();
@@ -503,19 +447,7 @@ fn a_silent_host_faults_a_running_rig_by_default() {
 #[test]
 fn gate_events_are_logged_on_the_device_clock() {
     let dir = temp_dir("gates");
-    let capture = sim_capture(
-        &dir,
-        &[
-            "--seconds",
-            "8",
-            "--command",
-            "0:speed,1800,2100",
-            "--command",
-            "0:start",
-            "--command",
-            "5000:release",
-        ],
-    );
+    let capture = capture_timed(&dir, "8", &["0:speed,1800,2100", "0:start", "5000:release"]);
     let csv = dir.join("t.csv");
     assert!(replay_to_csv(&capture, &csv).status.success());
     let text = std::fs::read_to_string(&csv).unwrap();

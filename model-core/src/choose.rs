@@ -30,8 +30,8 @@
 //!    Euler are not candidates (order 1, more expensive per evaluation on both cost tables).
 
 use crate::Real;
-use crate::ode::{self, Limits, Method, OdeError, OdeOutcome, OmegaProfile};
-use crate::particle::{self, Model, Outcome, Scene, SceneError};
+use crate::ode::{Limits, Method, OdeOutcome, OmegaProfile};
+use crate::particle::{self, Model, OdeError, Outcome, Scene, SceneError};
 use spread::{perturbations, spread};
 
 /// How well the scene's parameters are known.
@@ -66,7 +66,7 @@ pub enum Plan<T> {
         /// The mean bowl speed over `[0, T]`, rad/s.
         omega_rad_s: T,
     },
-    /// [`ode::integrate`] with this method.
+    /// [`particle::integrate`] with this method.
     Integrate(Method<T>),
 }
 
@@ -285,7 +285,7 @@ fn run<T: Real, P: OmegaProfile<T>>(
     method: Method<T>,
     limits: Limits<T>,
 ) -> Result<(T, u32), ChooseError> {
-    let r = ode::integrate(s, m, p, method, limits).map_err(ChooseError::Ode)?;
+    let r = particle::integrate(s, m, p, method, limits).map_err(ChooseError::Ode)?;
     let t = match r.outcome {
         OdeOutcome::Leaves {
             residence_time_s, ..

@@ -5,7 +5,7 @@ use model_core::control::estimator::WindowEvents;
 use model_core::control::pi::{LoopConstants, LoopInput, SpeedLoop};
 use model_core::control::{AxisConfig, ControllerConfig, State};
 use model_core::sim::experiments::{
-    commissioned_step, family_step, low_speed_hold, rig_with_pulses, true_model_config,
+    commissioned_step, family_step, low_speed_hold_at_rate, rig_with_pulses, true_model_config,
 };
 use model_core::sim::{ClosedLoop, Plant, PlantParams, StepMetrics};
 
@@ -74,7 +74,7 @@ fn family_passes_with_feedback_and_fails_with_feedforward_alone() {
 
 #[test]
 fn no_limit_cycle_above_5_percent_at_half_a_rad_per_second_with_12_pulses() {
-    let (r, fault) = low_speed_hold(5, 12, 0.5, 0.5, true, 20.0, 20.0);
+    let (r, fault) = low_speed_hold_at_rate(1000, 5, 12, 0.5, 0.5, true, 20.0, 20.0);
     assert!(fault.is_none());
     assert!(r.half_peak_to_peak <= 0.05, "{r:?}");
     assert!(r.steady_state_error <= 0.02, "{r:?}");
@@ -84,8 +84,8 @@ fn no_limit_cycle_above_5_percent_at_half_a_rad_per_second_with_12_pulses() {
 fn without_the_pulse_rate_schedule_the_same_gain_cycles_at_low_speed() {
     // The loop gain that is right at 3 rad/s (per-pulse bandwidth 1), kept at 0.5 rad/s (one
     // pulse a second with 12 pulses/rev), limit-cycles or runs away: what the schedule prevents.
-    let (scheduled, f_s) = low_speed_hold(5, 12, 0.5, 1.0, true, 20.0, 20.0);
-    let (fixed, f_f) = low_speed_hold(5, 12, 0.5, 1.0, false, 20.0, 20.0);
+    let (scheduled, f_s) = low_speed_hold_at_rate(1000, 5, 12, 0.5, 1.0, true, 20.0, 20.0);
+    let (fixed, f_f) = low_speed_hold_at_rate(1000, 5, 12, 0.5, 1.0, false, 20.0, 20.0);
     assert!(
         f_s.is_none() && scheduled.half_peak_to_peak <= 0.05,
         "{scheduled:?}"

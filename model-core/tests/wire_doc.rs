@@ -129,3 +129,82 @@ fn parameter_table_matches_the_code() {
         .collect();
     assert_eq!(rows, expected);
 }
+
+/// The command table of docs/protocol.md as the code's table (`wire::commands`) renders it.
+fn command_table_markdown() -> String {
+    let state = |s: DeviceState| match s {
+        DeviceState::Idle => "idle",
+        DeviceState::Commissioning => "commissioning",
+        DeviceState::SpinningUp => "spinning up",
+        DeviceState::Running => "running",
+        DeviceState::Stopping => "stopping",
+        DeviceState::Faulted => "faulted",
+    };
+    let all_states = (0..=5).filter_map(DeviceState::from_code);
+    let mut out =
+        String::from("| word | fields | answer | allowed in | meaning |\n|---|---|---|---|---|\n");
+    for kind in CommandKind::ALL {
+        let fields: Vec<String> = kind
+            .fields()
+            .iter()
+            .map(|f| {
+                let takes = match f.kind {
+                    FieldKind::Int { min, max, limit } => {
+                        let mut t = format!("{min}..={max} {}", f.unit);
+                        if let Some(p) = limit {
+                            t += &format!(", at most `{}`", p.token());
+                        }
+                        t
+                    }
+                    FieldKind::Choice(tokens) => {
+                        let t: Vec<String> = tokens.iter().map(|t| format!("`{t}`")).collect();
+                        t.join(" ")
+                    }
+                    FieldKind::ParamName => "a parameter's name (table below)".into(),
+                    FieldKind::ParamValue => "in that parameter's unit and range".into(),
+                };
+                format!("`{}`: {takes}", f.name)
+            })
+            .collect();
+        let answer = char::from(kind.answer().letter());
+        let answer = if kind.refusable() {
+            format!("{answer} / R")
+        } else {
+            answer.to_string()
+        };
+        let allowed = if kind.states() == States::ANY {
+            "any state".to_string()
+        } else {
+            let s: Vec<&str> = all_states
+                .clone()
+                .filter(|&s| kind.states().contains(s))
+                .map(state)
+                .collect();
+            s.join(", ")
+        };
+        let fields = if fields.is_empty() {
+            "none".to_string()
+        } else {
+            fields.join("; ")
+        };
+        out += &format!(
+            "| `{}` | {fields} | {answer} | {allowed} | {} |\n",
+            kind.token(),
+            kind.meaning()
+        );
+    }
+    out
+}
+
+/// docs/protocol.md's command table is exactly the code's table, rendered.
+#[test]
+fn command_table_matches_the_code() {
+    let doc = doc();
+    let table = command_table_markdown();
+    assert!(
+        doc.contains(&table),
+        "docs/protocol.md's command table differs from the code's (`wire::commands`); it \
+         should read:\n\n{table}"
+    );
+    assert_eq!(doc.matches("| word |").count(), 1, "one command table");
+}

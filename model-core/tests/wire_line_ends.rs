@@ -6,18 +6,6 @@ mod wire_support;
 use model_core::wire::*;
 use wire_support::*;
 
-fn decode_all(bytes: &[u8]) -> (Vec<Frame>, DecodeStats) {
-    let mut d = Decoder::new();
-    let mut frames = Vec::new();
-    d.push_slice(bytes, |r, _| {
-        if let Ok(f) = r {
-            frames.push(f)
-        }
-    });
-    d.finish();
-    (frames, *d.stats())
-}
-
 /// A line ends at `\r\n`, `\r` or `\n`, one line end each: no empty line, no noise, no
 /// frame lost, every byte in a good frame (a console's Enter sends `\r`).
 #[test]

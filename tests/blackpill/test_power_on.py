@@ -6,11 +6,12 @@ output control table, through the harness's record of every moment a pin that TI
 let go (`Machine.pwm_pin_floats`), and the LED's recorded changes (`Machine.led_changes`)."""
 
 import os
+import subprocess
 
 from checks import check, fill_parameter_region, fresh_flash, wedge_cpu
 from flash import BACKED_BASE, SECTOR_BASES
 from iwdg import LSI_HZ, LSI_MAX_HZ, LSI_MIN_HZ
-from session import ELF, LOGS, Session
+from session import BOWL, ELF, LOGS, Session
 
 
 def symbol_address(elf: str, mangled_part: str) -> int:
@@ -207,6 +208,11 @@ def test_parameter_flash_trouble_is_reported_on_the_wire():
         out = s.bowl("status")
         check("flags=1" in out and "booted on default parameters" in out,
               f"status of a new board: {out}")
+        # The monitor asks STATUS itself when it opens the port and says the board's condition.
+        mon = subprocess.run([BOWL, "monitor", s.link.path, "--plain", "--seconds", "8"],
+                             capture_output=True, text=True, timeout=60)
+        check("the rig reports: booted on default parameters" in mon.stdout,
+              f"the monitor on a new board: {mon.stdout[-2000:]} {mon.stderr[-500:]}")
         check(s.bowl("set", "TEETH2", "24").startswith("ok"), "SET refused")
         s.wait_emulated(1.2)
         s.call(lambda m: m.reset("pin"))

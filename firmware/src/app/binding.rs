@@ -4,8 +4,7 @@
 
 pub use model_core::binding::{
     AXES as BOUND_AXES, ControllerBackend, Injector, NoInjection, OVERSPEED_PER_MAX,
-    PERSISTED_COUNT, Persisted, default_params, default_persisted, describe_bowl, persisted,
-    split_persisted,
+    PERSISTED_COUNT, Persisted, default_params, default_persisted, persisted, split_persisted,
 };
 use model_core::control::State;
 use model_core::wire::device::Device;

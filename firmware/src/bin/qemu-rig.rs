@@ -20,7 +20,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
 use embassy_time::{Duration, Timer};
 use firmware::app::binding::{
-    ControllerBackend, DeviceCore, default_persisted, describe_bowl, persisted, split_persisted,
+    ControllerBackend, DeviceCore, default_persisted, persisted, split_persisted,
 };
 use firmware::app::motors::Motors;
 use firmware::app::reset;
@@ -30,10 +30,9 @@ use firmware::qemu::gates::{self, Granules};
 use firmware::qemu::plant::{self, PlantClock, PlantInjector, SimMotor};
 use firmware::qemu::watchdog::SoftWatchdog;
 use firmware::qemu::{self, executor, time_driver, usart};
-use model_core::binding::{AssemblyError, commission_on_plant};
 use model_core::control::ControllerConfig;
 use model_core::sim::granule::ParticleParams;
-use model_core::sim::{Plant, PlantParams};
+use model_core::sim::{AssemblyError, Plant, PlantParams, commission_on_plant};
 use model_core::wire::{Hello, ResetCause};
 
 type Core = SharedCore<ThreadModeRawMutex, DeviceCore<PlantInjector>>;
@@ -137,7 +136,7 @@ fn main() -> ! {
     // virtual rig is), so it runs on the models it identified, not on the datasheet's.
     // Its table describes the bowl its granules fall in (Granules: the default scene).
     let mut record = split_persisted(&default_persisted());
-    describe_bowl(&mut record.params, &ParticleParams::default());
+    ParticleParams::default().describe_bowl(&mut record.params);
     let (mut rig, _) = ControllerBackend::new(
         ControllerConfig::nominal(),
         persisted(&record),

@@ -60,7 +60,7 @@ fn fault_reaction(
     FaultReaction {
         injected_at_s: seconds(inject.at_ms),
         fault: detected.map(|t| format!("{:?}", t.fault)),
-        fault_text: detected.map(|t| crate::words::fault(t.fault).to_string()),
+        fault_text: detected.map(|t| rig_client::words::fault(t.fault).to_string()),
         detection_s: detected.map(since),
         expected_detection_s: expected,
         motors_off_s: off.map(since),
@@ -153,7 +153,7 @@ pub fn summarise(
             .zip(tel.last())
             .map_or(0.0, |(a, b)| seconds(b.time_ms.wrapping_sub(a.time_ms))),
         wall_s: info.wall_s,
-        frames: crate::replay::stats_json(stats),
+        frames: rig_client::decode_stats::stats_json(stats),
         telemetry_rows: tel.len(),
         aborted: info.aborted,
         board_console: info.board_console,

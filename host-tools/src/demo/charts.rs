@@ -1,4 +1,4 @@
-//! The demo's charts, drawn with the shared plot module (`crate::chart::plot`): per motor, the
+//! The demo's charts, drawn with the shared plot module (`lab::chart::plot`): per motor, the
 //! setpoint and the measured speed over device time, the session's steps and the fault marked.
 
 use std::path::{Path, PathBuf};
@@ -7,10 +7,10 @@ use anyhow::{Context, Result};
 use model_core::wire::{FaultCode, Residence, Telemetry};
 
 use super::script::{Mark, MarkKind};
-use crate::chart::plot::{Figure, Mark as Style, PlotError, Scale, Series, VLine};
+use lab::chart::plot::{Figure, Mark as Style, PlotError, Scale, Series, VLine};
 
 /// Palette indices (see the plot module).
-use crate::chart::log::{self, FAULT_COLOUR};
+use lab::chart::log::{self, FAULT_COLOUR};
 const STEP_COLOUR: usize = 7;
 
 fn t_s(t: &Telemetry) -> f64 {
@@ -34,7 +34,7 @@ fn markers(marks: &[Mark], tel: &[Telemetry]) -> Vec<VLine> {
     if let Some(t) = tel.iter().find(|t| t.fault != FaultCode::None) {
         v.push(VLine {
             x: t_s(t),
-            label: format!("fault detected: {}", crate::words::fault(t.fault)),
+            label: format!("fault detected: {}", rig_client::words::fault(t.fault)),
             color: FAULT_COLOUR,
         });
     }

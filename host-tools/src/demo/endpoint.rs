@@ -18,8 +18,8 @@ use anyhow::{Context, Result, bail};
 use bowl_emulator::qemu::{self, Profile, PtyBoard};
 use bowl_emulator::{blackpill, image};
 
-use crate::serve::{Backlog, LineNoise, Pacing, Pty, ServeStats, serve_on_pty};
-use crate::virtual_rig::VirtualRig;
+use virtual_rig::VirtualRig;
+use virtual_rig::serve::{Backlog, LineNoise, Pacing, Pty, ServeStats, serve_on_pty};
 
 /// Which rig the demo drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

@@ -9,12 +9,13 @@ use std::io::{BufWriter, Write};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
-use model_core::wire::{DecodeStats, Decoder, Frame, Hello, Telemetry};
+use model_core::wire::{Command, DecodeStats, Decoder, Frame, Hello, Telemetry};
 
 use crate::monitor::View;
-use crate::send::{command_line, describe, explain};
-use crate::serial::{Port, ReadOutcome};
-use crate::telemetry_csv;
+use rig_client::lines::{command_line, describe, explain};
+use rig_client::request::Request;
+use rig_client::serial::{Port, ReadOutcome};
+use rig_client::telemetry_csv;
 
 /// One command the script sent and what came back.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -32,9 +33,9 @@ pub struct CommandRecord {
     pub at_ms: Option<u32>,
 }
 
-/// An answer frame and the device time of the last telemetry frame before it in the stream.
+/// An answer frame (matched to its request by the request loop's rule) and the device time of
+/// the last telemetry frame before it in the stream.
 struct Answer {
-    id: u16,
     frame: Frame,
     after_ms: Option<u32>,
 }
@@ -188,8 +189,7 @@ impl Session {
                         self.event(format!("heartbeat refused: {}", describe(&other)));
                     }
                 }
-                Some(id) => answers.push(Answer {
-                    id,
+                Some(_) => answers.push(Answer {
                     frame: other,
                     after_ms: self.now_ms(),
                 }),
@@ -211,14 +211,16 @@ impl Session {
         }
         self.last_ping_ms = Some(now);
         let id = self.fresh_id();
-        let line = command_line(id, &["ping".to_string()])
+        let mut ping = Request::new(id, Command::Ping)
             .map_err(|r| anyhow!("PING rejected locally: {}", r.token()))?;
         self.ping_ids.push(id);
         if self.ping_ids.len() > 16 {
             // Unanswered heartbeats: shown, not piled up.
             self.ping_ids.remove(0);
         }
-        Ok(self.port.write_all(&line)?)
+        // Sent once: the next heartbeat is the resend.
+        let line = ping.due(Instant::now()).unwrap_or_default();
+        Ok(self.port.write_all(line)?)
     }
 
     fn draw(&mut self) -> Result<()> {
@@ -266,13 +268,19 @@ impl Session {
                 explain(r)
             )
         })?;
-        self.port.write_all(&line)?;
+        let mut request = Request::from_line(line)
+            .ok_or_else(|| anyhow!("{step}: `{text}` is not a command line (a bug in bowl)"))?;
         let deadline = Instant::now() + ANSWER_TIMEOUT;
         loop {
+            // The one request loop's schedule: sent now, and again with the same id every
+            // 200 ms until the answer comes (the rig carries a copy out once).
+            if let Some(line) = request.due(Instant::now()) {
+                self.port.write_all(line)?;
+            }
             let answers = self.pump(Duration::from_millis(10))?;
             if let Some(Answer {
                 frame, after_ms, ..
-            }) = answers.into_iter().find(|a| a.id == id)
+            }) = answers.into_iter().find(|a| request.answered_by(&a.frame))
             {
                 let accepted = !matches!(frame, Frame::Reject { .. });
                 let answer = match frame {

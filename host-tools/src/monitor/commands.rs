@@ -3,23 +3,21 @@
 
 use std::time::{Duration, Instant};
 
-use model_core::wire::{Command, Frame, decode_frame};
+use model_core::wire::Frame;
 
-use crate::command_words::local_refusal;
-use crate::link::{RESEND_EVERY, UnreadableAnswer, answers_kind};
-use crate::refusal::particulars;
-use crate::send::{command_line, describe, explain};
+use rig_client::command_words::local_refusal;
+use rig_client::lines::{command_line, describe, explain};
+use rig_client::refusal::particulars;
+use rig_client::request::{Request, fresh_id, next_id};
+use rig_client::unreadable::UnreadableAnswer;
 
 /// How often a typed command is sent in all when no answer comes (1 s).
 const ATTEMPTS: u32 = 5;
 
+/// A typed command in flight: its words and the one request loop's state (id, line, resends).
 struct Pending {
-    id: u16,
     words: String,
-    command: Command,
-    line: Vec<u8>,
-    sent_at: Instant,
-    attempts: u32,
+    request: Request,
 }
 
 /// The monitor's commands in flight.
@@ -33,7 +31,7 @@ impl Commands {
         // Ids from the clock, so no tool before this one used them within the rig's memory of
         // recent commands (a late copy of theirs must not look like ours, nor ours like theirs).
         Self {
-            next_id: crate::link::fresh_id(),
+            next_id: fresh_id(),
             pending: Vec::new(),
         }
     }
@@ -45,11 +43,7 @@ impl Commands {
             return Err("type a command, e.g. `status`, `speed 1800 2100`, `start`".into());
         }
         let id = self.next_id;
-        // u16::MAX is the heartbeat's.
-        self.next_id = match self.next_id.wrapping_add(1) {
-            u16::MAX => 0,
-            n => n,
-        };
+        self.next_id = next_id(self.next_id);
         let line = command_line(id, &words).map_err(|r| {
             format!(
                 "`{text}` not sent: {} - {} ({})",
@@ -58,16 +52,16 @@ impl Commands {
                 local_refusal(&words, r)
             )
         })?;
-        let Ok(Frame::Command { command, .. }) = decode_frame(&line) else {
+        let Some(mut request) = Request::from_line(line) else {
             return Err(format!("`{text}` not sent: not a command"));
         };
+        let line = request
+            .due(Instant::now())
+            .map(<[u8]>::to_vec)
+            .unwrap_or_default();
         self.pending.push(Pending {
-            id,
             words: text.trim().to_owned(),
-            command,
-            line: line.clone(),
-            sent_at: Instant::now(),
-            attempts: 1,
+            request,
         });
         Ok(line)
     }
@@ -78,7 +72,7 @@ impl Commands {
         let i = self
             .pending
             .iter()
-            .position(|p| p.id == id && answers_kind(&p.command, frame))?;
+            .position(|p| p.request.answered_by(frame))?;
         let p = self.pending.remove(i);
         let mut text = format!("{} -> {}", p.words, describe(frame));
         // The particulars that need no question to the rig (its state is on the screen).
@@ -94,7 +88,11 @@ impl Commands {
     /// An intact answer this bowl cannot read: the text to show (with the command it answers,
     /// which is then no longer waited for, if it is ours).
     pub fn on_unreadable(&mut self, answer: &UnreadableAnswer) -> String {
-        match self.pending.iter().position(|p| p.id == answer.id) {
+        match self
+            .pending
+            .iter()
+            .position(|p| p.request.id() == answer.id)
+        {
             Some(i) => format!("{} -> {answer}", self.pending.remove(i).words),
             None => answer.to_string(),
         }
@@ -104,20 +102,21 @@ impl Commands {
     pub fn due(&mut self) -> (Vec<Vec<u8>>, Vec<String>) {
         let mut resend = Vec::new();
         let mut gave_up = Vec::new();
+        let now = Instant::now();
         self.pending.retain_mut(|p| {
-            if p.sent_at.elapsed() < RESEND_EVERY {
+            if p.request.next_due().is_some_and(|t| t > now) {
                 return true;
             }
-            if p.attempts >= ATTEMPTS {
+            if p.request.sends() >= ATTEMPTS {
                 gave_up.push(format!(
                     "{} -> no answer (id {}, sent {} times)",
-                    p.words, p.id, p.attempts
+                    p.words,
+                    p.request.id(),
+                    p.request.sends()
                 ));
                 return false;
             }
-            p.attempts += 1;
-            p.sent_at = Instant::now();
-            resend.push(p.line.clone());
+            resend.extend(p.request.due(now).map(<[u8]>::to_vec));
             true
         });
         (resend, gave_up)

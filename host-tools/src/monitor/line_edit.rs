@@ -2,7 +2,7 @@
 //! the commands sent before, Tab completes the command word and its first argument (parameter
 //! names, residence models, injections).
 
-use crate::command_words::{all_words, first_arguments};
+use rig_client::command_words::{all_words, first_arguments};
 
 /// How many sent commands Up can bring back.
 const HISTORY_MAX: usize = 200;
@@ -94,7 +94,7 @@ impl LineEdit {
             (n, false) => (n - 1, words[n - 1]),
         };
         let options: Vec<String> = match index {
-            0 => all_words().into_iter().map(String::from).collect(),
+            0 => all_words(),
             1 => first_arguments(&words[0].to_ascii_lowercase()),
             _ => Vec::new(),
         };

@@ -2,7 +2,7 @@
 //! or one text line per second with `--plain` or when stdout is not a terminal), CSV log keyed on
 //! device time, frame counters; reopens the port after an unplug and keeps logging.
 //!
-//! It holds the port exclusively and serves a local socket ([`crate::relay`]) through which
+//! It holds the port exclusively and serves a local socket ([`rig_client::relay`]) through which
 //! `bowl send`, `bowl commission` and scripts reach the rig meanwhile. Commands can also be typed
 //! into the monitor itself (the UI's command line, or stdin lines in plain mode).
 
@@ -26,12 +26,12 @@ use anyhow::{Context, Result};
 use model_core::wire::{Decoder, Frame, FrameError};
 use serde_json::json;
 
-use crate::link::LineTap;
-use crate::relay::Relay;
-use crate::replay::stats_json;
-use crate::serial::{Port, ReadOutcome};
-use crate::telemetry_csv;
 use commands::Commands;
+use rig_client::decode_stats::stats_json;
+use rig_client::relay::Relay;
+use rig_client::serial::{Holder, Port, ReadOutcome, other_holders, shared_port_warning};
+use rig_client::telemetry_csv;
+use rig_client::unreadable::LineTap;
 use tui::{Action, Tui};
 
 /// Flags of `bowl monitor`.
@@ -87,10 +87,39 @@ fn stdin_lines() -> mpsc::Receiver<String> {
 }
 
 /// Runs `bowl monitor`.
+/// How often the monitor looks for programs that read the port beside it (a scan of `/proc`: a
+/// few milliseconds).
+const HOLDER_CHECK_EVERY: Duration = Duration::from_secs(5);
+
+/// Who else had the port open when last looked, so each change is said once.
+#[derive(Default)]
+struct SharedPort {
+    seen: Vec<Holder>,
+}
+
+impl SharedPort {
+    /// Looks again; the words to show when the set of other holders changed.
+    fn check(&mut self, port: &str) -> Option<String> {
+        let now = other_holders(port);
+        if now == self.seen {
+            return None;
+        }
+        let text = shared_port_warning(port, &now)
+            .unwrap_or_else(|| format!("{port} is no longer open in another program"));
+        self.seen = now;
+        Some(text)
+    }
+}
+
 /// Heartbeat period, well inside the rig's default link-loss timeout (3 s).
 const HEARTBEAT_EVERY: Duration = Duration::from_secs(1);
 /// The heartbeat's command id: other tools match answers by id and kind and never wait for it.
 const HEARTBEAT_ID: u16 = u16::MAX;
+/// The id of the monitor's own STATUS (asked when the port opens and after each rig restart, for
+/// the board conditions only STATUS carries: the parameters' source, the clock).
+const STATUS_ID: u16 = u16::MAX - 1;
+/// Asked again this often until answered.
+const STATUS_AGAIN_EVERY: Duration = Duration::from_secs(2);
 
 pub fn run(args: &Args) -> Result<()> {
     // The UI needs a screen and a keyboard; without either it prints lines.
@@ -134,6 +163,10 @@ pub fn run(args: &Args) -> Result<()> {
     let mut buf = [0u8; 4096];
     // An open gap in the telemetry: since when nothing came, and the frame count then.
     let mut gap: Option<(Instant, u64)> = None;
+    let mut holders = SharedPort::default();
+    // When to ask the rig's STATUS next (None: answered).
+    let mut status_due = Some(Instant::now());
+    let mut next_holder_check = Instant::now();
 
     while deadline.is_none_or(|d| Instant::now() < d) && !interrupted.load(Ordering::SeqCst) {
         if port.is_none() && last_open_try.elapsed() >= REOPEN_EVERY {
@@ -150,6 +183,7 @@ pub fn run(args: &Args) -> Result<()> {
                 view.set_connected(true);
                 view.reconnects += 1;
                 view.event(plain, format!("port {} reopened", args.port));
+                status_due = Some(Instant::now());
                 link_event(&mut log, decoder.stats().restarts, "port reopened")?;
             }
         }
@@ -210,6 +244,24 @@ pub fn run(args: &Args) -> Result<()> {
                             ui.on_telemetry(t);
                         }
                     }
+                    match &frame {
+                        Frame::Hello(_) => status_due = Some(Instant::now()),
+                        Frame::Status { id, status } if *id == STATUS_ID => {
+                            status_due = None;
+                            if view.board_flags != Some(status.flags) {
+                                view.board_flags = Some(status.flags);
+                                if let Some(words) =
+                                    rig_client::lines::status_flag_words(status.flags)
+                                {
+                                    let text = format!("the rig reports: {words}");
+                                    view.event(plain, text.clone());
+                                    link_event(&mut log, decoder.stats().restarts, &text)?;
+                                }
+                            }
+                            continue;
+                        }
+                        _ => {}
+                    }
                     match commands.on_frame(&frame) {
                         Some(text) => view.event(plain, text),
                         // Answers to other tools' commands are theirs to report.
@@ -256,6 +308,13 @@ pub fn run(args: &Args) -> Result<()> {
             }
             Some(_) => {}
         }
+        if port.is_some() && Instant::now() >= next_holder_check {
+            next_holder_check = Instant::now() + HOLDER_CHECK_EVERY;
+            if let Some(text) = holders.check(&args.port) {
+                view.event(plain, text.clone());
+                link_event(&mut log, decoder.stats().restarts, &text)?;
+            }
+        }
         let mut outgoing = relay.as_mut().map(Relay::poll).unwrap_or_default();
         let mut typed_now: Vec<String> = typed.iter().flat_map(|rx| rx.try_iter()).collect();
         if let Some(ui) = tui.as_mut() {
@@ -277,7 +336,13 @@ pub fn run(args: &Args) -> Result<()> {
         // the one program holding the port, keeps the link alive while it watches.
         if port.is_some() && last_heartbeat.elapsed() >= HEARTBEAT_EVERY {
             last_heartbeat = Instant::now();
-            if let Ok(line) = crate::send::command_line(HEARTBEAT_ID, &["PING".to_string()]) {
+            if let Ok(line) = rig_client::lines::command_line(HEARTBEAT_ID, &["PING".to_string()]) {
+                outgoing.push(line);
+            }
+        }
+        if port.is_some() && status_due.is_some_and(|due| Instant::now() >= due) {
+            status_due = Some(Instant::now() + STATUS_AGAIN_EVERY);
+            if let Ok(line) = rig_client::lines::command_line(STATUS_ID, &["STATUS".to_string()]) {
                 outgoing.push(line);
             }
         }

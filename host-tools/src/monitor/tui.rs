@@ -276,8 +276,20 @@ fn banner<'a>(
     if let Some(t) = view.latest.filter(|_| view.connected && silence.is_none()) {
         spans.push(Span::raw(format!(
             "  state {}  ",
-            crate::words::state(t.state)
+            rig_client::words::state(t.state)
         )));
+    }
+    // Board conditions the rig reported (defaults instead of the saved parameters, the
+    // internal oscillator): on the banner for as long as they hold, not only as an event.
+    if let Some(words) = view
+        .board_flags
+        .and_then(rig_client::lines::status_flag_words)
+        .filter(|_| view.connected)
+    {
+        spans.push(Span::styled(
+            format!(" board: {words} "),
+            Style::default().fg(Color::Black).bg(Color::Yellow),
+        ));
     }
     if paused {
         spans.push(Span::styled(
@@ -304,7 +316,7 @@ fn fault_line(view: &View, stale: bool) -> (String, Style) {
             format!(
                 " FAULT {}: the rig stopped the motors. {}. Type `:clear` once the cause is fixed",
                 t.fault.code(),
-                crate::words::fault(t.fault)
+                rig_client::words::fault(t.fault)
             ),
             Style::default()
                 .fg(Color::White)

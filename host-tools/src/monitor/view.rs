@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use model_core::wire::{Decoder, Frame, Hello, Residence, Telemetry};
 
-use crate::send::describe;
+use rig_client::lines::describe;
 
 /// How many points a trend line keeps (one per redraw, 5 per second: 12 s).
 const TREND_LEN: usize = 60;
@@ -98,6 +98,8 @@ pub(crate) struct View {
     period_ms: u32,
     /// Telemetry frames taken in.
     pub(crate) telemetry_frames: u64,
+    /// The board conditions the rig's STATUS reported (`wire::status_flags` bits), once asked.
+    pub(crate) board_flags: Option<u8>,
 }
 
 /// Telemetry is overdue after this many frame periods without a frame ...
@@ -126,6 +128,7 @@ impl View {
             heard_at: Instant::now(),
             period_ms: 0,
             telemetry_frames: 0,
+            board_flags: None,
         }
     }
 
@@ -164,7 +167,7 @@ impl View {
                     plain,
                     format!(
                         "rig booted: reset cause {}, reset count {}",
-                        crate::words::reset_cause(h.reset_cause),
+                        rig_client::words::reset_cause(h.reset_cause),
                         h.reset_count
                     ),
                 );
@@ -220,8 +223,8 @@ impl View {
                 "t={:.3}s seq={} state={} fault={} w1={:.3}/{:.3} w2={:.3}/{:.3} rad/s bowl={:.3} rad/s T_flat={} T_cor={}",
                 f64::from(t.time_ms) / 1000.0,
                 t.seq,
-                crate::words::state(t.state),
-                crate::words::fault(t.fault),
+                rig_client::words::state(t.state),
+                rig_client::words::fault(t.fault),
                 f64::from(t.precession.measured_mrad_s) / 1000.0,
                 f64::from(t.precession.set_mrad_s) / 1000.0,
                 f64::from(t.spin.measured_mrad_s) / 1000.0,
@@ -260,8 +263,8 @@ impl View {
                     "device time {:>12.3} s   seq {:>5}   state {}   fault: {}\n\n",
                     f64::from(t.time_ms) / 1000.0,
                     t.seq,
-                    crate::words::state(t.state),
-                    crate::words::fault(t.fault)
+                    rig_client::words::state(t.state),
+                    rig_client::words::fault(t.fault)
                 );
                 s += "              set rad/s  measured rad/s   duty %   pulses\n";
                 for (name, m) in [("precession w1", t.precession), ("spin       w2", t.spin)] {
@@ -288,7 +291,7 @@ impl View {
         if let Some(h) = self.hello {
             s += &format!(
                 "\nlast boot: reset cause {}, reset count {}\n",
-                crate::words::reset_cause(h.reset_cause),
+                rig_client::words::reset_cause(h.reset_cause),
                 h.reset_count
             );
         }

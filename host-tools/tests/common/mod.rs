@@ -76,6 +76,60 @@ impl Drop for Sim {
     }
 }
 
+/// `bowl serve`'s flags for a run of `seconds` with the timed commands `AT_MS:WORDS,...`.
+pub fn timed(seconds: &str, commands: &[&str]) -> Vec<String> {
+    let mut args = vec!["--seconds".to_string(), seconds.to_string()];
+    for c in commands {
+        args.extend(["--command".to_string(), (*c).to_string()]);
+    }
+    args
+}
+
+/// `bowl serve --pty` for `seconds` with the timed `commands`.
+pub fn sim_timed(seconds: &str, commands: &[&str]) -> Sim {
+    let args = timed(seconds, commands);
+    Sim::start(&args.iter().map(String::as_str).collect::<Vec<_>>())
+}
+
+/// `bowl serve --capture DIR/cap.bin ARGS...`: the capture's path.
+pub fn sim_capture(dir: &Path, args: &[&str]) -> PathBuf {
+    let capture = dir.join("cap.bin");
+    let mut all = vec!["serve", "--capture", capture.to_str().unwrap()];
+    all.extend_from_slice(args);
+    let made = bowl(&all);
+    assert!(made.status.success(), "{}", stdout(&made));
+    capture
+}
+
+/// [`sim_capture`] of a run of `seconds` with the timed `commands`.
+pub fn capture_timed(dir: &Path, seconds: &str, commands: &[&str]) -> PathBuf {
+    let args = timed(seconds, commands);
+    sim_capture(dir, &args.iter().map(String::as_str).collect::<Vec<_>>())
+}
+
+/// `bowl replay CAPTURE --csv CSV`.
+pub fn replay_to_csv(capture: &Path, csv: &Path) -> Output {
+    bowl(&[
+        "replay",
+        capture.to_str().unwrap(),
+        "--csv",
+        csv.to_str().unwrap(),
+    ])
+}
+
+/// `bowl monitor PORT --plain --seconds SECONDS --log LOG` run to its end.
+pub fn monitor_logged(port: &str, seconds: &str, log: &Path) -> Output {
+    bowl(&[
+        "monitor",
+        port,
+        "--seconds",
+        seconds,
+        "--plain",
+        "--log",
+        log.to_str().unwrap(),
+    ])
+}
+
 /// Runs `bowl ARGS` to its end and returns what it printed.
 pub fn bowl(args: &[&str]) -> Output {
     Command::new(BOWL)

@@ -29,22 +29,6 @@ pub fn default_params() -> ParamValues {
     ParamId::defaults()
 }
 
-/// A simulated rig's parameter table describes its own bowl, as an engineer sets a real rig's
-/// (docs/bring-up.md): the start radius, rim radius and k2 of the granules `particle` drops.
-/// Its mu stays the table's (`MU_PPM`, the model's guess): that is the truth an experiment has
-/// to find. Values outside a parameter's range are held at its limit.
-pub fn describe_bowl(params: &mut ParamValues, particle: &crate::sim::granule::ParticleParams) {
-    for (id, value) in [
-        (ParamId::StartUm, particle.release_radius_m),
-        (ParamId::RimUm, particle.rim_radius_m),
-        (ParamId::K2Ppm, particle.k2),
-    ] {
-        let (lo, hi) = id.range();
-        let micro = libm::round(value * 1e6).clamp(f64::from(lo), f64::from(hi));
-        params[id.index()] = micro as i32;
-    }
-}
-
 /// One setting of a motor axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AxisSetting {

@@ -7,25 +7,24 @@
 //! - [`configure`]: wire parameters (the table in [`crate::wire::params`]) to the controller's
 //!   configuration and the particle scene, and when each may change;
 //! - [`record`]: the layout of the record persisted in flash (parameters and motor models);
-//! - [`backend`]: [`ControllerBackend`], the controller and the scene behind the protocol;
-//! - [`assembly`]: commissioning on a simulated plant before a virtual rig or an emulated board
-//!   starts.
+//! - [`backend`]: [`ControllerBackend`], the controller and the scene behind the protocol.
+//!
+//! It depends on [`crate::wire`], [`crate::control`] and [`crate::particle`], never on the
+//! simulator: commissioning on a simulated plant is `crate::sim::assembly`, and a simulated
+//! granule's bowl in wire parameters `crate::sim::granule::ParticleParams::describe_bowl`.
 //!
 //! The parameters in force are kept in wire units (what SET sent is what PARAMS reports,
 //! exactly), and the controller's configuration is derived from them. A value the scene check
 //! or the controller's validation refuses is rejected with `RANGE` (or `STATE` when the
 //! controller is busy) and changes nothing.
 
-pub mod assembly;
 pub mod backend;
 pub mod configure;
 pub mod record;
 
-pub use assembly::{ASSEMBLY_COMMISSION_MAX_S, AssemblyError, commission_on_plant};
 pub use backend::ControllerBackend;
 pub use configure::{
-    OVERSPEED_PER_MAX, ParamRole, config_from_params, default_params, describe_bowl,
-    scene_from_params,
+    OVERSPEED_PER_MAX, ParamRole, config_from_params, default_params, scene_from_params,
 };
 pub use record::{
     PERSISTED_COUNT, Persisted, Record, default_persisted, persisted, split_persisted,

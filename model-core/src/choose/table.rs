@@ -25,7 +25,7 @@
 use super::{Choice, Plan, Source, Target, plan_cost};
 use crate::Real;
 use crate::ode::{self, Limits, Method, OdeOutcome, OmegaProfile, SpinUp};
-use crate::particle::{Model, Scene};
+use crate::particle::{self, Model, Scene, radial};
 
 /// One axis of the grid: `count` levels from `first`, `step` apart.
 #[derive(Debug, Clone, Copy)]
@@ -201,7 +201,7 @@ pub fn scene_at(point: usize) -> (Scene<f64>, SpinUp<f64>) {
 
 fn residence_s(scene: &Scene<f64>, model: Model, speed: &SpinUp<f64>, method: Method<f64>) -> f64 {
     let limits = Limits::for_scene(scene, speed);
-    match ode::integrate(scene, model, speed, method, limits).map(|r| r.outcome) {
+    match particle::integrate(scene, model, speed, method, limits).map(|r| r.outcome) {
         Ok(OdeOutcome::Leaves {
             residence_time_s, ..
         }) => residence_time_s,
@@ -265,8 +265,8 @@ pub fn measure(point: usize) -> ([u8; 3], Option<u8>) {
 /// When the particle is released (the integration's start), s.
 fn release_s<T: Real>(scene: &Scene<T>, speed: &SpinUp<T>) -> T {
     let limits = Limits::for_scene(scene, speed);
-    let stiff_rate = ode::stiff_rate_per_s(scene, Model::Coriolis, speed.max_omega_rad_s());
-    ode::start_time_s(scene, speed, stiff_rate, limits).unwrap_or(T::ZERO)
+    let stiff_rate = radial::stiff_rate_per_s(scene, Model::Coriolis, speed.max_omega_rad_s());
+    radial::start_time_s(scene, speed, stiff_rate, limits).unwrap_or(T::ZERO)
 }
 
 /// What the table says of a scene.

@@ -1,7 +1,7 @@
 //! The chooser's decisions checked against errors measured independently here.
 
 use super::*;
-use crate::ode::SpinUp;
+use crate::ode::{self, SpinUp};
 extern crate std;
 
 /// The particle tests' scene with the rim at 0.1 m.
@@ -55,12 +55,8 @@ fn mu_known_to_20_percent_needs_only_the_flat_closed_form() {
         c.tolerance_rel <= 0.1 * measured_spread * 1.0001,
         "{c:?} vs {measured_spread}"
     );
-    let tf = particle::residence(&s, Model::Flat)
-        .unwrap()
-        .residence_time_s();
-    let tc = particle::residence(&s, Model::Coriolis)
-        .unwrap()
-        .residence_time_s();
+    let tf = closed_form(&s, Model::Flat);
+    let tc = closed_form(&s, Model::Coriolis);
     assert!((tf - tc).abs() / tc <= c.tolerance_rel * 1.05);
 }
 
@@ -74,12 +70,8 @@ fn precisely_known_resistance_needs_the_coriolis_model() {
     };
     let c = choose_constant(&s, &k).unwrap();
     assert_eq!(c.model, Model::Coriolis);
-    let tf = particle::residence(&s, Model::Flat)
-        .unwrap()
-        .residence_time_s();
-    let tc = particle::residence(&s, Model::Coriolis)
-        .unwrap()
-        .residence_time_s();
+    let tf = closed_form(&s, Model::Flat);
+    let tc = closed_form(&s, Model::Coriolis);
     assert!(
         (tf - tc).abs() / tc > c.tolerance_rel,
         "flat would be too far off"
@@ -237,15 +229,13 @@ fn a_steady_trace_is_answered_by_the_closed_form_at_its_mean_speed() {
         (omega_rad_s - mean).abs() < 1e-4 * mean,
         "{omega_rad_s} vs {mean}"
     );
-    let t_mean = particle::residence(
+    let t_mean = closed_form(
         &Scene {
             omega_rad_s: mean,
             ..s
         },
         c.model,
-    )
-    .unwrap()
-    .residence_time_s();
+    );
     let err = (t_mean - truth).abs() / truth;
     assert!(err <= c.tolerance_rel, "{c:?}: error {err:e}");
     assert!(
@@ -253,6 +243,11 @@ fn a_steady_trace_is_answered_by_the_closed_form_at_its_mean_speed() {
         "{c:?}: error {err:e}"
     );
     assert_eq!(c.rhs_evaluations, 0);
+}
+
+/// The closed form's residence time of scene `s`.
+fn closed_form(s: &Scene<f64>, model: Model) -> f64 {
+    particle::residence(s, model).unwrap().residence_time_s()
 }
 
 #[test]
@@ -276,15 +271,13 @@ fn a_spin_up_trace_needs_an_integrator_that_meets_the_tolerance() {
     );
     // The closed form at the mean speed would miss: that is why it was not chosen.
     let mean = mean_omega_rad_s(&trace, truth);
-    let t_mean = particle::residence(
+    let t_mean = closed_form(
         &Scene {
             omega_rad_s: mean,
             ..s
         },
         c.model,
-    )
-    .unwrap()
-    .residence_time_s();
+    );
     assert!((t_mean - truth).abs() > 1e-4 * truth, "{t_mean} vs {truth}");
 }
 
@@ -552,7 +545,7 @@ fn random_spin_ups_meet_their_tolerance_from_the_table_and_nearly_always_by_the_
         };
         let (p, _) = choose_varying_reading(&s, &need, &profile, false).unwrap();
         let limits = ode::Limits::for_scene(&s, &profile);
-        let time = |m, model| match ode::integrate(&s, model, &profile, m, limits)
+        let time = |m, model| match particle::integrate(&s, model, &profile, m, limits)
             .unwrap()
             .outcome
         {

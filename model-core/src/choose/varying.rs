@@ -9,7 +9,7 @@ use super::{
 };
 use crate::Real;
 use crate::ode::{self, Limits, Method, OmegaProfile};
-use crate::particle::{Model, Scene};
+use crate::particle::{Model, Scene, radial};
 
 /// Chooses for a time-varying bowl speed, the tolerance from the parameters' uncertainty: see
 /// [`choose_varying_for`].
@@ -158,8 +158,8 @@ pub(crate) fn choose_varying_reading<T: Real, P: OmegaProfile<T>>(
         coriolis
     };
     let h = pilot.step_for(method_budget);
-    let stiff_rate = ode::stiff_rate_per_s(scene, model, w_max);
-    let t_start = ode::start_time_s(scene, profile, stiff_rate, limits).unwrap_or(T::ZERO);
+    let stiff_rate = radial::stiff_rate_per_s(scene, model, w_max);
+    let t_start = radial::start_time_s(scene, profile, stiff_rate, limits).unwrap_or(T::ZERO);
     // Steps to the rim: the span over the step, rounded up.
     let span = ((pilot.time_s - t_start) / h).to_f64().max(0.0);
     let whole = span as u64;

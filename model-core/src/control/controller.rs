@@ -241,6 +241,7 @@ impl Controller {
             let steady_i = steady[i] > 0.5
                 && a.est.is_valid()
                 && (a.measured.abs() - model).abs() <= 0.1 * model;
+            a.steady = steady_i;
             a.est.expect_speed_rad_s(model);
             let speed = a.est.tick(now_ticks, edges[i], steady_i, |_, _| {});
             seen[i] = a.est.accepted_edges() != before;
@@ -379,10 +380,20 @@ impl Controller {
         } else if r < 0.0 {
             a.direction = -1.0;
         }
+        if a.direction != was || r == 0.0 {
+            // The wheel's gaps now pass in the opposite order (or the shaft is let go: its
+            // angle may move unseen); the load pattern is learned anew.
+            a.load.forget();
+        }
         if a.direction != was {
             // The wheel's gaps now pass in the opposite order.
             a.est.forget_teeth();
         }
+        // The once-per-revolution load ahead of the loop (load_pattern.rs); `a.duty` is what
+        // drove the shaft since the last tick.
+        let model = a.speed_loop.model_rad_s().abs();
+        let load = a.load.tick(&a.est, a.duty, a.direction, a.steady, model);
+        let extra_duty = extra_duty + if self.feedback { load } else { 0.0 };
         let input = LoopInput {
             reference_rad_s: r,
             measured_rad_s: a.measured,
@@ -538,6 +549,15 @@ impl Controller {
         let k = &self.axes.get(axis)?.k;
         let wc = super::pi::bandwidth_ceiling_rad_s(self.cfg.axes.get(axis)?);
         Some((k.kp(wc), k.ki_per_s(wc)))
+    }
+
+    /// The once-per-revolution load learned on `axis` (0 = precession, 1 = spin): revolutions
+    /// learned since it was last forgotten and the pattern's amplitude, duty (see
+    /// [`super::load_pattern`]). `(0, 0.0)` for an axis out of range.
+    pub fn load_pattern(&self, axis: usize) -> (u16, f32) {
+        self.axes.get(axis).map_or((0, 0.0), |a| {
+            (a.load.revolutions_learned(), a.load.amplitude_duty())
+        })
     }
 
     /// Results of the last commissioning run, per axis.

@@ -137,6 +137,24 @@ pub struct PulseSpeedEstimator {
     rejected: u32,
     missing: u32,
     late_edges: u32,
+    /// The last gap measured alone (one pulse, an interval since the edge before).
+    last_gap: Gap,
+}
+
+/// One gap of the sensor wheel as the last single-pulse edge measured it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Gap {
+    /// Counts the edges accepted (wrapping), as [`PulseSpeedEstimator::accepted_edges`] did
+    /// when this gap ended: two gaps follow each other when their counts do.
+    pub serial: u32,
+    /// The gap's index around the wheel (see [`ToothMap::index`]).
+    pub index: u16,
+    /// Its length, pitches, by the learned gap lengths.
+    pub pitches: f32,
+    /// Its duration, timer ticks (0: no gap yet).
+    pub ticks: u32,
+    /// The extended clock when it ended.
+    pub end: u32,
 }
 
 impl PulseSpeedEstimator {
@@ -183,6 +201,13 @@ impl PulseSpeedEstimator {
             rejected: 0,
             missing: 0,
             late_edges: 0,
+            last_gap: Gap {
+                serial: 0,
+                index: 0,
+                pitches: 0.0,
+                ticks: 0,
+                end: 0,
+            },
         }
     }
 
@@ -283,7 +308,17 @@ impl PulseSpeedEstimator {
         self.prev_interval = self.last_interval;
         self.last_interval = dt / pulses;
         self.win_pulses += pulses;
-        self.win_pitches += self.teeth.edge(dt, pulses, steady);
+        let pitches = self.teeth.edge(dt, pulses, steady);
+        self.win_pitches += pitches;
+        if pulses == 1 {
+            self.last_gap = Gap {
+                serial: self.accepted,
+                index: self.teeth.index(),
+                pitches,
+                ticks: dt,
+                end: at,
+            };
+        }
         let wspan = at.wrapping_sub(self.win_start);
         if wspan >= self.window_ticks {
             let period = wspan as f32 / self.win_pulses as f32;
@@ -462,6 +497,18 @@ impl PulseSpeedEstimator {
     /// Extended clock at the last tick, timer ticks (wrapping).
     pub fn clock_ticks(&self) -> u32 {
         self.clock
+    }
+    /// The last gap measured alone (one pulse); its `serial` tells a new one from the last.
+    pub fn last_gap(&self) -> Gap {
+        self.last_gap
+    }
+    /// The sensor wheel as counted and learned.
+    pub fn teeth(&self) -> &ToothMap {
+        &self.teeth
+    }
+    /// Seconds per timer tick.
+    pub fn s_per_tick(&self) -> f32 {
+        self.s_per_tick
     }
 }
 

@@ -55,6 +55,7 @@
 //! - [`config`], the configuration and its validation.
 //! - [`estimator`], speed from edge timestamps.
 //! - [`pi`], feedforward + PI per axis.
+//! - [`load_pattern`], the once-per-revolution load, learned and fed forward.
 //! - [`planner`], setpoints, Eq. 2 split, ramps, the particle-model traits.
 //! - [`supervisor`], states and faults.
 //! - [`commission`], identification.
@@ -64,6 +65,7 @@ pub mod config;
 mod const_trig;
 mod controller;
 pub mod estimator;
+pub mod load_pattern;
 pub mod pi;
 pub mod planner;
 pub mod supervisor;

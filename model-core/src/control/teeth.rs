@@ -167,6 +167,25 @@ impl ToothMap {
         self.gaps_this_rev = 0;
     }
 
+    /// Teeth counted around the wheel (0: a wheel not counted, more than [`MAX_TEETH`]).
+    pub fn teeth(&self) -> u16 {
+        self.teeth
+    }
+
+    /// Index of the gap that ended at the last edge, counted around the wheel.
+    pub fn index(&self) -> u16 {
+        self.index
+    }
+
+    /// cos and sin of the angle `2 pi j / teeth` of tooth `j` (gap `j` ends there); (1, 0)
+    /// outside the wheel.
+    pub fn tooth_cos_sin(&self, j: u16) -> (f32, f32) {
+        match (self.cos.get(j as usize), self.sin.get(j as usize)) {
+            (Some(&c), Some(&s)) if j < self.teeth => (c, s),
+            _ => (1.0, 0.0),
+        }
+    }
+
     /// Revolutions learned so far.
     pub fn revolutions_learned(&self) -> u16 {
         self.revs_learned

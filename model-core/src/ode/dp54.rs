@@ -3,9 +3,9 @@
 //! right-hand sides per step. The rim crossing is located on the dense output.
 
 use super::event::locate;
-use super::{Limits, OdeError, OdeOutcome, OmegaProfile, Report, Rhs, leaves};
+use super::fixed::{Start, at_horizon};
+use super::{Crossing, Limits, SecondOrder, StepError, Stepped};
 use crate::Real;
-use crate::particle::Scene;
 
 pub(super) const C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
 pub(super) const A2: [f64; 1] = [1.0 / 5.0];
@@ -93,20 +93,19 @@ impl<T: Real> Dense<T> {
     }
 }
 
-pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
-    rhs: &mut Rhs<'_, T, P>,
-    scene: &Scene<T>,
+pub(crate) fn run<T: Real, S: SecondOrder<T>>(
+    equation: &mut S,
     rtol: T,
     atol: T,
     stiff_rate: T,
     limits: Limits<T>,
-    t_start: T,
-) -> Result<Report<T>, OdeError> {
+    start: Start<T>,
+) -> Result<Stepped<T>, StepError> {
     if !(rtol > T::ZERO && rtol.is_finite() && atol > T::ZERO && atol.is_finite()) {
-        return Err(OdeError::InvalidStep);
+        return Err(StepError::InvalidStep);
     }
-    let rim = scene.rim_radius_m;
-    let (mut t, mut r, mut v) = (t_start, scene.ri_m, T::ZERO);
+    let rim = start.target;
+    let (mut t, mut r, mut v) = (start.t_s, start.r, T::ZERO);
     // Initial step: a fifth of the tolerance's fifth root in units of the fastest time scale.
     let mut h = if stiff_rate > T::ZERO {
         T::from_f64(0.2) * rtol.ln().exp_scaled(0.2) / stiff_rate
@@ -115,28 +114,20 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
     };
     h = h.min(limits.horizon_s);
     let (mut steps, mut rejected) = (0u32, 0u32);
-    let mut k1 = rhs.eval(t, r, v)?;
+    let mut k1 = equation.eval(t, r, v)?;
     while steps < limits.max_steps {
         if t >= limits.horizon_s {
-            return Ok(Report {
-                outcome: OdeOutcome::NotLeftBy {
-                    horizon_s: limits.horizon_s,
-                    radius_m: r,
-                },
-                rhs_evaluations: rhs.evaluations,
-                steps,
-                rejected_steps: rejected,
-            });
+            return Ok(at_horizon(r, steps, rejected));
         }
         if h <= T::EPSILON * t {
             // The step has collapsed below the time's resolution.
-            return Err(OdeError::StepLimit);
+            return Err(StepError::StepLimit);
         }
         steps += 1;
         // A step never crosses a kink of the speed (a logged trace's samples): it ends on it,
         // so every step's error estimate sees a smooth right-hand side.
         let proposed = h;
-        let clipped = match rhs.profile.next_kink_after_s(t) {
+        let clipped = match equation.next_kink_after_s(t) {
             Some(kink) if t + h > kink => {
                 h = kink - t;
                 true
@@ -153,14 +144,14 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
                 yr += h * t_of::<T>(a) * kr[j];
                 yv += h * t_of::<T>(a) * kv[j];
             }
-            (kr[s + 1], kv[s + 1]) = rhs.eval(t + t_of::<T>(C[s + 1]) * h, yr, yv)?;
+            (kr[s + 1], kv[s + 1]) = equation.eval(t + t_of::<T>(C[s + 1]) * h, yr, yv)?;
         }
         let (mut r1, mut v1) = (r, v);
         for i in 0..6 {
             r1 += h * t_of::<T>(B[i]) * kr[i];
             v1 += h * t_of::<T>(B[i]) * kv[i];
         }
-        let k7 = rhs.eval(t + h, r1, v1)?;
+        let k7 = equation.eval(t + h, r1, v1)?;
         (kr[6], kv[6]) = k7;
         let (mut er, mut ev) = (T::ZERO, T::ZERO);
         for i in 0..7 {
@@ -168,7 +159,7 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
             ev += h * t_of::<T>(E[i]) * kv[i];
         }
         if !(r1.is_finite() && v1.is_finite() && er.is_finite() && ev.is_finite()) {
-            return Err(OdeError::NotFinite);
+            return Err(StepError::NotFinite);
         }
         let sr = atol + rtol * r.abs().max(r1.abs());
         let sv = atol + rtol * v.abs().max(v1.abs());
@@ -183,10 +174,11 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
                 let dv = Dense::new(v, v1, &hkv);
                 let theta = locate(|th| dr.at(th), rim);
                 let (v_exit, _) = dv.at(theta);
-                let outcome = leaves(rhs, scene, t + theta * h, v_exit)?;
-                return Ok(Report {
-                    outcome,
-                    rhs_evaluations: rhs.evaluations,
+                return Ok(Stepped {
+                    ended: Crossing::Reached {
+                        t_s: t + theta * h,
+                        v: v_exit,
+                    },
                     steps,
                     rejected_steps: rejected,
                 });
@@ -203,7 +195,7 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
             h *= factor.min(T::ONE);
         }
     }
-    Err(OdeError::StepLimit)
+    Err(StepError::StepLimit)
 }
 
 /// The step-size controller: the next step is `factor` times this one for a scaled error

@@ -3,9 +3,25 @@
 //! below RK4's own), the exit speed by cubic Hermite interpolation of `r'` (with `r''`).
 
 use super::event::{hermite, hermite5, locate};
-use super::{Limits, OdeError, OdeOutcome, OmegaProfile, Report, Rhs, leaves};
+use super::{Crossing, Limits, SecondOrder, StepError, Stepped};
 use crate::Real;
-use crate::particle::Scene;
+
+/// Where a run starts (at rest) and the value of `r` it runs to.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Start<T> {
+    pub t_s: T,
+    pub r: T,
+    pub target: T,
+}
+
+/// The run's end at the horizon (both methods), with `r` there.
+pub(crate) fn at_horizon<T>(r: T, steps: u32, rejected_steps: u32) -> Stepped<T> {
+    Stepped {
+        ended: Crossing::Horizon { r },
+        steps,
+        rejected_steps,
+    }
+}
 
 /// Which fixed-step scheme.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -27,61 +43,41 @@ impl Scheme {
     }
 }
 
-pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
-    rhs: &mut Rhs<'_, T, P>,
-    scene: &Scene<T>,
+pub(crate) fn run<T: Real, S: SecondOrder<T>>(
+    equation: &mut S,
     scheme: Scheme,
     h: T,
     stiff_rate: T,
     limits: Limits<T>,
-    t_start: T,
-) -> Result<Report<T>, OdeError> {
+    start: Start<T>,
+) -> Result<Stepped<T>, StepError> {
     if !(h > T::ZERO && h.is_finite()) {
-        return Err(OdeError::InvalidStep);
+        return Err(StepError::InvalidStep);
     }
     if let Some(limit) = scheme.stability_limit()
         && h * stiff_rate > T::from_f64(limit)
     {
-        return Err(OdeError::BeyondStabilityLimit);
+        return Err(StepError::BeyondStabilityLimit);
     }
-    let rim = scene.rim_radius_m;
-    let (mut r, mut v) = (scene.ri_m, T::ZERO);
+    let (t_start, rim) = (start.t_s, start.target);
+    let (mut r, mut v) = (start.r, T::ZERO);
     let mut steps: u32 = 0;
     while steps < limits.max_steps {
         // t from the step count, not a running sum, so round-off does not accumulate.
         let t = t_start + h * T::from_f64(steps as f64);
         if t >= limits.horizon_s {
-            return Ok(Report {
-                outcome: OdeOutcome::NotLeftBy {
-                    horizon_s: limits.horizon_s,
-                    radius_m: r,
-                },
-                rhs_evaluations: rhs.evaluations,
-                steps,
-                rejected_steps: 0,
-            });
+            return Ok(at_horizon(r, steps, 0));
         }
-        let (_, a0) = rhs.eval(t, r, v)?;
+        let (_, a0) = equation.eval(t, r, v)?;
         let (r1, v1) = match scheme {
             Scheme::Euler => (r + h * v, v + h * a0),
-            Scheme::SemiImplicit => {
-                // v first with the friction term implicit, then r with the new v.
-                let w = rhs.omega(t)?;
-                let push = r * w * w;
-                if v <= T::ZERO && push <= rhs.mu_g {
-                    (r, T::ZERO)
-                } else {
-                    let v1 = (v + h * rhs.k2 * (push - rhs.mu_g))
-                        / (T::ONE + h * rhs.k2 * rhs.two_mu_c * w);
-                    (r + h * v1, v1)
-                }
-            }
+            Scheme::SemiImplicit => equation.semi_implicit(t, r, v, h)?,
             Scheme::Rk4 => {
                 let half = T::HALF * h;
                 let (dr1, dv1) = (v, a0);
-                let (dr2, dv2) = rhs.eval(t + half, r + half * dr1, v + half * dv1)?;
-                let (dr3, dv3) = rhs.eval(t + half, r + half * dr2, v + half * dv2)?;
-                let (dr4, dv4) = rhs.eval(t + h, r + h * dr3, v + h * dv3)?;
+                let (dr2, dv2) = equation.eval(t + half, r + half * dr1, v + half * dv1)?;
+                let (dr3, dv3) = equation.eval(t + half, r + half * dr2, v + half * dv2)?;
+                let (dr4, dv4) = equation.eval(t + h, r + h * dr3, v + h * dv3)?;
                 let sixth = h / T::from_f64(6.0);
                 (
                     r + sixth * (dr1 + T::TWO * (dr2 + dr3) + dr4),
@@ -91,21 +87,22 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
         };
         steps += 1;
         if !(r1.is_finite() && v1.is_finite()) {
-            return Err(OdeError::NotFinite);
+            return Err(StepError::NotFinite);
         }
         if r1 >= rim {
             let t1 = t + h;
-            let (_, a1) = rhs.eval(t1, r1, v1)?;
+            let (_, a1) = equation.eval(t1, r1, v1)?;
             let h2 = h * h;
             let theta = locate(
                 |th| hermite5(r, h * v, h2 * a0, r1, h * v1, h2 * a1, th),
                 rim,
             );
             let (v_exit, _) = hermite(v, h * a0, v1, h * a1, theta);
-            let outcome = leaves(rhs, scene, t + theta * h, v_exit)?;
-            return Ok(Report {
-                outcome,
-                rhs_evaluations: rhs.evaluations,
+            return Ok(Stepped {
+                ended: Crossing::Reached {
+                    t_s: t + theta * h,
+                    v: v_exit,
+                },
                 steps,
                 rejected_steps: 0,
             });
@@ -113,5 +110,5 @@ pub(crate) fn run<T: Real, P: OmegaProfile<T>>(
         r = r1;
         v = v1;
     }
-    Err(OdeError::StepLimit)
+    Err(StepError::StepLimit)
 }

@@ -1,17 +1,16 @@
-//! Numerical integration of the particle's equation of motion (paper Eq. 5 and 9), for a
-//! constant bowl speed and for a speed that changes in time, omega(t) (spin-up as the PI loops
-//! drive it), where no closed form exists.
+//! The integrators, generic: they know equations, not particles. The particle models sit above
+//! them and implement their traits (`crate::particle::radial` the radial equation of paper
+//! Eq. 5 and 9 as a [`SecondOrder`] equation, `crate::particle::rolling` and
+//! `crate::particle::bowl` their systems for [`system`]); nothing here imports them.
 //!
-//! `r'' = k2 (r omega(t)^2 - mu g - c 2 mu omega(t) r')` with `c = 1` for [`Model::Coriolis`]
-//! and 0 for [`Model::Flat`], `r(0) = ri`, `r'(0) = 0`. Static friction holds a particle at rest
-//! while `r omega^2 <= mu g` (the closed forms' "never leaves"; the ODE alone would drag it
-//! inward, which is unphysical), so the right-hand side is 0 there; a run starts at the release
-//! time, where the hold lets go, so that no step straddles that kink (release.rs).
+//! A [`SecondOrder`] equation `r'' = f(t, r, r')` in one coordinate runs from `(t0, r0, 0)`
+//! until `r` reaches a target ([`run_to`]), for a bowl speed that may change in time
+//! ([`OmegaProfile`]: constant, a spin-up as the PI loops drive it, a logged trace).
 //!
 //! Methods ([`Method`]): explicit Euler, semi-implicit Euler, RK4 (fixed step, event located by
 //! quintic Hermite interpolation) and adaptive Dormand-Prince 5(4) (event located on its dense
-//! output). Every run reports the right-hand-side evaluations and steps, refuses a step beyond
-//! the method's stability limit instead of returning a wrong number, and stops at a step cap.
+//! output). Every run reports its steps, refuses a step beyond the method's stability limit
+//! instead of returning a wrong number, and stops at a step cap.
 //!
 //! Stability on this ODE: the fast mode is `l2 = -k omega (s + k mu)` (docs/model.md, Stability; `s + k mu = 1`
 //! for the flat model). Explicit Euler is stable for `h |l2| <= 2`, RK4 for `h |l2| <= 2.785`
@@ -24,10 +23,10 @@ mod fixed;
 mod release;
 pub mod system;
 
+pub(crate) use release::release_time_s;
 pub use release::scan_first_time_above;
 
 use crate::Real;
-use crate::particle::{Model, Scene, SceneError};
 
 /// A bowl speed that may change in time.
 pub trait OmegaProfile<T> {
@@ -198,25 +197,8 @@ pub enum Method<T> {
 pub struct Limits<T> {
     /// Stop (with [`OdeOutcome::NotLeftBy`]) if the particle is still in the bowl at this time, s.
     pub horizon_s: T,
-    /// At most this many steps (accepted and rejected) before [`OdeError::StepLimit`].
+    /// At most this many steps (accepted and rejected) before [`StepError::StepLimit`].
     pub max_steps: u32,
-}
-
-impl<T: Real> Limits<T> {
-    /// 1000 time constants `1/(k omega_max)` (a constant-speed particle that moves at all
-    /// leaves within about 40 in f64), and a million steps.
-    pub fn for_scene<P: OmegaProfile<T>>(scene: &Scene<T>, profile: &P) -> Self {
-        let rate = scene.k2.sqrt() * profile.max_omega_rad_s();
-        let horizon = if rate > T::ZERO {
-            T::from_f64(1000.0) / rate
-        } else {
-            T::from_f64(1000.0)
-        };
-        Self {
-            horizon_s: horizon,
-            max_steps: 1_000_000,
-        }
-    }
 }
 
 /// How a run ended.
@@ -260,219 +242,106 @@ pub struct Report<T> {
     pub rejected_steps: u32,
 }
 
-/// Why a run returned no result.
+/// Why a run of a [`SecondOrder`] equation returned no result.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum OdeError {
-    /// The scene was invalid.
-    Scene(SceneError),
-    /// The step (or a tolerance, or the horizon) was NaN, infinite, zero or negative.
+pub enum StepError {
+    /// The step (or a tolerance) was NaN, infinite, zero or negative.
     InvalidStep,
-    /// The fixed step exceeds the method's stability limit at the fastest speed reached: the
-    /// result would be numerical garbage (growing oscillation), so none is returned.
+    /// The fixed step exceeds the method's stability limit at the fastest rate: the result
+    /// would be numerical garbage (growing oscillation), so none is returned.
     BeyondStabilityLimit,
-    /// The step cap was reached before the rim or the horizon (step too small, or the adaptive
-    /// step collapsed).
+    /// The step cap was reached before the target or the horizon.
     StepLimit,
-    /// The profile gave a NaN, infinite or negative omega.
+    /// The equation's input (the speed profile) gave a NaN, infinite or negative value.
     InvalidOmega,
-    /// The state overflowed (a speed far outside the scene's scale).
+    /// The state overflowed.
     NotFinite,
 }
 
-/// The right-hand side, with the model and friction rules; counts its evaluations.
-pub(crate) struct Rhs<'a, T, P> {
-    pub k2: T,
-    pub mu_g: T,
-    /// `2 mu` for Coriolis, 0 for flat.
-    pub two_mu_c: T,
-    pub profile: &'a P,
-    pub evaluations: u32,
+/// A second-order equation in one coordinate, `r'' = f(t, r, r')`, as [`run_to`] integrates it.
+pub trait SecondOrder<T> {
+    /// `(r', r'')` at `(t, r, r')`; counts the evaluation.
+    fn eval(&mut self, t: T, r: T, v: T) -> Result<(T, T), StepError>;
+    /// One semi-implicit Euler step of `h` from `(t, r, v)`: `(r, v)` after it (the velocity
+    /// first, with whatever the equation takes implicitly, then the position with the new
+    /// velocity).
+    fn semi_implicit(&mut self, t: T, r: T, v: T, h: T) -> Result<(T, T), StepError>;
+    /// The first time after `t` where the right-hand side has a kink (a logged trace's next
+    /// sample): the adaptive method ends a step there.
+    fn next_kink_after_s(&self, t: T) -> Option<T>;
 }
 
-impl<T: Real, P: OmegaProfile<T>> Rhs<'_, T, P> {
-    /// `(r', r'')` at `(t, r, v)`; 0 while friction holds the particle at rest.
-    pub fn eval(&mut self, t: T, r: T, v: T) -> Result<(T, T), OdeError> {
-        self.evaluations = self.evaluations.saturating_add(1);
-        let w = self.omega(t)?;
-        let push = r * w * w;
-        if v <= T::ZERO && push <= self.mu_g {
-            return Ok((T::ZERO, T::ZERO));
-        }
-        Ok((v, self.k2 * (push - self.mu_g - self.two_mu_c * w * v)))
-    }
-
-    pub fn omega(&self, t: T) -> Result<T, OdeError> {
-        let w = self.profile.omega_rad_s(t);
-        if w.is_nonneg_finite() {
-            Ok(w)
-        } else {
-            Err(OdeError::InvalidOmega)
-        }
-    }
+/// Where a run of [`run_to`] ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Crossing<T> {
+    /// `r` reached the target at time `t_s` with velocity `v` (located on the interpolant).
+    Reached {
+        /// Time, s.
+        t_s: T,
+        /// `r'` there.
+        v: T,
+    },
+    /// The horizon came first, with `r` there.
+    Horizon {
+        /// Where `r` was.
+        r: T,
+    },
 }
 
-/// Integrates one scene with a speed profile (`scene.omega_rad_s` is ignored) until the rim,
-/// the horizon or a limit.
-pub fn integrate<T: Real, P: OmegaProfile<T>>(
-    scene: &Scene<T>,
-    model: Model,
-    profile: &P,
+/// What [`run_to`] returns: the crossing and the steps it took.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stepped<T> {
+    /// How it ended.
+    pub ended: Crossing<T>,
+    /// Steps taken, accepted and rejected.
+    pub steps: u32,
+    /// Steps rejected by the error control (DP54 only).
+    pub rejected_steps: u32,
+}
+
+/// Integrates `equation` with `method` from `(t_start, r0, r' = 0)` until `r` reaches `target`
+/// or the limits; `stiff_rate` (the fastest decay rate, 1/s) sets the stability check of the
+/// fixed-step methods and DP54's first step.
+pub fn run_to<T: Real, S: SecondOrder<T>>(
+    equation: &mut S,
     method: Method<T>,
+    stiff_rate: T,
     limits: Limits<T>,
-) -> Result<Report<T>, OdeError> {
-    scene.validate_except_omega().map_err(OdeError::Scene)?;
-    if !(limits.horizon_s > T::ZERO && limits.horizon_s.is_finite()) {
-        return Err(OdeError::InvalidStep);
-    }
-    let positive = |x: T| x > T::ZERO && x.is_finite();
-    let method_ok = match method {
-        Method::Euler { step_s }
-        | Method::SemiImplicitEuler { step_s }
-        | Method::Rk4 { step_s } => positive(step_s),
-        Method::Dp54 { rtol, atol } => positive(rtol) && positive(atol),
-    };
-    if !method_ok {
-        return Err(OdeError::InvalidStep);
-    }
-    let w_max = profile.max_omega_rad_s();
-    if !w_max.is_nonneg_finite() {
-        return Err(OdeError::InvalidOmega);
-    }
-    let mut rhs = Rhs {
-        k2: scene.k2,
-        mu_g: scene.mu * scene.g_m_s2,
-        two_mu_c: match model {
-            Model::Flat => T::ZERO,
-            Model::Coriolis => T::TWO * scene.mu,
-        },
-        profile,
-        evaluations: 0,
-    };
-    let w0 = rhs.omega(T::ZERO)?;
-    let done = |outcome| Report {
-        outcome,
-        rhs_evaluations: 0,
-        steps: 0,
-        rejected_steps: 0,
-    };
-    if scene.ri_m >= scene.rim_radius_m {
-        return Ok(done(OdeOutcome::AlreadyAtRim {
-            exit_total_velocity_m_s: w0 * scene.rim_radius_m,
-        }));
-    }
-    if profile.is_constant() && scene.ri_m * w0 * w0 <= rhs.mu_g {
-        return Ok(done(OdeOutcome::NeverLeaves));
-    }
-    let stiff_rate = stiff_rate_per_s(scene, model, w_max);
-    let Some(t_start) = start_time_s(scene, profile, stiff_rate, limits) else {
-        return Ok(done(OdeOutcome::NotLeftBy {
-            horizon_s: limits.horizon_s,
-            radius_m: scene.ri_m,
-        }));
+    t_start: T,
+    r0: T,
+    target: T,
+) -> Result<Stepped<T>, StepError> {
+    let start = fixed::Start {
+        t_s: t_start,
+        r: r0,
+        target,
     };
     match method {
         Method::Euler { step_s } => fixed::run(
-            &mut rhs,
-            scene,
+            equation,
             fixed::Scheme::Euler,
             step_s,
             stiff_rate,
             limits,
-            t_start,
+            start,
         ),
         Method::SemiImplicitEuler { step_s } => fixed::run(
-            &mut rhs,
-            scene,
+            equation,
             fixed::Scheme::SemiImplicit,
             step_s,
             stiff_rate,
             limits,
-            t_start,
+            start,
         ),
         Method::Rk4 { step_s } => fixed::run(
-            &mut rhs,
-            scene,
+            equation,
             fixed::Scheme::Rk4,
             step_s,
             stiff_rate,
             limits,
-            t_start,
+            start,
         ),
-        Method::Dp54 { rtol, atol } => {
-            dp54::run(&mut rhs, scene, rtol, atol, stiff_rate, limits, t_start)
-        }
+        Method::Dp54 { rtol, atol } => dp54::run(equation, rtol, atol, stiff_rate, limits, start),
     }
 }
-
-/// The fastest decay rate `|l2|` at the fastest speed `w_max`, 1/s: `k omega (s + k mu)` for
-/// the Coriolis model, `k omega` for the flat one (docs/model.md, Stability).
-pub(crate) fn stiff_rate_per_s<T: Real>(scene: &Scene<T>, model: Model, w_max: T) -> T {
-    let k = scene.k2.sqrt();
-    let m = match model {
-        Model::Flat => T::ZERO,
-        Model::Coriolis => k * scene.mu,
-    };
-    k * w_max * ((T::ONE + m * m).sqrt() + m)
-}
-
-/// Where [`integrate`] starts: static friction holds the particle at `ri` until the push first
-/// exceeds it, and the run starts there, where the solution is smooth (release.rs); `None`
-/// when that is beyond the horizon. The scan for the crossing looks every tenth of the fastest
-/// time scale (`stiff_rate`, 1/s); a closed-form profile needs no scan.
-pub(crate) fn start_time_s<T: Real, P: OmegaProfile<T>>(
-    scene: &Scene<T>,
-    profile: &P,
-    stiff_rate: T,
-    limits: Limits<T>,
-) -> Option<T> {
-    let scan_step = if stiff_rate > T::ZERO {
-        T::from_f64(0.1) / stiff_rate
-    } else {
-        limits.horizon_s * T::from_f64(1e-3)
-    };
-    let mu_g = scene.mu * scene.g_m_s2;
-    release::release_time_s(profile, scene.ri_m, mu_g, limits.horizon_s, scan_step)
-}
-
-/// [`integrate`] at the scene's own constant speed with [`Limits::for_scene`].
-pub fn integrate_constant<T: Real>(
-    scene: &Scene<T>,
-    model: Model,
-    method: Method<T>,
-) -> Result<Report<T>, OdeError> {
-    let profile = ConstantOmega(scene.omega_rad_s);
-    if !scene.omega_rad_s.is_nonneg_finite() {
-        return Err(OdeError::Scene(SceneError::InvalidOmega));
-    }
-    integrate(
-        scene,
-        model,
-        &profile,
-        method,
-        Limits::for_scene(scene, &profile),
-    )
-}
-
-/// The exit record once the crossing is located.
-pub(crate) fn leaves<T: Real, P: OmegaProfile<T>>(
-    rhs: &Rhs<'_, T, P>,
-    scene: &Scene<T>,
-    t: T,
-    v: T,
-) -> Result<OdeOutcome<T>, OdeError> {
-    let w = rhs.omega(t)?;
-    let tangential = w * scene.rim_radius_m;
-    let total = (v * v + tangential * tangential).sqrt();
-    if !(t.is_finite() && v.is_finite() && total.is_finite()) {
-        return Err(OdeError::NotFinite);
-    }
-    Ok(OdeOutcome::Leaves {
-        residence_time_s: t,
-        exit_radial_velocity_m_s: v,
-        exit_total_velocity_m_s: total,
-    })
-}
-
-#[cfg(test)]
-mod tests;

@@ -1,5 +1,5 @@
 //! The project's integrators for a system of `N` first-order equations `y' = f(t, y)` (the
-//! rolling granule of [`crate::particle::rolling`]): adaptive Dormand-Prince 5(4) with its dense
+//! rolling granule of `particle::rolling`, which implements it): adaptive Dormand-Prince 5(4) with its dense
 //! output (the same tableau and step control as the radial model's, `ode/dp54.rs`) and classical
 //! RK4 at a fixed step with cubic Hermite interpolation. Both stop at the first zero of an event
 //! function (the rim), located on the interpolant, so `T` keeps the method's order; a check

@@ -10,38 +10,28 @@
 //! path with its lane's time, which is the one-scene time bit for bit (the same operations in
 //! the same order, no contraction), every other one by the one-scene path itself.
 
+use super::batch::{Costly, LANES};
 use super::coriolis::{LocalRoot, PERTURBATIVE_M, local_root_parts};
 use super::{Model, Scene, SceneError, Shape, residence_time_s};
 use crate::Real;
 use crate::real::exp::phi_terms_f64;
 
-/// Scenes per group: two AVX2 registers of f64, enough to hide the latency of the divisions
-/// and square roots.
-const LANES: usize = 8;
-
 /// Largest `|z|` whose `e^z` the lanes compute ([`Real::exp_in_domain`]).
 const EXP_DOMAIN: f64 = 700.0;
 
-/// [`residence_time_s`] with [`Model::Coriolis`] for every f64 scene, into `out` (as many
-/// answers as both have). Inlined so that a caller compiled for wider SIMD (the host's AVX2
-/// path) compiles the lanes for it too. (The same frame as `flat_batch::times_s`, written out:
-/// shared through a generic helper taking the lanes as a closure, both batches lost their SIMD
-/// code, 5.8 -> 9.4 ns a flat scene and 38 -> 113 ns a Coriolis one.)
-#[inline(always)]
-pub(crate) fn times_s<T: Real>(scenes: &[Scene<T>], out: &mut [Result<T, SceneError>]) {
-    let n = scenes.len().min(out.len());
-    let (scenes, out) = (&scenes[..n], &mut out[..n]);
-    let mut groups = scenes.chunks_exact(LANES);
-    let mut answers = out.chunks_exact_mut(LANES);
-    for (group, answer) in (&mut groups).zip(&mut answers) {
-        lanes(group, answer);
-    }
-    for (scene, answer) in groups
-        .remainder()
-        .iter()
-        .zip(answers.into_remainder().iter_mut())
-    {
-        *answer = residence_time_s(scene, Model::Coriolis);
+/// The Coriolis model's costly lanes for [`super::batch::times_s`] (f64: the f32 batch follows
+/// the one-scene search, see [`super::residence_times_s`]).
+pub(crate) struct Coriolis;
+
+impl Costly for Coriolis {
+    const MODEL: Model = Model::Coriolis;
+
+    #[inline(always)]
+    fn lanes<T: Real>(
+        group: &[Scene<T>; LANES],
+        out: &mut [Result<T, SceneError>; LANES],
+    ) -> usize {
+        lanes(group, out)
     }
 }
 
@@ -58,10 +48,10 @@ fn phi_expm1<T: Real>(z: T) -> (T, T) {
     }
 }
 
-/// One group of exactly [`LANES`] scenes; returns how many the lanes answered (the others
-/// went to the one-scene path).
+/// One group of exactly [`LANES`] scenes; returns how many leave on the lanes' path (the
+/// others are at the rim, held, or went to the one-scene path).
 #[inline(always)]
-fn lanes<T: Real>(group: &[Scene<T>], out: &mut [Result<T, SceneError>]) -> usize {
+fn lanes<T: Real>(group: &[Scene<T>; LANES], out: &mut [Result<T, SceneError>; LANES]) -> usize {
     let mut time = [T::ZERO; LANES];
     let mut regular = [false; LANES];
     for ((scene, time), regular) in group.iter().zip(&mut time).zip(&mut regular) {
@@ -98,16 +88,12 @@ fn lanes<T: Real>(group: &[Scene<T>], out: &mut [Result<T, SceneError>]) -> usiz
         let u_end = if converged { next } else { root };
         *time = u_end / (shape.c1 * omega);
         // `&`, not `&&`: every test on every lane, no branch.
-        let valid = scene.mu.is_nonneg_finite()
-            & scene.g_m_s2.is_nonneg_finite()
-            & scene.k2.is_in_unit_interval()
-            & scene.ri_m.is_nonneg_finite()
-            & scene.rim_radius_m.is_nonneg_finite()
-            & omega.is_nonneg_finite();
+        let valid = scene.is_valid();
+        let inside = scene.ri_m < scene.rim_radius_m;
         let exp_domain = T::from_f64(EXP_DOMAIN);
         *regular = valid
             & (omega > T::ZERO)
-            & (scene.ri_m < scene.rim_radius_m)
+            & inside
             & (scene.ri_m > a)
             & (m <= T::ONE)
             & shape.q.is_finite()
@@ -142,7 +128,6 @@ fn lanes<T: Real>(group: &[Scene<T>], out: &mut [Result<T, SceneError>]) -> usiz
 mod tests {
     extern crate std;
     use super::*;
-    use std::vec::Vec;
 
     /// The rig's scenes (mu up to 0.1, the equilibrium radius 2..92 % of the rim's, released
     /// anywhere between) stay on the lanes' path, each with the one-scene answer bit for bit:
@@ -155,22 +140,20 @@ mod tests {
         let mut answered = 0;
         let groups = 200;
         for _ in 0..groups {
-            let group: Vec<Scene<f64>> = (0..LANES)
-                .map(|_| {
-                    // The equilibrium radius a share of the rim's, the release between them.
-                    let rim_radius_m = 0.05 + 0.25 * next();
-                    let a = rim_radius_m * (0.02 + 0.9 * next());
-                    let mu = 0.1 * next();
-                    Scene {
-                        omega_rad_s: (mu * 9.81 / a).sqrt(),
-                        mu,
-                        g_m_s2: 9.81,
-                        k2: 5.0 / 7.0,
-                        ri_m: a + (rim_radius_m - a) * (0.01 + 0.98 * next()),
-                        rim_radius_m,
-                    }
-                })
-                .collect();
+            let group: [Scene<f64>; LANES] = core::array::from_fn(|_| {
+                // The equilibrium radius a share of the rim's, the release between them.
+                let rim_radius_m = 0.05 + 0.25 * next();
+                let a = rim_radius_m * (0.02 + 0.9 * next());
+                let mu = 0.1 * next();
+                Scene {
+                    omega_rad_s: (mu * 9.81 / a).sqrt(),
+                    mu,
+                    g_m_s2: 9.81,
+                    k2: 5.0 / 7.0,
+                    ri_m: a + (rim_radius_m - a) * (0.01 + 0.98 * next()),
+                    rim_radius_m,
+                }
+            });
             let mut out = [Ok(-1.0); LANES];
             answered += lanes(&group, &mut out);
             for (s, got) in group.iter().zip(&out) {

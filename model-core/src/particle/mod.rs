@@ -21,16 +21,20 @@
 //! paper's own "correction factor" 0.029 (docs/model.md §5, "The parameter problem"); 0.4 stays
 //! reachable and then gives [`Outcome::NeverLeaves`].
 
+mod batch;
 pub mod bowl;
 mod coriolis;
 mod coriolis_batch;
 mod flat;
 mod flat_batch;
 mod inverse;
+pub mod named_scenes;
 mod phi;
+pub(crate) mod radial;
 pub mod rolling;
 
 pub use inverse::{InverseError, omega_for_residence_time};
+pub use radial::{OdeError, integrate, integrate_constant};
 
 use crate::Real;
 use phi::phi_expm1;
@@ -100,6 +104,12 @@ pub enum SceneError {
     InvalidStartRadius,
     /// The rim radius was NaN, infinite or negative.
     InvalidRimRadius,
+    /// A valid input outside the magnitudes the model computes with ([`magnitude_limits`]:
+    /// nonzero and below `1e-75` or above `1e75` in f64, `1e-9` and `1e9` in f32): products of
+    /// up to four inputs (`mu g / omega^2`, `(omega R)^2`) would underflow or overflow, and the
+    /// answer could come out the wrong way round (leaves for never leaves, an exit speed below
+    /// the radial one). Refused rather than answered; rescale the units (or pass 0).
+    ExtremeMagnitude(Input),
     /// The time was NaN, infinite or negative.
     InvalidTime,
     /// The inputs are valid but a result (or an intermediate of it) overflows the number type,
@@ -108,6 +118,44 @@ pub enum SceneError {
     /// The root finder for the residence time did not converge: no result rather than a wrong
     /// one (not seen on any tested input; it would be a defect).
     NoConvergence,
+}
+
+/// One input of a [`Scene`], as a refusal names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Input {
+    /// `omega_rad_s`.
+    Omega,
+    /// `mu`.
+    Resistance,
+    /// `g_m_s2`.
+    Gravity,
+    /// `k2`.
+    K2,
+    /// `ri_m`.
+    StartRadius,
+    /// `rim_radius_m`.
+    RimRadius,
+}
+
+/// The smallest and the largest nonzero magnitude of a scene's inputs (`1e-75`, `1e75` in f64;
+/// `1e-9`, `1e9` in f32): products of four of them stay normal numbers (`1e-300` to `1e300`
+/// in f64, with room for the rounding of a difference; `1e-36` to `1e36` in f32), so the
+/// equilibrium radius `a = mu g / omega^2`, `ri omega^2` and the squares of the exit speeds
+/// (paper Eq. 12) never underflow or overflow. Zero itself is exact and always accepted.
+pub fn magnitude_limits<T: Real>() -> (T, T) {
+    if T::is_single_precision() {
+        (T::from_f64(1e-9), T::from_f64(1e9))
+    } else {
+        (T::from_f64(1e-75), T::from_f64(1e75))
+    }
+}
+
+/// `x` is 0 or within [`magnitude_limits`] (false for NaN, infinities and negative values).
+#[inline(always)]
+fn within_magnitudes<T: Real>(x: T) -> bool {
+    let (low, high) = magnitude_limits::<T>();
+    (x == T::ZERO) | ((x >= low) & (x <= high))
 }
 
 /// The result of [`residence`]. Never NaN; the three physical cases are explicit.
@@ -181,13 +229,34 @@ fn nonneg_finite<T: Real>(x: T) -> bool {
 }
 
 impl<T: Real> Scene<T> {
-    /// Checks every parameter: finite and non-negative, `k2` in (0, 1].
+    /// Checks every parameter: finite and non-negative, `k2` in (0, 1], each 0 or within
+    /// [`magnitude_limits`].
     pub fn validate(&self) -> Result<(), SceneError> {
         self.validate_except_omega()?;
         if !nonneg_finite(self.omega_rad_s) {
             return Err(SceneError::InvalidOmega);
         }
+        if !within_magnitudes(self.omega_rad_s) {
+            return Err(SceneError::ExtremeMagnitude(Input::Omega));
+        }
         Ok(())
+    }
+
+    /// All of [`Scene::validate`]'s tests as one value, no branch: the batch's lanes
+    /// (`batch.rs`) pass a scene for which it is true on, and hand every other one to the
+    /// one-scene path, which names the refusal.
+    #[inline(always)]
+    pub(crate) fn is_valid(&self) -> bool {
+        // The window alone is the test: NaN, infinities and negative values fall outside it
+        // (-0 is 0). `&`, not `&&`: every test on every lane, float compares only.
+        let (low, _) = magnitude_limits::<T>();
+        within_magnitudes(self.mu)
+            & within_magnitudes(self.g_m_s2)
+            & (self.k2 >= low)
+            & (self.k2 <= T::ONE)
+            & within_magnitudes(self.ri_m)
+            & within_magnitudes(self.rim_radius_m)
+            & within_magnitudes(self.omega_rad_s)
     }
 
     /// As [`Scene::validate`] but ignores `omega_rad_s` (the inverse solves for it).
@@ -206,6 +275,17 @@ impl<T: Real> Scene<T> {
         }
         if !nonneg_finite(self.rim_radius_m) {
             return Err(SceneError::InvalidRimRadius);
+        }
+        for (value, input) in [
+            (self.mu, Input::Resistance),
+            (self.g_m_s2, Input::Gravity),
+            (self.k2, Input::K2),
+            (self.ri_m, Input::StartRadius),
+            (self.rim_radius_m, Input::RimRadius),
+        ] {
+            if !within_magnitudes(value) {
+                return Err(SceneError::ExtremeMagnitude(input));
+            }
         }
         Ok(())
     }
@@ -424,10 +504,10 @@ pub fn residence_times_s<T: Real>(
     out: &mut [Result<T, SceneError>],
 ) {
     match model {
-        Model::Flat => flat_batch::times_s(scenes, out),
+        Model::Flat => batch::times_s::<T, flat_batch::Flat>(scenes, out),
         // The lanes follow the f64 search (f32 takes no expansion step, see `coriolis`).
         Model::Coriolis if T::is_single_precision() => coriolis::times_s(scenes, out),
-        Model::Coriolis => coriolis_batch::times_s(scenes, out),
+        Model::Coriolis => batch::times_s::<T, coriolis_batch::Coriolis>(scenes, out),
     }
 }
 

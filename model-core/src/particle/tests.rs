@@ -433,34 +433,43 @@ proptest! {
     }
 }
 
-/// Paper Eq. 12 at magnitudes where `r'^2` overflows f32 but the total speed does not: the
-/// total must come out, not an out-of-range error.
+/// Paper Eq. 12 at the largest magnitudes taken in f32 ([`magnitude_limits`]: omega and the
+/// radii up to 1e9): the squares of the speeds stay within f32 and the total comes out; the
+/// magnitudes where `r'^2` overflowed f32 (omega 1e19) are refused.
 #[test]
-fn total_exit_speed_does_not_overflow_in_its_squares() {
+fn total_exit_speed_at_the_largest_magnitudes() {
     let s = Scene::<f32> {
-        omega_rad_s: 1e19,
+        omega_rad_s: 1e9,
         mu: 0.0,
         g_m_s2: 9.81,
         k2: 5.0 / 7.0,
-        ri_m: 1.0,
-        rim_radius_m: 2.0,
+        ri_m: 1e9 / 2.0,
+        rim_radius_m: 1e9,
     };
-    // r' = (ri - a) k omega sinh(k omega T) = k omega sqrt(3) ~ 1.46e19, omega R = 2e19: each
-    // square is ~1e38..4e38, their sum overflows f32 (3.4e38); the total is ~2.5e19.
+    // r' = k omega sqrt(R^2 - ri^2) (mu = 0), omega R = 1e18: the total is their hypotenuse.
     match residence(&s, Model::Flat) {
         Ok(Outcome::Leaves {
             exit_radial_velocity_m_s: v,
             exit_total_velocity_m_s: total,
             ..
         }) => {
-            let expected = (f64::from(v).powi(2) + 4e38).sqrt();
+            let expected = (f64::from(v).powi(2) + 1e36).sqrt();
             assert!(
                 ((f64::from(total) - expected) / expected).abs() < 1e-6,
                 "{total} vs {expected}"
             );
+            assert!(total >= v);
         }
         other => panic!("{other:?}"),
     }
+    let far = Scene {
+        omega_rad_s: 1e19,
+        ..s
+    };
+    assert_eq!(
+        residence(&far, Model::Flat),
+        Err(SceneError::ExtremeMagnitude(Input::Omega))
+    );
 }
 
 /// A target so long that only a speed within rounding of the threshold gives it (the largest
@@ -500,18 +509,20 @@ fn inverse_refuses_targets_beyond_the_precision() {
     }
 }
 
-/// A start radius (or `ri - a`) so small that `x = (R - ri)/(ri - a)` overflows: the Coriolis
-/// model must answer as the flat one does (it once returned OutOfRange). Reference: for such `x`,
-/// `e^{-q u}` vanishes and `F(u) = x` gives `u = ln(x / A)`, so at `mu -> 0` (`A = 1/2`)
-/// `T = ln(2 (R - ri)/(ri - a)) / (k omega)`, formed here with logarithms of the parts.
+/// A start radius (or `ri - a`) so small that `x = (R - ri)/(ri - a)` is beyond `1/epsilon`,
+/// down to the smallest magnitude taken ([`magnitude_limits`]): the Coriolis model must answer
+/// as the flat one does (it once returned OutOfRange where `x` overflowed). Reference: for such
+/// `x`, `e^{-q u}` vanishes and `F(u) = x` gives `u = ln(x / A)`, so at `mu -> 0` (`A = 1/2`)
+/// `T = ln(2 (R - ri)/(ri - a)) / (k omega)`, formed here with logarithms of the parts. A
+/// subnormal start radius, where `x` itself would overflow, is refused.
 #[test]
-fn coriolis_copes_with_subnormal_start_radius() {
+fn coriolis_copes_with_the_smallest_start_radius() {
     let (omega, g, k2, rim) = (10.0f64, 9.81, 5.0 / 7.0, 0.1);
     for (ri, mu) in [
-        (1e-310f64, 0.0),
-        (5e-324, 0.0),
-        (1e-310, 1e-320),
-        (1e-300, 1e-302),
+        (1e-75f64, 0.0),
+        (3e-70, 0.0),
+        (1e-70, 1e-75),
+        (1e-60, 1e-62),
     ] {
         let s = Scene {
             omega_rad_s: omega,
@@ -536,7 +547,14 @@ fn coriolis_copes_with_subnormal_start_radius() {
             );
         }
     }
-    for ri in [1e-40f32, 1e-45] {
+    for ri in [1e-310f64, 5e-324] {
+        let s = scene(omega, 0.0, ri, rim);
+        assert_eq!(
+            residence(&s, Model::Coriolis),
+            Err(SceneError::ExtremeMagnitude(Input::StartRadius))
+        );
+    }
+    for ri in [1e-9f32, 3e-9] {
         let s = Scene {
             omega_rad_s: 10.0f32,
             mu: 0.0,

@@ -179,34 +179,12 @@ pub fn family_step(seed: u32, index: u32, feedback: bool) -> StepOutcome {
     )
 }
 
-/// Holds `speed_rad_s` on both axes of the nominal rig with `pulses` per revolution and no
+/// At control tick rate `tick_hz` (the physics keeps a step of 250 us or less), holds
+/// `speed_rad_s` on both axes of the nominal rig with `pulses` per revolution and no
 /// disturbances (no ripple, ideal sensor), the controller given the true model; after
 /// `settle_s`, measures the spin axis's true speed for `measure_s`. `per_pulse_bandwidth`
 /// sets the loop gain; with `scheduled == false` the bandwidth is fixed at what the schedule
 /// gives at 3 rad/s (no reduction at low pulse rates). Returns the report and any fault.
-pub fn low_speed_hold(
-    seed: u32,
-    pulses: u16,
-    speed_rad_s: f32,
-    per_pulse_bandwidth: f32,
-    scheduled: bool,
-    settle_s: f32,
-    measure_s: f32,
-) -> (StepReport, Option<Fault>) {
-    low_speed_hold_at_rate(
-        1000,
-        seed,
-        pulses,
-        speed_rad_s,
-        per_pulse_bandwidth,
-        scheduled,
-        settle_s,
-        measure_s,
-    )
-}
-
-/// [`low_speed_hold`] at control tick rate `tick_hz` (the physics keeps a step of 250 us or
-/// less).
 #[allow(clippy::too_many_arguments)]
 pub fn low_speed_hold_at_rate(
     tick_hz: u32,

@@ -14,6 +14,7 @@
 
 use crate::particle::Model;
 use crate::sim::prng::Prng;
+use crate::wire::{ParamId, ParamValues};
 
 /// Gravity, m/s^2 (the value the particle model defaults to).
 pub const G_M_S2: f64 = 9.81;
@@ -97,6 +98,23 @@ impl ParticleParams {
             });
         }
         Ok(())
+    }
+
+    /// A simulated rig's parameter table describes its own bowl, as an engineer sets a real
+    /// rig's (docs/bring-up.md): the start radius, rim radius and k2 of the granules these
+    /// parameters drop. Its mu stays the table's (`MU_PPM`, the model's guess): that is the
+    /// truth an experiment has to find. Values outside a parameter's range are held at its
+    /// limit.
+    pub fn describe_bowl(&self, params: &mut ParamValues) {
+        for (id, value) in [
+            (ParamId::StartUm, self.release_radius_m),
+            (ParamId::RimUm, self.rim_radius_m),
+            (ParamId::K2Ppm, self.k2),
+        ] {
+            let (lo, hi) = id.range();
+            let micro = libm::round(value * 1e6).clamp(f64::from(lo), f64::from(hi));
+            params[id.index()] = micro as i32;
+        }
     }
 
     /// One granule drawn from the spreads: `mu` and the start radius Gaussian, clamped to be

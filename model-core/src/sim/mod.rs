@@ -8,6 +8,7 @@
 //! Left out on purpose: PWM ripple (20 kHz, averaged), gyroscopic torques between the axes
 //! (second order at these speeds), gearbox backlash.
 
+pub mod assembly;
 pub mod experiments;
 pub mod gates;
 pub mod granule;
@@ -16,6 +17,7 @@ pub mod motor;
 pub mod plant;
 pub mod prng;
 
+pub use assembly::{ASSEMBLY_COMMISSION_MAX_S, AssemblyError, commission_on_plant};
 pub use harness::{ClosedLoop, SETTLING_BAND, StepMetrics, StepReport};
 pub use motor::{MotorParams, MotorState};
 pub use plant::{AxisFaults, AxisParams, Plant, PlantParams, SensorParams};

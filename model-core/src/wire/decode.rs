@@ -2,11 +2,13 @@
 //! checked (CRC, version, every field's range). The byte stream around it is
 //! [`super::stream::Decoder`].
 
+use super::commands::{Command, CommandKind, FieldProblem, MAX_FIELDS, parse_int};
 use super::crc::crc32;
-use super::{
-    AxisModel, Command, DeviceState, FaultCode, Frame, GateEvent, GateKind, Hello, Injection,
-    MODEL_FIELD_MAX, MotorTelemetry, PARAM_COUNT, ParamId, ParamValues, Reason, ResetCause,
-    Residence, ResidenceModel, Status, Telemetry,
+use super::frame::Frame;
+use super::params::{PARAM_COUNT, ParamId, ParamValues};
+use super::types::{
+    AxisModel, DeviceState, FaultCode, GateEvent, GateKind, Hello, MODEL_FIELD_MAX, MotorTelemetry,
+    Reason, ResetCause, Residence, ResidenceModel, Status, Telemetry,
 };
 use super::{FRAME_END, FRAME_START, LINE_END_CR, PROTOCOL_VERSION};
 
@@ -77,7 +79,7 @@ impl<'a> Fields<'a> {
     }
 
     fn int(&mut self, lo: i64, hi: i64) -> Result<i64, FieldError> {
-        let v = parse_int(self.next_token()?)?;
+        let v = parse_int(self.next_token()?).ok_or(FieldError::Malformed)?;
         if (lo..=hi).contains(&v) {
             Ok(v)
         } else {
@@ -91,35 +93,6 @@ impl<'a> Fields<'a> {
             Some(_) => Err(FieldError::Malformed),
         }
     }
-}
-
-/// Canonical decimal: optional `-`, 1 to 18 digits, no leading zero, no `-0`.
-fn parse_int(tok: &[u8]) -> Result<i64, FieldError> {
-    let (neg, digits) = match tok.split_first() {
-        Some((b'-', d)) => (true, d),
-        _ => (false, tok),
-    };
-    if digits.is_empty() || digits.len() > 18 {
-        return Err(FieldError::Malformed);
-    }
-    if digits.len() > 1 && digits[0] == b'0' {
-        return Err(FieldError::Malformed);
-    }
-    let mut v: i64 = 0;
-    for &d in digits {
-        if !d.is_ascii_digit() {
-            return Err(FieldError::Malformed);
-        }
-        // 18 digits < 9.2e18: no overflow.
-        v = v * 10 + i64::from(d - b'0');
-    }
-    if neg {
-        if v == 0 {
-            return Err(FieldError::Malformed);
-        }
-        v = -v;
-    }
-    Ok(v)
 }
 
 fn hex_value(b: u8) -> Option<u32> {
@@ -216,50 +189,19 @@ fn token_of<T: Copy>(tok: &[u8], all: &[T], token: fn(T) -> &'static str) -> Opt
     all.iter().copied().find(|&t| token(t).as_bytes() == tok)
 }
 
-/// Parses the command word and its arguments. Unknown words and parameters get their own
-/// reasons; a well-formed number outside its range is `Range`.
+/// Parses the command word and its fields, as the command table declares them. Unknown words
+/// and parameters get their own reasons; a well-formed number outside its range is `Range`.
 fn command(f: &mut Fields<'_>) -> Result<Command, Reason> {
-    let word = f.next_token().map_err(Reason::from)?;
-    let cmd = match word {
-        b"SPEED" => Command::SetSpeeds {
-            precession_mrad_s: i16_field(f)?,
-            spin_mrad_s: i16_field(f)?,
-        },
-        b"RTIME" => {
-            let model = match f.next_token()? {
-                b"FLAT" => ResidenceModel::Flat,
-                b"CORI" => ResidenceModel::Coriolis,
-                _ => return Err(Reason::Malformed),
-            };
-            Command::SetResidence {
-                model,
-                time_ms: f.int(1, 9_999_999)? as u32,
-            }
-        }
-        b"START" => Command::Start,
-        b"STOP" => Command::Stop,
-        b"CLEAR" => Command::ClearFault,
-        b"SET" => {
-            let id = ParamId::from_token(f.next_token()?).ok_or(Reason::UnknownParam)?;
-            Command::SetParam {
-                id,
-                value: param_value(f, id)?,
-            }
-        }
-        b"STATUS" => Command::GetStatus,
-        b"PARAMS" => Command::GetParams,
-        b"INJECT" => Command::Inject(
-            token_of(f.next_token()?, &Injection::ALL, Injection::token)
-                .ok_or(Reason::Malformed)?,
-        ),
-        b"PING" => Command::Ping,
-        b"COMMISSION" => Command::Commission,
-        b"MODELS" => Command::GetModels,
-        b"RELEASE" => Command::Release,
-        _ => return Err(Reason::UnknownCommand),
-    };
+    let kind = CommandKind::from_token(f.next_token()?).ok_or(Reason::UnknownCommand)?;
+    let mut values = [0i64; MAX_FIELDS];
+    let mut param = None;
+    for (slot, field) in values.iter_mut().zip(kind.fields()) {
+        *slot = field
+            .parse(f.next_token()?, &mut param, false)
+            .map_err(FieldProblem::reason)?;
+    }
     f.end()?;
-    Ok(cmd)
+    Command::from_values(kind, &values).ok_or(Reason::Malformed)
 }
 
 impl From<FieldError> for FrameError {
@@ -377,11 +319,8 @@ fn parse_payload(payload: &[u8]) -> Result<Frame, FrameError> {
         },
         b'W' => Frame::ResidenceSet {
             id: u16_field(&mut f)?,
-            model: match f.next_token()? {
-                b"FLAT" => ResidenceModel::Flat,
-                b"CORI" => ResidenceModel::Coriolis,
-                _ => return Err(FrameError::Malformed),
-            },
+            model: token_of(f.next_token()?, &ResidenceModel::ALL, ResidenceModel::token)
+                .ok_or(FrameError::Malformed)?,
             precession_mrad_s: i16_field(&mut f)?,
             spin_mrad_s: i16_field(&mut f)?,
         },

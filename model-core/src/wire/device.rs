@@ -2,13 +2,14 @@
 //! hardware: the firmware and the virtual rig both drive a [`Device`] over their own [`Backend`]
 //! (what the protocol needs from the controller).
 
+use super::commands::Command;
 use super::decode::FrameError;
 use super::encode::{EncodeError, encode};
+use super::frame::Frame;
 use super::params::{PARAM_COUNT, ParamId, ParamValues};
 use super::stream::Decoder;
 use super::types::{
-    AxisModel, Command, Frame, GateEvent, Hello, Injection, Reason, ResidenceModel, Status,
-    Telemetry,
+    AxisModel, GateEvent, Hello, Injection, Reason, ResidenceModel, Status, Telemetry,
 };
 use super::{MAX_FRAME_LEN, max_telemetry_hz};
 
@@ -256,14 +257,11 @@ impl Device {
     /// id and the words of one of the last [`RECENT_COMMANDS`] (sent within
     /// [`RESEND_HORIZON_MS`]) is a copy of it: a resend after a lost answer, or a late duplicate
     /// that arrives after newer commands. It gets the original answer again and is never carried
-    /// out a second time, so a late copy cannot undo what came after it. Queries (STATUS,
-    /// PARAMS, MODELS, PING) change nothing and are always answered afresh.
+    /// out a second time, so a late copy cannot undo what came after it. Queries (the rows of
+    /// the command table that change nothing: STATUS, PARAMS, MODELS, PING) are always answered
+    /// afresh.
     pub fn answer<B: Backend>(&mut self, backend: &mut B, id: u16, command: Command) -> Frame {
-        let query = matches!(
-            command,
-            Command::GetStatus | Command::GetParams | Command::GetModels | Command::Ping
-        );
-        if query {
+        if !command.kind().changes() {
             return self.execute(backend, id, command);
         }
         let now = self.now_ms;
@@ -365,7 +363,7 @@ impl Device {
                     values: self.params(backend),
                 };
             }
-            Command::Inject(what) => backend.inject(what),
+            Command::Inject { what } => backend.inject(what),
             // The host was heard when the command arrived (`receive`).
             Command::Ping => Ok(()),
             Command::Commission => backend.commission(),

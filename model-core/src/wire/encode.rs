@@ -1,9 +1,11 @@
 //! The encoder: a [`Frame`] to its text line `$K1,field,...*CRC32\n`, into a caller's buffer.
 
+use super::commands::{Command, FieldKind};
 use super::crc::crc32;
-use super::{
-    AxisModel, Command, DUTY_MAX_BP, Frame, MODEL_FIELD_MAX, MotorTelemetry, PARAM_COUNT, ParamId,
-    RESIDENCE_MAX_MS, Residence, Telemetry,
+use super::frame::Frame;
+use super::params::{PARAM_COUNT, ParamId};
+use super::types::{
+    AxisModel, DUTY_MAX_BP, MODEL_FIELD_MAX, MotorTelemetry, RESIDENCE_MAX_MS, Residence, Telemetry,
 };
 use super::{FRAME_END, FRAME_START, LINE_END_CR, MAX_FRAME_LEN, PROTOCOL_VERSION};
 
@@ -54,9 +56,18 @@ impl Out<'_> {
         if v < 0 {
             self.byte(b'-');
         }
-        let mut mag = v.unsigned_abs();
+        let mut wide = v.unsigned_abs();
         let mut digits = [0u8; 20];
         let mut n = 0;
+        // Every wire value fits in 32 bits, which the MCU divides in hardware (a 64-bit
+        // division is a library call, about 100 instructions a digit); a wider value's low
+        // digits take the 64-bit way first.
+        while wide > u64::from(u32::MAX) {
+            digits[n] = b'0' + (wide % 10) as u8;
+            n += 1;
+            wide /= 10;
+        }
+        let mut mag = wide as u32;
         loop {
             digits[n] = b'0' + (mag % 10) as u8;
             n += 1;
@@ -108,11 +119,7 @@ fn check_param(id: ParamId, v: i32) -> bool {
 fn fields_in_range(frame: &Frame) -> bool {
     match frame {
         Frame::Telemetry(t) => telemetry_in_range(t),
-        Frame::Command { command, .. } => match *command {
-            Command::SetResidence { time_ms, .. } => (1..=RESIDENCE_MAX_MS).contains(&time_ms),
-            Command::SetParam { id, value } => check_param(id, value),
-            _ => true,
-        },
+        Frame::Command { command, .. } => command.in_range(),
         Frame::Params { values, .. } => ParamId::ALL
             .iter()
             .zip(values.iter())
@@ -206,39 +213,26 @@ fn body(out: &mut Out<'_>, frame: &Frame) {
     }
 }
 
+/// The command's word and fields, as the command table declares them.
 fn command_body(out: &mut Out<'_>, command: &Command) {
-    match *command {
-        Command::SetSpeeds {
-            precession_mrad_s,
-            spin_mrad_s,
-        } => {
-            out.token("SPEED");
-            out.int(precession_mrad_s.into());
-            out.int(spin_mrad_s.into());
+    let kind = command.kind();
+    out.token(kind.token());
+    for (field, v) in kind.fields().iter().zip(command.values()) {
+        match field.kind {
+            FieldKind::Int { .. } | FieldKind::ParamValue => out.int(v),
+            FieldKind::Choice(tokens) => out.token(
+                usize::try_from(v)
+                    .ok()
+                    .and_then(|i| tokens.get(i))
+                    .unwrap_or(&""),
+            ),
+            FieldKind::ParamName => out.token(
+                usize::try_from(v)
+                    .ok()
+                    .and_then(|i| ParamId::ALL.get(i))
+                    .map_or("", |p| p.token()),
+            ),
         }
-        Command::SetResidence { model, time_ms } => {
-            out.token("RTIME");
-            out.token(model.token());
-            out.int(time_ms.into());
-        }
-        Command::Start => out.token("START"),
-        Command::Stop => out.token("STOP"),
-        Command::ClearFault => out.token("CLEAR"),
-        Command::SetParam { id, value } => {
-            out.token("SET");
-            out.token(id.token());
-            out.int(value.into());
-        }
-        Command::GetStatus => out.token("STATUS"),
-        Command::GetParams => out.token("PARAMS"),
-        Command::Inject(what) => {
-            out.token("INJECT");
-            out.token(what.token());
-        }
-        Command::Ping => out.token("PING"),
-        Command::Commission => out.token("COMMISSION"),
-        Command::GetModels => out.token("MODELS"),
-        Command::Release => out.token("RELEASE"),
     }
 }
 

@@ -11,23 +11,35 @@
 //! Numbers are scaled integers (no float formatting on the MCU). The longest telemetry frame is
 //! [`MAX_TELEMETRY_LEN`] bytes: 50 frames/s use 48 % of a 115 200 baud link.
 //!
-//! - [`types`]: the plain data (telemetry, commands, answers);
+//! - [`types`]: the plain data (telemetry, status, states, reasons);
 //! - [`params`]: the settable parameters, one table (token, unit, range, default);
+//! - [`commands`]: the commands, one table (token, fields with units and ranges, answer, the
+//!   states that allow it);
+//! - [`typed`]: [`Command::from_words`] (the words a person types) and the refusal words;
+//! - [`frame`]: a frame in either direction;
 //! - [`encode()`] and [`decode`]: the codec and the streaming [`Decoder`];
 //! - [`device`]: the rig's side (command dispatch, telemetry pacing) over the [`device::Backend`] trait.
 
+pub mod commands;
 pub mod crc;
 pub mod decode;
 pub mod device;
 pub mod encode;
+pub mod frame;
 pub mod params;
 pub mod stream;
+pub mod typed;
 pub mod types;
 
+pub use commands::{
+    Answer, COMMAND_COUNT, Command, CommandKind, Field, FieldKind, FieldProblem, MAX_FIELDS, States,
+};
 pub use decode::{FrameError, decode_frame, parse_command_line, parse_line};
 pub use encode::{EncodeError, encode};
+pub use frame::Frame;
 pub use params::*;
 pub use stream::{DecodeStats, Decoder, REORDER_FRAMES};
+pub use typed::Refusal;
 pub use types::*;
 
 /// The protocol version in every frame header (`$T1`): one decimal digit.

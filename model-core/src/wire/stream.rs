@@ -2,7 +2,8 @@
 //! each line to [`super::decode`] and keeps the statistics (frames good, corrupt, missing).
 
 use super::decode::{FrameError, parse_command_line, parse_line};
-use super::{FRAME_END, FRAME_START, Frame, LINE_END_CR, MAX_FRAME_LEN};
+use super::frame::Frame;
+use super::{FRAME_END, FRAME_START, LINE_END_CR, MAX_FRAME_LEN};
 
 /// Counters of a [`Decoder`]. Every byte fed is either in a good frame or in `bytes_skipped`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -3,9 +3,8 @@
 //! Every number is a scaled integer with its unit in its name (`_mrad_s` = milliradians per
 //! second, `_ms` = milliseconds, `_bp` = basis points, 1/10 000). Each enum has a fixed numeric or
 //! token form, listed in `docs/protocol.md`. The settable parameters are one table of their
-//! own: [`super::params`].
-
-use super::params::{ParamId, ParamValues};
+//! own: [`super::params`], the commands too: [`super::commands`]; the frames that carry
+//! them: [`super::frame`].
 
 /// Pulse-count, sequence-number and request-id fields wrap modulo 2^16.
 pub type Wrapping16 = u16;
@@ -219,54 +218,6 @@ pub enum Injection {
     StallSpin,
 }
 
-/// A command from the PC.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Command {
-    /// `SPEED,w1,w2`: set both motor setpoints, mrad/s (0 or up to the axis's SPEED_MAX).
-    SetSpeeds {
-        /// Precession setpoint omega1, mrad/s.
-        precession_mrad_s: i16,
-        /// Spin setpoint omega2, mrad/s.
-        spin_mrad_s: i16,
-    },
-    /// `RTIME,model,ms`: choose the bowl speed whose predicted residence time is `time_ms`.
-    SetResidence {
-        /// Which model the target refers to.
-        model: ResidenceModel,
-        /// Target residence time, ms (1..=RESIDENCE_MAX_MS).
-        time_ms: u32,
-    },
-    /// `START`: run the motors towards the setpoints.
-    Start,
-    /// `STOP`: ramp the motors down (always accepted).
-    Stop,
-    /// `CLEAR`: clear a fault (motors stay off).
-    ClearFault,
-    /// `SET,name,value`: set one parameter.
-    SetParam {
-        /// Which parameter.
-        id: ParamId,
-        /// The new value, in the parameter's unit.
-        value: i32,
-    },
-    /// `STATUS`: answered by a [`Status`] frame.
-    GetStatus,
-    /// `PARAMS`: answered by a PARAMS frame with every value.
-    GetParams,
-    /// `INJECT,what`: make the simulated rig misbehave.
-    Inject(Injection),
-    /// `PING`: a heartbeat; keeps the rig's host-silence watchdog from faulting.
-    Ping,
-    /// `COMMISSION`: run the motor identification routine (from Idle).
-    Commission,
-    /// `MODELS`: answered by a [`Frame::Models`] frame: the motor models and loop gains in force.
-    GetModels,
-    /// `RELEASE`: drop one granule at the start radius (the release solenoid; on a simulated
-    /// rig, a simulated granule). The gates report its release and exit as `E` frames.
-    Release,
-}
-
 /// One axis's motor model and speed-loop gains as the rig uses them (a `M` answer), scaled
 /// integers like every wire field.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -347,85 +298,6 @@ impl Reason {
     }
 }
 
-/// One decoded frame, in either direction.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Frame {
-    /// `$T1`: periodic telemetry (device to PC).
-    Telemetry(Telemetry),
-    /// `$H1`: boot announcement (device to PC).
-    Hello(Hello),
-    /// `$C1`: a command with its request id (PC to device).
-    Command {
-        /// Request id chosen by the PC, echoed in the answer.
-        id: Wrapping16,
-        /// The command.
-        command: Command,
-    },
-    /// `$A1`: the command with this id was done.
-    Ack {
-        /// Request id.
-        id: Wrapping16,
-    },
-    /// `$R1`: the command with this id was rejected and changed nothing.
-    Reject {
-        /// Request id (0 if the command was too broken to read one).
-        id: Wrapping16,
-        /// Why.
-        reason: Reason,
-    },
-    /// `$S1`: the answer to STATUS.
-    Status {
-        /// Request id.
-        id: Wrapping16,
-        /// The status.
-        status: Status,
-    },
-    /// `$P1`: the answer to PARAMS, every value in [`ParamId::ALL`] order.
-    Params {
-        /// Request id.
-        id: Wrapping16,
-        /// The values.
-        values: ParamValues,
-    },
-    /// `$E1`: a gate event (device to PC).
-    Event(GateEvent),
-    /// `$W1`: the answer to RTIME: the model that answered (`FLAT` or `CORI`) and the motor
-    /// setpoints it chose, mrad/s.
-    ResidenceSet {
-        /// Request id.
-        id: Wrapping16,
-        /// The model that answered.
-        model: ResidenceModel,
-        /// Precession setpoint, mrad/s.
-        precession_mrad_s: i16,
-        /// Spin setpoint, mrad/s.
-        spin_mrad_s: i16,
-    },
-    /// `$M1`: the answer to MODELS, precession then spin.
-    Models {
-        /// Request id.
-        id: Wrapping16,
-        /// Per axis, precession then spin.
-        axes: [AxisModel; 2],
-    },
-}
-
-impl Frame {
-    /// The request id this frame answers, if it is an answer.
-    pub fn answer_id(&self) -> Option<Wrapping16> {
-        match *self {
-            Frame::Ack { id }
-            | Frame::Reject { id, .. }
-            | Frame::Status { id, .. }
-            | Frame::Params { id, .. }
-            | Frame::ResidenceSet { id, .. }
-            | Frame::Models { id, .. } => Some(id),
-            _ => None,
-        }
-    }
-}
-
 macro_rules! code_enum {
     ($ty:ident { $($variant:ident),* $(,)? }) => {
         impl $ty {
@@ -471,12 +343,15 @@ code_enum!(ResetCause {
 });
 
 impl ResidenceModel {
+    /// Every model, in the order of [`ResidenceModel::TOKENS`].
+    pub const ALL: [ResidenceModel; 2] = [ResidenceModel::Flat, ResidenceModel::Coriolis];
+
+    /// The wire tokens, in the order of [`ResidenceModel::ALL`].
+    pub const TOKENS: [&'static str; 2] = ["FLAT", "CORI"];
+
     /// The wire token.
     pub fn token(self) -> &'static str {
-        match self {
-            ResidenceModel::Flat => "FLAT",
-            ResidenceModel::Coriolis => "CORI",
-        }
+        Self::TOKENS[self as usize]
     }
 }
 
@@ -490,15 +365,12 @@ impl Injection {
         Injection::StallSpin,
     ];
 
+    /// The wire tokens, in the order of [`Injection::ALL`].
+    pub const TOKENS: [&'static str; 5] = ["NONE", "SENSOR1", "SENSOR2", "STALL1", "STALL2"];
+
     /// The wire token.
     pub fn token(self) -> &'static str {
-        match self {
-            Injection::None => "NONE",
-            Injection::SensorLostPrecession => "SENSOR1",
-            Injection::SensorLostSpin => "SENSOR2",
-            Injection::StallPrecession => "STALL1",
-            Injection::StallSpin => "STALL2",
-        }
+        Self::TOKENS[self as usize]
     }
 }
 

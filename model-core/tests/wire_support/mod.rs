@@ -4,6 +4,19 @@
 use model_core::wire::*;
 use proptest::prelude::*;
 
+/// Every frame a byte stream holds, and the decoder's counters after its end.
+pub fn decode_all(bytes: &[u8]) -> (Vec<Frame>, DecodeStats) {
+    let mut d = Decoder::new();
+    let mut frames = Vec::new();
+    d.push_slice(bytes, |r, _| {
+        if let Ok(f) = r {
+            frames.push(f)
+        }
+    });
+    d.finish();
+    (frames, *d.stats())
+}
+
 pub fn device_state() -> impl Strategy<Value = DeviceState> {
     (0i64..6).prop_map(|c| DeviceState::from_code(c).unwrap())
 }
@@ -89,7 +102,7 @@ pub fn command() -> impl Strategy<Value = Command> {
         param_value(id).prop_map(move |value| Command::SetParam { id, value })
     });
     prop_oneof![
-        (any::<i16>(), any::<i16>()).prop_map(|(p, s)| Command::SetSpeeds {
+        (0..=i16::MAX, 0..=i16::MAX).prop_map(|(p, s)| Command::SetSpeeds {
             precession_mrad_s: p,
             spin_mrad_s: s
         }),
@@ -105,7 +118,9 @@ pub fn command() -> impl Strategy<Value = Command> {
         Just(Command::Commission),
         Just(Command::GetModels),
         Just(Command::Release),
-        (0..Injection::ALL.len()).prop_map(|i| Command::Inject(Injection::ALL[i])),
+        (0..Injection::ALL.len()).prop_map(|i| Command::Inject {
+            what: Injection::ALL[i]
+        }),
     ]
 }
 

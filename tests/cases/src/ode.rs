@@ -3,8 +3,8 @@
 //! cost chart).
 
 use crate::check::{Bench, Case, Failure, close, ensure};
-use model_core::ode::{self, Method, OdeError, OdeOutcome};
-use model_core::particle::{Model, Outcome, Scene, residence};
+use model_core::ode::{Method, OdeOutcome};
+use model_core::particle::{self, Model, OdeError, Outcome, Scene, residence};
 
 /// Cases of this module.
 pub static CASES: &[Case] = &[
@@ -63,7 +63,7 @@ fn model(i: usize) -> Model {
 }
 
 fn bench(i: usize, method: Method<f32>) -> f32 {
-    match ode::integrate_constant(&Scene::<f32>::default(), model(i), method) {
+    match particle::integrate_constant(&Scene::<f32>::default(), model(i), method) {
         Ok(r) => match r.outcome {
             OdeOutcome::Leaves {
                 residence_time_s, ..
@@ -127,12 +127,12 @@ fn beyond_stability_refused() -> Result<(), Failure> {
     };
     ensure(
         "Euler h 0.8 s refused",
-        ode::integrate_constant(&s, Model::Flat, Method::Euler { step_s: 0.8 })
+        particle::integrate_constant(&s, Model::Flat, Method::Euler { step_s: 0.8 })
             == Err(OdeError::BeyondStabilityLimit),
     )?;
     ensure(
         "RK4 h 1.2 s refused",
-        ode::integrate_constant(&s, Model::Flat, Method::Rk4 { step_s: 1.2 })
+        particle::integrate_constant(&s, Model::Flat, Method::Rk4 { step_s: 1.2 })
             == Err(OdeError::BeyondStabilityLimit),
     )
 }

@@ -127,33 +127,27 @@ fn stored_motor_models_are_used_and_bad_ones_refused() {
     let Record {
         params, mut models, ..
     } = split_persisted(&default_persisted());
+    let boot = |models| {
+        ControllerBackend::new(
+            ControllerConfig::nominal(),
+            persisted(&Record {
+                params,
+                models,
+                identified: [false; AXES],
+            }),
+            hello,
+            NoInjection,
+        )
+    };
     models[0].time_constant_s = 0.11;
-    let (rig, ok) = ControllerBackend::new(
-        ControllerConfig::nominal(),
-        persisted(&Record {
-            params,
-            models,
-            identified: [false; AXES],
-        }),
-        hello,
-        NoInjection,
-    );
+    let (rig, ok) = boot(models);
     assert_eq!(ok, Ok(()));
     assert_eq!(
         rig.controller().config().axes[0].model.time_constant_s,
         0.11
     );
     models[1].volts_per_rad_s = f32::NAN;
-    let (rig, ok) = ControllerBackend::new(
-        ControllerConfig::nominal(),
-        persisted(&Record {
-            params,
-            models,
-            identified: [false; AXES],
-        }),
-        hello,
-        NoInjection,
-    );
+    let (rig, ok) = boot(models);
     assert_eq!(ok, Err(Reason::Range));
     let nominal = ControllerConfig::nominal();
     assert_eq!(

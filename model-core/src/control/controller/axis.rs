@@ -2,6 +2,7 @@
 
 use crate::control::config::{AxisConfig, ControllerConfig};
 use crate::control::estimator::PulseSpeedEstimator;
+use crate::control::load_pattern::LoadPattern;
 use crate::control::pi::{LoopConstants, SpeedLoop};
 use crate::control::supervisor::SensorWatch;
 
@@ -25,6 +26,10 @@ pub(super) struct AxisState {
     pub(super) measured: f32,
     /// The commanded direction (+1 or -1): one sensor per shaft cannot tell.
     pub(super) direction: f32,
+    /// The once-per-revolution load, learned and fed forward.
+    pub(super) load: LoadPattern,
+    /// The speed is steady this tick (the reference unchanged, the shaft near the model).
+    pub(super) steady: bool,
 }
 
 impl AxisState {
@@ -39,6 +44,8 @@ impl AxisState {
             duty: 0.0,
             measured: 0.0,
             direction: 1.0,
+            load: LoadPattern::new(a, cfg.supply_v),
+            steady: false,
         }
     }
 
@@ -46,5 +53,6 @@ impl AxisState {
     pub(super) const fn rest_loop(&mut self) {
         self.speed_loop = SpeedLoop::REST;
         self.watch = SensorWatch::CLEAR;
+        self.load.forget();
     }
 }

@@ -1,0 +1,156 @@
+//! `bowl chart family`: overshoot against settling time of every axis of a family of plants (a
+//! rig or family file), each commissioned and stepped from rest or from a running speed, with the
+//! targets marked.
+
+use super::plot::{Figure, Mark, Scale, Series, VLine};
+use super::table::Table;
+use crate::sim_reports::{self, PlantStep};
+use rig_file::Rig;
+
+/// Settling shown for an axis that never settled (the end of the run), s.
+fn never_s(target: f32) -> f64 {
+    f64::from(sim_reports::step_run_s(target))
+}
+
+/// Runs the family (on all cores) and draws it.
+pub fn chart(rigs: &[Rig], from: f32, target: f32, file: &str) -> (Figure, Table) {
+    let plants: Vec<PlantStep> =
+        crate::parallel::parallel(rigs, |r| sim_reports::family_plant(r, from, target));
+    let mut table = Table::new(&[
+        "plant",
+        "axis",
+        "commissioning",
+        "false_fault",
+        "overshoot_pct",
+        "settling_s",
+        "ripple_pct",
+    ]);
+    let mut pts: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
+    let mut never = Vec::new();
+    for p in &plants {
+        let Some(axes) = p.axes else {
+            table.row(vec![
+                p.name.clone(),
+                String::new(),
+                p.commissioning.clone(),
+                p.false_fault.to_string(),
+                String::new(),
+                String::new(),
+                String::new(),
+            ]);
+            continue;
+        };
+        for (i, (name, a)) in [("precession", axes.precession), ("spin", axes.spin)]
+            .into_iter()
+            .enumerate()
+        {
+            table.row(vec![
+                p.name.clone(),
+                name.into(),
+                p.commissioning.clone(),
+                p.false_fault.to_string(),
+                format!("{:.3}", a.overshoot_pct),
+                a.settling_s.map_or("never".into(), |s| format!("{s:.3}")),
+                format!("{:.3}", a.ripple_pct),
+            ]);
+            match a.settling_s {
+                Some(s) => pts[i].push((a.overshoot_pct, s)),
+                None => never.push((a.overshoot_pct, never_s(target))),
+            }
+        }
+    }
+    let s = sim_reports::summary(&plants);
+    let x_max = pts
+        .iter()
+        .flatten()
+        .chain(&never)
+        .map(|p| p.0)
+        .fold(11.0, f64::max);
+    let settle_target = if target < 1.0 { 10.0 } else { 3.0 };
+    let band = if target < 1.0 { 5 } else { 2 };
+    // Judged against this run's own target (the summary's share is the 3 s of a 3 rad/s step).
+    let axes_count = pts.iter().map(Vec::len).sum::<usize>() + never.len();
+    let settled = pts
+        .iter()
+        .flatten()
+        .filter(|p| p.1 <= settle_target)
+        .count();
+    let settled_share = 100.0 * settled as f64 / axes_count.max(1) as f64;
+    let mut series = vec![
+        Series {
+            name: "precession axes".into(),
+            points: pts[0].clone(),
+            mark: Mark::Points,
+            color: 1,
+        },
+        Series {
+            name: "spin axes".into(),
+            points: pts[1].clone(),
+            mark: Mark::Points,
+            color: 0,
+        },
+        Series {
+            name: format!("settling target {settle_target} s"),
+            points: vec![(0.0, settle_target), (x_max, settle_target)],
+            mark: Mark::Dashed,
+            color: 7,
+        },
+    ];
+    if !never.is_empty() {
+        series.push(Series {
+            name: "never settled (shown at the run's end)".into(),
+            points: never,
+            mark: Mark::Crosses,
+            color: 6,
+        });
+    }
+    let fig = Figure {
+        title: format!("Overshoot and settling, {from} -> {target} rad/s, every axis of {file}"),
+        x_label: "overshoot of the true speed (past the target, in the step's direction), % of the target"
+            .into(),
+        y_label: if target < 1.0 {
+            format!("{band} % settling (speed averaged over a revolution), s")
+        } else {
+            format!("{band} % settling (speed averaged over a revolution, at most 1 s), s")
+        },
+        x_scale: Scale::Linear,
+        y_scale: Scale::Linear,
+        series,
+        // The overshoot targets belong to the 3 rad/s step; the low-speed one has none.
+        vlines: if target < 1.0 {
+            Vec::new()
+        } else {
+            vec![
+                VLine {
+                    x: 5.0,
+                    label: " 5 % (95 % of axes)".into(),
+                    color: 7,
+                },
+                VLine {
+                    x: 10.0,
+                    label: " 10 % (every axis)".into(),
+                    color: 6,
+                },
+            ]
+        },
+        notes: vec![
+            format!(
+                "{} plants, {} commissioned, {} false faults",
+                s.plants, s.commissioned, s.false_faults
+            ),
+            format!(
+                "overshoot <= 5 %: {:.1} % of axes, worst {:.2} %",
+                s.overshoot_within_5_pct_share, s.overshoot_worst_pct
+            ),
+            format!(
+                "settled <= {settle_target} s: {:.1} % of axes, never: {}",
+                settled_share, s.never_settled
+            ),
+            format!(
+                "ripple median {:.2} %, worst {:.2} %",
+                s.ripple_median_pct, s.ripple_worst_pct
+            ),
+        ],
+    };
+    (fig, table)
+}

@@ -1,0 +1,121 @@
+//! A plan of releases run on a simulated rig ([`simulated`]) or on a rig over its serial line
+//! ([`port`]), one row per release written (see [`crate::results`]); a plan suggested
+//! ([`suggest`]); the fit's statistics benchmarked on simulated rigs ([`benchmark`]). Method and
+//! limits: docs/experiment.md; the command is `bowl experiment`.
+
+pub mod benchmark;
+pub mod plan;
+pub mod port;
+pub mod simulated;
+pub mod suggest;
+
+use std::io::Write;
+
+use anyhow::Result;
+
+use crate::results::{self, Row, Writer};
+use simulated::Release;
+
+/// A rig the plan's releases run on.
+pub trait ReleaseRig {
+    /// The nominal start radius (m), rim radius (m) and k2 of its granules (results columns).
+    fn geometry(&self) -> (f64, f64, f64);
+    /// Motor speeds for a combined bowl speed by the rig's split rule, rad/s.
+    fn split(&self, bowl_rad_s: f64) -> Result<[f64; 2]>;
+    /// Sets the motor speeds (starting the loop if idle) and waits until both measured speeds
+    /// are within 2 % for a second, then `settle_s` more.
+    fn settle(&mut self, targets: [f64; 2], settle_s: f64) -> Result<(), Release>;
+    /// Drops one granule and follows it to the exit gate.
+    fn release(&mut self) -> Release;
+    /// Stops the motors.
+    fn stop(&mut self);
+}
+
+/// Runs every release of `plan` on `rig`, writing each row as it is measured; returns the
+/// number of releases. A progress bar on standard error when `progress`.
+pub fn run_plan(
+    rig: &mut impl ReleaseRig,
+    plan: &plan::Plan,
+    writer: &mut Writer,
+    progress: bool,
+) -> Result<usize> {
+    let (release_radius_m, rim_radius_m, k2) = rig.geometry();
+    let total = plan::releases(plan);
+    let mut run_no = 0;
+    for (ci, c) in plan.condition.iter().enumerate() {
+        let targets = match (c.bowl_rad_s, c.precession_rad_s, c.spin_rad_s) {
+            (Some(w), _, _) => rig.split(w)?,
+            (None, Some(p), Some(s)) => [p, s],
+            _ => unreachable!("plan::parse checked the condition"),
+        };
+        let bowl = c.bowl_rad_s.unwrap_or_else(|| {
+            let a = std::f64::consts::FRAC_PI_3;
+            ((targets[0] * a.sin()).powi(2) + (targets[0] * a.cos() + targets[1]).powi(2)).sqrt()
+        });
+        for _ in 0..c.repeats {
+            run_no += 1;
+            let outcome = match rig.settle(targets, plan.settle_s) {
+                Ok(()) => rig.release(),
+                Err(e) => e,
+            };
+            let mut row = Row {
+                run: run_no,
+                condition: ci + 1,
+                bowl_rad_s: bowl,
+                precession_rad_s: targets[0],
+                spin_rad_s: targets[1],
+                release_radius_m,
+                rim_radius_m,
+                k2,
+                status: results::STATUS_OK.into(),
+                residence_s: None,
+                trace_mean_rad_s: None,
+                trace_sd_rad_s: None,
+                trace_path: String::new(),
+            };
+            let trace = match outcome {
+                Release::Left(t, trace) => {
+                    row.residence_s = Some(t);
+                    Some(trace)
+                }
+                Release::NeverLeft(trace) => {
+                    row.status = results::STATUS_NEVER_LEFT.into();
+                    Some(trace)
+                }
+                Release::NotSettled => {
+                    row.status = results::STATUS_NOT_SETTLED.into();
+                    None
+                }
+                Release::MotorFault(f) => {
+                    row.status = format!("{}: {f}", results::STATUS_MOTOR_FAULT);
+                    None
+                }
+            };
+            if let Some(trace) = trace {
+                if let Some((m, s)) = results::mean_sd(&trace) {
+                    row.trace_mean_rad_s = Some(m);
+                    row.trace_sd_rad_s = Some(s);
+                }
+                row.trace_path = writer.write_trace(run_no, &trace)?;
+            }
+            writer.push(&row)?;
+            if progress {
+                let done = run_no * 30 / total;
+                eprint!(
+                    "\r[{}{}] {run_no}/{total}",
+                    "#".repeat(done),
+                    ".".repeat(30 - done)
+                );
+                let _ = std::io::stderr().flush();
+            }
+        }
+    }
+    rig.stop();
+    if progress {
+        eprintln!();
+    }
+    Ok(run_no)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,149 @@
+//! The particle model's refusals in plain words (a scene, an inverse, an integration it
+//! refused): which value, the limit, what to do.
+
+use model_core::particle::OdeError;
+use model_core::particle::{Input, InverseError, Scene, SceneError, magnitude_limits};
+
+/// Why a scene was refused.
+pub fn scene(e: SceneError) -> String {
+    match e {
+        SceneError::InvalidOmega => "--omega-rad-s must be 0 or more (a bowl speed, rad/s)".into(),
+        SceneError::InvalidResistance => "--mu must be 0 or more (0.029 is the paper's)".into(),
+        SceneError::InvalidGravity => "--g must be 0 or more (9.81 on Earth)".into(),
+        SceneError::InvalidK2 => {
+            "--k2 must lie in (0, 1] (5/7 for a solid sphere, 3/5 for a hollow one)".into()
+        }
+        SceneError::InvalidStartRadius => "--ri-m must be 0 or more (the start radius, m)".into(),
+        SceneError::InvalidRimRadius => "--rim-radius-m must be 0 or more (m)".into(),
+        SceneError::InvalidTime => "the time must be 0 or more".into(),
+        SceneError::ExtremeMagnitude(input) => {
+            let (low, high) = magnitude_limits::<f64>();
+            let flag = match input {
+                Input::Omega => "--omega-rad-s",
+                Input::Resistance => "--mu",
+                Input::Gravity => "--g",
+                Input::K2 => "--k2",
+                Input::StartRadius => "--ri-m",
+                Input::RimRadius => "--rim-radius-m",
+            };
+            format!(
+                "{flag} is outside the magnitudes the model computes with (0, or {low:e} to \
+                 {high:e}): products of the inputs would underflow or overflow f64 and the \
+                 answer could come out the wrong way round; rescale the units (or pass 0)"
+            )
+        }
+        SceneError::OutOfRange => {
+            "the numbers overflow the arithmetic for this scene (absurd magnitudes): rescale the \
+             units"
+                .into()
+        }
+        SceneError::NoConvergence => {
+            "the residence time's root finder did not converge (a defect: please report the scene)"
+                .into()
+        }
+    }
+}
+
+/// Why a scene was refused, with the value given.
+pub fn scene_with_values(e: SceneError, s: &Scene<f64>) -> String {
+    match e {
+        SceneError::InvalidOmega => format!(
+            "--omega-rad-s {} rad/s: the paper's models take the bowl's speed as a rate of turning, \
+             0 or more (which way it turns is not one of their parameters): give 0 or a positive \
+             speed",
+            s.omega_rad_s
+        ),
+        SceneError::InvalidResistance => format!(
+            "--mu {}: the rolling resistance must be 0 or more (0.029 is the paper's)",
+            s.mu
+        ),
+        SceneError::InvalidGravity => {
+            format!("--g {}: must be 0 or more (9.81 on Earth)", s.g_m_s2)
+        }
+        SceneError::InvalidK2 => format!(
+            "--k2 {}: must lie in (0, 1] (5/7 for a solid sphere, 3/5 for a hollow one)",
+            s.k2
+        ),
+        SceneError::InvalidStartRadius => {
+            format!("--ri-m {} m: the start radius must be 0 or more", s.ri_m)
+        }
+        SceneError::InvalidRimRadius => format!(
+            "--rim-radius-m {} m: the rim radius must be 0 or more",
+            s.rim_radius_m
+        ),
+        other => scene(other),
+    }
+}
+
+/// The scene as the rig would take it: valid, and starting inside the rim (the rig refuses a
+/// start at or beyond the rim, so predicting T = 0 there would answer a question it never asks).
+pub fn check(s: &Scene<f64>) -> anyhow::Result<()> {
+    s.validate()
+        .map_err(|e| anyhow::anyhow!(scene_with_values(e, s)))?;
+    if s.ri_m >= s.rim_radius_m {
+        anyhow::bail!(
+            "--ri-m {} m is not inside the rim (--rim-radius-m {} m): the granule must start \
+             inside the bowl, as the rig requires",
+            s.ri_m,
+            s.rim_radius_m
+        );
+    }
+    Ok(())
+}
+
+/// What keeps a granule that never leaves in the bowl, in words.
+pub fn what_holds(scene: &Scene<f64>, equilibrium_radius_m: f64) -> String {
+    match (scene.omega_rad_s == 0.0, scene.mu == 0.0) {
+        (true, true) => "the bowl is not turning (omega 0) and there is no friction (mu 0): \
+                         nothing pushes the granule outward, so it stays where it was put"
+            .into(),
+        (true, false) => "the bowl is not turning (omega 0): nothing pushes the granule \
+                          outward, and friction keeps it where it was put"
+            .into(),
+        _ => format!("ri <= a = {equilibrium_radius_m:.6} m, friction holds it"),
+    }
+}
+
+/// Why no bowl speed was found for a target.
+pub fn inverse(e: InverseError, target_s: f64) -> String {
+    match e {
+        InverseError::Scene(s) => scene(s),
+        InverseError::InvalidTarget => {
+            format!("--target-time-s {target_s} must be a positive number of seconds")
+        }
+        InverseError::AlreadyAtRim => "the start radius is at the rim: T = 0 at every speed".into(),
+        InverseError::NeverLeaves => {
+            "a granule at the centre (--ri-m 0) never leaves at any speed".into()
+        }
+        InverseError::OutOfRange => format!(
+            "T = {target_s} s would need a speed beyond the arithmetic's range: give a longer target"
+        ),
+        InverseError::BeyondPrecision => format!(
+            "T = {target_s} s needs a speed within rounding of the threshold speed (below it the \
+             granule never leaves): no speed gives it reliably; give a shorter target"
+        ),
+        InverseError::NotConverged => {
+            "the speed search did not converge (a defect: please report the scene)".into()
+        }
+    }
+}
+
+/// Why an integration gave no result.
+pub fn ode(e: OdeError) -> String {
+    match e {
+        OdeError::Scene(s) => scene(s),
+        OdeError::InvalidStep => "--step-s and --tol must be positive numbers".into(),
+        OdeError::BeyondStabilityLimit => {
+            "the step is beyond the method's stability limit for this scene (docs/model.md, \
+             Stability): give a smaller --step-s"
+                .into()
+        }
+        OdeError::StepLimit => {
+            "the integration took too many steps: give a larger --step-s or a looser --tol".into()
+        }
+        OdeError::InvalidOmega => "the bowl speed must be 0 or more".into(),
+        OdeError::NotFinite => {
+            "the integration diverged (a state became infinite): give a smaller --step-s".into()
+        }
+    }
+}

@@ -1,0 +1,66 @@
+//! The closed-loop reports on rig files: `bowl sim family --rig-file` (commissioning, then the
+//! step from rest on both axes) and `bowl sim faults --rig-file` (the fault matrix), with the
+//! fixed JSON shapes docs/control.md describes. Every figure is taken on the plant's *true*
+//! speed, never on the controller's estimate.
+
+use model_core::control::{Controller, ControllerConfig, State};
+use model_core::sim::{ClosedLoop, Plant};
+use rig_file::Rig;
+
+mod faults;
+pub mod nominal;
+mod step;
+
+pub use faults::*;
+pub use step::*;
+
+/// Host-silence timeout the fault matrix configures, s (the link-loss row).
+pub const LINK_TIMEOUT_S: f32 = 1.0;
+/// Longest commissioning run allowed in a report, s.
+const COMMISSION_MAX_S: f32 = 300.0;
+
+/// The controller configuration a lab engineer gives for `rig`: the nominal one with the rig's
+/// pulses per revolution and capture timer (everything else is identified).
+pub fn config_for(rig: &Rig) -> ControllerConfig {
+    let mut cfg = ControllerConfig::nominal();
+    cfg.timer_hz = rig.params.timer_hz;
+    cfg.timer_bits = rig.params.timer_bits;
+    for (a, p) in cfg.axes.iter_mut().zip(&rig.params.axes) {
+        a.pulses_per_rev = p.sensor.pulses_per_rev;
+    }
+    cfg
+}
+
+/// Commissions `rig`; returns the closed loop (Idle, identified) or the plain reason.
+pub fn commissioned(rig: &Rig, cfg: ControllerConfig) -> Result<ClosedLoop, String> {
+    let ctrl = Controller::new(cfg).map_err(|e| {
+        format!(
+            "configuration rejected: {}",
+            virtual_rig::controller_words::config(e)
+        )
+    })?;
+    let mut cl = ClosedLoop::new(Plant::new(rig.params, rig.seed), ctrl);
+    match cl.commission(COMMISSION_MAX_S) {
+        State::Idle => Ok(cl),
+        _ => Err(match cl.ctrl.identify_error() {
+            Some(e) => e.reason().to_string(),
+            None => match cl.ctrl.fault() {
+                Some(f) => format!(
+                    "{} during identification",
+                    model_core::wire::FaultCode::from_code(i64::from(f.code()))
+                        .map_or("an unknown fault", rig_client::words::fault)
+                ),
+                None => "did not finish".to_string(),
+            },
+        }),
+    }
+}
+
+/// Adds each axis's `load_step_nm` (material poured in after commissioning) from now on.
+pub fn pour_material(cl: &mut ClosedLoop) {
+    let now = cl.rig.time_s() as f32;
+    for a in &mut cl.rig.params_mut().axes {
+        a.faults.load_step_from_s = now;
+        a.faults.load_step_nm = a.load_step_nm;
+    }
+}

@@ -1,0 +1,311 @@
+//! Why the rig refused a command, in particulars: which value and its limit (`RANGE`), which
+//! state it is in (`STATE`), which residence times it can give (`INFEASIBLE`).
+//!
+//! The wire's refusal is one token; the particulars come from what the PC knows (the command
+//! it sent, the one parameter table) and from asking the rig right after (STATUS, PARAMS), the
+//! way a motor-controller console reads the error registers after a refused request.
+
+use std::time::Duration;
+
+use model_core::binding::{config_from_params, scene_from_params};
+use model_core::bowl::MotorSpeeds;
+use model_core::control::estimator::lowest_speed_rad_s;
+use model_core::control::{BowlSpeedForResidence, Controller, ControllerConfig, InverseFailure};
+use model_core::particle::{Model, Scene, omega_for_residence_time};
+use model_core::wire::{Command, CommandKind, Frame, ParamId, ParamValues, Reason, Status};
+
+use crate::lines::command_line;
+use crate::link::Link;
+use crate::request::transact;
+use crate::words;
+
+/// The particulars of a refusal of `words` (the command as typed), asking the rig what it
+/// needs through `link`; `None` when there is nothing to add to the reason's own words.
+pub fn particulars(
+    link: Option<&mut Link>,
+    id: u16,
+    words: &[String],
+    reason: Reason,
+    timeout: Duration,
+) -> Option<String> {
+    let word = words.first()?.to_ascii_lowercase();
+    match (reason, word.as_str()) {
+        (Reason::Range, "set") => set_range(words),
+        (Reason::State, "release") => Some(
+            "the last release is not over: a simulated rig still has its granule in the bowl \
+             (wait for its exit gate event), the Black Pill's solenoid is still energised \
+             (40 ms)"
+                .into(),
+        ),
+        (Reason::Unsupported, "release") => Some(
+            "this rig has no release solenoid: drop the granule by hand (the release gate still \
+             times it once wired)"
+                .into(),
+        ),
+        (Reason::State, _) => {
+            let status = ask_status(link?, id, timeout)?;
+            Some(state_words(&status, &word))
+        }
+        (Reason::Range, "speed") => {
+            let params = ask_params(link?, id, timeout)?;
+            speed_limits(words, &params)
+        }
+        (Reason::Range | Reason::Infeasible, "rtime") => {
+            let params = ask_params(link?, id, timeout)?;
+            residence_range(words, &params)
+        }
+        _ => None,
+    }
+}
+
+/// `set NAME VALUE` refused: not an integer, or outside the parameter's own range (the
+/// command table's words), or, if the value is inside it, the rule that ties it to the others.
+pub(crate) fn set_range(words: &[String]) -> Option<String> {
+    match Command::from_words(words) {
+        Err(refusal) => Some(refusal.to_string()),
+        Ok(Command::SetParam { id, value }) => {
+            let (lo, hi) = id.range();
+            Some(format!(
+                "{} = {value} {} is inside its own range ({lo}..={hi}) but not with the other \
+                 parameters (the start radius must lie inside the rim, the loop settings must \
+                 fit the motors): see `bowl send PORT params`",
+                id.token(),
+                id.unit()
+            ))
+        }
+        Ok(_) => None,
+    }
+}
+
+fn state_words(s: &Status, command: &str) -> String {
+    use model_core::wire::DeviceState as D;
+    let todo = match s.state {
+        D::Faulted => format!(
+            "{}; clear it first (`bowl send PORT clear`)",
+            words::fault(s.fault)
+        ),
+        D::Commissioning => "wait for commissioning to end".to_string(),
+        D::Running | D::SpinningUp if command == "commission" => {
+            "stop the motors first (`bowl send PORT stop`)".to_string()
+        }
+        D::Idle if command == "clear" => "there is no fault to clear".to_string(),
+        _ => "see docs/protocol.md for what each state allows".to_string(),
+    };
+    // The states the command table allows it in.
+    let allowed = CommandKind::from_word(command).map(|kind| {
+        let states: Vec<&str> = (0..=5)
+            .filter_map(D::from_code)
+            .filter(|&state| kind.states().contains(state))
+            .map(words::state_token)
+            .collect();
+        format!(" (`{command}` is taken while {})", states.join(", "))
+    });
+    format!(
+        "the rig is {}: {todo}{}",
+        words::state(s.state),
+        allowed.unwrap_or_default()
+    )
+}
+
+/// The controller's view of the rig's parameters (speed limits, sensor wheels, axes angle).
+fn rig_config(params: &ParamValues) -> Option<ControllerConfig> {
+    config_from_params(&ControllerConfig::default(), params).ok()
+}
+
+/// `speed W1 W2` (mrad/s) out of range: which axis, which limit.
+fn speed_limits(words: &[String], params: &ParamValues) -> Option<String> {
+    let cfg = rig_config(params)?;
+    let names = [
+        ("precession", ParamId::SpeedMax1MradS),
+        ("spin", ParamId::SpeedMax2MradS),
+    ];
+    let mut out = Vec::new();
+    for (i, (axis, max_id)) in names.into_iter().enumerate() {
+        let Some(Ok(mrad_s)) = words.get(i + 1).map(|w| w.parse::<i64>()) else {
+            continue;
+        };
+        let w = mrad_s.unsigned_abs() as f64 * 1e-3;
+        let a = &cfg.axes[i];
+        let lowest = f64::from(lowest_speed_rad_s(a));
+        if w > f64::from(a.max_speed_rad_s) {
+            out.push(format!(
+                "the {axis} speed {w:.3} rad/s is above {} = {:.3} rad/s",
+                max_id.token(),
+                a.max_speed_rad_s
+            ));
+        } else if w > 0.0 && w < lowest {
+            out.push(format!(
+                "the {axis} speed {w:.3} rad/s is below {lowest:.3} rad/s, the lowest its sensor \
+                 ({} pulses per revolution) can measure; use 0 or at least {lowest:.3}",
+                a.pulses_per_rev
+            ));
+        }
+    }
+    (!out.is_empty()).then(|| out.join("; "))
+}
+
+/// The scene's inverse as the rig's controller uses it (f32, as on the board).
+struct RigInverse {
+    scene: Scene<f32>,
+    model: Model,
+}
+
+impl BowlSpeedForResidence for RigInverse {
+    fn omega_rad_s(&self, target_s: f32) -> Result<f32, InverseFailure> {
+        omega_for_residence_time(&self.scene, self.model, target_s)
+            .map_err(|_| InverseFailure::Unreachable)
+    }
+}
+
+/// `rtime MODEL MS` refused: the residence times the rig can give. Each candidate time is put
+/// to the controller the rig runs (its f32 inverse, its split into motor speeds, each motor
+/// between its lowest measurable speed and its limit); the feasible times form one interval
+/// (a longer time needs a slower bowl), found by bisection on its two ends.
+fn residence_range(words: &[String], params: &ParamValues) -> Option<String> {
+    let cfg = rig_config(params)?;
+    let model = match words.get(1)?.to_ascii_uppercase().as_str() {
+        "FLAT" => Model::Flat,
+        _ => Model::Coriolis,
+    };
+    let inverse = RigInverse {
+        scene: scene_from_params::<f32>(params).ok()?,
+        model,
+    };
+    let accepts = |t_s: f64| {
+        Controller::new(cfg)
+            .ok()
+            .and_then(|mut c| c.set_target_residence_time(t_s as f32, &inverse).ok())
+    };
+    // A feasible time to start from: the one at the bowl's fastest allowed speed or slower.
+    let grid = (0..=60).map(|i| 1e-3 * 10f64.powf(f64::from(i) / 10.0));
+    let inside = grid.clone().find(|&t| accepts(t).is_some())?;
+    let shortest = bisect(inside, 1e-4, &accepts);
+    let longest = bisect(inside, 1e6, &accepts);
+    let bowl = |t: f64| {
+        accepts(t)
+            .and_then(|w| {
+                let a = cfg.axes_angle_rad;
+                model_core::bowl::combined_speed_from_trig(
+                    a.cos(),
+                    a.sin(),
+                    MotorSpeeds {
+                        precession_rad_s: w[0],
+                        spin_rad_s: w[1],
+                    },
+                )
+                .ok()
+            })
+            .map(|w| format!(" (bowl at {w:.3} rad/s)"))
+            .unwrap_or_default()
+    };
+    let asked = words
+        .get(2)
+        .and_then(|w| w.parse::<f64>().ok())
+        .map(|ms| format!("{:.3} s asked; ", ms * 1e-3))
+        .unwrap_or_default();
+    Some(format!(
+        "{asked}this rig can give {shortest:.3} s{} to {longest:.3} s{} with the {} model",
+        bowl(shortest),
+        bowl(longest),
+        if model == Model::Flat {
+            "flat"
+        } else {
+            "Coriolis"
+        }
+    ))
+}
+
+/// The end of the feasible interval between `inside` (feasible) and `outside` (not), to 1e-4
+/// relative, returned on the feasible side.
+fn bisect(mut inside: f64, mut outside: f64, accepts: &dyn Fn(f64) -> Option<[f32; 2]>) -> f64 {
+    if accepts(outside).is_some() {
+        return outside;
+    }
+    while (outside - inside).abs() > 1e-4 * inside {
+        let mid = (inside * outside).sqrt();
+        if accepts(mid).is_some() {
+            inside = mid;
+        } else {
+            outside = mid;
+        }
+    }
+    inside
+}
+
+fn ask(link: &mut Link, id: u16, word: &str, timeout: Duration) -> Option<Frame> {
+    // Far from the refused command's id, so a script's next id is never this question's.
+    let query_id = id ^ 0x8000;
+    let line = command_line(query_id, &[word.to_string()]).ok()?;
+    transact(link, query_id, &line, timeout).ok()?.ok()
+}
+
+fn ask_status(link: &mut Link, id: u16, timeout: Duration) -> Option<Status> {
+    match ask(link, id, "status", timeout)? {
+        Frame::Status { status, .. } => Some(status),
+        _ => None,
+    }
+}
+
+fn ask_params(link: &mut Link, id: u16, timeout: Duration) -> Option<ParamValues> {
+    match ask(link, id, "params", timeout)? {
+        Frame::Params { values, .. } => Some(values),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use model_core::binding::default_params;
+
+    fn w(s: &str) -> Vec<String> {
+        s.split_whitespace().map(str::to_string).collect()
+    }
+
+    #[test]
+    fn set_out_of_range_names_the_range() {
+        let (lo, hi) = ParamId::MuPpm.range();
+        let text = set_range(&w(&format!("set MU_PPM {}", i64::from(hi) + 1))).unwrap();
+        assert!(text.contains(&format!("{lo}..={hi}")), "{text}");
+        assert!(
+            text.starts_with(&format!("MU_PPM {} ppm", i64::from(hi) + 1)),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn speed_above_the_limit_names_the_axis_and_limit() {
+        let p = default_params();
+        let max2 = p[ParamId::SpeedMax2MradS.index()];
+        let text = speed_limits(&w(&format!("speed 1000 {}", max2 + 1)), &p).unwrap();
+        assert!(text.contains("spin speed"), "{text}");
+        assert!(text.contains(ParamId::SpeedMax2MradS.token()), "{text}");
+        assert!(!text.contains("precession"), "{text}");
+    }
+
+    #[test]
+    fn speed_below_the_sensor_names_the_lowest() {
+        let p = default_params();
+        let text = speed_limits(&w("speed 10 0"), &p).unwrap();
+        assert!(
+            text.contains("precession speed 0.010 rad/s is below"),
+            "{text}"
+        );
+    }
+
+    /// A finite, positive range is printed for the nominal rig (its ends are checked against
+    /// the rig itself in tests/refusal_e2e.rs).
+    #[test]
+    fn residence_range_is_printed_for_the_nominal_rig() {
+        let p = default_params();
+        let text = residence_range(&w("rtime cori 1"), &p).unwrap();
+        assert!(text.contains("this rig can give"), "{text}");
+        let shortest: f64 = text
+            .split("this rig can give ")
+            .nth(1)
+            .and_then(|t| t.split(' ').next())
+            .and_then(|t| t.parse().ok())
+            .unwrap();
+        assert!(shortest > 0.0 && shortest.is_finite(), "{text}");
+    }
+}

@@ -1,0 +1,495 @@
+//! The one request loop: a command sent with its request id, its answer matched by id and kind,
+//! sent again with the same id until the answer comes; every other frame that arrives meanwhile
+//! handed to the caller. `bowl send`, the refusal's questions, commissioning, the experiment's
+//! rig ([`crate::rig::Rig`]), the monitor's command line and the demo all send through it
+//! ([`Request`] is its state: the monitor and the demo, which never block, drive it themselves).
+
+use std::time::{Duration, Instant};
+
+use model_core::wire::{Command, Decoder, Frame, MAX_FRAME_LEN, Reason, decode_frame, encode};
+
+use crate::link::Link;
+use crate::serial::{LinkError, ReadOutcome};
+use crate::unreadable::{LineTap, UnreadableAnswer};
+
+/// Whether `frame` is the kind of answer `command` gets, as the command table says (`S` to
+/// STATUS, `P` to PARAMS, `M` to MODELS, `W` to RTIME, `A` to the rest), or `R` (anything can
+/// be refused).
+pub fn answers_kind(command: &Command, frame: &Frame) -> bool {
+    matches!(frame, Frame::Reject { .. })
+        || model_core::wire::encode::kind_letter(frame) == command.kind().answer().letter()
+}
+
+/// A request id for the first command of a process: the wall clock in milliseconds, mod 2^16
+/// (one turn in 65.5 s). The rig takes a command with the id and words of one of its recent
+/// commands, up to 60 s old, for a copy and does not carry it out again (docs/protocol.md), so
+/// ids must not come back within 60 s: from the clock, each process starts past the ids of
+/// the ones before it and counts up from there (a process sends far fewer than one command a
+/// millisecond). `u16::MAX` and `u16::MAX - 1` are left to the monitor (its heartbeat and its
+/// own STATUS).
+pub fn fresh_id() -> u16 {
+    let ms = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_millis())
+        .unwrap_or(0);
+    match (ms % 65_536) as u16 {
+        0xFFFE..=u16::MAX => 0,
+        id => id,
+    }
+}
+
+/// The request id after `id`, skipping the monitor's own two (see [`fresh_id`]).
+pub fn next_id(id: u16) -> u16 {
+    match id.wrapping_add(1) {
+        0xFFFE..=u16::MAX => 0,
+        n => n,
+    }
+}
+
+/// How long one attempt waits before the command is sent again with the same id (the rig carries
+/// a resend out once). The rig answers within a few ms; a damaged answer is never repaired.
+pub const RESEND_EVERY: Duration = Duration::from_millis(200);
+
+/// What came from the rig while a command waited in vain for its answer: enough to say whether
+/// the line is dead, noisy, or alive but not answering.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Unanswered {
+    /// Frames that arrived intact (telemetry, other tools' answers).
+    pub frames_ok: u64,
+    /// Frames that arrived damaged.
+    pub frames_corrupt: u64,
+    /// How many times the command was sent (the first time and the resends).
+    pub sent: u32,
+}
+
+impl Unanswered {
+    /// What to try, in words.
+    pub fn advice(&self) -> String {
+        let seen = format!(
+            "sent {} times; meanwhile {} frames arrived intact and {} damaged",
+            self.sent, self.frames_ok, self.frames_corrupt
+        );
+        let todo = if self.frames_corrupt > 0 {
+            "the line is noisy: give it longer (`--timeout-ms 5000` resends every 200 ms until \
+             then), check the cable, its ground and the baud rate (`--baud`); `bowl monitor PORT` \
+             shows the frame counters"
+        } else if self.frames_ok == 0 {
+            "nothing came from the port at all: is the rig powered, is this its port (`bowl \
+             ports`), is the baud rate right (`--baud`)?"
+        } else {
+            "the rig is sending but did not answer: give it longer (`--timeout-ms 5000`); \
+             `bowl monitor PORT` shows its state and the frame counters"
+        };
+        format!("{seen}; {todo}")
+    }
+}
+
+/// The decoder of a connection and the raw line beside it (to show an answer it cannot read):
+/// kept for as long as the connection, so no frame is cut at a request's edge.
+#[derive(Default)]
+pub struct Reader {
+    /// The shared decoder (its counters are the link's).
+    pub decoder: Decoder,
+    tap: LineTap,
+}
+
+/// What one byte completed: a frame, or an intact answer this bowl cannot read, or a damaged
+/// line (counted by the decoder).
+pub enum Arrival {
+    /// An intact frame.
+    Frame(Frame),
+    /// An intact answer this bowl cannot read.
+    Unreadable(UnreadableAnswer),
+    /// A damaged line.
+    Damaged,
+}
+
+impl Reader {
+    /// Takes one byte; what it completed, if anything.
+    pub fn push(&mut self, byte: u8) -> Option<Arrival> {
+        self.tap.push(byte);
+        match self.decoder.push(byte)? {
+            Ok(frame) => Some(Arrival::Frame(frame)),
+            Err(e) => Some(match self.tap.unreadable_answer(e) {
+                Some(u) => Arrival::Unreadable(u),
+                None => Arrival::Damaged,
+            }),
+        }
+    }
+}
+
+/// One command on its way to the rig: encoded once, sent again with the same id every
+/// [`RESEND_EVERY`] until its answer (the frame with its id and the kind it gets) comes.
+#[derive(Debug, Clone)]
+pub struct Request {
+    id: u16,
+    command: Command,
+    line: Vec<u8>,
+    sent_at: Option<Instant>,
+    sends: u32,
+}
+
+impl Request {
+    /// A typed command with request `id`; refused here (as the rig would refuse it whatever its
+    /// settings) when it cannot be right: a speed below 0 (`RANGE`).
+    pub fn new(id: u16, command: Command) -> Result<Self, Reason> {
+        if let Command::SetSpeeds {
+            precession_mrad_s,
+            spin_mrad_s,
+        } = command
+            && (precession_mrad_s < 0 || spin_mrad_s < 0)
+        {
+            return Err(Reason::Range);
+        }
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let n = encode(&Frame::Command { id, command }, &mut buf).map_err(|_| Reason::Malformed)?;
+        Ok(Self::sent_as(id, command, buf[..n].to_vec()))
+    }
+
+    /// A command line already built and checked (`lines::command_line`, from typed words).
+    pub fn from_line(line: Vec<u8>) -> Option<Self> {
+        match decode_frame(&line) {
+            Ok(Frame::Command { id, command }) => Some(Self::sent_as(id, command, line)),
+            _ => None,
+        }
+    }
+
+    fn sent_as(id: u16, command: Command, line: Vec<u8>) -> Self {
+        Self {
+            id,
+            command,
+            line,
+            sent_at: None,
+            sends: 0,
+        }
+    }
+
+    /// The request id.
+    pub fn id(&self) -> u16 {
+        self.id
+    }
+
+    /// The command.
+    pub fn command(&self) -> &Command {
+        &self.command
+    }
+
+    /// How many times it was sent so far.
+    pub fn sends(&self) -> u32 {
+        self.sends
+    }
+
+    /// The line to send at `now`, if one is due: the first time, and again when
+    /// [`RESEND_EVERY`] has passed without the answer.
+    pub fn due(&mut self, now: Instant) -> Option<&[u8]> {
+        if self
+            .sent_at
+            .is_some_and(|t| now.duration_since(t) < RESEND_EVERY)
+        {
+            return None;
+        }
+        self.sent_at = Some(now);
+        self.sends += 1;
+        Some(&self.line)
+    }
+
+    /// When the next resend is due; `None` before the first send (due at once).
+    pub fn next_due(&self) -> Option<Instant> {
+        self.sent_at.map(|t| t + RESEND_EVERY)
+    }
+
+    /// Whether `frame` is this request's answer.
+    pub fn answered_by(&self, frame: &Frame) -> bool {
+        frame.answer_id() == Some(self.id) && answers_kind(&self.command, frame)
+    }
+}
+
+/// The one request loop: sends `request` on `link` and waits for its answer, sending it again
+/// every [`RESEND_EVERY`] until `timeout` has passed. Before each send, what already arrived is
+/// read out (before the first send it cannot be this request's answer). Every other frame that
+/// arrives meanwhile goes to `other` (telemetry, gate events, other tools' answers), so nothing
+/// is lost while a command waits. `Ok(Err(..))` when nothing answered (with what came
+/// instead); an error when the link failed ([`LinkError`]) or the answer could not be read
+/// ([`UnreadableAnswer`]).
+pub fn request(
+    link: &mut Link,
+    reader: &mut Reader,
+    request: &mut Request,
+    timeout: Duration,
+    other: &mut dyn FnMut(Frame),
+) -> anyhow::Result<Result<Frame, Unanswered>> {
+    let end = Instant::now() + timeout;
+    let mut buf = [0u8; 4096];
+    let mut unanswered = Unanswered::default();
+    let mut answer = None;
+    loop {
+        let now = Instant::now();
+        if now >= end {
+            return Ok(Err(unanswered));
+        }
+        if request.next_due().is_none_or(|t| t <= now) {
+            // What came before this attempt: handed on (an answer only once it was sent).
+            while let ReadOutcome::Data(n) = link.read(&mut buf, Duration::from_millis(1))? {
+                for &b in &buf[..n] {
+                    match reader.push(b) {
+                        Some(Arrival::Frame(f))
+                            if request.sends() > 0 && request.answered_by(&f) =>
+                        {
+                            answer = Some(f);
+                        }
+                        Some(Arrival::Frame(f)) => other(f),
+                        _ => {}
+                    }
+                }
+            }
+            if let Some(f) = answer {
+                return Ok(Ok(f));
+            }
+            if let Some(line) = request.due(Instant::now()) {
+                link.write_all(line)?;
+                unanswered.sent += 1;
+            }
+        }
+        let wait = request
+            .next_due()
+            .map_or(end, |t| t.min(end))
+            .saturating_duration_since(Instant::now())
+            .min(Duration::from_millis(50));
+        match link.read(&mut buf, wait)? {
+            ReadOutcome::Data(n) => {
+                // The whole read is taken in: frames after the answer are handed on too.
+                for &b in &buf[..n] {
+                    match reader.push(b) {
+                        Some(Arrival::Frame(f)) if answer.is_none() && request.answered_by(&f) => {
+                            answer = Some(f);
+                        }
+                        Some(Arrival::Frame(f)) => {
+                            unanswered.frames_ok += 1;
+                            other(f);
+                        }
+                        Some(Arrival::Unreadable(u)) if u.id == request.id() => {
+                            return Err(u.into());
+                        }
+                        Some(Arrival::Unreadable(_) | Arrival::Damaged) => {
+                            unanswered.frames_corrupt += 1;
+                        }
+                        None => {}
+                    }
+                }
+                if let Some(f) = answer {
+                    return Ok(Ok(f));
+                }
+            }
+            ReadOutcome::Timeout => {}
+            ReadOutcome::Gone => {
+                return Err(
+                    LinkError("the link went away while waiting for the answer".into()).into(),
+                );
+            }
+        }
+    }
+}
+
+/// Sends the command `line` (request `id`, built by `lines::command_line`) and waits for its
+/// answer through the one request loop ([`request`]); the frames that come meanwhile are
+/// counted, not kept.
+pub fn transact(
+    link: &mut Link,
+    id: u16,
+    line: &[u8],
+    timeout: Duration,
+) -> anyhow::Result<Result<Frame, Unanswered>> {
+    let Some(mut req) = Request::from_line(line.to_vec()).filter(|r| r.id() == id) else {
+        anyhow::bail!("not a command line (a bug in bowl)");
+    };
+    request(link, &mut Reader::default(), &mut req, timeout, &mut |_| {})
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use std::io::{BufRead, BufReader, Write};
+
+    use model_core::wire::{DeviceState, FaultCode, ResetCause, Status, encode};
+
+    use super::*;
+    use crate::lines::command_line;
+    use crate::link::Stream;
+
+    fn bytes(frame: &Frame) -> Vec<u8> {
+        let mut buf = [0u8; 512];
+        let n = encode(frame, &mut buf).unwrap();
+        buf[..n].to_vec()
+    }
+
+    fn status(id: u16) -> Frame {
+        status_at(id, 5)
+    }
+
+    fn status_at(id: u16, uptime_ms: u32) -> Frame {
+        Frame::Status {
+            id,
+            status: Status {
+                state: DeviceState::Running,
+                fault: FaultCode::None,
+                reset_cause: ResetCause::Pin,
+                reset_count: 1,
+                uptime_ms,
+                telemetry_hz: 50,
+                flags: 0,
+            },
+        }
+    }
+
+    /// A link whose other end is a scripted rig: it gets each command line the PC sent and
+    /// returns what to answer. Returns the link and the thread that yields the lines it saw.
+    fn scripted(
+        before: Vec<u8>,
+        mut answer: impl FnMut(usize, &str) -> Vec<u8> + Send + 'static,
+    ) -> (Link, std::thread::JoinHandle<Vec<String>>) {
+        let (pc, mut rig) = Stream::pair().unwrap();
+        rig.write_all(&before).unwrap();
+        let rig_thread = std::thread::spawn(move || {
+            let mut seen = Vec::new();
+            let mut reader = BufReader::new(rig.try_clone().unwrap());
+            let mut line = String::new();
+            while reader.read_line(&mut line).unwrap_or(0) > 0 {
+                let reply = answer(seen.len(), &line);
+                seen.push(std::mem::take(&mut line));
+                if rig.write_all(&reply).is_err() {
+                    break;
+                }
+            }
+            seen
+        });
+        // Let the stale bytes arrive before the command is sent.
+        std::thread::sleep(Duration::from_millis(20));
+        (Link::Monitor(pc), rig_thread)
+    }
+
+    #[test]
+    fn a_stale_answer_and_an_answer_of_the_wrong_kind_are_not_taken() {
+        // Left over from an earlier STATUS with the same id (its answer came late): discarded
+        // before sending.
+        let (mut link, rig) = scripted(bytes(&status_at(77, 1)), |_, _| {
+            // The same id but the kind STOP gets, then the STATUS answer.
+            let mut out = bytes(&Frame::Ack { id: 77 });
+            out.extend(bytes(&status(77)));
+            out
+        });
+        let line = command_line(77, &["status".into()]).unwrap();
+        let got = transact(&mut link, 77, &line, Duration::from_millis(1000)).unwrap();
+        assert_eq!(got, Ok(status(77)));
+        drop(link);
+        assert_eq!(rig.join().unwrap().len(), 1, "answered at the first try");
+    }
+
+    #[test]
+    fn a_lost_answer_is_asked_again_with_the_same_id() {
+        // The first answer is lost on the way; the resend is answered.
+        let (mut link, rig) = scripted(Vec::new(), |n, _| {
+            if n == 0 {
+                Vec::new()
+            } else {
+                bytes(&Frame::Ack { id: 9 })
+            }
+        });
+        let line = command_line(9, &["start".into()]).unwrap();
+        let got = transact(&mut link, 9, &line, Duration::from_millis(1000)).unwrap();
+        assert_eq!(got, Ok(Frame::Ack { id: 9 }));
+        drop(link);
+        let seen = rig.join().unwrap();
+        assert_eq!(seen.len(), 2);
+        assert_eq!(seen[0], seen[1], "the resend is the same line, same id");
+        assert_eq!(seen[0].as_bytes(), line.as_slice());
+    }
+
+    #[test]
+    fn no_answer_is_a_timeout_after_resends() {
+        let (mut link, rig) = scripted(Vec::new(), |_, _| Vec::new());
+        let line = command_line(5, &["stop".into()]).unwrap();
+        let started = Instant::now();
+        let got = transact(&mut link, 5, &line, Duration::from_millis(600)).unwrap();
+        let silence = got.unwrap_err();
+        assert_eq!(
+            (silence.sent, silence.frames_ok, silence.frames_corrupt),
+            (3, 0, 0)
+        );
+        assert!(silence.advice().contains("nothing came from the port"));
+        assert!(started.elapsed() >= Duration::from_millis(600));
+        drop(link);
+        assert_eq!(rig.join().unwrap().len(), 3, "sent every 200 ms");
+    }
+
+    /// A raw line with a correct CRC.
+    fn raw(payload: &str) -> Vec<u8> {
+        let crc = model_core::wire::crc::crc32(payload.as_bytes());
+        format!("${payload}*{crc:08X}\r\n").into_bytes()
+    }
+
+    #[test]
+    fn an_answer_bowl_cannot_read_is_reported_as_what_it_is() {
+        for (answer, says) in [
+            ("R1,5,BOGUS", "a word or a field this bowl does not know"),
+            ("A2,5", "in protocol version 2 (this bowl speaks version 1)"),
+            ("X1,5", "a kind of frame this bowl does not know ('X')"),
+        ] {
+            // Another request's unreadable answer first: not ours, not taken.
+            let (mut link, rig) = scripted(Vec::new(), move |_, _| {
+                let mut out = raw("R1,6,BOGUS");
+                out.extend(raw(answer));
+                out
+            });
+            let line = command_line(5, &["stop".into()]).unwrap();
+            let started = Instant::now();
+            let err = transact(&mut link, 5, &line, Duration::from_millis(1000)).unwrap_err();
+            assert!(
+                started.elapsed() < Duration::from_millis(500),
+                "not a timeout"
+            );
+            let text = err.to_string();
+            assert!(text.contains("request 5"), "{text}");
+            assert!(text.contains(says), "{text}");
+            assert!(
+                text.contains(&format!("`${answer}*")),
+                "the line as it came: {text}"
+            );
+            assert!(err.downcast_ref::<UnreadableAnswer>().is_some());
+            drop(link);
+            rig.join().unwrap();
+        }
+        // A damaged line (CRC wrong) is no answer at all: the PC resends and times out.
+        let (mut link, rig) = scripted(Vec::new(), |_, _| b"$R1,5,BOGUS*00000000\r\n".to_vec());
+        let line = command_line(5, &["stop".into()]).unwrap();
+        let got = transact(&mut link, 5, &line, Duration::from_millis(400)).unwrap();
+        let noisy = got.unwrap_err();
+        assert!(
+            (1..=u64::from(noisy.sent)).contains(&noisy.frames_corrupt),
+            "{noisy:?}"
+        );
+        assert!(
+            noisy.advice().contains("the line is noisy"),
+            "{}",
+            noisy.advice()
+        );
+        assert!(noisy.advice().contains("--timeout-ms"));
+        drop(link);
+        rig.join().unwrap();
+    }
+
+    #[test]
+    fn each_command_takes_only_its_kind_of_answer() {
+        let ack = Frame::Ack { id: 1 };
+        let reject = Frame::Reject {
+            id: 1,
+            reason: model_core::wire::Reason::State,
+        };
+        assert!(answers_kind(&Command::Start, &ack));
+        assert!(answers_kind(&Command::Start, &reject));
+        assert!(!answers_kind(&Command::Start, &status(1)));
+        assert!(answers_kind(&Command::GetStatus, &status(1)));
+        assert!(answers_kind(&Command::GetStatus, &reject));
+        assert!(!answers_kind(&Command::GetStatus, &ack));
+        assert!(!answers_kind(&Command::GetParams, &ack));
+        assert!(!answers_kind(&Command::GetModels, &status(1)));
+    }
+}

@@ -1,0 +1,86 @@
+//! The rig's states, faults and reset causes in plain words, for everything a person reads
+//! (monitor, send, commission, demo); the wire's tokens and codes stay in logs and JSON keys.
+//! The controller's own refusals are the virtual rig's (`virtual_rig::controller_words`).
+
+use model_core::wire::{DeviceState, FaultCode, ResetCause};
+
+/// The device's state.
+pub fn state(s: DeviceState) -> &'static str {
+    match s {
+        DeviceState::Idle => "idle",
+        DeviceState::Commissioning => "commissioning",
+        DeviceState::SpinningUp => "spinning up",
+        DeviceState::Running => "running",
+        DeviceState::Stopping => "stopping",
+        DeviceState::Faulted => "faulted (motors off)",
+    }
+}
+
+/// A fault, with what it means at the rig.
+pub fn fault(f: FaultCode) -> &'static str {
+    match f {
+        FaultCode::None => "no fault",
+        FaultCode::SensorLostOrStallPrecession => {
+            "precession motor: no sensor pulses (sensor lost or motor stalled)"
+        }
+        FaultCode::SensorLostOrStallSpin => {
+            "spin motor: no sensor pulses (sensor lost or motor stalled)"
+        }
+        FaultCode::OverspeedPrecession => "precession motor over its speed limit",
+        FaultCode::OverspeedSpin => "spin motor over its speed limit",
+        FaultCode::HostSilent => "the PC went silent (link loss)",
+        FaultCode::InvalidConfiguration => "the stored configuration is invalid",
+    }
+}
+
+/// Why the board last started.
+pub fn reset_cause(r: ResetCause) -> &'static str {
+    match r {
+        ResetCause::PowerOn => "power-on",
+        ResetCause::Pin => "reset pin",
+        ResetCause::Software => "software reset",
+        ResetCause::IndependentWatchdog => "watchdog (the control loop stalled)",
+        ResetCause::WindowWatchdog => "window watchdog",
+        ResetCause::LowPower => "low-power reset",
+        ResetCause::Unknown => "unknown",
+    }
+}
+
+/// The device's state as one lower-case word for `key=value` lines (`bowl send status`), which
+/// scripts read: the same states as [`state`], without its explanations.
+pub fn state_token(s: DeviceState) -> &'static str {
+    match s {
+        DeviceState::Idle => "idle",
+        DeviceState::Commissioning => "commissioning",
+        DeviceState::SpinningUp => "spinning-up",
+        DeviceState::Running => "running",
+        DeviceState::Stopping => "stopping",
+        DeviceState::Faulted => "faulted",
+    }
+}
+
+/// A fault as one lower-case word for `key=value` lines (see [`state_token`]).
+pub fn fault_token(f: FaultCode) -> &'static str {
+    match f {
+        FaultCode::None => "none",
+        FaultCode::SensorLostOrStallPrecession => "no-pulses-precession",
+        FaultCode::SensorLostOrStallSpin => "no-pulses-spin",
+        FaultCode::OverspeedPrecession => "overspeed-precession",
+        FaultCode::OverspeedSpin => "overspeed-spin",
+        FaultCode::HostSilent => "link-lost",
+        FaultCode::InvalidConfiguration => "invalid-configuration",
+    }
+}
+
+/// A reset cause as one lower-case word for `key=value` lines (see [`state_token`]).
+pub fn reset_cause_token(r: ResetCause) -> &'static str {
+    match r {
+        ResetCause::PowerOn => "power-on",
+        ResetCause::Pin => "pin",
+        ResetCause::Software => "software",
+        ResetCause::IndependentWatchdog => "watchdog",
+        ResetCause::WindowWatchdog => "window-watchdog",
+        ResetCause::LowPower => "low-power",
+        ResetCause::Unknown => "unknown",
+    }
+}

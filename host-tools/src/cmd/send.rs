@@ -1,0 +1,80 @@
+//! `bowl send PORT COMMAND ...`: send one command, print the rig's answer. Exit status as in
+//! `exit_code`: 0 done, 1 refused (by the rig or the local check), 3 link problem, 4 no answer.
+
+use std::time::Duration;
+
+use anyhow::Result;
+use model_core::wire::Frame;
+use rig_client::command_words;
+use rig_client::lines::{command_line, describe, explain};
+use rig_client::link::Link;
+use rig_client::refusal;
+use rig_client::request::transact;
+
+use crate::exit_code;
+
+/// Flags of `bowl send`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The serial port or pseudo-terminal of the rig.
+    port: String,
+    /// The command and its arguments, e.g. `speed 1800 2100`, `rtime cori 2500`, `start`, `stop`,
+    /// `clear`, `set MU_PPM 29000`, `status`, `params`, `models`, `commission`, `inject sensor2`
+    /// (see docs/protocol.md). A negative number is a value, judged by the protocol's rules.
+    #[arg(required = true, num_args = 1.., allow_negative_numbers = true)]
+    command: Vec<String>,
+    /// Baud rate.
+    #[arg(long, default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(50..=12_000_000))]
+    baud: u32,
+    /// Request id echoed by the rig (default: derived from the clock).
+    #[arg(long)]
+    id: Option<u16>,
+    /// How long to wait for the answer, ms (1..=60000: the rig remembers a command for 60 s to
+    /// know its copies, so resends must end before that).
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u64).range(1..=60_000))]
+    timeout_ms: u64,
+}
+
+/// Runs `bowl send`; returns the process exit status.
+pub fn run(args: &Args) -> Result<i32> {
+    let id = args.id.unwrap_or_else(rig_client::request::fresh_id);
+    let line = match command_line(id, &args.command) {
+        Ok(line) => line,
+        Err(reason) => {
+            // A command line that cannot be right on any rig: a usage error, said in words.
+            println!(
+                "rejected locally: {} - {} (not sent)",
+                reason.token(),
+                explain(reason)
+            );
+            println!("  {}", command_words::local_refusal(&args.command, reason));
+            return Ok(exit_code::USAGE);
+        }
+    };
+    let mut link = Link::open(&args.port, args.baud)?;
+    let timeout = Duration::from_millis(args.timeout_ms);
+    match transact(&mut link, id, &line, timeout)? {
+        Ok(frame) => {
+            println!("{}", describe(&frame));
+            if let Frame::Reject { reason, .. } = frame
+                && let Some(why) =
+                    refusal::particulars(Some(&mut link), id, &args.command, reason, timeout)
+            {
+                println!("  {why}");
+            }
+            Ok(if matches!(frame, Frame::Reject { .. }) {
+                exit_code::REFUSED
+            } else {
+                exit_code::OK
+            })
+        }
+        Err(unanswered) => {
+            println!(
+                "timeout: no answer to id {id} within {} ms ({})",
+                args.timeout_ms,
+                unanswered.advice()
+            );
+            Ok(exit_code::TIMEOUT)
+        }
+    }
+}

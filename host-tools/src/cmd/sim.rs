@@ -1,0 +1,427 @@
+//! `bowl sim`: the controller against the simulated rig (model-core's `sim`), on the host.
+//!
+//! - `bowl sim step`: 0 to 3 rad/s on both axes of the nominal rig (12 pulses/rev), after
+//!   commissioning; JSON with rise time, overshoot, 2 % settling, steady-state error, RMS ripple
+//!   of the rig's *true* speed.
+//! - `bowl sim family`: the same step on a seeded family of plants the controller is not told
+//!   about, each commissioned first; JSON with the worst case and the median.
+//! - `bowl sim commission`: identification on the simulated rig, identified vs true model.
+//! - `bowl sim sweep`: CSV of settling time against pulses per revolution.
+//! - `bowl sim stability`: CSV map of the limit-cycle amplitude at low speed against loop gain
+//!   (per-pulse bandwidth) and pulse rate, with and without the pulse-rate schedule.
+//! - `bowl sim trace`: CSV trace of the step on one family plant (or the nominal rig).
+//!
+//! The virtual rig on a link (pseudo-terminal or capture file) is `bowl serve` (`virtual_rig::serve`).
+
+use anyhow::{Result, bail};
+use model_core::control::ControllerConfig;
+use model_core::sim::experiments::rig_with_pulses;
+
+use lab::parallel::parallel;
+use lab::sim_reports::nominal::{
+    StepJson, StepOutcome, commission_report, family, stability, step_run_with, sweep, trace,
+};
+use lab::{family_file, sim_reports};
+
+#[derive(clap::Subcommand)]
+pub enum What {
+    /// Step 0 -> 3 rad/s on the nominal rig; JSON.
+    Step(StepArgs),
+    /// The step on a seeded family of perturbed plants; JSON with worst case and median.
+    Family(FamilyArgs),
+    /// Identification on the simulated rig; JSON.
+    Commission(CommonArgs),
+    /// CSV: settling time against pulses per revolution.
+    Sweep(CommonArgs),
+    /// CSV: limit-cycle amplitude at low speed against loop gain and pulse rate.
+    Stability(StabilityArgs),
+    /// CSV trace (every 10 ms) of the 0 -> 3 rad/s step on one family plant (or the nominal rig).
+    Trace(TraceArgs),
+    /// The fault matrix on every plant of a rig file; JSON.
+    Faults(FaultsArgs),
+    /// Writes a seeded family file of plants spread the way lab rigs differ (TOML, stdout).
+    MakeFamily(MakeFamilyArgs),
+}
+
+#[derive(clap::Args)]
+pub struct FaultsArgs {
+    /// Rig file or family file (TOML, see docs/rigs/nominal.toml).
+    #[arg(long)]
+    rig_file: std::path::PathBuf,
+    /// Speed both axes run at when each fault is injected, rad/s.
+    #[arg(long, default_value_t = 3.0)]
+    speed_rad_s: f32,
+    /// JSON output (the only format; accepted for symmetry with the other reports).
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+pub struct MakeFamilyArgs {
+    /// Seed of the spread.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Number of plants.
+    #[arg(long, default_value_t = 60)]
+    plants: u32,
+}
+
+#[derive(clap::Args)]
+pub struct TraceArgs {
+    #[command(flatten)]
+    common: CommonArgs,
+    /// Family plant index; without it, the nominal rig.
+    #[arg(long)]
+    plant: Option<u32>,
+    /// A rig file instead (the plant named by --name, or its first).
+    #[arg(long)]
+    rig_file: Option<std::path::PathBuf>,
+    /// The plant's name in --rig-file.
+    #[arg(long)]
+    name: Option<String>,
+    /// Step target, rad/s.
+    #[arg(long, default_value_t = 3.0)]
+    target_rad_s: f32,
+}
+
+#[derive(clap::Args, Clone)]
+pub struct CommonArgs {
+    /// Seed of tooth errors, jitter and the family.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+}
+
+/// The step of `sim step` and `sim family --rig-file`: from a speed (or rest) to a target.
+#[derive(clap::Args)]
+pub struct StepSpeeds {
+    /// Step target, rad/s.
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+    target_rad_s: f32,
+    /// Both axes first settle at this speed, then step to --target-rad-s (0 = from rest), rad/s.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    from_rad_s: f32,
+}
+
+impl StepSpeeds {
+    /// `(from, target)`, each judged in words.
+    fn checked(&self) -> Result<(f32, f32)> {
+        check_speed(self.target_rad_s, "--target-rad-s")?;
+        check_from(self.from_rad_s, self.target_rad_s)?;
+        Ok((self.from_rad_s, self.target_rad_s))
+    }
+}
+
+#[derive(clap::Args)]
+pub struct StepArgs {
+    #[command(flatten)]
+    common: CommonArgs,
+    /// Pulses per revolution of both sensors (at least 1: the controller measures speed from
+    /// the pulses).
+    #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u16).range(1..))]
+    pulses_per_rev: u16,
+    #[command(flatten)]
+    step: StepSpeeds,
+    /// JSON output (the only format; accepted for symmetry with the other reports).
+    #[arg(long)]
+    json: bool,
+    /// Feedforward only (feedback off): shows what the loop adds.
+    #[arg(long)]
+    no_feedback: bool,
+    /// Override the once-per-revolution load ripple of both axes, N m.
+    #[arg(long)]
+    ripple_nm: Option<f32>,
+    /// Override the loop's per-pulse bandwidth.
+    #[arg(long)]
+    per_pulse_bandwidth: Option<f32>,
+    /// Override the estimator's filter weight.
+    #[arg(long)]
+    filter_weight: Option<f32>,
+    /// Override the setpoint ramp, rad/s^2.
+    #[arg(long)]
+    accel_rad_s2: Option<f32>,
+    /// A rig file (one rig) instead of the nominal rig; its pulses per revolution and load
+    /// step apply (`--pulses-per-rev` and `--ripple-nm` are then ignored).
+    #[arg(long)]
+    rig_file: Option<std::path::PathBuf>,
+}
+
+#[derive(clap::Args)]
+pub struct FamilyArgs {
+    #[command(flatten)]
+    common: CommonArgs,
+    /// Number of plants (at least 50).
+    #[arg(long, default_value_t = 50)]
+    plants: u32,
+    /// Feedforward only (feedback off): the family must then fail.
+    #[arg(long)]
+    no_feedback: bool,
+    /// Allow fewer than 50 plants (for quick tests).
+    #[arg(long, hide = true)]
+    allow_small: bool,
+    /// Run the plants of this rig or family file instead of the built-in family.
+    #[arg(long)]
+    rig_file: Option<std::path::PathBuf>,
+    /// With --rig-file: the step.
+    #[command(flatten)]
+    step: StepSpeeds,
+    /// JSON output (the only format; accepted for symmetry).
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(clap::Args)]
+pub struct StabilityArgs {
+    #[command(flatten)]
+    common: CommonArgs,
+    /// Speed of the test, rad/s.
+    #[arg(long, default_value_t = 0.5)]
+    speed_rad_s: f32,
+    /// Only this pulse count (default: 1, 4, 12 and 60).
+    #[arg(long)]
+    pulses_per_rev: Option<u16>,
+    /// Control tick rate, Hz (the loop rate axis of the map).
+    #[arg(long, default_value_t = 1000)]
+    tick_hz: u32,
+}
+
+/// Runs `bowl sim`.
+pub fn run(what: &What) -> Result<()> {
+    match what {
+        What::Step(a) if a.rig_file.is_some() => {
+            let (from, target) = a.step.checked()?;
+            let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
+            let rigs = rig_file::load(path)?;
+            if rigs.len() != 1 {
+                bail!(
+                    "{} holds {} plants; `bowl sim step` runs one rig (use `bowl sim family --rig-file` for a family)",
+                    path.display(),
+                    rigs.len()
+                );
+            }
+            let rig = &rigs[0];
+            let cfg = sim_reports::config_for(rig);
+            let load = [
+                rig.params.axes[0].load_step_nm,
+                rig.params.axes[1].load_step_nm,
+            ];
+            let outcome = step_run_with(
+                rig.params,
+                cfg,
+                rig.seed,
+                from,
+                target,
+                !a.no_feedback,
+                load,
+            );
+            print_step(
+                "rig file, both axes from --from-rad-s (0 = rest) to the target, commissioned first, true speed",
+                rig.params.axes[1].sensor.pulses_per_rev,
+                (from, target),
+                !a.no_feedback,
+                outcome,
+            )?;
+        }
+        What::Family(a) if a.rig_file.is_some() => {
+            let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
+            let (from, target) = a.step.checked()?;
+            let rigs = rig_file::load(path)?;
+            check_lowest(&rigs, target, "--target-rad-s")?;
+            if from > 0.0 {
+                check_lowest(&rigs, from, "--from-rad-s")?;
+            }
+            let plants = parallel(&rigs, |r| sim_reports::family_plant(r, from, target));
+            let summary = sim_reports::summary(&plants);
+            let out = serde_json::json!({
+                "from_rad_s": from,
+                "target_rad_s": target,
+                "plants": plants,
+                "summary": summary,
+            });
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::Faults(a) => {
+            check_speed(a.speed_rad_s, "--speed-rad-s")?;
+            let rigs = rig_file::load(&a.rig_file)?;
+            check_lowest(&rigs, a.speed_rad_s, "--speed-rad-s")?;
+            let plants = parallel(&rigs, |r| sim_reports::fault_plant(r, a.speed_rad_s));
+            let out = serde_json::json!({ "plants": plants });
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::MakeFamily(a) => print!("{}", family_file::family_toml(a.seed, a.plants)),
+        What::Step(a) => {
+            let (from, target) = a.step.checked()?;
+            let mut rig = rig_with_pulses(a.pulses_per_rev);
+            if let Some(r) = a.ripple_nm {
+                for ax in &mut rig.axes {
+                    ax.ripple_nm = r;
+                }
+            }
+            let mut cfg = ControllerConfig::nominal();
+            for ax in &mut cfg.axes {
+                if let Some(p) = a.per_pulse_bandwidth {
+                    ax.per_pulse_bandwidth = p;
+                }
+                if let Some(w) = a.filter_weight {
+                    ax.filter_weight = w;
+                }
+                if let Some(acc) = a.accel_rad_s2 {
+                    ax.accel_limit_rad_s2 = acc;
+                }
+            }
+            let feedback = !a.no_feedback;
+            let outcome = step_run_with(rig, cfg, a.common.seed, from, target, feedback, [0.0; 2]);
+            print_step(
+                "nominal rig, both axes from --from-rad-s (0 = rest) to the target, commissioned first, true speed",
+                a.pulses_per_rev,
+                (from, target),
+                feedback,
+                outcome,
+            )?;
+        }
+        What::Family(a) => {
+            if a.plants < 50 && !a.allow_small {
+                bail!(
+                    "--plants must be at least 50, the family size the control targets are stated for (got {}); docs/control.md",
+                    a.plants
+                );
+            }
+            let out = family(a.common.seed, a.plants, !a.no_feedback);
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::Commission(a) => {
+            let out = commission_report(a.seed);
+            println!("{}", serde_json::to_string_pretty(&out)?);
+        }
+        What::Sweep(a) => sweep(a.seed),
+        What::Stability(a) => stability(a.common.seed, a.speed_rad_s, a.pulses_per_rev, a.tick_hz),
+        What::Trace(a) => {
+            let rig = match &a.rig_file {
+                Some(path) => {
+                    let rigs = rig_file::load(path)?;
+                    let found = match &a.name {
+                        Some(n) => rigs.into_iter().find(|r| &r.name == n),
+                        None => rigs.into_iter().next(),
+                    };
+                    Some(
+                        found
+                            .ok_or_else(|| anyhow::anyhow!("no plant of that name in the file"))?,
+                    )
+                }
+                None => None,
+            };
+            trace(a.common.seed, a.plant, rig, a.target_rad_s)
+        }
+    }
+    Ok(())
+}
+
+/// A step run that faulted or was never commissioned has no step figures: say so, fail.
+/// Prints a step's report as JSON, then fails if it is no step response.
+fn print_step(
+    scenario: &'static str,
+    pulses_per_rev: u16,
+    (from_rad_s, target_rad_s): (f32, f32),
+    feedback: bool,
+    outcome: StepOutcome,
+) -> Result<()> {
+    let out = StepJson {
+        scenario,
+        pulses_per_rev,
+        from_rad_s,
+        target_rad_s,
+        feedback,
+        outcome,
+    };
+    println!("{}", serde_json::to_string_pretty(&out)?);
+    check_step(&out.outcome)
+}
+
+fn check_step(o: &StepOutcome) -> Result<()> {
+    if !o.commissioned {
+        bail!(
+            "commissioning did not finish (fault code {}): the figures above are not a step response",
+            o.fault_code
+        );
+    }
+    if o.fault_code != 0 {
+        bail!(
+            "the run faulted (fault code {}, see docs/protocol.md): the figures above are not a step \
+             response",
+            o.fault_code
+        );
+    }
+    Ok(())
+}
+
+/// `--from-rad-s`: 0 (from rest) or a speed in the controller's range, not the target itself.
+fn check_from(from: f32, target: f32) -> Result<()> {
+    if from == 0.0 {
+        return Ok(());
+    }
+    check_speed(from, "--from-rad-s")?;
+    if from == target {
+        bail!(
+            "--from-rad-s {from} equals --target-rad-s: there is no step; give a different speed or 0 (from rest)"
+        );
+    }
+    Ok(())
+}
+
+fn check_speed(x: f32, flag: &str) -> Result<()> {
+    let max = ControllerConfig::nominal().axes[0].max_speed_rad_s;
+    if !(x.is_finite() && x > 0.0 && x <= max) {
+        bail!("{flag} {x} is outside 0 to {max} rad/s (the controller's speed range)");
+    }
+    Ok(())
+}
+
+/// Refuses a speed below the lowest one a plant's sensors can measure (one pulse per 4 s).
+fn check_lowest(rigs: &[rig_file::Rig], x: f32, flag: &str) -> Result<()> {
+    for r in rigs {
+        let cfg = sim_reports::config_for(r);
+        for (axis, name) in cfg.axes.iter().zip(["precession", "spin"]) {
+            let lowest = model_core::control::estimator::lowest_speed_rad_s(axis);
+            if x < lowest {
+                bail!(
+                    "{flag} {x} is below the lowest speed of plant {}'s {name} axis, {lowest:.3} rad/s ({} pulses per revolution); ask for at least that",
+                    r.name,
+                    axis.pulses_per_rev
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use lab::sim_reports::nominal::AxisFigures;
+
+    use super::*;
+
+    fn outcome(fault_code: u8, commissioned: bool) -> StepOutcome {
+        let axis = AxisFigures {
+            rise_time_s: 0.5,
+            overshoot_pct: 0.0,
+            settling_time_s: 0.0,
+            steady_state_error_pct: 0.0,
+            rms_ripple_pct: 0.0,
+        };
+        StepOutcome {
+            axes: [axis; 2],
+            worst: axis,
+            fault_code,
+            commissioned,
+        }
+    }
+
+    /// A faulted or uncommissioned run is an error that says why, never a row of zeros.
+    #[test]
+    fn a_faulted_step_is_an_error() {
+        assert!(check_step(&outcome(0, true)).is_ok());
+        let e = check_step(&outcome(3, true)).unwrap_err().to_string();
+        assert!(e.contains("faulted (fault code 3"), "{e}");
+        let e = check_step(&outcome(6, false)).unwrap_err().to_string();
+        assert!(e.contains("commissioning did not finish"), "{e}");
+    }
+}

@@ -1,0 +1,106 @@
+//! The words people read: the rig's states, faults and reset causes (`rig_client::words`) and the
+//! controller's refusals (`virtual_rig::controller_words`) are plain words, never Rust names; the
+//! `key=value` tokens are one lower-case word each, distinct within their kind.
+
+use model_core::control::{ConfigError, Rejection, State as ControllerState};
+use model_core::wire::{DeviceState, FaultCode, ResetCause};
+use rig_client::words::{fault, fault_token, reset_cause, reset_cause_token, state, state_token};
+use virtual_rig::controller_words::{config, rejection};
+
+const FAULTS: [FaultCode; 7] = [
+    FaultCode::None,
+    FaultCode::SensorLostOrStallPrecession,
+    FaultCode::SensorLostOrStallSpin,
+    FaultCode::OverspeedPrecession,
+    FaultCode::OverspeedSpin,
+    FaultCode::HostSilent,
+    FaultCode::InvalidConfiguration,
+];
+
+/// No word is a Rust name (no CamelCase run of two capitals).
+#[test]
+fn plain_words_only() {
+    // A Rust name: a word that starts with a capital and has a lower-upper run inside
+    // (`SpinningUp`); units such as `kHz` are not.
+    let camel = |s: &str| {
+        s.split(|c: char| !c.is_ascii_alphanumeric()).any(|w| {
+            w.starts_with(|c: char| c.is_ascii_uppercase())
+                && w.as_bytes()
+                    .windows(2)
+                    .any(|p| p[0].is_ascii_lowercase() && p[1].is_ascii_uppercase())
+        })
+    };
+    assert!(camel("state SpinningUp") && !camel("10 kHz"));
+    for f in FAULTS {
+        assert!(!camel(fault(f)), "{f:?}");
+    }
+    assert!(!camel(state(DeviceState::SpinningUp)));
+    // The key=value tokens: one lower-case word each, distinct within their kind.
+    let token = |t: &str| !t.is_empty() && t.chars().all(|c| c.is_ascii_lowercase() || c == '-');
+    let faults: Vec<&str> = FAULTS.into_iter().map(fault_token).collect();
+    let states: Vec<&str> = [
+        DeviceState::Idle,
+        DeviceState::Commissioning,
+        DeviceState::SpinningUp,
+        DeviceState::Running,
+        DeviceState::Stopping,
+        DeviceState::Faulted,
+    ]
+    .into_iter()
+    .map(state_token)
+    .collect();
+    let causes: Vec<&str> = [
+        ResetCause::PowerOn,
+        ResetCause::Pin,
+        ResetCause::Software,
+        ResetCause::IndependentWatchdog,
+        ResetCause::WindowWatchdog,
+        ResetCause::LowPower,
+        ResetCause::Unknown,
+    ]
+    .into_iter()
+    .map(reset_cause_token)
+    .collect();
+    for kind in [faults, states, causes] {
+        assert!(kind.iter().all(|t| token(t)), "{kind:?}");
+        let mut unique = kind.clone();
+        unique.sort_unstable();
+        unique.dedup();
+        assert_eq!(unique.len(), kind.len(), "{kind:?}");
+    }
+    assert!(!camel(reset_cause(ResetCause::IndependentWatchdog)));
+    use model_core::control::InverseFailure;
+    let configs = [
+        ConfigError::TickRate,
+        ConfigError::Timer,
+        ConfigError::SupplyVoltage,
+        ConfigError::PulsesPerRev(1),
+        ConfigError::SpeedLimits(0),
+        ConfigError::MotorModel(1),
+        ConfigError::LoopParameter(0),
+        ConfigError::Supervisor,
+        ConfigError::Geometry,
+        ConfigError::Commissioning,
+    ];
+    for c in configs {
+        let text = config(c);
+        assert!(!camel(&text) && !text.contains("Error"), "{c:?}: {text}");
+    }
+    for r in [
+        Rejection::NotFinite,
+        Rejection::AboveMaxSpeed(1),
+        Rejection::BelowMinSpeed(0),
+        Rejection::InvalidResidenceTime,
+        Rejection::Inverse(InverseFailure::Unreachable),
+        Rejection::SplitFailed,
+        Rejection::WrongState(ControllerState::Commissioning),
+        Rejection::Faulted(model_core::control::Fault::HostSilent),
+        Rejection::NotFaulted,
+        Rejection::InvalidConfig(ConfigError::Timer),
+        Rejection::InvalidTuning,
+    ] {
+        assert!(!camel(&rejection(r)), "{r:?}");
+    }
+    assert!(rejection(Rejection::AboveMaxSpeed(1)).contains("spin"));
+    assert!(config(ConfigError::PulsesPerRev(0)).contains("precession"));
+}

@@ -1,0 +1,107 @@
+//! The once-per-revolution load, learned and fed forward (control/load_pattern.rs), on the
+//! nominal rig with an eccentric load four times the nominal one (8 mN m): the pattern learned
+//! is the load the plant applies (its torque in duty, from the motor's own constants), and the
+//! true speed's ripple falls once it is fed forward.
+
+use model_core::control::Controller;
+use model_core::sim::experiments::{rig_with_pulses, true_model_config};
+use model_core::sim::{ClosedLoop, Plant, PlantParams};
+
+const RIPPLE_NM: f32 = 0.008;
+const SPEED_RAD_S: f32 = 1.0;
+
+fn eccentric_rig() -> PlantParams {
+    let mut rig = rig_with_pulses(12);
+    for a in &mut rig.axes {
+        a.ripple_nm = RIPPLE_NM;
+    }
+    rig
+}
+
+/// RMS of the true speed about its mean, in % of the mean.
+fn ripple_pct(trace: &[(f32, u16)]) -> f32 {
+    let n = trace.len() as f32;
+    let mean = trace.iter().map(|s| s.0).sum::<f32>() / n;
+    let var = trace.iter().map(|s| (s.0 - mean).powi(2)).sum::<f32>() / n;
+    100.0 * var.sqrt() / mean
+}
+
+fn started(rig: PlantParams) -> ClosedLoop {
+    let ctrl = Controller::new(true_model_config(&rig)).expect("the nominal configuration");
+    let mut cl = ClosedLoop::new(Plant::new(rig, 1), ctrl);
+    cl.ctrl
+        .set_motor_speeds(SPEED_RAD_S, SPEED_RAD_S)
+        .expect("speeds in range");
+    cl.ctrl.start().expect("starts");
+    cl
+}
+
+#[test]
+fn the_learned_pattern_is_the_plants_eccentric_load() {
+    let rig = eccentric_rig();
+    let mut cl = started(rig);
+    // The true speed and the revolutions learned, every tick for 60 s.
+    let mut trace = Vec::new();
+    cl.run(60.0, |c| {
+        trace.push((c.rig.speed_rad_s(1), c.ctrl.load_pattern(1).0))
+    });
+    let (revs, amplitude) = cl.ctrl.load_pattern(1);
+    // The duty that holds a load torque T against the armature: T R / (k V).
+    let m = rig.axes[1].motor;
+    let expected = RIPPLE_NM * m.resistance_ohm / (m.torque_constant * rig.supply_v);
+    assert!(revs >= 3, "revolutions learned: {revs}");
+    assert!(
+        (amplitude - expected).abs() <= 0.15 * expected,
+        "learned {amplitude:.5} duty, the plant's load is {expected:.5}"
+    );
+    // The revolution that ended with the first pattern learned (none fed forward through it)
+    // against the last one.
+    let per_rev = (core::f32::consts::TAU / SPEED_RAD_S / cl.dt_s()) as usize;
+    let first = trace
+        .iter()
+        .position(|&(_, r)| r > 0)
+        .expect("a pattern learned");
+    assert!(
+        first > per_rev + 1000,
+        "the first revolution began after 1 s: {first} ticks"
+    );
+    let before = ripple_pct(&trace[first - per_rev..first]);
+    let after = ripple_pct(&trace[trace.len() - per_rev..]);
+    eprintln!(
+        "learned {amplitude:.5} duty (plant {expected:.5}) in {revs} revolutions; \
+         ripple {before:.2} % -> {after:.2} %"
+    );
+    assert!(
+        after < 0.35 * before,
+        "true speed ripple {before:.2} % before learning, {after:.2} % after"
+    );
+}
+
+#[test]
+fn a_stop_forgets_the_pattern_and_a_restart_learns_it_again() {
+    let mut cl = started(eccentric_rig());
+    cl.run(40.0, |_| {});
+    assert!(cl.ctrl.load_pattern(1).0 >= 3);
+    cl.ctrl.stop().expect("stops");
+    cl.run(15.0, |_| {});
+    assert_eq!(cl.ctrl.load_pattern(1), (0, 0.0), "forgotten at rest");
+    cl.ctrl
+        .set_motor_speeds(SPEED_RAD_S, SPEED_RAD_S)
+        .expect("speeds in range");
+    cl.ctrl.start().expect("starts again");
+    cl.run(40.0, |_| {});
+    assert!(cl.ctrl.load_pattern(1).0 >= 3, "learned again");
+}
+
+/// Above the speed the tooth map learns at, nothing is learned (the wheel's own pattern would
+/// read as a load there), and nothing is fed forward.
+#[test]
+fn nothing_is_learned_above_the_tooth_maps_speed() {
+    let rig = eccentric_rig();
+    let ctrl = Controller::new(true_model_config(&rig)).expect("the nominal configuration");
+    let mut cl = ClosedLoop::new(Plant::new(rig, 1), ctrl);
+    cl.ctrl.set_motor_speeds(3.0, 3.0).expect("speeds in range");
+    cl.ctrl.start().expect("starts");
+    cl.run(30.0, |_| {});
+    assert_eq!(cl.ctrl.load_pattern(1), (0, 0.0));
+}
