@@ -29,14 +29,14 @@ fn uniform(state: &mut u64) -> f64 {
     (*state >> 11) as f64 / (1u64 << 53) as f64
 }
 
-fn scene(omega: f64, mu: f64, ri: f64, rim: f64) -> Scene<f64> {
+/// A scene on Earth with a solid sphere (the defaults' g and k2).
+fn scene(omega_rad_s: f64, mu: f64, ri_m: f64, rim_radius_m: f64) -> Scene<f64> {
     Scene {
-        omega_rad_s: omega,
+        omega_rad_s,
         mu,
-        g_m_s2: 9.81,
-        k2: 5.0 / 7.0,
-        ri_m: ri,
-        rim_radius_m: rim,
+        ri_m,
+        rim_radius_m,
+        ..Scene::default()
     }
 }
 

@@ -76,6 +76,29 @@ fn cheap<T: Real>(group: &[Scene<T>; LANES]) -> Cheap {
     found
 }
 
+/// The costly lanes' answers: a regular lane's `time`, every other one the one-scene path's;
+/// returns how many were regular. Two stores, not one of a merged value: the merge went
+/// through the stack byte by byte and stalled every store after it.
+#[inline(always)]
+pub(crate) fn answer<T: Real>(
+    group: &[Scene<T>; LANES],
+    out: &mut [Result<T, SceneError>; LANES],
+    time: [T; LANES],
+    regular: [bool; LANES],
+    model: Model,
+) -> usize {
+    let mut answered = 0;
+    for (((scene, answer), time), regular) in group.iter().zip(out).zip(time).zip(regular) {
+        if regular {
+            *answer = Ok(time);
+            answered += 1;
+        } else {
+            *answer = residence_time_s(scene, model);
+        }
+    }
+    answered
+}
+
 /// The one-scene answer, out of the lanes' way (a lane that is refused or unusual).
 #[cold]
 #[inline(never)]

@@ -40,35 +40,6 @@ fn leaves(o: Outcome<f64>) -> (f64, f64, f64) {
     }
 }
 
-/// Independent reference for the Coriolis time: bisection on the printed form
-/// `a + (ri - a)(A e^{l1 t} + B e^{l2 t}) = R` with the corrected A, B, l1, l2 of docs/model.md §3 computed directly.
-fn coriolis_time_bisection(s: &Scene<f64>) -> f64 {
-    let k = s.k2.sqrt();
-    let root = (1.0 + s.k2 * s.mu * s.mu).sqrt();
-    let (w, a) = (
-        s.omega_rad_s,
-        s.mu * s.g_m_s2 / (s.omega_rad_s * s.omega_rad_s),
-    );
-    let l1 = k * w / (root + k * s.mu);
-    let l2 = -k * w * (root + k * s.mu);
-    let ca = (1.0 + k * s.mu / root) / 2.0;
-    let cb = (1.0 - k * s.mu / root) / 2.0;
-    let r = |t: f64| a + (s.ri_m - a) * (ca * (l1 * t).exp() + cb * (l2 * t).exp());
-    let (mut lo, mut hi) = (0.0, 1.0);
-    while r(hi) < s.rim_radius_m {
-        hi *= 2.0;
-    }
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if r(mid) < s.rim_radius_m {
-            lo = mid
-        } else {
-            hi = mid
-        }
-    }
-    0.5 * (lo + hi)
-}
-
 #[test]
 fn corrected_coefficients_are_exact_at_mu_0_2() {
     // docs/model.md §3 check value: mu = 0.2, k2 = 5/7 -> l1 = 5 omega/7, l2 = -omega, A = 7/12.
@@ -99,29 +70,6 @@ fn flat_time_matches_acosh_and_energy() {
         // And the trajectory reaches the rim at T.
         let r = position_m(&s, Model::Flat, t).unwrap();
         assert!((r - 0.1).abs() < 1e-14);
-    }
-}
-
-#[test]
-fn coriolis_time_matches_bisection_and_is_slower() {
-    for &(w, mu, ri) in &[
-        (3.0, 0.029, 0.05),
-        (1.8, 0.01, 0.04),
-        (3.6, 0.05, 0.09),
-        (3.6, 0.0, 0.05),
-    ] {
-        let s = scene(w, mu, ri, 0.1);
-        let (t, v, _) = leaves(residence(&s, Model::Coriolis).unwrap());
-        let want = coriolis_time_bisection(&s);
-        assert!((t - want).abs() < 1e-13 * want, "{t} vs {want}");
-        let (tf, _, _) = leaves(residence(&s, Model::Flat).unwrap());
-        if mu > 0.0 {
-            assert!(t > tf, "Coriolis friction slows the particle");
-        } else {
-            assert!((t - tf).abs() < 1e-14 * tf);
-        }
-        let v_traj = radial_velocity_m_s(&s, Model::Coriolis, t).unwrap();
-        assert!((v - v_traj).abs() < 1e-12 * v_traj);
     }
 }
 
@@ -524,14 +472,7 @@ fn coriolis_copes_with_the_smallest_start_radius() {
         (1e-70, 1e-75),
         (1e-60, 1e-62),
     ] {
-        let s = Scene {
-            omega_rad_s: omega,
-            mu,
-            g_m_s2: g,
-            k2,
-            ri_m: ri,
-            rim_radius_m: rim,
-        };
+        let s = scene(omega, mu, ri, rim);
         let a = mu * g / (omega * omega);
         let t_ref = (2.0f64.ln() + (rim - ri).ln() - (ri - a).ln()) / (k2.sqrt() * omega);
         for model in [Model::Flat, Model::Coriolis] {
@@ -592,14 +533,7 @@ fn coriolis_exit_speed_keeps_full_precision_far_from_the_rim() {
         for x in [1e8f64, 1e10, 1e12] {
             // ri - a = (R - ri)/x  =>  ri = (R + a x)/(1 + x).
             let ri = (rim + a * x) / (1.0 + x);
-            let s = Scene {
-                omega_rad_s: omega,
-                mu,
-                g_m_s2: g,
-                k2,
-                ri_m: ri,
-                rim_radius_m: rim,
-            };
+            let s = scene(omega, mu, ri, rim);
             let k = k2.sqrt();
             let m = k * mu;
             let sq = (1.0 + m * m).sqrt();
