@@ -12,7 +12,19 @@ fn avx2(scenes: &[Scene<f64>], model: Model, out: &mut [Result<f64, SceneError>]
     residence_times_s(scenes, model, out);
 }
 
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn avx512(scenes: &[Scene<f64>], model: Model, out: &mut [Result<f64, SceneError>]) {
+    residence_times_s(scenes, model, out);
+}
+
 fn times(scenes: &[Scene<f64>], model: Model, out: &mut [Result<f64, SceneError>]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::env::var_os("AVX512").is_some() && std::is_x86_feature_detected!("avx512f") {
+        // SAFETY: the processor has just reported AVX-512F.
+        unsafe { avx512(scenes, model, out) };
+        return;
+    }
     #[cfg(target_arch = "x86_64")]
     if std::is_x86_feature_detected!("avx2") {
         // SAFETY: the processor has just reported AVX2.

@@ -586,3 +586,59 @@ proptest! {
         }
     }
 }
+
+/// Long batches through every path of the frame (`batch.rs`): the cheap pass, scenes gathered
+/// across groups, whole leaving groups sent straight to the costly lanes and back, invalid and
+/// extreme scenes, the remainder; every answer the one-scene answer bit for bit. Runs of the
+/// paper's range (96 % never leave), of leaving scenes, and of both mixed.
+#[test]
+fn long_batches_take_every_path_of_the_frame() {
+    let mut next = uniform_stream(31);
+    let mut scenes = Vec::new();
+    for run in 0..60 {
+        let leaving = run % 3 == 1;
+        for _ in 0..(40 + (next() * 200.0) as usize) {
+            let rim = 0.075 + 0.075 * next();
+            let s = if leaving || (run % 3 == 2 && next() < 0.5) {
+                let (w, mu) = (2.5 + 3.5 * next(), 0.1 * next());
+                let a = mu * 9.81 / (w * w);
+                scene(w, mu, a + (rim - a) * (0.001 + 0.998 * next()), rim)
+            } else {
+                scene(
+                    1.0 + 2.6 * next(),
+                    0.029 + 0.371 * next(),
+                    next() * rim,
+                    rim,
+                )
+            };
+            let odd = next();
+            scenes.push(if odd < 0.01 {
+                Scene { mu: -1.0, ..s }
+            } else if odd < 0.02 {
+                Scene { ri_m: 1e-300, ..s }
+            } else if odd < 0.03 {
+                Scene { ri_m: rim, ..s }
+            } else if odd < 0.04 {
+                // Within rounding of the threshold.
+                Scene {
+                    ri_m: s.equilibrium_radius_m(),
+                    ..s
+                }
+            } else {
+                s
+            });
+        }
+    }
+    for model in [Model::Flat, Model::Coriolis] {
+        let mut out = vec![Ok(-1.0); scenes.len()];
+        residence_times_s(&scenes, model, &mut out);
+        for (s, got) in scenes.iter().zip(&out) {
+            let want = residence_time_s(s, model);
+            assert_eq!(
+                got.map(f64::to_bits),
+                want.map(f64::to_bits),
+                "{model:?} {s:?}"
+            );
+        }
+    }
+}
