@@ -65,10 +65,12 @@ fn cheap<T: Real>(group: &[Scene<T>; LANES]) -> Cheap {
     for (i, s) in group.iter().enumerate() {
         let valid = s.is_valid();
         let at_rim = s.ri_m >= s.rim_radius_m;
-        // ri <= a = mu g / omega^2 (a infinite at omega = 0), by 8 epsilons.
+        // ri <= a = mu g / omega^2 (a infinite at omega = 0), by 8 epsilons. Only where the
+        // magnitude limits keep the products normal numbers (f64): in f32, which has none, an
+        // underflowing product could turn the margin round, so its costly lanes decide.
         let push = s.ri_m * s.omega_rad_s * s.omega_rad_s;
         let hold = s.mu * s.g_m_s2;
-        let held = (push < hold * below) | (s.omega_rad_s == T::ZERO);
+        let held = ((push < hold * below) & !T::is_single_precision()) | (s.omega_rad_s == T::ZERO);
         found.one_scene[i] = mask(!valid);
         found.at_rim[i] = mask(valid & at_rim);
         found.costly[i] = mask(valid & !at_rim & !held);
