@@ -6,7 +6,7 @@
 //! omega^2`, docs/model.md §4). Deciding that needs no division: `ri <= a` is
 //! `ri omega^2 <= mu g`, three products. The cheap pass computes, for [`LANES`] scenes at once
 //! with no branch, whether each is valid, at the rim, or held with a margin of 8 epsilons
-//! (which covers the roundings of both sides: `a` carries three, `ri omega^2` two; the
+//! (which covers the roundings of both sides: `a` carries three, `ri omega^2` two; in f64 the
 //! [`magnitude_limits`](super::magnitude_limits) keep every product a normal number, so the
 //! margin is a relative one). Those answers are the one-scene path's bit for bit: 0 at the
 //! rim, infinity when held. The rest (the granule may leave) go to the model's costly lanes
