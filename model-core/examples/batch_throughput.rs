@@ -12,7 +12,19 @@ fn avx2(scenes: &[Scene<f64>], model: Model, out: &mut [Result<f64, SceneError>]
     residence_times_s(scenes, model, out);
 }
 
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn avx512(scenes: &[Scene<f64>], model: Model, out: &mut [Result<f64, SceneError>]) {
+    residence_times_s(scenes, model, out);
+}
+
 fn times(scenes: &[Scene<f64>], model: Model, out: &mut [Result<f64, SceneError>]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::env::var_os("AVX512").is_some() && std::is_x86_feature_detected!("avx512f") {
+        // SAFETY: the processor has just reported AVX-512F.
+        unsafe { avx512(scenes, model, out) };
+        return;
+    }
     #[cfg(target_arch = "x86_64")]
     if std::is_x86_feature_detected!("avx2") {
         // SAFETY: the processor has just reported AVX2.
@@ -29,14 +41,14 @@ fn uniform(state: &mut u64) -> f64 {
     (*state >> 11) as f64 / (1u64 << 53) as f64
 }
 
-fn scene(omega: f64, mu: f64, ri: f64, rim: f64) -> Scene<f64> {
+/// A scene on Earth with a solid sphere (the defaults' g and k2).
+fn scene(omega_rad_s: f64, mu: f64, ri_m: f64, rim_radius_m: f64) -> Scene<f64> {
     Scene {
-        omega_rad_s: omega,
+        omega_rad_s,
         mu,
-        g_m_s2: 9.81,
-        k2: 5.0 / 7.0,
-        ri_m: ri,
-        rim_radius_m: rim,
+        ri_m,
+        rim_radius_m,
+        ..Scene::default()
     }
 }
 

@@ -2,13 +2,24 @@
 
     python tests/scipy/batch.py BOWL OUT_STEM [--scenes N]
 
-(tests/scipy/compare.sh runs it with the release `bowl`.)
+(tests/scipy/compare.sh runs it with the release `bowl`; numpy on one thread: OMP_NUM_THREADS,
+OPENBLAS_NUM_THREADS and MKL_NUM_THREADS are set to 1 before numpy is imported, and its
+element-wise ufuncs run on one thread anyway.)
 
-Draws N scenes per model where every granule leaves (seeded), writes them as a `bowl predict
---batch` file, has `bowl` compute them and measure its throughput (`--throughput`), computes
-the same residence times with vectorised numpy closed forms (flat, paper Eq. 6; Coriolis,
-Eq. 10 with the corrected A, B of docs/model.md, solved by vectorised Newton from the flat
-root), checks that both agree, and writes OUT_STEM.md and OUT_STEM.json.
+Two regimes, N scenes per model each (seeded):
+
+- *paper range*: omega 1 to 3.6 rad/s (up to the paper's Fig. 5 speed), mu 0.029 to 0.4 (the
+  paper's correction factor to its sliding coefficient), rim 0.075 to 0.15 m (the paper's 150 to
+  300 mm bowls read as diameters), the start anywhere inside: about 96 % never leave.
+- *leaving only*: omega 2.5 to 6 rad/s, mu 0 to 0.1, rim 0.1 m, the start at least 10 % above
+  the equilibrium radius: every granule leaves.
+
+Each regime's scenes go to a `bowl predict --batch` file; `bowl` computes them and measures its
+throughput (`--throughput`, the time alone through `particle::residence_times_s`); numpy computes
+the same residence times with vectorised closed forms (flat, paper Eq. 6; Coriolis, Eq. 10 with
+the corrected A, B of docs/model.md, solved by vectorised Newton from the flat root; infinity
+where the granule never leaves, as ours), the script checks that both agree and writes
+OUT_STEM.md and OUT_STEM.json.
 
 Timing: each figure is the best of 15 passes of at least 0.05 s (as `timeit` does), numpy's over
 whole arrays (the scenes already in memory as arrays), ours over the parsed scenes, in 5 rounds
@@ -21,34 +32,52 @@ import subprocess
 import sys
 import time
 
-import numpy as np
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import numpy as np  # noqa: E402
 
 G = 9.81
 K2 = 5.0 / 7.0
+# Rim of the leaving-only regime, m.
 RIM = 0.1
 # Rounds of timing, ours and numpy's in turn.
 ROUNDS = 5
 
 
-def scenes(n, rng):
-    """Speeds, resistances and start radii where the granule leaves: ri above the equilibrium
-    radius a = mu g / omega^2 by at least 10 %."""
+def leaving(n, rng):
+    """Speeds, resistances, start radii and rims where the granule leaves: ri above the
+    equilibrium radius a = mu g / omega^2 by at least 10 %."""
     omega = rng.uniform(2.5, 6.0, n)
     mu = rng.uniform(0.0, 0.1, n)
     a = mu * G / omega**2
     ri = np.maximum(a * 1.1, 0.01) + rng.uniform(0.0, 1.0, n) * (0.095 - np.maximum(a * 1.1, 0.01))
     ri = np.minimum(ri, 0.095)
     keep = ri > a * 1.05
-    return omega[keep], mu[keep], ri[keep]
+    return omega[keep], mu[keep], ri[keep], np.full(int(keep.sum()), RIM)
 
 
-def flat_numpy(omega, mu, ri):
+def paper_range(n, rng):
+    """The paper's range: omega 1..3.6 rad/s, mu 0.029..0.4, rim 0.075..0.15 m, the start
+    anywhere inside the rim (about 96 % never leave)."""
+    omega = rng.uniform(1.0, 3.6, n)
+    mu = rng.uniform(0.029, 0.4, n)
+    rim = rng.uniform(0.075, 0.15, n)
+    ri = rng.uniform(0.0, 1.0, n) * rim
+    return omega, mu, ri, rim
+
+
+REGIMES = {"paper range": paper_range, "leaving only": leaving}
+
+
+def flat_numpy(omega, mu, ri, rim):
     a = mu * G / omega**2
-    x = (RIM - ri) / (ri - a)
-    return np.log1p(x + np.sqrt(x * (x + 2.0))) / (np.sqrt(K2) * omega)
+    x = (rim - ri) / (ri - a)
+    t = np.log1p(x + np.sqrt(x * (x + 2.0))) / (np.sqrt(K2) * omega)
+    return np.where(ri > a, t, np.inf)
 
 
-def coriolis_numpy(omega, mu, ri):
+def coriolis_numpy(omega, mu, ri, rim):
     k = np.sqrt(K2)
     m = k * mu
     s = np.sqrt(1.0 + m * m)
@@ -58,7 +87,7 @@ def coriolis_numpy(omega, mu, ri):
     B = 0.5 / (s * sm)
     q = sm * sm
     a = mu * G / omega**2
-    x = (RIM - ri) / (ri - a)
+    x = (rim - ri) / (ri - a)
     # Start from the flat root, first order in m (as the project's solver does), then Newton
     # on F(u) = A (e^u - 1) + B (e^(-q u) - 1) = x, F'(u) = A (e^u - e^(-q u)) (B q = A).
     w = np.sqrt(x * (x + 2.0))
@@ -69,7 +98,7 @@ def coriolis_numpy(omega, mu, ri):
         ed = np.exp(-q * u)
         f = A * (eu - 1.0) + B * (ed - 1.0) - x
         u = u - f / (A * (eu - ed))
-    return u / (c1 * omega)
+    return np.where(ri > a, u / (c1 * omega), np.inf)
 
 
 def best_ns_per_scene(fn, *arrays):
@@ -90,68 +119,93 @@ def best_ns_per_scene(fn, *arrays):
 def main():
     bowl, stem = sys.argv[1], sys.argv[2]
     n = int(sys.argv[sys.argv.index("--scenes") + 1]) if "--scenes" in sys.argv else 100_000
+    np.seterr(all="ignore")
     rng = np.random.default_rng(7)
-    sets = {"flat": scenes(n, rng), "coriolis": scenes(n, rng)}
-    os.makedirs(os.path.dirname(stem) or ".", exist_ok=True)
-    scene_file = stem + "-scenes.csv"
-    with open(scene_file, "w") as f:
-        f.write("model,w_rad_s,mu,ri_m,R_m,g,k2\n")
-        for model, (omega, mu, ri) in sets.items():
-            for w, m, r in zip(omega, mu, ri):
-                f.write(f"{model},{float(w)!r},{float(m)!r},{float(r)!r},{RIM!r},{G!r},{K2!r}\n")
-    ours_file = stem + "-ours.csv"
     numpy_fn = {"flat": flat_numpy, "coriolis": coriolis_numpy}
+    # Per regime: per model the arrays, and the batch file holding both models.
+    sets, files = {}, {}
+    os.makedirs(os.path.dirname(stem) or ".", exist_ok=True)
+    for regime, draw in REGIMES.items():
+        sets[regime] = {model: draw(n, rng) for model in numpy_fn}
+        tag = regime.replace(" ", "-")
+        files[regime] = (stem + f"-{tag}-scenes.csv", stem + f"-{tag}-ours.csv")
+        with open(files[regime][0], "w") as f:
+            f.write("model,w_rad_s,mu,ri_m,R_m,g,k2\n")
+            for model, (omega, mu, ri, rim) in sets[regime].items():
+                for w, m, r, big_r in zip(omega, mu, ri, rim):
+                    f.write(f"{model},{float(w)!r},{float(m)!r},{float(r)!r},{float(big_r)!r},"
+                            f"{G!r},{K2!r}\n")
     # Ours and numpy's timings alternate over ROUNDS rounds and each side keeps its best: a
     # disturbance of this shared machine then falls on both sides alike, not on one.
-    ours = {}
-    numpy_best = {model: float("inf") for model in sets}
+    ours = {regime: {} for regime in REGIMES}
+    numpy_best = {(r, m): float("inf") for r in REGIMES for m in numpy_fn}
     for _ in range(ROUNDS):
-        out = subprocess.run([bowl, "predict", "--batch", scene_file, "--out", ours_file,
-                              "--throughput"], capture_output=True, text=True, check=True).stdout
-        for model, figures in json.loads(out).items():
-            if model not in ours:
-                ours[model] = figures
-            for key in ("ns_per_scene_one_thread", "ns_per_scene_all_cores"):
-                ours[model][key] = min(ours[model][key], figures[key])
-        for model, arrays in sets.items():
-            numpy_best[model] = min(numpy_best[model], best_ns_per_scene(numpy_fn[model], *arrays))
-    ours_t = {"flat": [], "coriolis": []}
-    with open(ours_file) as f:
-        header = f.readline().strip().split(",")
-        mi, ti = header.index("model"), header.index("residence_time_s")
-        for line in f:
-            cells = line.strip().split(",")
-            ours_t[cells[mi]].append(float(cells[ti]))
-    report = {"numpy": np.__version__}
+        for regime, (scene_file, ours_file) in files.items():
+            out = subprocess.run([bowl, "predict", "--batch", scene_file, "--out", ours_file,
+                                  "--throughput"], capture_output=True, text=True,
+                                 check=True).stdout
+            for model, figures in json.loads(out).items():
+                if model not in ours[regime]:
+                    ours[regime][model] = figures
+                for key in ("ns_per_scene_one_thread", "ns_per_scene_all_cores"):
+                    ours[regime][model][key] = min(ours[regime][model][key], figures[key])
+            for model, arrays in sets[regime].items():
+                key = (regime, model)
+                numpy_best[key] = min(numpy_best[key],
+                                      best_ns_per_scene(numpy_fn[model], *arrays))
+    report = {"numpy": np.__version__, "command": COMMAND}
     rows = []
-    for model, arrays in sets.items():
-        theirs = numpy_fn[model](*arrays)
-        mine = np.array(ours_t[model])
-        agree = float(np.max(np.abs(mine - theirs) / theirs))
-        numpy_ns = numpy_best[model]
-        o = ours[model]
-        report[model] = {
-            "scenes": len(arrays[0]),
-            "numpy_ns_per_scene": numpy_ns,
-            "ours_ns_per_scene_one_thread": o["ns_per_scene_one_thread"],
-            "ours_ns_per_scene_all_cores": o["ns_per_scene_all_cores"],
-            "threads": o["threads"],
-            "max_rel_difference": agree,
-        }
-        rows.append((model, len(arrays[0]), numpy_ns, o["ns_per_scene_one_thread"],
-                     o["ns_per_scene_all_cores"], o["threads"], agree))
+    for regime, (scene_file, ours_file) in files.items():
+        ours_t = {"flat": [], "coriolis": []}
+        with open(ours_file) as f:
+            header = f.readline().strip().split(",")
+            mi, ti = header.index("model"), header.index("residence_time_s")
+            for line in f:
+                cells = line.strip().split(",")
+                ours_t[cells[mi]].append(float(cells[ti]))
+        report[regime] = {}
+        for model, arrays in sets[regime].items():
+            theirs = numpy_fn[model](*arrays)
+            mine = np.array(ours_t[model])
+            leaves = np.isfinite(theirs)
+            if not np.array_equal(leaves, np.isfinite(mine)):
+                sys.exit(f"{regime}, {model}: ours and numpy's disagree on which scenes leave")
+            agree = float(np.max(np.abs(mine[leaves] - theirs[leaves]) / theirs[leaves]))
+            numpy_ns = numpy_best[(regime, model)]
+            o = ours[regime][model]
+            report[regime][model] = {
+                "scenes": len(arrays[0]),
+                "never_leave": int((~leaves).sum()),
+                "numpy_ns_per_scene": numpy_ns,
+                "ours_ns_per_scene_one_thread": o["ns_per_scene_one_thread"],
+                "ours_ns_per_scene_all_cores": o["ns_per_scene_all_cores"],
+                "threads": o["threads"],
+                "max_rel_difference": agree,
+            }
+            rows.append((regime, model, len(arrays[0]), 100.0 * (~leaves).mean(), numpy_ns,
+                         o["ns_per_scene_one_thread"], o["ns_per_scene_all_cores"],
+                         o["threads"], agree))
+        for path in files[regime]:
+            os.remove(path)
     with open(stem + ".json", "w") as f:
         json.dump(report, f, indent=1)
     with open(stem + ".md", "w") as f:
-        f.write("Batch closed forms, ns per scene (best of 5 rounds of 15 passes, ours and numpy's in turn; `tests/scipy/compare.sh`, numpy "
-                f"{np.__version__}, same scenes, same run):\n\n")
-        f.write("| model | scenes | numpy (vectorised) | ours, 1 thread | ours, all cores "
-                "| speed-up, 1 thread / all cores | max relative difference |\n")
-        f.write("|---|---|---|---|---|---|---|\n")
-        for model, count, numpy_ns, one, allc, threads, agree in rows:
-            f.write(f"| {model} | {count} | {numpy_ns:.1f} | {one:.1f} | {allc:.1f} ({threads}) "
-                    f"| {numpy_ns / one:.2f}x / {numpy_ns / allc:.2f}x | {agree:.1e} |\n")
+        f.write("Batch closed forms, ns per scene (best of 5 rounds of 15 passes, ours and "
+                f"numpy's in turn, numpy {np.__version__} on one thread, same scenes, same run; "
+                f"made by `{COMMAND}`):\n\n")
+        f.write("| regime | model | scenes | never leave | numpy (vectorised, 1 thread) "
+                "| ours, 1 thread | ours, all cores | speed-up, 1 thread / all cores "
+                "| max relative difference |\n")
+        f.write("|---|---|---|---|---|---|---|---|---|\n")
+        for regime, model, count, never, numpy_ns, one, allc, threads, agree in rows:
+            f.write(f"| {regime} | {model} | {count} | {never:.1f} % | {numpy_ns:.1f} | {one:.1f} "
+                    f"| {allc:.1f} ({threads}) | {numpy_ns / one:.2f}x / {numpy_ns / allc:.2f}x "
+                    f"| {agree:.1e} |\n")
     print(open(stem + ".md").read())
+
+
+# What makes the figures (written beside them).
+COMMAND = "tests/scipy/compare.sh --batch-only"
 
 
 if __name__ == "__main__":

@@ -317,31 +317,13 @@ pub fn run_to<T: Real, S: SecondOrder<T>>(
         r: r0,
         target,
     };
-    match method {
-        Method::Euler { step_s } => fixed::run(
-            equation,
-            fixed::Scheme::Euler,
-            step_s,
-            stiff_rate,
-            limits,
-            start,
-        ),
-        Method::SemiImplicitEuler { step_s } => fixed::run(
-            equation,
-            fixed::Scheme::SemiImplicit,
-            step_s,
-            stiff_rate,
-            limits,
-            start,
-        ),
-        Method::Rk4 { step_s } => fixed::run(
-            equation,
-            fixed::Scheme::Rk4,
-            step_s,
-            stiff_rate,
-            limits,
-            start,
-        ),
-        Method::Dp54 { rtol, atol } => dp54::run(equation, rtol, atol, stiff_rate, limits, start),
-    }
+    let (scheme, step_s) = match method {
+        Method::Euler { step_s } => (fixed::Scheme::Euler, step_s),
+        Method::SemiImplicitEuler { step_s } => (fixed::Scheme::SemiImplicit, step_s),
+        Method::Rk4 { step_s } => (fixed::Scheme::Rk4, step_s),
+        Method::Dp54 { rtol, atol } => {
+            return dp54::run(equation, rtol, atol, stiff_rate, limits, start);
+        }
+    };
+    fixed::run(equation, scheme, step_s, stiff_rate, limits, start)
 }

@@ -84,6 +84,26 @@ fn axpy<T: Real, const N: usize>(y: &[T; N], h: T, terms: &[(f64, &[T; N])]) -> 
     out
 }
 
+/// A state-only event as one of the time, the state and the step's direction.
+fn on_state<T: Real, const N: usize>(
+    event: EventFn<T, N>,
+) -> impl Fn(T, &[T; N], T, &[T; N]) -> (T, T) {
+    move |_: T, y: &[T; N], _: T, dy: &[T; N]| event(y, dy)
+}
+
+/// A run's end with what it cost.
+fn run_ended<T, const N: usize, S>(
+    ended: Ended<T, N, S>,
+    evaluations: u32,
+    steps: u32,
+) -> Result<Run<T, N, S>, SystemError> {
+    Ok(Run {
+        ended,
+        evaluations,
+        steps,
+    })
+}
+
 fn finite<T: Real, const N: usize>(y: &[T; N]) -> bool {
     y.iter().all(|v| v.is_finite())
 }
@@ -130,8 +150,7 @@ pub fn dp54<T: Real, const N: usize, S>(
     check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
     limits: SystemLimits<T>,
 ) -> Result<Run<T, N, S>, SystemError> {
-    let event = |_: T, y: &[T; N], _: T, dy: &[T; N]| event(y, dy);
-    dp54_with(f, t0, y0, rtol, atol, h0, &event, check, limits)
+    dp54_with(f, t0, y0, rtol, atol, h0, &on_state(event), check, limits)
 }
 
 /// A value-only event as `(g, g')` along `(dt, dy)` (per unit theta of a step), for
@@ -180,11 +199,7 @@ pub(crate) fn dp54_with<T: Real, const N: usize, S>(
     let mut k1 = f(t, &y);
     while steps < limits.max_steps {
         if t >= limits.horizon_s {
-            return Ok(Run {
-                ended: Ended::Horizon { y },
-                evaluations,
-                steps,
-            });
+            return run_ended(Ended::Horizon { y }, evaluations, steps);
         }
         if h <= T::EPSILON * t.abs() {
             return Err(SystemError::StepLimit);
@@ -237,21 +252,13 @@ pub(crate) fn dp54_with<T: Real, const N: usize, S>(
                 Dense::new(y[i], y1[i], &hk)
             });
             let (te, ye) = event_in_step(|i, th| dense[i].at(th), event, t, h);
-            return Ok(Run {
-                ended: Ended::Event { t: te, y: ye },
-                evaluations,
-                steps,
-            });
+            return run_ended(Ended::Event { t: te, y: ye }, evaluations, steps);
         }
         t += h;
         y = y1;
         k1 = k[6];
         if let ControlFlow::Break(why) = check(t, &y) {
-            return Ok(Run {
-                ended: Ended::Stopped { t, y, why },
-                evaluations,
-                steps,
-            });
+            return run_ended(Ended::Stopped { t, y, why }, evaluations, steps);
         }
         h = (h * factor).min(limits.horizon_s - t).max(T::EPSILON * t);
     }
@@ -269,8 +276,7 @@ pub fn rk4<T: Real, const N: usize, S>(
     check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
     limits: SystemLimits<T>,
 ) -> Result<Run<T, N, S>, SystemError> {
-    let event = |_: T, y: &[T; N], _: T, dy: &[T; N]| event(y, dy);
-    rk4_with(f, t0, y0, h, &event, check, limits)
+    rk4_with(f, t0, y0, h, &on_state(event), check, limits)
 }
 
 /// [`rk4`] with an event of the time, the state and the step's direction (as [`timed`] makes).
@@ -293,11 +299,7 @@ pub(crate) fn rk4_with<T: Real, const N: usize, S>(
     let half = T::HALF;
     while steps < limits.max_steps {
         if t >= limits.horizon_s {
-            return Ok(Run {
-                ended: Ended::Horizon { y },
-                evaluations,
-                steps,
-            });
+            return run_ended(Ended::Horizon { y }, evaluations, steps);
         }
         steps += 1;
         let k2 = f(t + half * h, &axpy(&y, h, &[(0.5, &k1)]));
@@ -326,22 +328,14 @@ pub(crate) fn rk4_with<T: Real, const N: usize, S>(
                 t,
                 h,
             );
-            return Ok(Run {
-                ended: Ended::Event { t: te, y: ye },
-                evaluations,
-                steps,
-            });
+            return run_ended(Ended::Event { t: te, y: ye }, evaluations, steps);
         }
         // The time as a multiple of the step, not a running sum: no rounding accumulates in it.
         t = t0 + T::from_f64(f64::from(steps)) * h;
         y = y1;
         k1 = k1_next;
         if let ControlFlow::Break(why) = check(t, &y) {
-            return Ok(Run {
-                ended: Ended::Stopped { t, y, why },
-                evaluations,
-                steps,
-            });
+            return run_ended(Ended::Stopped { t, y, why }, evaluations, steps);
         }
     }
     Err(SystemError::StepLimit)

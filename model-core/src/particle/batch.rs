@@ -6,7 +6,7 @@
 //! omega^2`, docs/model.md §4). Deciding that needs no division: `ri <= a` is
 //! `ri omega^2 <= mu g`, three products. The cheap pass computes, for [`LANES`] scenes at once
 //! with no branch, whether each is valid, at the rim, or held with a margin of 8 epsilons
-//! (which covers the roundings of both sides: `a` carries three, `ri omega^2` two; the
+//! (which covers the roundings of both sides: `a` carries three, `ri omega^2` two; in f64 the
 //! [`magnitude_limits`](super::magnitude_limits) keep every product a normal number, so the
 //! margin is a relative one). Those answers are the one-scene path's bit for bit: 0 at the
 //! rim, infinity when held. The rest (the granule may leave) go to the model's costly lanes
@@ -65,15 +65,40 @@ fn cheap<T: Real>(group: &[Scene<T>; LANES]) -> Cheap {
     for (i, s) in group.iter().enumerate() {
         let valid = s.is_valid();
         let at_rim = s.ri_m >= s.rim_radius_m;
-        // ri <= a = mu g / omega^2 (a infinite at omega = 0), by 8 epsilons.
+        // ri <= a = mu g / omega^2 (a infinite at omega = 0), by 8 epsilons. Only where the
+        // magnitude limits keep the products normal numbers (f64): in f32, which has none, an
+        // underflowing product could turn the margin round, so its costly lanes decide.
         let push = s.ri_m * s.omega_rad_s * s.omega_rad_s;
         let hold = s.mu * s.g_m_s2;
-        let held = (push < hold * below) | (s.omega_rad_s == T::ZERO);
+        let held = ((push < hold * below) & !T::is_single_precision()) | (s.omega_rad_s == T::ZERO);
         found.one_scene[i] = mask(!valid);
         found.at_rim[i] = mask(valid & at_rim);
         found.costly[i] = mask(valid & !at_rim & !held);
     }
     found
+}
+
+/// The costly lanes' answers: a regular lane's `time`, every other one the one-scene path's;
+/// returns how many were regular. Two stores, not one of a merged value: the merge went
+/// through the stack byte by byte and stalled every store after it.
+#[inline(always)]
+pub(crate) fn answer<T: Real>(
+    group: &[Scene<T>; LANES],
+    out: &mut [Result<T, SceneError>; LANES],
+    time: [T; LANES],
+    regular: [bool; LANES],
+    model: Model,
+) -> usize {
+    let mut answered = 0;
+    for (((scene, answer), time), regular) in group.iter().zip(out).zip(time).zip(regular) {
+        if regular {
+            *answer = Ok(time);
+            answered += 1;
+        } else {
+            *answer = residence_time_s(scene, model);
+        }
+    }
+    answered
 }
 
 /// The one-scene answer, out of the lanes' way (a lane that is refused or unusual).

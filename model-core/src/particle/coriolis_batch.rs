@@ -10,9 +10,9 @@
 //! path with its lane's time, which is the one-scene time bit for bit (the same operations in
 //! the same order, no contraction), every other one by the one-scene path itself.
 
-use super::batch::{Costly, LANES};
+use super::batch::{Costly, LANES, answer};
 use super::coriolis::{LocalRoot, PERTURBATIVE_M, local_root_parts};
-use super::{Model, Scene, SceneError, Shape, residence_time_s};
+use super::{Model, Scene, SceneError, Shape};
 use crate::Real;
 use crate::real::exp::phi_terms_f64;
 
@@ -111,23 +111,14 @@ fn lanes<T: Real>(group: &[Scene<T>; LANES], out: &mut [Result<T, SceneError>; L
             & (converged | (found & (root >= lower) & (root <= upper)))
             & time.is_finite();
     }
-    let mut answered = 0;
-    for (((scene, answer), time), regular) in group.iter().zip(out).zip(time).zip(regular) {
-        // Two stores, not one of a merged value (see `flat_batch`).
-        if regular {
-            *answer = Ok(time);
-            answered += 1;
-        } else {
-            *answer = residence_time_s(scene, Model::Coriolis);
-        }
-    }
-    answered
+    answer(group, out, time, regular, Model::Coriolis)
 }
 
 #[cfg(test)]
 mod tests {
     extern crate std;
     use super::*;
+    use crate::particle::residence_time_s;
 
     /// The rig's scenes (mu up to 0.1, the equilibrium radius 2..92 % of the rim's, released
     /// anywhere between) stay on the lanes' path, each with the one-scene answer bit for bit:

@@ -11,8 +11,8 @@
 //! (the same operations in the same order, no contraction), every other one by the one-scene
 //! path itself.
 
-use super::batch::{Costly, LANES};
-use super::{Model, Scene, SceneError, residence_time_s};
+use super::batch::{Costly, LANES, answer};
+use super::{Model, Scene, SceneError};
 use crate::Real;
 
 /// The flat model's costly lanes for [`super::batch::times_s`].
@@ -48,17 +48,6 @@ impl Costly for Flat {
                 & (x < T::ONE / T::EPSILON)
                 & time.is_finite();
         }
-        let mut answered = 0;
-        for (((scene, answer), time), regular) in group.iter().zip(out).zip(time).zip(regular) {
-            // Two stores, not one of a merged value: the merge went through the stack byte by
-            // byte and stalled every store after it.
-            if regular {
-                *answer = Ok(time);
-                answered += 1;
-            } else {
-                *answer = residence_time_s(scene, Model::Flat);
-            }
-        }
-        answered
+        answer(group, out, time, regular, Model::Flat)
     }
 }

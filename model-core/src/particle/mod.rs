@@ -105,7 +105,7 @@ pub enum SceneError {
     /// The rim radius was NaN, infinite or negative.
     InvalidRimRadius,
     /// A valid input outside the magnitudes the model computes with ([`magnitude_limits`]:
-    /// nonzero and below `1e-75` or above `1e75` in f64, `1e-9` and `1e9` in f32): products of
+    /// nonzero and below `1e-75` or above `1e75` in f64; none in f32): products of
     /// up to four inputs (`mu g / omega^2`, `(omega R)^2`) would underflow or overflow, and the
     /// answer could come out the wrong way round (leaves for never leaves, an exit speed below
     /// the radial one). Refused rather than answered; rescale the units (or pass 0).
@@ -138,14 +138,19 @@ pub enum Input {
     RimRadius,
 }
 
-/// The smallest and the largest nonzero magnitude of a scene's inputs (`1e-75`, `1e75` in f64;
-/// `1e-9`, `1e9` in f32): products of four of them stay normal numbers (`1e-300` to `1e300`
-/// in f64, with room for the rounding of a difference; `1e-36` to `1e36` in f32), so the
-/// equilibrium radius `a = mu g / omega^2`, `ri omega^2` and the squares of the exit speeds
-/// (paper Eq. 12) never underflow or overflow. Zero itself is exact and always accepted.
+/// The smallest and the largest nonzero magnitude of a scene's inputs in f64, `1e-75` and
+/// `1e75`: products of four of them stay normal numbers (`1e-300` to `1e300`, with room for
+/// the rounding of a difference), so the equilibrium radius `a = mu g / omega^2`, `ri omega^2`
+/// and the squares of the exit speeds (paper Eq. 12) never underflow or overflow. Zero itself
+/// is exact and always accepted.
+///
+/// In f32 (the MCU) there are no limits: `(0, infinity)`. The rig's scenes come from its wire
+/// parameters, held within their ranges (`binding::configure`: micrometres, ppm, a speed limit
+/// of a few rad/s), far inside f32's; the test would cost the one-scene forms some 130
+/// Cortex-M4F instructions (the flat time alone 150 -> 280), over their budgets.
 pub fn magnitude_limits<T: Real>() -> (T, T) {
     if T::is_single_precision() {
-        (T::from_f64(1e-9), T::from_f64(1e9))
+        (T::ZERO, T::INFINITY)
     } else {
         (T::from_f64(1e-75), T::from_f64(1e75))
     }
@@ -236,7 +241,7 @@ impl<T: Real> Scene<T> {
         if !nonneg_finite(self.omega_rad_s) {
             return Err(SceneError::InvalidOmega);
         }
-        if !within_magnitudes(self.omega_rad_s) {
+        if !T::is_single_precision() && !within_magnitudes(self.omega_rad_s) {
             return Err(SceneError::ExtremeMagnitude(Input::Omega));
         }
         Ok(())
@@ -247,8 +252,17 @@ impl<T: Real> Scene<T> {
     /// one-scene path, which names the refusal.
     #[inline(always)]
     pub(crate) fn is_valid(&self) -> bool {
+        // `&`, not `&&`: every test on every lane.
+        if T::is_single_precision() {
+            return nonneg_finite(self.mu)
+                & nonneg_finite(self.g_m_s2)
+                & self.k2.is_in_unit_interval()
+                & nonneg_finite(self.ri_m)
+                & nonneg_finite(self.rim_radius_m)
+                & nonneg_finite(self.omega_rad_s);
+        }
         // The window alone is the test: NaN, infinities and negative values fall outside it
-        // (-0 is 0). `&`, not `&&`: every test on every lane, float compares only.
+        // (-0 is 0); float compares only.
         let (low, _) = magnitude_limits::<T>();
         within_magnitudes(self.mu)
             & within_magnitudes(self.g_m_s2)
@@ -275,6 +289,10 @@ impl<T: Real> Scene<T> {
         }
         if !nonneg_finite(self.rim_radius_m) {
             return Err(SceneError::InvalidRimRadius);
+        }
+        if T::is_single_precision() {
+            // No magnitude limits in f32 (see `magnitude_limits`).
+            return Ok(());
         }
         for (value, input) in [
             (self.mu, Input::Resistance),

@@ -5,8 +5,8 @@
 use crate::check::{Bench, Case, Failure, close, ensure};
 use model_core::Real;
 use model_core::particle::{
-    self, InverseError, Model, Outcome, Scene, omega_for_residence_time, residence,
-    residence_time_s,
+    self, InverseError, Model, Outcome, Scene, omega_for_residence_time, radial_velocity_m_s,
+    residence, residence_time_s,
 };
 use model_core::real::micro::{MicroF32, MicroF32HwSqrt};
 
@@ -19,6 +19,10 @@ pub static CASES: &[Case] = &[
     Case {
         name: "particle::coriolis_time_f32_vs_f64_bisection",
         run: coriolis_time_vs_bisection,
+    },
+    Case {
+        name: "particle::coriolis_time_f64_vs_bisection",
+        run: coriolis_time_f64_vs_bisection,
     },
     Case {
         name: "particle::inverse_f32_round_trips_through_f64",
@@ -251,6 +255,54 @@ fn flat_time_vs_acosh() -> Result<(), Failure> {
             v as f64 / v_want,
             1.0,
             F32_TOL * c as f64,
+        )?;
+    }
+    Ok(())
+}
+
+/// f64 (the host's precision) against the same bisection, with the trajectory's speed at `T`
+/// (paper Eq. 11) as the exit speed and the Coriolis friction slowing the particle.
+fn coriolis_time_f64_vs_bisection() -> Result<(), Failure> {
+    for (w, mu, ri) in [
+        (3.0, 0.029, 0.05),
+        (1.8, 0.01, 0.04),
+        (3.6, 0.05, 0.09),
+        (3.6, 0.0, 0.05),
+    ] {
+        let s = Scene {
+            omega_rad_s: w,
+            mu,
+            ri_m: ri,
+            rim_radius_m: 0.1,
+            ..Scene::<f64>::default()
+        };
+        let leaves = |model| match residence(&s, model) {
+            Ok(Outcome::Leaves {
+                residence_time_s,
+                exit_radial_velocity_m_s,
+                ..
+            }) => Ok((residence_time_s, exit_radial_velocity_m_s)),
+            _ => ensure("the f64 scene leaves", false).map(|()| (0.0, 0.0)),
+        };
+        let (t, v) = leaves(Model::Coriolis)?;
+        close(
+            "Coriolis T f64 vs bisection (rel)",
+            t / coriolis_ref(&s),
+            1.0,
+            1e-13,
+        )?;
+        let (tf, _) = leaves(Model::Flat)?;
+        if mu > 0.0 {
+            ensure("Coriolis friction slows the particle", t > tf)?;
+        } else {
+            close("Coriolis T at mu = 0 vs flat (rel)", t / tf, 1.0, 1e-14)?;
+        }
+        let v_traj = radial_velocity_m_s(&s, Model::Coriolis, t).unwrap_or(f64::NAN);
+        close(
+            "Coriolis r'(T) vs the trajectory's (rel)",
+            v / v_traj,
+            1.0,
+            1e-12,
         )?;
     }
     Ok(())

@@ -147,3 +147,29 @@ pub fn ode(e: OdeError) -> String {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An extreme magnitude is refused in words: which input (its flag), the limits, what to do.
+    #[test]
+    fn extreme_magnitudes_are_refused_in_words() {
+        let s = Scene {
+            mu: 1e-200,
+            ..Scene::<f64>::default()
+        };
+        let said = check(&s).unwrap_err().to_string();
+        for part in [
+            "--mu",
+            "1e-75",
+            "1e75",
+            "underflow or overflow",
+            "rescale the units",
+        ] {
+            assert!(said.contains(part), "{said:?} lacks {part:?}");
+        }
+        let said = scene(SceneError::ExtremeMagnitude(Input::Omega));
+        assert!(said.starts_with("--omega-rad-s is outside"), "{said}");
+    }
+}
