@@ -293,20 +293,33 @@ pub fn check(
             ));
             continue;
         }
-        if let Some([lo, hi]) = e.telemetry_hz {
+        // Rows sent while a command was in transit are not judged: the command (a SET of the
+        // telemetry rate, say) may or may not have taken effect yet.
+        let judged: Vec<&Row> = span
+            .iter()
+            .copied()
+            .filter(|r| !r.contains_key(IN_TRANSIT))
+            .collect();
+        if let (Some([lo, hi]), [] | [_]) = (e.telemetry_hz, judged.as_slice()) {
+            failures.push(format!(
+                "{head}: expected {lo}..={hi} telemetry frames/s, got {} frame(s) outside the \
+                 commands' transit: no rate to measure",
+                judged.len()
+            ));
+        }
+        if let (Some([lo, hi]), [first, .., last]) = (e.telemetry_hz, judged.as_slice()) {
             // Frames per second between the span's first and last frame, on the rig's own clock.
             let clock = |r: &Row| {
                 r.get("board_time_ms")
                     .and_then(|t| t.parse::<u32>().ok())
                     .unwrap_or_else(|| time_ms(r))
             };
-            let (first, last) = (clock(span[0]), clock(span[span.len() - 1]));
-            let secs = f64::from(last.saturating_sub(first)) / 1000.0;
-            let hz = (span.len() - 1) as f64 / secs.max(1e-3);
+            let secs = f64::from(clock(last).saturating_sub(clock(first))) / 1000.0;
+            let hz = (judged.len() - 1) as f64 / secs.max(1e-3);
             if !(lo..=hi).contains(&hz) {
                 failures.push(format!(
                     "{head}: expected {lo}..={hi} telemetry frames/s, got {hz:.1} ({} frames in {secs} s)",
-                    span.len()
+                    judged.len()
                 ));
             }
         }
@@ -334,11 +347,6 @@ pub fn check(
                 format!("{col} in [{lo}, {hi}]"),
             ));
         }
-        let judged: Vec<&Row> = span
-            .iter()
-            .copied()
-            .filter(|r| !r.contains_key(IN_TRANSIT))
-            .collect();
         for (col, ok, expected) in &field_checks {
             let bad: Vec<&&Row> = judged
                 .iter()
