@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::bowl;
+use common::{bowl, predict_args, rig_axis_speed, tilted_rig};
 
 fn run(args: &[&str]) -> (Option<i32>, String, String) {
     let out = bowl(args);
@@ -33,23 +33,10 @@ fn a_negative_speed_is_a_value_judged_in_words() {
 
 #[test]
 fn a_negative_spin_is_taken() {
-    let (code, out, err) = run(&[
-        "predict",
-        "--model",
-        "bowl",
-        "--axes-angle-deg",
-        "60",
-        "--precession-rad-s",
-        "1.2",
-        "--spin-rad-s",
-        "-2.7",
-        "--rim-radius-m",
-        "0.075",
-        "--ri-m",
-        "0.0375",
-        "--release-azimuth-deg",
-        "0",
-    ]);
+    let (code, out, err) = run(&predict_args(
+        &tilted_rig("bowl", "1.2"),
+        &["--spin-rad-s", "-2.7", "--release-azimuth-deg", "0"],
+    ));
     assert_eq!(code, Some(0), "{err}");
     assert!(out.contains("w2 -2.7 rad/s"), "{out}");
     let (code, out, err) = run(&["kinematics", "--spin-rad-s", "-1.8"]);
@@ -59,26 +46,12 @@ fn a_negative_spin_is_taken() {
 
 #[test]
 fn the_rods_offset_has_its_name_and_the_old_one_still_works() {
+    let w = rig_axis_speed();
     let scene = |flag: &str| {
-        run(&[
-            "predict",
-            "--model",
-            "rolling",
-            flag,
-            "0.1",
-            "--precession-rad-s",
-            "2.08",
-            "--spin-rad-s",
-            "2.08",
-            "--axes-angle-deg",
-            "60",
-            "--ri-m",
-            "0.075",
-            "--rim-radius-m",
-            "0.15",
-            "--release-azimuth-deg",
-            "0",
-        ])
+        run(&predict_args(
+            &tilted_rig("rolling", &w),
+            &[flag, "0.1", "--release-azimuth-deg", "0"],
+        ))
     };
     let new = scene("--rod-offset-m");
     let old = scene("--rod-length-m");

@@ -4,8 +4,11 @@
 mod common;
 
 use std::path::PathBuf;
+use std::process::Output;
 
-use common::{bowl, json, run_batch};
+use common::{
+    bowl, json, predict_args, predict_batch, rig_axis_speed, run_batch, success_json, tilted_rig,
+};
 
 /// Flat residence time by the textbook formula, `acosh((R - a)/(ri - a)) / (k omega)`.
 fn flat_time(w: f64, mu: f64, ri: f64, rim: f64) -> f64 {
@@ -119,13 +122,7 @@ fn batch_with_a_bad_row_names_every_bad_line_and_writes_nothing() {
     )
     .unwrap();
     std::fs::write(&output, "an older result\n").unwrap();
-    let out = bowl(&[
-        "predict",
-        "--batch",
-        input.to_str().unwrap(),
-        "--out",
-        output.to_str().unwrap(),
-    ]);
+    let out = predict_batch(&input, &output, &[]);
     assert_eq!(out.status.code(), Some(1), "a failed row fails the run");
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -165,35 +162,26 @@ fn batch_with_a_bad_row_names_every_bad_line_and_writes_nothing() {
 /// Every result column against the single-scene `bowl predict --json` of the same scene.
 #[test]
 fn batch_rows_carry_the_results_condition_and_flags_of_single_predictions() {
-    let input = temp("in-good.csv");
-    let output = temp("out-good.csv");
     // a: ordinary; b: never leaves; f: Coriolis; t: a start just above the threshold.
     let a_thr = 0.029 * 9.81 / (3.0f64 * 3.0);
     let ri_t = a_thr * (1.0 + 1e-11);
-    std::fs::write(
-        &input,
-        format!(
+    let (out, text) = run_batch(
+        "good",
+        &format!(
             "label,model,w_rad_s,mu,ri_m,R_m,g,k2\n\
              \"a, quoted\",flat,3.6,0.01,0.03,0.1,9.81,0.7142857142857143\n\
              b,coriolis,3.6,0.4,0.05,0.1,9.81,0.7142857142857143\n\
              f,coriolis,3,0.029,0.05,0.1,9.81,0.7142857142857143\n\
              t,flat,3,0.029,{ri_t:e},0.1,9.81,0.7142857142857143\n"
         ),
-    )
-    .unwrap();
-    let out = bowl(&[
-        "predict",
-        "--batch",
-        input.to_str().unwrap(),
-        "--out",
-        output.to_str().unwrap(),
-    ]);
+        &[],
+    );
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let mut rdr = csv::Reader::from_path(&output).unwrap();
+    let mut rdr = csv::Reader::from_reader(text.as_bytes());
     let header: Vec<String> = rdr.headers().unwrap().iter().map(String::from).collect();
     assert_eq!(
         &header[8..],
@@ -268,8 +256,6 @@ fn batch_rows_carry_the_results_condition_and_flags_of_single_predictions() {
         &rows[3][12], "ill_conditioned",
         "a start 1e-11 above the threshold"
     );
-    let _ = std::fs::remove_file(input);
-    let _ = std::fs::remove_file(output);
 }
 
 #[test]
@@ -318,20 +304,9 @@ fn batch_throughput_is_measured_per_model() {
 
 #[test]
 fn batch_without_required_column_fails_naming_it() {
-    let input = temp("nocol.csv");
-    let output = temp("nocol-out.csv");
-    std::fs::write(&input, "model,mu,ri_m,R_m\nflat,0.01,0.03,0.1\n").unwrap();
-    let out = bowl(&[
-        "predict",
-        "--batch",
-        input.to_str().unwrap(),
-        "--out",
-        output.to_str().unwrap(),
-    ]);
+    let (out, _) = run_batch("nocol", "model,mu,ri_m,R_m\nflat,0.01,0.03,0.1\n", &[]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("w_rad_s"));
-    let _ = std::fs::remove_file(input);
-    let _ = std::fs::remove_file(output);
 }
 
 #[test]
@@ -371,36 +346,20 @@ fn a_step_beyond_stability_is_an_error_not_a_number() {
 /// (docs/model.md §9); one azimuth gives `residence_time_s`.
 #[test]
 fn rolling_model_on_the_tilted_rig() {
-    let w = 3.6 / (2.0 * (1.0 + 60f64.to_radians().cos())).sqrt();
-    let w = format!("{w}");
-    let base = [
-        "predict",
-        "--model",
-        "rolling",
-        "--precession-rad-s",
-        &w,
-        "--spin-rad-s",
-        &w,
-        "--axes-angle-deg",
-        "60",
-        "--mu",
-        "0.029",
-        "--ri-m",
-        "0.075",
-        "--rim-radius-m",
-        "0.15",
-        "--json",
-    ];
-    let mut all = base.to_vec();
-    all.extend(["--release-azimuth-deg", "all"]);
-    let v = json(&all);
+    let w = rig_axis_speed();
+    let rig = tilted_rig("rolling", &w);
+    let at = |azimuths| {
+        predict_args(
+            &rig,
+            &["--mu", "0.029", "--json", "--release-azimuth-deg", azimuths],
+        )
+    };
+    let v = json(&at("all"));
     let get = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("{k} in {v}"));
     assert!((get("residence_time_mean_s") - 0.211).abs() < 5e-4, "{v}");
     assert!((get("residence_time_min_s") - 0.153).abs() < 5e-4, "{v}");
     assert!((get("residence_time_max_s") - 0.287).abs() < 5e-4, "{v}");
-    let mut one = base.to_vec();
-    one.extend(["--release-azimuth-deg", "0"]);
-    let v = json(&one);
+    let v = json(&at("0"));
     let t = v["residence_time_s"].as_f64().unwrap();
     assert!(t > 0.15 && t < 0.29, "{v}");
     // A missing speed is said plainly, exit code 1.
@@ -513,24 +472,39 @@ fn reference_time(samples: &[f64], coriolis: bool) -> f64 {
     common::reference_residence_s(w, 0.029, 0.05, 0.1, coriolis)
 }
 
+/// A spin-up from 0.5 to 3 rad/s with time constant 0.3 s, rad/s at `t` s.
+fn spin_up(t: f64) -> f64 {
+    3.0 + (0.5 - 3.0) * (-t / 0.3).exp()
+}
+
+/// `bowl predict --omega-trace LOG EXTRA...` on a log of `omega(t)` for 3 s (named `name` in
+/// the temporary folder, removed after the run).
+fn predict_on_trace(name: &str, omega: impl Fn(f64) -> f64, extra: &[&str]) -> Output {
+    let path = temp(name);
+    write_trace(&path, 3.0, omega);
+    let mut args = vec!["predict", "--omega-trace", path.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let out = bowl(&args);
+    let _ = std::fs::remove_file(&path);
+    out
+}
+
 /// `bowl predict --omega-trace` on a log of `omega(t)` (3 s at 50 Hz, mrad/s as logged) with
-/// `tolerance`: its JSON, its T and the reference's T on the same logged samples.
+/// `tolerance` and the `extra` flags: its JSON, its T and the reference's T on the same logged
+/// samples.
 fn trace_prediction(
     name: &str,
     omega: impl Fn(f64) -> f64,
     tolerance: &str,
+    extra: &[&str],
 ) -> (serde_json::Value, f64, f64) {
-    let path = temp(name);
-    write_trace(&path, 3.0, &omega);
-    let v = json(&[
-        "predict",
-        "--omega-trace",
-        path.to_str().unwrap(),
-        "--tolerance",
-        tolerance,
-        "--json",
-    ]);
-    let _ = std::fs::remove_file(&path);
+    let mut flags = vec!["--tolerance", tolerance, "--json"];
+    flags.extend_from_slice(extra);
+    let out = predict_on_trace(name, &omega, &flags);
+    let v = success_json(
+        &out,
+        &format!("bowl predict --omega-trace {name} {flags:?}"),
+    );
     let samples: Vec<f64> = (0..=150)
         .map(|i| (omega(i as f64 * 0.02) * 1000.0).round() / 1000.0)
         .collect();
@@ -543,32 +517,22 @@ fn trace_prediction(
 fn a_logged_speed_trace_is_predicted_within_the_tolerance() {
     // A settled loop with 0.5 % ripple: the closed form at the mean speed is enough.
     let ripple = |t: f64| 3.0 * (1.0 + 0.005 * (7.0 * std::f64::consts::TAU * t).sin());
-    let (v, got, want) = trace_prediction("steady.csv", ripple, "1e-3");
+    let (v, got, want) = trace_prediction("steady.csv", ripple, "1e-3", &[]);
     assert_eq!(v["choice"]["method"], "closed", "{v}");
     assert!((got - want).abs() <= 1e-3 * want, "{got} vs {want}");
     assert_eq!(v["residence_time_from_choosing"], false, "{v}");
     // A spin-up from 0.5 to 3 rad/s: the particle waits for the speed, then leaves while it
     // still rises; an integrator over the trace is needed for 1e-5.
-    let rise = |t: f64| 3.0 + (0.5 - 3.0) * (-t / 0.3).exp();
-    let (v, got, want) = trace_prediction("spin-up.csv", rise, "1e-5");
+    let (v, got, want) = trace_prediction("spin-up.csv", spin_up, "1e-5", &[]);
     assert_ne!(v["choice"]["method"], "closed", "{v}");
     assert!((got - want).abs() <= 1e-5 * want, "{got} vs {want}: {v}");
     // The pilot's finer DP5(4) run answered: the plan was not run again.
     assert_eq!(v["choice"]["method"], "dp54", "{v}");
     assert_eq!(v["residence_time_from_choosing"], true, "{v}");
-    let spin_up = temp("spin-up.csv");
-    write_trace(&spin_up, 3.0, rise);
     // --model with a trace is refused in words.
-    let out = bowl(&[
-        "predict",
-        "--omega-trace",
-        spin_up.to_str().unwrap(),
-        "--model",
-        "flat",
-    ]);
+    let out = predict_on_trace("spin-up.csv", spin_up, &["--model", "flat"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("leave out --model"));
-    let _ = std::fs::remove_file(spin_up);
 }
 
 /// A trace's own measurement uncertainty takes the place of the default 1 % on omega: a
@@ -671,25 +635,7 @@ fn the_chooser_prices_for_the_mcu_in_f32() {
         "{text}"
     );
     // A spin-up trace for the MCU at 1e-4: a plan that meets it on the logged samples.
-    let rise = |t: f64| 3.0 + (0.5 - 3.0) * (-t / 0.3).exp();
-    let path = temp("mcu-spin-up.csv");
-    write_trace(&path, 3.0, rise);
-    let v = json(&[
-        "predict",
-        "--omega-trace",
-        path.to_str().unwrap(),
-        "--tolerance",
-        "1e-4",
-        "--target",
-        "mcu",
-        "--json",
-    ]);
-    let _ = std::fs::remove_file(&path);
+    let (v, got, want) = trace_prediction("mcu-spin-up.csv", spin_up, "1e-4", &["--target", "mcu"]);
     assert_eq!(v["choice"]["target"], "mcu", "{v}");
-    let samples: Vec<f64> = (0..=150)
-        .map(|i| (rise(i as f64 * 0.02) * 1000.0).round() / 1000.0)
-        .collect();
-    let want = reference_time(&samples, v["choice"]["model"] == "coriolis");
-    let got = v["residence_time_s"].as_f64().unwrap();
     assert!((got - want).abs() <= 1e-4 * want, "{got} vs {want}: {v}");
 }

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{bowl, json};
+use common::{bowl, json, predict_args, rig_axis_speed, tilted_rig};
 
 /// The command line with the scene's speeds, tilt and wall; a flag in `extra` replaces
 /// the default one.
@@ -15,7 +15,8 @@ fn bowl_args<'a>(
     wall: [&'a str; 3],
     extra: &[&'a str],
 ) -> Vec<&'a str> {
-    let pairs = [
+    let scene = [
+        ("--model", "bowl"),
         ("--axes-angle-deg", th),
         ("--precession-rad-s", w1),
         ("--spin-rad-s", w2),
@@ -30,14 +31,7 @@ fn bowl_args<'a>(
         ("--fillet-radius-m", wall[2]),
         ("--max-time-s", "3"),
     ];
-    let mut v = vec!["predict", "--model", "bowl"];
-    for (flag, value) in pairs {
-        if !extra.contains(&flag) {
-            v.extend([flag, value]);
-        }
-    }
-    v.extend_from_slice(extra);
-    v
+    predict_args(&scene, extra)
 }
 
 /// A still bowl tilted 60 deg with a bare rim: the granule slides straight down
@@ -209,7 +203,7 @@ fn a_bare_rim_agrees_with_scipy_in_the_inertial_frame() {
         env!("CARGO_MANIFEST_DIR"),
         "/../tests/scipy/bowl_reference.py"
     );
-    let w = format!("{}", 3.6 / (2.0 * (1.0 + 60f64.to_radians().cos())).sqrt());
+    let w = rig_axis_speed();
     for (mu_s, betas, tol) in [("0.35", "0,90,180,270", 1e-7), ("0.45", "180", 1e-5)] {
         let list: Vec<&str> = betas.split(',').collect();
         let mut cmd = vec![script, &w, &w, "60", "0.15", "0.075", "0.003", mu_s];
@@ -224,30 +218,20 @@ fn a_bare_rim_agrees_with_scipy_in_the_inertial_frame() {
             String::from_utf8_lossy(&out.stderr)
         );
         let reference = String::from_utf8(out.stdout).unwrap();
-        let v = json(&[
-            "predict",
-            "--model",
-            "bowl",
-            "--axes-angle-deg",
-            "60",
-            "--precession-rad-s",
-            &w,
-            "--spin-rad-s",
-            &w,
-            "--rim-radius-m",
-            "0.15",
-            "--ri-m",
-            "0.075",
-            "--mu",
-            "0",
-            "--sliding-mu",
-            mu_s,
-            "--release-azimuth-deg",
-            betas,
-            "--tol",
-            "1e-11",
-            "--json",
-        ]);
+        let v = json(&predict_args(
+            &tilted_rig("bowl", &w),
+            &[
+                "--mu",
+                "0",
+                "--sliding-mu",
+                mu_s,
+                "--release-azimuth-deg",
+                betas,
+                "--tol",
+                "1e-11",
+                "--json",
+            ],
+        ));
         for (line, rel) in reference.lines().zip(v["per_release"].as_array().unwrap()) {
             let fields: Vec<f64> = line
                 .split_whitespace()

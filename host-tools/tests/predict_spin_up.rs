@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{bowl, json};
+use common::{SPIN_UP_FROM_REST, bowl, json, predict_args};
 
 /// The reference T of the Coriolis model (or the flat one) for a spin-up from `start` to
 /// `end` rad/s with time constant `tau`, mu 0.029, ri 0.05 m, R 0.1 m.
@@ -59,14 +59,7 @@ fn a_spin_up_with_a_tolerance_is_read_from_the_table_and_meets_it() {
 
 #[test]
 fn a_derived_tolerance_runs_only_the_spread_and_the_mcu_runs_the_pilot() {
-    let base = [
-        "predict",
-        "--spin-up-from-rad-s",
-        "0",
-        "--time-constant-s",
-        "0.3",
-        "--json",
-    ];
+    let base = predict_args(&SPIN_UP_FROM_REST, &["--json"]);
     // The tolerance from the parameters' uncertainty (the default): the spread's runs, then
     // the method from the table.
     let v = json(&base);
@@ -149,16 +142,10 @@ fn bad_spin_ups_are_named_in_plain_words() {
 /// Coriolis term it leaves out), and T is within that claim of the Coriolis reference.
 #[test]
 fn a_flat_choice_claims_the_flat_models_own_error_too() {
-    let v = json(&[
-        "predict",
-        "--spin-up-from-rad-s",
-        "0",
-        "--time-constant-s",
-        "0.3",
-        "--tolerance",
-        "2e-2",
-        "--json",
-    ]);
+    let v = json(&predict_args(
+        &SPIN_UP_FROM_REST,
+        &["--tolerance", "2e-2", "--json"],
+    ));
     let c = &v["choice"];
     assert_eq!(c["model"], "flat", "{c}");
     let f = |k: &str| c[k].as_f64().unwrap();

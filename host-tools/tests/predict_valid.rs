@@ -4,37 +4,7 @@
 
 mod common;
 
-use common::{bowl, json};
-
-/// The tilted rig's rolling arguments (60 deg, R 150 mm, |Omega| 3.6 with w1 = w2).
-fn rig_rolling(extra: &[&str]) -> Vec<String> {
-    let w = 3.6 / (2.0 * (1.0 + 60f64.to_radians().cos())).sqrt();
-    let w = format!("{w}");
-    let mut v: Vec<String> = [
-        "predict",
-        "--model",
-        "rolling",
-        "--precession-rad-s",
-        &w,
-        "--spin-rad-s",
-        &w,
-        "--axes-angle-deg",
-        "60",
-        "--ri-m",
-        "0.075",
-        "--rim-radius-m",
-        "0.15",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    v.extend(extra.iter().map(|s| s.to_string()));
-    v
-}
-
-fn strs(v: &[String]) -> Vec<&str> {
-    v.iter().map(String::as_str).collect()
-}
+use common::{SPIN_UP_FROM_REST, bowl, json, predict_args, rig_axis_speed, tilted_rig};
 
 /// No silent T (issue 30): at the rig's 60 deg tilt rolling needs friction up to 0.67 of the
 /// normal force, more than the paper's measured 0.4, so the rolling model's answer is marked
@@ -42,7 +12,9 @@ fn strs(v: &[String]) -> Vec<&str> {
 /// With a contact that gives 0.8 it holds. Lift-off (rod 0.5 m, precession 4 rad/s) is said too.
 #[test]
 fn every_answer_says_whether_its_model_holds() {
-    let v = json(&strs(&rig_rolling(&["--json"])));
+    let w = rig_axis_speed();
+    let rig = tilted_rig("rolling", &w);
+    let v = json(&predict_args(&rig, &["--json"]));
     assert_eq!(v["valid"], false, "{v}");
     let why = v["invalid_reason"].as_str().unwrap();
     assert!(
@@ -53,23 +25,30 @@ fn every_answer_says_whether_its_model_holds() {
     let ratio = v["max_friction_ratio"].as_f64().unwrap();
     // The incline alone needs (1 - k2) tan 60 = 0.495; the rotation adds to it.
     assert!(ratio > 2.0 / 7.0 * 3f64.sqrt() && ratio < 0.8, "{ratio}");
-    let out = bowl(&strs(&rig_rolling(&[])));
+    let out = bowl(&predict_args(&rig, &[]));
     assert_eq!(out.status.code(), Some(0));
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.starts_with("NOT VALID HERE: "), "{text}");
-    let v = json(&strs(&rig_rolling(&["--json", "--sliding-mu", "0.8"])));
+    let v = json(&predict_args(&rig, &["--json", "--sliding-mu", "0.8"]));
     assert_eq!(v["valid"], true, "{v}");
     assert!(v["invalid_reason"].is_null());
-    let v = json(&strs(&rig_rolling(&[
-        "--json",
-        "--release-azimuth-deg",
-        "90",
-    ])));
+    let v = json(&predict_args(
+        &rig,
+        &["--json", "--release-azimuth-deg", "90"],
+    ));
     assert_eq!(v["valid"], false, "{v}");
-    let lift = rig_rolling(&["--json", "--rod-offset-m", "0.5", "--sliding-mu", "0.8"]);
-    let mut lift = strs(&lift);
-    lift[4] = "4";
-    let v = json(&lift);
+    let v = json(&predict_args(
+        &rig,
+        &[
+            "--json",
+            "--rod-offset-m",
+            "0.5",
+            "--sliding-mu",
+            "0.8",
+            "--precession-rad-s",
+            "4",
+        ],
+    ));
     assert_eq!(v["valid"], false, "{v}");
     assert!(
         v["invalid_reason"].as_str().unwrap().contains("lifts off"),
@@ -86,17 +65,12 @@ fn every_answer_says_whether_its_model_holds() {
 fn the_papers_models_say_where_the_granule_would_slide() {
     for (rim, valid) in [(0.1, true), (0.3, false)] {
         let r = format!("{rim}");
-        let args = [
-            "predict",
-            "--omega-rad-s",
-            "3.6",
-            "--mu",
-            "0.01",
-            "--model",
-            "flat",
-            "--rim-radius-m",
-            &r,
+        let scene = [
+            ("--omega-rad-s", "3.6"),
+            ("--mu", "0.01"),
+            ("--rim-radius-m", &r),
         ];
+        let args = predict_args(&scene, &["--model", "flat"]);
         let mut with_json = args.to_vec();
         with_json.push("--json");
         let v = json(&with_json);
@@ -121,22 +95,8 @@ fn the_papers_models_say_where_the_granule_would_slide() {
             );
         }
         // A spin-up to the same speed is judged at its top speed, the same way.
-        let v = json(&[
-            "predict",
-            "--spin-up-from-rad-s",
-            "0",
-            "--time-constant-s",
-            "0.3",
-            "--tolerance",
-            "1e-4",
-            "--omega-rad-s",
-            "3.6",
-            "--mu",
-            "0.01",
-            "--rim-radius-m",
-            &r,
-            "--json",
-        ]);
+        let spin_up = [SPIN_UP_FROM_REST.as_slice(), &scene].concat();
+        let v = json(&predict_args(&spin_up, &["--tolerance", "1e-4", "--json"]));
         assert_eq!(v["valid"], valid, "{v}");
         assert!(v["residence_time_s"].as_f64().is_some());
     }

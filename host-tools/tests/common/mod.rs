@@ -24,6 +24,15 @@ pub fn run_batch(name: &str, csv: &str, extra: &[&str]) -> (Output, String) {
     let input = temp(&format!("{name}.csv"));
     let output = temp(&format!("{name}-out.csv"));
     std::fs::write(&input, csv).unwrap();
+    let out = predict_batch(&input, &output, extra);
+    let text = std::fs::read_to_string(&output).unwrap_or_default();
+    let _ = std::fs::remove_file(input);
+    let _ = std::fs::remove_file(output);
+    (out, text)
+}
+
+/// `bowl predict --batch INPUT --out OUTPUT EXTRA...` run to its end.
+pub fn predict_batch(input: &Path, output: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
         "predict",
         "--batch",
@@ -32,12 +41,44 @@ pub fn run_batch(name: &str, csv: &str, extra: &[&str]) -> (Output, String) {
         output.to_str().unwrap(),
     ];
     args.extend_from_slice(extra);
-    let out = bowl(&args);
-    let text = std::fs::read_to_string(&output).unwrap_or_default();
-    let _ = std::fs::remove_file(input);
-    let _ = std::fs::remove_file(output);
-    (out, text)
+    bowl(&args)
 }
+
+/// A `bowl predict` command line: each of `scene`'s flags with its value unless `extra` names
+/// that flag too, then `extra` (so a flag in `extra` replaces the scene's).
+pub fn predict_args<'a>(scene: &[(&'a str, &'a str)], extra: &[&'a str]) -> Vec<&'a str> {
+    let mut v = vec!["predict"];
+    for &(flag, value) in scene {
+        if !extra.contains(&flag) {
+            v.extend([flag, value]);
+        }
+    }
+    v.extend_from_slice(extra);
+    v
+}
+
+/// The speed of each axis on the tilted rig, as a flag's value: |Omega| 3.6 rad/s with
+/// w1 = w2 and the axes 60 deg apart, `3.6 / sqrt(2 (1 + cos 60))`.
+pub fn rig_axis_speed() -> String {
+    format!("{}", 3.6 / (2.0 * (1.0 + 60f64.to_radians().cos())).sqrt())
+}
+
+/// The tilted rig's scene (docs/model.md §9) for `--model MODEL`: axes 60 deg apart, both
+/// turning at `w` ([`rig_axis_speed`] for the rig's own), rim 150 mm, the start at 75 mm.
+pub fn tilted_rig<'a>(model: &'a str, w: &'a str) -> [(&'a str, &'a str); 6] {
+    [
+        ("--model", model),
+        ("--precession-rad-s", w),
+        ("--spin-rad-s", w),
+        ("--axes-angle-deg", "60"),
+        ("--ri-m", "0.075"),
+        ("--rim-radius-m", "0.15"),
+    ]
+}
+
+/// A first-order spin-up from rest with time constant 0.3 s (to `--omega-rad-s`).
+pub const SPIN_UP_FROM_REST: [(&str, &str); 2] =
+    [("--spin-up-from-rad-s", "0"), ("--time-constant-s", "0.3")];
 
 /// The `bowl` binary under test.
 pub const BOWL: &str = env!("CARGO_BIN_EXE_bowl");
@@ -142,10 +183,15 @@ pub fn bowl(args: &[&str]) -> Output {
 
 /// `bowl ARGS`, which must succeed, its standard output parsed as one JSON document.
 pub fn json(args: &[&str]) -> serde_json::Value {
-    let out = bowl(args);
+    success_json(&bowl(args), &format!("bowl {args:?}"))
+}
+
+/// The output of `what`, a run that must have succeeded: its standard output parsed as one
+/// JSON document.
+pub fn success_json(out: &Output, what: &str) -> serde_json::Value {
     assert!(
         out.status.success(),
-        "bowl {args:?} failed: {}",
+        "{what} failed: {}",
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).expect("valid JSON")

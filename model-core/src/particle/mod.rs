@@ -308,6 +308,19 @@ impl<T: Real> Scene<T> {
         Ok(())
     }
 
+    /// The scene as this number type holds it, read back exactly in f64 (the inputs an f32
+    /// computation saw, for a reference to be computed at).
+    pub fn to_f64(&self) -> Scene<f64> {
+        Scene {
+            omega_rad_s: self.omega_rad_s.to_f64(),
+            mu: self.mu.to_f64(),
+            g_m_s2: self.g_m_s2.to_f64(),
+            k2: self.k2.to_f64(),
+            ri_m: self.ri_m.to_f64(),
+            rim_radius_m: self.rim_radius_m.to_f64(),
+        }
+    }
+
     /// The equilibrium radius `a = mu g / omega^2`, m (docs/model.md §4): infinite at `omega = 0`.
     /// Divides twice by omega rather than once by `omega^2` so a large omega cannot overflow.
     pub fn equilibrium_radius_m(&self) -> T {

@@ -158,18 +158,6 @@ fn scene_f64(i: usize) -> Scene<f64> {
     }
 }
 
-/// The f32 scene read back in f64, so the reference solves exactly the f32 inputs.
-fn widened(s: &Scene<f32>) -> Scene<f64> {
-    Scene {
-        omega_rad_s: s.omega_rad_s as f64,
-        mu: s.mu as f64,
-        g_m_s2: s.g_m_s2 as f64,
-        k2: s.k2 as f64,
-        ri_m: s.ri_m as f64,
-        rim_radius_m: s.rim_radius_m as f64,
-    }
-}
-
 fn err(what: &'static str) -> Failure {
     Failure {
         what,
@@ -235,7 +223,7 @@ fn flat_time_vs_acosh() -> Result<(), Failure> {
     for i in 0..GRID {
         let s = scene_f64(i).to_f32();
         let (t, v, c) = leaves_f32(residence(&s, Model::Flat))?;
-        let w = widened(&s);
+        let w = s.to_f64();
         let want = flat_ref(&w);
         close(
             "flat T f32 vs f64 acosh (rel)",
@@ -312,7 +300,7 @@ fn coriolis_time_vs_bisection() -> Result<(), Failure> {
     for i in 0..GRID {
         let s = scene_f64(i).to_f32();
         let (t, _, c) = leaves_f32(residence(&s, Model::Coriolis))?;
-        let want = coriolis_ref(&widened(&s));
+        let want = coriolis_ref(&s.to_f64());
         close(
             "Coriolis T f32 vs f64 bisection (rel)",
             t as f64 / want,
@@ -320,7 +308,7 @@ fn coriolis_time_vs_bisection() -> Result<(), Failure> {
             F32_TOL * c as f64,
         )?;
         if s.mu > 0.0 {
-            let tf = flat_ref(&widened(&s));
+            let tf = flat_ref(&s.to_f64());
             ensure("Coriolis slower than flat", want > tf)?;
         }
     }
@@ -340,7 +328,7 @@ fn inverse_round_trips() -> Result<(), Failure> {
                 omega_for_residence_time(&s, model, target).map_err(|_| err("inverse errored"))?;
             let back = reference(&Scene {
                 omega_rad_s: w as f64,
-                ..widened(&s)
+                ..s.to_f64()
             });
             let (_, _, c) = leaves_f32(residence(
                 &Scene {
@@ -430,7 +418,7 @@ fn near_threshold_flagged() -> Result<(), Failure> {
         "d = 1e-4: condition above 300 (about 1/(d ln x))",
         c > 300.0,
     )?;
-    let want = coriolis_ref(&widened(&small));
+    let want = coriolis_ref(&small.to_f64());
     close(
         "near-threshold T within condition (rel)",
         t as f64 / want,

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 
-use super::plot::{Figure, Mark, Scale, Series};
+use super::plot::{Figure, Mark, Series};
 use super::workprec::ERROR_FLOOR;
 
 /// One row of the comparison CSV.
@@ -128,19 +128,15 @@ pub fn figure(path: &Path, scene: &str, model: &str, cost: Cost) -> Result<Figur
             "time: scipy's is mostly Python interpreter overhead",
         ),
     };
-    Ok(Figure {
-        title: format!("scipy solve_ivp against ours: scene {scene}, {model} model"),
-        x_label: x_label.into(),
-        y_label: "relative error in residence time T".into(),
-        x_scale: Scale::Log,
-        y_scale: Scale::Log,
+    Ok(Figure::error_in_t(
+        format!("scipy solve_ivp against ours: scene {scene}, {model} model"),
+        x_label,
         series,
-        vlines: vec![],
-        notes: vec![
+        vec![
             note.into(),
             "scipy: rtol = tol, atol = tol R, terminal event r = R".into(),
             "ours: f64 DP5(4) (same tolerances) and RK4".into(),
             "error against the same 256-bit reference".into(),
         ],
-    })
+    ))
 }

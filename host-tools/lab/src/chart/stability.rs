@@ -12,7 +12,7 @@
 use model_core::ode;
 use model_core::particle::{self, Model, Scene};
 
-use super::plot::{Figure, Mark, Scale, Series, VLine};
+use super::plot::{Figure, Mark, Series, VLine};
 use super::reference::{self, RefModel, RefOutcome, RefScene};
 use super::table::Table;
 
@@ -208,14 +208,13 @@ pub fn chart() -> anyhow::Result<(Figure, Table)> {
     }
     Ok((
         Figure {
-            title: "Stability: error in T against step h*omega (fixed-step methods)".into(),
-            x_label: "step h * omega (dimensionless)".into(),
-            y_label: "relative error in residence time T".into(),
-            x_scale: Scale::Log,
-            y_scale: Scale::Log,
-            series,
             vlines,
-            notes,
+            ..Figure::error_in_t(
+                "Stability: error in T against step h*omega (fixed-step methods)".into(),
+                "step h * omega (dimensionless)",
+                series,
+                notes,
+            )
         },
         table,
     ))

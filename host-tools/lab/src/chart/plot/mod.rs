@@ -114,6 +114,26 @@ impl Figure {
             notes: notes.iter().map(|n| (*n).to_string()).collect(),
         }
     }
+
+    /// A figure of the relative error in residence time T (y) against `x_label`'s measure (a
+    /// cost or a step), both axes logarithmic, no marker lines, its notes under the legend.
+    pub fn error_in_t(
+        title: String,
+        x_label: &str,
+        series: Vec<Series>,
+        notes: Vec<String>,
+    ) -> Self {
+        Figure {
+            title,
+            x_label: x_label.into(),
+            y_label: "relative error in residence time T".into(),
+            x_scale: Scale::Log,
+            y_scale: Scale::Log,
+            series,
+            vlines: vec![],
+            notes,
+        }
+    }
 }
 
 /// Why a chart could not be drawn.

@@ -163,7 +163,7 @@ fn ode_method<T: Real>(m: &Method, s: &Scene<T>) -> Option<ode::Method<T>> {
 }
 
 fn ode_run<T: Real>(m: &Method, s: &Scene<T>, model: Model) -> Run {
-    let inputs = widen(s);
+    let inputs = s.to_f64();
     let Some(method) = ode_method(m, s) else {
         return Run {
             inputs,
@@ -219,25 +219,13 @@ fn narrow<T: Real>(s: &Scene<f64>) -> Scene<T> {
     }
 }
 
-/// The scene as a number type holds it, read back exactly in f64.
-fn widen<T: Real>(s: &Scene<T>) -> Scene<f64> {
-    Scene {
-        omega_rad_s: s.omega_rad_s.to_f64(),
-        mu: s.mu.to_f64(),
-        g_m_s2: s.g_m_s2.to_f64(),
-        k2: s.k2.to_f64(),
-        ri_m: s.ri_m.to_f64(),
-        rim_radius_m: s.rim_radius_m.to_f64(),
-    }
-}
-
 /// The closed forms in number type `T`.
 fn closed_run<T: Real>(s: &Scene<f64>, model: Model) -> anyhow::Result<Run> {
     let st = narrow::<T>(s);
     let o = residence(&st, model).map_err(scene_err)?;
     let (time_s, note) = outcome_note(&o);
     Ok(Run {
-        inputs: widen(&st),
+        inputs: st.to_f64(),
         time_s,
         rhs_evals: None,
         note,

@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use model_core::particle::Model;
 use model_core::particle::named_scenes::{SCENE_NAMES, scene};
 
-use super::plot::{Figure, Mark, Scale, Series};
+use super::plot::{Figure, Mark, Series};
 use super::qemu_log::Counts;
 use super::table::Table;
 use super::timing::Budget;
@@ -248,21 +248,17 @@ pub fn figure(points: &[Point], scene: &str, model: Model, axis: CostAxis) -> Fi
         CostAxis::RhsEvals => "right-hand-side evaluations",
         CostAxis::QemuInstructions => "Cortex-M4F instructions per call (QEMU)",
     };
-    Figure {
-        title: format!("Work-precision: scene {scene}, {} model", model_key(model)),
-        x_label: x_label.into(),
-        y_label: "relative error in residence time T".into(),
-        x_scale: Scale::Log,
-        y_scale: Scale::Log,
+    Figure::error_in_t(
+        format!("Work-precision: scene {scene}, {} model", model_key(model)),
+        x_label,
         series,
-        vlines: vec![],
-        notes: vec![
+        vec![
             "error against a 256-bit reference at the".into(),
             "inputs each method saw (f32: rounded inputs)".into(),
             format!("errors below {ERROR_FLOOR:.0e} drawn at {ERROR_FLOOR:.0e}"),
             "a missing point: the method gave no T".into(),
         ],
-    }
+    )
 }
 
 #[cfg(test)]
