@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, anyhow, bail};
 use model_core::particle::{Model, Outcome, Scene};
 
-use super::{Args, predict, refusals};
+use super::{Inputs, predict, refusals};
 
 /// Formats an f64 for the batch output: shortest round-trip digits, `inf`, `nan`.
 pub fn format_f64(x: f64) -> String {
@@ -244,7 +244,7 @@ fn line_of(starts: &[u64], offset: u64) -> usize {
 }
 
 /// Runs `bowl predict --batch INPUT --out OUTPUT`.
-pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
+pub fn run(input: &Path, output: &Path, args: &Inputs) -> Result<()> {
     let bytes = std::fs::read(input).with_context(|| format!("cannot open {}", input.display()))?;
     let starts = line_starts(&bytes);
     let mut reader = csv::ReaderBuilder::new()
