@@ -133,27 +133,8 @@ pub fn words(e: RollingError) -> String {
     }
 }
 
-fn outcome_json(o: &RollingOutcome<f64>) -> serde_json::Value {
-    match *o {
-        RollingOutcome::Leaves {
-            residence_time_s,
-            exit_speed_m_s,
-            max_friction_ratio,
-            first_slip_s,
-        } => json!({
-            "outcome": "leaves", "residence_time_s": residence_time_s,
-            "exit_speed_relative_m_s": exit_speed_m_s,
-            "max_friction_ratio": max_friction_ratio, "first_slip_s": first_slip_s,
-        }),
-        RollingOutcome::Held => json!({"outcome": "held"}),
-        RollingOutcome::LiftsOff { time_s } => json!({"outcome": "lifts_off", "time_s": time_s}),
-        RollingOutcome::NotLeftBy { horizon_s } => {
-            json!({"outcome": "not_left", "horizon_s": horizon_s})
-        }
-    }
-}
-
-fn outcome_text(o: &RollingOutcome<f64>, sliding_mu: f64) -> String {
+/// One release's outcome, as JSON and in words.
+fn outcome(o: &RollingOutcome<f64>, sliding_mu: f64) -> (serde_json::Value, String) {
     match *o {
         RollingOutcome::Leaves {
             residence_time_s,
@@ -172,17 +153,29 @@ fn outcome_text(o: &RollingOutcome<f64>, sliding_mu: f64) -> String {
                      normal force)"
                 ),
             };
-            format!(
-                "leaves after T = {residence_time_s:.6} s at {exit_speed_m_s:.4} m/s relative to the bowl{slip}"
+            (
+                json!({
+                    "outcome": "leaves", "residence_time_s": residence_time_s,
+                    "exit_speed_relative_m_s": exit_speed_m_s,
+                    "max_friction_ratio": max_friction_ratio, "first_slip_s": first_slip_s,
+                }),
+                format!(
+                    "leaves after T = {residence_time_s:.6} s at {exit_speed_m_s:.4} m/s relative to the bowl{slip}"
+                ),
             )
         }
-        RollingOutcome::Held => "held: the resistance keeps it at rest".into(),
-        RollingOutcome::LiftsOff { time_s } => {
-            format!("lifts off the bottom at t = {time_s:.4} s (normal force reaches zero)")
-        }
-        RollingOutcome::NotLeftBy { horizon_s } => {
-            format!("still in the bowl after {horizon_s} s")
-        }
+        RollingOutcome::Held => (
+            json!({"outcome": "held"}),
+            "held: the resistance keeps it at rest".into(),
+        ),
+        RollingOutcome::LiftsOff { time_s } => (
+            json!({"outcome": "lifts_off", "time_s": time_s}),
+            format!("lifts off the bottom at t = {time_s:.4} s (normal force reaches zero)"),
+        ),
+        RollingOutcome::NotLeftBy { horizon_s } => (
+            json!({"outcome": "not_left", "horizon_s": horizon_s}),
+            format!("still in the bowl after {horizon_s} s"),
+        ),
     }
 }
 
@@ -318,8 +311,8 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
         RollingOutcome::LiftsOff { .. } => validity::rolling(0, 1, 1, 0.0, r.sliding_mu),
         _ => validity::Validity::valid(),
     };
+    let (mut v, text) = outcome(&report.outcome, r.sliding_mu);
     if args.json {
-        let mut v = outcome_json(&report.outcome);
         validity.add_to(&mut v);
         v["model"] = json!("rolling");
         v["release_azimuth_deg"] = json!(beta_deg);
@@ -330,10 +323,7 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
             println!("{line}");
         }
         println!("{head}");
-        println!(
-            "release at {beta_deg} deg: {}",
-            outcome_text(&report.outcome, r.sliding_mu)
-        );
+        println!("release at {beta_deg} deg: {text}");
     }
     Ok(())
 }
