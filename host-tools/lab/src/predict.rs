@@ -9,6 +9,7 @@ use model_core::particle::{self, Model, Outcome, Scene};
 mod batch;
 mod bowl;
 mod choice;
+mod ends;
 pub(crate) mod ode;
 mod refusals;
 mod rolling;
@@ -19,6 +20,7 @@ mod trace;
 mod validity;
 
 pub use bowl::BowlInputs;
+pub use ends::{Ends, Leaves};
 pub use refusals::scene as scene_words;
 pub use rolling::RollingInputs;
 pub use rolling::words as rolling_words;
@@ -333,27 +335,21 @@ fn json_result(model: Model, method: MethodChoice, p: &Prediction) -> serde_json
         );
         obj.insert("step_warning".into(), serde_json::json!(c.warning()));
     }
-    let extra = match p.outcome {
-        Outcome::Leaves {
-            residence_time_s,
-            exit_radial_velocity_m_s,
-            exit_total_velocity_m_s,
-            condition_number,
-            ill_conditioned,
-        } => serde_json::json!({
-            "outcome": "leaves", "residence_time_s": residence_time_s,
-            "exit_radial_velocity_m_s": exit_radial_velocity_m_s,
-            "exit_total_velocity_m_s": exit_total_velocity_m_s,
-            "condition_number": condition_number, "ill_conditioned": ill_conditioned,
+    let extra = match Ends::from(p.outcome) {
+        Ends::Leaves(l) => serde_json::json!({
+            "outcome": "leaves", "residence_time_s": l.residence_time_s,
+            "exit_radial_velocity_m_s": l.exit_radial_velocity_m_s,
+            "exit_total_velocity_m_s": l.exit_total_velocity_m_s,
+            "condition_number": l.condition_number, "ill_conditioned": l.ill_conditioned,
         }),
-        Outcome::AlreadyAtRim {
+        Ends::AtRim {
             exit_total_velocity_m_s,
         } => serde_json::json!({
             "outcome": "already_at_rim", "residence_time_s": 0.0,
             "exit_radial_velocity_m_s": 0.0,
             "exit_total_velocity_m_s": exit_total_velocity_m_s,
         }),
-        Outcome::NeverLeaves {
+        Ends::Never {
             equilibrium_radius_m,
             near_threshold,
         } => serde_json::json!({
@@ -392,27 +388,25 @@ fn describe(scene: &Scene<f64>, model: Model, method: MethodChoice, p: &Predicti
     } else {
         String::new()
     };
-    match p.outcome {
-        Outcome::Leaves {
-            residence_time_s,
-            exit_radial_velocity_m_s,
-            exit_total_velocity_m_s,
-            condition_number,
-            ill_conditioned,
-        } => format!(
-            "{head} leaves after T = {residence_time_s:.9} s; exit radial {exit_radial_velocity_m_s:.6} m/s, total {exit_total_velocity_m_s:.6} m/s; condition {condition_number:.3}{}{cost}",
-            if ill_conditioned {
+    match Ends::from(p.outcome) {
+        Ends::Leaves(l) => format!(
+            "{head} leaves after T = {:.9} s; exit radial {:.6} m/s, total {:.6} m/s; condition {:.3}{}{cost}",
+            l.residence_time_s,
+            l.exit_radial_velocity_m_s,
+            l.exit_total_velocity_m_s,
+            l.condition_number,
+            if l.ill_conditioned {
                 " (ILL-CONDITIONED: start just above the threshold a)"
             } else {
                 ""
             }
         ),
-        Outcome::AlreadyAtRim {
+        Ends::AtRim {
             exit_total_velocity_m_s,
         } => {
             format!("{head} starts at the rim: T = 0, exit total {exit_total_velocity_m_s:.6} m/s")
         }
-        Outcome::NeverLeaves {
+        Ends::Never {
             equilibrium_radius_m,
             near_threshold,
         } => format!(

@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, anyhow, bail};
 use model_core::particle::{Model, Outcome, Scene};
 
-use super::{Inputs, predict, refusals};
+use super::{Ends, Inputs, predict, refusals};
 
 /// Formats an f64 for the batch output: shortest round-trip digits, `inf`, `nan`.
 pub fn format_f64(x: f64) -> String {
@@ -152,26 +152,20 @@ fn parse_row(row: &csv::StringRecord, cols: &Columns, width: usize) -> Result<(M
 
 /// The five result fields of one outcome.
 fn result_fields(o: &Outcome<f64>) -> [String; 5] {
-    match *o {
-        Outcome::Leaves {
-            residence_time_s,
-            exit_radial_velocity_m_s,
-            exit_total_velocity_m_s,
-            condition_number,
-            ill_conditioned,
-        } => [
-            format_f64(residence_time_s),
-            format_f64(exit_radial_velocity_m_s),
-            format_f64(exit_total_velocity_m_s),
-            format_f64(condition_number),
-            if ill_conditioned {
+    match Ends::from(*o) {
+        Ends::Leaves(l) => [
+            format_f64(l.residence_time_s),
+            format_f64(l.exit_radial_velocity_m_s),
+            format_f64(l.exit_total_velocity_m_s),
+            format_f64(l.condition_number),
+            if l.ill_conditioned {
                 "ill_conditioned"
             } else {
                 ""
             }
             .into(),
         ],
-        Outcome::AlreadyAtRim {
+        Ends::AtRim {
             exit_total_velocity_m_s,
         } => [
             "0".into(),
@@ -180,7 +174,7 @@ fn result_fields(o: &Outcome<f64>) -> [String; 5] {
             String::new(),
             String::new(),
         ],
-        Outcome::NeverLeaves { near_threshold, .. } => [
+        Ends::Never { near_threshold, .. } => [
             "inf".into(),
             "nan".into(),
             "nan".into(),
