@@ -152,15 +152,31 @@ fn method_name(m: MethodChoice) -> &'static str {
     }
 }
 
+/// A method and its settings (`--method`, `--step-s`, `--tol`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MethodSettings {
+    /// Closed form or one of the integrators.
+    pub method: MethodChoice,
+    /// Fixed step of euler / semi-implicit / rk4, s (`None`: 0.01 / omega).
+    pub step_s: Option<f64>,
+    /// Relative tolerance of dp54.
+    pub tol: f64,
+}
+
+impl Inputs {
+    /// `--method`, `--step-s` and `--tol`.
+    pub fn method_settings(&self) -> MethodSettings {
+        MethodSettings {
+            method: self.method,
+            step_s: self.step_s,
+            tol: self.tol,
+        }
+    }
+}
+
 /// Computes one scene with one model and method.
-pub fn predict(
-    scene: &Scene<f64>,
-    model: Model,
-    method: MethodChoice,
-    step_s: Option<f64>,
-    tol: f64,
-) -> Result<Prediction> {
-    match method {
+pub fn predict(scene: &Scene<f64>, model: Model, how: &MethodSettings) -> Result<Prediction> {
+    match how.method {
         MethodChoice::Closed => {
             let outcome =
                 particle::residence(scene, model).map_err(|e| anyhow!(refusals::scene(e)))?;
@@ -171,7 +187,7 @@ pub fn predict(
                 check: None,
             })
         }
-        other => ode::predict(scene, model, other, step_s, tol),
+        _ => ode::predict(scene, model, how),
     }
 }
 
@@ -260,7 +276,7 @@ pub fn run(args: &Inputs) -> Result<()> {
     }
     let mut rows = Vec::new();
     for &model in models {
-        let p = predict(&scene, model, args.method, args.step_s, args.tol)?;
+        let p = predict(&scene, model, &args.method_settings())?;
         if let Some(warning) = p.check.as_ref().and_then(ode::StepCheck::warning) {
             eprintln!("warning: {} model: {warning}", model_name(model));
         }

@@ -272,6 +272,7 @@ pub fn run(input: &Path, output: &Path, args: &Inputs) -> Result<()> {
     let (mut failed, mut rows) = (0usize, 0usize);
     let mut scenes = Vec::new();
     let mut record = csv::StringRecord::new();
+    let how = args.method_settings();
     loop {
         // Line numbers as a user sees them: the header is line 1, whatever ends the lines.
         let (row, byte) = match reader.read_record(&mut record) {
@@ -286,7 +287,7 @@ pub fn run(input: &Path, output: &Path, args: &Inputs) -> Result<()> {
         rows += 1;
         let result = row.and_then(|row| {
             let (model, scene) = parse_row(&row, &cols, header.len())?;
-            let p = predict(&scene, model, args.method, args.step_s, args.tol)?;
+            let p = predict(&scene, model, &how)?;
             if args.throughput {
                 scenes.push((model, scene));
             }

@@ -4,7 +4,7 @@ use anyhow::{Result, anyhow};
 use model_core::ode::{self, Method, OdeOutcome};
 use model_core::particle::{self, Model, Outcome, Scene};
 
-use super::{Ends, Leaves, MethodChoice, Prediction};
+use super::{Ends, Leaves, MethodChoice, MethodSettings, Prediction};
 
 /// DP5(4) at tolerance `tol` on scene `s`: relative `tol`, absolute `tol R` (the same for r in
 /// m and r' in m/s; r' at the rim is of order omega R). The one rule for `bowl predict --method
@@ -37,13 +37,12 @@ pub fn plan(
 
 /// Integrates one scene with a numerical method. The condition number reported is the
 /// problem's (from the closed form): it does not depend on the method.
-pub fn predict(
-    scene: &Scene<f64>,
-    model: Model,
-    method: MethodChoice,
-    step_s: Option<f64>,
-    tol: f64,
-) -> Result<Prediction> {
+pub fn predict(scene: &Scene<f64>, model: Model, how: &MethodSettings) -> Result<Prediction> {
+    let MethodSettings {
+        method,
+        step_s,
+        tol,
+    } = *how;
     // Default step: a hundredth of the time scale 1/omega.
     let h = step_s.unwrap_or_else(|| {
         if scene.omega_rad_s > 0.0 {
