@@ -26,7 +26,7 @@ enum Command {
     /// Charts: work-precision (error against cost), and the paper's Figures 5-7 redrawn.
     Chart(cmd::chart::Args),
     /// Residence time and exit velocities of a particle (paper Eq. 5-12, corrected), or a batch CSV.
-    Predict(Box<lab::predict::Args>),
+    Predict(Box<cmd::predict::Args>),
     /// Live view of the rig's telemetry, with CSV log and frame counters.
     Monitor(monitor::Args),
     /// The serial ports on this computer, with their USB descriptions.
@@ -119,7 +119,7 @@ fn run(cli: Cli) -> Result<i32> {
     match cli.command {
         Command::Kinematics(args) => done(cmd::kinematics::run(&args)),
         Command::Chart(args) => done(cmd::chart::run(&args)),
-        Command::Predict(args) => done(lab::predict::run(&args)),
+        Command::Predict(args) => done(cmd::predict::run(&args)),
         Command::Monitor(args) => done(monitor::run(&args)),
         Command::Ports => done(cmd::ports::run()),
         Command::Send(args) => cmd::send::run(&args),

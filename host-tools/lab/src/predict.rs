@@ -9,6 +9,7 @@ use model_core::particle::{self, Model, Outcome, Scene};
 mod batch;
 mod bowl;
 mod choice;
+mod ends;
 pub(crate) mod ode;
 mod refusals;
 mod rolling;
@@ -18,135 +19,106 @@ mod throughput;
 mod trace;
 mod validity;
 
+pub use bowl::BowlInputs;
+pub use ends::{Ends, Leaves};
 pub use refusals::scene as scene_words;
+pub use rolling::RollingInputs;
 pub use rolling::words as rolling_words;
+pub use target::RunsOn;
 
-/// Which model(s) to evaluate.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+/// Which model(s) to evaluate (`--model`; its help is the binary's).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ModelChoice {
-    /// The chooser picks the least model the scene needs (the tolerance from --tolerance or
-    /// --uncertainty) and says why.
+    /// The chooser picks flat or Coriolis.
     Auto,
-    /// Paper Eq. 5 to 7: no Coriolis term.
+    /// No Coriolis term.
     Flat,
-    /// Paper Eq. 9 to 11 with the corrected A, B.
+    /// With the Coriolis term.
     Coriolis,
-    /// Both, side by side.
+    /// Flat and Coriolis.
     Both,
-    /// The granule rolling on the tilted, precessing bowl (docs/model.md §9): needs
-    /// --precession-rad-s, --spin-rad-s and --axes-angle-deg.
+    /// The tilted, precessing bowl (docs/model.md §9).
     Rolling,
-    /// The granule rolling or sliding in the real bowl, wall and lip included (docs/model.md
-    /// §10): the rolling model's flags and --sliding-mu, --wall-angle-deg, --wall-height-m,
-    /// --fillet-radius-m, --restitution, --max-time-s.
+    /// The real bowl (docs/model.md §10).
     Bowl,
 }
 
-/// How to compute the residence time.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+/// How to compute the residence time (`--method`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MethodChoice {
-    /// The closed forms (log1p / bracketed Newton): exact to rounding.
+    /// Exact to rounding.
     Closed,
-    /// Explicit Euler with fixed step --step-s.
+    /// Explicit Euler.
     Euler,
-    /// Semi-implicit (symplectic) Euler with fixed step --step-s.
+    /// Symplectic Euler.
     SemiImplicit,
-    /// Classical Runge-Kutta 4 with fixed step --step-s.
+    /// Runge-Kutta 4.
     Rk4,
-    /// Adaptive Dormand-Prince 5(4) with tolerance --tol, dense-output event location.
+    /// Dormand-Prince 5(4).
     Dp54,
 }
 
-/// Flags of `bowl predict`.
-#[derive(clap::Args)]
-pub struct Args {
+/// The inputs of `bowl predict` (the binary's flags, typed).
+#[derive(Debug, Clone)]
+pub struct Inputs {
     /// Combined bowl speed omega (paper Eq. 2), rad/s.
-    #[arg(long, visible_alias = "w-rad-s", default_value_t = 3.0)]
-    omega_rad_s: f64,
+    pub omega_rad_s: f64,
     /// Effective rolling resistance coefficient mu (the paper's literal 0.4 makes nothing move).
-    #[arg(long, default_value_t = 0.029)]
-    mu: f64,
+    pub mu: f64,
     /// Start radius ri, m (the particle starts at rest).
-    #[arg(long, default_value_t = 0.05)]
-    ri_m: f64,
+    pub ri_m: f64,
     /// Rim radius R, m (0.1 m: a 200 mm bowl, reading the paper's sizes as diameters).
-    #[arg(long, visible_alias = "r-m", default_value_t = 0.1)]
-    rim_radius_m: f64,
+    pub rim_radius_m: f64,
     /// Gravity, m/s^2.
-    #[arg(long, default_value_t = 9.81)]
-    g: f64,
+    pub g: f64,
     /// k2 = m rp^2 / (I + m rp^2): 5/7 solid sphere, 3/5 hollow.
-    #[arg(long, default_value_t = 5.0 / 7.0)]
-    k2: f64,
+    pub k2: f64,
     /// Model: auto (the chooser), flat, coriolis, both or rolling.
-    #[arg(long, value_enum, default_value_t = ModelChoice::Auto)]
-    model: ModelChoice,
+    pub model: ModelChoice,
     /// The chooser: relative tolerance on T (0.01 = 1 %).
-    #[arg(long, conflicts_with = "uncertainty")]
-    tolerance: Option<f64>,
+    pub tolerance: Option<f64>,
     /// The chooser: the parameters' uncertainty, `mu=REL,radius_m=M,omega=REL` (default
     /// mu=0.2,radius_m=0.001,omega=0.01); the tolerance is a tenth of the spread it causes in T.
-    #[arg(long, value_name = "mu=REL,radius_m=M,omega=REL")]
-    uncertainty: Option<String>,
+    pub uncertainty: Option<String>,
     /// The bowl speed from a logged run (bowl monitor --log, bowl replay --csv): the chooser
     /// decides between the closed form at the mean speed and an integrator over the trace.
-    #[arg(long, value_name = "RUN.csv")]
-    omega_trace: Option<std::path::PathBuf>,
+    pub omega_trace: Option<std::path::PathBuf>,
     /// With --omega-trace: the device time of the release, ms (default: the log's first row).
-    #[arg(long, requires = "omega_trace")]
-    release_at_ms: Option<f64>,
+    pub release_at_ms: Option<f64>,
     /// A spin-up, as a tuned speed loop drives it: the bowl starts at this speed, rad/s, and
     /// approaches --omega-rad-s with --time-constant-s; the particle is released at t = 0.
     /// The chooser picks the model and the integrator (from its precomputed error table when
     /// --tolerance is given).
-    #[arg(
-        long,
-        requires = "time_constant_s",
-        conflicts_with_all = ["omega_trace", "batch", "target_time_s"]
-    )]
-    spin_up_from_rad_s: Option<f64>,
+    pub spin_up_from_rad_s: Option<f64>,
     /// With --spin-up-from-rad-s: the spin-up's time constant, s.
-    #[arg(long, requires = "spin_up_from_rad_s")]
-    time_constant_s: Option<f64>,
+    pub time_constant_s: Option<f64>,
     /// Method: closed form or one of the integrators.
-    #[arg(long, value_enum, default_value_t = MethodChoice::Closed)]
-    method: MethodChoice,
+    pub method: MethodChoice,
     /// Fixed step of euler / semi-implicit / rk4, s (default: 0.01 / omega).
-    #[arg(long, visible_alias = "step")]
-    step_s: Option<f64>,
+    pub step_s: Option<f64>,
     /// Relative tolerance of dp54.
-    #[arg(long, default_value_t = 1e-9)]
-    tol: f64,
+    pub tol: f64,
     /// Instead of the residence time: the bowl speed that gives this residence time, s.
-    #[arg(long)]
-    target_time_s: Option<f64>,
+    pub target_time_s: Option<f64>,
     /// The chooser: where the chosen plan runs: host (f64, priced in ns) or mcu (the
     /// Cortex-M4F: f32, priced in instructions).
-    #[arg(long, value_enum, default_value_t = target::RunsOn::Host)]
-    target: target::RunsOn,
+    pub target: RunsOn,
     /// Print JSON instead of text.
-    #[arg(long)]
-    json: bool,
+    pub json: bool,
     /// Batch mode: read scenes from this CSV file (see the module docs for the columns).
-    #[arg(long, requires = "out")]
-    batch: Option<std::path::PathBuf>,
+    pub batch: Option<std::path::PathBuf>,
     /// Batch mode: write results to this CSV file.
-    #[arg(long, requires = "batch")]
-    out: Option<std::path::PathBuf>,
+    pub out: Option<std::path::PathBuf>,
     /// Batch mode: also measure the closed forms' throughput over the file's scenes (the time
     /// alone, ns per scene on one thread and on every core; JSON on standard output).
-    #[arg(long, requires = "batch")]
-    throughput: bool,
+    pub throughput: bool,
     /// Batch mode: write every row, with a `status` column (`ok` or why the row was refused),
     /// instead of nothing when a row is refused; the exit status is still 1 if any row was.
-    #[arg(long, requires = "batch")]
-    keep_going: bool,
+    pub keep_going: bool,
     /// The rolling model's own flags.
-    #[command(flatten)]
-    rolling: rolling::RollingArgs,
+    pub rolling: rolling::RollingInputs,
     /// The bowl model's own flags.
-    #[command(flatten)]
-    bowl: bowl::BowlArgs,
+    pub bowl: bowl::BowlInputs,
 }
 
 /// One computed result, whatever the method.
@@ -180,15 +152,31 @@ fn method_name(m: MethodChoice) -> &'static str {
     }
 }
 
+/// A method and its settings (`--method`, `--step-s`, `--tol`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MethodSettings {
+    /// Closed form or one of the integrators.
+    pub method: MethodChoice,
+    /// Fixed step of euler / semi-implicit / rk4, s (`None`: 0.01 / omega).
+    pub step_s: Option<f64>,
+    /// Relative tolerance of dp54.
+    pub tol: f64,
+}
+
+impl Inputs {
+    /// `--method`, `--step-s` and `--tol`.
+    pub fn method_settings(&self) -> MethodSettings {
+        MethodSettings {
+            method: self.method,
+            step_s: self.step_s,
+            tol: self.tol,
+        }
+    }
+}
+
 /// Computes one scene with one model and method.
-pub fn predict(
-    scene: &Scene<f64>,
-    model: Model,
-    method: MethodChoice,
-    step_s: Option<f64>,
-    tol: f64,
-) -> Result<Prediction> {
-    match method {
+pub fn predict(scene: &Scene<f64>, model: Model, how: &MethodSettings) -> Result<Prediction> {
+    match how.method {
         MethodChoice::Closed => {
             let outcome =
                 particle::residence(scene, model).map_err(|e| anyhow!(refusals::scene(e)))?;
@@ -199,12 +187,12 @@ pub fn predict(
                 check: None,
             })
         }
-        other => ode::predict(scene, model, other, step_s, tol),
+        _ => ode::predict(scene, model, how),
     }
 }
 
 /// Runs `bowl predict`.
-pub fn run(args: &Args) -> Result<()> {
+pub fn run(args: &Inputs) -> Result<()> {
     if args.spin_up_from_rad_s.is_some()
         && (args.model != ModelChoice::Auto || args.method != MethodChoice::Closed)
     {
@@ -288,7 +276,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let mut rows = Vec::new();
     for &model in models {
-        let p = predict(&scene, model, args.method, args.step_s, args.tol)?;
+        let p = predict(&scene, model, &args.method_settings())?;
         if let Some(warning) = p.check.as_ref().and_then(ode::StepCheck::warning) {
             eprintln!("warning: {} model: {warning}", model_name(model));
         }
@@ -363,27 +351,21 @@ fn json_result(model: Model, method: MethodChoice, p: &Prediction) -> serde_json
         );
         obj.insert("step_warning".into(), serde_json::json!(c.warning()));
     }
-    let extra = match p.outcome {
-        Outcome::Leaves {
-            residence_time_s,
-            exit_radial_velocity_m_s,
-            exit_total_velocity_m_s,
-            condition_number,
-            ill_conditioned,
-        } => serde_json::json!({
-            "outcome": "leaves", "residence_time_s": residence_time_s,
-            "exit_radial_velocity_m_s": exit_radial_velocity_m_s,
-            "exit_total_velocity_m_s": exit_total_velocity_m_s,
-            "condition_number": condition_number, "ill_conditioned": ill_conditioned,
+    let extra = match Ends::from(p.outcome) {
+        Ends::Leaves(l) => serde_json::json!({
+            "outcome": "leaves", "residence_time_s": l.residence_time_s,
+            "exit_radial_velocity_m_s": l.exit_radial_velocity_m_s,
+            "exit_total_velocity_m_s": l.exit_total_velocity_m_s,
+            "condition_number": l.condition_number, "ill_conditioned": l.ill_conditioned,
         }),
-        Outcome::AlreadyAtRim {
+        Ends::AtRim {
             exit_total_velocity_m_s,
         } => serde_json::json!({
             "outcome": "already_at_rim", "residence_time_s": 0.0,
             "exit_radial_velocity_m_s": 0.0,
             "exit_total_velocity_m_s": exit_total_velocity_m_s,
         }),
-        Outcome::NeverLeaves {
+        Ends::Never {
             equilibrium_radius_m,
             near_threshold,
         } => serde_json::json!({
@@ -422,27 +404,25 @@ fn describe(scene: &Scene<f64>, model: Model, method: MethodChoice, p: &Predicti
     } else {
         String::new()
     };
-    match p.outcome {
-        Outcome::Leaves {
-            residence_time_s,
-            exit_radial_velocity_m_s,
-            exit_total_velocity_m_s,
-            condition_number,
-            ill_conditioned,
-        } => format!(
-            "{head} leaves after T = {residence_time_s:.9} s; exit radial {exit_radial_velocity_m_s:.6} m/s, total {exit_total_velocity_m_s:.6} m/s; condition {condition_number:.3}{}{cost}",
-            if ill_conditioned {
+    match Ends::from(p.outcome) {
+        Ends::Leaves(l) => format!(
+            "{head} leaves after T = {:.9} s; exit radial {:.6} m/s, total {:.6} m/s; condition {:.3}{}{cost}",
+            l.residence_time_s,
+            l.exit_radial_velocity_m_s,
+            l.exit_total_velocity_m_s,
+            l.condition_number,
+            if l.ill_conditioned {
                 " (ILL-CONDITIONED: start just above the threshold a)"
             } else {
                 ""
             }
         ),
-        Outcome::AlreadyAtRim {
+        Ends::AtRim {
             exit_total_velocity_m_s,
         } => {
             format!("{head} starts at the rim: T = 0, exit total {exit_total_velocity_m_s:.6} m/s")
         }
-        Outcome::NeverLeaves {
+        Ends::Never {
             equilibrium_radius_m,
             near_threshold,
         } => format!(

@@ -6,6 +6,7 @@ pub mod experiment;
 pub mod fit;
 pub mod kinematics;
 pub mod ports;
+pub mod predict;
 pub mod replay;
 pub mod send;
 pub mod serve;

@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, anyhow, bail};
 use model_core::particle::{Model, Outcome, Scene};
 
-use super::{Args, predict, refusals};
+use super::{Ends, Inputs, predict, refusals};
 
 /// Formats an f64 for the batch output: shortest round-trip digits, `inf`, `nan`.
 pub fn format_f64(x: f64) -> String {
@@ -152,26 +152,20 @@ fn parse_row(row: &csv::StringRecord, cols: &Columns, width: usize) -> Result<(M
 
 /// The five result fields of one outcome.
 fn result_fields(o: &Outcome<f64>) -> [String; 5] {
-    match *o {
-        Outcome::Leaves {
-            residence_time_s,
-            exit_radial_velocity_m_s,
-            exit_total_velocity_m_s,
-            condition_number,
-            ill_conditioned,
-        } => [
-            format_f64(residence_time_s),
-            format_f64(exit_radial_velocity_m_s),
-            format_f64(exit_total_velocity_m_s),
-            format_f64(condition_number),
-            if ill_conditioned {
+    match Ends::from(*o) {
+        Ends::Leaves(l) => [
+            format_f64(l.residence_time_s),
+            format_f64(l.exit_radial_velocity_m_s),
+            format_f64(l.exit_total_velocity_m_s),
+            format_f64(l.condition_number),
+            if l.ill_conditioned {
                 "ill_conditioned"
             } else {
                 ""
             }
             .into(),
         ],
-        Outcome::AlreadyAtRim {
+        Ends::AtRim {
             exit_total_velocity_m_s,
         } => [
             "0".into(),
@@ -180,7 +174,7 @@ fn result_fields(o: &Outcome<f64>) -> [String; 5] {
             String::new(),
             String::new(),
         ],
-        Outcome::NeverLeaves { near_threshold, .. } => [
+        Ends::Never { near_threshold, .. } => [
             "inf".into(),
             "nan".into(),
             "nan".into(),
@@ -244,7 +238,7 @@ fn line_of(starts: &[u64], offset: u64) -> usize {
 }
 
 /// Runs `bowl predict --batch INPUT --out OUTPUT`.
-pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
+pub fn run(input: &Path, output: &Path, args: &Inputs) -> Result<()> {
     let bytes = std::fs::read(input).with_context(|| format!("cannot open {}", input.display()))?;
     let starts = line_starts(&bytes);
     let mut reader = csv::ReaderBuilder::new()
@@ -278,6 +272,7 @@ pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
     let (mut failed, mut rows) = (0usize, 0usize);
     let mut scenes = Vec::new();
     let mut record = csv::StringRecord::new();
+    let how = args.method_settings();
     loop {
         // Line numbers as a user sees them: the header is line 1, whatever ends the lines.
         let (row, byte) = match reader.read_record(&mut record) {
@@ -292,7 +287,7 @@ pub fn run(input: &Path, output: &Path, args: &Args) -> Result<()> {
         rows += 1;
         let result = row.and_then(|row| {
             let (model, scene) = parse_row(&row, &cols, header.len())?;
-            let p = predict(&scene, model, args.method, args.step_s, args.tol)?;
+            let p = predict(&scene, model, &how)?;
             if args.throughput {
                 scenes.push((model, scene));
             }

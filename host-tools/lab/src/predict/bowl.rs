@@ -9,36 +9,30 @@ use model_core::particle::rolling::{AZIMUTHS_DEG, MAX_STEPS, RollingMethod};
 use serde_json::{Value, json};
 
 use super::validity::Validity;
-use super::{Args, MethodChoice, rolling};
+use super::{Inputs, MethodChoice, rolling};
 
 /// The bowl model's own flags (the scene's are the rolling model's; `--mu` is the rolling
 /// resistance, `--sliding-mu` the contact's sliding coefficient).
-#[derive(clap::Args, Debug, Clone)]
-pub struct BowlArgs {
+#[derive(Debug, Clone)]
+pub struct BowlInputs {
     /// Bowl model: the wall's angle from the bottom plane, degrees (90 = vertical; default 90
     /// or the rig file's).
-    #[arg(long, allow_negative_numbers = true)]
-    wall_angle_deg: Option<f64>,
+    pub wall_angle_deg: Option<f64>,
     /// Bowl model: the wall's height above the bottom, m (0 = a bare rim at --rim-radius-m;
     /// default 0 or the rig file's).
-    #[arg(long, allow_negative_numbers = true)]
-    wall_height_m: Option<f64>,
+    pub wall_height_m: Option<f64>,
     /// Bowl model: the fillet's radius between bottom and wall, m (0 = a sharp corner; default
     /// 0 or the rig file's).
-    #[arg(long, allow_negative_numbers = true)]
-    fillet_radius_m: Option<f64>,
+    pub fillet_radius_m: Option<f64>,
     /// Bowl model: coefficient of restitution of the impact with a sharp corner's wall
     /// (default 0.5 or the rig file's).
-    #[arg(long, allow_negative_numbers = true)]
-    restitution: Option<f64>,
+    pub restitution: Option<f64>,
     /// Bowl model: follow each release this long, s; still inside then, it has not left.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 10.0)]
-    max_time_s: f64,
+    pub max_time_s: f64,
     /// Bowl model: the bowl from a rig file's [bowl] table (docs/rigs/nominal.toml): its wall
     /// keys unless given as flags, its tilt unless --axes-angle-deg is given, and its bottom
     /// and granule radii in place of --rim-radius-m and --particle-radius-m.
-    #[arg(long, value_name = "RIG.toml")]
-    rig_file: Option<std::path::PathBuf>,
+    pub rig_file: Option<std::path::PathBuf>,
 }
 
 /// The wall flags with the rig file's `[bowl]` table (or the defaults) under them.
@@ -49,7 +43,7 @@ struct Wall {
     restitution: f64,
 }
 
-impl BowlArgs {
+impl BowlInputs {
     fn wall(&self, table: Option<&rig_file::BowlGeometry>) -> Wall {
         let pick =
             |flag: Option<f64>, from: Option<f64>, default: f64| flag.or(from).unwrap_or(default);
@@ -133,7 +127,7 @@ fn outcome_name(o: &BowlOutcome<f64>) -> &'static str {
 }
 
 /// Runs `bowl predict --model bowl`.
-pub fn run(args: &Args, r: &rolling::RollingArgs, b: &BowlArgs) -> Result<()> {
+pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<()> {
     if args.target_time_s.is_some() || args.batch.is_some() {
         bail!("--target-time-s and --batch are for the flat and Coriolis models, not the bowl");
     }

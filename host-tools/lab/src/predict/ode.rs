@@ -4,7 +4,7 @@ use anyhow::{Result, anyhow};
 use model_core::ode::{self, Method, OdeOutcome};
 use model_core::particle::{self, Model, Outcome, Scene};
 
-use super::{MethodChoice, Prediction};
+use super::{Ends, Leaves, MethodChoice, MethodSettings, Prediction};
 
 /// DP5(4) at tolerance `tol` on scene `s`: relative `tol`, absolute `tol R` (the same for r in
 /// m and r' in m/s; r' at the rim is of order omega R). The one rule for `bowl predict --method
@@ -37,13 +37,12 @@ pub fn plan(
 
 /// Integrates one scene with a numerical method. The condition number reported is the
 /// problem's (from the closed form): it does not depend on the method.
-pub fn predict(
-    scene: &Scene<f64>,
-    model: Model,
-    method: MethodChoice,
-    step_s: Option<f64>,
-    tol: f64,
-) -> Result<Prediction> {
+pub fn predict(scene: &Scene<f64>, model: Model, how: &MethodSettings) -> Result<Prediction> {
+    let MethodSettings {
+        method,
+        step_s,
+        tol,
+    } = *how;
     // Default step: a hundredth of the time scale 1/omega.
     let h = step_s.unwrap_or_else(|| {
         if scene.omega_rad_s > 0.0 {
@@ -64,21 +63,20 @@ pub fn predict(
             exit_radial_velocity_m_s,
             exit_total_velocity_m_s,
         } => {
-            let (condition_number, ill_conditioned) = match closed {
-                Outcome::Leaves {
-                    condition_number,
-                    ill_conditioned,
-                    ..
-                } => (condition_number, ill_conditioned),
+            // The condition is the problem's: the closed form's (well conditioned when that
+            // does not leave).
+            let (condition_number, ill_conditioned) = match Ends::from(closed) {
+                Ends::Leaves(c) => (c.condition_number, c.ill_conditioned),
                 _ => (1.0, false),
             };
-            Outcome::Leaves {
+            Leaves {
                 residence_time_s,
                 exit_radial_velocity_m_s,
                 exit_total_velocity_m_s,
                 condition_number,
                 ill_conditioned,
             }
+            .into()
         }
         OdeOutcome::AlreadyAtRim {
             exit_total_velocity_m_s,

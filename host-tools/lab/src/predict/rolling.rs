@@ -10,54 +10,44 @@ use model_core::particle::rolling::{
 };
 use serde_json::json;
 
-use super::{Args, MethodChoice, validity};
+use super::{Inputs, MethodChoice, validity};
 
-/// Flags of the rolling model (the shared ones: `--mu` is its rolling resistance, `--ri-m`,
+/// Inputs of the rolling model (the shared ones: `--mu` is its rolling resistance, `--ri-m`,
 /// `--rim-radius-m`, `--g`, `--k2`, `--method`, `--tol`, `--step-s`, `--json`).
-#[derive(clap::Args, Debug, Clone)]
-pub struct RollingArgs {
+#[derive(Debug, Clone)]
+pub struct RollingInputs {
     /// Rolling model: precession speed w1 of the bowl's axis about the vertical, rad/s.
-    #[arg(long, allow_negative_numbers = true)]
-    precession_rad_s: Option<f64>,
+    pub precession_rad_s: Option<f64>,
     /// Rolling model: spin speed w2 of the bowl about its own axis, rad/s (negative: the
     /// other way, e.g. --spin-rad-s -2.7).
-    #[arg(long, allow_negative_numbers = true)]
-    spin_rad_s: Option<f64>,
+    pub spin_rad_s: Option<f64>,
     /// Rolling model: angle between the bowl's axis and the vertical, degrees (paper Eq. 2).
-    #[arg(long)]
-    axes_angle_deg: Option<f64>,
+    pub axes_angle_deg: Option<f64>,
     /// Rolling model: granule radius a, m.
-    #[arg(long, default_value_t = 0.003)]
-    particle_radius_m: f64,
+    pub particle_radius_m: f64,
     /// Rolling model: the rod's horizontal offset L, the distance of the bowl's centre from the
     /// precession axis, m. Not the rod's length: a rod of length l at angle th from the
     /// vertical gives L = l sin(th) (l overstates L by 15 % at 60 deg). `--rod-length-m` is
     /// this flag's old name, kept as an alias.
-    #[arg(long, visible_alias = "rod-length-m", default_value_t = 0.0)]
-    rod_offset_m: f64,
+    pub rod_offset_m: f64,
     /// Rolling model: release azimuth from the downhill direction, degrees, or `all` (mean, min
     /// and max over 0, 30, ..., 330).
-    #[arg(long, default_value = "all")]
-    release_azimuth_deg: String,
+    pub release_azimuth_deg: String,
     /// Rolling model: the friction coefficient the contact can give (slip beyond it is reported).
-    #[arg(long, default_value_t = 0.4)]
-    sliding_mu: f64,
+    pub sliding_mu: f64,
     /// Rolling model: every member of the model hierarchy on this scene, its mean residence
     /// time and its difference from the full model, and the cheapest member within this
     /// relative tolerance (e.g. 0.05).
-    #[arg(long, conflicts_with = "hierarchy_uncertainty_mu")]
-    hierarchy_tolerance: Option<f64>,
+    pub hierarchy_tolerance: Option<f64>,
     /// Rolling model: as --hierarchy-tolerance, the tolerance set by this uncertainty in the
     /// rolling resistance (the change of the full model's mean T when mu moves by it).
-    #[arg(long)]
-    hierarchy_uncertainty_mu: Option<f64>,
+    pub hierarchy_uncertainty_mu: Option<f64>,
     /// Rolling model: with the hierarchy, judge each single release (the worst azimuth), not
     /// the mean over the releases.
-    #[arg(long)]
-    each_release: bool,
+    pub each_release: bool,
 }
 
-impl RollingArgs {
+impl RollingInputs {
     /// The contact's sliding coefficient (every model judges its rolling against it).
     pub fn sliding_mu(&self) -> f64 {
         self.sliding_mu
@@ -72,7 +62,7 @@ impl RollingArgs {
     /// the tilt in degrees; `model` names the model in the words of a missing flag.
     pub fn scene(
         &self,
-        args: &Args,
+        args: &Inputs,
         model: &str,
         default_tilt_deg: Option<f64>,
     ) -> Result<(RollingScene<f64>, f64)> {
@@ -143,27 +133,8 @@ pub fn words(e: RollingError) -> String {
     }
 }
 
-fn outcome_json(o: &RollingOutcome<f64>) -> serde_json::Value {
-    match *o {
-        RollingOutcome::Leaves {
-            residence_time_s,
-            exit_speed_m_s,
-            max_friction_ratio,
-            first_slip_s,
-        } => json!({
-            "outcome": "leaves", "residence_time_s": residence_time_s,
-            "exit_speed_relative_m_s": exit_speed_m_s,
-            "max_friction_ratio": max_friction_ratio, "first_slip_s": first_slip_s,
-        }),
-        RollingOutcome::Held => json!({"outcome": "held"}),
-        RollingOutcome::LiftsOff { time_s } => json!({"outcome": "lifts_off", "time_s": time_s}),
-        RollingOutcome::NotLeftBy { horizon_s } => {
-            json!({"outcome": "not_left", "horizon_s": horizon_s})
-        }
-    }
-}
-
-fn outcome_text(o: &RollingOutcome<f64>, sliding_mu: f64) -> String {
+/// One release's outcome, as JSON and in words.
+fn outcome(o: &RollingOutcome<f64>, sliding_mu: f64) -> (serde_json::Value, String) {
     match *o {
         RollingOutcome::Leaves {
             residence_time_s,
@@ -182,22 +153,34 @@ fn outcome_text(o: &RollingOutcome<f64>, sliding_mu: f64) -> String {
                      normal force)"
                 ),
             };
-            format!(
-                "leaves after T = {residence_time_s:.6} s at {exit_speed_m_s:.4} m/s relative to the bowl{slip}"
+            (
+                json!({
+                    "outcome": "leaves", "residence_time_s": residence_time_s,
+                    "exit_speed_relative_m_s": exit_speed_m_s,
+                    "max_friction_ratio": max_friction_ratio, "first_slip_s": first_slip_s,
+                }),
+                format!(
+                    "leaves after T = {residence_time_s:.6} s at {exit_speed_m_s:.4} m/s relative to the bowl{slip}"
+                ),
             )
         }
-        RollingOutcome::Held => "held: the resistance keeps it at rest".into(),
-        RollingOutcome::LiftsOff { time_s } => {
-            format!("lifts off the bottom at t = {time_s:.4} s (normal force reaches zero)")
-        }
-        RollingOutcome::NotLeftBy { horizon_s } => {
-            format!("still in the bowl after {horizon_s} s")
-        }
+        RollingOutcome::Held => (
+            json!({"outcome": "held"}),
+            "held: the resistance keeps it at rest".into(),
+        ),
+        RollingOutcome::LiftsOff { time_s } => (
+            json!({"outcome": "lifts_off", "time_s": time_s}),
+            format!("lifts off the bottom at t = {time_s:.4} s (normal force reaches zero)"),
+        ),
+        RollingOutcome::NotLeftBy { horizon_s } => (
+            json!({"outcome": "not_left", "horizon_s": horizon_s}),
+            format!("still in the bowl after {horizon_s} s"),
+        ),
     }
 }
 
 /// Runs `bowl predict --model rolling`.
-pub fn run(args: &Args, r: &RollingArgs) -> Result<()> {
+pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
     let (Some(w1), Some(w2), Some(th_deg)) = (r.precession_rad_s, r.spin_rad_s, r.axes_angle_deg)
     else {
         bail!(
@@ -328,8 +311,8 @@ pub fn run(args: &Args, r: &RollingArgs) -> Result<()> {
         RollingOutcome::LiftsOff { .. } => validity::rolling(0, 1, 1, 0.0, r.sliding_mu),
         _ => validity::Validity::valid(),
     };
+    let (mut v, text) = outcome(&report.outcome, r.sliding_mu);
     if args.json {
-        let mut v = outcome_json(&report.outcome);
         validity.add_to(&mut v);
         v["model"] = json!("rolling");
         v["release_azimuth_deg"] = json!(beta_deg);
@@ -340,10 +323,7 @@ pub fn run(args: &Args, r: &RollingArgs) -> Result<()> {
             println!("{line}");
         }
         println!("{head}");
-        println!(
-            "release at {beta_deg} deg: {}",
-            outcome_text(&report.outcome, r.sliding_mu)
-        );
+        println!("release at {beta_deg} deg: {text}");
     }
     Ok(())
 }

@@ -13,7 +13,7 @@ use model_core::ode::{Method, SpinUp};
 use model_core::particle::Scene;
 
 /// Where the chosen plan runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum RunsOn {
     /// The PC, f64, priced in nanoseconds.
     #[default]
