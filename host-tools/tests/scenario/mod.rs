@@ -300,27 +300,35 @@ pub fn check(
             .copied()
             .filter(|r| !r.contains_key(IN_TRANSIT))
             .collect();
-        if let (Some([lo, hi]), [] | [_]) = (e.telemetry_hz, judged.as_slice()) {
-            failures.push(format!(
-                "{head}: expected {lo}..={hi} telemetry frames/s, got {} frame(s) outside the \
-                 commands' transit: no rate to measure",
-                judged.len()
-            ));
-        }
-        if let (Some([lo, hi]), [first, .., last]) = (e.telemetry_hz, judged.as_slice()) {
-            // Frames per second between the span's first and last frame, on the rig's own clock.
+        if let Some([lo, hi]) = e.telemetry_hz {
+            // Frames per second from the intervals between neighbouring frames that were both
+            // sent outside a command's transit, on the rig's own clock: a transit (a SET of the
+            // rate in flight, a harness late on a loaded machine) is left out, frames and time.
             let clock = |r: &Row| {
                 r.get("board_time_ms")
                     .and_then(|t| t.parse::<u32>().ok())
                     .unwrap_or_else(|| time_ms(r))
             };
-            let secs = f64::from(clock(last).saturating_sub(clock(first))) / 1000.0;
-            let hz = (judged.len() - 1) as f64 / secs.max(1e-3);
-            if !(lo..=hi).contains(&hz) {
+            let gaps: Vec<u32> = span
+                .windows(2)
+                .filter(|w| !w[0].contains_key(IN_TRANSIT) && !w[1].contains_key(IN_TRANSIT))
+                .map(|w| clock(w[1]).saturating_sub(clock(w[0])))
+                .collect();
+            let secs = f64::from(gaps.iter().sum::<u32>()) / 1000.0;
+            if gaps.is_empty() || secs <= 0.0 {
                 failures.push(format!(
-                    "{head}: expected {lo}..={hi} telemetry frames/s, got {hz:.1} ({} frames in {secs} s)",
-                    judged.len()
+                    "{head}: expected {lo}..={hi} telemetry frames/s, got no two neighbouring \
+                     frames outside the commands' transit: no rate to measure"
                 ));
+            } else {
+                let hz = gaps.len() as f64 / secs;
+                if !(lo..=hi).contains(&hz) {
+                    failures.push(format!(
+                        "{head}: expected {lo}..={hi} telemetry frames/s, got {hz:.1} ({} \
+                         intervals over {secs} s)",
+                        gaps.len()
+                    ));
+                }
             }
         }
         let mut field_checks: Vec<CellCheck> = Vec::new();
