@@ -1,4 +1,4 @@
-//! `bowl fit results.csv [--json] [--fit-k2]`: the effective rolling resistance `mu` of each
+//! `bowl fit results.csv [--json] [--fit-k2] [--models flat,coriolis,rolling]`: the effective rolling resistance `mu` of each
 //! candidate model (and with `--fit-k2` the granule's `k2` too) from measured residence times,
 //! its 95 % interval, the residuals per condition, and which model the data supports (AIC), by
 //! the lab's fit (`lab::fit`). Method and limits: docs/experiment.md.
@@ -6,9 +6,12 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
+use lab::fit::models::CANDIDATES;
 use lab::fit::models::Method;
 use lab::fit::stats::AIC_DECISIVE;
-use lab::fit::{DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit, load, to_json};
+use lab::fit::{
+    DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit_candidates, load, to_json,
+};
 
 /// Arguments of `bowl fit`.
 #[derive(clap::Args)]
@@ -32,6 +35,15 @@ pub struct Args {
     /// results file's k2 is the starting point).
     #[arg(long)]
     pub fit_k2: bool,
+    /// The models fitted and compared, comma-separated (the rolling model takes by far the
+    /// longest to fit: leave it out for a quick look at the paper's two).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_parser = ["flat", "coriolis", "rolling"],
+        default_value = "flat,coriolis,rolling"
+    )]
+    pub models: Vec<String>,
 }
 
 /// `bowl fit`.
@@ -46,7 +58,12 @@ pub fn run(args: &Args) -> Result<()> {
     for r in &mut runs {
         r.axes_angle_rad = args.axes_angle_deg.to_radians();
     }
-    let fit = fit(runs, excluded, args.fit_k2)?;
+    let candidates: Vec<_> = CANDIDATES
+        .iter()
+        .filter(|c| args.models.iter().any(|m| m == c.name))
+        .copied()
+        .collect();
+    let fit = fit_candidates(runs, excluded, &candidates, args.fit_k2)?;
     if !args.no_charts {
         let dir = args.charts.clone().unwrap_or_else(|| {
             let stem = args
