@@ -176,8 +176,14 @@ pub fn mu_ceiling_for(run: &Run, equation: Equation) -> f64 {
 
 /// The largest `mu` at which the run can leave: `ri omega^2 / g` at its fastest speed.
 pub fn mu_ceiling(run: &Run) -> f64 {
-    let fastest = run.trace.iter().map(|p| p.1).fold(run.mean_rad_s, f64::max);
+    let fastest = fastest_rad_s(run);
     run.release_radius_m * fastest * fastest / G_M_S2
+}
+
+/// The run's fastest measured speed (its trace's, or the mean if higher), rad/s: no model is
+/// given a faster one.
+pub fn fastest_rad_s(run: &Run) -> f64 {
+    run.trace.iter().map(|p| p.1).fold(run.mean_rad_s, f64::max)
 }
 
 /// The shortest residence time any candidate model can give the run at any resistance, s: a
@@ -200,7 +206,7 @@ pub fn mu_ceiling(run: &Run) -> f64 {
 /// is inside it (`acosh(R / ri) / omega` is longer); on the rig (7 rad/s, 0.05 m to 0.15 m) the
 /// bound is 0.11 s against 0.30 s without friction.
 pub fn shortest_residence_s(run: &Run) -> f64 {
-    let fastest = run.trace.iter().map(|p| p.1).fold(run.mean_rad_s, f64::max);
+    let fastest = fastest_rad_s(run);
     let a =
         RollingScene::equal_speeds(fastest, run.axes_angle_rad, run.rim_radius_m).particle_radius_m;
     let w2 = fastest * fastest;

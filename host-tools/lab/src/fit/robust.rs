@@ -19,7 +19,9 @@
 use serde::Serialize;
 
 use super::ModelFit;
-use super::models::{CANDIDATES, Equation, Run, mu_ceiling_for, predict, shortest_residence_s};
+use super::models::{
+    CANDIDATES, Equation, Run, fastest_rad_s, mu_ceiling_for, predict, shortest_residence_s,
+};
 use super::stats::minimise;
 
 /// The longest a release can last on either rig before it is recorded as `never_left`, s.
@@ -58,7 +60,7 @@ pub fn impossible(runs: &[Run]) -> Option<String> {
         .filter_map(|r| {
             let least = shortest_residence_s(r);
             (r.residence_s < least).then(|| {
-                let fastest = r.trace.iter().map(|p| p.1).fold(r.mean_rad_s, f64::max);
+                let fastest = fastest_rad_s(r);
                 format!(
                     "line {}: residence time {:e} s, under the {least:.3} s that the fastest \
                      possible release takes from rest at {} m to the rim at {} m with the bowl \
