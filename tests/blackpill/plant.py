@@ -15,6 +15,8 @@ PLANT_TIMER_HZ = 1_000_000
 DIR_PINS = (12, 13)
 # GPIOB pin of the release solenoid driver.
 SOLENOID_PIN = 5
+# GPIOB pin of the motor supply switch's enable (high = closed; its pull-down opens it).
+SUPPLY_PIN = 14
 # TIM2 channel index of the exit light gate (CH3, PB10).
 EXIT_GATE_CHANNEL = 2
 
@@ -83,8 +85,15 @@ class RigPlant:
         self.granules = []
 
     def duties_from_board(self, tim1, gpiob):
+        """Each bridge's duty from its PWM and DIR pins; zero while the motor supply switch
+        (PB14, an output driven high to close it) is open: a bridge without supply drives
+        nothing, whatever its inputs say."""
         duties = []
         odr = gpiob.instance.ODR if gpiob is not None else 0
+        supply = gpiob is not None and ((gpiob.instance.MODER >> (2 * SUPPLY_PIN)) & 3) == 1 \
+            and (odr >> SUPPLY_PIN) & 1
+        if not supply:
+            return (0.0, 0.0)
         for axis in (0, 1):
             frac = tim1.pwm_fraction(axis) if tim1 is not None else 0.0
             reverse = (odr >> DIR_PINS[axis]) & 1
