@@ -19,6 +19,7 @@ from qiling.extensions.mcu.stm32f4 import stm32f411
 from unicorn import UC_HOOK_CODE, UcError
 from unicorn.arm_const import UC_ARM_REG_FPSCR, UC_ARM_REG_S0
 
+from adc import Adc, AdcCommon
 from clock_tree import HSE_HZ, ClockTree
 from dma import Dma
 from exti import Exti
@@ -38,6 +39,10 @@ CODE_FLASH_SIZE = BACKED_BASE - 0x0800_0000
 
 IRQ_TIM1_BRK, IRQ_TIM1_UP, IRQ_TIM1_CC, IRQ_TIM2, IRQ_TIM5 = 24, 25, 27, 28, 50
 IRQ_EXTI0 = 6
+IRQ_ADC = 18
+# The current-sense amplifiers (docs/wiring.md: INA240A1, 20 V/V, on a 10 mOhm shunt, zero at
+# mid-supply): volts at PB0 (ADC1_IN8, precession) and PB1 (IN9, spin) for a motor current.
+SENSE_ZERO_V, SENSE_V_PER_A, SENSE_CHANNELS = 1.65, 0.2, (8, 9)
 # The release push button: PA0 (the Black Pill's KEY), active low.
 BUTTON_PORT, BUTTON_PIN = "a", 0
 IRQ_USART2 = 38
@@ -123,6 +128,11 @@ class Board:
         self.iwdg = add("iwdg", Iwdg(ql, "iwdg", m), 0x4000_3000)
         self.flash = add("flash", FlashInterface(ql, "flash", m, m.store), 0x4002_3C00)
         self.exti = add("exti", Exti(ql, "exti", ql.hw.syscfg), 0x4001_3C00)
+        self.adc1 = add("adc1", Adc(ql, "adc1", self.tim1), 0x4001_2000)
+        self.adc_common = add("adc_common", AdcCommon(ql, "adc_common"), 0x4001_2300)
+        self.adc1.now_ns = lambda: m.now_ns
+        for axis, channel in enumerate(SENSE_CHANNELS):
+            self.adc1.inputs[channel] = lambda a=axis: self.sense_volts(a)
         self.timers = (self.tim1, self.tim2, self.tim5)
         self.clocked = (self.tim1, self.tim2, self.tim5, self.usart2, self.iwdg)
         self.stepping = [e for k, e in ql.hw.stepable.items() if k in ("rcc", "pwr")]
@@ -134,6 +144,7 @@ class Board:
         self.nvic.connect(IRQ_TIM5, lambda: self.tim5.irq_level(0x1F))
         self.nvic.connect(IRQ_USART2, self.usart2.irq_level)
         self.nvic.connect(IRQ_EXTI0, lambda: self.exti.irq_level(1 << BUTTON_PIN))
+        self.nvic.connect(IRQ_ADC, self.adc1.irq_level)
         for stream, irq in IRQ_DMA1_STREAM.items():
             self.nvic.connect(irq, lambda s=stream: self.dma1.irq_level(s))
 
@@ -168,6 +179,14 @@ class Board:
         self.sleeping = False
         self.at_wfe = None
         self.in_isr = False
+
+    def sense_volts(self, axis: int) -> float:
+        """The amplifier's output for the plant's motor current (rails at 0 and 3.3 V); 0 V
+        without a plant (nothing connected)."""
+        if self.m.plant is None:
+            return 0.0
+        v = SENSE_ZERO_V + SENSE_V_PER_A * self.m.plant.current_a(axis)
+        return max(0.0, min(3.3, v))
 
     # --- hooks -------------------------------------------------------------------------
     def _flash_read(self, ql, offset, size):
@@ -454,6 +473,7 @@ class Machine:
                 b.tim2.capture(axis, at)
             while self.plant.time_ns <= self.now_ns:
                 self.plant.step(b.tim1, b.gpiob)
+                b.adc1.plant_stepped()
         b.sync_peripherals()
 
     def _poll_host(self):

@@ -14,6 +14,8 @@
 //! | Release solenoid driver      | PB5  | GPIO out, high = energised                   |
 //! | Hardware stop (break input)  | PA6  | TIM1_BKIN (AF1), active low, pull-up         |
 //! | Motor supply enable          | PB14 | GPIO out, high = supply switch closed        |
+//! | Precession motor current     | PB0  | ADC1_IN8, injected group on TIM1's update    |
+//! | Spin motor current           | PB1  | ADC1_IN9, same conversion sequence           |
 //! | Host link TX                 | PA2  | USART2_TX, DMA1 stream 6                      |
 //! | Host link RX                 | PA3  | USART2_RX, DMA1 stream 5 (circular)           |
 //! | Status LED (active low)      | PC13 | GPIO out, a pattern per state (`app::led`)   |
@@ -26,6 +28,7 @@
 
 pub mod capture;
 pub mod clocks;
+pub mod current_sense;
 pub mod flash_region;
 pub mod gates;
 pub mod motor_pwm;

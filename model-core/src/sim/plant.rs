@@ -294,6 +294,10 @@ impl Plant {
     pub fn cut_supply(&mut self) {
         self.supply_cut = true;
     }
+    /// Closes the supply cut again (a board that switches its supply back on after CLEAR).
+    pub fn restore_supply(&mut self) {
+        self.supply_cut = false;
+    }
     /// The supply cut is open.
     pub fn supply_is_cut(&self) -> bool {
         self.supply_cut
