@@ -100,7 +100,9 @@ pub fn start(pb0: Peri<'static, PB0>, pb1: Peri<'static, PB1>) -> AdcCurrents {
         w.set_jexten(Exten::RISING_EDGE);
     });
     // TIM1 sends its update event as TRGO.
-    embassy_stm32::pac::TIM1.cr2().modify(|w| w.set_mms(Mms::UPDATE));
+    embassy_stm32::pac::TIM1
+        .cr2()
+        .modify(|w| w.set_mms(Mms::UPDATE));
     AdcCurrents { _pins: (pb0, pb1) }
 }
 
