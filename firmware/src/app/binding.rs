@@ -66,6 +66,17 @@ impl<I: Injector> TaskCore for DeviceCore<I> {
         self.backend.controller().state() == State::Fault
     }
 
+    fn hardware_stop(&mut self) {
+        self.backend.controller_mut().hardware_stop();
+    }
+
+    fn cuts_supply(&self) -> bool {
+        self.backend
+            .controller()
+            .fault()
+            .is_some_and(|f| f.cuts_supply())
+    }
+
     fn hello(&mut self, out: &mut [u8; FRAME_BYTES]) -> Option<usize> {
         self.device.hello(&self.backend, out)
     }

@@ -17,6 +17,27 @@ pub trait MotorOutput {
     }
 }
 
+/// The output stage's protection around the bridges: the hardware stop (on the STM32 TIM1's
+/// break input, which switches the PWM off without the CPU) and the motor supply switch (a
+/// relay or high-side switch whose enable is off without power: fail-safe).
+pub trait PowerStage {
+    /// Whether the hardware stop has tripped since the last call, or its line is still active.
+    /// The PWM is already off when this says so; the caller latches the fault.
+    fn stop_tripped(&mut self) -> bool;
+    /// Closes (`true`) or opens the motor supply switch.
+    fn set_supply(&mut self, on: bool);
+}
+
+/// A board without a hardware stop or a supply switch (the QEMU board, the host): never trips.
+pub struct NoPowerStage;
+
+impl PowerStage for NoPowerStage {
+    fn stop_tripped(&mut self) -> bool {
+        false
+    }
+    fn set_supply(&mut self, _on: bool) {}
+}
+
 /// The free-running timer the edge timestamps come from.
 pub trait CaptureClock {
     /// The timer's current value (same units and wrap as the edge timestamps).

@@ -30,6 +30,9 @@ pub fn fault(f: FaultCode) -> &'static str {
         FaultCode::OverspeedSpin => "spin motor over its speed limit",
         FaultCode::HostSilent => "the PC went silent (link loss)",
         FaultCode::InvalidConfiguration => "the stored configuration is invalid",
+        FaultCode::HardwareStop => {
+            "hardware stop: over-current or a bridge driver fault switched the motors off (motor supply cut)"
+        }
     }
 }
 
@@ -69,6 +72,7 @@ pub fn fault_token(f: FaultCode) -> &'static str {
         FaultCode::OverspeedSpin => "overspeed-spin",
         FaultCode::HostSilent => "link-lost",
         FaultCode::InvalidConfiguration => "invalid-configuration",
+        FaultCode::HardwareStop => "hardware-stop",
     }
 }
 

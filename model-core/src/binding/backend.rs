@@ -77,6 +77,7 @@ fn fault_code(f: Option<Fault>) -> FaultCode {
         Some(Fault::Overspeed(_)) => FaultCode::OverspeedSpin,
         Some(Fault::HostSilent) => FaultCode::HostSilent,
         Some(Fault::InvalidConfiguration) => FaultCode::InvalidConfiguration,
+        Some(Fault::HardwareStop) => FaultCode::HardwareStop,
     }
 }
 

@@ -522,6 +522,13 @@ impl Controller {
         self.commissioning = None;
     }
 
+    /// The board's hardware stop (its break input) tripped: latch [`Fault::HardwareStop`] (a
+    /// fault already latched is kept). The board calls it at every tick while the stop's line
+    /// is active, so a CLEAR holds only once the line is released.
+    pub fn hardware_stop(&mut self) {
+        self.latch(Fault::HardwareStop);
+    }
+
     /// Feedback on or off (diagnostics and the test that shows the feedforward alone is not
     /// enough). On by default.
     pub fn set_feedback_enabled(&mut self, on: bool) {

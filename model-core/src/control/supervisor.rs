@@ -45,18 +45,31 @@ pub enum Fault {
     HostSilent,
     /// The configuration is invalid, or commissioning identified an implausible model or timed out.
     InvalidConfiguration,
+    /// The board's hardware stop tripped: the break input (an over-current comparator or the
+    /// bridge driver's fault output) switched the PWM off without the CPU. The bridge cannot be
+    /// trusted after it, so the board also cuts the motor supply ([`Fault::cuts_supply`]).
+    HardwareStop,
 }
 
 impl Fault {
     /// Telemetry code: 0 means no fault; 1/2 sensor lost or stall on precession/spin,
-    /// 3/4 over-speed on precession/spin, 5 host silent, 6 invalid configuration.
+    /// 3/4 over-speed on precession/spin, 5 host silent, 6 invalid configuration, 7 hardware
+    /// stop.
     pub fn code(self) -> u8 {
         match self {
             Fault::SensorLostOrStall(a) => 1 + a.min(1),
             Fault::Overspeed(a) => 3 + a.min(1),
             Fault::HostSilent => 5,
             Fault::InvalidConfiguration => 6,
+            Fault::HardwareStop => 7,
         }
+    }
+
+    /// Whether a board with a supply-cut switch opens it for this fault: the faults a bridge
+    /// told to stop may not stop (its own hardware stop tripped). The others are stopped by the
+    /// bridge itself (duty zero, TIM1's main output off).
+    pub fn cuts_supply(self) -> bool {
+        matches!(self, Fault::HardwareStop)
     }
 }
 

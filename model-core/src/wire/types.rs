@@ -45,6 +45,9 @@ pub enum FaultCode {
     HostSilent = 5,
     /// The configuration is invalid, or commissioning failed.
     InvalidConfiguration = 6,
+    /// The board's hardware stop (break input: over-current comparator or driver fault) cut the
+    /// PWM; the motor supply is cut too where the board has the switch.
+    HardwareStop = 7,
 }
 
 /// What caused the last reset of the microcontroller (STM32 RCC_CSR flags).
@@ -330,6 +333,7 @@ code_enum!(FaultCode {
     OverspeedSpin,
     HostSilent,
     InvalidConfiguration,
+    HardwareStop,
 });
 code_enum!(GateKind { Release, Exit });
 code_enum!(ResetCause {

@@ -45,6 +45,7 @@ fn fault_words(fault: Option<Fault>) -> String {
         Some(Fault::SensorLostOrStall(a)) => format!("{} sensor lost or shaft stalled", axis(a)),
         Some(Fault::Overspeed(a)) => format!("{} over speed", axis(a)),
         Some(Fault::HostSilent) => "host silent".into(),
+        Some(Fault::HardwareStop) => "hardware stop (break input)".into(),
         Some(Fault::InvalidConfiguration) | None => "invalid configuration".into(),
     }
 }
