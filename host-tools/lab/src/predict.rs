@@ -13,6 +13,7 @@ mod ends;
 pub(crate) mod ode;
 mod refusals;
 mod rolling;
+mod speed_range;
 mod spin_up;
 mod target;
 mod throughput;

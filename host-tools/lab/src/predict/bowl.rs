@@ -8,6 +8,7 @@ use model_core::particle::bowl::{self, BowlError, BowlOutcome, BowlReport, BowlS
 use model_core::particle::rolling::{AZIMUTHS_DEG, MAX_STEPS, RollingMethod};
 use serde_json::{Value, json};
 
+use super::speed_range::{self, SpeedAxis, SpeedReport};
 use super::validity::Validity;
 use super::{Inputs, MethodChoice, rolling};
 
@@ -33,6 +34,10 @@ pub struct BowlInputs {
     /// keys unless given as flags, its tilt unless --axes-angle-deg is given, and its bottom
     /// and granule radii in place of --rim-radius-m and --particle-radius-m.
     pub rig_file: Option<std::path::PathBuf>,
+    /// Bowl model: also report what speed can do (`speed_range`).
+    pub speed_range: bool,
+    /// Bowl model: store the residence-time table on the rig at this port.
+    pub store_table: Option<String>,
 }
 
 /// The wall flags with the rig file's `[bowl]` table (or the defaults) under them.
@@ -246,6 +251,11 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
         scene.rim_radius_m
     };
     let evaluations: u64 = rows.iter().map(|(_, rep)| u64::from(rep.evaluations)).sum();
+    // What speed can do: the same releases at other bowl speeds (docs/model.md §11).
+    let mean_t = |s: &model_core::particle::rolling::RollingScene<f64>| {
+        mean_time(s, &shape, &betas, method, limits)
+    };
+    let speed = speed_report(&scene, b, &mean_t)?;
     if args.json {
         let mut per: Vec<(f64, Value)> = rows
             .iter()
@@ -294,6 +304,9 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
             },
             "max_time_s": b.max_time_s, "rhs_evaluations": evaluations,
         });
+        if let (Some(obj), Some(sp)) = (v.as_object_mut(), &speed) {
+            obj.insert("speed".into(), sp.json(th_deg));
+        }
         validity.add_to(&mut v);
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
@@ -344,6 +357,9 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
     for (deg, why) in &gave_up {
         println!("release at {deg} deg: no answer: {why}");
     }
+    if let Some(sp) = &speed {
+        println!("what speed can do: {}", sp.words(th_deg));
+    }
     match (mean, min, max) {
         (Some(m), Some(lo), Some(hi)) => println!(
             "over {releases} releases: {} leave, T mean {m:.6} s, min {lo:.6} s, max {hi:.6} s",
@@ -356,4 +372,68 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
         ),
     }
     Ok(())
+}
+
+/// The mean residence time over the releases that leave (`None`: none leaves or one fails).
+fn mean_time(
+    scene: &model_core::particle::rolling::RollingScene<f64>,
+    shape: &BowlShape<f64>,
+    betas: &[f64],
+    method: RollingMethod<f64>,
+    limits: SystemLimits<f64>,
+) -> Option<f64> {
+    let mut times = Vec::new();
+    for deg in betas {
+        let rep = bowl::residence(scene, shape, deg.to_radians(), method, limits).ok()?;
+        if let BowlOutcome::Leaves {
+            residence_time_s, ..
+        } = rep.outcome
+        {
+            times.push(residence_time_s);
+        }
+    }
+    (!times.is_empty()).then(|| times.iter().sum::<f64>() / times.len() as f64)
+}
+
+/// What speed can do at the flags' ratio and the default limits, and with `--store-table` at
+/// the rig's, stored there; `None` with `--speed-range false`.
+fn speed_report(
+    scene: &model_core::particle::rolling::RollingScene<f64>,
+    b: &BowlInputs,
+    mean_t: &dyn Fn(&model_core::particle::rolling::RollingScene<f64>) -> Option<f64>,
+) -> Result<Option<SpeedReport>> {
+    if let Some(port) = &b.store_table {
+        let params = speed_range::rig_params(port)?;
+        let axis = SpeedAxis::of_rig(&params, scene)?;
+        let omega = axis.range_rad_s.map_or(0.0, |(lo, hi)| 0.5 * (lo + hi));
+        let rep = speed_range::report(scene, &axis, omega, mean_t);
+        let Some(table) = rep.table else {
+            bail!(
+                "no table to store: {}",
+                rep.why_not.unwrap_or_else(|| "no speed range".into())
+            );
+        };
+        speed_range::store(port, &table)?;
+        eprintln!(
+            "stored on {port}: T at {} bowl speeds from {:.3} to {:.3} rad/s (the rig's limits \
+             and RATIO_PPM); `rtime table MS` now uses it",
+            table.residence_s().len(),
+            table.speed_range_rad_s().0,
+            table.speed_range_rad_s().1
+        );
+        return Ok(Some(rep));
+    }
+    if !b.speed_range {
+        return Ok(None);
+    }
+    Ok(Some(match SpeedAxis::of_scene(scene) {
+        Ok((axis, omega)) => speed_range::report(scene, &axis, omega, mean_t),
+        // A bowl at rest: no speed to vary; the prediction itself stands.
+        Err(e) => SpeedReport {
+            table: None,
+            samples: Vec::new(),
+            slope_s2_per_rad: None,
+            why_not: Some(e.to_string()),
+        },
+    }))
 }
