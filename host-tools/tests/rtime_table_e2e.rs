@@ -137,3 +137,88 @@ fn at_ten_degrees_a_target_inside_is_set_and_one_outside_refused() {
     assert!(text.contains("at 10 deg tilt T is"), "{text}");
     assert!(text.contains("ask for a time in that range"), "{text}");
 }
+
+/// Between the table's eight speeds `bowl predict` checks the table against the model at each
+/// segment's midpoint and reports the worst error: checked here by running the model at those
+/// midpoints independently (docs/model.md §11 prints the figures: `cargo test -p host-tools
+/// --test rtime_table_e2e midpoint -- --nocapture`), on bare rims and flared walls from 5 to
+/// 60 degrees of tilt. Where T is smooth in speed the error is small; where the regime changes
+/// it is large, and the words say so.
+#[test]
+fn the_reported_midpoint_error_is_the_models_own() {
+    let scenes: [(&str, &str, &str, &[&str]); 7] = [
+        ("5", "1.0", "1.0", &[]),
+        ("10", "1.2", "-2.7", &[]),
+        ("20", "2.0", "1.0", &[]),
+        (
+            "30",
+            "1.0",
+            "1.0",
+            &["--wall-angle-deg", "60", "--wall-height-m", "0.02"],
+        ),
+        ("45", "1.2", "-2.7", &[]),
+        (
+            "60",
+            "1.2",
+            "-2.7",
+            &["--wall-angle-deg", "60", "--wall-height-m", "0.02"],
+        ),
+        ("60", "2.0", "2.0", &[]),
+    ];
+    for (tilt, w1, w2, wall) in scenes {
+        let mut args = scene(tilt, w1);
+        let at = args.iter().position(|a| a == "--spin-rad-s").unwrap();
+        args[at + 1] = w2.to_string();
+        args.extend(wall.iter().map(|s| s.to_string()));
+        let a: Vec<&str> = args.iter().map(String::as_str).collect();
+        let v = success_json(&bowl(&a), "bowl predict");
+        let table: Vec<(f64, f64)> = v["speed"]["table"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| {
+                (
+                    e["omega_rad_s"].as_f64().unwrap(),
+                    e["residence_time_s"].as_f64().unwrap(),
+                )
+            })
+            .collect();
+        // The asked bowl speed (Eq. 2 of the motors' magnitudes): motors scale with it.
+        let (p, s): (f64, f64) = (w1.parse().unwrap(), w2.parse().unwrap());
+        let th = tilt.parse::<f64>().unwrap().to_radians();
+        let omega = (p * p + s * s + 2.0 * p.abs() * s.abs() * th.cos()).sqrt();
+        let mut worst = 0.0f64;
+        for k in 0..table.len() - 1 {
+            let (wa, ta) = table[k];
+            let (wb, tb) = table[k + 1];
+            let wm = 0.5 * (wa + wb);
+            let mut at_m = args.clone();
+            let i = at_m.iter().position(|a| a == "--precession-rad-s").unwrap();
+            at_m[i + 1] = format!("{}", p * wm / omega);
+            let i = at_m.iter().position(|a| a == "--spin-rad-s").unwrap();
+            at_m[i + 1] = format!("{}", s * wm / omega);
+            at_m.extend(["--speed-range".to_string(), "false".to_string()]);
+            let a: Vec<&str> = at_m.iter().map(String::as_str).collect();
+            let t = success_json(&bowl(&a), "bowl predict at a midpoint")["residence_time_mean_s"]
+                .as_f64()
+                .unwrap();
+            worst = worst.max((0.5 * (ta + tb) - t).abs() / t);
+        }
+        let reported = v["speed"]["table_midpoint_error_max_rel"].as_f64().unwrap();
+        assert!(
+            (reported - worst).abs() <= 1e-9 * worst.max(1e-9),
+            "{reported} vs {worst}"
+        );
+        let words = v["speed"]["words"].as_str().unwrap();
+        assert_eq!(words.contains("is off by up to"), worst > 0.01, "{words}");
+        println!(
+            "tilt {tilt} deg, w1 {w1}, w2 {w2} {wall:?}: speeds {:.3}-{:.3} rad/s, T {:.4}-{:.4} s, \
+             worst midpoint interpolation error {:.4} %",
+            table[0].0,
+            table[7].0,
+            table.iter().map(|e| e.1).fold(f64::INFINITY, f64::min),
+            table.iter().map(|e| e.1).fold(0.0, f64::max),
+            100.0 * worst
+        );
+    }
+}

@@ -434,6 +434,7 @@ fn speed_report(
             samples: Vec::new(),
             slope_s2_per_rad: None,
             why_not: Some(e.to_string()),
+            midpoint_error: None,
         },
     }))
 }
