@@ -15,7 +15,9 @@ const MODELS: Choices<ModelChoice> = &[
     (
         "auto",
         "The chooser picks the least model the scene needs (the tolerance from --tolerance or \
-         --uncertainty) and says why",
+         --uncertainty) and says why; with the tilted bowl's flags (--precession-rad-s, \
+         --spin-rad-s, --axes-angle-deg or --rig-file) over the whole hierarchy: incline, \
+         rolling, rolling-or-sliding, bowl (--tolerance, default 0.01)",
         ModelChoice::Auto,
     ),
     (

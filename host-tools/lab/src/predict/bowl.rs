@@ -5,7 +5,7 @@
 use anyhow::{Result, bail};
 use model_core::ode::system::SystemLimits;
 use model_core::particle::bowl::{self, BowlError, BowlOutcome, BowlReport, BowlShape};
-use model_core::particle::rolling::{AZIMUTHS_DEG, MAX_STEPS, RollingMethod};
+use model_core::particle::rolling::{AZIMUTHS_DEG, MAX_STEPS, RollingMethod, RollingScene};
 use serde_json::{Value, json};
 
 use super::speed_range::{self, SpeedAxis, SpeedReport};
@@ -41,7 +41,7 @@ pub struct BowlInputs {
 }
 
 /// The wall flags with the rig file's `[bowl]` table (or the defaults) under them.
-struct Wall {
+pub(super) struct Wall {
     angle_deg: f64,
     height_m: f64,
     fillet_m: f64,
@@ -61,7 +61,7 @@ impl BowlInputs {
     }
 }
 
-fn words(e: BowlError) -> String {
+pub(super) fn words(e: BowlError) -> String {
     match e {
         BowlError::Scene(e) => rolling::words(e),
         BowlError::InvalidWallAngle => {
@@ -81,7 +81,7 @@ fn words(e: BowlError) -> String {
 }
 
 /// `all`, one azimuth or a comma-separated list, degrees.
-fn azimuths(text: &str) -> Result<Vec<f64>> {
+pub(super) fn azimuths(text: &str) -> Result<Vec<f64>> {
     if text.trim() == "all" {
         return Ok(AZIMUTHS_DEG.to_vec());
     }
@@ -136,57 +136,13 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
     if args.target_time_s.is_some() || args.batch.is_some() {
         bail!("--target-time-s and --batch are for the flat and Coriolis models, not the bowl");
     }
-    let table = match &b.rig_file {
-        Some(path) => {
-            let rigs = rig_file::load(path)?;
-            let Some(t) = rigs.first().and_then(|rig| rig.bowl) else {
-                bail!(
-                    "the rig file {} has no [bowl] table (its keys: docs/rigs/nominal.toml)",
-                    path.display()
-                );
-            };
-            Some(t)
-        }
-        None => None,
-    };
-    let (mut scene, th_deg) = r.scene(args, "bowl", table.map(|t| t.axes_angle_deg))?;
-    if let Some(t) = &table {
-        scene.rim_radius_m = t.rim_radius_m;
-        scene.particle_radius_m = t.particle_radius_m;
-        scene.validate().map_err(|e| {
-            anyhow::anyhow!("with the rig file's [bowl] table: {}", rolling::words(e))
-        })?;
-    }
-    let wall = b.wall(table.as_ref());
-    let method = match args.method {
-        MethodChoice::Closed | MethodChoice::Dp54 => RollingMethod::Dp54 { rtol: args.tol },
-        MethodChoice::Rk4 => RollingMethod::Rk4 {
-            step_s: args.step_s.unwrap_or(1e-4),
-        },
-        other => {
-            bail!("--method {other:?} is not offered for the bowl model: use dp54 (default) or rk4")
-        }
-    };
-    for (v, flag) in [
-        (wall.angle_deg, "--wall-angle-deg"),
-        (wall.height_m, "--wall-height-m"),
-        (wall.fillet_m, "--fillet-radius-m"),
-        (wall.restitution, "--restitution"),
-        (b.max_time_s, "--max-time-s"),
-    ] {
-        if !v.is_finite() {
-            bail!("{flag} must be a finite number, not {v}");
-        }
-    }
-    let shape = BowlShape {
-        wall_angle_rad: wall.angle_deg.to_radians(),
-        wall_height_m: wall.height_m,
-        fillet_radius_m: wall.fillet_m,
-        restitution: wall.restitution,
-    };
-    shape
-        .validate(&scene)
-        .map_err(|e| anyhow::anyhow!(words(e)))?;
+    let BowlSetup {
+        scene,
+        th_deg,
+        wall,
+        shape,
+        method,
+    } = scene_and_shape(args, r, b)?;
     let limits = SystemLimits {
         horizon_s: b.max_time_s,
         max_steps: MAX_STEPS,
@@ -252,9 +208,7 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
     };
     let evaluations: u64 = rows.iter().map(|(_, rep)| u64::from(rep.evaluations)).sum();
     // What speed can do: the same releases at other bowl speeds (docs/model.md §11).
-    let mean_t = |s: &model_core::particle::rolling::RollingScene<f64>| {
-        mean_time(s, &shape, &betas, method, limits)
-    };
+    let mean_t = |s: &RollingScene<f64>| mean_time(s, &shape, &betas, method, limits);
     let speed = speed_report(&scene, b, &mean_t)?;
     if args.json {
         let mut per: Vec<(f64, Value)> = rows
@@ -376,7 +330,7 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
 
 /// The mean residence time over the releases that leave (`None`: none leaves or one fails).
 fn mean_time(
-    scene: &model_core::particle::rolling::RollingScene<f64>,
+    scene: &RollingScene<f64>,
     shape: &BowlShape<f64>,
     betas: &[f64],
     method: RollingMethod<f64>,
@@ -398,9 +352,9 @@ fn mean_time(
 /// What speed can do at the flags' ratio and the default limits, and with `--store-table` at
 /// the rig's, stored there; `None` with `--speed-range false`.
 fn speed_report(
-    scene: &model_core::particle::rolling::RollingScene<f64>,
+    scene: &RollingScene<f64>,
     b: &BowlInputs,
-    mean_t: &dyn Fn(&model_core::particle::rolling::RollingScene<f64>) -> Option<f64>,
+    mean_t: &dyn Fn(&RollingScene<f64>) -> Option<f64>,
 ) -> Result<Option<SpeedReport>> {
     if let Some(port) = &b.store_table {
         let params = speed_range::rig_params(port)?;
@@ -437,4 +391,81 @@ fn speed_report(
             midpoint_error: None,
         },
     }))
+}
+
+/// The bowl model's scene, checked, as the flags and the rig file give it.
+pub(super) struct BowlSetup {
+    pub(super) scene: RollingScene<f64>,
+    /// The tilt, degrees.
+    pub(super) th_deg: f64,
+    pub(super) wall: Wall,
+    pub(super) shape: BowlShape<f64>,
+    pub(super) method: RollingMethod<f64>,
+}
+
+/// The bowl model's scene, tilt (degrees), wall, shape and method from the flags and the rig
+/// file's `[bowl]` table, checked (also the whole-hierarchy chooser's, `--model auto`).
+pub(super) fn scene_and_shape(
+    args: &Inputs,
+    r: &rolling::RollingInputs,
+    b: &BowlInputs,
+) -> Result<BowlSetup> {
+    let table = match &b.rig_file {
+        Some(path) => {
+            let rigs = rig_file::load(path)?;
+            let Some(t) = rigs.first().and_then(|rig| rig.bowl) else {
+                bail!(
+                    "the rig file {} has no [bowl] table (its keys: docs/rigs/nominal.toml)",
+                    path.display()
+                );
+            };
+            Some(t)
+        }
+        None => None,
+    };
+    let (mut scene, th_deg) = r.scene(args, "bowl", table.map(|t| t.axes_angle_deg))?;
+    if let Some(t) = &table {
+        scene.rim_radius_m = t.rim_radius_m;
+        scene.particle_radius_m = t.particle_radius_m;
+        scene.validate().map_err(|e| {
+            anyhow::anyhow!("with the rig file's [bowl] table: {}", rolling::words(e))
+        })?;
+    }
+    let wall = b.wall(table.as_ref());
+    let method = match args.method {
+        MethodChoice::Closed | MethodChoice::Dp54 => RollingMethod::Dp54 { rtol: args.tol },
+        MethodChoice::Rk4 => RollingMethod::Rk4 {
+            step_s: args.step_s.unwrap_or(1e-4),
+        },
+        other => {
+            bail!("--method {other:?} is not offered for the bowl model: use dp54 (default) or rk4")
+        }
+    };
+    for (v, flag) in [
+        (wall.angle_deg, "--wall-angle-deg"),
+        (wall.height_m, "--wall-height-m"),
+        (wall.fillet_m, "--fillet-radius-m"),
+        (wall.restitution, "--restitution"),
+        (b.max_time_s, "--max-time-s"),
+    ] {
+        if !v.is_finite() {
+            bail!("{flag} must be a finite number, not {v}");
+        }
+    }
+    let shape = BowlShape {
+        wall_angle_rad: wall.angle_deg.to_radians(),
+        wall_height_m: wall.height_m,
+        fillet_radius_m: wall.fillet_m,
+        restitution: wall.restitution,
+    };
+    shape
+        .validate(&scene)
+        .map_err(|e| anyhow::anyhow!(words(e)))?;
+    Ok(BowlSetup {
+        scene,
+        th_deg,
+        wall,
+        shape,
+        method,
+    })
 }
