@@ -142,8 +142,24 @@ pub(crate) fn run_level(
                     ..*shape
                 }
             };
+            // Near the stick threshold the slide/roll switch can chatter at a loose tolerance
+            // (and, erratically, at some tight ones): a release that takes 200 000 steps is
+            // run again at rtol 1e-10, which gets through where the loose one did not.
+            let quick = SystemLimits {
+                max_steps: limits.max_steps.min(200_000),
+                ..limits
+            };
+            let tight = RollingMethod::Dp54 { rtol: 1e-10 };
             for &deg in betas {
-                match bowl::residence(scene, &shape, deg.to_radians(), method, limits) {
+                let b = deg.to_radians();
+                let first = bowl::residence(scene, &shape, b, method, quick);
+                let rep = match first {
+                    Err(bowl::BowlError::Scene(rolling::RollingError::Integration(_))) => {
+                        bowl::residence(scene, &shape, b, tight, limits)
+                    }
+                    other => other,
+                };
+                match rep {
                     Ok(rep) => match rep.outcome {
                         BowlOutcome::Leaves {
                             residence_time_s, ..
