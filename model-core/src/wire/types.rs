@@ -78,6 +78,9 @@ pub enum ResidenceModel {
     Flat,
     /// With the Coriolis friction term (paper Eq. 9-11, coefficients corrected). Token `CORI`.
     Coriolis,
+    /// The residence-time table the PC computed with the model chosen for the rig's bowl, tilt
+    /// and granule and stored in the `RT_*` parameters (docs/model.md §11). Token `TABLE`.
+    Table,
 }
 
 /// A predicted residence time as sent in telemetry.
@@ -260,7 +263,8 @@ pub enum Reason {
     /// Not allowed in the current state (for instance START while faulted). Token `STATE`.
     State,
     /// The target cannot be reached (for instance a residence time the bowl cannot produce
-    /// within the speed limit, or a particle that never leaves). Token `INFEASIBLE`.
+    /// within the speed limit, a particle that never leaves, a residence-time table that speed
+    /// barely moves, or no table stored for `RTIME TABLE`). Token `INFEASIBLE`.
     Infeasible,
     /// This device does not do that (fault injection on real hardware). Token `UNSUPPORTED`.
     Unsupported,
@@ -348,10 +352,14 @@ code_enum!(ResetCause {
 
 impl ResidenceModel {
     /// Every model, in the order of [`ResidenceModel::TOKENS`].
-    pub const ALL: [ResidenceModel; 2] = [ResidenceModel::Flat, ResidenceModel::Coriolis];
+    pub const ALL: [ResidenceModel; 3] = [
+        ResidenceModel::Flat,
+        ResidenceModel::Coriolis,
+        ResidenceModel::Table,
+    ];
 
     /// The wire tokens, in the order of [`ResidenceModel::ALL`].
-    pub const TOKENS: [&'static str; 2] = ["FLAT", "CORI"];
+    pub const TOKENS: [&'static str; 3] = ["FLAT", "CORI", "TABLE"];
 
     /// The wire token.
     pub fn token(self) -> &'static str {
