@@ -7,7 +7,7 @@ use model_core::wire::{DeviceState, FaultCode, ResetCause};
 use rig_client::words::{fault, fault_token, reset_cause, reset_cause_token, state, state_token};
 use virtual_rig::controller_words::{config, rejection};
 
-const FAULTS: [FaultCode; 7] = [
+const FAULTS: [FaultCode; 15] = [
     FaultCode::None,
     FaultCode::SensorLostOrStallPrecession,
     FaultCode::SensorLostOrStallSpin,
@@ -15,6 +15,14 @@ const FAULTS: [FaultCode; 7] = [
     FaultCode::OverspeedSpin,
     FaultCode::HostSilent,
     FaultCode::InvalidConfiguration,
+    FaultCode::SensorLostPrecession,
+    FaultCode::SensorLostSpin,
+    FaultCode::StallPrecession,
+    FaultCode::StallSpin,
+    FaultCode::OverCurrentPrecession,
+    FaultCode::OverCurrentSpin,
+    FaultCode::CurrentAboveModelPrecession,
+    FaultCode::CurrentAboveModelSpin,
 ];
 
 /// No word is a Rust name (no CamelCase run of two capitals).
@@ -31,6 +39,8 @@ fn plain_words_only() {
         })
     };
     assert!(camel("state SpinningUp") && !camel("10 kHz"));
+    // Every wire code is listed.
+    assert_eq!(FaultCode::from_code(FAULTS.len() as i64), None);
     for f in FAULTS {
         assert!(!camel(fault(f)), "{f:?}");
     }
