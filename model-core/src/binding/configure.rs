@@ -12,7 +12,9 @@
 //!   over-speed fault limit follows at [`OVERSPEED_PER_MAX`] times it), `ACCELn_MRAD_S2`
 //!   `accel_limit_rad_s2`, `DUTY_MAXn_BP` `duty_limit`, `TEETHn` `pulses_per_rev` (these only
 //!   while idle or faulted);
-//! - `TELEM_HZ`: the protocol device's telemetry rate (the device owns it).
+//! - `TELEM_HZ`: the protocol device's telemetry rate (the device owns it);
+//! - `CUR_SENSE`: whether the board passes its current samples to the controller (idle or
+//!   faulted: the current watch learns its offset at zero duty).
 
 use super::AXES;
 use crate::Real;
@@ -62,6 +64,8 @@ pub enum ParamRole {
     TelemetryRate,
     /// The host link silence timeout: rebuilds the controller (idle or faulted).
     LinkTimeout,
+    /// Whether the board's current samples reach the controller (idle or faulted).
+    CurrentSense,
 }
 
 impl ParamRole {
@@ -87,6 +91,7 @@ impl ParamRole {
             P::Teeth2 => ParamRole::Axis(1, S::PulsesPerRev),
             P::TelemetryHz => ParamRole::TelemetryRate,
             P::LinkTimeoutMs => ParamRole::LinkTimeout,
+            P::CurrentSense => ParamRole::CurrentSense,
         }
     }
 }
@@ -140,7 +145,7 @@ pub fn config_from_params(
     for id in ParamId::ALL {
         let value = params[id.index()];
         match ParamRole::of(id) {
-            ParamRole::Scene | ParamRole::TelemetryRate => {}
+            ParamRole::Scene | ParamRole::TelemetryRate | ParamRole::CurrentSense => {}
             ParamRole::AxesAngle => cfg.axes_angle_rad = (value as f32 * 1e-3).to_radians(),
             ParamRole::SplitRatio => cfg.spin_per_precession = value as f32 * 1e-6,
             ParamRole::LinkTimeout => cfg.host_timeout_s = value as f32 / 1000.0,

@@ -116,6 +116,10 @@ parameter_table! {
     /// Host link silence (no command, PING included) after which a driving rig faults and
     /// stops both motors; 0 disables the check. Host tools PING every second.
     LinkTimeoutMs: "LINK_TIMEOUT_MS", "ms", range (0, 3_600_000), default 3_000;
+    /// The board measures the motor currents (docs/wiring.md: a current-sense amplifier on each
+    /// motor lead into the ADC): 1 turns on the current trips (over-current, a bridge driving
+    /// harder than told, the supply cut) and tells a stall from a dead sensor; 0 = pulses only.
+    CurrentSense: "CUR_SENSE", "0/1", range (0, 1), default 0;
 }
 
 /// The values of all parameters, indexed by [`ParamId::index`].
