@@ -219,6 +219,8 @@ mod tests {
             // The rig's link-loss timeout is on (3 s) by default; the controller's own
             // default is off so the closed-loop simulations need no heartbeat.
             3_000,
+            // Pulses only until the board is said to measure its currents.
+            0,
         ];
         assert_eq!(default_params(), expected);
         let derived = config_from_params(&cfg, &default_params()).expect("defaults pass");
