@@ -1,7 +1,7 @@
 """STM32F411 ADC1 (RM0383 section 11), as much as the motor-current sampling uses: the injected
 group (JSQR: up to four channels, results in JDR1..), its hardware trigger from TIM1's TRGO or
-CC4 (JEXTSEL 1 / 0, JEXTEN), the analog watchdog on the injected channels (JAWDEN, HTR/LTR,
-AWD flag, AWDIE -> the ADC interrupt) and the flags' rc_w0 clearing.
+CC4 (JEXTSEL 1 / 0, JEXTEN), the end-of-conversion flag and interrupt (JEOC, JEOCIE) and the
+flags' rc_w0 clearing.
 
 What a channel reads comes from `inputs`: channel -> a function returning the pin's voltage at
 the moment (the board wires PB0/PB1 = IN8/IN9 to the current-sense amplifiers of the plant).
@@ -17,9 +17,9 @@ SR, CR1, CR2, SMPR1, SMPR2 = 0x00, 0x04, 0x08, 0x0C, 0x10
 HTR, LTR, SQR1, SQR2, SQR3, JSQR = 0x24, 0x28, 0x2C, 0x30, 0x34, 0x38
 JDR_BASE, DR = 0x3C, 0x4C
 # SR flags.
-AWD, EOC, JEOC, JSTRT = 1 << 0, 1 << 1, 1 << 2, 1 << 3
+JEOC, JSTRT = 1 << 2, 1 << 3
 # CR1 bits.
-AWDIE, JEOCIE, SCAN, AWDSGL, JAWDEN = 1 << 6, 1 << 7, 1 << 8, 1 << 9, 1 << 22
+JEOCIE = 1 << 7
 # CR2 bits.
 ADON, JSWSTART = 1 << 0, 1 << 22
 VREF_V = 3.3
@@ -39,9 +39,6 @@ class Adc(QlPeripheral):
         # channel -> callable returning volts (unconnected channels read 0 V).
         self.inputs = {}
         self.conversions = 0
-        # Each analog-watchdog trip: (time ns, channel, counts).
-        self.awd_trips = []
-        self.now_ns = lambda: 0
 
     # --- the injected group -------------------------------------------------------------
     def injected_channels(self):
@@ -67,18 +64,9 @@ class Adc(QlPeripheral):
         return max(0, min(FULL_SCALE, round(volts / VREF_V * FULL_SCALE)))
 
     def convert(self):
-        """One injected sequence now: results, JEOC, and the analog watchdog."""
-        cr1 = self.regs[CR1]
-        awd_single = cr1 & AWDSGL
-        awd_channel = cr1 & 0x1F
+        """One injected sequence now: the results and JEOC."""
         for k, ch in enumerate(self.injected_channels()):
-            v = self.counts(ch)
-            self.jdr[k] = v
-            watched = cr1 & JAWDEN and (not awd_single or ch == awd_channel)
-            if watched and (v > self.regs[HTR] or v < self.regs[LTR]):
-                if not self.regs[SR] & AWD:
-                    self.awd_trips.append((self.now_ns(), ch, v))
-                self.regs[SR] |= AWD
+            self.jdr[k] = self.counts(ch)
         self.regs[SR] |= JEOC | JSTRT
         self.conversions += 1
 
@@ -87,8 +75,7 @@ class Adc(QlPeripheral):
             self.convert()
 
     def irq_level(self) -> bool:
-        sr, cr1 = self.regs[SR], self.regs[CR1]
-        return bool((sr & AWD and cr1 & AWDIE) or (sr & JEOC and cr1 & JEOCIE))
+        return bool(self.regs[SR] & JEOC and self.regs[CR1] & JEOCIE)
 
     # --- registers ----------------------------------------------------------------------
     def read(self, offset: int, size: int) -> int:

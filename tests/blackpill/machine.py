@@ -130,7 +130,6 @@ class Board:
         self.exti = add("exti", Exti(ql, "exti", ql.hw.syscfg), 0x4001_3C00)
         self.adc1 = add("adc1", Adc(ql, "adc1", self.tim1), 0x4001_2000)
         self.adc_common = add("adc_common", AdcCommon(ql, "adc_common"), 0x4001_2300)
-        self.adc1.now_ns = lambda: m.now_ns
         for axis, channel in enumerate(SENSE_CHANNELS):
             self.adc1.inputs[channel] = lambda a=axis: self.sense_volts(a)
         self.timers = (self.tim1, self.tim2, self.tim5)

@@ -36,9 +36,16 @@ pub const SUPERVISOR_PERIOD: Duration = Duration::from_millis(20);
 /// What the tasks need from the controller and the protocol. The binding to
 /// `model_core::control` and `model_core::wire` implements it.
 pub trait TaskCore {
-    /// One control tick: the edges since the previous tick (oldest first) and the capture
-    /// clock read after draining them. Returns the duties (-1..=1, 0 = off).
-    fn control_tick(&mut self, now_ticks: u32, edges: [&[u32]; AXES]) -> [f32; AXES];
+    /// One control tick: the edges since the previous tick (oldest first), the capture clock
+    /// read after draining them, and the motor currents the board sampled (None where it has
+    /// none; used only where the parameters say the board measures them). Returns the duties
+    /// (-1..=1, 0 = off).
+    fn control_tick(
+        &mut self,
+        now_ticks: u32,
+        edges: [&[u32]; AXES],
+        currents_a: [Option<f32>; AXES],
+    ) -> [f32; AXES];
     /// Whether a fault is latched (the motors are then kept off whatever the duties say).
     fn faulted(&self) -> bool;
     /// The board's hardware stop tripped: latch its fault (kept if another came first).
@@ -137,10 +144,11 @@ pub async fn control<RM: RawMutex, C: TaskCore, M: MotorOutput, K: CaptureClock,
         let now = clock.now_ticks();
         let dropped = [queues[0].dropped(), queues[1].dropped()];
         let tripped = power.stop_tripped();
+        let currents = power.currents_a();
         let (duties, faulted, cut) = core.lock(|c| {
             let mut c = c.borrow_mut();
             c.set_dropped_edges(dropped);
-            let d = c.control_tick(now, [&buffers[0], &buffers[1]]);
+            let d = c.control_tick(now, [&buffers[0], &buffers[1]], currents);
             if tripped {
                 c.hardware_stop();
             }

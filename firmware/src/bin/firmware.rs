@@ -43,6 +43,7 @@ use firmware::app::slot::Slot;
 use firmware::app::tasks::{self, Heartbeat, SharedCore};
 use firmware::blackpill::capture::{self, Tim2Clock};
 use firmware::blackpill::clocks::{self, ClockSource};
+use firmware::blackpill::current_sense;
 use firmware::blackpill::flash_region::ParamSector;
 use firmware::blackpill::gates::{self, BoardGates, ReleaseButton};
 use firmware::blackpill::motor_pwm::{self, PWM_HZ, PwmMotor};
@@ -127,9 +128,10 @@ async fn main(spawner: Spawner) {
         ),
     ]);
     motors.all_off();
-    // The hardware stop on PA6 and the motor supply switch on PB14 (open until the control
-    // task runs).
-    let power = power_stage::start(p.PA6, Output::new(p.PB14, Level::Low, Speed::Low));
+    // The hardware stop on PA6, the motor supply switch on PB14 (open until the control task
+    // runs) and the motor currents on PB0/PB1 (used once CUR_SENSE says the board has them).
+    let currents = current_sense::start(p.PB0, p.PB1);
+    let power = power_stage::start(p.PA6, Output::new(p.PB14, Level::Low, Speed::Low), currents);
     let solenoid = Output::new(p.PB5, Level::Low, Speed::Low);
     let capture = capture::start(p.TIM2, p.PA15, p.PB3, p.PB10);
     let button = gates::start_button(p.PA0, p.EXTI0);

@@ -6,17 +6,12 @@
 //! 12 V and 20 kHz, d = 0.5: far below the sense chain's own offset).
 //!
 //! The results stay in JDR1/JDR2 until the next conversion; the control tick reads the latest
-//! (no DMA, no interrupt per sample). ADC1's analog watchdog watches both injected channels
-//! against a window set by [`AdcCurrents::arm_trip`]: a sample outside it raises the ADC
-//! interrupt, which switches the PWM off at once ([`super::motor_pwm::emergency_off`]) and
-//! leaves the flag for the control tick to latch the fault: within one PWM period of the sample,
-//! the firmware's own version of the over-current comparator on the break input.
-
-use core::sync::atomic::{AtomicBool, Ordering};
+//! (no DMA, no interrupt per sample) and the controller checks every one it gets (the current
+//! trips, `model_core::control::supervisor`): a fault on the current is latched at the first
+//! tick after it, within 1 ms. The stop that does not wait for the CPU is the comparator on the
+//! break input ([`super::power_stage`]).
 
 use embassy_stm32::Peri;
-use embassy_stm32::interrupt;
-use embassy_stm32::interrupt::InterruptExt;
 use embassy_stm32::pac::adc::vals::{Exten, SampleTime};
 use embassy_stm32::pac::adccommon::vals::Adcpre;
 use embassy_stm32::pac::gpio::vals::Moder;
@@ -35,9 +30,6 @@ const CHANNELS: [u8; 2] = [8, 9];
 /// JEXTSEL for TIM1_TRGO (RM0383, ADC external trigger for injected channels).
 const JEXTSEL_TIM1_TRGO: u8 = 1;
 
-/// Set by the ADC interrupt when a sample left the trip window; taken by the control tick.
-static TRIPPED: AtomicBool = AtomicBool::new(false);
-
 /// ADC1 sampling both motor currents with the PWM.
 pub struct AdcCurrents {
     _pins: (Peri<'static, PB0>, Peri<'static, PB1>),
@@ -48,21 +40,8 @@ fn volts(counts: u16) -> f32 {
     f32::from(counts) * (VREF_V / FULL_SCALE)
 }
 
-/// The ADC count the amplifier gives for `current_a`, clamped to the converter's range.
-fn counts_for(current_a: f32) -> u16 {
-    let v = ZERO_V + V_PER_A * current_a;
-    let c = v * (FULL_SCALE / VREF_V) + 0.5;
-    if c.is_nan() || c <= 0.0 {
-        0
-    } else if c >= FULL_SCALE {
-        FULL_SCALE as u16
-    } else {
-        c as u16
-    }
-}
-
 /// Configures PB0/PB1 as analog inputs and ADC1's injected group on TIM1's update (after the PWM
-/// timer is set up); the trip window stays open (nothing trips) until [`AdcCurrents::arm_trip`].
+/// timer is set up).
 pub fn start(pb0: Peri<'static, PB0>, pb1: Peri<'static, PB1>) -> AdcCurrents {
     let pac = embassy_stm32::pac::RCC;
     pac.apb2enr().modify(|w| w.set_adc1en(true));
@@ -87,13 +66,7 @@ pub fn start(pb0: Peri<'static, PB0>, pb1: Peri<'static, PB1>) -> AdcCurrents {
         w.set_jsq(2, CHANNELS[0]);
         w.set_jsq(3, CHANNELS[1]);
     });
-    // Both channels watched (AWDSGL = 0), on the injected group only; window wide open.
-    adc.htr().write(|w| w.set_ht(0xFFF));
-    adc.ltr().write(|w| w.set_lt(0));
-    adc.cr1().write(|w| {
-        w.set_scan(true);
-        w.set_jawden(true);
-    });
+    adc.cr1().write(|w| w.set_scan(true));
     adc.cr2().write(|w| {
         w.set_adon(true);
         w.set_jextsel(JEXTSEL_TIM1_TRGO);
@@ -113,43 +86,4 @@ impl AdcCurrents {
         let adc = embassy_stm32::pac::ADC1;
         [0, 1].map(|k| (volts(adc.jdr(k).read().jdata()) - ZERO_V) / V_PER_A)
     }
-
-    /// Arms the trip: a sample beyond `limit_a` either way (as the amplifier reads it) raises
-    /// the ADC interrupt, which switches the PWM off. A limit that is not finite or positive
-    /// disarms it.
-    pub fn arm_trip(&mut self, limit_a: f32) {
-        let adc = embassy_stm32::pac::ADC1;
-        if !(limit_a.is_finite() && limit_a > 0.0) {
-            adc.cr1().modify(|w| w.set_awdie(false));
-            interrupt::ADC.disable();
-            return;
-        }
-        adc.htr().write(|w| w.set_ht(counts_for(limit_a)));
-        adc.ltr().write(|w| w.set_lt(counts_for(-limit_a)));
-        let mut keep = embassy_stm32::pac::adc::regs::Sr(0xFFFF_FFFF);
-        keep.set_awd(false);
-        adc.sr().write_value(keep);
-        adc.cr1().modify(|w| w.set_awdie(true));
-        interrupt::ADC.unpend();
-        // SAFETY: the handler below only writes TIM1's and ADC1's registers and an atomic.
-        unsafe { interrupt::ADC.enable() };
-    }
-
-    /// Whether a sample left the trip window since the last call.
-    pub fn take_trip(&mut self) -> bool {
-        TRIPPED.swap(false, Ordering::AcqRel)
-    }
-}
-
-#[interrupt]
-fn ADC() {
-    // The motors first: the same raw-register stop as the fault and panic paths.
-    super::motor_pwm::emergency_off();
-    let adc = embassy_stm32::pac::ADC1;
-    // No second interrupt for the same trip: the control tick re-arms after CLEAR.
-    adc.cr1().modify(|w| w.set_awdie(false));
-    let mut keep = embassy_stm32::pac::adc::regs::Sr(0xFFFF_FFFF);
-    keep.set_awd(false);
-    adc.sr().write_value(keep);
-    TRIPPED.store(true, Ordering::Release);
 }

@@ -22,6 +22,7 @@ use embassy_stm32::pac::gpio::vals::{Moder, Pupdr};
 use embassy_stm32::pac::timer::vals::Bkp;
 use embassy_stm32::peripherals::PA6;
 
+use super::current_sense::AdcCurrents;
 use crate::app::hal::PowerStage;
 
 /// The break pin's number on GPIOA, and its alternate function (TIM1_BKIN).
@@ -30,16 +31,22 @@ const AF_TIM1: u8 = 1;
 /// The supply enable's pin number on GPIOB.
 const SUPPLY_PIN: usize = 14;
 
-/// The break input (owned: nothing else may reconfigure PA6) and the supply switch.
+/// The break input (owned: nothing else may reconfigure PA6), the supply switch and the
+/// motor currents.
 pub struct BoardPowerStage {
     _bkin: Peri<'static, PA6>,
     supply: Output<'static>,
+    currents: AdcCurrents,
 }
 
 /// Configures PA6 as TIM1_BKIN (active low, pull-up) and enables the break on TIM1, after the
 /// PWM outputs exist (their off state must already be the driven one: OSSI = 1). `supply` is
 /// PB14 set up low (open); [`PowerStage::set_supply`] closes it once the control task runs.
-pub fn start(bkin: Peri<'static, PA6>, supply: Output<'static>) -> BoardPowerStage {
+pub fn start(
+    bkin: Peri<'static, PA6>,
+    supply: Output<'static>,
+    currents: AdcCurrents,
+) -> BoardPowerStage {
     let gpioa = embassy_stm32::pac::GPIOA;
     // Pull-up and alternate function before the mode: the pin never reads low on the way.
     gpioa
@@ -60,10 +67,15 @@ pub fn start(bkin: Peri<'static, PA6>, supply: Output<'static>) -> BoardPowerSta
     BoardPowerStage {
         _bkin: bkin,
         supply,
+        currents,
     }
 }
 
 impl PowerStage for BoardPowerStage {
+    fn currents_a(&mut self) -> [Option<f32>; 2] {
+        self.currents.currents_a().map(Some)
+    }
+
     fn stop_tripped(&mut self) -> bool {
         let tim1 = embassy_stm32::pac::TIM1;
         let flagged = tim1.sr().read().bif(0);

@@ -87,6 +87,14 @@ fn fault_code(f: Option<Fault>) -> FaultCode {
         Some(Fault::Overspeed(_)) => FaultCode::OverspeedSpin,
         Some(Fault::HostSilent) => FaultCode::HostSilent,
         Some(Fault::InvalidConfiguration) => FaultCode::InvalidConfiguration,
+        Some(Fault::SensorLost(0)) => FaultCode::SensorLostPrecession,
+        Some(Fault::SensorLost(_)) => FaultCode::SensorLostSpin,
+        Some(Fault::Stall(0)) => FaultCode::StallPrecession,
+        Some(Fault::Stall(_)) => FaultCode::StallSpin,
+        Some(Fault::OverCurrent(0)) => FaultCode::OverCurrentPrecession,
+        Some(Fault::OverCurrent(_)) => FaultCode::OverCurrentSpin,
+        Some(Fault::CurrentAboveModel(0)) => FaultCode::CurrentAboveModelPrecession,
+        Some(Fault::CurrentAboveModel(_)) => FaultCode::CurrentAboveModelSpin,
         Some(Fault::HardwareStop) => FaultCode::HardwareStop,
     }
 }
@@ -373,6 +381,7 @@ impl<I: Injector> Backend for ControllerBackend<I> {
             ParamRole::AxesAngle
             | ParamRole::SplitRatio
             | ParamRole::LinkTimeout
+            | ParamRole::CurrentSense
             | ParamRole::Axis(..) => self.ctrl.set_parameters(cfg).map_err(reason)?,
         }
         self.scene = scene;

@@ -15,6 +15,8 @@
 //! - `TELEM_HZ`: the protocol device's telemetry rate (the device owns it);
 //! - `RT_W_LO_MRAD_S`, `RT_W_HI_MRAD_S`, `RT_T1_US`..`RT_T8_US`: the residence-time table the PC
 //!   computed with the chosen model ([`table_from_params`], `RTIME TABLE`), any time.
+//! - `CUR_SENSE`: whether the board passes its current samples to the controller (idle or
+//!   faulted: the current watch learns its offset at zero duty).
 
 use super::AXES;
 use crate::Real;
@@ -67,6 +69,8 @@ pub enum ParamRole {
     LinkTimeout,
     /// The residence-time table (`RTIME TABLE`): like the scene, any time.
     ResidenceTable,
+    /// Whether the board's current samples reach the controller (idle or faulted).
+    CurrentSense,
 }
 
 impl ParamRole {
@@ -102,6 +106,7 @@ impl ParamRole {
             | P::RtTime6Us
             | P::RtTime7Us
             | P::RtTime8Us => ParamRole::ResidenceTable,
+            P::CurrentSense => ParamRole::CurrentSense,
         }
     }
 }
@@ -155,7 +160,10 @@ pub fn config_from_params(
     for id in ParamId::ALL {
         let value = params[id.index()];
         match ParamRole::of(id) {
-            ParamRole::Scene | ParamRole::TelemetryRate | ParamRole::ResidenceTable => {}
+            ParamRole::Scene
+            | ParamRole::TelemetryRate
+            | ParamRole::ResidenceTable
+            | ParamRole::CurrentSense => {}
             ParamRole::AxesAngle => cfg.axes_angle_rad = (value as f32 * 1e-3).to_radians(),
             ParamRole::SplitRatio => cfg.spin_per_precession = value as f32 * 1e-6,
             ParamRole::LinkTimeout => cfg.host_timeout_s = value as f32 / 1000.0,
@@ -292,6 +300,8 @@ mod tests {
             0,
             0,
             0,
+            0,
+            // Pulses only until the board is said to measure its currents.
             0,
         ];
         assert_eq!(default_params(), expected);

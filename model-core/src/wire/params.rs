@@ -138,6 +138,10 @@ parameter_table! {
     RtTime7Us: "RT_T7_US", "us", range (0, 8_000_000), default 0;
     /// The table's residence time at its fastest speed (entry 8 of 8).
     RtTime8Us: "RT_T8_US", "us", range (0, 8_000_000), default 0;
+    /// The board measures the motor currents (docs/wiring.md: a current-sense amplifier on each
+    /// motor lead into the ADC): 1 turns on the current trips (over-current, a bridge driving
+    /// harder than told, the supply cut) and tells a stall from a dead sensor; 0 = pulses only.
+    CurrentSense: "CUR_SENSE", "0/1", range (0, 1), default 0;
 }
 
 /// The values of all parameters, indexed by [`ParamId::index`].

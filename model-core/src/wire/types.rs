@@ -45,9 +45,27 @@ pub enum FaultCode {
     HostSilent = 5,
     /// The configuration is invalid, or commissioning failed.
     InvalidConfiguration = 6,
+    /// Precession: no pulse, and the current shows a turning shaft (sensor dead).
+    SensorLostPrecession = 7,
+    /// Spin: no pulse, and the current shows a turning shaft (sensor dead).
+    SensorLostSpin = 8,
+    /// Precession: no pulse, and the current shows no back-EMF (shaft blocked).
+    StallPrecession = 9,
+    /// Spin: no pulse, and the current shows no back-EMF (shaft blocked).
+    StallSpin = 10,
+    /// Precession: current above the over-current limit.
+    OverCurrentPrecession = 11,
+    /// Spin: current above the over-current limit.
+    OverCurrentSpin = 12,
+    /// Precession: more current than the duty drives at the measured speed (a bridge stuck on
+    /// or shorted).
+    CurrentAboveModelPrecession = 13,
+    /// Spin: more current than the duty drives at the measured speed (a bridge stuck on or
+    /// shorted).
+    CurrentAboveModelSpin = 14,
     /// The board's hardware stop (break input: over-current comparator or driver fault) cut the
     /// PWM; the motor supply is cut too where the board has the switch.
-    HardwareStop = 7,
+    HardwareStop = 15,
 }
 
 /// What caused the last reset of the microcontroller (STM32 RCC_CSR flags).
@@ -337,6 +355,14 @@ code_enum!(FaultCode {
     OverspeedSpin,
     HostSilent,
     InvalidConfiguration,
+    SensorLostPrecession,
+    SensorLostSpin,
+    StallPrecession,
+    StallSpin,
+    OverCurrentPrecession,
+    OverCurrentSpin,
+    CurrentAboveModelPrecession,
+    CurrentAboveModelSpin,
     HardwareStop,
 });
 code_enum!(GateKind { Release, Exit });

@@ -219,6 +219,14 @@ fn state_and_fault_names_keep_the_controller_codes() {
         Fault::Overspeed(1),
         Fault::HostSilent,
         Fault::InvalidConfiguration,
+        Fault::SensorLost(0),
+        Fault::SensorLost(1),
+        Fault::Stall(0),
+        Fault::Stall(1),
+        Fault::OverCurrent(0),
+        Fault::OverCurrent(1),
+        Fault::CurrentAboveModel(0),
+        Fault::CurrentAboveModel(1),
     ] {
         assert_eq!(fault_code(Some(fault)).code(), fault.code(), "{fault:?}");
     }
