@@ -45,13 +45,22 @@ def test_boot_says_hello_and_reports_power_on():
         s.close()
 
 
+def documented_parameters() -> list:
+    """The parameter names of docs/protocol.md's table, in its order."""
+    with open(os.path.join(ROOT, "docs", "protocol.md")) as f:
+        return re.findall(r"^\| \d+ \| `([A-Z0-9_]+)` \|", f.read(), flags=re.M)
+
+
 def test_every_command_and_its_refusals():
     s = Session(fresh_flash("commands"))
     try:
         s.wait_until_s(0.3)
         p = s.params()
-        check(len(p) == 20 and p["TEETH1"] == 12 and p["SPEED_MAX1_MRAD_S"] == 4000
-              and p["LINK_TIMEOUT_MS"] == 3000,
+        # Every parameter docs/protocol.md's table lists (model-core/tests/wire_doc.rs holds
+        # that table to the code), in its order.
+        check(list(p) == documented_parameters() and p["TEETH1"] == 12
+              and p["SPEED_MAX1_MRAD_S"] == 4000 and p["LINK_TIMEOUT_MS"] == 3000
+              and p["CUR_SENSE"] == 0,
               f"PARAMS: {p}")
         check(s.bowl("set", "TEETH1", "24").startswith("ok"), "SET TEETH1 24 refused")
         check(s.params()["TEETH1"] == 24, "PARAMS does not show TEETH1 24 after SET")
