@@ -59,7 +59,9 @@
 //!
 //! Both only start a shaft from rest: once the loop has seen it move, a shaft that goes quiet is
 //! not pushed (a dead sensor on a turning shaft would otherwise run it away before the
-//! supervisor's expected-edge watch faults it).
+//! supervisor's expected-edge watch faults it). "From rest" is the loop's view: no window closed
+//! since the loop started, whatever edge the estimator still holds from before (a restart after
+//! a fault or a zero reference, see `rest` in [`SpeedLoop::step`]).
 
 use super::config::AxisConfig;
 use super::estimator::WindowEvents;
