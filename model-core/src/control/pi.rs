@@ -59,7 +59,9 @@
 //!
 //! Both only start a shaft from rest: once the loop has seen it move, a shaft that goes quiet is
 //! not pushed (a dead sensor on a turning shaft would otherwise run it away before the
-//! supervisor's expected-edge watch faults it).
+//! supervisor's expected-edge watch faults it). "From rest" is the loop's view: no window closed
+//! since the loop started, whatever edge the estimator still holds from before (a restart after
+//! a fault or a zero reference, see `rest` in [`SpeedLoop::step`]).
 
 use super::config::AxisConfig;
 use super::estimator::WindowEvents;
@@ -375,20 +377,31 @@ impl SpeedLoop {
         // integral (the loop corrects the rest either way), so a loaded shaft at low speed does
         // not stick again at once. (The first measurement after a crawl reads the load itself,
         // above.)
-        let first_edge = !input.at_rest && !self.moved;
+        //
+        // "From rest" is the loop's view: no window closed since the loop started. A shaft let
+        // go by a fault, a STOP or a zero reference may have stopped between two edges while
+        // the estimator, which calls it stopped only after two pitches at the lowest speed
+        // (8 s at 12 pulses a revolution), still holds the edge from before: its reading is
+        // then only the stall bound, an upper bound from an old edge. Restarted from there, it
+        // got no kick and no push, and the loop integrated the model against that bound until
+        // the first edge came (up to a pitch of travel later): 13 to 31 % overshoot at 2 rad/s
+        // on the nominal rig and the seeded family, a false runaway fault on the emulated Black
+        // Pill (issue 27). It starts like a shaft at rest instead.
+        let rest = input.at_rest || !self.window_open;
+        let first_edge = !rest && !self.moved;
         if first_edge {
             self.integral += PUSH_KEPT * self.push.max(k.kick_level(r_abs)) * input.direction;
             self.push = 0.0;
             self.push_sum = 0.0;
         }
-        if !input.at_rest {
+        if !rest {
             self.moved = true;
         }
         // Push a shaft that should have given an edge by now: from rest before it first moved,
         // or crawling between its first and second edge (no measurement yet). Never a shaft
         // that went quiet after moving (the estimator reset it to rest): that is the
         // supervisor's to judge, and pushing it would run away a shaft with a dead sensor.
-        let starting = input.at_rest && !self.moved;
+        let starting = rest && !self.moved;
         let crawling = !input.at_rest && !input.measurement_valid;
         // The kick: from rest, the identified breakaway duty, just long enough for the model
         // driven by it to reach the reference; then the feedforward holds Coulomb friction.
@@ -419,8 +432,9 @@ impl SpeedLoop {
             self.push += k.push_per_rad_tick * r_abs;
             self.push_sum += self.push;
         }
-        // The stall bound is only active with a valid measurement.
-        if ev.bound_active && input.feedback {
+        // The stall bound is only active with a valid measurement, and counts only from an
+        // edge the loop has seen (see `rest`).
+        if ev.bound_active && input.feedback && !rest {
             let at_least = rp - input.measured_rad_s;
             e = if input.direction > 0.0 {
                 e.max(at_least)

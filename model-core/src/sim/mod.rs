@@ -16,6 +16,7 @@ pub mod harness;
 pub mod motor;
 pub mod plant;
 pub mod prng;
+pub mod restart;
 
 pub use assembly::{ASSEMBLY_COMMISSION_MAX_S, AssemblyError, commission_on_plant};
 pub use harness::{ClosedLoop, SETTLING_BAND, StepMetrics, StepReport};
