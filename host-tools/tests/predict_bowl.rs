@@ -127,9 +127,37 @@ fn a_flared_wall_keeps_it_longer() {
         flared["residence_time_mean_s"].as_f64().unwrap(),
     );
     assert!(f > 1.1 * b && f < 1.6 * b, "{b} {f}");
+    // On the wall, or over it in flight (the sharp corner's rebound flies).
     for rel in flared["per_release"].as_array().unwrap() {
-        assert!(rel["on_wall_s"].as_f64().unwrap() > 0.0, "{rel}");
+        let away = rel["on_wall_s"].as_f64().unwrap() + rel["flight_s"].as_f64().unwrap();
+        assert!(away > 0.0, "{rel}");
     }
+}
+
+/// Lift-off (issue 30: rod offset 0.3 m, precession 4.4 rad/s at 60 deg) used to end the bowl
+/// model with no answer; now the granule flies, lands and leaves: the answer is valid, every
+/// release leaves, and the regimes carry a `fly` share (the shares of each release add to 1).
+#[test]
+fn a_lift_off_scene_answers_with_a_fly_share() {
+    let v = json(&bowl_args(
+        "4.4",
+        "2",
+        "60",
+        ["60", "0.02", "0.005"],
+        &["--rod-offset-m", "0.3", "--json"],
+    ));
+    assert_eq!(v["valid"], true, "{v}");
+    assert_eq!(v["releases_leaving"], 12, "{v}");
+    let mut flying = 0;
+    for rel in v["per_release"].as_array().unwrap() {
+        let regime = rel["regime"].as_object().unwrap();
+        let sum: f64 = regime.values().map(|x| x.as_f64().unwrap()).sum();
+        assert!((sum - 1.0).abs() < 1e-9, "{rel}");
+        if regime.get("fly").and_then(|x| x.as_f64()).unwrap_or(0.0) > 0.0 {
+            flying += 1;
+        }
+    }
+    assert!(flying >= 3, "{v}");
 }
 
 /// Bad input is said in plain words naming the flag and its limit, exit 1, no Rust names.

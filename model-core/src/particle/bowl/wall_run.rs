@@ -22,8 +22,8 @@ pub enum WallEnd<T> {
     Bottom(T, WallState<T>),
     /// Over the lip at this time, at this speed relative to the bowl, m/s.
     Lip(T, T),
-    /// The normal force reached zero at this time.
-    LiftsOff(T),
+    /// The normal force reached zero at this time, in this wall state: it flies.
+    LiftsOff(T, WallState<T>),
     /// Still on the wall at the horizon.
     Horizon,
 }
@@ -148,7 +148,7 @@ pub fn stay<T: Real>(
     loop {
         let remaining = out.tally.remaining(limits, max_switches)?;
         let Some(contact) = next_contact(sc, m, t, &y, must_slide) else {
-            out.end = WallEnd::LiftsOff(t);
+            out.end = WallEnd::LiftsOff(t, y);
             return Ok(out);
         };
         let rolling = matches!(contact, Contact::Roll);
@@ -207,16 +207,10 @@ pub fn stay<T: Real>(
                 );
                 return Ok(out);
             }
-            2 if m.over_edge(ye[0]) => {
-                // Airborne from the lip's edge, outwards: over the lip.
-                out.end = WallEnd::Lip(
-                    te,
-                    norm(&wall_forces(sc, m, te, &ye, now(dir.get())).velocity_m_s),
-                );
-                return Ok(out);
-            }
             2 => {
-                out.end = WallEnd::LiftsOff(te);
+                // Airborne (from the wall, or from the lip's edge: the flight decides whether
+                // it goes over or falls back in).
+                out.end = WallEnd::LiftsOff(te, ye);
                 return Ok(out);
             }
             _ => {
