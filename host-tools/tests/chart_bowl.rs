@@ -7,7 +7,7 @@ use common::{bowl, temp_dir};
 /// At 2 rad/s on a bare rim the granule slides from the tilt where rolling down the incline
 /// needs more than mu_s: `(1 - k2) tan th > 0.4`, th > 54.5 deg (the rotation shifts it a
 /// little): none at 45 deg, all at 60 deg and above; a vertical 20 mm wall with a sharp corner
-/// lets no release out at any tilt; the bare rim lets every release out.
+/// lets no release out at any tilt up to 75 deg; the bare rim lets every release out.
 #[test]
 fn the_regime_map_shows_the_sliding_threshold_and_the_held_granules() {
     let d = temp_dir("chart-bowl-regimes");
@@ -28,7 +28,7 @@ fn the_regime_map_shows_the_sliding_threshold_and_the_held_granules() {
             f[0],
             f[1].parse().unwrap(),
             f[2].parse().unwrap(),
-            f[4].parse().unwrap(),
+            f[5].parse().unwrap(),
         );
         match shape {
             "bare rim" => {
@@ -41,12 +41,14 @@ fn the_regime_map_shows_the_sliding_threshold_and_the_held_granules() {
                 }
                 checked += 1;
             }
-            "vertical wall 20 mm" => {
+            // Up to 75 deg; at 80 deg the bowl's axis is near horizontal, the normal force
+            // small, and a granule that lifts off can fly over the wall (2 of 12 do).
+            "vertical wall 20 mm" if tilt <= 75.0 => {
                 assert_eq!(leaving, 0.0, "{line}");
                 checked += 1;
             }
             _ => {}
         }
     }
-    assert_eq!(checked, 32);
+    assert_eq!(checked, 31);
 }

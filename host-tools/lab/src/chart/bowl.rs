@@ -121,13 +121,14 @@ pub fn residence(tilt_deg: f64) -> Result<(Figure, Table)> {
 }
 
 /// The regime map against the tilt at one speed: for each bowl shape, the share of the time
-/// the granules slide (the rest they roll, or sit held) and the share of releases that leave
-/// within the horizon (the rest are held by the wall).
+/// the granules slide and fly (the rest they roll, or sit held) and the share of releases that
+/// leave within the horizon (the rest are held by the wall).
 pub fn regimes(omega_rad_s: f64) -> Result<(Figure, Table)> {
     let mut table = Table::new(&[
         "shape",
         "tilt_deg",
         "slide_share",
+        "fly_share",
         "held_share",
         "leaving_share",
     ]);
@@ -144,27 +145,30 @@ pub fn regimes(omega_rad_s: f64) -> Result<(Figure, Table)> {
             fillet_radius_m: 0.0,
             restitution: 0.5,
         };
-        let (mut slide, mut leave) = (Vec::new(), Vec::new());
+        let (mut slide, mut fly, mut leave) = (Vec::new(), Vec::new(), Vec::new());
         for &tilt in &tilts {
             let s = RollingScene::equal_speeds(omega_rad_s, tilt.to_radians(), RIM_M);
-            let (mut sl, mut held, mut total, mut left) = (0.0, 0.0, 0.0, 0usize);
+            let (mut sl, mut fl, mut held, mut total, mut left) = (0.0, 0.0, 0.0, 0.0, 0usize);
             for deg in AZIMUTHS_DEG {
                 let Ok(r) = bowl::residence(&s, &shape, deg.to_radians(), METHOD, limits) else {
                     continue;
                 };
                 sl += r.regime.slide_s;
+                fl += r.flight_s;
                 held += r.held_s;
-                total += r.regime.slide_s + r.regime.roll_s + r.held_s;
+                total += r.regime.slide_s + r.regime.roll_s + r.flight_s + r.held_s;
                 left += usize::from(matches!(r.outcome, BowlOutcome::Leaves { .. }));
             }
             let share = |x: f64| if total > 0.0 { x / total } else { f64::NAN };
             let leaving = left as f64 / AZIMUTHS_DEG.len() as f64;
             slide.push((tilt, share(sl)));
+            fly.push((tilt, share(fl)));
             leave.push((tilt, leaving));
             table.row(vec![
                 (*name).into(),
                 format!("{tilt}"),
                 format!("{}", share(sl)),
+                format!("{}", share(fl)),
                 format!("{}", share(held)),
                 format!("{leaving}"),
             ]);
@@ -173,6 +177,12 @@ pub fn regimes(omega_rad_s: f64) -> Result<(Figure, Table)> {
             name: format!("{name}: share of time sliding"),
             points: slide,
             mark: Mark::LinePoints,
+            color: i + 1,
+        });
+        series.push(Series {
+            name: format!("{name}: share of time flying"),
+            points: fly,
+            mark: Mark::Points,
             color: i + 1,
         });
         series.push(Series {
@@ -189,8 +199,8 @@ pub fn regimes(omega_rad_s: f64) -> Result<(Figure, Table)> {
         series,
         &[
             SCENE_NOTE,
-            "not sliding: rolling, or held in",
-            "a corner; not leaving in 3 s: held",
+            "not sliding or flying: rolling, or held",
+            "in a corner; not leaving in 3 s: held",
         ],
     );
     Ok((fig, table))
