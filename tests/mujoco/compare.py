@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Runs `bowl_mujoco.py` (MuJoCo) and `bowl predict --model bowl --json` on the same scenes and
-prints a Markdown table: per-release T (or held) and regime, and the mean T's difference.
+prints a Markdown table: per-release T (or held) and regime, and the mean T's difference, the
+model with restitution 0 (MuJoCo's contact is critically damped), 0.15 (the normal speed MuJoCo
+returns at the 60 deg corner: 0.60 m/s in, 0.085 m/s out at 1.27 rad/s, release 0 deg) and 0.5.
 
 Usage: compare.py BOWL_BINARY PYTHON
 """
@@ -60,11 +62,12 @@ def mean(rows):
 
 print("| scene | \\|w1\\| = \\|w2\\| rad/s | MuJoCo T per release (s) | MuJoCo regime (mean) |"
       " bowl model e 0: T per release (s) | regime (mean) | mean T, model / MuJoCo - 1 |"
-      " bowl model e 0.5: mean T |")
-print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+      " e 0.15: mean T, model / MuJoCo - 1 | e 0.5: mean T, model / MuJoCo - 1 |")
+print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
 for name, w, alpha, h, horizon in SCENES:
     mj = mujoco_run(w, alpha, h, horizon)
     us = ours(w, alpha, h, horizon, 0.0)
+    us15 = ours(w, alpha, h, horizon, 0.15)
     us5 = ours(w, alpha, h, horizon, 0.5)
 
     def times(rows):
@@ -74,9 +77,13 @@ for name, w, alpha, h, horizon in SCENES:
         keys = {k for _, r in rows for k in r}
         return {k: sum(r.get(k, 0.0) for _, r in rows) / len(rows) for k in keys}
 
-    m_mj, m_us, m_us5 = mean(mj), mean(us), mean(us5)
-    diff = (f"{100 * (m_us / m_mj - 1):+.1f} %" if m_mj and m_us else
-            ("both held" if m_mj is None and m_us is None else "differ"))
+    m_mj = mean(mj)
+
+    def diff(rows):
+        m = mean(rows)
+        if m_mj and m:
+            return f"{m:.4f} s, {100 * (m / m_mj - 1):+.1f} %"
+        return "both held" if m_mj is None and m is None else "differ"
+
     print(f"| {name} | {w} | {times(mj)} | {fmt_regime(avg_regime(mj))} | {times(us)} | "
-          f"{fmt_regime(avg_regime(us))} | {diff} | "
-          f"{'held' if m_us5 is None else f'{m_us5:.4f}'} |", flush=True)
+          f"{fmt_regime(avg_regime(us))} | {diff(us)} | {diff(us15)} | {diff(us5)} |", flush=True)

@@ -317,7 +317,14 @@ pub fn residence<T: Real>(
                         if rebound > rest {
                             Phase::Flight(launch(sc, te, q, u2, s2))
                         } else {
-                            Phase::Wall(te, from_space(&m, T::ZERO, &q, &u2, &s2))
+                            // Along the wall with what the impact left: the speed up its slope
+                            // `u . (cos alpha e_rho + sin alpha e_z)` is the meridian speed the
+                            // corner's stand-in fillet turns from the bottom's direction to the
+                            // wall's.
+                            let mut w = from_space(&m, T::ZERO, &q, &u2, &s2);
+                            let (ex, ey) = (entry[1], entry[2]);
+                            w[3] = (u2[0] * ex + u2[1] * ey) * ca + u2[2] * sa;
+                            Phase::Wall(te, w)
                         }
                     }
                 }
