@@ -205,3 +205,94 @@ pub fn regimes(omega_rad_s: f64) -> Result<(Figure, Table)> {
     );
     Ok((fig, table))
 }
+
+/// The dominant regime over the tilt and the speed (w1 = w2): for each release the mode it
+/// spent most time in (roll, slide or fly), or held by the wall if it has not left within the
+/// horizon; each cell is marked with what most of its twelve releases did. A 60 deg wall 20 mm
+/// high with a sharp corner (e 0.5), on a rod offset of `rod_m` (lift-off needs one).
+pub fn regime_map(rod_m: f64) -> Result<(Figure, Table)> {
+    let mut table = Table::new(&[
+        "tilt_deg",
+        "speed_rad_s",
+        "roll",
+        "slide",
+        "fly",
+        "held",
+        "dominant",
+    ]);
+    let limits = SystemLimits {
+        horizon_s: HORIZON_S,
+        max_steps: MAX_STEPS,
+    };
+    let shape = BowlShape {
+        wall_angle_rad: 60f64.to_radians(),
+        wall_height_m: 0.02,
+        fillet_radius_m: 0.0,
+        restitution: 0.5,
+    };
+    let names = ["roll", "slide", "fly", "held by the wall"];
+    let mut points: [Vec<(f64, f64)>; 4] = Default::default();
+    for ti in 1..=16 {
+        let tilt = 5.0 * f64::from(ti);
+        for wi in 1..=10 {
+            let w = 0.5 * f64::from(wi);
+            let sc = RollingScene {
+                precession_rad_s: w,
+                spin_rad_s: w,
+                axes_angle_rad: tilt.to_radians(),
+                rod_length_m: rod_m,
+                rolling_resistance: 0.029,
+                sliding_friction: 0.4,
+                ..RollingScene::equal_speeds(1.0, 1.0, RIM_M)
+            };
+            let mut count = [0usize; 4];
+            for deg in AZIMUTHS_DEG {
+                let Ok(r) = bowl::residence(&sc, &shape, deg.to_radians(), METHOD, limits) else {
+                    continue;
+                };
+                let which = if !matches!(r.outcome, BowlOutcome::Leaves { .. }) {
+                    3
+                } else {
+                    let t = [r.regime.roll_s, r.regime.slide_s, r.flight_s];
+                    (0..3).fold(0, |b, i| if t[i] > t[b] { i } else { b })
+                };
+                count[which] += 1;
+            }
+            let dominant = (0..4).fold(0, |b, i| if count[i] > count[b] { i } else { b });
+            points[dominant].push((tilt, w));
+            table.row(vec![
+                format!("{tilt}"),
+                format!("{w}"),
+                format!("{}", count[0]),
+                format!("{}", count[1]),
+                format!("{}", count[2]),
+                format!("{}", count[3]),
+                names[dominant].into(),
+            ]);
+        }
+    }
+    let series = points
+        .into_iter()
+        .enumerate()
+        .map(|(i, p)| Series {
+            name: format!("most releases: {}", names[i]),
+            points: p,
+            mark: Mark::Points,
+            color: i + 1,
+        })
+        .collect();
+    let rod_note = format!("rod offset {rod_m} m; wall 60 deg 20 mm, sharp corner, e 0.5");
+    let fig = Figure::linear(
+        "Regime map: what most of the 12 releases do, over tilt and speed".to_string(),
+        "angle between the vertical and the bowl's axis (paper Eq. 2), deg",
+        "w1 = w2, rad/s",
+        series,
+        &[
+            SCENE_NOTE,
+            &rod_note,
+            "a release's regime: the mode it spends",
+            "most time in; held: not out in 3 s",
+        ],
+    );
+    Ok((fig, table))
+}
