@@ -352,8 +352,8 @@ fn the_rig_files_bowl_table_gives_the_bowl() {
 /// bowl of primitives driven about the vertical and its own axis, the sphere on a free joint):
 /// the rig's scene (60 deg, 75 mm bottom, w1 = w2 = 1.27 rad/s), four releases. A bare rim: T
 /// per release within 1.5 %, sliding all the way in both; a 60 deg wall 20 mm high: mean T within
-/// 5 % with the restitution MuJoCo's contact gives at that corner (0.15); a vertical 20 mm wall:
-/// every release held in both. Needs python with mujoco (tests/mujoco/compare.sh makes
+/// 5 % (the target; measured 1.2 %) with the restitution MuJoCo's contact gives at that
+/// corner (0.15); a vertical 20 mm wall: every release held in both. Needs python with mujoco (tests/mujoco/compare.sh makes
 /// target/mujoco-venv): `BOWL_MUJOCO_PYTHON=target/mujoco-venv/bin/python cargo test -p
 /// host-tools --test predict_bowl -- --ignored` (about 2 minutes).
 #[test]
