@@ -6,9 +6,11 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use lab::fit::models::Method;
+use lab::fit::models::{BOWL_CANDIDATES, CANDIDATES, Method};
 use lab::fit::stats::AIC_DECISIVE;
-use lab::fit::{DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit, load, to_json};
+use lab::fit::{
+    DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit, fit_candidates, load, to_json,
+};
 
 /// Arguments of `bowl fit`.
 #[derive(clap::Args)]
@@ -32,6 +34,12 @@ pub struct Args {
     /// results file's k2 is the starting point).
     #[arg(long)]
     pub fit_k2: bool,
+    /// Also fit the bowl model (docs/model.md section 10) with each of its walls (bare rim,
+    /// 60 deg 10 and 20 mm, vertical 20 mm): its parameter is the sliding friction mu_s, and
+    /// the AIC says which model and which wall the measured times prefer. Slower (twelve
+    /// releases in the real bowl per run and trial).
+    #[arg(long)]
+    pub bowl_walls: bool,
 }
 
 /// `bowl fit`.
@@ -46,7 +54,13 @@ pub fn run(args: &Args) -> Result<()> {
     for r in &mut runs {
         r.axes_angle_rad = args.axes_angle_deg.to_radians();
     }
-    let fit = fit(runs, excluded, args.fit_k2)?;
+    let fit = if args.bowl_walls {
+        let mut all = CANDIDATES.to_vec();
+        all.extend(BOWL_CANDIDATES);
+        fit_candidates(runs, excluded, &all, args.fit_k2)?
+    } else {
+        fit(runs, excluded, args.fit_k2)?
+    };
     if !args.no_charts {
         let dir = args.charts.clone().unwrap_or_else(|| {
             let stem = args
