@@ -7,6 +7,7 @@
 #   bash docs/charts/transitions.sh tests/rigs/family-60.toml            # the whole matrix
 #   bash docs/charts/transitions.sh F "3 1" "3 0.5" "0 0.5"              # only these changes
 #   BOWL=path/to/bowl bash docs/charts/transitions.sh F                  # another build
+#   SIM_FLAGS=--current-sense bash docs/charts/transitions.sh F          # with current sense
 #
 # "low" stands for the family's lowest speed: the highest over its plants of 0.2 rad/s and one
 # pulse per 4 s (docs/control.md).
@@ -40,7 +41,8 @@ for c in "${changes[@]}"; do
   read -r a b <<<"$c"
   [ "$a" = low ] && a=$low
   [ "$b" = low ] && b=$low
-  "$bowl" sim family --rig-file "$file" --from-rad-s "$a" --target-rad-s "$b" --json |
+  # shellcheck disable=SC2086
+  "$bowl" sim family --rig-file "$file" --from-rad-s "$a" --target-rad-s "$b" ${SIM_FLAGS:-} --json |
     python3 -c '
 import json, sys
 d = json.load(sys.stdin)

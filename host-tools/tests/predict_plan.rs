@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::json;
+use common::{bowl, json, stdout};
 
 #[test]
 fn the_cli_and_the_chart_run_the_same_dp54_plan() {
@@ -54,4 +54,78 @@ fn the_cli_and_the_chart_run_the_same_dp54_plan() {
         checked += 1;
     }
     assert!(checked >= 4, "{checked} dp54 rows of the paper scene");
+}
+
+/// The chooser chart's DP5(4) plans (its not-choosing baseline, its reference, its brute-force
+/// grid) are the plan `bowl predict --method dp54 --tol` runs at the same tolerance: on the
+/// chart's scenes at their final speed held, the same evaluations and the same T to the last
+/// digit, for each of the chart's tolerances.
+#[test]
+fn the_cli_and_the_chooser_chart_run_the_same_dp54_plan() {
+    use lab::chart::chooser::{not_choosing, time};
+    use model_core::ode::{Method, SpinUp};
+    use model_core::particle::{Model, Scene};
+    let mut checked = 0;
+    for (mu, omega, model) in [
+        (0.01, 3.0, Model::Flat),
+        (0.029, 3.0, Model::Coriolis),
+        (0.1, 6.0, Model::Coriolis),
+    ] {
+        // The chart's scene (docs/charts/chooser.csv), its speed held: the CLI's constant speed.
+        let s = Scene {
+            omega_rad_s: omega,
+            mu,
+            g_m_s2: 9.81,
+            k2: 5.0 / 7.0,
+            ri_m: 0.05,
+            rim_radius_m: 0.1,
+        };
+        let held = SpinUp {
+            start_rad_s: omega,
+            final_rad_s: omega,
+            time_constant_s: 0.3,
+        };
+        for tolerance in [1e-3, 1e-5, 1e-7] {
+            let plan = not_choosing(tolerance, &s);
+            let Method::Dp54 { rtol, .. } = plan else {
+                panic!("the baseline is DP5(4): {plan:?}");
+            };
+            let (t, evals) = time(&s, model, &held, plan);
+            let name = format!("{model:?}").to_lowercase();
+            let out = bowl(&[
+                "predict",
+                "--model",
+                &name,
+                "--method",
+                "dp54",
+                "--tol",
+                &format!("{rtol:e}"),
+                &format!("--omega-rad-s={omega}"),
+                &format!("--mu={mu}"),
+                "--ri-m",
+                "0.05",
+                "--rim-radius-m",
+                "0.1",
+                "--json",
+            ]);
+            let text = stdout(&out);
+            let v: serde_json::Value = serde_json::from_str(&text).expect(&text);
+            let r = &v["results"][0];
+            let what = format!("{name} mu {mu} omega {omega} tolerance {tolerance:e}: {r}");
+            assert_eq!(
+                r["rhs_evaluations"].as_u64(),
+                Some(u64::from(evals)),
+                "{what}"
+            );
+            // T from the printed digits (serde_json's own reading may be an ulp off).
+            let printed = text
+                .split("\"residence_time_s\":")
+                .nth(1)
+                .and_then(|rest| rest.split([',', '}', '\n']).next())
+                .map(|digits| digits.trim().parse::<f64>().unwrap());
+            assert_eq!(printed, Some(t), "{what}");
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 9);
 }

@@ -309,6 +309,7 @@ mod spread;
 pub mod table;
 mod trace;
 mod varying;
+pub mod whole;
 
 pub use cost::{MethodCost, Target, plan_cost};
 #[cfg(test)]

@@ -422,3 +422,45 @@ fn material_leaving_the_bowl_near_the_top_speed_is_no_runaway() {
     // The load's release shows: the shaft did speed up.
     assert!(peak > 3.05, "peak {peak} rad/s");
 }
+
+#[test]
+fn a_hardware_stop_latches_in_its_tick_and_asks_for_the_supply_cut() {
+    let mut cl = running_loop(PlantParams::nominal(), |_| {});
+    cl.ctrl.set_motor_speeds(1.0, 2.0).unwrap();
+    cl.ctrl.start().unwrap();
+    cl.run(2.0, |_| {});
+    assert!(cl.ctrl.fault().is_none());
+    assert!(
+        cl.tick().iter().any(|d| *d != 0.0),
+        "not driving before the stop"
+    );
+    // The board's break input tripped: latched at once, both duties zero from the next tick.
+    cl.ctrl.hardware_stop();
+    assert_eq!(cl.ctrl.state(), State::Fault);
+    assert_eq!(cl.ctrl.fault(), Some(Fault::HardwareStop));
+    assert!(Fault::HardwareStop.cuts_supply());
+    assert_eq!(cl.tick(), [0.0, 0.0]);
+    // The other faults are stopped by the bridge itself: no supply cut asked.
+    for f in [
+        Fault::SensorLostOrStall(0),
+        Fault::Overspeed(1),
+        Fault::HostSilent,
+        Fault::InvalidConfiguration,
+    ] {
+        assert!(!f.cuts_supply(), "{f:?} asks for the supply cut");
+    }
+    // CLEAR returns to Idle; a stop tripped again (the line still low) latches again.
+    cl.ctrl.clear_fault().unwrap();
+    assert_eq!(cl.ctrl.state(), State::Idle);
+    cl.ctrl.hardware_stop();
+    assert_eq!(cl.ctrl.fault(), Some(Fault::HardwareStop));
+    // A fault latched first is kept (the first cause is the one to read).
+    cl.ctrl.clear_fault().unwrap();
+    cl.ctrl.set_motor_speeds(1.0, 2.0).unwrap();
+    cl.ctrl.start().unwrap();
+    cl.rig.params_mut().axes[1].faults.dead_sensor_from_s = cl.rig.time_s() as f32;
+    cl.run(3.0, |_| {});
+    assert_eq!(cl.ctrl.fault(), Some(Fault::SensorLostOrStall(1)));
+    cl.ctrl.hardware_stop();
+    assert_eq!(cl.ctrl.fault(), Some(Fault::SensorLostOrStall(1)));
+}

@@ -50,6 +50,24 @@ fn widest_telemetry_is_max_telemetry_len() {
     assert_eq!(encode_vec(&Frame::Telemetry(t)).len(), MAX_TELEMETRY_LEN);
 }
 
+/// The widest PARAMS answer (every value at the wider end of its range, the longest id) fits
+/// in `MAX_FRAME_LEN`: the residence-time table's ten parameters were sized for it.
+#[test]
+fn the_widest_params_answer_fits_the_frame_limit() {
+    let mut values = [0i32; PARAM_COUNT];
+    for (v, id) in values.iter_mut().zip(ParamId::ALL) {
+        let (lo, hi) = id.range();
+        *v = if lo.to_string().len() > hi.to_string().len() {
+            lo
+        } else {
+            hi
+        };
+    }
+    let n = encode_vec(&Frame::Params { id: 65535, values }).len();
+    assert!(n <= MAX_FRAME_LEN, "{n} bytes");
+    println!("widest PARAMS answer: {n} of {MAX_FRAME_LEN} bytes");
+}
+
 #[test]
 fn out_of_range_fields_are_refused_by_the_encoder() {
     let mut buf = [0u8; MAX_FRAME_LEN];

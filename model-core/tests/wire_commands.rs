@@ -111,7 +111,9 @@ fn refusals_say_the_value_the_limit_and_the_names() {
     assert!(said("speed -1 2100").contains("SPEED_MAX1_MRAD_S"));
     assert!(said("set TELEM_HZ 51").contains("TELEM_HZ 51 frames/s is outside its range 0..=50"));
     assert!(said("set FOO 1").contains("`FOO` is not a parameter; the parameters: RIM_UM"));
-    assert!(said("rtime fast 2500").contains("`fast` is not a residence model: flat or cori"));
+    assert!(
+        said("rtime fast 2500").contains("`fast` is not a residence model: flat, cori or table")
+    );
     assert!(said("speed 1800").contains("`speed` takes 2 values after it, got 1"));
     assert!(said("speed 01800 2100").contains("write `01800` as `1800`"));
     assert!(said("jump").contains("`jump` is not a command; the commands: speed, rtime"));

@@ -49,7 +49,7 @@ impl Backend for Recorder {
                 precession_mrad_s: (t / 2) as i16,
                 spin_mrad_s: (t / 3) as i16,
             }),
-            ResidenceModel::Flat => Err(Reason::Infeasible),
+            ResidenceModel::Flat | ResidenceModel::Table => Err(Reason::Infeasible),
         }
     }
     fn start(&mut self) -> Result<(), Reason> {

@@ -9,7 +9,7 @@
 use anyhow::{Result, anyhow};
 use model_core::particle::Model;
 use model_core::sim::granule::ParticleParams;
-use model_core::sim::{AxisParams, PlantParams};
+use model_core::sim::{AxisParams, CurrentSense, PlantParams};
 use serde::Deserialize;
 use std::path::Path;
 use toml::Spanned;
@@ -31,6 +31,19 @@ pub struct Rig {
     pub particle: Option<ParticleParams>,
     /// The `[bowl]` table: the bowl's shape and tilt (`bowl predict --model bowl`), if any.
     pub bowl: Option<BowlGeometry>,
+}
+
+impl Rig {
+    /// Gives every axis the typical current sense ([`CurrentSense::TYPICAL`]) where the file
+    /// gave it none (`bowl sim --current-sense`: a family file run as if its rigs had one).
+    pub fn with_current_sense(mut self) -> Self {
+        for a in &mut self.params.axes {
+            if !a.current_sense.enabled {
+                a.current_sense = CurrentSense::TYPICAL;
+            }
+        }
+        self
+    }
 }
 
 type Num = Option<Spanned<f64>>;
@@ -74,6 +87,10 @@ struct RigToml {
     timer_hz: Num,
     timer_bits: Num,
     seed: Num,
+    current_sense: Option<bool>,
+    current_offset_a: Num,
+    current_gain_error: Num,
+    current_noise_a: Num,
     precession: Option<AxisToml>,
     spin: Option<AxisToml>,
     particle: Option<ParticleToml>,
@@ -215,7 +232,60 @@ impl Checker<'_> {
         {
             self.axis(section, axis.as_ref().unwrap_or(&empty), &mut p.axes[i])?;
         }
+        self.current_sense(t, &mut p)?;
         Ok(p)
+    }
+
+    /// The bridges' current sense (both axes: one driver board) and its errors.
+    fn current_sense(&self, t: &RigToml, p: &mut PlantParams) -> Result<()> {
+        let typical = CurrentSense::TYPICAL;
+        let f = |v: &Num, key: &str, lo: f64, hi: f64, d: f32| -> Result<f32> {
+            Ok(self.get(v, key, lo, hi, d.into())? as f32)
+        };
+        let c = CurrentSense {
+            enabled: t.current_sense.unwrap_or(false),
+            offset_a: f(
+                &t.current_offset_a,
+                "current_offset_a",
+                -1.0,
+                1.0,
+                typical.offset_a,
+            )?,
+            gain_error: f(
+                &t.current_gain_error,
+                "current_gain_error",
+                -0.5,
+                0.5,
+                typical.gain_error,
+            )?,
+            noise_a: f(
+                &t.current_noise_a,
+                "current_noise_a",
+                0.0,
+                1.0,
+                typical.noise_a,
+            )?,
+        };
+        let error_key = [
+            &t.current_offset_a,
+            &t.current_gain_error,
+            &t.current_noise_a,
+        ]
+        .into_iter()
+        .flatten()
+        .next();
+        if let (false, Some(v)) = (c.enabled, error_key) {
+            return Err(anyhow!(
+                "rig file {}, line {}: a current-sense error key without `current_sense = true`; \
+                 add that line, or leave the error keys out",
+                self.file,
+                (self.at)(v.span().start)
+            ));
+        }
+        for a in &mut p.axes {
+            a.current_sense = if c.enabled { c } else { CurrentSense::NONE };
+        }
+        Ok(())
     }
 
     /// The `[particle]` table, each key checked against [`ParticleParams::ranges`].
@@ -435,6 +505,52 @@ mod tests {
         assert_eq!(r[0].params.axes[1].motor.inertia_kg_m2, 0.05);
         assert_eq!(r[0].params.axes[1].sensor.pulses_per_rev, 60);
         assert_eq!(r[0].params.axes[0], PlantParams::nominal().axes[0]);
+    }
+
+    #[test]
+    fn current_sense_is_off_by_default_and_its_keys_reach_both_axes() {
+        let r = parse("", "x.toml", "x").unwrap();
+        assert!(!r[0].params.axes[0].current_sense.enabled);
+        assert_eq!(r[0].params, PlantParams::nominal());
+        let r = parse("current_sense = true\n", "x.toml", "x").unwrap();
+        assert_eq!(r[0].params.axes[1].current_sense, CurrentSense::TYPICAL);
+        let r = parse(
+            "[[plant]]\nname = \"a\"\ncurrent_sense = true\ncurrent_offset_a = -0.05\n\
+             current_gain_error = 0.1\ncurrent_noise_a = 0.002\n[[plant]]\nname = \"b\"\n",
+            "f.toml",
+            "x",
+        )
+        .unwrap();
+        let c = r[0].params.axes[0].current_sense;
+        assert!(c.enabled);
+        assert_eq!((c.offset_a, c.gain_error, c.noise_a), (-0.05, 0.1, 0.002));
+        assert_eq!(r[0].params.axes[1].current_sense, c);
+        assert!(!r[1].params.axes[0].current_sense.enabled);
+        assert!(
+            r[1].clone().with_current_sense().params.axes[0]
+                .current_sense
+                .enabled
+        );
+    }
+
+    #[test]
+    fn a_current_sense_error_key_needs_current_sense() {
+        let e = parse("current_noise_a = 0.01\n", "c.toml", "x")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("c.toml, line 1"), "{e}");
+        assert!(e.contains("current_sense = true"), "{e}");
+        let e = parse(
+            "current_sense = true\ncurrent_gain_error = 0.9\n",
+            "c.toml",
+            "x",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("line 2") && e.contains("current_gain_error"),
+            "{e}"
+        );
     }
 
     #[test]

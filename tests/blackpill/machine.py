@@ -19,6 +19,7 @@ from qiling.extensions.mcu.stm32f4 import stm32f411
 from unicorn import UC_HOOK_CODE, UcError
 from unicorn.arm_const import UC_ARM_REG_FPSCR, UC_ARM_REG_S0
 
+from adc import Adc, AdcCommon
 from clock_tree import HSE_HZ, ClockTree
 from dma import Dma
 from exti import Exti
@@ -26,9 +27,9 @@ from flash import BACKED_BASE, BACKED_SIZE, FlashInterface, FlashStore
 from iwdg import LSI_HZ, Iwdg
 from nvic import Nvic
 from pins import PwmPinWatch
-from plant import DIR_PINS, SOLENOID_PIN
+from plant import DIR_PINS, SOLENOID_PIN, SUPPLY_PIN
 from rtt import RttReader
-from timers import Timer
+from timers import BIF, Timer
 from usart import Usart
 
 SLICE_NS = 20_000
@@ -36,8 +37,12 @@ SLICE_NS = 20_000
 # sectors 0..4 (128 KiB), so sector 5 can sit behind the flash model with 6 and 7.
 CODE_FLASH_SIZE = BACKED_BASE - 0x0800_0000
 
-IRQ_TIM1_UP, IRQ_TIM1_CC, IRQ_TIM2, IRQ_TIM5 = 25, 27, 28, 50
+IRQ_TIM1_BRK, IRQ_TIM1_UP, IRQ_TIM1_CC, IRQ_TIM2, IRQ_TIM5 = 24, 25, 27, 28, 50
 IRQ_EXTI0 = 6
+IRQ_ADC = 18
+# The current-sense amplifiers (docs/wiring.md: INA240A1, 20 V/V, on a 10 mOhm shunt, zero at
+# mid-supply): volts at PB0 (ADC1_IN8, precession) and PB1 (IN9, spin) for a motor current.
+SENSE_ZERO_V, SENSE_V_PER_A, SENSE_CHANNELS = 1.65, 0.2, (8, 9)
 # The release push button: PA0 (the Black Pill's KEY), active low.
 BUTTON_PORT, BUTTON_PIN = "a", 0
 IRQ_USART2 = 38
@@ -51,6 +56,8 @@ LED_PIN = 13
 # RCC_CR's crystal ready flag (RM0383 6.3.1).
 HSERDY = 1 << 17
 DIR_MASK = sum(1 << pin for pin in DIR_PINS)
+# TIM1's break input: PA6 in alternate function 1 (docs/wiring.md), active low on the rig.
+BKIN_PIN, AF_TIM1 = 6, 1
 
 # RCC_CSR reset flags (RM0383 6.3.21).
 CSR_FLAGS = {
@@ -121,16 +128,22 @@ class Board:
         self.iwdg = add("iwdg", Iwdg(ql, "iwdg", m), 0x4000_3000)
         self.flash = add("flash", FlashInterface(ql, "flash", m, m.store), 0x4002_3C00)
         self.exti = add("exti", Exti(ql, "exti", ql.hw.syscfg), 0x4001_3C00)
+        self.adc1 = add("adc1", Adc(ql, "adc1", self.tim1), 0x4001_2000)
+        self.adc_common = add("adc_common", AdcCommon(ql, "adc_common"), 0x4001_2300)
+        for axis, channel in enumerate(SENSE_CHANNELS):
+            self.adc1.inputs[channel] = lambda a=axis: self.sense_volts(a)
         self.timers = (self.tim1, self.tim2, self.tim5)
         self.clocked = (self.tim1, self.tim2, self.tim5, self.usart2, self.iwdg)
         self.stepping = [e for k, e in ql.hw.stepable.items() if k in ("rcc", "pwr")]
 
+        self.nvic.connect(IRQ_TIM1_BRK, lambda: self.tim1.irq_level(BIF))
         self.nvic.connect(IRQ_TIM1_UP, lambda: self.tim1.irq_level(0x01))
         self.nvic.connect(IRQ_TIM1_CC, lambda: self.tim1.irq_level(0x1E))
         self.nvic.connect(IRQ_TIM2, lambda: self.tim2.irq_level(0x1F))
         self.nvic.connect(IRQ_TIM5, lambda: self.tim5.irq_level(0x1F))
         self.nvic.connect(IRQ_USART2, self.usart2.irq_level)
         self.nvic.connect(IRQ_EXTI0, lambda: self.exti.irq_level(1 << BUTTON_PIN))
+        self.nvic.connect(IRQ_ADC, self.adc1.irq_level)
         for stream, irq in IRQ_DMA1_STREAM.items():
             self.nvic.connect(irq, lambda s=stream: self.dma1.irq_level(s))
 
@@ -140,10 +153,13 @@ class Board:
         scb.hook_write(self._scb_write)
         self.dir_pins = self.gpiob.instance.ODR & DIR_MASK
         self.solenoid_on = False
+        # The motor supply switch's enable (PB14): off in reset (its pull-down).
+        self.supply_on = False
         self.gpiob.hook_write(self._gpiob_written, intercept=QL_INTERCEPT.EXIT)
         # The PWM pins after every write that can change them (GPIOA's mode, TIM1's outputs).
         self.pwm_pins = PwmPinWatch(m, ql.hw.gpioa, self.tim1)
-        ql.hw.gpioa.hook_write(self.pwm_pins.check, intercept=QL_INTERCEPT.EXIT)
+        ql.hw.gpioa.hook_write(self._gpioa_written, intercept=QL_INTERCEPT.EXIT)
+        self.route_break_line()
         self.tim1.on_write = self.pwm_pins.check
         # The status LED on PC13 (active low): each change, as (time ns, lit).
         self.led_lit = False
@@ -163,6 +179,14 @@ class Board:
         self.at_wfe = None
         self.in_isr = False
 
+    def sense_volts(self, axis: int) -> float:
+        """The amplifier's output for the plant's motor current (rails at 0 and 3.3 V); 0 V
+        without a plant (nothing connected)."""
+        if self.m.plant is None:
+            return 0.0
+        v = SENSE_ZERO_V + SENSE_V_PER_A * self.m.plant.current_a(axis)
+        return max(0.0, min(3.3, v))
+
     # --- hooks -------------------------------------------------------------------------
     def _flash_read(self, ql, offset, size):
         return self.m.store.read(offset, size)
@@ -175,9 +199,32 @@ class Board:
         if offset == 0x0C and (value >> 16) == 0x05FA and value & 4:
             self.m.request_reset("software")
 
+    def _gpioa_written(self, *args):
+        self.route_break_line()
+        self.pwm_pins.check()
+
+    def route_break_line(self):
+        """PA6's level (the rig's break line: pulled up, pulled low by a comparator or a
+        driver fault) in GPIOA's input register and, while PA6 is in alternate function 1, at
+        TIM1's break input. Elsewhere the timer's input reads the inactive (high) level: the
+        firmware enables the break only after routing the pin."""
+        g = self.ql.hw.gpioa.instance
+        high = not self.m.break_line_low
+        g.IDR = (g.IDR & ~(1 << BKIN_PIN)) | (int(high) << BKIN_PIN)
+        routed = ((g.MODER >> (2 * BKIN_PIN)) & 3) == 2 and \
+            ((g.AFRL >> (4 * BKIN_PIN)) & 0xF) == AF_TIM1
+        level = high if routed else True
+        if level != self.tim1.break_line_high:
+            self.tim1.set_break_line(level)
+
     def _gpiob_written(self, gpio, access, offset, size, value):
         # A DIR pin that turns while its PWM channel still drives the bridge drives the new
         # direction with the old duty: the harness records every such moment.
+        out_mode = ((gpio.instance.MODER >> (2 * SUPPLY_PIN)) & 3) == 1
+        supply = out_mode and bool(gpio.instance.ODR & (1 << SUPPLY_PIN))
+        if supply != self.supply_on:
+            self.supply_on = supply
+            self.m.supply_changes.append((self.m.now_ns, supply))
         solenoid = bool(gpio.instance.ODR & (1 << SOLENOID_PIN))
         if solenoid != self.solenoid_on:
             self.solenoid_on = solenoid
@@ -285,6 +332,10 @@ class Machine:
         self.pwm_pin_floats = []
         # The status LED's changes (time ns, lit), across resets.
         self.led_changes = []
+        # The break line PA6 pulled low from outside (a comparator, a driver fault), and the
+        # motor supply switch's changes (time ns, closed), across resets.
+        self.break_line_low = False
+        self.supply_changes = []
         self.dir_changes = 0
         self.resets = []
         self.interrupts = 0
@@ -354,6 +405,11 @@ class Machine:
         self.inputs.append((at_ns + 200_000_000, board_edge(False)))
         self.inputs.sort(key=lambda e: e[0])
 
+    def pull_break_line(self, low: bool):
+        """An over-current comparator or a driver's fault output pulls PA6 low (or lets go)."""
+        self.break_line_low = low
+        self.board.route_break_line()
+
     def request_reset(self, kind: str):
         self.reset_request = kind
         b = getattr(self, "board", None)
@@ -416,6 +472,7 @@ class Machine:
                 b.tim2.capture(axis, at)
             while self.plant.time_ns <= self.now_ns:
                 self.plant.step(b.tim1, b.gpiob)
+                b.adc1.plant_stepped()
         b.sync_peripherals()
 
     def _poll_host(self):

@@ -15,6 +15,8 @@ PLANT_TIMER_HZ = 1_000_000
 DIR_PINS = (12, 13)
 # GPIOB pin of the release solenoid driver.
 SOLENOID_PIN = 5
+# GPIOB pin of the motor supply switch's enable (high = closed; its pull-down opens it).
+SUPPLY_PIN = 14
 # TIM2 channel index of the exit light gate (CH3, PB10).
 EXIT_GATE_CHANNEL = 2
 
@@ -46,6 +48,9 @@ def load_library(path: str):
     lib.plant_speed_rad_s.argtypes = [ctypes.c_void_p, ctypes.c_uint32]
     lib.plant_speed_rad_s.restype = ctypes.c_float
     lib.plant_inject.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_float]
+    lib.plant_current_a.argtypes = [ctypes.c_void_p, ctypes.c_uint32]
+    lib.plant_current_a.restype = ctypes.c_float
+    lib.plant_set_supply.argtypes = [ctypes.c_void_p, ctypes.c_uint32]
     lib.plant_release.argtypes = [ctypes.c_void_p, ctypes.c_uint32]
     lib.plant_exit.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_uint32)]
     return lib
@@ -81,10 +86,21 @@ class RigPlant:
         self.exit_us = ctypes.c_uint32(0)
         # (release time ns, exit gate time ns or None) of each granule, for the tests.
         self.granules = []
+        # The supply switch as the plant last saw it (open until the board closes it).
+        self.supply_on = True
+        self.lib.plant_set_supply(self.handle, 1)
 
     def duties_from_board(self, tim1, gpiob):
+        """Each bridge's duty from its PWM and DIR pins. The motor supply switch (PB14, an
+        output driven high to close it) goes to the plant's own supply cut: with it open no
+        bridge drives, whatever its inputs say or however it failed."""
         duties = []
         odr = gpiob.instance.ODR if gpiob is not None else 0
+        supply = gpiob is not None and ((gpiob.instance.MODER >> (2 * SUPPLY_PIN)) & 3) == 1 \
+            and bool((odr >> SUPPLY_PIN) & 1)
+        if supply != self.supply_on:
+            self.supply_on = supply
+            self.lib.plant_set_supply(self.handle, int(supply))
         for axis in (0, 1):
             frac = tim1.pwm_fraction(axis) if tim1 is not None else 0.0
             reverse = (odr >> DIR_PINS[axis]) & 1
@@ -125,6 +141,9 @@ class RigPlant:
     def speed_rad_s(self, axis: int) -> float:
         return self.lib.plant_speed_rad_s(self.handle, axis)
 
+    def current_a(self, axis: int) -> float:
+        return self.lib.plant_current_a(self.handle, axis)
+
     def _inject(self, axis: int, kind: int, from_s: float):
         if self.lib.plant_inject(self.handle, axis, kind, from_s) != 0:
             raise RuntimeError(f"plant_inject({axis}, {kind}) refused")
@@ -138,6 +157,10 @@ class RigPlant:
     def stick_bridge(self, axis: int, from_s: float):
         """The bridge stuck on: any nonzero duty drives at full duty (a shorted driver input)."""
         self._inject(axis, 2, from_s)
+
+    def short_bridge(self, axis: int, from_s: float):
+        """A shorted bridge: full duty even at zero duty; only the supply switch stops it."""
+        self._inject(axis, 3, from_s)
 
     def next_event_ns(self):
         t = self.time_ns

@@ -23,6 +23,7 @@ from timers import BDTR, MOE  # noqa: E402
 from checks import WORK, check, fill_parameter_region, fresh_flash, mean_speed, wedge_cpu  # noqa: E402
 from test_gates import *  # noqa: E402,F401,F403  (the gate tests join this run)
 from test_power_on import *  # noqa: E402,F401,F403  (the first-power-on tests join this run)
+from test_power_stage import *  # noqa: E402,F401,F403  (the break input and supply switch tests)
 
 # The control task's tick counter in the image (`HEARTBEAT` static).
 HEARTBEAT = None

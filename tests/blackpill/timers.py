@@ -16,7 +16,9 @@ CR1, CR2, SMCR, DIER, SR, EGR, CCMR1, CCMR2, CCER, CNT, PSC, ARR, RCR = range(0,
 CCR_BASE, BDTR = 0x34, 0x44
 CEN, URS, ARPE = 1 << 0, 1 << 2, 1 << 7
 MOE, OSSR, OSSI = 1 << 15, 1 << 11, 1 << 10
+BKE, BKP, AOE = 1 << 12, 1 << 13, 1 << 14
 UIF = 1
+BIF = 1 << 7
 
 
 class Timer(QlPeripheral):
@@ -43,6 +45,10 @@ class Timer(QlPeripheral):
         self.updates = 0
         # Called after every register write (the board watches its output pins with it).
         self.on_write = None
+        # The advanced timer's break input (BKIN) as the pin drives it: True = high. Only what
+        # reaches the timer: the board routes the pin here while it is in its alternate function.
+        self.break_line_high = True
+        self.breaks = 0
 
     # --- time base -------------------------------------------------------------------
     def tick_hz(self) -> float:
@@ -198,6 +204,29 @@ class Timer(QlPeripheral):
         frac = self.pwm_fraction(ch)
         return "low" if frac == 0.0 else "high" if frac == 1.0 else "pwm"
 
+    # --- break input (RM0383, TIM1 "Using the break function") ---------------------------
+    def break_active(self) -> bool:
+        bdtr = self.regs[BDTR]
+        return bool(self.advanced and bdtr & BKE and self.break_line_high == bool(bdtr & BKP))
+
+    def _apply_break(self):
+        """The break acts on the line's level, without the CPU and without the timer's clock:
+        MOE is cleared at once (the outputs go to their off state per OSSI) and BIF is set; while
+        the break is active MOE cannot be set again (neither by software nor AOE) and BIF cannot
+        be cleared."""
+        if self.break_active():
+            if self.regs[BDTR] & MOE:
+                self.breaks += 1
+            self.regs[BDTR] &= ~MOE
+            self.regs[SR] |= BIF
+
+    def set_break_line(self, high: bool):
+        """The break pin's level changed (routed here by the board)."""
+        self.break_line_high = high
+        self._apply_break()
+        if self.on_write is not None:
+            self.on_write()
+
     # --- registers ---------------------------------------------------------------------
     def read(self, offset: int, size: int) -> int:
         self.sync()
@@ -245,6 +274,7 @@ class Timer(QlPeripheral):
                 self.anchor_ns = self.machine.now_ns
         elif offset in self.regs:
             self.regs[offset] = value
+        self._apply_break()
         if self.on_write is not None:
             self.on_write()
 

@@ -58,12 +58,31 @@ impl<I: Injector> DeviceCore<I> {
 }
 
 impl<I: Injector> TaskCore for DeviceCore<I> {
-    fn control_tick(&mut self, now_ticks: u32, edges: [&[u32]; AXES]) -> [f32; AXES] {
-        self.backend.controller_mut().tick(now_ticks, edges)
+    fn control_tick(
+        &mut self,
+        now_ticks: u32,
+        edges: [&[u32]; AXES],
+        currents_a: [Option<f32>; AXES],
+    ) -> [f32; AXES] {
+        // Only a board declared to measure them (CUR_SENSE 1): unconnected ADC pins read noise.
+        let fitted = self.backend.params()[ParamId::CurrentSense.index()] == 1;
+        let currents = if fitted { currents_a } else { [None; AXES] };
+        self.backend
+            .controller_mut()
+            .tick_with_currents(now_ticks, edges, currents)
     }
 
     fn faulted(&self) -> bool {
         self.backend.controller().state() == State::Fault
+    }
+
+    fn hardware_stop(&mut self) {
+        self.backend.controller_mut().hardware_stop();
+    }
+
+    fn cuts_supply(&self) -> bool {
+        let c = self.backend.controller();
+        c.supply_cut_requested() || c.fault().is_some_and(|f| f.cuts_supply())
     }
 
     fn hello(&mut self, out: &mut [u8; FRAME_BYTES]) -> Option<usize> {

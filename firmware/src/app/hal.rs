@@ -17,6 +17,34 @@ pub trait MotorOutput {
     }
 }
 
+/// The power stage around the bridges: the hardware stop (on the STM32 TIM1's break input,
+/// which switches the PWM off without the CPU), the motor supply switch (a relay or high-side
+/// switch whose enable is off without power: fail-safe) and the bridges' current sense.
+pub trait PowerStage {
+    /// The latest sample of each motor's current, A, signed in the motor's forward direction,
+    /// taken in step with the PWM; None where the board measures none.
+    fn currents_a(&mut self) -> [Option<f32>; 2];
+    /// Whether the hardware stop has tripped since the last call, or its line is still active.
+    /// The PWM is already off when this says so; the caller latches the fault.
+    fn stop_tripped(&mut self) -> bool;
+    /// Closes (`true`) or opens the motor supply switch.
+    fn set_supply(&mut self, on: bool);
+}
+
+/// A board without a hardware stop, a supply switch or current sense (the QEMU board, the
+/// host): never trips, measures nothing.
+pub struct NoPowerStage;
+
+impl PowerStage for NoPowerStage {
+    fn currents_a(&mut self) -> [Option<f32>; 2] {
+        [None; 2]
+    }
+    fn stop_tripped(&mut self) -> bool {
+        false
+    }
+    fn set_supply(&mut self, _on: bool) {}
+}
+
 /// The free-running timer the edge timestamps come from.
 pub trait CaptureClock {
     /// The timer's current value (same units and wrap as the edge timestamps).

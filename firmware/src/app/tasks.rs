@@ -21,7 +21,7 @@ use embedded_io_async::{Read, Write};
 use heapless::Vec;
 
 use super::edges::{EDGES_PER_TICK, EdgeQueue};
-use super::hal::{CaptureClock, MotorOutput, Watchdog};
+use super::hal::{CaptureClock, MotorOutput, PowerStage, Watchdog};
 use super::motors::{AXES, Motors};
 
 /// The control tick rate (the controller's nominal `tick_hz`).
@@ -36,11 +36,22 @@ pub const SUPERVISOR_PERIOD: Duration = Duration::from_millis(20);
 /// What the tasks need from the controller and the protocol. The binding to
 /// `model_core::control` and `model_core::wire` implements it.
 pub trait TaskCore {
-    /// One control tick: the edges since the previous tick (oldest first) and the capture
-    /// clock read after draining them. Returns the duties (-1..=1, 0 = off).
-    fn control_tick(&mut self, now_ticks: u32, edges: [&[u32]; AXES]) -> [f32; AXES];
+    /// One control tick: the edges since the previous tick (oldest first), the capture clock
+    /// read after draining them, and the motor currents the board sampled (None where it has
+    /// none; used only where the parameters say the board measures them). Returns the duties
+    /// (-1..=1, 0 = off).
+    fn control_tick(
+        &mut self,
+        now_ticks: u32,
+        edges: [&[u32]; AXES],
+        currents_a: [Option<f32>; AXES],
+    ) -> [f32; AXES];
     /// Whether a fault is latched (the motors are then kept off whatever the duties say).
     fn faulted(&self) -> bool;
+    /// The board's hardware stop tripped: latch its fault (kept if another came first).
+    fn hardware_stop(&mut self);
+    /// Whether the latched fault is one the bridge may not stop, so the supply must be cut.
+    fn cuts_supply(&self) -> bool;
     /// The boot announcement frame.
     fn hello(&mut self, out: &mut [u8; FRAME_BYTES]) -> Option<usize>;
     /// Bytes from the host; every answer frame goes to `send`.
@@ -104,14 +115,22 @@ impl Heartbeat {
 
 /// The fixed-rate control loop, forever. A tick whose work ends more than `deadline` after
 /// the tick was due has missed its deadline (see [`Heartbeat`]).
-pub async fn control<RM: RawMutex, C: TaskCore, M: MotorOutput, K: CaptureClock>(
+///
+/// The power stage: a tripped hardware stop latches its fault in the same tick, and the motor
+/// supply stays cut from then until the fault is cleared (CLEAR holds only once the stop's
+/// line is released: it re-latches at every tick while active), or while the latched fault is
+/// one the bridge may not stop ([`TaskCore::cuts_supply`]).
+pub async fn control<RM: RawMutex, C: TaskCore, M: MotorOutput, K: CaptureClock, P: PowerStage>(
     core: &SharedCore<RM, C>,
     queues: &[EdgeQueue; AXES],
     clock: &K,
     motors: &mut Motors<M>,
+    power: &mut P,
     heartbeat: &Heartbeat,
     deadline: Duration,
 ) -> ! {
+    let mut stop_tripped = false;
+    power.set_supply(true);
     let mut buffers: [Vec<u32, EDGES_PER_TICK>; AXES] = [Vec::new(), Vec::new()];
     let period = Duration::from_hz(CONTROL_HZ);
     let mut ticker = Ticker::every(period);
@@ -124,17 +143,25 @@ pub async fn control<RM: RawMutex, C: TaskCore, M: MotorOutput, K: CaptureClock>
         // Read after draining: every edge handed over is older than `now`.
         let now = clock.now_ticks();
         let dropped = [queues[0].dropped(), queues[1].dropped()];
-        let (duties, faulted) = core.lock(|c| {
+        let tripped = power.stop_tripped();
+        let currents = power.currents_a();
+        let (duties, faulted, cut) = core.lock(|c| {
             let mut c = c.borrow_mut();
             c.set_dropped_edges(dropped);
-            let d = c.control_tick(now, [&buffers[0], &buffers[1]]);
-            (d, c.faulted())
+            let d = c.control_tick(now, [&buffers[0], &buffers[1]], currents);
+            if tripped {
+                c.hardware_stop();
+            }
+            (d, c.faulted(), c.cuts_supply())
         });
+        // The motors first, then the supply: a fault stops the outputs before anything else.
         if faulted {
             motors.fault_stop();
         } else {
             motors.apply(duties);
         }
+        stop_tripped = (stop_tripped || tripped) && faulted;
+        power.set_supply(!(stop_tripped || cut));
         // A tick that starts late (the ticker catching up) counts from when it was due.
         let done = Instant::now();
         if done > due + deadline {

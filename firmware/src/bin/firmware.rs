@@ -43,9 +43,11 @@ use firmware::app::slot::Slot;
 use firmware::app::tasks::{self, Heartbeat, SharedCore};
 use firmware::blackpill::capture::{self, Tim2Clock};
 use firmware::blackpill::clocks::{self, ClockSource};
+use firmware::blackpill::current_sense;
 use firmware::blackpill::flash_region::ParamSector;
 use firmware::blackpill::gates::{self, BoardGates, ReleaseButton};
 use firmware::blackpill::motor_pwm::{self, PWM_HZ, PwmMotor};
+use firmware::blackpill::power_stage::{self, BoardPowerStage};
 use firmware::blackpill::reset_cause::{self, ResetFlag};
 use model_core::control::ControllerConfig;
 use model_core::wire::{Hello, ResetCause, status_flags};
@@ -126,6 +128,10 @@ async fn main(spawner: Spawner) {
         ),
     ]);
     motors.all_off();
+    // The hardware stop on PA6, the motor supply switch on PB14 (open until the control task
+    // runs) and the motor currents on PB0/PB1 (used once CUR_SENSE says the board has them).
+    let currents = current_sense::start(p.PB0, p.PB1);
+    let power = power_stage::start(p.PA6, Output::new(p.PB14, Level::Low, Speed::Low), currents);
     let solenoid = Output::new(p.PB5, Level::Low, Speed::Low);
     let capture = capture::start(p.TIM2, p.PA15, p.PB3, p.PB10);
     let button = gates::start_button(p.PA0, p.EXTI0);
@@ -197,7 +203,7 @@ async fn main(spawner: Spawner) {
     iwdg.unleash();
 
     let led = Output::new(p.PC13, Level::High, Speed::Low);
-    spawn(spawner, control_task(core, motors, capture));
+    spawn(spawner, control_task(core, motors, power, capture));
     spawn(spawner, link_task(core, rx, tx));
     spawn(spawner, supervisor_task(Iwdg(iwdg), core, log));
     spawn(spawner, led_task(led, core, clock));
@@ -218,6 +224,7 @@ fn spawn<S>(
 /// A startup invariant failed: motors off, log, and reset (the next boot reports `Software`).
 fn halt(what: &str) -> ! {
     motor_pwm::emergency_off();
+    power_stage::cut_supply_now();
     error!("startup failed: {}", what);
     reset_cause::software_reset()
 }
@@ -226,6 +233,7 @@ fn halt(what: &str) -> ! {
 async fn control_task(
     core: &'static Core,
     mut motors: Motors<PwmMotor>,
+    mut power: BoardPowerStage,
     _capture: capture::Capture,
 ) {
     tasks::control(
@@ -233,6 +241,7 @@ async fn control_task(
         &capture::EDGES,
         &Tim2Clock,
         &mut motors,
+        &mut power,
         &HEARTBEAT,
         CONTROL_DEADLINE,
     )
@@ -321,6 +330,7 @@ async fn led_task(mut led: Output<'static>, core: &'static Core, clock: ClockSou
 fn panic(info: &core::panic::PanicInfo) -> ! {
     // Motors first: raw register writes, no locks, nothing that could panic again.
     motor_pwm::emergency_off();
+    power_stage::cut_supply_now();
     // Only the location: formatting the message would link core's float formatting (about
     // 18 KiB) for the float arguments of panic messages anywhere in the image.
     match info.location() {
@@ -333,6 +343,7 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
 #[exception]
 unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
     motor_pwm::emergency_off();
+    power_stage::cut_supply_now();
     error!("hard fault at pc {=u32:#010x}", frame.pc());
     reset_cause::software_reset()
 }

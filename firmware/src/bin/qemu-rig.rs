@@ -22,6 +22,7 @@ use embassy_time::{Duration, Timer};
 use firmware::app::binding::{
     ControllerBackend, DeviceCore, default_persisted, persisted, split_persisted,
 };
+use firmware::app::hal::NoPowerStage;
 use firmware::app::motors::Motors;
 use firmware::app::reset;
 use firmware::app::slot::Slot;
@@ -58,6 +59,8 @@ async fn control_task(core: &'static Core) {
         &plant::EDGES,
         &PlantClock,
         &mut motors,
+        // The QEMU board has no break input or supply switch.
+        &mut NoPowerStage,
         &HEARTBEAT,
         CONTROL_DEADLINE,
     )

@@ -12,6 +12,10 @@
 //! | Exit light gate              | PB10 | TIM2_CH3 (AF1) input capture, same counter   |
 //! | Release push button (KEY)    | PA0  | EXTI0 falling edge, reads the same counter   |
 //! | Release solenoid driver      | PB5  | GPIO out, high = energised                   |
+//! | Hardware stop (break input)  | PA6  | TIM1_BKIN (AF1), active low, pull-up         |
+//! | Motor supply enable          | PB14 | GPIO out, high = supply switch closed        |
+//! | Precession motor current     | PB0  | ADC1_IN8, injected group on TIM1's update    |
+//! | Spin motor current           | PB1  | ADC1_IN9, same conversion sequence           |
 //! | Host link TX                 | PA2  | USART2_TX, DMA1 stream 6                      |
 //! | Host link RX                 | PA3  | USART2_RX, DMA1 stream 5 (circular)           |
 //! | Status LED (active low)      | PC13 | GPIO out, a pattern per state (`app::led`)   |
@@ -24,7 +28,9 @@
 
 pub mod capture;
 pub mod clocks;
+pub mod current_sense;
 pub mod flash_region;
 pub mod gates;
 pub mod motor_pwm;
+pub mod power_stage;
 pub mod reset_cause;

@@ -13,11 +13,13 @@ mod ends;
 pub(crate) mod ode;
 mod refusals;
 mod rolling;
+mod speed_range;
 mod spin_up;
 mod target;
 mod throughput;
 mod trace;
 mod validity;
+mod whole;
 
 pub use bowl::BowlInputs;
 pub use ends::{Ends, Leaves};
@@ -206,6 +208,9 @@ pub fn run(args: &Inputs) -> Result<()> {
     }
     if args.model == ModelChoice::Bowl {
         return bowl::run(args, &args.rolling, &args.bowl);
+    }
+    if args.model == ModelChoice::Auto && whole::wanted(args) {
+        return whole::run(args);
     }
     if let (Some(input), Some(output)) = (&args.batch, &args.out) {
         return batch::run(input, output, args);

@@ -94,7 +94,7 @@ mod tests {
         );
         let text = refused("rtime fast 2500");
         assert!(
-            text.contains("`fast` is not a residence model: flat or cori"),
+            text.contains("`fast` is not a residence model: flat, cori or table"),
             "{text}"
         );
         let text = refused("inject fire");

@@ -118,6 +118,7 @@ pub fn describe(frame: &Frame) -> String {
             match model {
                 model_core::wire::ResidenceModel::Flat => "flat",
                 model_core::wire::ResidenceModel::Coriolis => "Coriolis",
+                model_core::wire::ResidenceModel::Table => "stored table's",
             },
             f64::from(*precession_mrad_s) * 1e-3,
             f64::from(*spin_mrad_s) * 1e-3

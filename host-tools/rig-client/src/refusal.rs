@@ -7,10 +7,11 @@
 
 use std::time::Duration;
 
-use model_core::binding::{config_from_params, scene_from_params};
+use model_core::binding::{config_from_params, scene_from_params, table_from_params};
 use model_core::bowl::MotorSpeeds;
 use model_core::control::estimator::lowest_speed_rad_s;
 use model_core::control::{BowlSpeedForResidence, Controller, ControllerConfig, InverseFailure};
+use model_core::particle::speed_table::SpeedTable;
 use model_core::particle::{Model, Scene, omega_for_residence_time};
 use model_core::wire::{Command, CommandKind, Frame, ParamId, ParamValues, Reason, Status};
 
@@ -49,6 +50,14 @@ pub fn particulars(
         (Reason::Range, "speed") => {
             let params = ask_params(link?, id, timeout)?;
             speed_limits(words, &params)
+        }
+        (Reason::Infeasible, "rtime")
+            if words
+                .get(1)
+                .is_some_and(|m| m.eq_ignore_ascii_case("table")) =>
+        {
+            let params = ask_params(link?, id, timeout)?;
+            Some(table_refusal(words, &params))
         }
         (Reason::Range | Reason::Infeasible, "rtime") => {
             let params = ask_params(link?, id, timeout)?;
@@ -215,6 +224,66 @@ fn residence_range(words: &[String], params: &ParamValues) -> Option<String> {
     ))
 }
 
+/// `t0-t1 s` with as many decimals (3 to 6) as it takes to tell them apart.
+fn time_span(t0: f64, t1: f64) -> String {
+    let places = (3..=6)
+        .find(|&p| format!("{t0:.p$}") != format!("{t1:.p$}"))
+        .unwrap_or(6);
+    format!("{t0:.places$}-{t1:.places$} s")
+}
+
+/// What speed can do with a residence-time table, in words: `at 60 deg tilt T is
+/// 0.143-0.144 s at every speed from 0.5 to 3.6 rad/s: speed cannot set it; the tilt or the
+/// wall can` when the table is flat ([`SpeedTable::is_flat`]), else the range of T and the
+/// speeds that give its ends. The one wording for `bowl predict` and the refusals.
+pub fn speed_range_words(tilt_deg: f64, table: &SpeedTable) -> String {
+    let (w_lo, w_hi) = table.speed_range_rad_s();
+    let (t_lo, t_hi) = table.residence_range_s();
+    let (t_lo, t_hi) = (f64::from(t_lo), f64::from(t_hi));
+    let t = table.residence_s();
+    let speeds = format!("{:.2} to {:.2} rad/s", w_lo, w_hi);
+    if table.is_flat() {
+        format!(
+            "at {tilt_deg} deg tilt T is {} at every speed from {speeds}: speed cannot set it; \
+             the tilt or the wall can",
+            time_span(t_lo, t_hi)
+        )
+    } else {
+        let slow = f64::from(t[0]);
+        let fast = f64::from(t[t.len() - 1]);
+        format!(
+            "at {tilt_deg} deg tilt T is {} over the speeds from {speeds} ({slow:.4} s at the \
+             slowest, {fast:.4} s at the fastest)",
+            time_span(t_lo, t_hi)
+        )
+    }
+}
+
+/// `rtime table MS` refused: no table stored, a flat one, or a target outside its times.
+fn table_refusal(words: &[String], params: &ParamValues) -> String {
+    let tilt_deg = f64::from(params[ParamId::AxesMdeg.index()]) * 1e-3;
+    let asked = words
+        .get(2)
+        .and_then(|w| w.parse::<f64>().ok())
+        .map(|ms| format!("{:.3} s asked; ", ms * 1e-3))
+        .unwrap_or_default();
+    match table_from_params(params) {
+        Ok(Some(table)) if table.is_flat() => {
+            format!("{asked}{}", speed_range_words(tilt_deg, &table))
+        }
+        Ok(Some(table)) => format!(
+            "{asked}{}; ask for a time in that range, or change the tilt or the wall",
+            speed_range_words(tilt_deg, &table)
+        ),
+        Ok(None) | Err(_) => format!(
+            "{asked}no residence-time table is stored on this rig (RT_W_HI_MRAD_S is 0): \
+             compute one for its bowl, tilt and granule and store it with `bowl predict --model \
+             bowl --rig-file RIG.toml --store-table PORT`, or use `rtime cori` / `rtime flat` \
+             (the paper's 1-D models)"
+        ),
+    }
+}
+
 /// The end of the feasible interval between `inside` (feasible) and `outside` (not), to 1e-4
 /// relative, returned on the feasible side.
 fn bisect(mut inside: f64, mut outside: f64, accepts: &dyn Fn(f64) -> Option<[f32; 2]>) -> f64 {
@@ -289,6 +358,30 @@ mod tests {
         let text = speed_limits(&w("speed 10 0"), &p).unwrap();
         assert!(
             text.contains("precession speed 0.010 rad/s is below"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn a_flat_table_is_said_in_the_issues_words() {
+        let t: [f32; 8] = core::array::from_fn(|k| 0.1432 + 0.0009 * k as f32 / 7.0);
+        let table = SpeedTable::new(0.5, 3.6, t).unwrap();
+        assert_eq!(
+            speed_range_words(60.0, &table),
+            "at 60 deg tilt T is 0.143-0.144 s at every speed from 0.50 to 3.60 rad/s: speed \
+             cannot set it; the tilt or the wall can"
+        );
+        let mut p = default_params();
+        assert!(table_refusal(&w("rtime table 143"), &p).contains("no residence-time table"));
+        for (id, v) in model_core::binding::TABLE_PARAMS
+            .into_iter()
+            .zip(model_core::binding::table_to_params(&table).unwrap())
+        {
+            p[id.index()] = v;
+        }
+        let text = table_refusal(&w("rtime table 143"), &p);
+        assert!(
+            text.starts_with("0.143 s asked; at 60 deg tilt T is 0.143-0.144 s"),
             "{text}"
         );
     }

@@ -30,6 +30,29 @@ pub fn fault(f: FaultCode) -> &'static str {
         FaultCode::OverspeedSpin => "spin motor over its speed limit",
         FaultCode::HostSilent => "the PC went silent (link loss)",
         FaultCode::InvalidConfiguration => "the stored configuration is invalid",
+        FaultCode::SensorLostPrecession => {
+            "precession motor: no sensor pulses while the current shows it turning (sensor lost)"
+        }
+        FaultCode::SensorLostSpin => {
+            "spin motor: no sensor pulses while the current shows it turning (sensor lost)"
+        }
+        FaultCode::StallPrecession => {
+            "precession motor: no sensor pulses and no back-EMF in the current (shaft stalled)"
+        }
+        FaultCode::StallSpin => {
+            "spin motor: no sensor pulses and no back-EMF in the current (shaft stalled)"
+        }
+        FaultCode::OverCurrentPrecession => "precession motor: current over its limit",
+        FaultCode::OverCurrentSpin => "spin motor: current over its limit",
+        FaultCode::CurrentAboveModelPrecession => {
+            "precession motor: more current than the duty drives at its speed (bridge stuck on or shorted, or shaft stopped dead)"
+        }
+        FaultCode::CurrentAboveModelSpin => {
+            "spin motor: more current than the duty drives at its speed (bridge stuck on or shorted, or shaft stopped dead)"
+        }
+        FaultCode::HardwareStop => {
+            "hardware stop: over-current or a bridge driver fault switched the motors off (motor supply cut)"
+        }
     }
 }
 
@@ -69,6 +92,15 @@ pub fn fault_token(f: FaultCode) -> &'static str {
         FaultCode::OverspeedSpin => "overspeed-spin",
         FaultCode::HostSilent => "link-lost",
         FaultCode::InvalidConfiguration => "invalid-configuration",
+        FaultCode::SensorLostPrecession => "sensor-lost-precession",
+        FaultCode::SensorLostSpin => "sensor-lost-spin",
+        FaultCode::StallPrecession => "stall-precession",
+        FaultCode::StallSpin => "stall-spin",
+        FaultCode::OverCurrentPrecession => "over-current-precession",
+        FaultCode::OverCurrentSpin => "over-current-spin",
+        FaultCode::CurrentAboveModelPrecession => "current-above-model-precession",
+        FaultCode::CurrentAboveModelSpin => "current-above-model-spin",
+        FaultCode::HardwareStop => "hardware-stop",
     }
 }
 

@@ -1,4 +1,4 @@
-//! `bowl fit results.csv [--json] [--fit-k2]`: the effective rolling resistance `mu` of each
+//! `bowl fit results.csv [--json] [--fit-k2] [--models flat,coriolis,rolling]`: the effective rolling resistance `mu` of each
 //! candidate model (and with `--fit-k2` the granule's `k2` too) from measured residence times,
 //! its 95 % interval, the residuals per condition, and which model the data supports (AIC), by
 //! the lab's fit (`lab::fit`). Method and limits: docs/experiment.md.
@@ -9,7 +9,7 @@ use anyhow::Result;
 use lab::fit::models::{BOWL_CANDIDATES, CANDIDATES, Method};
 use lab::fit::stats::AIC_DECISIVE;
 use lab::fit::{
-    DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit, fit_candidates, load, to_json,
+    DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit_candidates, load, to_json,
 };
 
 /// Arguments of `bowl fit`.
@@ -34,6 +34,15 @@ pub struct Args {
     /// results file's k2 is the starting point).
     #[arg(long)]
     pub fit_k2: bool,
+    /// The models fitted and compared, comma-separated (the rolling model takes by far the
+    /// longest to fit: leave it out for a quick look at the paper's two).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_parser = ["flat", "coriolis", "rolling"],
+        default_value = "flat,coriolis,rolling"
+    )]
+    pub models: Vec<String>,
     /// Also fit the bowl model (docs/model.md section 10) with each of its walls (bare rim,
     /// 60 deg 10 and 20 mm, vertical 20 mm): its parameter is the sliding friction mu_s, and
     /// the AIC says which model and which wall the measured times prefer. Slower (twelve
@@ -54,13 +63,15 @@ pub fn run(args: &Args) -> Result<()> {
     for r in &mut runs {
         r.axes_angle_rad = args.axes_angle_deg.to_radians();
     }
-    let fit = if args.bowl_walls {
-        let mut all = CANDIDATES.to_vec();
-        all.extend(BOWL_CANDIDATES);
-        fit_candidates(runs, excluded, &all, args.fit_k2)?
-    } else {
-        fit(runs, excluded, args.fit_k2)?
-    };
+    let mut candidates: Vec<_> = CANDIDATES
+        .iter()
+        .filter(|c| args.models.iter().any(|m| m == c.name))
+        .copied()
+        .collect();
+    if args.bowl_walls {
+        candidates.extend(BOWL_CANDIDATES);
+    }
+    let fit = fit_candidates(runs, excluded, &candidates, args.fit_k2)?;
     if !args.no_charts {
         let dir = args.charts.clone().unwrap_or_else(|| {
             let stem = args

@@ -15,7 +15,9 @@ const MODELS: Choices<ModelChoice> = &[
     (
         "auto",
         "The chooser picks the least model the scene needs (the tolerance from --tolerance or \
-         --uncertainty) and says why",
+         --uncertainty) and says why; with the tilted bowl's flags (--precession-rad-s, \
+         --spin-rad-s, --axes-angle-deg or --rig-file) over the whole hierarchy: incline, \
+         rolling, rolling-or-sliding, bowl (--tolerance, default 0.01)",
         ModelChoice::Auto,
     ),
     (
@@ -264,6 +266,15 @@ pub struct BowlArgs {
     /// and granule radii in place of --rim-radius-m and --particle-radius-m.
     #[arg(long, value_name = "RIG.toml")]
     rig_file: Option<std::path::PathBuf>,
+    /// Bowl model: also compute what speed can do (T over the rig's speed range and
+    /// dT/domega, docs/model.md §11); on by default, `--speed-range false` skips it (ten more
+    /// runs of the model).
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set, value_name = "BOOL")]
+    speed_range: bool,
+    /// Bowl model: compute the residence-time table at the rig's own speed limits and split
+    /// (read from PORT) and store it on the rig for `rtime table MS` (docs/model.md §11).
+    #[arg(long, value_name = "PORT")]
+    store_table: Option<String>,
 }
 
 impl Args {
@@ -314,6 +325,8 @@ impl Args {
                 restitution: b.restitution,
                 max_time_s: b.max_time_s,
                 rig_file: b.rig_file.clone(),
+                speed_range: b.speed_range,
+                store_table: b.store_table.clone(),
             },
         }
     }

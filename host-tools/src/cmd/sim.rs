@@ -51,6 +51,10 @@ pub struct FaultsArgs {
     /// Speed both axes run at when each fault is injected, rad/s.
     #[arg(long, default_value_t = 3.0)]
     speed_rad_s: f32,
+    /// Give every plant the typical current sense (`current_sense = true`) where its file
+    /// gave none.
+    #[arg(long)]
+    current_sense: bool,
     /// JSON output (the only format; accepted for symmetry with the other reports).
     #[arg(long)]
     json: bool,
@@ -164,6 +168,10 @@ pub struct FamilyArgs {
     /// With --rig-file: the step.
     #[command(flatten)]
     step: StepSpeeds,
+    /// With --rig-file: give every plant the typical current sense (`current_sense = true`)
+    /// where its file gave none.
+    #[arg(long, requires = "rig_file")]
+    current_sense: bool,
     /// JSON output (the only format; accepted for symmetry).
     #[arg(long)]
     json: bool,
@@ -224,7 +232,7 @@ pub fn run(what: &What) -> Result<()> {
         What::Family(a) if a.rig_file.is_some() => {
             let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
             let (from, target) = a.step.checked()?;
-            let rigs = rig_file::load(path)?;
+            let rigs = sensed(rig_file::load(path)?, a.current_sense);
             check_lowest(&rigs, target, "--target-rad-s")?;
             if from > 0.0 {
                 check_lowest(&rigs, from, "--from-rad-s")?;
@@ -241,7 +249,7 @@ pub fn run(what: &What) -> Result<()> {
         }
         What::Faults(a) => {
             check_speed(a.speed_rad_s, "--speed-rad-s")?;
-            let rigs = rig_file::load(&a.rig_file)?;
+            let rigs = sensed(rig_file::load(&a.rig_file)?, a.current_sense);
             check_lowest(&rigs, a.speed_rad_s, "--speed-rad-s")?;
             let plants = parallel(&rigs, |r| sim_reports::fault_plant(r, a.speed_rad_s));
             let out = serde_json::json!({ "plants": plants });
@@ -313,6 +321,17 @@ pub fn run(what: &What) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The rigs, with the typical current sense where `on` and a rig has none.
+fn sensed(rigs: Vec<rig_file::Rig>, on: bool) -> Vec<rig_file::Rig> {
+    if on {
+        rigs.into_iter()
+            .map(rig_file::Rig::with_current_sense)
+            .collect()
+    } else {
+        rigs
+    }
 }
 
 /// A step run that faulted or was never commissioned has no step figures: say so, fail.

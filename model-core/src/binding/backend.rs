@@ -2,13 +2,14 @@
 //! [`Backend`] trait. It keeps the parameters in wire units and the motor models to persist,
 //! and turns the controller's states, faults and refusals into the wire's codes.
 
-use super::configure::{AxisSetting, ParamRole, derive, with_models};
+use super::configure::{AxisSetting, ParamRole, derive, table_from_params, with_models};
 use super::record::{Persisted, Record, persisted, split_persisted};
 use super::{AXES, Injector, default_params};
 use crate::control::{
     BowlSpeedForResidence, Controller, ControllerConfig, Fault, InverseFailure, MotorModel,
     Rejection, State,
 };
+use crate::particle::speed_table::SpeedTable;
 use crate::particle::{self, InverseError, Model, Scene};
 use crate::wire::device::{Backend, ResidenceChoice};
 use crate::wire::{
@@ -35,6 +36,15 @@ impl BowlSpeedForResidence for SceneModel {
             E::Scene(_) | E::InvalidTarget => InverseFailure::ModelRejected,
             _ => InverseFailure::Unreachable,
         })
+    }
+}
+
+/// The stored residence-time table as the controller's inverse (`RTIME TABLE`): refused when
+/// flat or outside its times (docs/model.md §11).
+impl BowlSpeedForResidence for SpeedTable {
+    fn omega_rad_s(&self, target_s: f32) -> Result<f32, InverseFailure> {
+        self.omega_for_s(target_s)
+            .map_err(|_| InverseFailure::Unreachable)
     }
 }
 
@@ -77,6 +87,15 @@ fn fault_code(f: Option<Fault>) -> FaultCode {
         Some(Fault::Overspeed(_)) => FaultCode::OverspeedSpin,
         Some(Fault::HostSilent) => FaultCode::HostSilent,
         Some(Fault::InvalidConfiguration) => FaultCode::InvalidConfiguration,
+        Some(Fault::SensorLost(0)) => FaultCode::SensorLostPrecession,
+        Some(Fault::SensorLost(_)) => FaultCode::SensorLostSpin,
+        Some(Fault::Stall(0)) => FaultCode::StallPrecession,
+        Some(Fault::Stall(_)) => FaultCode::StallSpin,
+        Some(Fault::OverCurrent(0)) => FaultCode::OverCurrentPrecession,
+        Some(Fault::OverCurrent(_)) => FaultCode::OverCurrentSpin,
+        Some(Fault::CurrentAboveModel(0)) => FaultCode::CurrentAboveModelPrecession,
+        Some(Fault::CurrentAboveModel(_)) => FaultCode::CurrentAboveModelSpin,
+        Some(Fault::HardwareStop) => FaultCode::HardwareStop,
     }
 }
 
@@ -240,13 +259,11 @@ impl<I: Injector> ControllerBackend<I> {
         due
     }
 
-    fn model(&self, m: ResidenceModel) -> SceneModel {
+    /// One of the paper's 1-D models on the scene in force.
+    fn model(&self, m: Model) -> SceneModel {
         SceneModel {
             scene: self.scene,
-            model: match m {
-                ResidenceModel::Flat => Model::Flat,
-                ResidenceModel::Coriolis => Model::Coriolis,
-            },
+            model: m,
         }
     }
 }
@@ -273,8 +290,8 @@ impl<I: Injector> Backend for ControllerBackend<I> {
             precession: motor(0),
             spin: motor(1),
             bowl_mrad_s: round(s.combined_measured_rad_s * 1000.0) as u16,
-            residence_flat: predicted(ResidenceModel::Flat),
-            residence_coriolis: predicted(ResidenceModel::Coriolis),
+            residence_flat: predicted(Model::Flat),
+            residence_coriolis: predicted(Model::Coriolis),
         }
     }
 
@@ -300,11 +317,21 @@ impl<I: Injector> Backend for ControllerBackend<I> {
         model: ResidenceModel,
         time_ms: u32,
     ) -> Result<ResidenceChoice, Reason> {
-        let m = self.model(model);
-        match self
-            .ctrl
-            .set_target_residence_time(time_ms as f32 * 1e-3, &m)
-        {
+        let target_s = time_ms as f32 * 1e-3;
+        let chosen = match model {
+            ResidenceModel::Flat => self
+                .ctrl
+                .set_target_residence_time(target_s, &self.model(Model::Flat)),
+            ResidenceModel::Coriolis => self
+                .ctrl
+                .set_target_residence_time(target_s, &self.model(Model::Coriolis)),
+            // The table in force (checked when it was set); none stored: nothing to answer with.
+            ResidenceModel::Table => match table_from_params(&self.params) {
+                Ok(Some(table)) => self.ctrl.set_target_residence_time(target_s, &table),
+                Ok(None) | Err(_) => return Err(Reason::Infeasible),
+            },
+        };
+        match chosen {
             // Within the motors' range (checked), so the casts cannot saturate.
             Ok(speeds) => Ok(ResidenceChoice {
                 model,
@@ -340,8 +367,9 @@ impl<I: Injector> Backend for ControllerBackend<I> {
         match ParamRole::of(id) {
             // Owned by the protocol device, never passed here.
             ParamRole::TelemetryRate => return Err(Reason::Internal),
-            // The scene only feeds RTIME and the predictions: any time.
-            ParamRole::Scene => {}
+            // The scene and the residence-time table only feed RTIME and the predictions: any
+            // time.
+            ParamRole::Scene | ParamRole::ResidenceTable => {}
             // Loop tuning: also while running, bumpless.
             ParamRole::Axis(axis, AxisSetting::Bandwidth | AxisSetting::PerPulseBandwidth) => {
                 let a = cfg.axes.get(axis).ok_or(Reason::Internal)?;
@@ -353,6 +381,7 @@ impl<I: Injector> Backend for ControllerBackend<I> {
             ParamRole::AxesAngle
             | ParamRole::SplitRatio
             | ParamRole::LinkTimeout
+            | ParamRole::CurrentSense
             | ParamRole::Axis(..) => self.ctrl.set_parameters(cfg).map_err(reason)?,
         }
         self.scene = scene;

@@ -12,12 +12,17 @@
 //!   over-speed fault limit follows at [`OVERSPEED_PER_MAX`] times it), `ACCELn_MRAD_S2`
 //!   `accel_limit_rad_s2`, `DUTY_MAXn_BP` `duty_limit`, `TEETHn` `pulses_per_rev` (these only
 //!   while idle or faulted);
-//! - `TELEM_HZ`: the protocol device's telemetry rate (the device owns it).
+//! - `TELEM_HZ`: the protocol device's telemetry rate (the device owns it);
+//! - `RT_W_LO_MRAD_S`, `RT_W_HI_MRAD_S`, `RT_T1_US`..`RT_T8_US`: the residence-time table the PC
+//!   computed with the chosen model ([`table_from_params`], `RTIME TABLE`), any time.
+//! - `CUR_SENSE`: whether the board passes its current samples to the controller (idle or
+//!   faulted: the current watch learns its offset at zero duty).
 
 use super::AXES;
 use crate::Real;
 use crate::control::{AxisConfig, ControllerConfig, MotorModel};
 use crate::particle::Scene;
+use crate::particle::speed_table::{SPEED_TABLE_LEN, SpeedTable};
 use crate::wire::{ParamId, ParamValues, Reason};
 
 /// Over-speed fault limit as a multiple of `SPEED_MAX` (the nominal 5.5 / 4.0 rad/s).
@@ -62,6 +67,10 @@ pub enum ParamRole {
     TelemetryRate,
     /// The host link silence timeout: rebuilds the controller (idle or faulted).
     LinkTimeout,
+    /// The residence-time table (`RTIME TABLE`): like the scene, any time.
+    ResidenceTable,
+    /// Whether the board's current samples reach the controller (idle or faulted).
+    CurrentSense,
 }
 
 impl ParamRole {
@@ -87,6 +96,17 @@ impl ParamRole {
             P::Teeth2 => ParamRole::Axis(1, S::PulsesPerRev),
             P::TelemetryHz => ParamRole::TelemetryRate,
             P::LinkTimeoutMs => ParamRole::LinkTimeout,
+            P::RtSpeedLoMradS
+            | P::RtSpeedHiMradS
+            | P::RtTime1Us
+            | P::RtTime2Us
+            | P::RtTime3Us
+            | P::RtTime4Us
+            | P::RtTime5Us
+            | P::RtTime6Us
+            | P::RtTime7Us
+            | P::RtTime8Us => ParamRole::ResidenceTable,
+            P::CurrentSense => ParamRole::CurrentSense,
         }
     }
 }
@@ -140,7 +160,10 @@ pub fn config_from_params(
     for id in ParamId::ALL {
         let value = params[id.index()];
         match ParamRole::of(id) {
-            ParamRole::Scene | ParamRole::TelemetryRate => {}
+            ParamRole::Scene
+            | ParamRole::TelemetryRate
+            | ParamRole::ResidenceTable
+            | ParamRole::CurrentSense => {}
             ParamRole::AxesAngle => cfg.axes_angle_rad = (value as f32 * 1e-3).to_radians(),
             ParamRole::SplitRatio => cfg.spin_per_precession = value as f32 * 1e-6,
             ParamRole::LinkTimeout => cfg.host_timeout_s = value as f32 / 1000.0,
@@ -166,12 +189,65 @@ pub(crate) fn with_models(
     cfg
 }
 
-/// Controller configuration and scene for a set of wire parameters, or why they do not fit.
+/// The residence-time table's parameters in wire order: the two speeds, then the eight times.
+pub const TABLE_PARAMS: [ParamId; 2 + SPEED_TABLE_LEN] = [
+    ParamId::RtSpeedLoMradS,
+    ParamId::RtSpeedHiMradS,
+    ParamId::RtTime1Us,
+    ParamId::RtTime2Us,
+    ParamId::RtTime3Us,
+    ParamId::RtTime4Us,
+    ParamId::RtTime5Us,
+    ParamId::RtTime6Us,
+    ParamId::RtTime7Us,
+    ParamId::RtTime8Us,
+];
+
+/// The residence-time table the parameters hold: `Ok(None)` while it is off
+/// (`RT_W_HI_MRAD_S` not above `RT_W_LO_MRAD_S`, so a PC writing a table sets the fastest
+/// speed last), [`Reason::Range`] when it is on and a time is 0.
+pub fn table_from_params(params: &ParamValues) -> Result<Option<SpeedTable>, Reason> {
+    let p = |id: ParamId| params[id.index()];
+    let (lo, hi) = (p(ParamId::RtSpeedLoMradS), p(ParamId::RtSpeedHiMradS));
+    if hi <= lo {
+        return Ok(None);
+    }
+    let mut times = [0.0f32; SPEED_TABLE_LEN];
+    for (slot, id) in times.iter_mut().zip(&TABLE_PARAMS[2..]) {
+        *slot = p(*id) as f32 * 1e-6;
+    }
+    SpeedTable::new(lo as f32 * 1e-3, hi as f32 * 1e-3, times)
+        .map(Some)
+        .map_err(|_| Reason::Range)
+}
+
+/// The wire values of a table (speeds rounded to mrad/s, times to us), in [`TABLE_PARAMS`]
+/// order, or [`Reason::Range`] if one is outside its parameter's range (a time over 8 s).
+pub fn table_to_params(table: &SpeedTable) -> Result<[i32; 2 + SPEED_TABLE_LEN], Reason> {
+    let (lo, hi) = table.speed_range_rad_s();
+    let mut out = [0i32; 2 + SPEED_TABLE_LEN];
+    let values = [lo * 1e3, hi * 1e3]
+        .into_iter()
+        .chain(table.residence_s().iter().map(|t| t * 1e6));
+    for ((slot, id), x) in out.iter_mut().zip(TABLE_PARAMS).zip(values) {
+        let (min, max) = id.range();
+        let v = libm::roundf(x);
+        if !(v >= min as f32 && v <= max as f32) {
+            return Err(Reason::Range);
+        }
+        *slot = v as i32;
+    }
+    Ok(out)
+}
+
+/// Controller configuration and scene for a set of wire parameters, or why they do not fit
+/// (the residence-time table too, when it is on).
 pub(crate) fn derive(
     base: &ControllerConfig,
     params: &ParamValues,
 ) -> Result<(ControllerConfig, Scene<f32>), Reason> {
     let scene = scene_from_params(params)?;
+    table_from_params(params)?;
     Ok((config_from_params(base, params)?, scene))
 }
 
@@ -214,6 +290,19 @@ mod tests {
             // The rig's link-loss timeout is on (3 s) by default; the controller's own
             // default is off so the closed-loop simulations need no heartbeat.
             3_000,
+            // No residence-time table: speeds 0, times 0.
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            // Pulses only until the board is said to measure its currents.
+            0,
         ];
         assert_eq!(default_params(), expected);
         let derived = config_from_params(&cfg, &default_params()).expect("defaults pass");

@@ -24,7 +24,8 @@ pub mod record;
 
 pub use backend::ControllerBackend;
 pub use configure::{
-    OVERSPEED_PER_MAX, ParamRole, config_from_params, default_params, scene_from_params,
+    OVERSPEED_PER_MAX, ParamRole, TABLE_PARAMS, config_from_params, default_params,
+    scene_from_params, table_from_params, table_to_params,
 };
 pub use record::{
     PERSISTED_COUNT, Persisted, Record, default_persisted, persisted, split_persisted,

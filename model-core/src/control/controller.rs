@@ -2,10 +2,12 @@
 //!
 //! - this file: the state, its construction, the control tick and the telemetry snapshot;
 //! - [`axis`]: one motor axis's runtime state (estimator, loop, sensor watch, outputs);
-//! - [`commands`]: the host's commands, each of which also counts as hearing from the host.
+//! - [`commands`]: the host's commands, each of which also counts as hearing from the host;
+//! - [`current`]: the current sense's samples, trips and the supply cut.
 
 mod axis;
 mod commands;
+mod current;
 
 use super::const_trig::{cos_const, sin_const};
 
@@ -119,6 +121,8 @@ pub struct Controller {
     decouple_duty_per_rad_s: f32,
     /// Both references were reached since the last start or setpoint (arms the runaway check).
     reached: bool,
+    /// The supply cut is asked open: a bridge drove harder than it was told.
+    supply_cut: bool,
 }
 
 /// Precession duty per rad/s of `r - r_p` of the spin (its model accelerates at
@@ -215,6 +219,7 @@ impl Controller {
             sin_axes: sin_const(cfg.axes_angle_rad),
             decouple_duty_per_rad_s: decouple_duty_per_rad_s(&cfg),
             reached: false,
+            supply_cut: false,
         }
     }
 
@@ -224,6 +229,33 @@ impl Controller {
     /// the timestamps captured on that axis since the previous tick, oldest first. Returns the
     /// duties `[precession, spin]` in -1..=1 (sign = direction; 0 = coast).
     pub fn tick(&mut self, now_ticks: u32, edges: [&[u32]; 2]) -> [f32; 2] {
+        self.tick_with_currents(now_ticks, edges, [None; 2])
+    }
+
+    /// [`Controller::tick`] on a board with current sense: `currents_a[axis]` is the bridge's
+    /// current-sense reading at the end of the last period (under the duty this controller
+    /// returned last tick), A, signed in the motor's positive direction, sampled in step with
+    /// the PWM; None where the axis has no current sense. Every sample is checked against
+    /// the over-current and model limits (see [`CurrentWatch`]): a trip latches
+    /// [`Fault::OverCurrent`] or [`Fault::CurrentAboveModel`] in this tick, and a bridge that
+    /// drives harder than it is told (a current at zero duty, or more than the duty drives into
+    /// a held shaft) or an over-current also asks for the supply cut
+    /// ([`Controller::supply_cut_requested`]).
+    ///
+    /// [`CurrentWatch`]: super::supervisor::CurrentWatch
+    pub fn tick_with_currents(
+        &mut self,
+        now_ticks: u32,
+        edges: [&[u32]; 2],
+        currents_a: [Option<f32>; 2],
+    ) -> [f32; 2] {
+        // The duties the readings were taken under (a trip on one axis zeroes both).
+        let applied = [self.axes[0].duty, self.axes[1].duty];
+        for (i, c) in currents_a.iter().enumerate() {
+            if let Some(reading) = *c {
+                self.current_sample(i, reading, applied[i]);
+            }
+        }
         if self.state == State::Commissioning {
             return self.tick_commissioning(now_ticks, edges);
         }
@@ -246,6 +278,9 @@ impl Controller {
             let speed = a.est.tick(now_ticks, edges[i], steady_i, |_, _| {});
             seen[i] = a.est.accepted_edges() != before;
             a.measured = a.direction * speed;
+            if seen[i] && steady_i {
+                a.current.note_turning();
+            }
             // Runaway (a bridge stuck on): once both axes have reached their references, an
             // edge that came far sooner than the plant model expects faults at once, without
             // waiting for the filtered speed to reach the absolute limit.
@@ -417,7 +452,7 @@ impl Controller {
             a.speed_loop.model_rad_s(),
             a.est.rad_per_pulse(),
         ) {
-            self.latch(Fault::SensorLostOrStall(i as u8));
+            self.latch(self.lost_edges_fault(i));
             return true;
         }
         false
@@ -498,11 +533,16 @@ impl Controller {
     #[inline(never)]
     fn rebuild_keep_state(&mut self, cfg: ControllerConfig) {
         let est = [self.axes[0].est, self.axes[1].est];
+        let current = [self.axes[0].current, self.axes[1].current];
         let identified = self.identified;
         let feedback = self.feedback;
+        let supply_cut = self.supply_cut;
         *self = Self::build(cfg);
-        self.axes[0].est = est[0];
-        self.axes[1].est = est[1];
+        self.supply_cut = supply_cut;
+        for (a, (e, c)) in self.axes.iter_mut().zip(est.into_iter().zip(current)) {
+            a.est = e;
+            a.current = c;
+        }
         self.identified = identified;
         self.feedback = feedback;
     }
@@ -520,6 +560,13 @@ impl Controller {
         }
         self.planner.reset();
         self.commissioning = None;
+    }
+
+    /// The board's hardware stop (its break input) tripped: latch [`Fault::HardwareStop`] (a
+    /// fault already latched is kept). The board calls it at every tick while the stop's line
+    /// is active, so a CLEAR holds only once the line is released.
+    pub fn hardware_stop(&mut self) {
+        self.latch(Fault::HardwareStop);
     }
 
     /// Feedback on or off (diagnostics and the test that shows the feedforward alone is not

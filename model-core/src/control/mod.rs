@@ -77,4 +77,4 @@ pub use config::{
 };
 pub use controller::{AxisStatus, Controller, Rejection, Status};
 pub use planner::{BowlSpeedForResidence, InverseFailure, ResidenceForBowlSpeed};
-pub use supervisor::{Fault, State};
+pub use supervisor::{CurrentTrip, CurrentWatch, DetectedBy, Fault, State};

@@ -32,6 +32,7 @@ pub mod named_scenes;
 mod phi;
 pub(crate) mod radial;
 pub mod rolling;
+pub mod speed_table;
 
 pub use inverse::{InverseError, omega_for_residence_time};
 pub use radial::{OdeError, integrate, integrate_constant};

@@ -31,7 +31,12 @@ impl ClosedLoop {
     /// and its duties drive the rig through the next period.
     pub fn tick(&mut self) -> [f32; 2] {
         let now = self.rig.now_ticks();
-        let duties = self.ctrl.tick(now, [self.rig.edges(0), self.rig.edges(1)]);
+        let currents = [self.rig.sensed_current_a(0), self.rig.sensed_current_a(1)];
+        let edges = [self.rig.edges(0), self.rig.edges(1)];
+        let duties = self.ctrl.tick_with_currents(now, edges, currents);
+        if self.ctrl.supply_cut_requested() {
+            self.rig.cut_supply();
+        }
         self.rig.advance(duties, self.dt_s);
         self.duties = duties;
         duties

@@ -20,4 +20,4 @@ pub mod prng;
 pub use assembly::{ASSEMBLY_COMMISSION_MAX_S, AssemblyError, commission_on_plant};
 pub use harness::{ClosedLoop, SETTLING_BAND, StepMetrics, StepReport};
 pub use motor::{MotorParams, MotorState};
-pub use plant::{AxisFaults, AxisParams, Plant, PlantParams, SensorParams};
+pub use plant::{AxisFaults, AxisParams, CurrentSense, Plant, PlantParams, SensorParams};

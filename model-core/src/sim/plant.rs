@@ -42,6 +42,10 @@ pub struct AxisFaults {
     /// at full duty in the commanded direction (a shorted driver input); a zero duty still
     /// coasts (the driver's enable follows the controller's stop).
     pub bridge_stuck_from_s: f32,
+    /// From this time on, the bridge is shorted: it drives the motor at full duty whatever the
+    /// controller commands, zero included (a shorted FET pair), in the direction of the last
+    /// nonzero duty; only the supply cut ([`Plant::cut_supply`]) stops it.
+    pub bridge_shorted_from_s: f32,
 }
 
 impl AxisFaults {
@@ -55,6 +59,43 @@ impl AxisFaults {
         load_step_from_s: f32::INFINITY,
         load_step_nm: 0.0,
         bridge_stuck_from_s: f32::INFINITY,
+        bridge_shorted_from_s: f32::INFINITY,
+    };
+}
+
+/// The H-bridge's current-sense output of one axis as the MCU's ADC reads it, sampled once per
+/// control tick in step with the PWM (VNH5019 CS, BTS7960 IS, or a shunt and amplifier), with
+/// the errors a real one has. The armature current flows through the sense only while the
+/// bridge drives: a coasting bridge's (or a cut supply's) reading is the offset and the noise.
+/// Signed in the motor's positive direction (firmware multiplies an unsigned CS reading by
+/// the direction the bridge drives).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurrentSense {
+    /// The axis has one (rig file `current_sense = true`); most rigs have none yet.
+    pub enabled: bool,
+    /// Zero offset, A (added to every reading).
+    pub offset_a: f32,
+    /// Gain error, fraction (a reading is `(1 + gain_error) * i + offset + noise`).
+    pub gain_error: f32,
+    /// Noise, A (uniform in +/- this, independent per sample).
+    pub noise_a: f32,
+}
+
+impl CurrentSense {
+    /// No current sense.
+    pub const NONE: Self = Self {
+        enabled: false,
+        offset_a: 0.0,
+        gain_error: 0.0,
+        noise_a: 0.0,
+    };
+    /// A typical sense chain when `current_sense = true` and no error keys are given: 20 mA
+    /// offset, 3 % gain error, 10 mA noise (a VNH5019's CS through a 12-bit ADC).
+    pub const TYPICAL: Self = Self {
+        enabled: true,
+        offset_a: 0.02,
+        gain_error: 0.03,
+        noise_a: 0.01,
     };
 }
 
@@ -72,6 +113,8 @@ pub struct AxisParams {
     pub load_step_nm: f32,
     /// Injected faults.
     pub faults: AxisFaults,
+    /// The bridge's current-sense output, if the rig has one.
+    pub current_sense: CurrentSense,
 }
 
 /// The whole rig.
@@ -111,6 +154,7 @@ impl PlantParams {
                     ripple_nm: 0.002,
                     load_step_nm: 0.0,
                     faults: AxisFaults::NONE,
+                    current_sense: CurrentSense::NONE,
                 },
                 AxisParams {
                     motor: MotorParams::nominal_spin(),
@@ -118,6 +162,7 @@ impl PlantParams {
                     ripple_nm: 0.002,
                     load_step_nm: 0.0,
                     faults: AxisFaults::NONE,
+                    current_sense: CurrentSense::NONE,
                 },
             ],
             supply_v: 12.0,
@@ -149,6 +194,8 @@ struct AxisSim {
     lost_overflow: u32,
     edges_emitted: u32,
     torque_nm: f32,
+    /// Sign of the last nonzero duty commanded (a shorted bridge drives that way).
+    last_direction: f32,
 }
 
 /// The simulated rig.
@@ -160,6 +207,10 @@ pub struct Plant {
     rng: Prng,
     seed: u32,
     mask: u32,
+    /// Control periods so far (indexes the current sense's noise).
+    tick_count: u32,
+    /// The supply cut is open: no bridge drives (see [`Plant::cut_supply`]).
+    supply_cut: bool,
 }
 
 impl Plant {
@@ -175,6 +226,7 @@ impl Plant {
             lost_overflow: 0,
             edges_emitted: 0,
             torque_nm: 0.0,
+            last_direction: 1.0,
         };
         let mut axes = [a; 2];
         // Start between teeth, not on one.
@@ -189,6 +241,8 @@ impl Plant {
             time_s: 0.0,
             rng: Prng::new(seed),
             seed,
+            tick_count: 0,
+            supply_cut: false,
             mask: if p.timer_bits >= 32 {
                 u32::MAX
             } else {
@@ -221,6 +275,33 @@ impl Plant {
     pub fn current_a(&self, axis: usize) -> f32 {
         self.axes[axis].motor.current_a
     }
+    /// The current-sense reading of an axis at the end of the last control period, A (sampled
+    /// in step with the PWM): `(1 + gain_error) i + offset + noise`, where `i` is the armature
+    /// current while the bridge drives and 0 while it coasts. None where the axis has no
+    /// current sense.
+    pub fn sensed_current_a(&self, axis: usize) -> Option<f32> {
+        let c = self.p.axes[axis].current_sense;
+        if !c.enabled {
+            return None;
+        }
+        let i = self.axes[axis].motor.current_a;
+        let n = self.tick_count.wrapping_mul(2).wrapping_add(axis as u32);
+        let noise = c.noise_a * hashed_symmetric(self.seed ^ 0x00c0_ffee, n);
+        Some((1.0 + c.gain_error) * i + c.offset_a + noise)
+    }
+    /// Opens the supply cut (a relay or high-side switch ahead of both bridges): from now on no
+    /// bridge drives, whatever it is told or however it failed. Stays open.
+    pub fn cut_supply(&mut self) {
+        self.supply_cut = true;
+    }
+    /// Closes the supply cut again (a board that switches its supply back on after CLEAR).
+    pub fn restore_supply(&mut self) {
+        self.supply_cut = false;
+    }
+    /// The supply cut is open.
+    pub fn supply_is_cut(&self) -> bool {
+        self.supply_cut
+    }
     /// Capture timer value now.
     pub fn now_ticks(&self) -> u32 {
         ticks_of(self.time_s, self.p.timer_hz) & self.mask
@@ -243,6 +324,7 @@ impl Plant {
         for a in &mut self.axes {
             a.len = 0;
         }
+        self.tick_count = self.tick_count.wrapping_add(1);
         let n = self.p.substeps.max(1);
         let h = dt_s / n as f32;
         for _ in 0..n {
@@ -267,6 +349,15 @@ impl Plant {
             };
             if d != 0.0 && t0 as f32 >= f.bridge_stuck_from_s {
                 d = d.signum();
+            }
+            if d != 0.0 {
+                ax.last_direction = d.signum();
+            }
+            if t0 as f32 >= f.bridge_shorted_from_s {
+                d = ax.last_direction;
+            }
+            if self.supply_cut {
+                d = 0.0;
             }
             let volts = if d == 0.0 {
                 None

@@ -339,7 +339,10 @@ command_table! {
         example "rtime cori 2500",
         meaning "choose the bowl speed for this residence time; the answer `$W1,id,MODEL,w1,w2` \
                  names the model that answered and the motor setpoints it chose (mrad/s); \
-                 `INFEASIBLE` if no speed within the limits gives it"
+                 `INFEASIBLE` if no speed within the limits gives it. `TABLE`: the table of \
+                 times the PC computed with the chosen model and stored in the `RT_*` \
+                 parameters, inverted by interpolation; `INFEASIBLE` outside its times, when \
+                 speed barely moves them (span under 1 %) or with no table stored"
     {
         /// Which model the target refers to.
         model: ResidenceModel = FieldKind::Choice(&ResidenceModel::TOKENS), "", "a residence model";

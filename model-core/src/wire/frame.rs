@@ -50,7 +50,7 @@ pub enum Frame {
     },
     /// `$E1`: a gate event (device to PC).
     Event(GateEvent),
-    /// `$W1`: the answer to RTIME: the model that answered (`FLAT` or `CORI`) and the motor
+    /// `$W1`: the answer to RTIME: the model that answered (`FLAT`, `CORI` or `TABLE`) and the motor
     /// setpoints it chose, mrad/s.
     ResidenceSet {
         /// Request id.

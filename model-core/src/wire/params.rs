@@ -116,6 +116,32 @@ parameter_table! {
     /// Host link silence (no command, PING included) after which a driving rig faults and
     /// stops both motors; 0 disables the check. Host tools PING every second.
     LinkTimeoutMs: "LINK_TIMEOUT_MS", "ms", range (0, 3_600_000), default 3_000;
+    /// What speed can do (`RTIME TABLE`, docs/model.md §11): the slowest bowl speed of the
+    /// residence-time table the PC computed and stored; the table is off while
+    /// `RT_W_HI_MRAD_S` is not above it.
+    RtSpeedLoMradS: "RT_W_LO_MRAD_S", "mrad/s", range (0, 99_999), default 0;
+    /// The table's fastest bowl speed (0 = no table).
+    RtSpeedHiMradS: "RT_W_HI_MRAD_S", "mrad/s", range (0, 99_999), default 0;
+    /// The table's residence time at its slowest speed (entry 1 of 8).
+    RtTime1Us: "RT_T1_US", "us", range (0, 8_000_000), default 0;
+    /// The table's residence time at speed number 2 of 8 (evenly spaced).
+    RtTime2Us: "RT_T2_US", "us", range (0, 8_000_000), default 0;
+    /// The table's residence time at speed number 3 of 8 (evenly spaced).
+    RtTime3Us: "RT_T3_US", "us", range (0, 8_000_000), default 0;
+    /// The table's residence time at speed number 4 of 8 (evenly spaced).
+    RtTime4Us: "RT_T4_US", "us", range (0, 8_000_000), default 0;
+    /// The table's residence time at speed number 5 of 8 (evenly spaced).
+    RtTime5Us: "RT_T5_US", "us", range (0, 8_000_000), default 0;
+    /// The table's residence time at speed number 6 of 8 (evenly spaced).
+    RtTime6Us: "RT_T6_US", "us", range (0, 8_000_000), default 0;
+    /// The table's residence time at speed number 7 of 8 (evenly spaced).
+    RtTime7Us: "RT_T7_US", "us", range (0, 8_000_000), default 0;
+    /// The table's residence time at its fastest speed (entry 8 of 8).
+    RtTime8Us: "RT_T8_US", "us", range (0, 8_000_000), default 0;
+    /// The board measures the motor currents (docs/wiring.md: a current-sense amplifier on each
+    /// motor lead into the ADC): 1 turns on the current trips (over-current, a bridge driving
+    /// harder than told, the supply cut) and tells a stall from a dead sensor; 0 = pulses only.
+    CurrentSense: "CUR_SENSE", "0/1", range (0, 1), default 0;
 }
 
 /// The values of all parameters, indexed by [`ParamId::index`].

@@ -45,6 +45,27 @@ pub enum FaultCode {
     HostSilent = 5,
     /// The configuration is invalid, or commissioning failed.
     InvalidConfiguration = 6,
+    /// Precession: no pulse, and the current shows a turning shaft (sensor dead).
+    SensorLostPrecession = 7,
+    /// Spin: no pulse, and the current shows a turning shaft (sensor dead).
+    SensorLostSpin = 8,
+    /// Precession: no pulse, and the current shows no back-EMF (shaft blocked).
+    StallPrecession = 9,
+    /// Spin: no pulse, and the current shows no back-EMF (shaft blocked).
+    StallSpin = 10,
+    /// Precession: current above the over-current limit.
+    OverCurrentPrecession = 11,
+    /// Spin: current above the over-current limit.
+    OverCurrentSpin = 12,
+    /// Precession: more current than the duty drives at the measured speed (a bridge stuck on
+    /// or shorted).
+    CurrentAboveModelPrecession = 13,
+    /// Spin: more current than the duty drives at the measured speed (a bridge stuck on or
+    /// shorted).
+    CurrentAboveModelSpin = 14,
+    /// The board's hardware stop (break input: over-current comparator or driver fault) cut the
+    /// PWM; the motor supply is cut too where the board has the switch.
+    HardwareStop = 15,
 }
 
 /// What caused the last reset of the microcontroller (STM32 RCC_CSR flags).
@@ -75,6 +96,9 @@ pub enum ResidenceModel {
     Flat,
     /// With the Coriolis friction term (paper Eq. 9-11, coefficients corrected). Token `CORI`.
     Coriolis,
+    /// The residence-time table the PC computed with the model chosen for the rig's bowl, tilt
+    /// and granule and stored in the `RT_*` parameters (docs/model.md §11). Token `TABLE`.
+    Table,
 }
 
 /// A predicted residence time as sent in telemetry.
@@ -257,7 +281,8 @@ pub enum Reason {
     /// Not allowed in the current state (for instance START while faulted). Token `STATE`.
     State,
     /// The target cannot be reached (for instance a residence time the bowl cannot produce
-    /// within the speed limit, or a particle that never leaves). Token `INFEASIBLE`.
+    /// within the speed limit, a particle that never leaves, a residence-time table that speed
+    /// barely moves, or no table stored for `RTIME TABLE`). Token `INFEASIBLE`.
     Infeasible,
     /// This device does not do that (fault injection on real hardware). Token `UNSUPPORTED`.
     Unsupported,
@@ -330,6 +355,15 @@ code_enum!(FaultCode {
     OverspeedSpin,
     HostSilent,
     InvalidConfiguration,
+    SensorLostPrecession,
+    SensorLostSpin,
+    StallPrecession,
+    StallSpin,
+    OverCurrentPrecession,
+    OverCurrentSpin,
+    CurrentAboveModelPrecession,
+    CurrentAboveModelSpin,
+    HardwareStop,
 });
 code_enum!(GateKind { Release, Exit });
 code_enum!(ResetCause {
@@ -344,10 +378,14 @@ code_enum!(ResetCause {
 
 impl ResidenceModel {
     /// Every model, in the order of [`ResidenceModel::TOKENS`].
-    pub const ALL: [ResidenceModel; 2] = [ResidenceModel::Flat, ResidenceModel::Coriolis];
+    pub const ALL: [ResidenceModel; 3] = [
+        ResidenceModel::Flat,
+        ResidenceModel::Coriolis,
+        ResidenceModel::Table,
+    ];
 
     /// The wire tokens, in the order of [`ResidenceModel::ALL`].
-    pub const TOKENS: [&'static str; 2] = ["FLAT", "CORI"];
+    pub const TOKENS: [&'static str; 3] = ["FLAT", "CORI", "TABLE"];
 
     /// The wire token.
     pub fn token(self) -> &'static str {

@@ -22,7 +22,7 @@ pub fn device_state() -> impl Strategy<Value = DeviceState> {
 }
 
 pub fn fault() -> impl Strategy<Value = FaultCode> {
-    (0i64..7).prop_map(|c| FaultCode::from_code(c).unwrap())
+    (0i64..15).prop_map(|c| FaultCode::from_code(c).unwrap())
 }
 
 pub fn reset_cause() -> impl Strategy<Value = ResetCause> {

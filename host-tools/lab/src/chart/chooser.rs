@@ -12,11 +12,18 @@ use model_core::choose::{Need, Plan, Source, Target, choose_varying_for, plan_co
 use model_core::ode::{Limits, Method, OdeOutcome, SpinUp};
 use model_core::particle::{self, Model, Scene};
 
+// DP5(4) at a tolerance by the one rule of `bowl predict --method dp54 --tol` and the
+// work-precision chart, for the reference, the brute-force grid and the baseline alike: a
+// tolerance in this chart's table is the plan the CLI runs at that tolerance (the chart had its
+// own absolute tolerance, `rtol R / 100`, a third rule; host-tools/tests/predict_plan.rs).
+use crate::predict::ode::dp54;
+
 use super::plot::{Figure, Mark, Scale, Series};
 use super::table::Table;
 
-/// `T` of one run, infinite when it does not leave (or fails).
-fn time(s: &Scene<f64>, m: Model, p: &SpinUp<f64>, method: Method<f64>) -> (f64, u32) {
+/// `T` of one run and its right-hand-side evaluations; `T` infinite when it does not leave (or
+/// fails).
+pub fn time(s: &Scene<f64>, m: Model, p: &SpinUp<f64>, method: Method<f64>) -> (f64, u32) {
     let limits = Limits::for_scene(s, p);
     match particle::integrate(s, m, p, method, limits) {
         Ok(r) => match r.outcome {
@@ -29,11 +36,10 @@ fn time(s: &Scene<f64>, m: Model, p: &SpinUp<f64>, method: Method<f64>) -> (f64,
     }
 }
 
-fn dp(rtol: f64, s: &Scene<f64>) -> Method<f64> {
-    Method::Dp54 {
-        rtol,
-        atol: rtol * s.rim_radius_m * 1e-2,
-    }
+/// Not choosing: an adaptive method told the tolerance (DP5(4) at a tenth of it), the usual way
+/// to meet a tolerance without knowing the scene; the chart's baseline for what choosing saves.
+pub fn not_choosing(tolerance: f64, s: &Scene<f64>) -> Method<f64> {
+    dp54(tolerance * 0.1, s)
 }
 
 /// A plan found by brute force: (cost, method, error).
@@ -60,7 +66,7 @@ fn cheapest(
             .map(|k| Method::SemiImplicitEuler { step_s: steps(k) })
             .collect(),
         (0..44)
-            .map(|k| dp(0.1 * 10f64.powf(-f64::from(k) / 4.0), s))
+            .map(|k| dp54(0.1 * 10f64.powf(-f64::from(k) / 4.0), s))
             .collect(),
     ];
     let cheaper = |a: Option<Found>, b: Found| match a {
@@ -176,7 +182,7 @@ pub fn chart() -> Result<(Figure, Figure, Table)> {
                     let Plan::Integrate(method) = c.plan else {
                         continue;
                     };
-                    let (t_ref, _) = time(&s, c.model, &p, dp(1e-12, &s));
+                    let (t_ref, _) = time(&s, c.model, &p, dp54(1e-12, &s));
                     if !t_ref.is_finite() {
                         continue;
                     }
@@ -188,9 +194,7 @@ pub fn chart() -> Result<(Figure, Figure, Table)> {
                         std::hint::black_box(time(&s, c.model, &p, method));
                     });
                     choosing_ratios.push(choosing_ns / plan_ns);
-                    // Not choosing: an adaptive method told the tolerance (DP5(4) at a tenth
-                    // of it), the usual way to meet a tolerance without knowing the scene.
-                    let adaptive = dp(tolerance * 0.1, &s);
+                    let adaptive = not_choosing(tolerance, &s);
                     let (t_adaptive, _) = time(&s, c.model, &p, adaptive);
                     let adaptive_ns = best_ns(|| {
                         std::hint::black_box(time(&s, c.model, &p, adaptive));

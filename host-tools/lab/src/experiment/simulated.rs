@@ -45,6 +45,16 @@ fn fault_words(fault: Option<Fault>) -> String {
         Some(Fault::SensorLostOrStall(a)) => format!("{} sensor lost or shaft stalled", axis(a)),
         Some(Fault::Overspeed(a)) => format!("{} over speed", axis(a)),
         Some(Fault::HostSilent) => "host silent".into(),
+        Some(Fault::SensorLost(a)) => format!("{} sensor lost", axis(a)),
+        Some(Fault::Stall(a)) => format!("{} shaft stalled", axis(a)),
+        Some(Fault::OverCurrent(a)) => format!("{} over current", axis(a)),
+        Some(Fault::CurrentAboveModel(a)) => {
+            format!(
+                "{} current above the model (bridge stuck on or shorted, or shaft stopped dead)",
+                axis(a)
+            )
+        }
+        Some(Fault::HardwareStop) => "hardware stop (break input)".into(),
         Some(Fault::InvalidConfiguration) | None => "invalid configuration".into(),
     }
 }

@@ -272,6 +272,49 @@ pub fn mu_ceiling_for(run: &Run, equation: Equation) -> f64 {
 
 /// The largest `mu` at which the run can leave: `ri omega^2 / g` at its fastest speed.
 pub fn mu_ceiling(run: &Run) -> f64 {
-    let fastest = run.trace.iter().map(|p| p.1).fold(run.mean_rad_s, f64::max);
+    let fastest = fastest_rad_s(run);
     run.release_radius_m * fastest * fastest / G_M_S2
+}
+
+/// The run's fastest measured speed (its trace's, or the mean if higher), rad/s: no model is
+/// given a faster one.
+pub fn fastest_rad_s(run: &Run) -> f64 {
+    run.trace.iter().map(|p| p.1).fold(run.mean_rad_s, f64::max)
+}
+
+/// The shortest residence time any candidate model can give the run at any resistance, s: a
+/// measured time below it is not a release of this run (a slip of a unit, a gate fired twice).
+///
+/// The bound: the granule starts at rest relative to the bowl at `ri` and must travel at least
+/// `R - ri` to reach the rim. Along its path (length `s`, speed `v = s'`) only these forces can
+/// raise its speed, in every candidate (docs/model.md sections 2 and 9; the rolling model as the
+/// fit runs it: equal motor speeds, no rod offset, a 3 mm sphere of radius `a`): gravity's
+/// in-plane part (at most `g`), the centrifugal and Euler terms of the turning frame (at most
+/// `omega^2 |p|` and `omega^2 |p| / 2` with `|p| <= ri + s + a`, since `w1 w2 <= omega^2 / 2`
+/// for axes at most 90 degrees apart, paper Eq. 2), and for the rolling sphere the coupling to
+/// its spin about the axis (at most `omega^2 s + omega^2 a / 2`, its spin starting at zero and
+/// changing at most at `omega v`); `k2 <= 1` only scales these down. Friction and rolling
+/// resistance act against the motion, and the Coriolis and gyroscopic terms are perpendicular
+/// to it: they never speed it up. So `v' <= b + c s` with `c = 5/2 omega^2` and
+/// `b = g + omega^2 (3/2 ri + 2 a)`, `omega` the run's fastest measured speed, and by comparison
+/// (`s'' = b + c s` from rest) `s(t) <= (b / c)(cosh(sqrt(c) t) - 1)`: the rim is reached no
+/// sooner than `acosh(1 + c (R - ri) / b) / sqrt(c)`. The paper's frictionless `r'' = omega^2 r`
+/// is inside it (`acosh(R / ri) / omega` is longer); on the rig (7 rad/s, 0.05 m to 0.15 m) the
+/// bound is 0.11 s against 0.30 s without friction.
+pub fn shortest_residence_s(run: &Run) -> f64 {
+    let fastest = fastest_rad_s(run);
+    let a =
+        RollingScene::equal_speeds(fastest, run.axes_angle_rad, run.rim_radius_m).particle_radius_m;
+    let w2 = fastest * fastest;
+    let c = 2.5 * w2;
+    let b = G_M_S2 + w2 * (1.5 * run.release_radius_m + 2.0 * a);
+    let distance = run.rim_radius_m - run.release_radius_m;
+    if c > 0.0 {
+        // acosh(1 + x), accurate for small x too.
+        let x = c * distance / b;
+        (x + (x * (x + 2.0)).sqrt()).ln_1p() / c.sqrt()
+    } else {
+        // Not turning: gravity alone.
+        (2.0 * distance / b).sqrt()
+    }
 }

@@ -2,7 +2,9 @@
 //!
 //! * **refused**: an `ok` row whose residence time no release can have. Both rigs give a release
 //!   up after [`RIG_GIVE_UP_S`] (status `never_left`), so a recorded time above it (1e300 s, a
-//!   typing slip of a unit) is not a measurement; the fit stops and names every such row.
+//!   typing slip of a unit) is not a measurement; nor is one below the time the fastest possible
+//!   release takes (`models::shortest_residence_s`: no friction, gravity and the frame's forces
+//!   at full strength; a time in ms typed as s). The fit stops and names every such row.
 //! * **outliers**: a release far from what the other releases say. Each paper model (flat,
 //!   Coriolis) is fitted by least absolute deviations, which one wild value cannot drag; the
 //!   model that fits best in that sense gives each run's relative residual; the residuals' scale
@@ -17,7 +19,9 @@
 use serde::Serialize;
 
 use super::ModelFit;
-use super::models::{CANDIDATES, Equation, Run, mu_ceiling_for, predict};
+use super::models::{
+    CANDIDATES, Equation, Run, fastest_rad_s, mu_ceiling_for, predict, shortest_residence_s,
+};
 use super::stats::minimise;
 
 /// The longest a release can last on either rig before it is recorded as `never_left`, s.
@@ -46,19 +50,48 @@ pub struct Outlier {
 
 /// The rows whose residence time no release can have, in words; `None` when there are none.
 pub fn impossible(runs: &[Run]) -> Option<String> {
-    let bad: Vec<String> = runs
+    let too_long: Vec<String> = runs
         .iter()
         .filter(|r| r.residence_s > RIG_GIVE_UP_S)
         .map(|r| format!("line {}: residence time {:e} s", r.row, r.residence_s))
         .collect();
-    if bad.is_empty() {
+    let too_short: Vec<String> = runs
+        .iter()
+        .filter_map(|r| {
+            let least = shortest_residence_s(r);
+            (r.residence_s < least).then(|| {
+                let fastest = fastest_rad_s(r);
+                format!(
+                    "line {}: residence time {:e} s, under the {least:.3} s that the fastest \
+                     possible release takes from rest at {} m to the rim at {} m with the bowl \
+                     at up to {fastest:.2} rad/s",
+                    r.row, r.residence_s, r.release_radius_m, r.rim_radius_m
+                )
+            })
+        })
+        .collect();
+    let mut said = Vec::new();
+    if !too_long.is_empty() {
+        said.push(format!(
+            "{}: beyond what the rig can record (a release is given up after {RIG_GIVE_UP_S} s \
+             and recorded as never_left, so an ok row's time is at most that)",
+            too_long.join("; ")
+        ));
+    }
+    if !too_short.is_empty() {
+        said.push(format!(
+            "{}: shorter than any release can be (gravity and the turning bowl at full strength, \
+             with no friction, cannot bring a granule to the rim sooner; no model the fit \
+             compares gives less at any mu)",
+            too_short.join("; ")
+        ));
+    }
+    if said.is_empty() {
         return None;
     }
     Some(format!(
-        "{}: beyond what the rig can record (a release is given up after {RIG_GIVE_UP_S} s and \
-         recorded as never_left, so an ok row's time is at most that). Correct the value (seconds) \
-         or delete the row, then fit again.",
-        bad.join("; ")
+        "{}. Correct the value (seconds) or delete the row, then fit again.",
+        said.join(". ")
     ))
 }
 
@@ -232,6 +265,31 @@ mod tests {
             .to_string();
         assert!(e.contains("line 6: residence time 1e300 s"), "{e}");
         assert!(e.contains("60 s") && e.contains("Correct the value"), "{e}");
+    }
+
+    /// 1 ms (a time in ms typed as s) is refused with its line, the bound and what to do; the
+    /// rig's own runs are not.
+    #[test]
+    fn an_impossibly_short_time_is_refused_with_its_row() {
+        let mut runs = rig();
+        assert_eq!(impossible(&runs), None);
+        runs[4].residence_s = 1e-3;
+        let least = shortest_residence_s(&runs[4]);
+        let e = fit_candidates(runs, Vec::new(), &CANDIDATES[..2], false)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("line 6: residence time 1e-3 s, under the"),
+            "{e}"
+        );
+        assert!(e.contains(&format!("{least:.3} s")), "{e}");
+        assert!(
+            e.contains("from rest at 0.05 m to the rim at 0.15 m"),
+            "{e}"
+        );
+        assert!(e.contains("shorter than any release can be"), "{e}");
+        assert!(e.ends_with("Correct the value (seconds) or delete the row, then fit again."));
+        assert!(!e.contains("60 s"), "{e}");
     }
 
     fn model(name: &'static str, rms: f64, at_limit: bool) -> ModelFit {

@@ -271,3 +271,97 @@ fn the_bowl_fit_finds_the_wall_and_mu_s() {
         "{vertical:?}"
     );
 }
+
+/// `shortest_residence_s` is a lower bound for every candidate without friction (the fastest
+/// each can be), against the models themselves: the paper's closed forms at mu 0 and k2 1, and
+/// the rolling model (rolling resistance 0) at each release azimuth, over speeds from 0.3 to 30
+/// rad/s, release radii from 5 to 140 mm of a 150 mm rim, axes 0 to 85 degrees apart and k2 from
+/// 0.4 to 0.99; and not far below on the rig (within a factor 3 of the fastest).
+#[test]
+fn the_shortest_residence_time_bounds_every_model_from_below() {
+    use model_core::particle::rolling::{self, RollingMethod, RollingScene, SystemLimits};
+    let (mut tightest, mut checked) = (f64::INFINITY, 0);
+    for w in [0.3, 3.0, 7.0, 30.0] {
+        for ri in [0.005, 0.05, 0.14] {
+            for angle_deg in [0.0f64, 60.0, 85.0] {
+                for k2 in [0.4, 5.0 / 7.0, 0.99] {
+                    let run = Run {
+                        row: 2,
+                        condition: 1,
+                        residence_s: 1.0,
+                        mean_rad_s: w,
+                        release_radius_m: ri,
+                        rim_radius_m: 0.15,
+                        k2,
+                        trace: vec![(0.0, w)],
+                        method: Method::ClosedForm,
+                        axes_angle_rad: angle_deg.to_radians(),
+                    };
+                    let bound = models::shortest_residence_s(&run);
+                    let mut fastest = f64::INFINITY;
+                    for model in [Model::Flat, Model::Coriolis] {
+                        fastest = fastest.min(closed_form(
+                            &Run {
+                                k2: 1.0,
+                                ..run.clone()
+                            },
+                            model,
+                            0.0,
+                            w,
+                        ));
+                    }
+                    let scene = RollingScene {
+                        rolling_resistance: 0.0,
+                        k2,
+                        ri_m: ri,
+                        rim_radius_m: 0.15,
+                        ..RollingScene::equal_speeds(w, run.axes_angle_rad, 0.15)
+                    };
+                    let limits = SystemLimits {
+                        horizon_s: 10.0,
+                        max_steps: 200_000,
+                    };
+                    let s = rolling::over_azimuths_within(
+                        &scene,
+                        RollingMethod::Dp54 { rtol: 1e-10 },
+                        limits,
+                    )
+                    .unwrap_or_else(|e| panic!("w {w} ri {ri} angle {angle_deg} k2 {k2}: {e:?}"));
+                    if let Some(min) = s.min_s {
+                        fastest = fastest.min(min);
+                    }
+                    assert!(
+                        bound > 0.0 && bound <= fastest,
+                        "w {w} ri {ri} angle {angle_deg} k2 {k2}: bound {bound} s, fastest {fastest} s"
+                    );
+                    if fastest.is_finite() {
+                        tightest = tightest.min(fastest / bound);
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 80, "{checked} scenes left under some model");
+    eprintln!("closest: the fastest model {tightest:.3}x the bound over {checked} scenes");
+    // The rig: 7 rad/s, 0.05 m to 0.15 m, 60 degrees.
+    let rig = Run {
+        row: 2,
+        condition: 1,
+        residence_s: 1.0,
+        mean_rad_s: 7.0,
+        release_radius_m: 0.05,
+        rim_radius_m: 0.15,
+        k2: 5.0 / 7.0,
+        trace: vec![(0.0, 7.0)],
+        method: Method::ClosedForm,
+        axes_angle_rad: 60f64.to_radians(),
+    };
+    let frictionless =
+        predict(&rig, models::Equation::Rolling, 0.0).min(closed_form(&rig, Model::Flat, 0.0, 7.0));
+    let bound = models::shortest_residence_s(&rig);
+    assert!(
+        bound > frictionless / 3.0,
+        "{bound} s against {frictionless} s"
+    );
+}

@@ -5,9 +5,10 @@
 use anyhow::{Result, bail};
 use model_core::ode::system::SystemLimits;
 use model_core::particle::bowl::{self, BowlError, BowlOutcome, BowlReport, BowlShape};
-use model_core::particle::rolling::{AZIMUTHS_DEG, MAX_STEPS, RollingMethod};
+use model_core::particle::rolling::{AZIMUTHS_DEG, MAX_STEPS, RollingMethod, RollingScene};
 use serde_json::{Value, json};
 
+use super::speed_range::{self, SpeedAxis, SpeedReport};
 use super::validity::Validity;
 use super::{Inputs, MethodChoice, rolling};
 
@@ -33,10 +34,14 @@ pub struct BowlInputs {
     /// keys unless given as flags, its tilt unless --axes-angle-deg is given, and its bottom
     /// and granule radii in place of --rim-radius-m and --particle-radius-m.
     pub rig_file: Option<std::path::PathBuf>,
+    /// Bowl model: also report what speed can do (`speed_range`).
+    pub speed_range: bool,
+    /// Bowl model: store the residence-time table on the rig at this port.
+    pub store_table: Option<String>,
 }
 
 /// The wall flags with the rig file's `[bowl]` table (or the defaults) under them.
-struct Wall {
+pub(super) struct Wall {
     angle_deg: f64,
     height_m: f64,
     fillet_m: f64,
@@ -56,7 +61,7 @@ impl BowlInputs {
     }
 }
 
-fn words(e: BowlError) -> String {
+pub(super) fn words(e: BowlError) -> String {
     match e {
         BowlError::Scene(e) => rolling::words(e),
         BowlError::InvalidWallAngle => {
@@ -76,7 +81,7 @@ fn words(e: BowlError) -> String {
 }
 
 /// `all`, one azimuth or a comma-separated list, degrees.
-fn azimuths(text: &str) -> Result<Vec<f64>> {
+pub(super) fn azimuths(text: &str) -> Result<Vec<f64>> {
     if text.trim() == "all" {
         return Ok(AZIMUTHS_DEG.to_vec());
     }
@@ -132,57 +137,13 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
     if args.target_time_s.is_some() || args.batch.is_some() {
         bail!("--target-time-s and --batch are for the flat and Coriolis models, not the bowl");
     }
-    let table = match &b.rig_file {
-        Some(path) => {
-            let rigs = rig_file::load(path)?;
-            let Some(t) = rigs.first().and_then(|rig| rig.bowl) else {
-                bail!(
-                    "the rig file {} has no [bowl] table (its keys: docs/rigs/nominal.toml)",
-                    path.display()
-                );
-            };
-            Some(t)
-        }
-        None => None,
-    };
-    let (mut scene, th_deg) = r.scene(args, "bowl", table.map(|t| t.axes_angle_deg))?;
-    if let Some(t) = &table {
-        scene.rim_radius_m = t.rim_radius_m;
-        scene.particle_radius_m = t.particle_radius_m;
-        scene.validate().map_err(|e| {
-            anyhow::anyhow!("with the rig file's [bowl] table: {}", rolling::words(e))
-        })?;
-    }
-    let wall = b.wall(table.as_ref());
-    let method = match args.method {
-        MethodChoice::Closed | MethodChoice::Dp54 => RollingMethod::Dp54 { rtol: args.tol },
-        MethodChoice::Rk4 => RollingMethod::Rk4 {
-            step_s: args.step_s.unwrap_or(1e-4),
-        },
-        other => {
-            bail!("--method {other:?} is not offered for the bowl model: use dp54 (default) or rk4")
-        }
-    };
-    for (v, flag) in [
-        (wall.angle_deg, "--wall-angle-deg"),
-        (wall.height_m, "--wall-height-m"),
-        (wall.fillet_m, "--fillet-radius-m"),
-        (wall.restitution, "--restitution"),
-        (b.max_time_s, "--max-time-s"),
-    ] {
-        if !v.is_finite() {
-            bail!("{flag} must be a finite number, not {v}");
-        }
-    }
-    let shape = BowlShape {
-        wall_angle_rad: wall.angle_deg.to_radians(),
-        wall_height_m: wall.height_m,
-        fillet_radius_m: wall.fillet_m,
-        restitution: wall.restitution,
-    };
-    shape
-        .validate(&scene)
-        .map_err(|e| anyhow::anyhow!(words(e)))?;
+    let BowlSetup {
+        scene,
+        th_deg,
+        wall,
+        shape,
+        method,
+    } = scene_and_shape(args, r, b)?;
     let limits = SystemLimits {
         horizon_s: b.max_time_s,
         max_steps: MAX_STEPS,
@@ -247,6 +208,9 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
         scene.rim_radius_m
     };
     let evaluations: u64 = rows.iter().map(|(_, rep)| u64::from(rep.evaluations)).sum();
+    // What speed can do: the same releases at other bowl speeds (docs/model.md §11).
+    let mean_t = |s: &RollingScene<f64>| mean_time(s, &shape, &betas, method, limits);
+    let speed = speed_report(&scene, b, &mean_t)?;
     if args.json {
         let mut per: Vec<(f64, Value)> = rows
             .iter()
@@ -296,6 +260,9 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
             },
             "max_time_s": b.max_time_s, "rhs_evaluations": evaluations,
         });
+        if let (Some(obj), Some(sp)) = (v.as_object_mut(), &speed) {
+            obj.insert("speed".into(), sp.json(th_deg));
+        }
         validity.add_to(&mut v);
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
@@ -346,6 +313,9 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
     for (deg, why) in &gave_up {
         println!("release at {deg} deg: no answer: {why}");
     }
+    if let Some(sp) = &speed {
+        println!("what speed can do: {}", sp.words(th_deg));
+    }
     match (mean, min, max) {
         (Some(m), Some(lo), Some(hi)) => println!(
             "over {releases} releases: {} leave, T mean {m:.6} s, min {lo:.6} s, max {hi:.6} s",
@@ -358,4 +328,146 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
         ),
     }
     Ok(())
+}
+
+/// The mean residence time over the releases that leave (`None`: none leaves or one fails).
+fn mean_time(
+    scene: &RollingScene<f64>,
+    shape: &BowlShape<f64>,
+    betas: &[f64],
+    method: RollingMethod<f64>,
+    limits: SystemLimits<f64>,
+) -> Option<f64> {
+    let mut times = Vec::new();
+    for deg in betas {
+        let rep = bowl::residence(scene, shape, deg.to_radians(), method, limits).ok()?;
+        if let BowlOutcome::Leaves {
+            residence_time_s, ..
+        } = rep.outcome
+        {
+            times.push(residence_time_s);
+        }
+    }
+    (!times.is_empty()).then(|| times.iter().sum::<f64>() / times.len() as f64)
+}
+
+/// What speed can do at the flags' ratio and the default limits, and with `--store-table` at
+/// the rig's, stored there; `None` with `--speed-range false`.
+fn speed_report(
+    scene: &RollingScene<f64>,
+    b: &BowlInputs,
+    mean_t: &dyn Fn(&RollingScene<f64>) -> Option<f64>,
+) -> Result<Option<SpeedReport>> {
+    if let Some(port) = &b.store_table {
+        let params = speed_range::rig_params(port)?;
+        let axis = SpeedAxis::of_rig(&params, scene)?;
+        let omega = axis.range_rad_s.map_or(0.0, |(lo, hi)| 0.5 * (lo + hi));
+        let rep = speed_range::report(scene, &axis, omega, mean_t);
+        let Some(table) = rep.table else {
+            bail!(
+                "no table to store: {}",
+                rep.why_not.unwrap_or_else(|| "no speed range".into())
+            );
+        };
+        speed_range::store(port, &table)?;
+        eprintln!(
+            "stored on {port}: T at {} bowl speeds from {:.3} to {:.3} rad/s (the rig's limits \
+             and RATIO_PPM); `rtime table MS` now uses it",
+            table.residence_s().len(),
+            table.speed_range_rad_s().0,
+            table.speed_range_rad_s().1
+        );
+        return Ok(Some(rep));
+    }
+    if !b.speed_range {
+        return Ok(None);
+    }
+    Ok(Some(match SpeedAxis::of_scene(scene) {
+        Ok((axis, omega)) => speed_range::report(scene, &axis, omega, mean_t),
+        // A bowl at rest: no speed to vary; the prediction itself stands.
+        Err(e) => SpeedReport {
+            table: None,
+            samples: Vec::new(),
+            slope_s2_per_rad: None,
+            why_not: Some(e.to_string()),
+            midpoint_error: None,
+        },
+    }))
+}
+
+/// The bowl model's scene, checked, as the flags and the rig file give it.
+pub(super) struct BowlSetup {
+    pub(super) scene: RollingScene<f64>,
+    /// The tilt, degrees.
+    pub(super) th_deg: f64,
+    pub(super) wall: Wall,
+    pub(super) shape: BowlShape<f64>,
+    pub(super) method: RollingMethod<f64>,
+}
+
+/// The bowl model's scene, tilt (degrees), wall, shape and method from the flags and the rig
+/// file's `[bowl]` table, checked (also the whole-hierarchy chooser's, `--model auto`).
+pub(super) fn scene_and_shape(
+    args: &Inputs,
+    r: &rolling::RollingInputs,
+    b: &BowlInputs,
+) -> Result<BowlSetup> {
+    let table = match &b.rig_file {
+        Some(path) => {
+            let rigs = rig_file::load(path)?;
+            let Some(t) = rigs.first().and_then(|rig| rig.bowl) else {
+                bail!(
+                    "the rig file {} has no [bowl] table (its keys: docs/rigs/nominal.toml)",
+                    path.display()
+                );
+            };
+            Some(t)
+        }
+        None => None,
+    };
+    let (mut scene, th_deg) = r.scene(args, "bowl", table.map(|t| t.axes_angle_deg))?;
+    if let Some(t) = &table {
+        scene.rim_radius_m = t.rim_radius_m;
+        scene.particle_radius_m = t.particle_radius_m;
+        scene.validate().map_err(|e| {
+            anyhow::anyhow!("with the rig file's [bowl] table: {}", rolling::words(e))
+        })?;
+    }
+    let wall = b.wall(table.as_ref());
+    let method = match args.method {
+        MethodChoice::Closed | MethodChoice::Dp54 => RollingMethod::Dp54 { rtol: args.tol },
+        MethodChoice::Rk4 => RollingMethod::Rk4 {
+            step_s: args.step_s.unwrap_or(1e-4),
+        },
+        other => {
+            bail!("--method {other:?} is not offered for the bowl model: use dp54 (default) or rk4")
+        }
+    };
+    for (v, flag) in [
+        (wall.angle_deg, "--wall-angle-deg"),
+        (wall.height_m, "--wall-height-m"),
+        (wall.fillet_m, "--fillet-radius-m"),
+        (wall.restitution, "--restitution"),
+        (b.max_time_s, "--max-time-s"),
+    ] {
+        if !v.is_finite() {
+            bail!("{flag} must be a finite number, not {v}");
+        }
+    }
+    let shape = BowlShape {
+        wall_angle_rad: wall.angle_deg.to_radians(),
+        wall_height_m: wall.height_m,
+        fillet_radius_m: wall.fillet_m,
+        restitution: wall.restitution,
+    };
+    shape
+        .validate(&scene)
+        .map_err(|e| anyhow::anyhow!(words(e)))?;
+    Ok(BowlSetup {
+        scene,
+        th_deg,
+        wall,
+        shape,
+        method,
+    })
 }

@@ -3,6 +3,8 @@
 
 use model_core::control::Fault;
 use model_core::sim::ClosedLoop;
+use model_core::wire::FaultCode;
+use rig_client::words;
 use rig_file::Rig;
 use serde::Serialize;
 use std::f64::consts::TAU;
@@ -10,7 +12,7 @@ use std::f64::consts::TAU;
 use super::{LINK_TIMEOUT_S, commissioned, config_for, pour_material};
 
 /// One injected fault's outcome (the worse of the two axes it was injected on, one at a time).
-#[derive(Serialize, Debug, Clone, Copy)]
+#[derive(Serialize, Debug, Clone)]
 pub struct FaultOutcome {
     /// From injection to the latched fault, s; None = not detected.
     pub detected_s: Option<f64>,
@@ -26,17 +28,32 @@ pub struct FaultOutcome {
     pub pwm_zero: bool,
     /// Still latched, duties zero, one second later.
     pub latched: bool,
+    /// Highest true speed of the faulted axis from injection until no bridge drives it, rad/s:
+    /// the detection, or for a shorted bridge (which drives on after the fault) the supply cut;
+    /// one second after detection at most. (Coasting afterwards, a rod can still speed up as
+    /// the spin's reaction hands it the bowl's momentum: no drive to stop.)
+    pub peak_until_drive_off_rad_s: f64,
+    /// The supervisor opened the supply cut (a current flowed after the bridge was told to stop).
+    pub supply_cut: bool,
+    /// What caught the fault: "edges", "current" or "watchdog" (the host link's); None = not
+    /// detected. (A break input stops the bridge in hardware and is the firmware's to report.)
+    pub detected_by: Option<&'static str>,
+    /// The latched fault in words; None = not detected.
+    pub fault: Option<String>,
 }
 
-/// The four faults.
-#[derive(Serialize, Debug, Clone, Copy)]
+/// The five faults.
+#[derive(Serialize, Debug, Clone)]
 pub struct FaultSet {
     /// Dead sensor.
     pub sensor_lost: FaultOutcome,
     /// Blocked shaft.
     pub stall: FaultOutcome,
-    /// Bridge stuck on (full duty in the commanded direction).
+    /// Bridge stuck on (full duty in the commanded direction; zero duty still coasts).
     pub overspeed: FaultOutcome,
+    /// Bridge shorted (full duty whatever it is told, zero included: only the supply cut
+    /// stops it).
+    pub shorted_bridge: FaultOutcome,
     /// No command or heartbeat from the host.
     pub link_lost: FaultOutcome,
 }
@@ -59,6 +76,7 @@ enum Injected {
     SensorLost,
     Stall,
     Overspeed,
+    ShortedBridge,
     LinkLost,
 }
 
@@ -125,6 +143,7 @@ pub fn fault_plant(rig: &Rig, speed: f32) -> PlantFaults {
             sensor_lost: one(Injected::SensorLost),
             stall: one(Injected::Stall),
             overspeed: one(Injected::Overspeed),
+            shorted_bridge: one(Injected::ShortedBridge),
             link_lost: one(Injected::LinkLost),
         }),
     }
@@ -139,6 +158,7 @@ fn inject(mut cl: ClosedLoop, what: Injected, axis: usize, bound_s: f64) -> Faul
             Injected::SensorLost => f.dead_sensor_from_s = now,
             Injected::Stall => f.blocked_from_s = now,
             Injected::Overspeed => f.bridge_stuck_from_s = now,
+            Injected::ShortedBridge => f.bridge_shorted_from_s = now,
             Injected::LinkLost => {}
         }
     }
@@ -167,11 +187,18 @@ fn inject(mut cl: ClosedLoop, what: Injected, axis: usize, bound_s: f64) -> Faul
         }
     }
     let mut latched = false;
+    let mut peak_until_drive_off = peak;
+    let fault: Option<Fault> = cl.ctrl.fault();
     if detected.is_some() {
-        let fault: Option<Fault> = cl.ctrl.fault();
         latched = true;
+        let mut driven = what == Injected::ShortedBridge && !cl.rig.supply_is_cut();
         cl.run(1.0, |c| {
             latched &= c.ctrl.fault() == fault && c.duties() == [0.0; 2];
+            if driven {
+                peak_until_drive_off =
+                    peak_until_drive_off.max(c.rig.speed_rad_s(axis).abs() as f64);
+                driven = !c.rig.supply_is_cut();
+            }
         });
     }
     FaultOutcome {
@@ -181,5 +208,17 @@ fn inject(mut cl: ClosedLoop, what: Injected, axis: usize, bound_s: f64) -> Faul
         first_edge_speed_rad_s: first_edge_speed,
         pwm_zero,
         latched,
+        peak_until_drive_off_rad_s: peak_until_drive_off,
+        supply_cut: cl.rig.supply_is_cut(),
+        detected_by: fault.map(|f| f.detected_by().word()),
+        fault: fault.map(fault_words),
     }
+}
+
+/// A fault in the words the monitor and `bowl send status` use (by its telemetry code).
+fn fault_words(f: Fault) -> String {
+    FaultCode::from_code(f.code().into()).map_or_else(
+        || format!("fault code {}", f.code()),
+        |c| words::fault(c).to_string(),
+    )
 }

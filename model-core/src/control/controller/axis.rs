@@ -4,7 +4,7 @@ use crate::control::config::{AxisConfig, ControllerConfig};
 use crate::control::estimator::PulseSpeedEstimator;
 use crate::control::load_pattern::LoadPattern;
 use crate::control::pi::{LoopConstants, SpeedLoop};
-use crate::control::supervisor::SensorWatch;
+use crate::control::supervisor::{CurrentWatch, SensorWatch};
 
 /// What the controller keeps per axis between ticks: the speed estimator, the loop and its
 /// constants, the sensor watch, and the last outputs.
@@ -30,6 +30,8 @@ pub(super) struct AxisState {
     pub(super) load: LoadPattern,
     /// The speed is steady this tick (the reference unchanged, the shaft near the model).
     pub(super) steady: bool,
+    /// The current sense's offset, current per duty and back-EMF (none: never sampled).
+    pub(super) current: CurrentWatch,
 }
 
 impl AxisState {
@@ -46,6 +48,7 @@ impl AxisState {
             direction: 1.0,
             load: LoadPattern::new(a, cfg.supply_v),
             steady: false,
+            current: CurrentWatch::NEW,
         }
     }
 
@@ -54,5 +57,6 @@ impl AxisState {
         self.speed_loop = SpeedLoop::REST;
         self.watch = SensorWatch::CLEAR;
         self.load.forget();
+        self.current.restart();
     }
 }

@@ -187,6 +187,8 @@ impl Controller {
             c.fault = None;
             c.state = State::Idle;
             c.planner.reset();
+            // The supply closes again: a bridge still shorted trips within a sample.
+            c.supply_cut = false;
             Ok(())
         })
     }

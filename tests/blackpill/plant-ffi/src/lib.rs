@@ -302,8 +302,42 @@ pub unsafe extern "C" fn plant_speed_rad_s(plant: *const SimRig, axis: u32) -> f
     }
 }
 
+/// Armature current of `axis`, A, signed in the motor's positive direction (what an inline
+/// shunt and amplifier measure; NaN for a bad pointer or axis: the caller checks).
+///
+/// # Safety
+/// `plant` is null or came from [`plant_new`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_current_a(plant: *const SimRig, axis: u32) -> f32 {
+    // SAFETY: the caller passes null or a live plant.
+    match unsafe { plant.as_ref() } {
+        Some(p) if axis <= 1 => p.plant.current_a(axis as usize),
+        _ => f32::NAN,
+    }
+}
+
+/// The motor supply switch ahead of both bridges: `on` 0 opens it (no bridge drives, however
+/// it failed), anything else closes it. Returns 0, or -1 for a null plant.
+///
+/// # Safety
+/// `plant` is null or came from [`plant_new`].
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn plant_set_supply(plant: *mut SimRig, on: u32) -> i32 {
+    // SAFETY: the caller passes null or a live plant.
+    let Some(p) = (unsafe { plant.as_mut() }) else {
+        return -1;
+    };
+    if on == 0 {
+        p.plant.cut_supply();
+    } else {
+        p.plant.restore_supply();
+    }
+    0
+}
+
 /// Injects a fault into `axis` from plant time `from_s` on: `kind` 0 blocks the shaft (a stall),
-/// 1 silences the sensor, 2 sticks the bridge on (any nonzero duty drives at full duty). Returns
+/// 1 silences the sensor, 2 sticks the bridge on (any nonzero duty drives at full duty), 3 shorts
+/// the bridge (drives at full duty even at zero duty: only the supply switch stops it). Returns
 /// 0, or -1 for a null plant, an axis other than 0 or 1, or an unknown kind.
 ///
 /// # Safety
@@ -327,6 +361,7 @@ pub unsafe extern "C" fn plant_inject(
         0 => faults.blocked_from_s = from_s,
         1 => faults.dead_sensor_from_s = from_s,
         2 => faults.bridge_stuck_from_s = from_s,
+        3 => faults.bridge_shorted_from_s = from_s,
         _ => return -1,
     }
     0

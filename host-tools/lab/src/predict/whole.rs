@@ -1,0 +1,318 @@
+//! `bowl predict --model auto` on the tilted bowl (any of `--precession-rad-s`, `--spin-rad-s`,
+//! `--axes-angle-deg` or `--rig-file` given): the chooser over the whole hierarchy
+//! (model-core `choose::whole`, docs/model.md §12) picks the least model that meets the
+//! tolerance and says why each cheaper one does not; the chosen one answers.
+
+use anyhow::Result;
+use model_core::choose::whole::{
+    Fails, LEVELS, Level, WholeChoice, choose_level, incline_release_s,
+};
+use model_core::ode::system::SystemLimits;
+use model_core::particle::bowl::{self, BowlOutcome, BowlShape};
+use model_core::particle::rolling::{self, MAX_STEPS, RollingMethod, RollingOutcome, RollingScene};
+use serde_json::{Value, json};
+
+use super::validity::Validity;
+use super::{Inputs, bowl as bowl_cli};
+
+/// The tolerance when none is given: the bowl model's own accuracy against the independent
+/// reference (issue 30: T per release within 1 %).
+pub const DEFAULT_TOLERANCE: f64 = 0.01;
+
+/// The integrated levels' DP5(4) tolerance: a tenth of the tolerance (the model takes the
+/// rest), and at most 1e-6: looser, the rolling-or-sliding switch near the stick threshold can
+/// chatter for the whole step cap (measured in docs/model.md §12: a 30 deg scene at 3.6 rad/s
+/// takes over 30 s per call at 1e-3 to 1e-5, 0.05 s at 1e-6).
+pub fn integrator_rtol(tolerance: f64) -> f64 {
+    (0.1 * tolerance).clamp(1e-12, 1e-6)
+}
+
+/// Whether `--model auto` means the tilted bowl (its flags or a rig file are given).
+pub fn wanted(args: &Inputs) -> bool {
+    let r = &args.rolling;
+    r.precession_rad_s.is_some()
+        || r.spin_rad_s.is_some()
+        || r.axes_angle_deg.is_some()
+        || args.bowl.rig_file.is_some()
+}
+
+/// Why a level does not hold, in words.
+pub fn fails_words(f: &Fails<f64>, tolerance: f64) -> String {
+    match *f {
+        Fails::Wall {
+            lip_m,
+            rim_m,
+            height_m,
+        } if lip_m > rim_m => format!(
+            "the wall matters: the lip at {lip_m:.4} m is beyond R = {rim_m:.4} m (a wall \
+             {height_m} m high)"
+        ),
+        Fails::Wall { height_m, .. } => format!(
+            "the wall matters: a vertical wall {height_m} m high holds the granule unless it \
+             climbs it"
+        ),
+        Fails::Slides { needed, mu_s } => format!(
+            "slides at this tilt: rolling needs {needed:.3} of the normal force at release, the \
+             contact gives mu_s = {mu_s}"
+        ),
+        Fails::Rotation { estimate } => format!(
+            "the bowl's rotation changes T by about {:.2} %, more than the tolerance {:.2} %",
+            100.0 * estimate,
+            100.0 * tolerance
+        ),
+        Fails::EachRelease => {
+            "single releases are wanted, and the incline does not follow a release's turning path"
+                .into()
+        }
+        Fails::NoDrive => "the tilt does not move the granule down the incline".into(),
+    }
+}
+
+/// What the chosen level gave.
+pub(crate) struct Answer {
+    level: Level,
+    /// Per release: azimuth, T (None: did not leave).
+    pub(crate) times: Vec<(f64, Option<f64>)>,
+    validity: Validity,
+    /// Why the first level run was given up for this one, if it was.
+    escalated: Option<String>,
+}
+
+/// Runs `level` on the releases; `None` when it holds no answer (the rolling model found the
+/// granule slides).
+pub(crate) fn run_level(
+    level: Level,
+    scene: &RollingScene<f64>,
+    shape: &BowlShape<f64>,
+    betas: &[f64],
+    method: RollingMethod<f64>,
+    limits: SystemLimits<f64>,
+) -> Result<std::result::Result<Answer, String>> {
+    let mut times = Vec::new();
+    let mut why = Vec::new();
+    match level {
+        Level::Incline => {
+            for &deg in betas {
+                times.push((deg, incline_release_s(scene, deg.to_radians())));
+            }
+        }
+        Level::Rolling => {
+            let mut worst: f64 = 0.0;
+            for &deg in betas {
+                let rep = match rolling::residence_within(scene, deg.to_radians(), method, limits) {
+                    Ok(rep) => rep,
+                    // The next level answers (the rolling model is the one that gave up).
+                    Err(e) => {
+                        return Ok(Err(format!(
+                            "the rolling model gave no answer at {deg} deg: {}",
+                            super::rolling::words(e)
+                        )));
+                    }
+                };
+                match rep.outcome {
+                    RollingOutcome::Leaves {
+                        residence_time_s,
+                        max_friction_ratio,
+                        ..
+                    } => {
+                        worst = worst.max(max_friction_ratio);
+                        times.push((deg, Some(residence_time_s)));
+                    }
+                    RollingOutcome::LiftsOff { .. } => {
+                        why.push("the normal force reaches zero (it would fly)".to_string());
+                        times.push((deg, None));
+                    }
+                    _ => times.push((deg, None)),
+                }
+            }
+            if worst > scene.sliding_friction {
+                return Ok(Err(format!(
+                    "it rolled at release but slides later: rolling needed {worst:.3} of the \
+                     normal force, the contact gives mu_s = {}",
+                    scene.sliding_friction
+                )));
+            }
+        }
+        Level::RollingOrSliding | Level::Bowl => {
+            let shape = if level == Level::Bowl {
+                *shape
+            } else {
+                BowlShape {
+                    wall_height_m: 0.0,
+                    ..*shape
+                }
+            };
+            // Near the stick threshold the slide/roll switch can chatter at a loose tolerance
+            // (and, erratically, at some tight ones): a release that takes 5 000 steps (tens of times a normal one) is
+            // run again at rtol 1e-10, which gets through where the loose one did not.
+            let quick = SystemLimits {
+                max_steps: limits.max_steps.min(5_000),
+                ..limits
+            };
+            let tight = RollingMethod::Dp54 { rtol: 1e-10 };
+            for &deg in betas {
+                let b = deg.to_radians();
+                let first = bowl::residence(scene, &shape, b, method, quick);
+                let rep = match first {
+                    Err(bowl::BowlError::Scene(rolling::RollingError::Integration(_))) => {
+                        bowl::residence(scene, &shape, b, tight, limits)
+                    }
+                    other => other,
+                };
+                match rep {
+                    Ok(rep) => match rep.outcome {
+                        BowlOutcome::Leaves {
+                            residence_time_s, ..
+                        } => times.push((deg, Some(residence_time_s))),
+                        BowlOutcome::LiftsOff { .. } => {
+                            why.push(
+                                "the normal force reaches zero in a release (it would fly): \
+                                 flight is not modelled"
+                                    .to_string(),
+                            );
+                            times.push((deg, None));
+                        }
+                        _ => times.push((deg, None)),
+                    },
+                    Err(e) => {
+                        why.push(format!(
+                            "release at {deg} deg: no answer: {}",
+                            bowl_cli::words(e)
+                        ));
+                        times.push((deg, None));
+                    }
+                }
+            }
+        }
+    }
+    why.dedup();
+    Ok(Ok(Answer {
+        level,
+        times,
+        validity: if why.is_empty() {
+            Validity::valid()
+        } else {
+            Validity(Some(why.join("; ")))
+        },
+        escalated: None,
+    }))
+}
+
+/// Runs the chooser and the model it picks.
+pub fn run(args: &Inputs) -> Result<()> {
+    let setup = bowl_cli::scene_and_shape(args, &args.rolling, &args.bowl)?;
+    let (scene, th_deg, shape) = (setup.scene, setup.th_deg, setup.shape);
+    let tolerance = args.tolerance.unwrap_or(DEFAULT_TOLERANCE);
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        anyhow::bail!("--tolerance must be a positive number (0.01 = 1 %), not {tolerance}");
+    }
+    let each = args.rolling.each_release;
+    let choice = choose_level(&scene, &shape, tolerance, each);
+    let method = RollingMethod::Dp54 {
+        rtol: integrator_rtol(tolerance),
+    };
+    let limits = SystemLimits {
+        horizon_s: args.bowl.max_time_s,
+        max_steps: MAX_STEPS,
+    };
+    let betas = super::bowl::azimuths(args.rolling.release_azimuth_deg())?;
+    let mut answer = match run_level(choice.level, &scene, &shape, &betas, method, limits)? {
+        Ok(a) => a,
+        Err(why) => {
+            let mut a = run_level(
+                Level::RollingOrSliding,
+                &scene,
+                &shape,
+                &betas,
+                method,
+                limits,
+            )?
+            .map_err(anyhow::Error::msg)?;
+            a.escalated = Some(why);
+            a
+        }
+    };
+    if answer.level == Level::Incline {
+        answer.validity = Validity::valid();
+    }
+    report(args, &scene, th_deg, tolerance, &choice, &answer)
+}
+
+fn report(
+    args: &Inputs,
+    scene: &RollingScene<f64>,
+    th_deg: f64,
+    tolerance: f64,
+    choice: &WholeChoice<f64>,
+    a: &Answer,
+) -> Result<()> {
+    let left: Vec<f64> = a.times.iter().filter_map(|t| t.1).collect();
+    let mean = (!left.is_empty()).then(|| left.iter().sum::<f64>() / left.len() as f64);
+    let min = left.iter().copied().reduce(f64::min);
+    let max = left.iter().copied().reduce(f64::max);
+    let rejected: Vec<(Level, String)> = LEVELS
+        .iter()
+        .zip(choice.cheaper_fail)
+        .filter_map(|(l, f)| f.map(|f| (*l, fails_words(&f, tolerance))))
+        .chain(a.escalated.as_ref().map(|w| (Level::Rolling, w.clone())))
+        .collect();
+    let why = if rejected.is_empty() {
+        format!(
+            "the cheapest model, and within the tolerance: the rotation changes T by about {:.3} %",
+            100.0 * choice.rotation_estimate
+        )
+    } else {
+        let (l, w) = &rejected[rejected.len() - 1];
+        format!("not the {} model: {w}", l.name())
+    };
+    if args.json {
+        let mut v = json!({
+            "model": "auto",
+            "chosen": a.level.name(),
+            "tolerance": tolerance,
+            "why": why,
+            "not_cheaper": rejected.iter().map(|(l, w)| json!({"model": l.name(), "why": w})).collect::<Vec<Value>>(),
+            "rotation_estimate_rel": choice.rotation_estimate.is_finite().then_some(choice.rotation_estimate),
+            "friction_needed_at_release": choice.friction_needed,
+            "residence_time_mean_s": mean, "residence_time_min_s": min,
+            "residence_time_max_s": max, "releases": a.times.len(),
+            "releases_leaving": left.len(),
+            "per_release": a.times.iter().map(|(d, t)| json!({"azimuth_deg": d, "left": t.is_some(), "residence_time_s": t})).collect::<Vec<Value>>(),
+            "axes_angle_deg": th_deg,
+        });
+        a.validity.add_to(&mut v);
+        println!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    if let Some(line) = a.validity.text_line() {
+        println!("{line}");
+    }
+    println!(
+        "chooser (tolerance {:.2} %): the {} model, the least of incline < rolling < \
+         rolling-or-sliding < bowl that meets it at this scene (tilt {th_deg} deg, |Omega| {:.3} rad/s)",
+        100.0 * tolerance,
+        a.level.name(),
+        scene.combined_speed_rad_s()
+    );
+    for (l, w) in &rejected {
+        println!("  not the {}: {w}", l.name());
+    }
+    if a.level == Level::Incline {
+        println!(
+            "  the incline holds: the bowl's rotation changes T by about {:.3} % (docs/model.md §12)",
+            100.0 * choice.rotation_estimate
+        );
+    }
+    match (mean, min, max) {
+        (Some(m), Some(lo), Some(hi)) => println!(
+            "over {} releases: {} leave, T mean {m:.6} s, min {lo:.6} s, max {hi:.6} s",
+            a.times.len(),
+            left.len()
+        ),
+        _ => println!("none of the {} releases leaves", a.times.len()),
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;

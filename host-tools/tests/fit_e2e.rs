@@ -1,0 +1,188 @@
+//! `bowl fit` end to end, the binary on small results files: a good set, one with an outlier
+//! (named in words on the terminal and in the JSON's `outliers`, left out), one with impossible
+//! rows (refused, exit 1, each line named with its value and the limit). Six releases of a
+//! Coriolis granule (mu 0.03, k2 5/7) at three steady speeds, timed by the closed form
+//! (`model_core::particle::residence`, the truth) with a fixed gate jitter of at most 1 ms: the
+//! steady traces take the fit's closed-form path and `--models flat,coriolis` leaves out the
+//! rolling model's integrations, so each file fits in about a second of CPU in debug.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{bowl, stdout, success_json, temp_dir};
+use lab::results::{Row, Writer};
+use model_core::particle::{Model, Scene, residence};
+
+const TRUE_MU: f64 = 0.03;
+const RI_M: f64 = 0.05;
+const RIM_M: f64 = 0.15;
+const K2: f64 = 5.0 / 7.0;
+/// (condition, speed rad/s, gate jitter s) of each release, in file order.
+const RELEASES: [(usize, f64, f64); 6] = [
+    (1, 2.9, 0.0008),
+    (1, 2.9, -0.0006),
+    (2, 3.5, 0.0003),
+    (2, 3.5, -0.0010),
+    (3, 4.2, 0.0005),
+    (3, 4.2, -0.0002),
+];
+
+/// The true residence time at `omega`, s.
+fn truth_s(omega: f64) -> f64 {
+    let s = Scene {
+        omega_rad_s: omega,
+        mu: TRUE_MU,
+        g_m_s2: 9.81,
+        k2: K2,
+        ri_m: RI_M,
+        rim_radius_m: RIM_M,
+    };
+    residence(&s, Model::Coriolis).unwrap().residence_time_s()
+}
+
+/// A results file of the six releases, release `i`'s time replaced where `times` says so.
+fn results(name: &str, times: &[(usize, f64)]) -> PathBuf {
+    let dir = temp_dir(name);
+    let path = dir.join("results.csv");
+    let mut w = Writer::create(&path).unwrap();
+    for (i, &(condition, omega, jitter)) in RELEASES.iter().enumerate() {
+        let run = i + 1;
+        let trace = w.write_trace(run, &[(0.0, omega), (0.5, omega)]).unwrap();
+        let t = times
+            .iter()
+            .find(|(j, _)| *j == i)
+            .map_or(truth_s(omega) + jitter, |(_, t)| *t);
+        w.push(&Row {
+            run,
+            condition,
+            bowl_rad_s: omega,
+            precession_rad_s: omega / 3f64.sqrt(),
+            spin_rad_s: omega / 3f64.sqrt(),
+            release_radius_m: RI_M,
+            rim_radius_m: RIM_M,
+            k2: K2,
+            status: "ok".into(),
+            residence_s: Some(t),
+            trace_mean_rad_s: Some(omega),
+            trace_sd_rad_s: Some(0.0),
+            trace_path: trace,
+        })
+        .unwrap();
+    }
+    path
+}
+
+/// `bowl fit` of the paper's two models (the rolling model takes 15 s of CPU in debug here; its
+/// marking is tested in `lab::fit::robust`).
+fn fit(path: &Path, json: bool) -> std::process::Output {
+    let mut args = vec![
+        "fit",
+        path.to_str().unwrap(),
+        "--no-charts",
+        "--models",
+        "flat,coriolis",
+    ];
+    if json {
+        args.push("--json");
+    }
+    bowl(&args)
+}
+
+/// The Coriolis model's mu lies within 1 % of the truth and inside its own interval.
+fn holds_the_truth(v: &serde_json::Value) {
+    let c = &v["models"]["coriolis"];
+    let mu = c["mu"].as_f64().unwrap();
+    let (lo, hi) = (
+        c["mu_ci95"][0].as_f64().unwrap(),
+        c["mu_ci95"][1].as_f64().unwrap(),
+    );
+    assert!((mu - TRUE_MU).abs() < 0.01 * TRUE_MU, "{c}");
+    assert!(lo <= TRUE_MU && TRUE_MU <= hi, "{c}");
+}
+
+#[test]
+fn a_good_set_fits_the_truth_with_nothing_dropped() {
+    let path = results("fit-good", &[]);
+    let v = success_json(&fit(&path, true), "bowl fit --json");
+    assert_eq!(v["runs"], 6, "{v}");
+    assert_eq!(v["excluded"], serde_json::json!([]), "{v}");
+    assert_eq!(v["outliers"], serde_json::json!([]), "{v}");
+    holds_the_truth(&v);
+    let out = fit(&path, false);
+    assert!(out.status.success());
+    let text = stdout(&out);
+    assert!(text.contains("6 runs (6 by the closed form"), "{text}");
+    assert!(text.contains("0 excluded, 0 outliers left out"), "{text}");
+    assert!(text.contains("preferred: coriolis"), "{text}");
+    // Only the models asked for, and an unknown one refused by name.
+    assert!(v["models"].get("rolling").is_none(), "{v}");
+    let out = bowl(&["fit", path.to_str().unwrap(), "--models", "flat,rollin"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("invalid value 'rollin' for '--models"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(path.parent().unwrap());
+}
+
+#[test]
+fn an_outlier_is_named_in_words_and_in_the_json_and_left_out() {
+    // Release 4 (line 5) timed ten times too long.
+    let slow = 10.0 * truth_s(3.5);
+    let path = results("fit-outlier", &[(3, slow)]);
+    let out = fit(&path, false);
+    assert_eq!(out.status.code(), Some(0));
+    let text = stdout(&out);
+    assert!(
+        text.contains("5 runs") && text.contains("1 outliers left out"),
+        "{text}"
+    );
+    let said = format!("outlier line 5: residence time {slow:.4} s where the other runs say");
+    assert!(text.contains(&said), "{text}");
+    assert!(text.contains("left out of the fit"), "{text}");
+
+    let out = fit(&path, true);
+    let v = success_json(&out, "bowl fit --json");
+    let outliers = v["outliers"].as_array().unwrap();
+    assert_eq!(outliers.len(), 1, "{v}");
+    assert_eq!(outliers[0]["row"], 5);
+    assert_eq!(outliers[0]["value"].as_f64(), Some(slow));
+    let why = outliers[0]["why"].as_str().unwrap();
+    assert!(why.contains("robust standard deviations off"), "{why}");
+    assert_eq!(v["runs"], 5);
+    holds_the_truth(&v);
+    // Said on the terminal too when standard output is JSON.
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bowl fit: outlier line 5: "), "{err}");
+    let _ = std::fs::remove_dir_all(path.parent().unwrap());
+}
+
+#[test]
+fn impossible_times_are_refused_with_their_lines() {
+    // Release 3 (line 4) in ms typed as s: 0.6 ms; release 5 (line 6) at 1e300 s.
+    let path = results("fit-impossible", &[(2, 6e-4), (4, 1e300)]);
+    for json in [false, true] {
+        let out = fit(&path, json);
+        assert_eq!(out.status.code(), Some(1), "json {json}");
+        assert!(out.stdout.is_empty(), "json {json}: {}", stdout(&out));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("line 4: residence time 6e-4 s, under the")
+                && err.contains("from rest at 0.05 m to the rim at 0.15 m")
+                && err.contains("shorter than any release can be"),
+            "{err}"
+        );
+        assert!(
+            err.contains("line 6: residence time 1e300 s: beyond what the rig can record"),
+            "{err}"
+        );
+        assert!(
+            err.contains("Correct the value (seconds) or delete the row"),
+            "{err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(path.parent().unwrap());
+}

@@ -1,0 +1,120 @@
+//! `bowl predict --model auto` on the tilted bowl: the chooser over the whole hierarchy picks
+//! the least model that meets the tolerance, says why the cheaper ones do not, and its answer is
+//! within the tolerance of the full bowl model run independently (docs/model.md §12).
+
+mod common;
+
+use common::json;
+
+const SCENE: [&str; 8] = [
+    "--rim-radius-m",
+    "0.075",
+    "--ri-m",
+    "0.0375",
+    "--release-azimuth-deg",
+    "all",
+    "--max-time-s",
+    "5",
+];
+
+fn args<'a>(tilt: &'a str, w: &'a str, mu_s: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut a = vec![
+        "predict",
+        "--axes-angle-deg",
+        tilt,
+        "--precession-rad-s",
+        w,
+        "--spin-rad-s",
+        w,
+        "--sliding-mu",
+        mu_s,
+        "--json",
+    ];
+    a.extend(SCENE);
+    a.extend(extra);
+    a
+}
+
+/// The chooser's answer and the bowl model's own at rtol 1e-10 (the reference).
+fn chosen_and_reference(
+    tilt: &str,
+    w: &str,
+    mu_s: &str,
+    tol: &str,
+    wall: &[&str],
+) -> (serde_json::Value, f64) {
+    let mut extra = vec!["--tolerance", tol];
+    extra.extend(wall);
+    let v = json(&args(tilt, w, mu_s, &extra));
+    let mut reference = vec![
+        "--model",
+        "bowl",
+        "--tol",
+        "1e-10",
+        "--speed-range",
+        "false",
+    ];
+    reference.extend(wall);
+    let r = json(&args(tilt, w, mu_s, &reference));
+    (v, r["residence_time_mean_s"].as_f64().unwrap())
+}
+
+fn within(v: &serde_json::Value, reference: f64, tol: f64) {
+    let t = v["residence_time_mean_s"].as_f64().unwrap();
+    assert!(
+        (t - reference).abs() <= tol * reference,
+        "{} gives {t}, the bowl model {reference}",
+        v["chosen"]
+    );
+    assert_eq!(v["valid"], true, "{v}");
+}
+
+fn reasons(v: &serde_json::Value) -> String {
+    v["not_cheaper"].to_string()
+}
+
+#[test]
+fn at_the_rigs_tilt_a_loose_tolerance_takes_the_incline() {
+    let (v, r) = chosen_and_reference("60", "1.0", "0.4", "0.01", &[]);
+    assert_eq!(v["chosen"], "incline", "{v}");
+    within(&v, r, 0.01);
+}
+
+#[test]
+fn a_tight_tolerance_at_the_rigs_tilt_needs_the_sliding_disc() {
+    let (v, r) = chosen_and_reference("60", "2.0", "0.4", "0.001", &[]);
+    assert_eq!(v["chosen"], "rolling-or-sliding", "{v}");
+    assert!(reasons(&v).contains("slides at this tilt"), "{v}");
+    assert!(reasons(&v).contains("the bowl's rotation changes T"), "{v}");
+    within(&v, r, 0.001);
+}
+
+#[test]
+fn where_it_rolls_the_rolling_model_is_enough() {
+    let (v, r) = chosen_and_reference("30", "2.0", "0.4", "0.001", &[]);
+    assert_eq!(v["chosen"], "rolling", "{v}");
+    within(&v, r, 0.001);
+}
+
+#[test]
+fn rolling_at_release_and_sliding_later_goes_on_to_the_sliding_disc() {
+    let (v, r) = chosen_and_reference("45", "1.0", "0.31", "0.001", &[]);
+    assert_eq!(v["chosen"], "rolling-or-sliding", "{v}");
+    assert!(
+        reasons(&v).contains("it rolled at release but slides later"),
+        "{v}"
+    );
+    within(&v, r, 0.001);
+}
+
+#[test]
+fn a_wall_needs_the_bowl_and_says_where_the_lip_is() {
+    let wall = ["--wall-angle-deg", "60", "--wall-height-m", "0.02"];
+    let (v, r) = chosen_and_reference("60", "2.0", "0.4", "0.01", &wall);
+    assert_eq!(v["chosen"], "bowl", "{v}");
+    assert!(
+        reasons(&v).contains("the wall matters: the lip at 0.0865 m is beyond R = 0.0750 m"),
+        "{v}"
+    );
+    within(&v, r, 0.01);
+}
