@@ -127,9 +127,37 @@ fn a_flared_wall_keeps_it_longer() {
         flared["residence_time_mean_s"].as_f64().unwrap(),
     );
     assert!(f > 1.1 * b && f < 1.6 * b, "{b} {f}");
+    // On the wall, or over it in flight (the sharp corner's rebound flies).
     for rel in flared["per_release"].as_array().unwrap() {
-        assert!(rel["on_wall_s"].as_f64().unwrap() > 0.0, "{rel}");
+        let away = rel["on_wall_s"].as_f64().unwrap() + rel["flight_s"].as_f64().unwrap();
+        assert!(away > 0.0, "{rel}");
     }
+}
+
+/// Lift-off (issue 30: rod offset 0.3 m, precession 4.4 rad/s at 60 deg) used to end the bowl
+/// model with no answer; now the granule flies, lands and leaves: the answer is valid, every
+/// release leaves, and the regimes carry a `fly` share (the shares of each release add to 1).
+#[test]
+fn a_lift_off_scene_answers_with_a_fly_share() {
+    let v = json(&bowl_args(
+        "4.4",
+        "2",
+        "60",
+        ["60", "0.02", "0.005"],
+        &["--rod-offset-m", "0.3", "--json"],
+    ));
+    assert_eq!(v["valid"], true, "{v}");
+    assert_eq!(v["releases_leaving"], 12, "{v}");
+    let mut flying = 0;
+    for rel in v["per_release"].as_array().unwrap() {
+        let regime = rel["regime"].as_object().unwrap();
+        let sum: f64 = regime.values().map(|x| x.as_f64().unwrap()).sum();
+        assert!((sum - 1.0).abs() < 1e-9, "{rel}");
+        if regime.get("fly").and_then(|x| x.as_f64()).unwrap_or(0.0) > 0.0 {
+            flying += 1;
+        }
+    }
+    assert!(flying >= 3, "{v}");
 }
 
 /// Bad input is said in plain words naming the flag and its limit, exit 1, no Rust names.
@@ -318,4 +346,89 @@ fn the_rig_files_bowl_table_gives_the_bowl() {
     let out = bowl(&none);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("has no [bowl] table"));
+}
+
+/// Against a rigid-body simulation nobody here wrote (MuJoCo, tests/mujoco/bowl_mujoco.py: a
+/// bowl of primitives driven about the vertical and its own axis, the sphere on a free joint):
+/// the rig's scene (60 deg, 75 mm bottom, w1 = w2 = 1.27 rad/s), four releases. A bare rim: T
+/// per release within 1.5 %, sliding all the way in both; a 60 deg wall 20 mm high: mean T within
+/// 5 % (the issue's target; measured 1.2 %) with the restitution MuJoCo's contact gives at that
+/// corner (0.15); a vertical 20 mm wall: every release held in both. Needs python with mujoco (tests/mujoco/compare.sh makes
+/// target/mujoco-venv): `BOWL_MUJOCO_PYTHON=target/mujoco-venv/bin/python cargo test -p
+/// host-tools --test predict_bowl -- --ignored` (about 2 minutes).
+#[test]
+#[ignore = "needs python with mujoco: set BOWL_MUJOCO_PYTHON"]
+fn the_walls_agree_with_a_rigid_body_simulation() {
+    let python =
+        std::env::var("BOWL_MUJOCO_PYTHON").expect("BOWL_MUJOCO_PYTHON: a python with mujoco");
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/mujoco/bowl_mujoco.py"
+    );
+    let w = "1.27";
+    for (alpha, h) in [("90", "0"), ("60", "0.02"), ("90", "0.02")] {
+        let out = std::process::Command::new(&python)
+            .args([
+                script, w, w, "60", "0.075", "0.0375", "0.003", "0.029", "0.4", alpha, h, "0", "1",
+                "0", "90", "180", "270",
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let reference: Vec<(Option<f64>, f64)> = String::from_utf8(out.stdout)
+            .unwrap()
+            .lines()
+            .map(|l| {
+                let f: Vec<&str> = l.split_whitespace().collect();
+                (f[1].parse().ok(), f[3].parse().unwrap())
+            })
+            .collect();
+        assert_eq!(reference.len(), 4);
+        let v = json(&bowl_args(
+            w,
+            w,
+            "60",
+            [alpha, h, "0"],
+            &[
+                "--restitution",
+                "0.15",
+                "--max-time-s",
+                "1",
+                "--release-azimuth-deg",
+                "0,90,180,270",
+                "--json",
+            ],
+        ));
+        let ours: Vec<Option<f64>> = v["per_release"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r["residence_time_s"].as_f64())
+            .collect();
+        match (alpha, h) {
+            ("90", "0") => {
+                for ((t_ref, slide), t) in reference.iter().zip(&ours) {
+                    let (t_ref, t) = (t_ref.unwrap(), t.unwrap());
+                    assert!((t / t_ref - 1.0).abs() < 0.015, "{t} vs {t_ref}");
+                    assert!(*slide > 0.95, "{slide}");
+                }
+                for rel in v["per_release"].as_array().unwrap() {
+                    assert!(rel["regime"]["slide"].as_f64().unwrap() > 0.95, "{rel}");
+                }
+            }
+            ("60", _) => {
+                let m_ref = reference.iter().map(|r| r.0.unwrap()).sum::<f64>() / 4.0;
+                let m = ours.iter().map(|t| t.unwrap()).sum::<f64>() / 4.0;
+                assert!((m / m_ref - 1.0).abs() < 0.05, "{m} vs {m_ref}");
+            }
+            _ => {
+                assert!(reference.iter().all(|r| r.0.is_none()), "{reference:?}");
+                assert!(ours.iter().all(Option::is_none), "{v}");
+            }
+        }
+    }
 }

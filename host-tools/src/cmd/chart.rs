@@ -49,6 +49,11 @@ enum Which {
     BowlResidence(RollingResidenceArgs),
     /// Bowl model: sliding and leaving against the tilt at 2 rad/s (the regime map).
     BowlRegimes(Out),
+    /// Bowl model: what most releases do (roll, slide, fly, held by the wall) over tilt and
+    /// speed, on a rod offset of 0.3 m.
+    BowlRegimeMap(Out),
+    /// Bowl model: work-precision of DP5(4) and RK4 with the wall and with flights.
+    BowlWorkPrecision(Out),
     /// Rolling model: the twelve releases' paths on the bowl bottom.
     RollingPaths(Out),
     /// Rolling model: each simpler member's difference from the full model (the hierarchy map).
@@ -396,6 +401,14 @@ pub fn run(args: &Args) -> Result<()> {
         }
         Which::BowlRegimes(out) => {
             let (f, t) = bowl::regimes(2.0)?;
+            write_all(out, &f, &t)
+        }
+        Which::BowlRegimeMap(out) => {
+            let (f, t) = bowl::regime_map(0.3)?;
+            write_all(out, &f, &t)
+        }
+        Which::BowlWorkPrecision(out) => {
+            let (f, t) = bowl::work_precision()?;
             write_all(out, &f, &t)
         }
         Which::RollingPaths(out) => {

@@ -6,8 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use lab::fit::models::CANDIDATES;
-use lab::fit::models::Method;
+use lab::fit::models::{BOWL_CANDIDATES, CANDIDATES, Method};
 use lab::fit::stats::AIC_DECISIVE;
 use lab::fit::{
     DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit_candidates, load, to_json,
@@ -44,6 +43,12 @@ pub struct Args {
         default_value = "flat,coriolis,rolling"
     )]
     pub models: Vec<String>,
+    /// Also fit the bowl model (docs/model.md section 10) with each of its walls (bare rim,
+    /// 60 deg 10 and 20 mm, vertical 20 mm): its parameter is the sliding friction mu_s, and
+    /// the AIC says which model and which wall the measured times prefer. Slower (twelve
+    /// releases in the real bowl per run and trial).
+    #[arg(long)]
+    pub bowl_walls: bool,
 }
 
 /// `bowl fit`.
@@ -58,11 +63,14 @@ pub fn run(args: &Args) -> Result<()> {
     for r in &mut runs {
         r.axes_angle_rad = args.axes_angle_deg.to_radians();
     }
-    let candidates: Vec<_> = CANDIDATES
+    let mut candidates: Vec<_> = CANDIDATES
         .iter()
         .filter(|c| args.models.iter().any(|m| m == c.name))
         .copied()
         .collect();
+    if args.bowl_walls {
+        candidates.extend(BOWL_CANDIDATES);
+    }
     let fit = fit_candidates(runs, excluded, &candidates, args.fit_k2)?;
     if !args.no_charts {
         let dir = args.charts.clone().unwrap_or_else(|| {

@@ -79,7 +79,7 @@ fn model_curves(
         .enumerate()
         .filter_map(|(i, m)| match m.candidate.equation {
             Equation::Paper(model) => Some((i, m, model)),
-            Equation::Rolling => None,
+            Equation::Rolling | Equation::Bowl(_) => None,
         })
         .map(|(i, m, model)| Series {
             name: format!("{} model, fitted mu {:.4}", m.candidate.name, m.mu),
@@ -183,7 +183,7 @@ pub fn write(fit: &Fit, dir: &Path) -> Result<()> {
         .enumerate()
         .filter_map(|(i, m)| match m.candidate.equation {
             Equation::Paper(model) => Some((i, m, model)),
-            Equation::Rolling => None,
+            Equation::Rolling | Equation::Bowl(_) => None,
         })
         .map(|(i, m, model)| {
             let s = scene(fit, m, w5);

@@ -5,6 +5,8 @@
 //! steady, otherwise by integrating the equation over the trace
 //! (`model_core::sim::granule::Granule`, the same integrator the simulated rig's granules use).
 
+use model_core::ode::system::SystemLimits;
+use model_core::particle::bowl::{self, BowlOutcome, BowlShape};
 use model_core::particle::rolling::{self, RollingMethod, RollingScene};
 use model_core::particle::{Model, Scene, residence};
 use model_core::sim::granule::{G_M_S2, Granule};
@@ -28,7 +30,58 @@ pub enum Equation {
     /// over the twelve release azimuths at the run's mean speed split equally between the
     /// motors, at the run's axes angle.
     Rolling,
+    /// The granule in the real bowl with this wall (docs/model.md section 10: rolling, sliding,
+    /// flying, over the lip), the mean over the twelve azimuths as [`Equation::Rolling`]; the
+    /// fitted parameter is the sliding friction `mu_s` (rolling resistance
+    /// [`BOWL_ROLLING_RESISTANCE`], a sharp corner, restitution 0).
+    Bowl(Wall),
 }
+
+/// A bowl's wall for the bowl model's candidates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Wall {
+    /// Angle from the bottom plane, degrees (90 = vertical).
+    pub angle_deg: f64,
+    /// Height above the bottom, m (0 = a bare rim).
+    pub height_m: f64,
+}
+
+/// The bowl model's rolling resistance in the fit (the rig's, docs/model.md section 10): the
+/// fit's parameter is `mu_s`, which decides whether and where it slides.
+pub const BOWL_ROLLING_RESISTANCE: f64 = 0.029;
+
+/// The bowl model with each wall the fit can tell apart (`bowl fit --bowl-walls`): which wall
+/// the measured times prefer, and `mu_s` under each.
+pub const BOWL_CANDIDATES: [Candidate; 4] = [
+    Candidate {
+        name: "bowl-bare-rim",
+        equation: Equation::Bowl(Wall {
+            angle_deg: 90.0,
+            height_m: 0.0,
+        }),
+    },
+    Candidate {
+        name: "bowl-wall-60deg-10mm",
+        equation: Equation::Bowl(Wall {
+            angle_deg: 60.0,
+            height_m: 0.01,
+        }),
+    },
+    Candidate {
+        name: "bowl-wall-60deg-20mm",
+        equation: Equation::Bowl(Wall {
+            angle_deg: 60.0,
+            height_m: 0.02,
+        }),
+    },
+    Candidate {
+        name: "bowl-wall-vertical-20mm",
+        equation: Equation::Bowl(Wall {
+            angle_deg: 90.0,
+            height_m: 0.02,
+        }),
+    },
+];
 
 /// A model the fit can try: a name and an equation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -110,6 +163,7 @@ pub fn predict_with_k2(run: &Run, equation: Equation, mu: f64, k2: f64) -> f64 {
     let model = match equation {
         Equation::Paper(m) => m,
         Equation::Rolling => return rolling_mean(run, mu, k2),
+        Equation::Bowl(wall) => return bowl_mean(run, wall, mu, k2),
     };
     match run.method {
         Method::ClosedForm => closed_form_with_k2(run, model, mu, k2, run.mean_rad_s),
@@ -163,6 +217,48 @@ fn rolling_mean(run: &Run, mu: f64, k2: f64) -> f64 {
     }
 }
 
+/// The bowl model's integration in the fit: DP5(4) at rtol 1e-7, whose error in the mean T on
+/// the rig's walled scene is 1e-9 relative (docs/model.md §10, work-precision), far under any
+/// gate's scatter, at a third of rtol 1e-9's cost (a fit takes thousands of means).
+const BOWL_METHOD: RollingMethod<f64> = RollingMethod::Dp54 { rtol: 1e-7 };
+
+/// The bowl model's mean residence time over the azimuths at the run's mean speed with the
+/// sliding friction `mu_s`, s (infinite when a release does not leave or gives up).
+fn bowl_mean(run: &Run, wall: Wall, mu_s: f64, k2: f64) -> f64 {
+    let scene = RollingScene {
+        rolling_resistance: BOWL_ROLLING_RESISTANCE,
+        sliding_friction: mu_s,
+        k2,
+        ri_m: run.release_radius_m,
+        rim_radius_m: run.rim_radius_m,
+        g_m_s2: G_M_S2,
+        ..RollingScene::equal_speeds(run.mean_rad_s, run.axes_angle_rad, run.rim_radius_m)
+    };
+    let shape = BowlShape {
+        wall_angle_rad: wall.angle_deg.to_radians(),
+        wall_height_m: wall.height_m,
+        fillet_radius_m: 0.0,
+        restitution: 0.0,
+    };
+    let limits = SystemLimits {
+        horizon_s: 20.0 * run.residence_s + 1.0,
+        max_steps: 20 * ROLLING_MAX_STEPS,
+    };
+    let mut sum = 0.0;
+    for deg in rolling::AZIMUTHS_DEG {
+        match bowl::residence(&scene, &shape, deg.to_radians(), BOWL_METHOD, limits) {
+            Ok(r) => match r.outcome {
+                BowlOutcome::Leaves {
+                    residence_time_s, ..
+                } => sum += residence_time_s,
+                _ => return f64::INFINITY,
+            },
+            Err(_) => return f64::INFINITY,
+        }
+    }
+    sum / rolling::AZIMUTHS_DEG.len() as f64
+}
+
 /// The largest `mu` at which the run can leave under `equation`: for the paper's equation
 /// `ri omega^2 / g` at its fastest speed; for the rolling model on the tilted bottom, where
 /// gravity's in-plane part drives it, `tan th` (the fixed incline's hold) plus that centrifugal
@@ -170,7 +266,7 @@ fn rolling_mean(run: &Run, mu: f64, k2: f64) -> f64 {
 pub fn mu_ceiling_for(run: &Run, equation: Equation) -> f64 {
     match equation {
         Equation::Paper(_) => mu_ceiling(run),
-        Equation::Rolling => run.axes_angle_rad.tan() + mu_ceiling(run),
+        Equation::Rolling | Equation::Bowl(_) => run.axes_angle_rad.tan() + mu_ceiling(run),
     }
 }
 

@@ -231,6 +231,47 @@ fn rolling_truth_is_recognised() {
     );
 }
 
+/// `bowl fit --bowl-walls`: runs made by the bowl model itself with a 60 deg wall 10 mm high at
+/// `mu_s` 0.4 on the rig's tilt (75 mm bottom, 60 deg, three speeds, 0.5 ms timing noise) are
+/// preferred by that wall over the bare rim and the 20 mm wall, and its `mu_s` interval holds
+/// 0.4; the vertical wall, which holds every release, cannot reproduce them (at the limit or
+/// never leaving).
+#[test]
+fn the_bowl_fit_finds_the_wall_and_mu_s() {
+    use super::models::{BOWL_CANDIDATES, Equation, predict};
+    let mut rng = Prng::new(11);
+    let truth = BOWL_CANDIDATES[1];
+    let mut runs = Vec::new();
+    for (c, &w) in [0.8, 2.0, 3.6].iter().enumerate() {
+        let mut run = Run {
+            row: 0,
+            condition: c + 1,
+            residence_s: 0.0,
+            mean_rad_s: w,
+            release_radius_m: 0.0375,
+            rim_radius_m: 0.075,
+            k2: 5.0 / 7.0,
+            trace: vec![(0.0, w)],
+            method: Method::ClosedForm,
+            axes_angle_rad: 60f64.to_radians(),
+        };
+        let t = predict(&run, truth.equation, 0.4);
+        assert!(t.is_finite() && matches!(truth.equation, Equation::Bowl(_)));
+        run.residence_s = t + 0.0005 * gaussian(&mut rng);
+        runs.push(run);
+    }
+    let f = fit_candidates(runs, Vec::new(), &BOWL_CANDIDATES, false).unwrap();
+    assert_eq!(f.preferred, truth.name, "{:?}", f.models);
+    let m = fitted(&f, truth.name);
+    assert!(m.mu_ci95.0 <= 0.4 && 0.4 <= m.mu_ci95.1, "{:?}", m.mu_ci95);
+    assert!(m.mu_ci95.1 - m.mu_ci95.0 < 0.1, "{:?}", m.mu_ci95);
+    let vertical = fitted(&f, BOWL_CANDIDATES[3].name);
+    assert!(
+        vertical.cannot_reproduce.is_some() || vertical.at_limit,
+        "{vertical:?}"
+    );
+}
+
 /// `shortest_residence_s` is a lower bound for every candidate without friction (the fastest
 /// each can be), against the models themselves: the paper's closed forms at mu 0 and k2 1, and
 /// the rolling model (rolling resistance 0) at each release azimuth, over speeds from 0.3 to 30

@@ -106,12 +106,13 @@ fn regime(r: &BowlReport<f64>) -> Value {
     if r.outcome == BowlOutcome::Held {
         return json!({"held": 1.0});
     }
-    let total = r.regime.roll_s + r.regime.slide_s + r.held_s;
+    let total = r.regime.roll_s + r.regime.slide_s + r.flight_s + r.held_s;
     let mut m = serde_json::Map::new();
     if total > 0.0 {
         for (name, t) in [
             ("roll", r.regime.roll_s),
             ("slide", r.regime.slide_s),
+            ("fly", r.flight_s),
             ("held", r.held_s),
         ] {
             if t > 0.0 {
@@ -183,8 +184,8 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
     let mut why = Vec::new();
     if lifted > 0 {
         why.push(format!(
-            "the granule's normal force reaches zero in {lifted} of {releases} releases (it \
-             would fly): flight is not modelled, so those releases have no residence time"
+            "the granule lifts off in {lifted} of {releases} releases and no landing was \
+             found, so those releases have no residence time"
         ));
     }
     if !gave_up.is_empty() {
@@ -227,6 +228,7 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
                         "azimuth_deg": deg, "left": t.is_some(), "residence_time_s": t,
                         "regime": regime(rep), "outcome": outcome_name(&rep.outcome),
                         "exit_speed_relative_m_s": v, "on_wall_s": rep.on_wall_s,
+                        "flight_s": rep.flight_s, "landings": rep.landings,
                         "switches": rep.switches, "rhs_evaluations": rep.evaluations,
                     }),
                 )
@@ -299,7 +301,7 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
             ),
             BowlOutcome::Held => "held at rest where it was released".into(),
             BowlOutcome::LiftsOff { time_s } => {
-                format!("lifts off at t = {time_s:.4} s (flight is not modelled)")
+                format!("lifts off at t = {time_s:.4} s (no landing found)")
             }
             BowlOutcome::Inside { horizon_s } if rep.held_s > 0.0 => {
                 format!("held by the wall: still inside after {horizon_s} s")

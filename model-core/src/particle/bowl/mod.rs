@@ -6,31 +6,29 @@
 //! the wall the same contact on a surface of revolution ([`wall`]). `H = 0` is a bare rim at
 //! `R`: the flat-disc model exactly.
 //!
-//! A corner sharper than the granule (`F <= a`) is an impact: the velocity into the wall is
-//! reversed and scaled by the restitution `e` (a vertical wall sends the granule back along
-//! the bottom; below a rest speed it stays in the corner), the velocity along the wall kept.
-//! Not modelled yet: flight (a granule whose normal force reaches zero off the lip's edge is
-//! reported as lifting off there, with no residence time; the rebound off a flared sharp
-//! corner, which would be a flight, is dropped as if `e = 0`).
+//! A corner sharper than the granule (`F <= a`) is an impact: on a vertical wall the velocity
+//! into it is reversed and scaled by the restitution `e` (back along the bottom; below a rest
+//! speed it stays in the corner, held), on a flared wall the impact of [`flight`] (restitution
+//! and Coulomb friction; a rebound flies). Where the normal force reaches zero the granule
+//! flies ([`flight`]): ballistic until it lands (an impact, then it rolls, slides or bounces
+//! again) or its centre passes over the lip.
 
+pub mod flight;
 pub mod wall;
 pub mod wall_run;
 
 use crate::Real;
 use crate::ode::system::{SystemError, SystemLimits};
 use crate::particle::rolling::modes::{MAX_SWITCHES, ModesOutcome, Regime, Tally, run_from};
+use crate::particle::rolling::slide::SlideState;
 use crate::particle::rolling::{RollingError, RollingMethod, RollingScene};
-use wall::{Meridian, onto_bottom, onto_wall};
+use flight::{Flight, FlightEnd, REST_SPEED, Surface, fly, impact, launch};
+use wall::{Meridian, WallState, from_space, onto_bottom, onto_wall, to_space};
 use wall_run::{WallEnd, stay};
 
 /// The radius, in units of the rim's, of the fillet a sharp corner is given for a granule that
 /// stays in it.
 const SHARP_FILLET: f64 = 1e-2;
-
-/// Below this speed towards a sharp corner's wall, in units of `sqrt(g R)`, a granule no longer
-/// rebounds from it but stays in the corner (a bounce sequence would otherwise take ever
-/// shorter flights without end).
-const REST_SPEED: f64 = 1e-3;
 
 /// The bowl's wall. SI units; angles in radians.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79,6 +77,10 @@ pub struct BowlReport<T> {
     pub on_wall_s: T,
     /// Time held at rest in a vertical wall's sharp corner, up to the horizon, s.
     pub held_s: T,
+    /// Time in flight, s.
+    pub flight_s: T,
+    /// Landings (impacts after a flight).
+    pub landings: u32,
     /// Changes of contact (roll/slide) and of surface (bottom/wall).
     pub switches: u32,
     /// Right-hand sides.
@@ -180,7 +182,8 @@ impl<T: Real> BowlShape<T> {
 }
 
 /// One release at azimuth `beta_rad` (from the downhill direction, as the rolling model's), at
-/// rest on the bottom at `ri`, followed until it leaves over the lip, lifts off, or the horizon.
+/// rest on the bottom at `ri`, followed (rolling, sliding, flying) until it leaves over the lip
+/// or the horizon.
 pub fn residence<T: Real>(
     sc: &RollingScene<T>,
     shape: &BowlShape<T>,
@@ -210,112 +213,203 @@ pub fn residence<T: Real>(
         },
         on_wall_s: T::ZERO,
         held_s: T::ZERO,
+        flight_s: T::ZERO,
+        landings: 0,
         switches: 0,
         evaluations: 0,
         steps: 0,
     };
-    // The first stay on the bottom starts from the release (with its held-at-rest check).
-    let first =
-        crate::particle::rolling::modes::roll_or_slide_within(&bottom, beta_rad, method, limits)
-            .map_err(BowlError::Scene)?;
-    let mut on_bottom = first;
-    let mut t = T::ZERO;
+    // Where the granule is: on the bottom (the first stay from the release, with its
+    // held-at-rest check), on the wall, or in flight; each stay ends in the next.
+    let mut phase = Phase::Bottom(T::ZERO, None);
+    let restitution = shape.restitution;
+    let rest = T::from_f64(REST_SPEED) * (sc.g_m_s2 * sc.rim_radius_m).sqrt();
     loop {
-        report.add(&on_bottom.tally);
-        let (te, exit_speed) = match on_bottom.outcome {
-            ModesOutcome::Leaves {
-                residence_time_s,
-                exit_speed_m_s,
-            } => (t + residence_time_s, exit_speed_m_s),
-            // Still on the bottom at the horizon: the report's outcome already says so.
-            ModesOutcome::Inside { .. } => return Ok(report),
-            held_or_lifted => {
-                report.outcome = held_or_lifted;
-                return Ok(report);
-            }
-        };
-        let Some(m) = meridian else {
-            report.outcome = BowlOutcome::Leaves {
-                residence_time_s: te,
-                exit_speed_m_s: exit_speed,
-            };
-            return Ok(report);
-        };
         if report.switches > MAX_SWITCHES {
             return Err(BowlError::Scene(RollingError::Integration(
                 SystemError::StepLimit,
             )));
         }
-        report.switches += 1;
         let remaining = SystemLimits {
             horizon_s: limits.horizon_s,
             max_steps: limits.max_steps.saturating_sub(report.steps),
         };
-        let mut entry = onto_wall(&m, &on_bottom.end_state);
-        if shape.sharp_corner(sc) {
-            // The impact: the velocity's part into the wall (normal (-sin alpha, cos alpha) in
-            // the meridian plane) is reversed and scaled by e, the part along the wall kept.
-            let (sa, ca) = (shape.wall_angle_rad.sin(), shape.wall_angle_rad.cos());
-            let into = entry[3] * sa;
-            let rebound = shape.restitution * into;
-            let rest = T::from_f64(REST_SPEED) * (sc.g_m_s2 * sc.rim_radius_m).sqrt();
-            let vertical = ca <= T::from_f64(1e-9);
-            if vertical && rebound <= rest {
-                // At rest against a vertical wall in a sharp corner: its centre stays at
-                // `R - a` or nearer the axis, inside the lip at `R`, and only a flight could
-                // take it out: held by the wall for the rest of the time.
-                report.held_s = limits.horizon_s - te;
-                return Ok(report);
-            }
-            if vertical {
-                // A vertical wall sends it straight back along the bottom.
-                let mut back = on_bottom.end_state;
-                let rho = (back[0] * back[0] + back[1] * back[1])
-                    .sqrt()
-                    .max(T::EPSILON);
-                let (ex, ey) = (back[0] / rho, back[1] / rho);
-                let radial = back[2] * ex + back[3] * ey;
-                back[2] -= (radial + rebound) * ex;
-                back[3] -= (radial + rebound) * ey;
-                t = te;
-                on_bottom =
-                    run_from(&bottom, te, back, method, remaining).map_err(BowlError::Scene)?;
-                continue;
-            }
-            // A flared wall: it goes on along the wall with what is left (the rebound off the
-            // wall would be a flight, which is not modelled: it is dropped, as if e = 0).
-            entry[3] *= ca;
+        if remaining.max_steps == 0 {
+            return Err(BowlError::Scene(RollingError::Integration(
+                SystemError::StepLimit,
+            )));
         }
-        let w =
-            stay(sc, &m, te, entry, method, remaining, MAX_SWITCHES).map_err(BowlError::Scene)?;
-        report.add(&w.tally);
-        report.on_wall_s += w.tally.regime.roll_s + w.tally.regime.slide_s;
-        match w.end {
-            WallEnd::Lip(tl, speed) => {
-                report.outcome = BowlOutcome::Leaves {
-                    residence_time_s: tl,
-                    exit_speed_m_s: speed,
+        phase = match phase {
+            Phase::Bottom(t, from) => {
+                let on_bottom = match from {
+                    None => crate::particle::rolling::modes::roll_or_slide_within(
+                        &bottom, beta_rad, method, limits,
+                    ),
+                    Some(y) => run_from(&bottom, t, y, method, remaining),
+                }
+                .map_err(BowlError::Scene)?;
+                report.add(&on_bottom.tally);
+                let (te, exit_speed) = match on_bottom.outcome {
+                    ModesOutcome::Leaves {
+                        residence_time_s,
+                        exit_speed_m_s,
+                    } => (t + residence_time_s, exit_speed_m_s),
+                    ModesOutcome::LiftsOff { time_s } => {
+                        report.switches += 1;
+                        let y = on_bottom.end_state;
+                        let a = sc.particle_radius_m;
+                        phase = Phase::Flight(launch(
+                            sc,
+                            time_s,
+                            [y[0], y[1], a],
+                            [y[2], y[3], T::ZERO],
+                            [y[4], y[5], y[6]],
+                        ));
+                        continue;
+                    }
+                    // Still on the bottom at the horizon: the report's outcome says so.
+                    ModesOutcome::Inside { .. } => return Ok(report),
+                    ModesOutcome::Held => {
+                        report.outcome = ModesOutcome::Held;
+                        return Ok(report);
+                    }
                 };
-                return Ok(report);
-            }
-            WallEnd::LiftsOff(tl) => {
-                report.outcome = BowlOutcome::LiftsOff { time_s: tl };
-                return Ok(report);
-            }
-            WallEnd::Horizon => return Ok(report),
-            WallEnd::Bottom(tb, yw) => {
+                let Some(m) = meridian else {
+                    report.outcome = BowlOutcome::Leaves {
+                        residence_time_s: te,
+                        exit_speed_m_s: exit_speed,
+                    };
+                    return Ok(report);
+                };
                 report.switches += 1;
-                let remaining = SystemLimits {
-                    horizon_s: limits.horizon_s,
-                    max_steps: limits.max_steps.saturating_sub(report.steps),
-                };
-                t = tb;
-                on_bottom = run_from(&bottom, tb, onto_bottom(&m, &yw), method, remaining)
-                    .map_err(BowlError::Scene)?;
+                let y = on_bottom.end_state;
+                let entry = onto_wall(&m, &y);
+                if !shape.sharp_corner(sc) {
+                    Phase::Wall(te, entry)
+                } else {
+                    let (sa, ca) = (shape.wall_angle_rad.sin(), shape.wall_angle_rad.cos());
+                    let vertical = ca <= T::from_f64(1e-9);
+                    if vertical {
+                        // The impact on a vertical wall: the radial velocity reversed and
+                        // scaled by e, the rest kept; it goes back along the bottom.
+                        let rebound = restitution * entry[3];
+                        if rebound <= rest {
+                            // At rest against a vertical wall in a sharp corner: its centre
+                            // stays at `R - a` or nearer the axis, inside the lip at `R`, and
+                            // only a flight could take it out: held by the wall for the rest
+                            // of the time.
+                            report.held_s = limits.horizon_s - te;
+                            return Ok(report);
+                        }
+                        let mut back = y;
+                        let (ex, ey) = (entry[1], entry[2]);
+                        let radial = back[2] * ex + back[3] * ey;
+                        back[2] -= (radial + rebound) * ex;
+                        back[3] -= (radial + rebound) * ey;
+                        Phase::Bottom(te, Some(back))
+                    } else {
+                        // A flared wall met in a sharp corner: an impact on the wall (normal
+                        // (-sin alpha, cos alpha) in the meridian plane) with restitution and
+                        // friction; a rebound flies, a slower one goes on along the wall.
+                        let [q, u, sg] = to_space(&m, &entry);
+                        let n = [-sa * entry[1], -sa * entry[2], ca];
+                        let (u2, s2, rebound) = impact(sc, restitution, u, sg, n);
+                        if rebound > rest {
+                            Phase::Flight(launch(sc, te, q, u2, s2))
+                        } else {
+                            // Along the wall with what the impact left: the speed up its slope
+                            // `u . (cos alpha e_rho + sin alpha e_z)` is the meridian speed the
+                            // corner's stand-in fillet turns from the bottom's direction to the
+                            // wall's.
+                            let mut w = from_space(&m, T::ZERO, &q, &u2, &s2);
+                            let (ex, ey) = (entry[1], entry[2]);
+                            w[3] = (u2[0] * ex + u2[1] * ey) * ca + u2[2] * sa;
+                            Phase::Wall(te, w)
+                        }
+                    }
+                }
             }
-        }
+            Phase::Wall(t, entry) => {
+                let Some(m) = meridian else {
+                    return Ok(report);
+                };
+                let w = stay(sc, &m, t, entry, method, remaining, MAX_SWITCHES)
+                    .map_err(BowlError::Scene)?;
+                report.add(&w.tally);
+                report.on_wall_s += w.tally.regime.roll_s + w.tally.regime.slide_s;
+                match w.end {
+                    WallEnd::Lip(tl, speed) => {
+                        report.outcome = BowlOutcome::Leaves {
+                            residence_time_s: tl,
+                            exit_speed_m_s: speed,
+                        };
+                        return Ok(report);
+                    }
+                    WallEnd::LiftsOff(tl, yw) => {
+                        report.switches += 1;
+                        let [q, u, sg] = to_space(&m, &yw);
+                        Phase::Flight(launch(sc, tl, q, u, sg))
+                    }
+                    WallEnd::Horizon => return Ok(report),
+                    WallEnd::Bottom(tb, yw) => {
+                        report.switches += 1;
+                        Phase::Bottom(tb, Some(onto_bottom(&m, &yw)))
+                    }
+                }
+            }
+            Phase::Flight(f) => match fly(sc, meridian.as_ref(), &f, limits.horizon_s) {
+                FlightEnd::Exits(te, speed) => {
+                    report.flight_s += te - f.t0_s;
+                    report.outcome = BowlOutcome::Leaves {
+                        residence_time_s: te,
+                        exit_speed_m_s: speed,
+                    };
+                    return Ok(report);
+                }
+                FlightEnd::Horizon => {
+                    report.flight_s += limits.horizon_s - f.t0_s;
+                    return Ok(report);
+                }
+                FlightEnd::Lands(l) => {
+                    report.flight_s += l.t_s - f.t0_s;
+                    report.switches += 1;
+                    report.landings += 1;
+                    let (u2, s2, rebound) = impact(sc, restitution, l.u_m_s, l.s_m_s, l.normal);
+                    let (q, t) = (l.q_m, l.t_s);
+                    if rebound > rest {
+                        Phase::Flight(launch(sc, t, q, u2, s2))
+                    } else {
+                        // Too slow to bounce: it stays on the surface, its velocity along it.
+                        let n = l.normal;
+                        let vn = u2[0] * n[0] + u2[1] * n[1] + u2[2] * n[2];
+                        let u3: [T; 3] = core::array::from_fn(|i| u2[i] - vn * n[i]);
+                        match (l.surface, meridian) {
+                            (Surface::Wall(s), Some(m)) => {
+                                Phase::Wall(t, from_space(&m, s, &q, &u3, &s2))
+                            }
+                            _ => Phase::Bottom(
+                                t,
+                                Some([q[0], q[1], u3[0], u3[1], s2[0], s2[1], s2[2]]),
+                            ),
+                        }
+                    }
+                }
+            },
+        };
     }
 }
 
+/// Where a release is between its stays.
+enum Phase<T> {
+    /// On the bottom from this time and state (`None`: the release itself).
+    Bottom(T, Option<SlideState<T>>),
+    /// On the fillet or the wall from this time and state.
+    Wall(T, WallState<T>),
+    /// In flight.
+    Flight(Flight<T>),
+}
+
+#[cfg(test)]
+mod flight_tests;
 #[cfg(test)]
 mod tests;

@@ -273,8 +273,10 @@ fn a_vertical_wall_holds_the_granule() {
 }
 
 /// ... and a wall flared at 60 deg lets it climb over the lip, later than a bare rim (the
-/// simulation: 12-37 % longer). Here the mean over four azimuths is 12 % longer for a 10 mm
-/// wall and 25 to 45 % for 20 mm, at every speed; every release spends time on the wall.
+/// simulation: 12-37 % longer for 10-40 mm). Here, with the sharp corner's rebound (e 0.5) a
+/// flight, the mean over four azimuths is 8 to 40 % longer for a 10 mm wall and 20 to 50 % for
+/// 20 mm, at every speed, the higher wall the later; every release spends time on the wall or
+/// in flight (without flight, when the rebound was dropped, 12 % and 30 %: docs/model.md §10).
 #[test]
 fn a_flared_wall_lets_it_climb_out_later() {
     for omega in [0.5, 3.6] {
@@ -290,7 +292,7 @@ fn a_flared_wall_lets_it_climb_out_later() {
                     panic!("{r:?}")
                 };
                 if sh.wall_height_m > 0.0 {
-                    assert!(r.on_wall_s > 0.005, "{r:?}");
+                    assert!(r.on_wall_s + r.flight_s > 0.005, "{r:?}");
                 }
                 sum += residence_time_s;
             }
@@ -299,8 +301,8 @@ fn a_flared_wall_lets_it_climb_out_later() {
         let bare = mean(&BowlShape::bare_rim());
         let low = mean(&shape(60.0, 0.01, 0.0)) / bare - 1.0;
         let high = mean(&shape(60.0, 0.02, 0.0)) / bare - 1.0;
-        assert!(low > 0.08 && low < 0.16, "{omega}: {low}");
-        assert!(high > 0.2 && high < 0.45 && high > low, "{omega}: {high}");
+        assert!(low > 0.08 && low < 0.4, "{omega}: {low}");
+        assert!(high > 0.2 && high < 0.5 && high > low, "{omega}: {high}");
     }
 }
 

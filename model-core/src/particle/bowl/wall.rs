@@ -312,3 +312,42 @@ pub fn onto_bottom<T: Real>(m: &Meridian<T>, y: &WallState<T>) -> [T; 7] {
         y[7],
     ]
 }
+
+/// A wall state as the centre `q`, its velocity `u` relative to the bowl and the spin `s`
+/// (the flight's terms).
+pub fn to_space<T: Real>(m: &Meridian<T>, y: &WallState<T>) -> [[T; 3]; 3] {
+    let en = (y[1] * y[1] + y[2] * y[2]).sqrt().max(T::EPSILON);
+    let (ex, ey) = (y[1] / en, y[2] / en);
+    let p = m.at(y[0]);
+    let [rho, z] = p.pos;
+    let [rp, zp] = p.tangent;
+    let (sd, pd) = (y[3], y[4]);
+    [
+        [rho * ex, rho * ey, z],
+        [
+            sd * rp * ex - rho * pd * ey,
+            sd * rp * ey + rho * pd * ex,
+            sd * zp,
+        ],
+        [y[5], y[6], y[7]],
+    ]
+}
+
+/// A centre `q` on the wall at arc length `s`, moving along it at `u` (relative to the bowl)
+/// with the spin `sig`, as a wall state: the velocity's part along the normal is dropped.
+pub fn from_space<T: Real>(
+    m: &Meridian<T>,
+    s: T,
+    q: &[T; 3],
+    u: &[T; 3],
+    sig: &[T; 3],
+) -> WallState<T> {
+    let en = (q[0] * q[0] + q[1] * q[1]).sqrt().max(T::EPSILON);
+    let (ex, ey) = (q[0] / en, q[1] / en);
+    let p = m.at(s);
+    let [rp, zp] = p.tangent;
+    let rho = p.pos[0].max(T::EPSILON);
+    let sd = u[0] * rp * ex + u[1] * rp * ey + u[2] * zp;
+    let pd = (-u[0] * ey + u[1] * ex) / rho;
+    [s, ex, ey, sd, pd, sig[0], sig[1], sig[2]]
+}

@@ -22,8 +22,8 @@ pub enum WallEnd<T> {
     Bottom(T, WallState<T>),
     /// Over the lip at this time, at this speed relative to the bowl, m/s.
     Lip(T, T),
-    /// The normal force reached zero at this time.
-    LiftsOff(T),
+    /// The normal force reached zero at this time, in this wall state: it flies.
+    LiftsOff(T, WallState<T>),
     /// Still on the wall at the horizon.
     Horizon,
 }
@@ -41,6 +41,7 @@ fn norm<T: Real>(v: &[T; 3]) -> T {
     (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
 
+#[allow(clippy::too_many_arguments)]
 fn events<T: Real>(
     sc: &RollingScene<T>,
     m: &Meridian<T>,
@@ -49,7 +50,8 @@ fn events<T: Real>(
     contact: Contact<T>,
     armed: bool,
     refs: (T, T),
-) -> [T; 4] {
+    below_edge: bool,
+) -> [T; 5] {
     let (reference, speed_ref) = refs;
     let f = wall_forces(sc, m, t, y, contact);
     let rim = sc.rim_radius_m;
@@ -66,11 +68,20 @@ fn events<T: Real>(
             stuck / speed_ref
         }
     };
+    // Reaching the lip's edge (from the cone onto the pivot about it): the path's curvature
+    // jumps from 0 to 1/a there, so the normal force jumps by `|u|^2 / a`; an event on the
+    // smooth arc length, not on the force's jump, decides there whether it flies off the edge.
+    let edge = if below_edge {
+        (y[0] - m.top_s) / rim
+    } else {
+        -T::ONE
+    };
     [
         -y[0] / rim,
         (f.rho_m - m.lip_m) / rim,
         -f.normal_m_s2 / reference,
         switch,
+        edge,
     ]
 }
 
@@ -148,7 +159,7 @@ pub fn stay<T: Real>(
     loop {
         let remaining = out.tally.remaining(limits, max_switches)?;
         let Some(contact) = next_contact(sc, m, t, &y, must_slide) else {
-            out.end = WallEnd::LiftsOff(t);
+            out.end = WallEnd::LiftsOff(t, y);
             return Ok(out);
         };
         let rolling = matches!(contact, Contact::Roll);
@@ -162,6 +173,7 @@ pub fn stay<T: Real>(
             Contact::Roll => [T::ZERO; 3],
         });
         let armed = Cell::new(false);
+        let below_edge = y[0] < m.top_s;
         let now = |d: [T; 3]| {
             if rolling {
                 Contact::Roll
@@ -177,8 +189,8 @@ pub fn stay<T: Real>(
             method,
             scales,
             |t, y: &WallState<T>| {
-                let e = events(sc, m, t, y, now(dir.get()), armed.get(), refs);
-                e[0].max(e[1]).max(e[2]).max(e[3])
+                let e = events(sc, m, t, y, now(dir.get()), armed.get(), refs, below_edge);
+                e[0].max(e[1]).max(e[2]).max(e[3]).max(e[4])
             },
             |t, y: &WallState<T>| {
                 if !rolling {
@@ -192,7 +204,16 @@ pub fn stay<T: Real>(
         else {
             return Ok(out);
         };
-        let e = events(sc, m, te, &ye, now(dir.get()), armed.get(), refs);
+        let e = events(
+            sc,
+            m,
+            te,
+            &ye,
+            now(dir.get()),
+            armed.get(),
+            refs,
+            below_edge,
+        );
         match fired(&e) {
             0 => {
                 let mut back = ye;
@@ -207,16 +228,18 @@ pub fn stay<T: Real>(
                 );
                 return Ok(out);
             }
-            2 if m.over_edge(ye[0]) => {
-                // Airborne from the lip's edge, outwards: over the lip.
-                out.end = WallEnd::Lip(
-                    te,
-                    norm(&wall_forces(sc, m, te, &ye, now(dir.get())).velocity_m_s),
-                );
-                return Ok(out);
+            4 => {
+                // At the edge: on, just onto the pivot; the next contact flies if the pivot
+                // needs a pull (`N <= 0`), else it pivots on.
+                must_slide = false;
+                t = te;
+                y = ye;
+                y[0] = m.top_s + (m.top_s.abs() + m.pivot_m) * T::from_f64(4.0) * T::EPSILON;
             }
             2 => {
-                out.end = WallEnd::LiftsOff(te);
+                // Airborne (from the wall, or from the lip's edge: the flight decides whether
+                // it goes over or falls back in).
+                out.end = WallEnd::LiftsOff(te, ye);
                 return Ok(out);
             }
             _ => {

@@ -409,6 +409,7 @@ pub(crate) fn run_from<T: Real>(
         let (ended, which) = match next_mode(scene, t, &y, must_slide) {
             Next::LiftsOff => {
                 report.outcome = ModesOutcome::LiftsOff { time_s: t };
+                report.end_state = y;
                 return Ok(report);
             }
             Next::Roll(yr) => {
