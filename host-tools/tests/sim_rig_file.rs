@@ -271,3 +271,78 @@ fn small_family_step(from: &str, to: &str) -> serde_json::Value {
     );
     serde_json::from_slice(&out.stdout).expect("valid JSON")
 }
+
+/// With `--current-sense` (issue 29): every fault of the small family at 0.5 and 3 rad/s held
+/// below 1.5 x setpoint + 0.3 rad/s until no bridge drives it, the bridge faults caught by the
+/// current at the first sample (the report counts to the end of the next tick: 2 ms) with a
+/// shorted bridge's supply cut, and every report saying what caught it.
+#[test]
+fn with_current_sense_every_fault_is_held_below_the_speed_bound() {
+    for speed in ["0.5", "3"] {
+        let v = json(&[
+            "sim",
+            "faults",
+            "--rig-file",
+            SMALL,
+            "--speed-rad-s",
+            speed,
+            "--current-sense",
+            "--json",
+        ]);
+        let sp: f64 = speed.parse().unwrap();
+        for p in v["plants"].as_array().unwrap() {
+            assert_eq!(p["false_fault"], false, "{p}");
+            for kind in [
+                "sensor_lost",
+                "stall",
+                "overspeed",
+                "shorted_bridge",
+                "link_lost",
+            ] {
+                let f = &p["faults"][kind];
+                let what = format!("{} at {speed} rad/s, {kind}: {f}", p["name"]);
+                assert!(f["detected_s"].as_f64().is_some(), "not detected: {what}");
+                let peak = f["peak_until_drive_off_rad_s"].as_f64().unwrap();
+                assert!(peak <= 1.5 * sp + 0.3, "too fast before the stop: {what}");
+                let by = f["detected_by"].as_str().unwrap();
+                let expected = match kind {
+                    "link_lost" => "watchdog",
+                    "sensor_lost" => "edges",
+                    _ => by,
+                };
+                assert_eq!(by, expected, "{what}");
+                if by == "current" {
+                    assert!(f["detected_s"].as_f64().unwrap() <= 0.0021, "{what}");
+                }
+                // The supply cut: always for a shorted bridge, never for a fault the bridge
+                // stops (a bridge stuck on: where it drove more than into a held shaft).
+                match kind {
+                    "shorted_bridge" => assert_eq!(f["supply_cut"], true, "{what}"),
+                    "overspeed" => {}
+                    _ => assert_eq!(f["supply_cut"], false, "{what}"),
+                }
+            }
+            // The stuck and the shorted bridge below 3 rad/s: the current, always.
+            if sp < 3.0 {
+                for kind in ["overspeed", "shorted_bridge"] {
+                    assert_eq!(p["faults"][kind]["detected_by"], "current", "{p}");
+                }
+            }
+        }
+    }
+    // Without current sense nothing cuts a shorted bridge: the report says so.
+    let v = json(&[
+        "sim",
+        "faults",
+        "--rig-file",
+        SMALL,
+        "--speed-rad-s",
+        "3",
+        "--json",
+    ]);
+    for p in v["plants"].as_array().unwrap() {
+        let f = &p["faults"]["shorted_bridge"];
+        assert_eq!(f["supply_cut"], false, "{f}");
+        assert_eq!(f["detected_by"], "edges", "{f}");
+    }
+}

@@ -3,7 +3,7 @@
 //! (one 1 ms tick), the supply cut opened only when a current flows with the bridge told to stop,
 //! a stall told from a dead sensor, and no trip on a healthy rig.
 
-use model_core::control::{Controller, DetectedBy, Fault, State};
+use model_core::control::{Controller, CurrentTrip, CurrentWatch, DetectedBy, Fault, State};
 use model_core::sim::experiments::true_model_config;
 use model_core::sim::{ClosedLoop, CurrentSense, Plant, PlantParams};
 
@@ -200,4 +200,47 @@ fn without_current_sense_nothing_changes() {
         assert_eq!(da, b.duties());
     }
     assert!(!b.ctrl.supply_cut_requested());
+}
+
+#[test]
+fn a_braking_duty_and_its_regenerative_current_are_no_trip() {
+    // g = 1.5 A per duty, offset 20 mA, back-EMF 0.146 duty per rad/s (the nominal rig).
+    let (g, offset, emf) = (1.5f32, 0.02f32, 1.75f32 / 12.0);
+    let mut w = CurrentWatch::NEW;
+    for _ in 0..40 {
+        assert_eq!(w.sample(offset, 0.0, 1.0, true, 0.0, emf, 0.95), None);
+    }
+    // A start from rest: the held shaft draws g d.
+    for _ in 0..5 {
+        assert_eq!(
+            w.sample(offset + g * 0.2, 0.2, 1.0, true, 0.0, emf, 0.95),
+            None
+        );
+    }
+    // The first edge: the start's fit is taken.
+    assert_eq!(
+        w.sample(offset + 0.1, 0.2, 1.0, false, 0.0, emf, 0.95),
+        None
+    );
+    assert!(
+        (w.amps_per_duty() - g).abs() < 1e-3,
+        "{}",
+        w.amps_per_duty()
+    );
+    // Slowing from 2 rad/s forward on a slightly reversed duty: the current is negative and
+    // larger than g |d| (the back-EMF adds to the reversed drive), which is no bridge fault.
+    for speed in [2.0f32, 1.0, 0.3] {
+        let d = -0.005;
+        let i = g * (d - emf * speed);
+        assert_eq!(
+            w.sample(offset + i, d, 1.0, false, 0.5 * speed, emf, 0.95),
+            None
+        );
+    }
+    // The same duty, a bridge stuck on forward instead: full duty's current trips.
+    let i = g * (1.0 - emf * 2.0);
+    assert_eq!(
+        w.sample(offset + i, 0.3, 1.0, false, 1.0, emf, 0.95),
+        Some(CurrentTrip::BridgeDriving)
+    );
 }

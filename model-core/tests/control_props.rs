@@ -1,4 +1,5 @@
-//! Property tests: no input sequence makes the controller panic or command an invalid duty.
+//! Property tests: no input sequence (commands, edges, current-sense readings) makes the
+//! controller panic or command an invalid duty.
 
 use model_core::control::commission::LineFit;
 use model_core::control::{Controller, ControllerConfig, State};
@@ -10,6 +11,7 @@ enum Op {
         dt_us: u32,
         e0: Vec<u32>,
         e1: Vec<u32>,
+        currents: [Option<f32>; 2],
     },
     Speeds(f32, f32),
     Start,
@@ -32,8 +34,9 @@ fn any_f32() -> impl Strategy<Value = f32> {
 fn op() -> impl Strategy<Value = Op> {
     prop_oneof![
         6 => (0u32..5000, proptest::collection::vec(0u32..5000, 0..4),
-              proptest::collection::vec(0u32..5000, 0..4))
-            .prop_map(|(dt_us, e0, e1)| Op::Tick { dt_us, e0, e1 }),
+              proptest::collection::vec(0u32..5000, 0..4),
+              proptest::option::of(any_f32()), proptest::option::of(any_f32()))
+            .prop_map(|(dt_us, e0, e1, c0, c1)| Op::Tick { dt_us, e0, e1, currents: [c0, c1] }),
         1 => (any_f32(), any_f32()).prop_map(|(a, b)| Op::Speeds(a, b)),
         1 => Just(Op::Start),
         1 => Just(Op::Stop),
@@ -56,12 +59,13 @@ proptest! {
         let mut now = 0u32;
         for op in ops {
             match op {
-                Op::Tick { dt_us, e0, e1 } => {
+                Op::Tick { dt_us, e0, e1, currents } => {
                     // Edges at offsets inside (or, wrongly, beyond) this tick.
                     let e0: Vec<u32> = e0.iter().map(|o| now.wrapping_add(*o)).collect();
                     let e1: Vec<u32> = e1.iter().map(|o| now.wrapping_add(*o)).collect();
                     now = now.wrapping_add(dt_us);
-                    let d = c.tick(now, [&e0, &e1]);
+                    // Any current-sense reading, NaN and infinite included (or none).
+                    let d = c.tick_with_currents(now, [&e0, &e1], currents);
                     for x in d {
                         prop_assert!(x.is_finite() && x.abs() <= 1.0, "duty {x}");
                     }
@@ -71,6 +75,10 @@ proptest! {
                     let s = c.status();
                     prop_assert!(s.combined_measured_rad_s.is_finite());
                     prop_assert_eq!(s.fault_code, c.fault().map_or(0, |f| f.code()));
+                    for axis in 0..2 {
+                        let (offset, g) = c.current_sense_learned(axis);
+                        prop_assert!(offset.is_finite() && g.is_finite() && g >= 0.0);
+                    }
                 }
                 Op::Speeds(a, b) => {
                     let before = c;

@@ -245,6 +245,8 @@ impl SensorWatch {
     }
 }
 
+/// Readings above this magnitude are ignored as broken, A.
+pub const CURRENT_READING_LIMIT_A: f32 = 1000.0;
 /// The least duty whose current teaches the current per duty: below it the sense chain's
 /// offset and noise weigh too much.
 pub const CURRENT_LEARN_MIN_DUTY: f32 = 0.05;
@@ -363,20 +365,25 @@ impl CurrentWatch {
         CURRENT_BAND_A + CURRENT_BAND_NOISE * self.noise_a
     }
 
-    /// One sample: `reading_a` under the duty `applied` of the last period, with the shaft at
-    /// rest (no edge since it stopped) or not, its speed at least `speed_lo_rad_s` (0 if
+    /// One sample: `reading_a` under the duty `applied` of the last period, the shaft turning
+    /// (if at all) in `direction` (+1 or -1, the commanded one), at rest (no edge since it
+    /// stopped) or not, its speed at least `speed_lo_rad_s` (0 if
     /// unknown) and the identified back-EMF per rad/s as a share of the supply,
     /// `emf_duty_per_rad_s`. Learns, then returns a trip, if any.
+    #[allow(clippy::too_many_arguments)]
     pub fn sample(
         &mut self,
         reading_a: f32,
         applied: f32,
+        direction: f32,
         at_rest: bool,
         speed_lo_rad_s: f32,
         emf_duty_per_rad_s: f32,
         duty_limit: f32,
     ) -> Option<CurrentTrip> {
-        if !reading_a.is_finite() {
+        // No sense chain reads more than its ADC's full scale; a value beyond any motor's current
+        // is a broken reading, not a current (and would overflow the running means).
+        if !reading_a.is_finite() || reading_a.abs() > CURRENT_READING_LIMIT_A {
             return None;
         }
         let i = reading_a - self.offset_a;
@@ -396,8 +403,10 @@ impl CurrentWatch {
             }
             return None;
         }
-        let d = applied.abs();
-        let i_dir = i * applied.signum();
+        // In the shaft's direction: a braking duty (against it) is negative, and so is the
+        // current it and the back-EMF drive.
+        let d = applied * direction;
+        let i_dir = i * direction;
         if at_rest {
             self.learn_at_rest(i_dir, d);
         } else if self.start_armed || self.start_samples > 0 {
@@ -412,13 +421,13 @@ impl CurrentWatch {
         if i.abs() > OVERCURRENT_MARGIN * g * duty_limit + band {
             return Some(CurrentTrip::OverCurrent);
         }
-        let allowed = g * (d - emf_duty_per_rad_s * speed_lo_rad_s.max(0.0)).max(0.0)
-            + UNCOMMANDED_SHARE * g
-            + band;
-        if i_dir > g * d + UNCOMMANDED_SHARE * g + band {
+        // `i = g (d - e w)` with `w >= 0` along the shaft's direction: the held shaft draws the
+        // most, a turning one less by its back-EMF.
+        let margin = UNCOMMANDED_SHARE * g + band;
+        if i_dir > g * d + margin {
             return Some(CurrentTrip::BridgeDriving);
         }
-        if i_dir > allowed {
+        if i_dir > g * (d - emf_duty_per_rad_s * speed_lo_rad_s.max(0.0)) + margin {
             return Some(CurrentTrip::Uncommanded);
         }
         None

@@ -26,6 +26,7 @@ impl Controller {
         let trip = a.current.sample(
             reading_a,
             applied,
+            a.direction,
             a.est.at_rest(),
             speed_lo_rad_s,
             a.k.duty_per_rad_s(),
