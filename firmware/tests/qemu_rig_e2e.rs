@@ -42,6 +42,12 @@ fn rig_runs_closed_loop_and_handles_a_sensor_fault_under_qemu() {
         "both motors identified at boot: {models}"
     );
 
+    // The host-silence check off, as in the scenarios on this board: the harness PINGs through
+    // `bowl send`, one process at a time, which on a loaded machine cannot keep pace with a board
+    // running faster than real time (it faulted HostSilent in a loaded CI run). The check itself
+    // is tested on the host rig, the device tests and the Black Pill.
+    assert_eq!(split.send(&bowl, &["set", "LINK_TIMEOUT_MS", "0"]).0, 0);
+
     // Speeds, start, and 6 s of device time.
     assert_eq!(split.send(&bowl, &["speed", "2000", "3000"]).0, 0);
     assert_eq!(split.send(&bowl, &["start"]).0, 0);

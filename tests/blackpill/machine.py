@@ -97,6 +97,41 @@ def _find_opcodes(elf_path: str, opcode: bytes):
     return found
 
 
+def _it_blocks_split_by_a_page(elf_path: str):
+    """The Thumb IT instructions of the image whose block reaches into the next 1 KiB page.
+
+    unicorn 2.0.1 (QEMU's translator) ends a translation block at a 1 KiB page boundary, so such
+    an IT block is split between two blocks; when an instruction count ends a slice there, the
+    emulation resumes inside the IT block with one of its instructions executed twice (seen:
+    `it hi; addhi.w r0, r0, #0x20000` across 0x...c00 added twice, a parameter-flash read out
+    of bounds at boot; unicorn issue #853 is the same family). The harness stops before each of
+    these IT instructions and runs the block on its own ([`Machine.step`])."""
+    from elftools.elf.elffile import ELFFile
+    sites = {}
+    with open(elf_path, "rb") as f:
+        elf = ELFFile(f)
+        for sec in elf.iter_sections():
+            if not (sec["sh_flags"] & 0x4 and sec["sh_type"] == "SHT_PROGBITS"):
+                continue
+            data, base = sec.data(), sec["sh_addr"]
+            for off in range(0, len(data) - 1, 2):
+                mask = data[off] & 0x0F
+                if data[off + 1] != 0xBF or not mask:
+                    continue
+                # Instructions in the block: 4 minus the trailing zeros of the mask.
+                count = 4 - (mask & -mask).bit_length() + 1
+                at = off + 2
+                for _ in range(count):
+                    if at + 1 >= len(data):
+                        break
+                    first = data[at] | data[at + 1] << 8
+                    at += 4 if first >= 0xE800 else 2
+                start = base + off
+                if (start >> 10) != ((base + at - 1) >> 10):
+                    sites[start] = count
+    return sites
+
+
 class Board:
     """One boot of the MCU: a fresh core and peripherals on the machine's clock."""
 
@@ -165,6 +200,12 @@ class Board:
         self.led_lit = False
         ql.hw.gpioc.hook_write(self._gpioc_written, intercept=QL_INTERCEPT.EXIT)
 
+        for addr in m.split_it_sites:
+            self.uc.hook_add(UC_HOOK_CODE, self._on_split_it, begin=addr, end=addr)
+        # The IT instruction the CPU was stopped before (it runs next, on its own), and the one
+        # whose hook lets it pass once.
+        self.at_split_it = None
+        self.split_it_pass = None
         for addr in m.wfe_sites:
             self.uc.hook_add(UC_HOOK_CODE, self._on_wfe, begin=addr, end=addr)
         for addr in m.sev_sites:
@@ -250,6 +291,17 @@ class Board:
         self.at_wfe = address
         uc.emu_stop()
 
+    def _on_split_it(self, uc, address, size, user_data):
+        # Inside an interrupt handler qiling runs the handler to its end in one call: no slice
+        # ends there, nothing to guard (and a stop would cut the handler short).
+        if self.in_isr:
+            return
+        if self.split_it_pass == address:
+            self.split_it_pass = None
+            return
+        self.at_split_it = address
+        uc.emu_stop()
+
     def resume_after_wfe(self):
         """At a WFE: skip it; sleep unless an event (SEV, an interrupt) is latched."""
         self.ql.arch.regs.pc = self.at_wfe + 2
@@ -323,6 +375,8 @@ class Machine:
         self.now_ns = 0
         self.wfe_sites = _find_opcodes(elf, THUMB_WFE)
         self.sev_sites = _find_opcodes(elf, THUMB_SEV)
+        self.split_it_sites = _it_blocks_split_by_a_page(elf)
+        self.split_it_runs = 0
         self.reset_request = None
         self.power_cut = False
         self.in_dma = False
@@ -525,6 +579,13 @@ class Machine:
             limit = min(limit, max(nxt, self.now_ns + 100))
         count = max(1, int((limit - self.now_ns) * self.clocks.sysclk_hz() / 1e9))
         pc = b.ql.arch.regs.pc
+        if b.at_split_it == pc:
+            # An IT block split by a page boundary: the IT instruction (counted), its block (not
+            # counted by unicorn) and the next instruction, in one run that cannot end inside it.
+            b.at_split_it = None
+            b.split_it_pass = pc
+            count = 2
+            self.split_it_runs += 1
         try:
             b.uc.emu_start(pc | 1, 0, 0, count)
         except UcError as e:
