@@ -2,8 +2,10 @@
 //! amplifiers' outputs on PB0 (ADC1_IN8, precession) and PB1 (ADC1_IN9, spin), converted by ADC1's
 //! injected group at every PWM period's start (TIM1's update as TRGO), so each sample sits at the
 //! same point of the PWM cycle whatever the duty: the valley of the current's ripple, below the
-//! period's mean by `V d (1 - d) T / (2 L)` at most (0.19 mA on the nominal 2 mH motor at
-//! 12 V and 20 kHz, d = 0.5: far below the sense chain's own offset).
+//! period's mean by `V d (1 - d) T / (2 L)` at most: 37.5 mA on the nominal 2 mH motor at 12 V and
+//! 20 kHz, d = 0.5 (a duty-dependent bias inside the current trips' 50 mA band; a centre-aligned
+//! PWM sampled at its peak would read the mean, at the cost of the timer's mode and the
+//! emulator's up-counting timer model).
 //!
 //! The results stay in JDR1/JDR2 until the next conversion; the control tick reads the latest
 //! (no DMA, no interrupt per sample) and the controller checks every one it gets (the current
