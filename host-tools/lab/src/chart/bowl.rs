@@ -10,7 +10,8 @@ use model_core::particle::rolling::{self, AZIMUTHS_DEG, MAX_STEPS, RollingMethod
 /// The scene both bowl charts draw, said under their legends.
 const SCENE_NOTE: &str = "75 mm bottom, ri = R/2, mu_r 0.029, mu_s 0.4";
 
-use super::plot::{Figure, Mark, Scale, Series};
+use super::plot::{Figure, Mark, Series};
+use super::rolling::{Run, method_series, work_precision_figure};
 use super::table::Table;
 
 const METHOD: RollingMethod<f64> = RollingMethod::Dp54 { rtol: 1e-9 };
@@ -354,7 +355,7 @@ pub fn work_precision() -> Result<(Figure, Table)> {
     let mut series = Vec::new();
     for (si, (name, s, shape)) in scenes.iter().enumerate() {
         let (reference, _) = bowl_mean_by(s, shape, RollingMethod::Dp54 { rtol: 1e-12 })?;
-        let mut runs: Vec<(&str, String, RollingMethod<f64>)> = (3..=11)
+        let mut runs: Vec<Run> = (3..=11)
             .map(|k| {
                 let tol = 10f64.powi(-k);
                 (
@@ -368,56 +369,24 @@ pub fn work_precision() -> Result<(Figure, Table)> {
             let h = 2e-3 / 2f64.powi(k);
             ("rk4", format!("{h:e}"), RollingMethod::Rk4 { step_s: h })
         }));
-        let (mut dp, mut rk) = (Vec::new(), Vec::new());
-        for (family, setting, method) in runs {
-            match bowl_mean_by(s, shape, method) {
-                Ok((t, n)) => {
-                    let e = ((t - reference) / reference).abs().max(1e-17);
-                    if family == "dp54" { &mut dp } else { &mut rk }.push((n as f64, e));
-                    table.row(vec![
-                        (*name).into(),
-                        family.into(),
-                        setting,
-                        n.to_string(),
-                        format!("{e:e}"),
-                    ]);
-                }
-                Err(e) => table.row(vec![
-                    (*name).into(),
-                    family.into(),
-                    setting,
-                    "-".into(),
-                    format!("failed: {e}").replace(',', ";"),
-                ]),
-            }
-        }
-        series.push(Series {
-            name: format!("DP5(4), {name}"),
-            points: dp,
-            mark: Mark::LinePoints,
-            color: 2 * si,
-        });
-        series.push(Series {
-            name: format!("RK4, {name}"),
-            points: rk,
-            mark: Mark::DashedPoints,
-            color: 2 * si + 1,
-        });
+        series.extend(method_series(
+            name,
+            si,
+            reference,
+            runs,
+            |m| bowl_mean_by(s, shape, m).map(|(t, n)| (t, n as f64)),
+            &mut table,
+        ));
     }
-    let fig = Figure {
-        title: "Work-precision on the bowl model (mean over 12 releases)".into(),
-        x_label: "right-hand-side evaluations (12 releases)".into(),
-        y_label: "relative error in the mean residence time".into(),
-        x_scale: Scale::Log,
-        y_scale: Scale::Log,
+    let fig = work_precision_figure(
+        "Work-precision on the bowl model (mean over 12 releases)",
         series,
-        vlines: vec![],
-        notes: vec![
+        vec![
             SCENE_NOTE.into(),
             "reference: DP5(4) at rtol 1e-12".into(),
             "DP5(4) rtol 1e-3..1e-11; RK4 h 2 ms / 2^k".into(),
             "flights in closed form (not counted)".into(),
         ],
-    };
+    );
     Ok((fig, table))
 }

@@ -259,6 +259,79 @@ fn mean_by(s: &RollingScene<f64>, method: RollingMethod<f64>) -> Result<(f64, u3
     Ok((mean, sum.evaluations))
 }
 
+/// One run of a work-precision sweep: its family (`dp54` or `rk4`), its setting as the table
+/// writes it, the method.
+pub(super) type Run = (&'static str, String, RollingMethod<f64>);
+
+/// One scene's runs on a work-precision chart: each run's error in the mean residence time
+/// against `reference` (from `mean_by`: the mean and the right-hand-side evaluations) as a row of
+/// `table` and a point of its family's series, DP5(4) solid and RK4 dashed in the scene's two
+/// colours; a run that fails is a row that says why.
+pub(super) fn method_series(
+    name: &str,
+    scene_index: usize,
+    reference: f64,
+    runs: Vec<Run>,
+    mut mean_by: impl FnMut(RollingMethod<f64>) -> Result<(f64, f64)>,
+    table: &mut Table,
+) -> [Series; 2] {
+    let (mut dp, mut rk) = (Vec::new(), Vec::new());
+    for (family, setting, method) in runs {
+        match mean_by(method) {
+            Ok((t, n)) => {
+                let e = ((t - reference) / reference).abs().max(1e-17);
+                if family == "dp54" { &mut dp } else { &mut rk }.push((n, e));
+                table.row(vec![
+                    name.into(),
+                    family.into(),
+                    setting,
+                    format!("{n}"),
+                    format!("{e:e}"),
+                ]);
+            }
+            Err(e) => table.row(vec![
+                name.into(),
+                family.into(),
+                setting,
+                "-".into(),
+                format!("failed: {e}").replace(',', ";"),
+            ]),
+        }
+    }
+    [
+        Series {
+            name: format!("DP5(4), {name}"),
+            points: dp,
+            mark: Mark::LinePoints,
+            color: 2 * scene_index,
+        },
+        Series {
+            name: format!("RK4, {name}"),
+            points: rk,
+            mark: Mark::DashedPoints,
+            color: 2 * scene_index + 1,
+        },
+    ]
+}
+
+/// A work-precision figure: evaluations against the relative error, both on log axes.
+pub(super) fn work_precision_figure(
+    title: &str,
+    series: Vec<Series>,
+    notes: Vec<String>,
+) -> Figure {
+    Figure {
+        title: title.into(),
+        x_label: "right-hand-side evaluations (12 releases)".into(),
+        y_label: "relative error in the mean residence time".into(),
+        x_scale: Scale::Log,
+        y_scale: Scale::Log,
+        series,
+        vlines: vec![],
+        notes,
+    }
+}
+
 /// Work-precision of DP5(4) and RK4 on the rolling equation: the error in the mean residence
 /// time against right-hand-side evaluations, on the rig's 60-degree scene and on a 30-degree
 /// scene close to the stick/slip threshold (resistance near `tan 30`), where the start from rest
@@ -278,80 +351,37 @@ pub fn work_precision() -> Result<(Figure, Table)> {
     let mut series = Vec::new();
     for (si, (name, s)) in scenes.iter().enumerate() {
         let (reference, _) = mean_by(s, REFERENCE)?;
-        let mut dp = Vec::new();
-        for k in 3..=12 {
-            let tol = 10f64.powi(-k);
-            match mean_by(s, RollingMethod::Dp54 { rtol: tol }) {
-                Ok((t, n)) => {
-                    let e = ((t - reference) / reference).abs().max(1e-17);
-                    dp.push((f64::from(n), e));
-                    table.row(vec![
-                        name.to_string(),
-                        "dp54".into(),
-                        format!("{tol:e}"),
-                        n.to_string(),
-                        format!("{e:e}"),
-                    ]);
-                }
-                Err(e) => table.row(vec![
-                    name.to_string(),
-                    "dp54".into(),
+        let mut runs: Vec<Run> = (3..=12)
+            .map(|k| {
+                let tol = 10f64.powi(-k);
+                (
+                    "dp54",
                     format!("{tol:e}"),
-                    "-".into(),
-                    format!("failed: {e}").replace(',', ";"),
-                ]),
-            }
-        }
-        let mut rk = Vec::new();
-        for k in 0..=10 {
+                    RollingMethod::Dp54 { rtol: tol },
+                )
+            })
+            .collect();
+        runs.extend((0..=10).map(|k| {
             let h = 0.02 / 2f64.powi(k);
-            match mean_by(s, RollingMethod::Rk4 { step_s: h }) {
-                Ok((t, n)) => {
-                    let e = ((t - reference) / reference).abs().max(1e-17);
-                    rk.push((f64::from(n), e));
-                    table.row(vec![
-                        name.to_string(),
-                        "rk4".into(),
-                        format!("{h:e}"),
-                        n.to_string(),
-                        format!("{e:e}"),
-                    ]);
-                }
-                Err(e) => table.row(vec![
-                    name.to_string(),
-                    "rk4".into(),
-                    format!("{h:e}"),
-                    "-".into(),
-                    format!("failed: {e}").replace(',', ";"),
-                ]),
-            }
-        }
-        series.push(Series {
-            name: format!("DP5(4), {name}"),
-            points: dp,
-            mark: Mark::LinePoints,
-            color: 2 * si,
-        });
-        series.push(Series {
-            name: format!("RK4, {name}"),
-            points: rk,
-            mark: Mark::DashedPoints,
-            color: 2 * si + 1,
-        });
+            ("rk4", format!("{h:e}"), RollingMethod::Rk4 { step_s: h })
+        }));
+        series.extend(method_series(
+            name,
+            si,
+            reference,
+            runs,
+            |m| mean_by(s, m).map(|(t, n)| (t, f64::from(n))),
+            &mut table,
+        ));
     }
-    let fig = Figure {
-        title: "Work-precision on the rolling equation (mean over 12 releases)".into(),
-        x_label: "right-hand-side evaluations (12 releases)".into(),
-        y_label: "relative error in the mean residence time".into(),
-        x_scale: Scale::Log,
-        y_scale: Scale::Log,
+    let fig = work_precision_figure(
+        "Work-precision on the rolling equation (mean over 12 releases)",
         series,
-        vlines: vec![],
-        notes: vec![
+        vec![
             "reference: DP5(4) at rtol 1e-13".into(),
             "DP5(4) rtol 1e-3..1e-12; RK4 h 0.02 s / 2^k".into(),
         ],
-    };
+    );
     Ok((fig, table))
 }
 
