@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{Sim, bowl, stdout};
+use common::{Sim, bowl, sim_timed, stdout};
 use model_core::binding::default_params;
 use model_core::wire::ParamId;
 
@@ -28,6 +28,27 @@ fn state_refusal_says_the_state_and_what_to_do() {
     );
     // The states the command table allows it in.
     assert!(text.contains("(`clear` is taken while faulted)"), "{text}");
+}
+
+/// SET's states are the parameter's: a setting that rebuilds the controller is refused while
+/// the motors run with that reason, and one that changes while running (the loop tuning) is
+/// taken. Checked against the rig: each parameter's role says which, and the rig agrees.
+#[test]
+fn set_while_running_names_the_parameter_and_what_to_do() {
+    let sim = sim_timed("30", &["0:speed,1000,1000", "0:start"]);
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let (code, text) = send(&sim.path, "set CUR_SENSE 1");
+    assert_eq!(code, 1, "{text}");
+    assert!(
+        text.contains(
+            "CUR_SENSE changes only while the rig is idle or faulted (it rebuilds the \
+             controller); stop the motors first (`bowl send PORT stop`), then set it"
+        ),
+        "{text}"
+    );
+    let bw = default_params()[ParamId::Bandwidth1MradS.index()];
+    let (code, text) = send(&sim.path, &format!("set BW1_MRAD_S {bw}"));
+    assert_eq!(code, 0, "loop tuning is taken while running: {text}");
 }
 
 #[test]

@@ -111,6 +111,15 @@ fn refusals_say_the_value_the_limit_and_the_names() {
     assert!(said("speed -1 2100").contains("SPEED_MAX1_MRAD_S"));
     assert!(said("set TELEM_HZ 51").contains("TELEM_HZ 51 frames/s is outside its range 0..=50"));
     assert!(said("set FOO 1").contains("`FOO` is not a parameter; the parameters: RIM_UM"));
+    // A switch is named as one: no unit "0/1" printed as if it were one.
+    assert_eq!(
+        said("set CUR_SENSE 2"),
+        "CUR_SENSE is a switch: 0 (off) or 1 (on), not 2"
+    );
+    assert_eq!(
+        said("set CUR_SENSE on"),
+        "CUR_SENSE is a switch: 0 (off) or 1 (on), not `on`"
+    );
     assert!(
         said("rtime fast 2500").contains("`fast` is not a residence model: flat, cori or table")
     );

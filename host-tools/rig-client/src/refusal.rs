@@ -7,7 +7,7 @@
 
 use std::time::Duration;
 
-use model_core::binding::{config_from_params, scene_from_params, table_from_params};
+use model_core::binding::{ParamRole, config_from_params, scene_from_params, table_from_params};
 use model_core::bowl::MotorSpeeds;
 use model_core::control::estimator::lowest_speed_rad_s;
 use model_core::control::{BowlSpeedForResidence, Controller, ControllerConfig, InverseFailure};
@@ -45,7 +45,7 @@ pub fn particulars(
         ),
         (Reason::State, _) => {
             let status = ask_status(link?, id, timeout)?;
-            Some(state_words(&status, &word))
+            Some(state_words(&status, &word, words))
         }
         (Reason::Range, "speed") => {
             let params = ask_params(link?, id, timeout)?;
@@ -86,8 +86,30 @@ pub(crate) fn set_range(words: &[String]) -> Option<String> {
     }
 }
 
-fn state_words(s: &Status, command: &str) -> String {
+fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
     use model_core::wire::DeviceState as D;
+    // SET's states are its parameter's, not the command's (the parameter table's roles).
+    let param = (command == "set")
+        .then(|| {
+            typed
+                .get(1)
+                .and_then(|w| ParamId::from_token(w.to_ascii_uppercase().as_bytes()))
+        })
+        .flatten();
+    if let Some(p) = param
+        && !ParamRole::of(p).changes_while_running()
+        && matches!(
+            s.state,
+            D::Running | D::SpinningUp | D::Stopping | D::Commissioning
+        )
+    {
+        return format!(
+            "the rig is {}: {} changes only while the rig is idle or faulted (it rebuilds the \
+             controller); stop the motors first (`bowl send PORT stop`), then set it",
+            words::state(s.state),
+            p.token()
+        );
+    }
     let todo = match s.state {
         D::Faulted => format!(
             "{}; clear it first (`bowl send PORT clear`)",

@@ -74,6 +74,19 @@ pub enum ParamRole {
 }
 
 impl ParamRole {
+    /// Whether SET may change it while the motors run (the scene, the residence-time table,
+    /// the telemetry rate and the loop tuning); the rest rebuilds the controller, so idle or
+    /// faulted only.
+    pub const fn changes_while_running(self) -> bool {
+        matches!(
+            self,
+            ParamRole::Scene
+                | ParamRole::TelemetryRate
+                | ParamRole::ResidenceTable
+                | ParamRole::Axis(_, AxisSetting::Bandwidth | AxisSetting::PerPulseBandwidth)
+        )
+    }
+
     /// The role of `id`. A new parameter needs its line here (the match is exhaustive).
     pub const fn of(id: ParamId) -> Self {
         use AxisSetting as S;

@@ -10,6 +10,9 @@ use super::commands::{Command, CommandKind, FieldKind, FieldProblem, MAX_FIELDS}
 use super::params::ParamId;
 use super::types::Reason;
 
+/// The unit of a parameter that is a switch (0 off, 1 on).
+const SWITCH_UNIT: &str = "0/1";
+
 impl Command {
     /// The command in the words a person types (`speed 1800 2100`, `set TELEM_HZ 20`; each
     /// word may also hold several, split at commas: `speed,1800,2100`), judged by the table:
@@ -201,6 +204,13 @@ impl fmt::Display for Refusal<'_> {
                 };
                 let (lo, hi) = field.range(param);
                 match problem {
+                    // A switch (unit `0/1`) is named as one, not given a unit.
+                    FieldProblem::OutOfRange(v) if unit == SWITCH_UNIT => {
+                        write!(f, "{what} is a switch: 0 (off) or 1 (on), not {v}")
+                    }
+                    FieldProblem::NotAnInteger if unit == SWITCH_UNIT => {
+                        write!(f, "{what} is a switch: 0 (off) or 1 (on), not `{word}`")
+                    }
                     FieldProblem::NotAnInteger => write!(
                         f,
                         "{what}: `{word}` is not an integer (a whole number of {unit}, {lo}..={hi})"

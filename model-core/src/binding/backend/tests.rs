@@ -452,3 +452,34 @@ fn rtime_with_a_paper_model_outside_the_speed_limits_is_infeasible() {
         }
     );
 }
+
+/// `ParamRole::changes_while_running` is what the rig does: with the motors started, SET of
+/// each parameter (to its default) is taken exactly when its role says so, and refused STATE
+/// otherwise (the PC's refusal words rely on it).
+#[test]
+fn set_while_running_follows_each_parameters_role() {
+    let mut s = station();
+    assert_eq!(
+        command(&mut s, "C1,1,SPEED,1000,1000"),
+        Frame::Ack { id: 1 }
+    );
+    assert_eq!(command(&mut s, "C1,2,START"), Frame::Ack { id: 2 });
+    for (i, id) in ParamId::ALL.iter().copied().enumerate() {
+        let n = 10 + i as u16;
+        let line = std::format!("C1,{n},SET,{},{}", id.token(), id.default_value());
+        let f = command(&mut s, &line);
+        if ParamRole::of(id).changes_while_running() {
+            assert_eq!(f, Frame::Ack { id: n }, "{}", id.token());
+        } else {
+            assert_eq!(
+                f,
+                Frame::Reject {
+                    id: n,
+                    reason: Reason::State
+                },
+                "{}",
+                id.token()
+            );
+        }
+    }
+}
