@@ -11,7 +11,7 @@ use model_core::particle::rolling::{self, AZIMUTHS_DEG, MAX_STEPS, RollingMethod
 const SCENE_NOTE: &str = "75 mm bottom, ri = R/2, mu_r 0.029, mu_s 0.4";
 
 use super::plot::{Figure, Mark, Series};
-use super::rolling::{Run, method_series, work_precision_figure};
+use super::rolling::{method_runs, method_series, work_precision_figure};
 use super::table::Table;
 
 const METHOD: RollingMethod<f64> = RollingMethod::Dp54 { rtol: 1e-9 };
@@ -355,20 +355,7 @@ pub fn work_precision() -> Result<(Figure, Table)> {
     let mut series = Vec::new();
     for (si, (name, s, shape)) in scenes.iter().enumerate() {
         let (reference, _) = bowl_mean_by(s, shape, RollingMethod::Dp54 { rtol: 1e-12 })?;
-        let mut runs: Vec<Run> = (3..=11)
-            .map(|k| {
-                let tol = 10f64.powi(-k);
-                (
-                    "dp54",
-                    format!("{tol:e}"),
-                    RollingMethod::Dp54 { rtol: tol },
-                )
-            })
-            .collect();
-        runs.extend((0..=8).map(|k| {
-            let h = 2e-3 / 2f64.powi(k);
-            ("rk4", format!("{h:e}"), RollingMethod::Rk4 { step_s: h })
-        }));
+        let runs = method_runs(3..=11, 2e-3, 8);
         series.extend(method_series(
             name,
             si,

@@ -263,6 +263,30 @@ fn mean_by(s: &RollingScene<f64>, method: RollingMethod<f64>) -> Result<(f64, u3
 /// writes it, the method.
 pub(super) type Run = (&'static str, String, RollingMethod<f64>);
 
+/// A work-precision chart's runs: DP5(4) at rtol `1e-k` for each `k` of `dp54_exponents`, then
+/// RK4 at `first_step_s` halved `rk4_halvings` times.
+pub(super) fn method_runs(
+    dp54_exponents: core::ops::RangeInclusive<i32>,
+    first_step_s: f64,
+    rk4_halvings: i32,
+) -> Vec<Run> {
+    let mut runs: Vec<Run> = dp54_exponents
+        .map(|k| {
+            let tol = 10f64.powi(-k);
+            (
+                "dp54",
+                format!("{tol:e}"),
+                RollingMethod::Dp54 { rtol: tol },
+            )
+        })
+        .collect();
+    runs.extend((0..=rk4_halvings).map(|k| {
+        let h = first_step_s / 2f64.powi(k);
+        ("rk4", format!("{h:e}"), RollingMethod::Rk4 { step_s: h })
+    }));
+    runs
+}
+
 /// One scene's runs on a work-precision chart: each run's error in the mean residence time
 /// against `reference` (from `mean_by`: the mean and the right-hand-side evaluations) as a row of
 /// `table` and a point of its family's series, DP5(4) solid and RK4 dashed in the scene's two
@@ -351,20 +375,7 @@ pub fn work_precision() -> Result<(Figure, Table)> {
     let mut series = Vec::new();
     for (si, (name, s)) in scenes.iter().enumerate() {
         let (reference, _) = mean_by(s, REFERENCE)?;
-        let mut runs: Vec<Run> = (3..=12)
-            .map(|k| {
-                let tol = 10f64.powi(-k);
-                (
-                    "dp54",
-                    format!("{tol:e}"),
-                    RollingMethod::Dp54 { rtol: tol },
-                )
-            })
-            .collect();
-        runs.extend((0..=10).map(|k| {
-            let h = 0.02 / 2f64.powi(k);
-            ("rk4", format!("{h:e}"), RollingMethod::Rk4 { step_s: h })
-        }));
+        let runs = method_runs(3..=12, 0.02, 10);
         series.extend(method_series(
             name,
             si,
