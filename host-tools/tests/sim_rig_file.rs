@@ -19,6 +19,11 @@ fn the_small_family_commissions_and_steps_within_the_targets() {
     for p in plants {
         assert_eq!(p["commissioning"], "ok", "{p}");
         assert_eq!(p["false_fault"], false, "{p}");
+        // Which fault and when: present (null) on every plant, so a reader need not guess.
+        assert!(
+            p["fault"].is_null() && p["fault_after_step_s"].is_null(),
+            "{p}"
+        );
         for axis in ["precession", "spin"] {
             let a = &p["axes"][axis];
             let overshoot = a["overshoot_pct"].as_f64().unwrap();

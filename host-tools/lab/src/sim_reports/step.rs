@@ -3,6 +3,7 @@
 
 use model_core::control::State;
 use model_core::sim::ClosedLoop;
+use model_core::wire::FaultCode;
 use rig_file::Rig;
 use serde::Serialize;
 use std::f64::consts::TAU;
@@ -44,6 +45,11 @@ pub struct PlantStep {
     pub commissioning: String,
     /// A fault latched on this healthy plant.
     pub false_fault: bool,
+    /// Which fault (the console's word for it, as `bowl send` prints it), if one latched.
+    pub fault: Option<&'static str>,
+    /// When it latched, s after the command to the target (null while still settling at
+    /// `from_rad_s`, or no fault).
+    pub fault_after_step_s: Option<f64>,
     /// None when commissioning refused.
     pub axes: Option<Axes<AxisStep>>,
 }
@@ -197,7 +203,11 @@ fn settle_at(cl: &mut ClosedLoop, speed: f32) -> bool {
 /// Runs a commissioned loop (material poured in) at `from` on both axes until settled there
 /// (from rest when `from` is 0), then steps both axes to `target`; records the true speed from
 /// the step on.
-fn step(mut cl: ClosedLoop, from: f32, target: f32) -> (Axes<AxisStep>, bool) {
+/// A step's figures, whether a fault latched (or a command was refused), which fault (the
+/// console's word) and when (s after the step's command).
+type StepRun = (Axes<AxisStep>, bool, Option<&'static str>, Option<f64>);
+
+fn step(mut cl: ClosedLoop, from: f32, target: f32) -> StepRun {
     pour_material(&mut cl);
     let mut fault = false;
     if from > 0.0 {
@@ -212,9 +222,13 @@ fn step(mut cl: ClosedLoop, from: f32, target: f32) -> (Axes<AxisStep>, bool) {
         speed: Vec::new(),
         angle: Vec::new(),
     };
+    let mut fault_at = None;
     cl.run(step_run_s(target), |c| {
         rec.speed.push([c.rig.speed_rad_s(0), c.rig.speed_rad_s(1)]);
         rec.angle.push([c.rig.angle_rad(0), c.rig.angle_rad(1)]);
+        if !fault && c.ctrl.fault().is_some() {
+            fault_at = Some(rec.speed.len() as f64 * rec.dt_s);
+        }
         fault |= c.ctrl.fault().is_some();
     });
     let (from, sp) = (from as f64, target as f64);
@@ -224,6 +238,11 @@ fn step(mut cl: ClosedLoop, from: f32, target: f32) -> (Axes<AxisStep>, bool) {
             spin: figures(&rec, 1, from, sp),
         },
         fault,
+        cl.ctrl
+            .fault()
+            .and_then(|f| FaultCode::from_code(i64::from(f.code())))
+            .map(rig_client::words::fault_token),
+        fault_at,
     )
 }
 
@@ -240,14 +259,18 @@ pub fn family_plant(rig: &Rig, from: f32, target: f32) -> PlantStep {
             name: rig.name.clone(),
             commissioning: format!("refused: {reason}"),
             false_fault: false,
+            fault: None,
+            fault_after_step_s: None,
             axes: None,
         },
         Ok(cl) => {
-            let (axes, fault) = step(cl, from, target);
+            let (axes, fault, fault_word, fault_at) = step(cl, from, target);
             PlantStep {
                 name: rig.name.clone(),
                 commissioning: "ok".into(),
                 false_fault: fault,
+                fault: fault_word,
+                fault_after_step_s: fault_at,
                 axes: Some(axes),
             }
         }
