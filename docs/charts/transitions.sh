@@ -35,7 +35,7 @@ else
     done
   done
 fi
-echo "| change, rad/s | false faults | overshoot <= 5 % | <= 10 % | worst % | 2 % settled <= 3 s | 5 % settled <= 10 s | <= 8 s | never settled | ripple median / worst % |"
+echo "| change, rad/s | false faults | overshoot <= 5 % | <= 10 % | worst % | 2 % settled <= 3 s | 5 % settled <= 10 s | <= 8 s | never settled (of them saturated) | ripple median / worst % |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
 for c in "${changes[@]}"; do
   read -r a b <<<"$c"
@@ -51,7 +51,7 @@ s["change"] = "%g -> %g" % (d["from_rad_s"], d["target_rad_s"])
 print("| {change} | {false_faults} / {plants} | {overshoot_within_5_pct_share:.1f} % "
       "| {overshoot_within_10_pct_share:.1f} % | {overshoot_worst_pct:.1f} "
       "| {settled_2pct_within_3_s_share:.1f} % | {settled_5pct_within_10_s_share:.1f} % "
-      "| {settled_5pct_within_8_s_share:.1f} % | {never_settled} "
+      "| {settled_5pct_within_8_s_share:.1f} % | {never_settled} ({saturated_axes}) "
       "| {ripple_median_pct:.2f} / {ripple_worst_pct:.2f} |".format(**s))
 '
 done

@@ -351,3 +351,32 @@ fn with_current_sense_every_fault_is_held_below_the_speed_bound() {
         assert_eq!(f["detected_by"], "edges", "{f}");
     }
 }
+
+/// An axis full duty cannot take to the target is reported as saturated, not as a loop that
+/// failed to settle; the reachable share leaves it out.
+#[test]
+fn an_axis_full_duty_cannot_take_to_the_target_is_reported_saturated() {
+    let v = json(&[
+        "sim",
+        "family",
+        "--rig-file",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../tests/rigs/saturated-spin.toml"
+        ),
+        "--target-rad-s",
+        "4",
+        "--json",
+    ]);
+    let axes = &v["plants"][0]["axes"];
+    assert_eq!(axes["spin"]["saturated"], true, "{axes}");
+    assert!(axes["spin"]["settling_2pct_s"].is_null(), "{axes}");
+    assert_eq!(axes["precession"]["saturated"], false, "{axes}");
+    let s = &v["summary"];
+    assert_eq!(s["saturated_axes"], 1, "{s}");
+    assert_eq!(s["settled_2pct_within_3_s_share"], 50.0, "{s}");
+    assert_eq!(
+        s["settled_2pct_within_3_s_share_of_reachable"], 100.0,
+        "{s}"
+    );
+}

@@ -25,6 +25,9 @@ pub struct AxisStep {
     pub settling_5pct_s: Option<f64>,
     /// RMS of the true speed about its mean over whole revolutions at steady state, %.
     pub ripple_pct: f64,
+    /// Full duty held the axis short of the target at the end of the run: the plant cannot
+    /// reach it (see `saturated` in this module).
+    pub saturated: bool,
 }
 
 /// Both axes.
@@ -59,6 +62,30 @@ struct Record {
     dt_s: f64,
     speed: Vec<[f32; 2]>,
     angle: Vec<[f64; 2]>,
+    /// The applied duty each tick, and each axis's duty limit.
+    duty: Vec<[f32; 2]>,
+    duty_limit: [f32; 2],
+}
+
+/// How long the duty must have sat at its limit at the end of a run for an axis to count as
+/// saturated, s.
+const SATURATED_HOLD_S: f64 = 1.0;
+
+/// Whether axis `i` ended its run saturated: the duty at its limit for the last
+/// [`SATURATED_HOLD_S`] while the true speed stayed short of the target. Full duty cannot take
+/// such an axis to the target (material and friction the motor cannot overcome at this
+/// supply); no loop can settle it, and the report says so instead of counting it as a loop's
+/// failure.
+fn saturated(rec: &Record, i: usize, sp: f64) -> bool {
+    let k = ((SATURATED_HOLD_S / rec.dt_s) as usize).min(rec.duty.len());
+    let tail = rec.duty.len() - k;
+    k > 0
+        && rec.duty[tail..]
+            .iter()
+            .all(|d| d[i].abs() >= 0.999 * rec.duty_limit[i])
+        && rec.speed[tail..]
+            .iter()
+            .all(|w| (w[i] as f64) < sp * (1.0 - band_for(sp as f32)))
 }
 
 /// Figures of axis `i` of `rec` for a step from `from` to `sp` (`settling_s` in the band
@@ -90,6 +117,7 @@ fn figures(rec: &Record, i: usize, from: f64, sp: f64) -> AxisStep {
     let mean = w.iter().sum::<f64>() / w.len() as f64;
     let var = w.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / w.len() as f64;
     AxisStep {
+        saturated: saturated(rec, i, sp),
         overshoot_pct,
         settling_s,
         settling_2pct_s,
@@ -217,15 +245,19 @@ fn step(mut cl: ClosedLoop, from: f32, target: f32) -> StepRun {
     } else {
         fault |= cl.ctrl.set_motor_speeds(target, target).is_err() || cl.ctrl.start().is_err();
     }
+    let limits = cl.ctrl.config().axes.map(|a| a.duty_limit);
     let mut rec = Record {
         dt_s: cl.dt_s() as f64,
         speed: Vec::new(),
         angle: Vec::new(),
+        duty: Vec::new(),
+        duty_limit: limits,
     };
     let mut fault_at = None;
     cl.run(step_run_s(target), |c| {
         rec.speed.push([c.rig.speed_rad_s(0), c.rig.speed_rad_s(1)]);
         rec.angle.push([c.rig.angle_rad(0), c.rig.angle_rad(1)]);
+        rec.duty.push(c.duties());
         if !fault && c.ctrl.fault().is_some() {
             fault_at = Some(rec.speed.len() as f64 * rec.dt_s);
         }
@@ -304,6 +336,11 @@ pub struct FamilySummary {
     pub settled_5pct_within_8_s_share: f64,
     /// Axes that never settled.
     pub never_settled: usize,
+    /// Axes full duty could not take to the target (saturated at the end of the run, short of
+    /// the band): out of any loop's reach on this plant.
+    pub saturated_axes: usize,
+    /// Axes whose 2 % settling took 3 s or less, in % of the axes that were not saturated.
+    pub settled_2pct_within_3_s_share_of_reachable: f64,
     /// Worst settling, s (None if any axis never settled).
     pub settling_worst_s: Option<f64>,
     /// Median ripple, %.
@@ -338,6 +375,16 @@ pub fn summary(plants: &[PlantStep]) -> FamilySummary {
         settled_5pct_within_10_s_share: share(&|a| a.settling_5pct_s.is_some_and(|s| s <= 10.0)),
         settled_5pct_within_8_s_share: share(&|a| a.settling_5pct_s.is_some_and(|s| s <= 8.0)),
         never_settled: never,
+        saturated_axes: axes.iter().filter(|a| a.saturated).count(),
+        settled_2pct_within_3_s_share_of_reachable: {
+            let reachable: Vec<&AxisStep> = axes.iter().filter(|a| !a.saturated).collect();
+            100.0
+                * reachable
+                    .iter()
+                    .filter(|a| a.settling_2pct_s.is_some_and(|s| s <= 3.0))
+                    .count() as f64
+                / reachable.len().max(1) as f64
+        },
         settling_worst_s: if never > 0 {
             None
         } else {
