@@ -1,5 +1,6 @@
-//! The rotation estimate's calibration (docs/model.md §12): the incline's error in the mean `T`
-//! against the rolling-or-sliding disc, per scene, on a fitting grid and a held-out grid.
+//! The chooser's measured tables (docs/model.md §12): the rotation estimate's calibration (the
+//! incline's error in the mean `T` against the rolling-or-sliding disc, per scene, on a
+//! fitting grid and a held-out grid), and the bowl model's steps at each DP5(4) tolerance.
 
 use super::*;
 
