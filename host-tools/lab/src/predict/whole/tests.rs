@@ -249,3 +249,60 @@ fn cost_over(grid: &[(RollingScene<f64>, BowlShape<f64>)]) {
         "{rows} scene-tolerances: within 1.25x of the cheapest in {within}, median ratio {median:.2}, worst {worst:.2}; tolerance missed {misses}"
     );
 }
+
+/// The chatter handling of `run_level` gives the bowl model's answer: a scene where the granule
+/// rolls at release and must slide before the rim (run at rtol 1e-10 from the start), and a
+/// wall where two releases chatter at 1e-6 (run again at 1e-10, the rest after them too):
+/// every release leaves, each within 1e-4 of the bowl model at rtol 1e-10 run release by
+/// release.
+#[test]
+fn chattering_scenes_still_answer_within_the_tolerance() {
+    use model_core::choose::whole::{friction_needed_at_release, friction_needed_at_rim};
+    let limits = SystemLimits {
+        horizon_s: 10.0,
+        max_steps: 200_000,
+    };
+    for (s, sh, level) in [
+        (
+            rig(60.0, 3.6, 3.6, 0.6),
+            shape(90.0, 0.0),
+            Level::RollingOrSliding,
+        ),
+        (rig(45.0, 3.6, 3.6, 0.6), shape(60.0, 0.02), Level::Bowl),
+    ] {
+        if level == Level::RollingOrSliding {
+            assert!(friction_needed_at_release(&s) <= 0.6 && friction_needed_at_rim(&s) > 0.6);
+        }
+        let a = run_level(
+            level,
+            &s,
+            &sh,
+            &AZIMUTHS,
+            RollingMethod::Dp54 { rtol: 1e-6 },
+            limits,
+        )
+        .unwrap()
+        .unwrap();
+        for (deg, t) in a.times {
+            let r = bowl::residence(
+                &s,
+                &sh,
+                deg.to_radians(),
+                RollingMethod::Dp54 { rtol: 1e-10 },
+                limits,
+            )
+            .unwrap();
+            let BowlOutcome::Leaves {
+                residence_time_s, ..
+            } = r.outcome
+            else {
+                panic!("{deg} deg: the reference does not leave: {:?}", r.outcome);
+            };
+            let t = t.unwrap_or_else(|| panic!("{deg} deg: no time"));
+            assert!(
+                (t - residence_time_s).abs() <= 1e-4 * residence_time_s,
+                "{deg} deg: {t} vs {residence_time_s}"
+            );
+        }
+    }
+}
