@@ -57,7 +57,7 @@ pub fn fails_words(f: &Fails<f64>, tolerance: f64) -> String {
              contact gives mu_s = {mu_s}"
         ),
         Fails::Rotation { estimate } => format!(
-            "the bowl's rotation changes T by about {:.2} %, more than the tolerance {:.2} %",
+            "the bowl's rotation changes T by up to {:.2} %, more than the tolerance {:.2} %",
             100.0 * estimate,
             100.0 * tolerance
         ),
@@ -270,7 +270,7 @@ fn report(
         .collect();
     let why = if rejected.is_empty() {
         format!(
-            "the cheapest model, and within the tolerance: the rotation changes T by about {:.3} %",
+            "the cheapest model, and within the tolerance: the rotation changes T by up to {:.3} %",
             100.0 * choice.rotation_estimate
         )
     } else {
@@ -311,7 +311,7 @@ fn report(
     }
     if a.level == Level::Incline {
         println!(
-            "  the incline holds: the bowl's rotation changes T by about {:.3} % (docs/model.md §12)",
+            "  the incline holds: the bowl's rotation changes T by up to {:.3} % (docs/model.md §12)",
             100.0 * choice.rotation_estimate
         );
     }
