@@ -118,3 +118,40 @@ fn a_wall_needs_the_bowl_and_says_where_the_lip_is() {
     );
     within(&v, r, 0.01);
 }
+
+#[test]
+fn opposite_speeds_at_a_low_tilt_do_not_take_the_incline() {
+    // 5 deg, w1 3.6, w2 -2.7 rad/s: |Omega| is only 0.9 rad/s, but the precession turns the
+    // downhill direction and the incline is 7 % off (docs/model.md §12): a 5 % tolerance needs
+    // an integrated model, whose answer is within it.
+    let scene = |extra: &[&'static str]| {
+        let mut a = vec![
+            "predict",
+            "--axes-angle-deg",
+            "5",
+            "--precession-rad-s",
+            "3.6",
+            "--spin-rad-s",
+            "-2.7",
+            "--sliding-mu",
+            "0.4",
+            "--json",
+        ];
+        a.extend(SCENE);
+        a.extend(extra);
+        json(&a)
+    };
+    let v = scene(&["--tolerance", "0.05"]);
+    assert_ne!(v["chosen"], "incline", "{v}");
+    assert!(reasons(&v).contains("the bowl's rotation changes T"), "{v}");
+    assert!(v["rotation_estimate_rel"].as_f64().unwrap() > 0.072, "{v}");
+    let r = scene(&[
+        "--model",
+        "bowl",
+        "--tol",
+        "1e-10",
+        "--speed-range",
+        "false",
+    ]);
+    within(&v, r["residence_time_mean_s"].as_f64().unwrap(), 0.05);
+}

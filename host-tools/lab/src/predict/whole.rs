@@ -5,7 +5,8 @@
 
 use anyhow::Result;
 use model_core::choose::whole::{
-    Fails, LEVELS, Level, WholeChoice, choose_level, incline_release_s,
+    Fails, LEVELS, Level, WholeChoice, choose_level, friction_needed_at_release,
+    friction_needed_at_rim, incline_release_s,
 };
 use model_core::ode::system::SystemLimits;
 use model_core::particle::bowl::{self, BowlOutcome, BowlShape};
@@ -56,7 +57,7 @@ pub fn fails_words(f: &Fails<f64>, tolerance: f64) -> String {
              contact gives mu_s = {mu_s}"
         ),
         Fails::Rotation { estimate } => format!(
-            "the bowl's rotation changes T by about {:.2} %, more than the tolerance {:.2} %",
+            "the bowl's rotation changes T by up to {:.2} %, more than the tolerance {:.2} %",
             100.0 * estimate,
             100.0 * tolerance
         ),
@@ -143,21 +144,32 @@ pub(crate) fn run_level(
                 }
             };
             // Near the stick threshold the slide/roll switch can chatter at a loose tolerance
-            // (and, erratically, at some tight ones): a release that takes 5 000 steps (tens of times a normal one) is
-            // run again at rtol 1e-10, which gets through where the loose one did not.
+            // (and, erratically, at some tight ones): a release that takes 5 000 steps (tens of
+            // times a normal one) is run again at rtol 1e-10, which gets through where the
+            // loose one did not. Once one release of the scene has needed that, the rest start
+            // there (they share the scene's threshold); so do all of them where the granule
+            // rolls at release and must slide before the rim (the switch is on every path:
+            // docs/model.md §12).
             let quick = SystemLimits {
                 max_steps: limits.max_steps.min(5_000),
                 ..limits
             };
             let tight = RollingMethod::Dp54 { rtol: 1e-10 };
+            let mu_s = scene.sliding_friction;
+            let mut chatters =
+                friction_needed_at_release(scene) <= mu_s && friction_needed_at_rim(scene) > mu_s;
             for &deg in betas {
                 let b = deg.to_radians();
-                let first = bowl::residence(scene, &shape, b, method, quick);
-                let rep = match first {
-                    Err(bowl::BowlError::Scene(rolling::RollingError::Integration(_))) => {
-                        bowl::residence(scene, &shape, b, tight, limits)
+                let rep = if chatters {
+                    bowl::residence(scene, &shape, b, tight, limits)
+                } else {
+                    match bowl::residence(scene, &shape, b, method, quick) {
+                        Err(bowl::BowlError::Scene(rolling::RollingError::Integration(_))) => {
+                            chatters = true;
+                            bowl::residence(scene, &shape, b, tight, limits)
+                        }
+                        other => other,
                     }
-                    other => other,
                 };
                 match rep {
                     Ok(rep) => match rep.outcome {
@@ -258,7 +270,7 @@ fn report(
         .collect();
     let why = if rejected.is_empty() {
         format!(
-            "the cheapest model, and within the tolerance: the rotation changes T by about {:.3} %",
+            "the cheapest model, and within the tolerance: the rotation changes T by up to {:.3} %",
             100.0 * choice.rotation_estimate
         )
     } else {
@@ -299,7 +311,7 @@ fn report(
     }
     if a.level == Level::Incline {
         println!(
-            "  the incline holds: the bowl's rotation changes T by about {:.3} % (docs/model.md §12)",
+            "  the incline holds: the bowl's rotation changes T by up to {:.3} % (docs/model.md §12)",
             100.0 * choice.rotation_estimate
         );
     }
@@ -314,5 +326,7 @@ fn report(
     Ok(())
 }
 
+#[cfg(test)]
+mod rotation_fit;
 #[cfg(test)]
 mod tests;
