@@ -79,6 +79,9 @@ pub struct BowlReport<T> {
     pub held_s: T,
     /// Time in flight, s.
     pub flight_s: T,
+    /// Whether it left in flight (its centre passed the lip while flying, e.g. off the lip's
+    /// edge) rather than in contact (rolling or sliding over the lip or a bare rim).
+    pub left_in_flight: bool,
     /// Landings (impacts after a flight).
     pub landings: u32,
     /// Changes of contact (roll/slide) and of surface (bottom/wall).
@@ -214,6 +217,7 @@ pub fn residence<T: Real>(
         on_wall_s: T::ZERO,
         held_s: T::ZERO,
         flight_s: T::ZERO,
+        left_in_flight: false,
         landings: 0,
         switches: 0,
         evaluations: 0,
@@ -360,6 +364,7 @@ pub fn residence<T: Real>(
             Phase::Flight(f) => match fly(sc, meridian.as_ref(), &f, limits.horizon_s) {
                 FlightEnd::Exits(te, speed) => {
                     report.flight_s += te - f.t0_s;
+                    report.left_in_flight = true;
                     report.outcome = BowlOutcome::Leaves {
                         residence_time_s: te,
                         exit_speed_m_s: speed,
