@@ -196,7 +196,7 @@ def run(w1, w2, th, rim, ri, a, mu_r, mu_s, alpha, h, rod, horizon, beta, fillet
         # so its contact list does not say this. Touching: sliding if the last contact's
         # friction force is at the friction cone (|f_t| >= 0.8 mu_s f_n: a slide reads 0.97,
         # the cone shared with the rolling resistance), rolling if inside it. Not the slip
-        # speed: the soft contact lets a rolling (sticking) granule creep at 4-9 mm/s on the
+        # speed: the soft contact lets a rolling (sticking) granule creep at 4-10 mm/s on the
         # wall with its friction at 9-15 % of the cone.
         verdicts = []
         for i in range(d.ncon):

@@ -11,7 +11,7 @@ settings of bowl_mujoco.py (elliptic cone, sliding mu, solref 0.0005 1, solimp 0
 Closed form (per unit mass; slip of the contact point v_c = vx - a wy, normal impulse
 J_n = (1 + e) vz): the slip stops if (1 - k2) |v_c| <= mu J_n (a sticking impact: vx' = vx -
 (1 - k2) v_c, rolling after), else J_t = mu J_n against the slip (a sliding impact: vx' = vx -
-mu J_n sign(v_c)); the spin takes a J_t / (a^2 k2/(1 - k2)) ... written out below.
+mu J_n sign(v_c)); the spin takes a dwy = -(k2 / (1 - k2)) J_t (torque of the impulse at -a e_z).
 
 Usage: impact_mujoco.py [IMPRATIO [TIMECONST_S [NOSLIP_ITERATIONS]]]
 prints one line per case: vx vz a*wy | MuJoCo vx' a*wy' e | Routh vx' a*wy' (e MuJoCo's) | regime
