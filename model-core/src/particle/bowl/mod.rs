@@ -319,7 +319,16 @@ pub fn residence<T: Real>(
                         let n = [-sa * entry[1], -sa * entry[2], ca];
                         let (u2, s2, rebound) = impact(sc, restitution, u, sg, n);
                         if rebound > rest {
-                            Phase::Flight(launch(sc, te, q, u2, s2))
+                            // The rebound starts on the wall: at the stand-in fillet's end
+                            // (on the offset cone), not its start, which is
+                            // `r (1 - cos alpha)` off the cone (0.375 mm in a 75 mm bowl at 60
+                            // deg): launched there, the hop fell that much further (19 ms
+                            // instead of 15 ms at e 0.125, landing 50 % faster than it left;
+                            // docs/model.md §10).
+                            let end = m.at(m.arc_radius_m * shape.wall_angle_rad).pos;
+                            let (ex, ey) = (entry[1], entry[2]);
+                            let q_end = [end[0] * ex, end[0] * ey, end[1]];
+                            Phase::Flight(launch(sc, te, q_end, u2, s2))
                         } else {
                             // Along the wall with what the impact left: the speed up its slope
                             // `u . (cos alpha e_rho + sin alpha e_z)` is the meridian speed the
