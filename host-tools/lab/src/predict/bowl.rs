@@ -229,6 +229,7 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
                         "regime": regime(rep), "outcome": outcome_name(&rep.outcome),
                         "exit_speed_relative_m_s": v, "on_wall_s": rep.on_wall_s,
                         "flight_s": rep.flight_s, "landings": rep.landings,
+                        "left_in_flight": t.is_some() && rep.left_in_flight,
                         "switches": rep.switches, "rhs_evaluations": rep.evaluations,
                     }),
                 )

@@ -306,3 +306,94 @@ fn the_answer_converges_with_the_tolerance_through_flights() {
         );
     }
 }
+
+/// A sphere's oblique impact with Coulomb friction and incoming spin, in closed form (Routh;
+/// Stronge, Impact Mechanics, ch. 5: for a sphere the slip keeps its direction through the
+/// impact). With `v_n = u . n < 0` and the contact point's slip `c = (u - s x n)_t`: a sticking
+/// impact when `(1 - k2) |c| <= mu (1 + e) |v_n|`, after which it rolls with
+/// `u_t' = k2 u_t + (1 - k2) (s x n)_t`; else sliding, `u_t' = u_t - mu (1 + e) |v_n| c / |c|`.
+/// Either way `u_n' = -e v_n` and the angular momentum about the contact point,
+/// `((1 - k2)/k2) s + n x u` per `m a`, is kept (the impulse passes through that point), and no
+/// energy is made. Oblique normals, spins with and against the motion, slip not along `u`.
+#[test]
+fn an_oblique_impact_with_spin_matches_rouths_closed_form() {
+    let base = scene(0.0, 0.0, 0.0, 0.0);
+    let k2 = base.k2;
+    let unit = |v: [f64; 3]| {
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        [v[0] / l, v[1] / l, v[2] / l]
+    };
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (mut sticking, mut sliding) = (0, 0);
+    for n in [
+        [0.0, 0.0, 1.0],
+        unit([-0.866, 0.0, 0.5]),
+        unit([0.3, -0.5, 0.8]),
+    ] {
+        for (u, s) in [
+            ([0.4, 0.1, -0.6], [0.0, 0.0, 0.0]),
+            ([0.4, 0.1, -0.6], [0.2, 0.5, -0.1]),
+            ([1.5, -0.7, -0.3], [-0.3, 0.9, 0.2]),
+            ([0.05, 0.02, -0.9], [1.2, -0.4, 0.0]),
+        ] {
+            // Make the normal component of u inbound on this normal.
+            let un = dot(u, n);
+            let u: [f64; 3] = core::array::from_fn(|i| u[i] - (un + 0.5) * n[i]);
+            for (e, mu) in [(0.0, 0.4), (0.15, 0.4), (0.5, 0.1), (1.0, 0.05), (0.3, 2.0)] {
+                let sc = RollingScene {
+                    sliding_friction: mu,
+                    ..base
+                };
+                let (u2, s2, rebound) = impact(&sc, e, u, s, n);
+                let vn = dot(u, n);
+                close(rebound, -e * vn, 1e-14, "rebound");
+                close(dot(u2, n), -e * vn, 1e-14, "normal velocity");
+                let sxn = cross(&s, &n);
+                let tang = |v: [f64; 3]| -> [f64; 3] {
+                    let vn = dot(v, n);
+                    core::array::from_fn(|i| v[i] - vn * n[i])
+                };
+                let c = tang(core::array::from_fn(|i| u[i] - sxn[i]));
+                let cl = dot(c, c).sqrt();
+                let jn = (1.0 + e) * -vn;
+                let (ut, sxn_t) = (tang(u), tang(sxn));
+                let want: [f64; 3] = if (1.0 - k2) * cl <= mu * jn {
+                    sticking += 1;
+                    // Rolls after: no slip.
+                    let slip2 = tang(core::array::from_fn(|i| u2[i] - cross(&s2, &n)[i]));
+                    close(dot(slip2, slip2).sqrt(), 0.0, 1e-14, "slip after sticking");
+                    core::array::from_fn(|i| k2 * ut[i] + (1.0 - k2) * sxn_t[i])
+                } else {
+                    sliding += 1;
+                    core::array::from_fn(|i| ut[i] - mu * jn * c[i] / cl)
+                };
+                let u2t = tang(u2);
+                for i in 0..3 {
+                    close(u2t[i], want[i], 1e-14, "tangential velocity");
+                }
+                // Angular momentum about the contact point, per m a.
+                let l = |u: [f64; 3], s: [f64; 3]| -> [f64; 3] {
+                    let nu = cross(&n, &u);
+                    core::array::from_fn(|i| (1.0 - k2) / k2 * s[i] + nu[i])
+                };
+                let (l0, l1) = (l(u, s), l(u2, s2));
+                for i in 0..3 {
+                    close(
+                        l1[i],
+                        l0[i],
+                        1e-14,
+                        "angular momentum about the contact point",
+                    );
+                }
+                // Kinetic energy per m: |u|^2/2 + ((1 - k2)/(2 k2)) |s|^2, not increased.
+                let ke =
+                    |u: [f64; 3], s: [f64; 3]| 0.5 * dot(u, u) + 0.5 * (1.0 - k2) / k2 * dot(s, s);
+                assert!(ke(u2, s2) <= ke(u, s) * (1.0 + 1e-14), "energy made");
+            }
+        }
+    }
+    assert!(
+        sticking >= 10 && sliding >= 10,
+        "{sticking} sticking, {sliding} sliding"
+    );
+}

@@ -79,6 +79,9 @@ pub struct BowlReport<T> {
     pub held_s: T,
     /// Time in flight, s.
     pub flight_s: T,
+    /// Whether it left in flight (its centre passed the lip while flying, e.g. off the lip's
+    /// edge) rather than in contact (rolling or sliding over the lip or a bare rim).
+    pub left_in_flight: bool,
     /// Landings (impacts after a flight).
     pub landings: u32,
     /// Changes of contact (roll/slide) and of surface (bottom/wall).
@@ -214,6 +217,7 @@ pub fn residence<T: Real>(
         on_wall_s: T::ZERO,
         held_s: T::ZERO,
         flight_s: T::ZERO,
+        left_in_flight: false,
         landings: 0,
         switches: 0,
         evaluations: 0,
@@ -315,7 +319,16 @@ pub fn residence<T: Real>(
                         let n = [-sa * entry[1], -sa * entry[2], ca];
                         let (u2, s2, rebound) = impact(sc, restitution, u, sg, n);
                         if rebound > rest {
-                            Phase::Flight(launch(sc, te, q, u2, s2))
+                            // The rebound starts on the wall: at the stand-in fillet's end
+                            // (on the offset cone), not its start, which is
+                            // `r (1 - cos alpha)` off the cone (0.375 mm in a 75 mm bowl at 60
+                            // deg): launched there, the hop fell that much further (19 ms
+                            // instead of 15 ms at e 0.125, landing 50 % faster than it left;
+                            // docs/model.md §10).
+                            let end = m.at(m.arc_radius_m * shape.wall_angle_rad).pos;
+                            let (ex, ey) = (entry[1], entry[2]);
+                            let q_end = [end[0] * ex, end[0] * ey, end[1]];
+                            Phase::Flight(launch(sc, te, q_end, u2, s2))
                         } else {
                             // Along the wall with what the impact left: the speed up its slope
                             // `u . (cos alpha e_rho + sin alpha e_z)` is the meridian speed the
@@ -360,6 +373,7 @@ pub fn residence<T: Real>(
             Phase::Flight(f) => match fly(sc, meridian.as_ref(), &f, limits.horizon_s) {
                 FlightEnd::Exits(te, speed) => {
                     report.flight_s += te - f.t0_s;
+                    report.left_in_flight = true;
                     report.outcome = BowlOutcome::Leaves {
                         residence_time_s: te,
                         exit_speed_m_s: speed,
