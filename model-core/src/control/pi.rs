@@ -57,6 +57,12 @@
 //!   up while the push had already started the shaft: 15..25 % too fast for 5 s on loaded
 //!   spin axes, which at a pulse a second the loop corrects only slowly.
 //!
+//! - With current sense (breakaway.rs): the back-EMF shows the breakaway at once, where the
+//!   first edge may come a second later. The kick then lasts until the current shows it (not
+//!   until the model says it should have), kick and push drop there to feedforward + integral
+//!   (half a push kept, nothing of the kick), and until the first measurement the integral
+//!   holds the back-EMF speed in a band around the model speed.
+//!
 //! Both only start a shaft from rest: once the loop has seen it move, a shaft that goes quiet is
 //! not pushed (a dead sensor on a turning shaft would otherwise run it away before the
 //! supervisor's expected-edge watch faults it). "From rest" is the loop's view: no window closed
@@ -547,7 +553,7 @@ impl SpeedLoop {
             // The kick did not start it, the push did: load the model does not know holds the
             // shaft back (material), and half of the push stays in the integral as at the first
             // edge. Dropped to the feedforward, such shafts crawled until the expected-edge
-            // watch faulted them (3 of 420 plants at 0 -> 0.5 rad/s).
+            // watch faulted them (4 of 480 plants at 0 -> 0.5 rad/s).
             self.integral += PUSH_KEPT * self.push * input.direction;
         }
         if released && !was_released {
