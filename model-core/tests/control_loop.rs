@@ -133,6 +133,7 @@ fn anti_windup_holds_the_integral_when_the_output_saturates() {
         feedback: true,
         extra_duty: 0.0,
         at_rest: false,
+        torque_duty: None,
     };
     l.step(&k, input(sample(0.0, 4.0)));
     for i in 0..30_000 {

@@ -139,6 +139,10 @@ struct FamilyArgs {
     /// Both axes settle at this speed first, then step to the target (0 = from rest), rad/s.
     #[arg(long, default_value_t = 0.0)]
     from_rad_s: f32,
+    /// Give every plant the typical current sense (`current_sense = true`) where its file gave
+    /// none (as `bowl sim family --current-sense`).
+    #[arg(long)]
+    current_sense: bool,
 }
 
 /// Options of the control charts (`settling`, `control-stability`).
@@ -436,11 +440,22 @@ pub fn run(args: &Args) -> Result<()> {
             write_all(out, &f, &t)
         }
         Which::Family(a) => {
-            let rigs = rig_file::load(&a.rig_file)?;
+            let mut rigs = rig_file::load(&a.rig_file)?;
+            if a.current_sense {
+                rigs = rigs
+                    .into_iter()
+                    .map(rig_file::Rig::with_current_sense)
+                    .collect();
+            }
             let name = a
                 .rig_file
                 .file_name()
                 .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+            let name = if a.current_sense {
+                format!("{name}, current sense")
+            } else {
+                name
+            };
             let (f, t) = family::chart(&rigs, a.from_rad_s, a.target_rad_s, &name);
             write_all(&a.out, &f, &t)
         }

@@ -438,9 +438,15 @@ impl Controller {
             feedback: self.feedback,
             extra_duty,
             at_rest: a.est.at_rest(),
+            torque_duty: a.torque_duty.take(),
         };
         let duty = a.speed_loop.step(&a.k, input);
         a.duty = duty;
+        if a.speed_loop.take_breakaway() {
+            // The current showed the shaft start turning now: its first edge is due a pitch
+            // from here, not from the start of a long hold (breakaway.rs).
+            a.watch.reset();
+        }
         // Expected edges are watched whatever the duty: at low speed the duty that holds the
         // shaft can be below any fixed threshold.
         if a.watch.step(

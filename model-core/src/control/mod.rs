@@ -55,11 +55,13 @@
 //! - [`config`], the configuration and its validation.
 //! - [`estimator`], speed from edge timestamps.
 //! - [`pi`], feedforward + PI per axis.
+//! - [`breakaway`], the breakaway seen in the motor current, for the loop.
 //! - [`load_pattern`], the once-per-revolution load, learned and fed forward.
 //! - [`planner`], setpoints, Eq. 2 split, ramps, the particle-model traits.
 //! - [`supervisor`], states and faults.
 //! - [`commission`], identification.
 
+pub mod breakaway;
 pub mod commission;
 pub mod config;
 mod const_trig;

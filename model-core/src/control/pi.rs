@@ -57,12 +57,19 @@
 //!   up while the push had already started the shaft: 15..25 % too fast for 5 s on loaded
 //!   spin axes, which at a pulse a second the loop corrects only slowly.
 //!
+//! - With current sense (breakaway.rs): the back-EMF shows the breakaway at once, where the
+//!   first edge may come a second later. The kick then lasts until the current shows it (not
+//!   until the model says it should have), kick and push drop there to feedforward + integral
+//!   (half a push kept, nothing of the kick), and until the first measurement the integral
+//!   holds the back-EMF speed in a band around the model speed.
+//!
 //! Both only start a shaft from rest: once the loop has seen it move, a shaft that goes quiet is
 //! not pushed (a dead sensor on a turning shaft would otherwise run it away before the
 //! supervisor's expected-edge watch faults it). "From rest" is the loop's view: no window closed
 //! since the loop started, whatever edge the estimator still holds from before (a restart after
 //! a fault or a zero reference, see `rest` in [`SpeedLoop::step`]).
 
+use super::breakaway::Breakaway;
 use super::config::AxisConfig;
 use super::estimator::WindowEvents;
 use super::supervisor::{
@@ -107,6 +114,10 @@ pub struct SpeedLoop {
     slowing: bool,
     /// Seconds since the model was last more than 2 % above the reference's magnitude.
     model_down_quiet_s: f32,
+    /// What the current says of this start (axes with current sense only).
+    breakaway: Breakaway,
+    /// The current showed the breakaway in this step (see [`SpeedLoop::take_breakaway`]).
+    breakaway_news: bool,
 }
 
 /// Inputs of one loop step.
@@ -128,6 +139,10 @@ pub struct LoopInput {
     pub extra_duty: f32,
     /// No edge since the shaft last stopped (the estimator's view).
     pub at_rest: bool,
+    /// The current-sense reading under the last period's duty as the duty that drives it into
+    /// a held shaft (`(i - offset) / g`, in the commanded direction; breakaway.rs); None
+    /// without current sense or before the supervisor learned the offset and `g`.
+    pub torque_duty: Option<f32>,
 }
 
 /// Per-axis constants of the loop, precomputed from the configuration.
@@ -298,6 +313,8 @@ impl SpeedLoop {
         push_sum: 0.0,
         slowing: false,
         model_down_quiet_s: 0.0,
+        breakaway: Breakaway::NONE,
+        breakaway_news: false,
     };
 
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
@@ -388,9 +405,18 @@ impl SpeedLoop {
         // on the nominal rig and the seeded family, a false runaway fault on the emulated Black
         // Pill (issue 27). It starts like a shaft at rest instead.
         let rest = input.at_rest || !self.window_open;
+        // With current sense, the back-EMF shows the breakaway at once (breakaway.rs): the kick
+        // and the push stop there, and what started the shaft is not kept (the current showed
+        // no load holding it back; one that does is found below).
+        let released = match input.torque_duty {
+            Some(c) => self.sample_current(k, input, c, rest && !self.moved, r_abs),
+            None => false,
+        };
         let first_edge = !rest && !self.moved;
         if first_edge {
-            self.integral += PUSH_KEPT * self.push.max(k.kick_level(r_abs)) * input.direction;
+            if !released {
+                self.integral += PUSH_KEPT * self.push.max(k.kick_level(r_abs)) * input.direction;
+            }
             self.push = 0.0;
             self.push_sum = 0.0;
         }
@@ -401,14 +427,18 @@ impl SpeedLoop {
         // or crawling between its first and second edge (no measurement yet). Never a shaft
         // that went quiet after moving (the estimator reset it to rest): that is the
         // supervisor's to judge, and pushing it would run away a shaft with a dead sensor.
-        let starting = rest && !self.moved;
-        let crawling = !input.at_rest && !input.measurement_valid;
+        let starting = rest && !self.moved && !released;
+        let crawling = !input.at_rest && !input.measurement_valid && !released;
         // The kick: from rest, the identified breakaway duty, just long enough for the model
         // driven by it to reach the reference; then the feedforward holds Coulomb friction.
         // Stiction needs more than sliding does, and a gradual push overshoots it by as much
         // as it rises before the first edge can tell (up to a pitch of travel).
         let mut kick = 0.0;
-        if starting && input.feedback && self.push == 0.0 && self.kick_rad_s < r_abs {
+        // With current sense the kick lasts until the current shows the breakaway (`starting`
+        // ends there), not until the model says it should have: a shaft the kick did not
+        // start (material since commissioning) is not left at the feedforward until the push.
+        let kick_on = self.kick_rad_s < r_abs || input.torque_duty.is_some();
+        if starting && input.feedback && self.push == 0.0 && kick_on {
             kick = k.kick_level(r_abs);
             // Driven by the applied duty (the slew limit holds it back at first) above
             // friction: the true breakaway lies below the identified one (the search's duty
@@ -495,6 +525,65 @@ impl SpeedLoop {
             + (1.0 - reading) * PUSH_KEPT * self.push * direction;
         self.push_sum = 0.0;
         self.push = 0.0;
+    }
+
+    /// One current sample (see [`LoopInput::torque_duty`]): the breakaway watch, and between
+    /// the breakaway and the first measurement the integral held to the back-EMF speed's band.
+    /// Returns whether the current said the shaft broke away. Out of line: only axes with
+    /// current sense pay for it.
+    #[inline(never)]
+    fn sample_current(
+        &mut self,
+        k: &LoopConstants,
+        input: LoopInput,
+        torque_duty: f32,
+        starting: bool,
+        r_abs: f32,
+    ) -> bool {
+        let applied = self.duty * input.direction;
+        let was_released = self.breakaway.released();
+        let released = self.breakaway.sample(
+            applied,
+            torque_duty,
+            (k.duty_per_rad_s, k.friction_duty),
+            (starting, starting),
+            r_abs,
+        );
+        if released && !was_released && self.push != 0.0 {
+            // The kick did not start it, the push did: load the model does not know holds the
+            // shaft back (material), and half of the push stays in the integral as at the first
+            // edge. Dropped to the feedforward, such shafts crawled until the expected-edge
+            // watch faulted them (4 of 480 plants at 0 -> 0.5 rad/s).
+            self.integral += PUSH_KEPT * self.push * input.direction;
+        }
+        if released && !was_released {
+            self.breakaway_news = true;
+        }
+        if released {
+            // The push has done its work.
+            self.push = 0.0;
+            self.push_sum = 0.0;
+        }
+        if released && input.feedback && !input.measurement_valid && !self.slowing {
+            let step = self.breakaway.fused_integral_step(
+                (self.model_rad_s.abs(), r_abs),
+                k.duty_per_rad_s,
+                k.dt_s,
+            );
+            self.integral = clamp(self.integral + step * input.direction, k.duty_limit);
+        }
+        released
+    }
+
+    /// Whether the current showed the breakaway since the last call (once per start).
+    pub fn take_breakaway(&mut self) -> bool {
+        core::mem::replace(&mut self.breakaway_news, false)
+    }
+
+    /// The back-EMF speed the current shows, rad/s in the commanded direction (0 without
+    /// current sense).
+    pub fn back_emf_rad_s(&self) -> f32 {
+        self.breakaway.speed_rad_s()
     }
 
     /// The plant model's speed (the reference through the identified lag), rad/s.

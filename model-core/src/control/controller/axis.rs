@@ -32,6 +32,9 @@ pub(super) struct AxisState {
     pub(super) steady: bool,
     /// The current sense's offset, current per duty and back-EMF (none: never sampled).
     pub(super) current: CurrentWatch,
+    /// This tick's current reading as the duty that drives it into a held shaft, for the loop
+    /// (see `LoopInput::torque_duty`); taken by the loop each tick.
+    pub(super) torque_duty: Option<f32>,
 }
 
 impl AxisState {
@@ -49,6 +52,7 @@ impl AxisState {
             load: LoadPattern::new(a, cfg.supply_v),
             steady: false,
             current: CurrentWatch::NEW,
+            torque_duty: None,
         }
     }
 

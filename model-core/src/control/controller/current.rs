@@ -4,7 +4,9 @@
 //! watch's fault told apart (stall or dead sensor) by the back-EMF.
 
 use super::Controller;
-use crate::control::supervisor::{BACK_EMF_SPEED_SHARE, BACK_EMF_STEADY_SHARE, CurrentTrip, Fault};
+use crate::control::supervisor::{
+    BACK_EMF_SPEED_SHARE, BACK_EMF_STEADY_SHARE, CURRENT_READING_LIMIT_A, CurrentTrip, Fault,
+};
 
 impl Controller {
     /// One current sample of axis `i` (see [`Controller::tick_with_currents`]). Out of line:
@@ -12,6 +14,11 @@ impl Controller {
     #[inline(never)]
     pub(super) fn current_sample(&mut self, i: usize, reading_a: f32, applied: f32) {
         let a = &mut self.axes[i];
+        // The loop's view of the reading (breakaway.rs): the current as the duty that drives it
+        // into a held shaft, once the watch has learned the offset and the current per duty.
+        let g = a.current.amps_per_duty();
+        a.torque_duty = (g > 0.0 && reading_a.abs() <= CURRENT_READING_LIMIT_A)
+            .then(|| (reading_a - a.current.offset_a()) * a.direction / g);
         let model = a.speed_loop.model_rad_s().abs();
         let share = if a.steady {
             BACK_EMF_STEADY_SHARE

@@ -1,0 +1,167 @@
+//! The breakaway seen in the motor current (issue 27 part 2): on an axis with current sense, the
+//! back-EMF speed tells the loop that a shaft held by stiction has broken away, at once, where
+//! the first edge may come a second later (12 pulses a revolution at 0.5 rad/s).
+//!
+//! The armature settles within a tick (`L / R` = 0.25 ms on the nominal motor, docs/model.md's
+//! `L di/dt = V d - R i - k w`), so `i = (V d - k w) / R`: with `g = V / R` (times the sense
+//! chain's gain; the supervisor's [`CurrentWatch`](super::supervisor::CurrentWatch) learns it,
+//! and the offset, once, and the controller hands the loop `c = i / g`, the current as the duty
+//! that drives it into a held shaft) the back-EMF speed is `w = (d - c) / (k / V)`. The loop
+//! knows `volts_per_rad_s / V`, which also holds the viscous share (`k + R b / k`): the speed
+//! read is low by that share (4.5 % on the nominal motor, up to 12 % on the family), so it is
+//! used for what a few percent do not change: the breakaway, and a dead band around the model
+//! speed between the breakaway and the first valid measurement from the edges.
+
+/// Weight of a new sample in the back-EMF speed's running mean (5 ms at 1 kHz: a tenth of a
+/// nominal shaft's time constant; the 10 mA noise of one sample is 0.03 rad/s, 0.01 after it).
+pub const SPEED_WEIGHT: f32 = 0.2;
+/// The back-EMF speed, as a share of the reference, above which a shaft at rest has broken
+/// away (a third of the way there: the kick's excess over friction is then spent).
+pub const BREAKAWAY_SHARE: f32 = 0.3;
+/// ... and never below this speed, rad/s (four times the filtered noise on the family's weakest
+/// motor, while the reference ramps up from zero).
+pub const BREAKAWAY_FLOOR_RAD_S: f32 = 0.05;
+/// Consecutive samples above the threshold that confirm a breakaway.
+pub const BREAKAWAY_CONFIRM: u8 = 3;
+/// The dead band of the back-EMF speed around the model speed, as a share of it, inside which
+/// the loop leaves the integral alone between the breakaway and the first measurement: wider
+/// than the viscous share the back-EMF speed misses.
+pub const FUSED_BAND_SHARE: f32 = 0.2;
+/// The back-EMF speed, as a share of the model speed, above which the loop takes duty off
+/// while the edges give no measurement: above the error of a current per duty not fitted in
+/// this start (the supervisor's, up to 10 % off on the family: 0.1 rad/s at a duty of 0.15).
+pub const FUSED_ABOVE_SHARE: f32 = 1.4;
+/// The model speed's share of the reference from which the lower band applies.
+pub const MODEL_THERE: f32 = 0.95;
+/// Bandwidth of the integral on the back-EMF speed outside the band, rad/s (a loaded shaft that
+/// crawls gets the duty it lacks within a second; slow against the plant's lag, so stable).
+pub const FUSED_BANDWIDTH_RAD_S: f32 = 2.0;
+
+/// The in-start fit of the held shaft's current per duty below the friction duty (see
+/// [`Breakaway::sample`]) starts from the supervisor's `g` with this weight, duty^2 (as many
+/// samples as ten at 0.03 duty): a light motor's duty passes the friction duty in ten ticks,
+/// too few to fit alone; a heavy one's spends a hundred below it, and its fit then rules.
+pub const FIT_PRIOR_DUTY2: f32 = 0.01;
+/// Share of the identified friction duty below which a shaft is certainly held (stiction is at
+/// least Coulomb friction, and material only adds to it): its current fits the held ratio.
+pub const FIT_BELOW_FRICTION: f32 = 0.9;
+
+/// What the current says of one start.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Breakaway {
+    /// The back-EMF speed's running mean, rad/s in the commanded direction.
+    speed_rad_s: f32,
+    /// A sample was taken since the loop started.
+    sampled: bool,
+    /// Consecutive samples above the breakaway threshold.
+    above: u8,
+    /// The current said the shaft broke away: kick and push are off.
+    released: bool,
+    /// Sums of `c d` and `d^2` over the held samples of this start (the fit's data).
+    fit_cd: f32,
+    fit_dd: f32,
+}
+
+impl Breakaway {
+    /// Nothing seen.
+    pub const NONE: Self = Self {
+        speed_rad_s: 0.0,
+        sampled: false,
+        above: 0,
+        released: false,
+        fit_cd: 0.0,
+        fit_dd: 0.0,
+    };
+
+    /// One sample: `applied` duty and current `torque_duty` (both in the commanded direction,
+    /// the current as the duty that drives it into a held shaft) over the last period, the
+    /// identified `duty_per_rad_s` and `friction_duty`; while `starting` (at rest, not moved
+    /// since the start) fits the held ratio, and while `watch` watches for the breakaway
+    /// against the reference `r_abs` (`starting` and `watch`, in that order). Returns
+    /// whether the shaft has broken away since the start.
+    ///
+    /// The supervisor's `g` is a mean over past starts of the largest window's ratio: a 2 %
+    /// error reads as 0.05 rad/s of back-EMF at a duty of 0.4 (a heavy family plant's
+    /// feedforward), more than the breakaway threshold while the reference ramps up. So while
+    /// the duty is below [`FIT_BELOW_FRICTION`] of the friction duty (the shaft held for sure)
+    /// the start fits `c = h d` (least squares through zero, from `h = 1`) and reads the
+    /// current as `c / h`.
+    pub fn sample(
+        &mut self,
+        applied: f32,
+        torque_duty: f32,
+        (duty_per_rad_s, friction_duty): (f32, f32),
+        (starting, watch): (bool, bool),
+        r_abs: f32,
+    ) -> bool {
+        if !(torque_duty.is_finite() && duty_per_rad_s > 0.0) {
+            return self.released;
+        }
+        if starting
+            && !self.released
+            && applied > 0.0
+            && applied <= FIT_BELOW_FRICTION * friction_duty
+        {
+            self.fit_cd += torque_duty * applied;
+            self.fit_dd += applied * applied;
+        }
+        let h = (self.fit_cd + FIT_PRIOR_DUTY2) / (self.fit_dd + FIT_PRIOR_DUTY2);
+        let held = if h > 0.5 {
+            torque_duty / h
+        } else {
+            torque_duty
+        };
+        let w = (applied - held) / duty_per_rad_s;
+        if self.sampled {
+            self.speed_rad_s += (w - self.speed_rad_s) * SPEED_WEIGHT;
+        } else {
+            self.speed_rad_s = w;
+            self.sampled = true;
+        }
+        if watch && !self.released {
+            let threshold = (BREAKAWAY_SHARE * r_abs).max(BREAKAWAY_FLOOR_RAD_S);
+            self.above = if self.speed_rad_s > threshold {
+                self.above.saturating_add(1)
+            } else {
+                0
+            };
+            self.released = self.above >= BREAKAWAY_CONFIRM;
+        }
+        self.released
+    }
+
+    /// The integral's change this tick (duty, in the commanded direction) between the breakaway
+    /// and the first measurement from the edges (this start's fit holds the current's scale):
+    /// the back-EMF speed held below [`FUSED_ABOVE_SHARE`] times the model speed `model_abs` (a
+    /// shaft that leapt, brought back; the speed read is low if anything, by the viscous share,
+    /// so this never slows a shaft at the model speed), and above `1 - FUSED_BAND_SHARE` of it
+    /// once the model has reached [`MODEL_THERE`] of the reference `r_abs` (a loaded shaft that
+    /// crawls gets the duty it lacks; a shaft still accelerating behind the model during a
+    /// ramp, as at 0 -> 3 rad/s, is the edges' to judge).
+    pub fn fused_integral_step(
+        &self,
+        (model_abs, r_abs): (f32, f32),
+        duty_per_rad_s: f32,
+        dt_s: f32,
+    ) -> f32 {
+        let lo = (1.0 - FUSED_BAND_SHARE) * model_abs;
+        let hi = FUSED_ABOVE_SHARE * model_abs;
+        let err = if self.speed_rad_s < lo && model_abs >= MODEL_THERE * r_abs {
+            lo - self.speed_rad_s
+        } else if self.speed_rad_s > hi {
+            hi - self.speed_rad_s
+        } else {
+            0.0
+        };
+        FUSED_BANDWIDTH_RAD_S * dt_s * duty_per_rad_s * err
+    }
+
+    /// The current showed the breakaway of this start.
+    pub fn released(&self) -> bool {
+        self.released
+    }
+    /// The back-EMF speed, rad/s in the commanded direction (0 before the first sample).
+    pub fn speed_rad_s(&self) -> f32 {
+        self.speed_rad_s
+    }
+}

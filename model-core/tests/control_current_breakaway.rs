@@ -1,0 +1,101 @@
+//! The breakaway seen in the motor current (model-core/src/control/breakaway.rs, issue 27 part
+//! 2): with current sense, a shaft whose static friction exceeds its running friction no longer
+//! leaps past a low setpoint once it breaks away. Measured on the simulator's true speed, against
+//! the same plants without current sense (the pulses-only loop, unchanged).
+
+use model_core::control::ControllerConfig;
+use model_core::control::breakaway::Breakaway;
+use model_core::sim::experiments::{commissioned_step, family_plant};
+use model_core::sim::{CurrentSense, PlantParams};
+
+fn sensed(mut rig: PlantParams) -> PlantParams {
+    for a in &mut rig.axes {
+        a.current_sense = CurrentSense::TYPICAL;
+    }
+    rig
+}
+
+/// Overshoot of both axes, % of the target, of the commissioned 0 -> `target` step.
+fn overshoot_pct(rig: PlantParams, seed: u32, target: f32, load: [f32; 2]) -> [f32; 2] {
+    let o = commissioned_step(rig, ControllerConfig::nominal(), seed, target, true, load);
+    assert!(o.commissioned, "commissioning failed");
+    assert_eq!(o.fault, None, "a false fault");
+    [
+        100.0 * o.reports[0].overshoot,
+        100.0 * o.reports[1].overshoot,
+    ]
+}
+
+#[test]
+fn the_nominal_rig_reaches_half_a_radian_per_second_without_the_leap() {
+    let pulses_only = overshoot_pct(PlantParams::nominal(), 1, 0.5, [0.0; 2]);
+    let with_current = overshoot_pct(sensed(PlantParams::nominal()), 1, 0.5, [0.0; 2]);
+    // Without current the precession leaps: the first edge comes 0.6 s after the breakaway
+    // (35 % on main); the current shows the breakaway at once.
+    assert!(pulses_only[0] > 25.0, "pulses only: {pulses_only:?}");
+    for (axis, os) in with_current.iter().enumerate() {
+        assert!(*os <= 5.0, "axis {axis}: {os} % with current sense");
+    }
+}
+
+#[test]
+fn a_seeded_family_mostly_stays_within_ten_percent_at_half_a_radian_per_second() {
+    // 20 plants of seed 5 (friction x0.5..x2, material added after commissioning), both axes.
+    let mut within = 0;
+    let mut worst: f32 = 0.0;
+    let mut within_pulses = 0;
+    let n = 20;
+    for i in 0..n {
+        let (rig, load) = family_plant(5, i);
+        for os in overshoot_pct(sensed(rig), 5 + i, 0.5, load) {
+            within += usize::from(os <= 10.0);
+            worst = worst.max(os);
+        }
+        for os in overshoot_pct(rig, 5 + i, 0.5, load) {
+            within_pulses += usize::from(os <= 10.0);
+        }
+    }
+    let axes = 2 * n as usize;
+    eprintln!(
+        "within 10 %: {within} of {axes} with current, {within_pulses} pulses only; worst {worst} %"
+    );
+    // Measured: 39 of 40 with current sense (worst 27.9 %), 21 of 40 pulses only; main ignored
+    // the current, so there both were 21.
+    assert!(
+        within * 100 >= 90 * axes,
+        "{within} of {axes} axes within 10 % (pulses only {within_pulses})"
+    );
+    assert!(
+        within > within_pulses + axes / 4,
+        "{within} vs {within_pulses}"
+    );
+    assert!(worst < 50.0, "worst {worst} %");
+}
+
+/// The breakaway watch alone: a held shaft read through a current per duty 10 % off (the
+/// supervisor's learned `g` on a family plant) is not taken for a turning one, and a turning
+/// one is seen within a few samples.
+#[test]
+fn a_held_shaft_is_not_read_as_turning_and_a_turning_one_is_seen() {
+    let duty_per_rad_s = 0.14;
+    let friction_duty = 0.3;
+    let r = 0.2;
+    let mut b = Breakaway::NONE;
+    // The duty rises through the friction duty at 4 per second, the shaft held: the current
+    // is `h d` with `h = 0.9` (g learned 10 % high).
+    let mut d = 0.0;
+    for _ in 0..120 {
+        d = (d + 0.004f32).min(0.45);
+        assert!(!b.sample(d, 0.9 * d, (duty_per_rad_s, friction_duty), (true, true), r));
+    }
+    // It breaks away and runs at 0.1 rad/s: the back-EMF takes `0.9 (k/V) w` off the current.
+    let mut seen_after = None;
+    for k in 0..20 {
+        let c = 0.9 * (d - duty_per_rad_s * 0.1);
+        if b.sample(d, c, (duty_per_rad_s, friction_duty), (true, true), r) {
+            seen_after = Some(k + 1);
+            break;
+        }
+    }
+    assert!(seen_after.is_some_and(|k| k <= 10), "{seen_after:?}");
+}
