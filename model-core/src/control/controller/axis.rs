@@ -3,6 +3,7 @@
 use crate::control::config::{AxisConfig, ControllerConfig};
 use crate::control::estimator::PulseSpeedEstimator;
 use crate::control::load_pattern::LoadPattern;
+use crate::control::observer::{AngleObserver, ObserverConstants};
 use crate::control::pi::{LoopConstants, SpeedLoop};
 use crate::control::supervisor::{CurrentWatch, SensorWatch};
 
@@ -32,6 +33,13 @@ pub(super) struct AxisState {
     pub(super) steady: bool,
     /// The current sense's offset, current per duty and back-EMF (none: never sampled).
     pub(super) current: CurrentWatch,
+    /// The shaft's angle, speed and unknown load, by the identified plant and the edges.
+    pub(super) obs: AngleObserver,
+    /// The observer's constants for this axis's motor model.
+    pub(super) ok: ObserverConstants,
+    /// What the last duty held beyond the identified model (the spin's reaction on the
+    /// precession axis, the once-per-revolution load): not what drives the observer's plant.
+    pub(super) extra_duty: f32,
 }
 
 impl AxisState {
@@ -49,6 +57,9 @@ impl AxisState {
             load: LoadPattern::new(a, cfg.supply_v),
             steady: false,
             current: CurrentWatch::NEW,
+            obs: AngleObserver::REST,
+            ok: ObserverConstants::new(a, dt_s, cfg.supply_v),
+            extra_duty: 0.0,
         }
     }
 
