@@ -447,14 +447,22 @@ impl Controller {
         let duty = a.speed_loop.step(&a.k, input);
         a.duty = duty;
         // Expected edges are watched whatever the duty: at low speed the duty that holds the
-        // shaft can be below any fixed threshold.
+        // shaft can be below any fixed threshold. The travel expected is the observer's once
+        // it tracks the shaft (a shaft that lags its reference, saturated or slowing as its
+        // inertia lets it, is expected where it is); from rest, where the observer knows no
+        // stiction, the loop's plant model's.
+        let expected_rad_s = if a.obs.tracking() {
+            a.obs.speed_rad_s()
+        } else {
+            a.speed_loop.model_rad_s()
+        };
         if a.watch.step(
             dt,
             duty.abs(),
             0.0,
             seen,
             self.cfg.sensor_timeout_floor_s,
-            a.speed_loop.model_rad_s(),
+            expected_rad_s,
             a.est.rad_per_pulse(),
         ) {
             self.latch(self.lost_edges_fault(i));
