@@ -4,7 +4,9 @@
 
 use model_core::control::estimator::PulseSpeedEstimator;
 use model_core::control::observer::{AngleObserver, ObserverConstants};
-use model_core::control::{AxisConfig, ControllerConfig};
+use model_core::control::{AxisConfig, Controller, ControllerConfig};
+use model_core::sim::ClosedLoop;
+use model_core::sim::experiments::{rig_with_pulses, true_model_config};
 use model_core::sim::plant::{Plant, PlantParams};
 use proptest::prelude::*;
 
@@ -357,6 +359,54 @@ fn the_expected_edge_time_matches_the_simulated_plants() {
         "an edge came {:.1} % of a pulse period from where the observer expected it",
         100.0 * worst
     );
+}
+
+/// In closed loop on the simulated rig, a sensor that drops one pulse in twenty: running at 3
+/// rad/s, then slowing to 1 and to 0.5 rad/s. No fault; the pulses inferred missing are never
+/// more than the sensor dropped (a slowing shaft's long intervals are not among them) and most of
+/// them; the shaft holds its last speed.
+#[test]
+fn in_closed_loop_dropped_pulses_are_inferred_and_slowing_is_not() {
+    let mut rig = rig_with_pulses(12);
+    for a in &mut rig.axes {
+        a.faults.missing_probability = 0.05;
+    }
+    let cfg = true_model_config(&rig);
+    let mut cl = ClosedLoop::new(Plant::new(rig, 5), Controller::new(cfg).unwrap());
+    let pitch = TAU / 12.0;
+    let teeth = |c: &ClosedLoop, i: usize| (c.rig.angle_rad(i) / pitch).floor();
+    let start = [teeth(&cl, 0), teeth(&cl, 1)];
+    cl.ctrl.set_motor_speeds(3.0, 3.0).unwrap();
+    cl.ctrl.start().unwrap();
+    cl.run(40.0, |_| {});
+    cl.ctrl.set_motor_speeds(1.0, 1.0).unwrap();
+    cl.run(12.0, |_| {});
+    cl.ctrl.set_motor_speeds(0.5, 0.5).unwrap();
+    cl.run(12.0, |_| {});
+    let mut mean = [0.0f64; 2];
+    let n = 3000;
+    cl.run(3.0, |c| {
+        for (i, m) in mean.iter_mut().enumerate() {
+            *m += c.rig.speed_rad_s(i) as f64 / n as f64;
+        }
+    });
+    assert_eq!(cl.ctrl.fault(), None);
+    let status = cl.ctrl.status();
+    for i in 0..2 {
+        let passed = teeth(&cl, i) - start[i];
+        let dropped = passed - cl.rig.edges_emitted(i) as f64;
+        let inferred = status.axes[i].inferred_missing as f64;
+        assert!(dropped >= 8.0, "axis {i}: only {dropped} dropped");
+        assert!(
+            inferred <= dropped + 1.0 && inferred >= 0.5 * dropped,
+            "axis {i}: {inferred} inferred missing, {dropped} dropped"
+        );
+        assert!(
+            (mean[i] - 0.5).abs() < 0.02 * 0.5,
+            "axis {i}: {} rad/s at the end",
+            mean[i]
+        );
+    }
 }
 
 proptest! {
