@@ -22,14 +22,19 @@
 //! `e pitch / T`, of which the speed takes [`SPEED_GAIN`] and the load [`LOAD_GAIN`] (as duty
 //! through the model's `volts_per_rad_s / V`). The gains are per edge, so the observer's
 //! bandwidth is scheduled on the pulse rate (as ODrive's encoder PLL's is on its bandwidth, with
-//! `kp = 2 bw`, `ki = bw^2 / 4`): with `beta = 0.5`, `gamma = 0.25` the error of a step of
-//! load halves in about two edges where the plant is fast against a pulse period.
+//! `kp = 2 bw`, `ki = bw^2 / 4`): where the plant settles within a pulse period, the load's
+//! error shrinks by `1 - gamma` per edge (halves within three edges); raised to 0.8 / 0.5
+//! the observer was tried as the loop's speed and not kept (docs/control.md, "The observer in
+//! the loop").
 //!
 //! # What it gives
 //! - [`AngleObserver::predicted_pitches`]: the angle expected at an edge time, which tells a
 //!   missing pulse (an interval of `k` expected pitches, `k` = 2 or 3) from a shaft that slowed
 //!   (the observer, driven by the throttled duty, expected about one pitch);
 //! - [`AngleObserver::speed_rad_s`]: the speed the sensor watch integrates into expected travel.
+//!
+//! [`AngleObserver::track`] is the controller's one call per axis and tick: it hands the
+//! estimator the expected angle, runs it on the tick's edges, then propagates and corrects.
 
 use super::config::AxisConfig;
 use super::estimator::PulseSpeedEstimator;
@@ -70,11 +75,6 @@ impl ObserverConstants {
             duty_per_rad_s: axis.model.volts_per_rad_s / supply_v,
             friction_duty: axis.model.friction_duty,
         }
-    }
-
-    /// The pitch, rad.
-    pub fn pitch_rad(&self) -> f32 {
-        self.pitch_rad
     }
 }
 
@@ -190,17 +190,6 @@ impl AngleObserver {
             }
         }
         speed
-    }
-
-    /// Forget the reference edge (the shaft was let go, or the estimator called it stopped).
-    pub fn lose_edge(&mut self) {
-        self.has_edge = false;
-        self.tracked = 0;
-    }
-
-    /// Back to rest.
-    pub fn reset(&mut self) {
-        *self = Self::REST;
     }
 
     /// Speed, rad/s (magnitude).
