@@ -238,31 +238,20 @@ fn a_decelerating_shafts_long_interval_is_not_read_as_missing() {
             &mut n,
         );
         assert!(a.obs.tracking());
-        // Not steady while it slows (the controller's "steady": the reference unchanged for
-        // half a second and the measurement within 10 % of the model), steady after.
-        a.steady = false;
+        // Steady as far as the caller says, throughout (the worst case: the old rule's
+        // "reference unchanged" alone): only the observer's expectation stands between the
+        // slowing and a missing pulse. (Its speed is not judged here: the tooth map learns
+        // the slowing as tooth offsets when told it is steady.)
         run(
             &mut a,
             &mut shaft,
-            2.0,
-            |_| d1,
-            |_| true,
-            |_, _, e| times.extend_from_slice(e),
-            &mut n,
-        );
-        a.steady = true;
-        run(
-            &mut a,
-            &mut shaft,
-            8.0,
+            10.0,
             |_| d1,
             |_| true,
             |_, _, e| times.extend_from_slice(e),
             &mut n,
         );
         assert_eq!(a.est.inferred_missing(), 0, "3 -> {to} rad/s");
-        let v = a.obs.speed_rad_s() as f64;
-        assert!((v - to).abs() < 0.02 * to, "3 -> {to}: observer {v}");
         // The test is not empty: an interval through the slowing is close to two or three of
         // the one before it, which the rule of the last measured period (the estimator alone)
         // reads as missing pulses.

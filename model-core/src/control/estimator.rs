@@ -30,9 +30,9 @@
 //! [`PulseSpeedEstimator::rejected_edges`]). An interval is taken as `k` = 2 or 3 pulses with
 //! the middle ones missing (counted in [`PulseSpeedEstimator::inferred_missing`]) when the
 //! shaft's observer ([`super::observer`], through [`PulseSpeedEstimator::expect_travel`])
-//! expected `k` pitches over it (within 0.3): a shaft that slowed gives a long interval too, but
-//! its observer, driven by the throttled duty, expected one pitch. Without an observer (the
-//! estimator on its own) the rule is the last measured period's, at a steady speed.
+//! expected `k` pitches over it (within 0.3), at a steady speed: a shaft that slowed gives a
+//! long interval too, but its observer, driven by the throttled duty, expected one pitch. Without
+//! an observer (the estimator on its own) the rule is the last measured period's.
 //!
 //! # Tooth offsets
 //! Each window counts its gaps by their learned lengths ([`super::teeth::ToothMap`]): at
@@ -318,10 +318,16 @@ impl PulseSpeedEstimator {
             // The observer's angle at this edge: an interval counts as `k` pulses only when the
             // observer, driven by the duty that was applied, expected `k` pitches over it. A
             // shaft slowing to a lower reference gives intervals of 2 or 3 of its last periods,
-            // but the observer, slowing with it, expected about one pitch.
+            // but the observer, slowing with it, expected about one pitch. Only at a steady
+            // speed: the observer knows no stiction, and a shaft sticking on its way down to the
+            // lowest speed took two expected pitches for one (family-60 p18, 3 -> 0.2 rad/s).
             let since_tick = at.wrapping_sub(self.clock) as f32;
             let predicted = self.expect_pitches + self.expect_pitches_per_tick * since_tick;
-            pulses = pulses_expected(predicted);
+            pulses = if steady {
+                pulses_expected(predicted)
+            } else {
+                1
+            };
             if pulses > 1 {
                 self.missing = self.missing.wrapping_add(pulses - 1);
             }
@@ -386,8 +392,8 @@ impl PulseSpeedEstimator {
 
     /// The observer's expectation for this tick's edges: `pitches` turned since the last edge
     /// at the previous tick and `pitches_per_s` after it (both 0 while the observer is not
-    /// trusted: no pulse is then inferred missing). Once called, the observer alone judges
-    /// missing pulses (replacing the rule of the last raw period at a steady speed).
+    /// trusted: no pulse is then inferred missing). Once called, the observer judges missing
+    /// pulses at a steady speed (replacing the rule of the last raw period).
     pub fn expect_travel(&mut self, pitches: f32, pitches_per_s: f32) {
         self.observed = true;
         self.expect_pitches = pitches;
