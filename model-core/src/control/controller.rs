@@ -267,15 +267,19 @@ impl Controller {
             let before = a.est.accepted_edges();
             // Steady as the shaft shows it, not only by the reference's age: the reference
             // unchanged for half a second *and* the measurement within 10 % of the plant model
-            // the loop runs. A shaft still slowing towards a new, lower reference is not steady,
-            // and its long intervals are not missing pulses.
+            // the loop runs. It sets the estimator's relative lockout, its two-pitch stall bound
+            // and tooth learning; missing pulses are the observer's to judge (below).
             let model = a.speed_loop.model_rad_s().abs();
             let steady_i = steady[i] > 0.5
                 && a.est.is_valid()
                 && (a.measured.abs() - model).abs() <= 0.1 * model;
             a.steady = steady_i;
-            a.est.expect_speed_rad_s(model);
-            let speed = a.est.tick(now_ticks, edges[i], steady_i, |_, _| {});
+            // The observer (observer.rs) judges missing pulses by its expected angle, and is
+            // driven by last tick's duty less what that held beyond the model.
+            let duty = (a.duty - a.extra_duty) * a.direction;
+            let speed = a
+                .obs
+                .track(&a.ok, &mut a.est, now_ticks, edges[i], steady_i, duty);
             seen[i] = a.est.accepted_edges() != before;
             a.measured = a.direction * speed;
             if seen[i] && steady_i {
@@ -429,6 +433,7 @@ impl Controller {
         let model = a.speed_loop.model_rad_s().abs();
         let load = a.load.tick(&a.est, a.duty, a.direction, a.steady, model);
         let extra_duty = extra_duty + if self.feedback { load } else { 0.0 };
+        a.extra_duty = extra_duty;
         let input = LoopInput {
             reference_rad_s: r,
             measured_rad_s: a.measured,
@@ -448,14 +453,22 @@ impl Controller {
             a.watch.reset();
         }
         // Expected edges are watched whatever the duty: at low speed the duty that holds the
-        // shaft can be below any fixed threshold.
+        // shaft can be below any fixed threshold. The travel expected is the observer's once
+        // it tracks the shaft (a shaft that lags its reference, saturated or slowing as its
+        // inertia lets it, is expected where it is); from rest, where the observer knows no
+        // stiction, the loop's plant model's.
+        let expected_rad_s = if a.obs.tracking() {
+            a.obs.speed_rad_s()
+        } else {
+            a.speed_loop.model_rad_s()
+        };
         if a.watch.step(
             dt,
             duty.abs(),
             0.0,
             seen,
             self.cfg.sensor_timeout_floor_s,
-            a.speed_loop.model_rad_s(),
+            expected_rad_s,
             a.est.rad_per_pulse(),
         ) {
             self.latch(self.lost_edges_fault(i));

@@ -27,9 +27,12 @@
 //! # Bounce and missing pulses
 //! An edge closer to the previous accepted edge than half the pulse period at the over-speed
 //! limit, or than 40 % of the last measured period, is a bounce and is ignored (counted in
-//! [`PulseSpeedEstimator::rejected_edges`]). When the caller says the speed is steady, an
-//! interval of about 2 or 3 measured periods (within 0.3 of the integer) is taken as that many
-//! pulses with the middle ones missing (counted in [`PulseSpeedEstimator::inferred_missing`]).
+//! [`PulseSpeedEstimator::rejected_edges`]). An interval is taken as `k` = 2 or 3 pulses with
+//! the middle ones missing (counted in [`PulseSpeedEstimator::inferred_missing`]) when the
+//! shaft's observer ([`super::observer`], through [`PulseSpeedEstimator::expect_travel`])
+//! expected `k` pitches over it (within 0.3), at a steady speed: a shaft that slowed gives a
+//! long interval too, but its observer, driven by the throttled duty, expected one pitch. Without
+//! an observer (the estimator on its own) the rule is the last measured period's.
 //!
 //! # Tooth offsets
 //! Each window counts its gaps by their learned lengths ([`super::teeth::ToothMap`]): at
@@ -119,9 +122,18 @@ pub struct PulseSpeedEstimator {
     raw_period_ticks: f32,
     lockout_now: u32,
     missing_from: u32,
-    /// The pulse period the caller's model of the shaft expects now, ticks (0 = no model:
-    /// the last raw period alone judges a missing pulse).
-    expected_period_ticks: f32,
+    /// An observer of the shaft judges missing pulses (see [`Self::expect_travel`]); without
+    /// one the last raw period does, at a steady speed.
+    observed: bool,
+    /// The pitches the observer expects the shaft to have turned since the last edge at
+    /// `clock`, and per timer tick after it (both 0: no inference).
+    expect_pitches: f32,
+    expect_pitches_per_tick: f32,
+    /// Edges of this tick: a first edge after rest came, the pitches since the edge before the
+    /// tick (or since the restart), and how many were accepted.
+    tick_restarted: bool,
+    tick_pitches: f32,
+    tick_edges: u32,
     speed_filt: f32,
     speed: f32,
     bound_active: bool,
@@ -188,7 +200,12 @@ impl PulseSpeedEstimator {
             raw_period_ticks: 0.0,
             lockout_now: (0.5 * min_period_s * ticks_per_s) as u32,
             missing_from: u32::MAX,
-            expected_period_ticks: 0.0,
+            observed: false,
+            expect_pitches: 0.0,
+            expect_pitches_per_tick: 0.0,
+            tick_restarted: false,
+            tick_pitches: 0.0,
+            tick_edges: 0,
             speed_filt: 0.0,
             speed: 0.0,
             bound_active: false,
@@ -230,6 +247,9 @@ impl PulseSpeedEstimator {
         let span = now.wrapping_sub(self.prev_now) & self.mask;
         self.restart_at = None;
         self.closed_at = None;
+        self.tick_restarted = false;
+        self.tick_pitches = 0.0;
+        self.tick_edges = 0;
         for &t in edges {
             let mut offset = t.wrapping_sub(self.prev_now) & self.mask;
             if offset > span {
@@ -265,6 +285,11 @@ impl PulseSpeedEstimator {
             self.win_pulses = 0;
             self.win_pitches = 0.0;
             self.restart_at = Some(at);
+            self.tick_restarted = true;
+            self.tick_pitches = 0.0;
+            self.tick_edges = 1;
+            self.expect_pitches = 0.0;
+            self.expect_pitches_per_tick = 0.0;
             self.last_interval = 0;
             self.prev_interval = 0;
             self.accepted = self.accepted.wrapping_add(1);
@@ -289,15 +314,29 @@ impl PulseSpeedEstimator {
             return None;
         }
         let mut pulses = 1u32;
-        if steady && dt > self.missing_from {
+        if self.observed {
+            // The observer's angle at this edge: an interval counts as `k` pulses only when the
+            // observer, driven by the duty that was applied, expected `k` pitches over it. A
+            // shaft slowing to a lower reference gives intervals of 2 or 3 of its last periods,
+            // but the observer, slowing with it, expected about one pitch. Only at a steady
+            // speed: the observer knows no stiction, and a shaft sticking on its way down to the
+            // lowest speed took two expected pitches for one (family-60 p18, 3 -> 0.2 rad/s).
+            let since_tick = at.wrapping_sub(self.clock) as f32;
+            let predicted = self.expect_pitches + self.expect_pitches_per_tick * since_tick;
+            pulses = if steady {
+                pulses_expected(predicted)
+            } else {
+                1
+            };
+            if pulses > 1 {
+                self.missing = self.missing.wrapping_add(pulses - 1);
+            }
+            // The next edge of this tick counts its expectation from this one.
+            self.expect_pitches = -self.expect_pitches_per_tick * since_tick;
+        } else if steady && dt > self.missing_from {
+            // Without an observer (the estimator on its own): the last raw period.
             let k = whole_periods(dt as f32, self.raw_period_ticks);
-            // With a model of the shaft, the interval must also be that many of the periods the
-            // model expects now: a shaft slowing down gives intervals of 2 or 3 of its last
-            // measured periods (one at its new speed), and read as missing pulses those throttled
-            // the loop until the shaft stalled (3 -> 1 rad/s faulted 10 of 60 healthy plants).
-            let agrees = self.expected_period_ticks <= 0.0
-                || whole_periods(dt as f32, self.expected_period_ticks) == k;
-            if k >= 2 && agrees {
+            if k >= 2 {
                 pulses = k;
                 self.missing = self.missing.wrapping_add(k - 1);
             }
@@ -310,6 +349,8 @@ impl PulseSpeedEstimator {
         self.win_pulses += pulses;
         let pitches = self.teeth.edge(dt, pulses, steady);
         self.win_pitches += pitches;
+        self.tick_pitches += pitches;
+        self.tick_edges += 1;
         if pulses == 1 {
             self.last_gap = Gap {
                 serial: self.accepted,
@@ -349,15 +390,26 @@ impl PulseSpeedEstimator {
         Some(pulses)
     }
 
-    /// The speed the caller's model of the shaft expects now, rad/s (magnitude; 0 = none): a
-    /// pulse is then inferred missing only where the interval is a whole multiple of both the
-    /// last measured period and the period this speed gives.
-    pub fn expect_speed_rad_s(&mut self, speed_rad_s: f32) {
-        self.expected_period_ticks = if speed_rad_s > 0.0 {
-            self.rad_ticks_per_pulse_s / speed_rad_s
-        } else {
-            0.0
-        };
+    /// The observer's expectation for this tick's edges: `pitches` turned since the last edge
+    /// at the previous tick and `pitches_per_s` after it (both 0 while the observer is not
+    /// trusted: no pulse is then inferred missing). Once called, the observer judges missing
+    /// pulses at a steady speed (replacing the rule of the last raw period).
+    pub fn expect_travel(&mut self, pitches: f32, pitches_per_s: f32) {
+        self.observed = true;
+        self.expect_pitches = pitches;
+        self.expect_pitches_per_tick = pitches_per_s * self.s_per_tick;
+    }
+
+    /// The edges of the last tick, for an observer: None without an accepted edge; otherwise
+    /// whether the first was a start after rest, the pitches (by the learned gap lengths) from
+    /// the edge before the tick (or from that start) to the last, and how long before the
+    /// tick's `now` the last came, s.
+    pub fn tick_edges(&self) -> Option<(bool, f32, f32)> {
+        if self.tick_edges == 0 {
+            return None;
+        }
+        let ago = self.clock.wrapping_sub(self.last_edge) as f32 * self.s_per_tick;
+        Some((self.tick_restarted, self.tick_pitches, ago))
     }
 
     /// `pitches`: how many pitches the shaft may have turned since the last edge (2 at steady
@@ -530,4 +582,16 @@ fn whole_periods(dt: f32, period: f32) -> u32 {
     } else {
         1
     }
+}
+
+/// How many pulses an edge stands for, given the pitches the observer expected since the
+/// previous edge: `k` (2 or 3, the middle ones missing) when the expectation lies within 0.3
+/// of `k`; 1 otherwise (or for a non-finite expectation).
+pub fn pulses_expected(predicted_pitches: f32) -> u32 {
+    if !(predicted_pitches.is_finite() && predicted_pitches > 1.7 && predicted_pitches < 3.3) {
+        return 1;
+    }
+    let k = (predicted_pitches + 0.5) as u32;
+    let off = predicted_pitches - k as f32;
+    if off > -0.3 && off < 0.3 { k } else { 1 }
 }

@@ -68,6 +68,7 @@ mod const_trig;
 mod controller;
 pub mod estimator;
 pub mod load_pattern;
+pub mod observer;
 pub mod pi;
 pub mod planner;
 pub mod supervisor;

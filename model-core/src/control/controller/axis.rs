@@ -3,6 +3,7 @@
 use crate::control::config::{AxisConfig, ControllerConfig};
 use crate::control::estimator::PulseSpeedEstimator;
 use crate::control::load_pattern::LoadPattern;
+use crate::control::observer::{AngleObserver, ObserverConstants};
 use crate::control::pi::{LoopConstants, SpeedLoop};
 use crate::control::supervisor::{CurrentWatch, SensorWatch};
 
@@ -35,6 +36,13 @@ pub(super) struct AxisState {
     /// This tick's current reading as the duty that drives it into a held shaft, for the loop
     /// (see `LoopInput::torque_duty`); taken by the loop each tick.
     pub(super) torque_duty: Option<f32>,
+    /// The shaft's angle, speed and unknown load, by the identified plant and the edges.
+    pub(super) obs: AngleObserver,
+    /// The observer's constants for this axis's motor model.
+    pub(super) ok: ObserverConstants,
+    /// What the last duty held beyond the identified model (the spin's reaction on the
+    /// precession axis, the once-per-revolution load): not what drives the observer's plant.
+    pub(super) extra_duty: f32,
 }
 
 impl AxisState {
@@ -53,6 +61,9 @@ impl AxisState {
             steady: false,
             current: CurrentWatch::NEW,
             torque_duty: None,
+            obs: AngleObserver::REST,
+            ok: ObserverConstants::new(a, dt_s, cfg.supply_v),
+            extra_duty: 0.0,
         }
     }
 
