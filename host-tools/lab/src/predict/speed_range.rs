@@ -335,19 +335,7 @@ mod tests {
     use super::*;
 
     fn scene(w1: f64, w2: f64) -> RollingScene<f64> {
-        RollingScene {
-            precession_rad_s: w1,
-            spin_rad_s: w2,
-            axes_angle_rad: 60f64.to_radians(),
-            rolling_resistance: 0.029,
-            sliding_friction: 0.4,
-            g_m_s2: 9.81,
-            k2: 5.0 / 7.0,
-            particle_radius_m: 0.003,
-            rod_length_m: 0.0,
-            ri_m: 0.0375,
-            rim_radius_m: 0.075,
-        }
+        RollingScene::with_speeds(w1, w2, 60f64.to_radians(), 0.075)
     }
 
     #[test]

@@ -72,6 +72,16 @@ impl<T: Real> RollingScene<T> {
         }
     }
 
+    /// The motor speeds as given (`precession_rad_s`, `spin_rad_s`), the rest as
+    /// [`RollingScene::equal_speeds`] has it: the project's default scene at that tilt and rim.
+    pub fn with_speeds(precession_rad_s: T, spin_rad_s: T, axes_angle_rad: T, rim_m: T) -> Self {
+        Self {
+            precession_rad_s,
+            spin_rad_s,
+            ..Self::equal_speeds(T::ONE, axes_angle_rad, rim_m)
+        }
+    }
+
     /// Checks every input; the first bad one is named.
     pub fn validate(&self) -> Result<(), RollingError> {
         let finite = |v: T| v.is_finite();

@@ -9,55 +9,46 @@ type Row = (f64, f64, f64, f64, f64, f64);
 
 fn scene((tilt, w1, w2, mu_s, ri, rim): Row) -> RollingScene<f64> {
     RollingScene {
-        precession_rad_s: w1,
-        spin_rad_s: w2,
-        axes_angle_rad: tilt.to_radians(),
-        rolling_resistance: 0.029,
         sliding_friction: mu_s,
-        g_m_s2: 9.81,
-        k2: 5.0 / 7.0,
-        particle_radius_m: 0.003,
-        rod_length_m: 0.0,
         ri_m: ri,
-        rim_radius_m: rim,
+        ..RollingScene::with_speeds(w1, w2, tilt.to_radians(), rim)
     }
+}
+
+/// The rolling-or-sliding disc's mean `T` over the twelve releases at DP5(4) rtol 1e-10 (the
+/// reference the rotation estimate is fitted against); None unless every release leaves.
+fn disc_mean_s(s: &RollingScene<f64>) -> Option<f64> {
+    let betas = model_core::particle::rolling::AZIMUTHS_DEG.to_vec();
+    let limits = SystemLimits {
+        horizon_s: 20.0,
+        max_steps: 2_000_000,
+    };
+    let Ok(Ok(a)) = run_level(
+        Level::RollingOrSliding,
+        s,
+        &BowlShape::bare_rim(),
+        &betas,
+        RollingMethod::Dp54 { rtol: 1e-10 },
+        limits,
+    ) else {
+        return None;
+    };
+    let left: Vec<f64> = a.times.iter().filter_map(|t| t.1).collect();
+    (left.len() == betas.len()).then(|| left.iter().sum::<f64>() / left.len() as f64)
 }
 
 /// Per scene: the incline's error in the mean `T` against the disc (relative, absolute value),
 /// the rotation estimate's form without its constant, and its constant (the incline's mode).
 fn dump(name: &str, rows: &[Row]) -> Vec<(f64, f64, f64)> {
     let mut out = Vec::new();
-    let bare = BowlShape {
-        wall_angle_rad: core::f64::consts::FRAC_PI_2,
-        wall_height_m: 0.0,
-        fillet_radius_m: 0.0,
-        restitution: 0.5,
-    };
-    let limits = SystemLimits {
-        horizon_s: 20.0,
-        max_steps: 2_000_000,
-    };
-    let betas = model_core::particle::rolling::AZIMUTHS_DEG.to_vec();
     for &r in rows {
         let s = scene(r);
         let Some(ti) = model_core::choose::whole::incline_mean_s(&s) else {
             continue;
         };
-        let Ok(Ok(a)) = run_level(
-            Level::RollingOrSliding,
-            &s,
-            &bare,
-            &betas,
-            RollingMethod::Dp54 { rtol: 1e-10 },
-            limits,
-        ) else {
+        let Some(t) = disc_mean_s(&s) else {
             continue;
         };
-        let left: Vec<f64> = a.times.iter().filter_map(|t| t.1).collect();
-        if left.len() < betas.len() {
-            continue;
-        }
-        let t = left.iter().sum::<f64>() / left.len() as f64;
         let slides = model_core::choose::whole::incline_friction_needed(&s) > s.sliding_friction;
         let (tilt, w1, w2, mu_s, ri, rim) = r;
         let unit = model_core::choose::whole::rotation_form(&s, ti);
@@ -209,32 +200,9 @@ fn rod_offset_data() {
         let Some(ti) = model_core::choose::whole::incline_mean_s(&s) else {
             continue;
         };
-        let bare = BowlShape {
-            wall_angle_rad: core::f64::consts::FRAC_PI_2,
-            wall_height_m: 0.0,
-            fillet_radius_m: 0.0,
-            restitution: 0.5,
-        };
-        let betas = model_core::particle::rolling::AZIMUTHS_DEG.to_vec();
-        let limits = SystemLimits {
-            horizon_s: 20.0,
-            max_steps: 2_000_000,
-        };
-        let Ok(Ok(a)) = run_level(
-            Level::RollingOrSliding,
-            &s,
-            &bare,
-            &betas,
-            RollingMethod::Dp54 { rtol: 1e-10 },
-            limits,
-        ) else {
+        let Some(t) = disc_mean_s(&s) else {
             continue;
         };
-        let left: Vec<f64> = a.times.iter().filter_map(|t| t.1).collect();
-        if left.len() < betas.len() {
-            continue;
-        }
-        let t = left.iter().sum::<f64>() / left.len() as f64;
         let est = rotation_estimate(&s, ti);
         got.push((
             name == "fit",
