@@ -105,3 +105,46 @@ fn nothing_is_learned_above_the_tooth_maps_speed() {
     cl.run(30.0, |_| {});
     assert_eq!(cl.ctrl.load_pattern(1), (0, 0.0));
 }
+
+/// The load belongs to the angle, not to the speed: a pattern learned at 1 rad/s is kept
+/// through a set-point change (to 2 rad/s, where nothing is learned, and back), and the shaft
+/// coming back to 1 rad/s is within 2 % of it (the true speed averaged over a second, as the
+/// family report judges settling) from 3 s after the step on, with no revolution learned anew.
+#[test]
+fn a_set_point_change_keeps_the_pattern() {
+    let mut cl = started(eccentric_rig());
+    cl.run(40.0, |_| {});
+    let (learned, amplitude) = cl.ctrl.load_pattern(1);
+    assert!(learned >= 3, "revolutions learned at 1 rad/s: {learned}");
+    cl.ctrl.set_motor_speeds(2.0, 2.0).expect("speeds in range");
+    cl.run(10.0, |_| {});
+    assert_eq!(
+        cl.ctrl.load_pattern(1),
+        (learned, amplitude),
+        "kept unchanged at 2 rad/s"
+    );
+    cl.ctrl
+        .set_motor_speeds(SPEED_RAD_S, SPEED_RAD_S)
+        .expect("speeds in range");
+    // The spin axis's angle every tick for 3 s after the step, then one revolution more.
+    let dt = cl.dt_s();
+    let mut angle = Vec::new();
+    let until = 3.0 + core::f32::consts::TAU / SPEED_RAD_S + 0.5;
+    cl.run(until, |c| angle.push(c.rig.angle_rad(1)));
+    let first_k = (3.0 / dt) as usize;
+    let half = (0.5 / dt) as usize;
+    let mut worst_pct = 0.0f64;
+    for k in first_k..angle.len() - half {
+        let w = (angle[k + half] - angle[k - half]) / (2 * half) as f64 / dt as f64;
+        worst_pct = worst_pct.max(100.0 * (w - SPEED_RAD_S as f64).abs() / SPEED_RAD_S as f64);
+    }
+    eprintln!("back at 1 rad/s: worst 1 s mean {worst_pct:.2} % off from 3 s on");
+    assert!(
+        worst_pct <= 2.0,
+        "1 s mean {worst_pct:.2} % off the target 3 s after the step back to 1 rad/s"
+    );
+    assert!(
+        cl.ctrl.load_pattern(1).0 >= learned,
+        "the pattern was restarted by the set-point change"
+    );
+}
