@@ -100,7 +100,7 @@ impl BowlTruth {
             horizon_s: HORIZON_S,
             max_steps: MAX_STEPS,
         };
-        match bowl::residence(&scene, &self.shape, azimuth_rad, METHOD, limits) {
+        match bowl::residence_f64(&scene, &self.shape, azimuth_rad, METHOD, limits) {
             Ok(r) => match r.outcome {
                 BowlOutcome::Leaves {
                     residence_time_s, ..
