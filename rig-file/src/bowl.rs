@@ -2,10 +2,19 @@
 //! (`bowl predict --model bowl --rig-file`, model-core `particle::bowl`, docs/model.md §10).
 //! How to measure each key on a real bowl: docs/rigs/nominal.toml.
 
-use anyhow::Result;
+use anyhow::{Result, anyhow};
+use model_core::particle::bowl::{BowlError, BowlShape};
+use model_core::particle::rolling::RollingError;
+use model_core::sim::bowl_granule::BowlTruth;
+use model_core::sim::granule::ParticleParams;
 use serde::Deserialize;
 
-use super::{Checker, Num};
+use super::{Checker, Num, ParticleToml};
+
+/// `[particle] sliding_mu`: default and range (the paper's measured 0.4).
+const SLIDING_MU: (f64, f64, f64) = (0.4, 0.0, 2.0);
+/// `[particle] sliding_mu_spread`: default and range.
+const SLIDING_MU_SPREAD: (f64, f64, f64) = (0.0, 0.0, 0.5);
 
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
@@ -81,6 +90,105 @@ impl Checker<'_> {
     }
 }
 
+impl Checker<'_> {
+    /// `[particle] model = "bowl"` (declared on line `in_bowl`): the granule follows the bowl
+    /// model in the rig's `[bowl]` table, which it needs; its `sliding_mu` and
+    /// `sliding_mu_spread` are read (and refused without `model = "bowl"`), and its rim is the
+    /// bowl's bottom radius (a `[particle] rim_radius_m` that differs is refused: one rim).
+    pub(crate) fn granule_in_bowl(
+        &self,
+        t: &ParticleToml,
+        bowl: Option<&BowlToml>,
+        in_bowl: Option<usize>,
+        p: &mut ParticleParams,
+    ) -> Result<()> {
+        let Some(line) = in_bowl else {
+            if let Some(v) = t.sliding_mu.as_ref().or(t.sliding_mu_spread.as_ref()) {
+                return Err(anyhow!(
+                    "rig file {}, line {}: [particle] sliding_mu and sliding_mu_spread are the \
+                     bowl model's: give them with model = \"bowl\" (and a [bowl] table) or \
+                     leave them out",
+                    self.file,
+                    (self.at)(v.span().start)
+                ));
+            }
+            return Ok(());
+        };
+        let Some(b) = bowl else {
+            return Err(anyhow!(
+                "rig file {}, line {line}: [particle] model = \"bowl\" needs a [bowl] table (the \
+                 bowl's tilt, bottom radius and wall; keys in docs/rigs/nominal.toml)",
+                self.file
+            ));
+        };
+        let g = self.bowl(b)?;
+        if let Some(v) = &t.rim_radius_m
+            && *v.get_ref() != g.rim_radius_m
+        {
+            return Err(anyhow!(
+                "rig file {}, line {}: [particle] rim_radius_m = {} differs from [bowl] \
+                 rim_radius_m = {}: in the bowl model the rim is the bowl's bottom radius; leave \
+                 [particle] rim_radius_m out",
+                self.file,
+                (self.at)(v.span().start),
+                v.get_ref(),
+                g.rim_radius_m
+            ));
+        }
+        p.rim_radius_m = g.rim_radius_m;
+        let (d, lo, hi) = SLIDING_MU;
+        let sliding_mu = self.get(&t.sliding_mu, "[particle] sliding_mu", lo, hi, d)?;
+        let (d, lo, hi) = SLIDING_MU_SPREAD;
+        let sliding_mu_spread = self.get(
+            &t.sliding_mu_spread,
+            "[particle] sliding_mu_spread",
+            lo,
+            hi,
+            d,
+        )?;
+        let truth = BowlTruth {
+            shape: BowlShape {
+                wall_angle_rad: g.wall_angle_deg.to_radians(),
+                wall_height_m: g.wall_height_m,
+                fillet_radius_m: g.fillet_radius_m,
+                restitution: g.restitution,
+            },
+            axes_angle_rad: g.axes_angle_deg.to_radians(),
+            particle_radius_m: g.particle_radius_m,
+            sliding_mu,
+            sliding_mu_spread,
+        };
+        // The shape against the granule's scene at its nominal start (speeds do not matter);
+        // a start outside the rim is refused after this, in the [particle] table's words.
+        let scene = truth.scene(p, [1.0, 1.0], sliding_mu, p.release_radius_m);
+        let why = match truth.shape.validate(&scene) {
+            _ if p.release_radius_m >= p.rim_radius_m => None,
+            Ok(()) => None,
+            Err(BowlError::FilletReachesRelease) => Some(format!(
+                "the granule's start (release_radius_m = {} m) must lie on the flat bottom, \
+                 inside the fillet between bottom and wall (fillet_radius_m = {} m, bottom radius \
+                 {} m): give a smaller release_radius_m or fillet_radius_m",
+                p.release_radius_m, g.fillet_radius_m, g.rim_radius_m
+            )),
+            Err(BowlError::Scene(RollingError::InvalidK2)) => Some(format!(
+                "[particle] k2 = {} must be below 1 in the bowl model (a rolling sphere: 5/7 for \
+                 a solid one)",
+                p.k2
+            )),
+            Err(_) => Some(
+                "the [bowl] table and [particle] do not make a scene the bowl model accepts: \
+                 check them against docs/rigs/nominal.toml"
+                    .into(),
+            ),
+        };
+        if let Some(why) = why {
+            return Err(anyhow!("rig file {}, line {line}: {why}", self.file));
+        }
+        p.bowl = Some(truth);
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use crate::parse;
@@ -127,5 +235,57 @@ mod tests {
             err.contains("line 2") && err.contains("wall_hieght_m"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn a_granule_in_the_bowl_takes_the_bowls_rim_and_its_sliding_friction() {
+        let rigs = parse(
+            "[particle]\nmodel = \"bowl\"\nmu = 0.029\nrelease_radius_m = 0.0375\n\
+             sliding_mu = 0.35\nsliding_mu_spread = 0.02\n\
+             [bowl]\naxes_angle_deg = 60\nrim_radius_m = 0.075\nwall_angle_deg = 60\n\
+             wall_height_m = 0.01\nrestitution = 0\n",
+            "t.toml",
+            "t",
+        )
+        .unwrap();
+        let p = rigs[0].particle.unwrap();
+        let b = p.bowl.unwrap();
+        assert_eq!(p.rim_radius_m, 0.075);
+        assert_eq!((b.sliding_mu, b.sliding_mu_spread), (0.35, 0.02));
+        assert_eq!(b.shape.wall_height_m, 0.01);
+        assert!((b.axes_angle_rad - 60f64.to_radians()).abs() < 1e-15);
+        // Without model = "bowl" the granule follows the paper's equations.
+        let rigs = parse("[particle]\nmu = 0.03\n[bowl]\n", "t.toml", "t").unwrap();
+        assert_eq!(rigs[0].particle.unwrap().bowl, None);
+    }
+
+    #[test]
+    fn a_granule_in_the_bowl_is_refused_in_words() {
+        let err = |text: &str| parse(text, "t.toml", "t").unwrap_err().to_string();
+        let e = err("[particle]\nmodel = \"bowl\"\n");
+        assert!(
+            e.contains("line 2") && e.contains("needs a [bowl] table"),
+            "{e}"
+        );
+        let e = err("[particle]\nsliding_mu = 0.4\n");
+        assert!(
+            e.contains("line 2") && e.contains("model = \"bowl\""),
+            "{e}"
+        );
+        let e = err("[particle]\nmodel = \"bowl\"\nrim_radius_m = 0.15\n[bowl]\n");
+        assert!(
+            e.contains("line 3") && e.contains("differs from [bowl]"),
+            "{e}"
+        );
+        let e = err("[particle]\nmodel = \"bowl\"\nsliding_mu = 3\n[bowl]\n");
+        assert!(
+            e.contains("sliding_mu = 3 is outside its range 0 to 2"),
+            "{e}"
+        );
+        let e = err("[particle]\nmodel = \"bowl\"\nrelease_radius_m = 0.06\n\
+             [bowl]\nwall_height_m = 0.01\nfillet_radius_m = 0.02\n");
+        assert!(e.contains("line 2") && e.contains("flat bottom"), "{e}");
+        let e = err("[particle]\nmodel = \"bowl\"\nrelease_radius_m = 0.08\n[bowl]\n");
+        assert!(e.contains("must lie inside the rim"), "{e}");
     }
 }

@@ -76,6 +76,8 @@ struct ParticleToml {
     rim_radius_m: Num,
     release_spread_m: Num,
     gate_jitter_s: Num,
+    sliding_mu: Num,
+    sliding_mu_spread: Num,
 }
 
 #[derive(Deserialize, Default)]
@@ -152,7 +154,11 @@ pub fn parse(text: &str, file: &str, default_name: &str) -> Result<Vec<Rig>> {
         rigs.push(Rig {
             params: check.rig(t)?,
             seed: check.get(&t.seed, "seed", 0.0, u32::MAX as f64, 1.0)? as u32,
-            particle: t.particle.as_ref().map(|p| check.particle(p)).transpose()?,
+            particle: t
+                .particle
+                .as_ref()
+                .map(|p| check.particle(p, t.bowl.as_ref()))
+                .transpose()?,
             bowl: t.bowl.as_ref().map(|b| check.bowl(b)).transpose()?,
             name,
         });
@@ -288,19 +294,22 @@ impl Checker<'_> {
         Ok(())
     }
 
-    /// The `[particle]` table, each key checked against [`ParticleParams::ranges`].
-    fn particle(&self, t: &ParticleToml) -> Result<ParticleParams> {
+    /// The `[particle]` table, each key checked against [`ParticleParams::ranges`]; with
+    /// `model = "bowl"` the granule in the rig's `[bowl]` ([`Checker::granule_in_bowl`]).
+    fn particle(&self, t: &ParticleToml, bowl: Option<&bowl::BowlToml>) -> Result<ParticleParams> {
         let mut p = ParticleParams::default();
+        let mut in_bowl = None;
         if let Some(m) = &t.model {
-            p.model = match m.get_ref().as_str() {
-                "flat" => Model::Flat,
-                "coriolis" => Model::Coriolis,
+            let line = (self.at)(m.span().start);
+            match m.get_ref().as_str() {
+                "flat" => p.model = Model::Flat,
+                "coriolis" => p.model = Model::Coriolis,
+                "bowl" => in_bowl = Some(line),
                 other => {
                     return Err(anyhow!(
-                        "rig file {}, line {}: [particle] model = {other:?} must be \"flat\" or \
-                         \"coriolis\"",
+                        "rig file {}, line {line}: [particle] model = {other:?} must be \"flat\", \
+                         \"coriolis\" or \"bowl\"",
                         self.file,
-                        (self.at)(m.span().start)
                     ));
                 }
             };
@@ -333,6 +342,7 @@ impl Checker<'_> {
             p.release_spread_m,
             p.gate_jitter_s,
         ] = values;
+        self.granule_in_bowl(t, bowl, in_bowl, &mut p)?;
         if p.release_radius_m >= p.rim_radius_m {
             let line = t
                 .release_radius_m
@@ -474,7 +484,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("line 2") && e.contains("\"flat\" or \"coriolis\""),
+            e.contains("line 2") && e.contains("\"flat\", \"coriolis\" or \"bowl\""),
             "{e}"
         );
         let e = particle("[particle]\nmus = 1\n").unwrap_err().to_string();

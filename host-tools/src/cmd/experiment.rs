@@ -17,7 +17,8 @@ pub struct Args {
     /// The plan (TOML: settle_s, [[condition]] bowl_rad_s or precession_rad_s + spin_rad_s,
     /// repeats). Not needed with --suggest.
     pub plan: Option<PathBuf>,
-    /// Run on a simulated rig described by this rig file (its [particle] table is the truth).
+    /// Run on a simulated rig described by this rig file (its [particle] table is the truth;
+    /// with `model = "bowl"` the granules follow the bowl model in its [bowl] table).
     #[arg(long, required_unless_present = "port", conflicts_with = "port")]
     pub rig_file: Option<PathBuf>,
     /// Run on the rig on this serial port (or a `bowl serve --pty` pseudo-terminal): releases by

@@ -7,6 +7,9 @@
 //! equation of motion under the plant's true combined bowl speed (paper Eq. 2 from the two true
 //! shaft speeds) one control period at a time, and the exit gate fires when it reaches the rim,
 //! with the gate's timing error, to the microsecond, as the firmware's capture would report it.
+//! A granule in the bowl model (`[particle] model = "bowl"`) follows that model at the true
+//! shaft speeds of the period it drops in, from a random azimuth, and the exit gate fires when
+//! its centre passes the lip (`model_core::sim::bowl_granule`).
 
 use std::collections::VecDeque;
 
@@ -67,6 +70,11 @@ impl World {
         self.gates.particle()
     }
 
+    /// The last granule dropped in the bowl model, as drawn (azimuth, `mu_s`, start, exit).
+    pub fn last_bowl_release(&self) -> Option<model_core::sim::bowl_granule::BowlRelease> {
+        self.gates.last_bowl_release()
+    }
+
     /// The sensor of `axis` is lost (its edges do not reach the controller).
     pub fn sensor_lost(&self, axis: usize) -> bool {
         matches!(
@@ -106,7 +114,7 @@ impl World {
     pub fn step(&mut self, speeds_rad_s: [f64; 2], now_us: u32, dt_s: f64) {
         if self.release_asked {
             self.release_asked = false;
-            self.gates.drop_granule(now_us);
+            self.gates.drop_granule_at(now_us, speeds_rad_s);
             self.push(GateKind::Release, now_us);
         }
         if let Some(exit_us) = self.gates.step(speeds_rad_s, dt_s) {

@@ -2,16 +2,30 @@
 //! start radius, follows its equation of motion ([`super::granule`]) under the plant's true
 //! combined bowl speed (paper Eq. 2 from the two true shaft speeds) one step at a time, and the
 //! exit gate fires when it reaches the rim, with the gate's timing error, to the microsecond.
+//! A granule in the bowl model ([`super::bowl_granule`], `[particle] model = "bowl"`) is
+//! followed once, at the shaft speeds of the moment it drops ([`Gates::drop_granule_at`]), and
+//! its exit gate fires when that time has passed.
 //! Every simulated rig uses this one: the host's virtual rig, the QEMU board's plant task.
 
+use super::bowl_granule::BowlRelease;
 use super::granule::{Granule, ParticleParams};
 use super::prng::Prng;
 use crate::bowl::{MotorSpeeds, combined_speed_from_trig};
 
+/// How the granule in the bowl moves.
+#[derive(Debug, Clone, Copy)]
+enum Motion {
+    /// Stepped under the speed of each step (the paper's radial equations).
+    Stepped(Granule),
+    /// Its exit known at the release (the bowl model): seconds from the release to the exit
+    /// (`None`: never), and the time since the release.
+    Timed { exit_s: Option<f64>, elapsed_s: f64 },
+}
+
 /// The granule in the bowl and its release time on the capture clock, us.
 #[derive(Debug, Clone, Copy)]
 struct InFlight {
-    granule: Granule,
+    motion: Motion,
     released_us: u32,
 }
 
@@ -22,6 +36,7 @@ pub struct Gates {
     rng: Prng,
     cos_sin: (f64, f64),
     in_flight: Option<InFlight>,
+    last_bowl_release: Option<BowlRelease>,
 }
 
 impl Gates {
@@ -33,12 +48,19 @@ impl Gates {
             rng: Prng::new(seed ^ 0x6772_616e),
             cos_sin: (libm::cos(axes_rad), libm::sin(axes_rad)),
             in_flight: None,
+            last_bowl_release: None,
         }
     }
 
     /// The granules' truth.
     pub fn particle(&self) -> &ParticleParams {
         &self.particle
+    }
+
+    /// The last granule dropped in the bowl model: its azimuth, friction, start and exit (the
+    /// hidden truth a fit of the gate times should find; `None` before the first).
+    pub fn last_bowl_release(&self) -> Option<BowlRelease> {
+        self.last_bowl_release
     }
 
     /// A granule is in the bowl.
@@ -52,10 +74,31 @@ impl Gates {
     }
 
     /// Drops a granule at capture time `now_us` (the release gate's time); a granule already
-    /// in the bowl is replaced.
+    /// in the bowl is replaced. It follows the paper's radial equation (`particle.model`); a
+    /// rig whose granules follow the bowl model drops them with [`Gates::drop_granule_at`].
     pub fn drop_granule(&mut self, now_us: u32) {
         self.in_flight = Some(InFlight {
-            granule: self.particle.release(&mut self.rng),
+            motion: Motion::Stepped(self.particle.release(&mut self.rng)),
+            released_us: now_us,
+        });
+    }
+
+    /// As [`Gates::drop_granule`], the shafts turning at `speeds_rad_s` (true,
+    /// `[precession, spin]`): with a bowl truth (`particle.bowl`) the granule follows the bowl
+    /// model at these speeds from a random azimuth, its exit computed now (milliseconds of
+    /// CPU on a PC: the firmware's QEMU plant, whose granules follow the radial equations,
+    /// calls [`Gates::drop_granule`] and never links the bowl model).
+    pub fn drop_granule_at(&mut self, now_us: u32, speeds_rad_s: [f64; 2]) {
+        let Some(truth) = self.particle.bowl else {
+            return self.drop_granule(now_us);
+        };
+        let r = truth.release(&self.particle, &mut self.rng, speeds_rad_s);
+        self.last_bowl_release = Some(r);
+        self.in_flight = Some(InFlight {
+            motion: Motion::Timed {
+                exit_s: r.exit_s,
+                elapsed_s: 0.0,
+            },
             released_us: now_us,
         });
     }
@@ -65,16 +108,31 @@ impl Gates {
     /// rim.
     pub fn step(&mut self, speeds_rad_s: [f64; 2], dt_s: f64) -> Option<u32> {
         let f = self.in_flight.as_mut()?;
-        let bowl_rad_s = combined_speed_from_trig(
-            self.cos_sin.0,
-            self.cos_sin.1,
-            MotorSpeeds {
-                precession_rad_s: speeds_rad_s[0],
-                spin_rad_s: speeds_rad_s[1],
-            },
-        )
-        .unwrap_or(0.0);
-        let exit_s = f.granule.step(bowl_rad_s, dt_s)?;
+        let exit_s = match &mut f.motion {
+            Motion::Stepped(granule) => {
+                let bowl_rad_s = combined_speed_from_trig(
+                    self.cos_sin.0,
+                    self.cos_sin.1,
+                    MotorSpeeds {
+                        precession_rad_s: speeds_rad_s[0],
+                        spin_rad_s: speeds_rad_s[1],
+                    },
+                )
+                .unwrap_or(0.0);
+                granule.step(bowl_rad_s, dt_s)?
+            }
+            Motion::Timed { exit_s, elapsed_s } => {
+                if dt_s.is_finite() && dt_s > 0.0 {
+                    *elapsed_s += dt_s;
+                }
+                // The gate fires in the step within which the exit falls.
+                let exit = (*exit_s)?;
+                if *elapsed_s < exit {
+                    return None;
+                }
+                exit
+            }
+        };
         let released_us = f.released_us;
         self.in_flight = None;
         let error_s = self.particle.gate_error_s(&mut self.rng);
@@ -121,5 +179,62 @@ mod tests {
         // RK4 at 1 ms with the exit interpolated in the step, rounded to the microsecond.
         assert!((measured - want).abs() < 2e-6, "{measured} vs {want}");
         assert!(!gates.in_bowl());
+    }
+
+    /// A granule in the bowl model: the exit gate fires at the release plus the bowl model's
+    /// time for the drawn azimuth at the speeds of the drop (no jitter), to the microsecond;
+    /// one held by a vertical wall never fires.
+    #[test]
+    fn a_granule_in_the_bowl_leaves_when_the_bowl_model_says() {
+        use crate::particle::bowl::BowlShape;
+        use crate::sim::bowl_granule::BowlTruth;
+        let truth = BowlTruth {
+            shape: BowlShape {
+                wall_angle_rad: 60f64.to_radians(),
+                wall_height_m: 0.01,
+                fillet_radius_m: 0.0,
+                restitution: 0.0,
+            },
+            axes_angle_rad: 60f64.to_radians(),
+            particle_radius_m: 0.003,
+            sliding_mu: 0.4,
+            sliding_mu_spread: 0.0,
+        };
+        let particle = ParticleParams {
+            release_radius_m: 0.0375,
+            rim_radius_m: 0.075,
+            bowl: Some(truth),
+            ..ParticleParams::default()
+        };
+        let speeds = [1.3, 1.1];
+        let mut gates = Gates::new(particle, 9, 60f64.to_radians());
+        // The same draw, made again from the same generator state.
+        let mut rng = gates.rng;
+        let want = truth.release(&particle, &mut rng, speeds).exit_s.unwrap();
+        gates.drop_granule_at(1_000_000, speeds);
+        let mut exit = None;
+        for _ in 0..10_000 {
+            if let Some(at) = gates.step(speeds, 1e-3) {
+                exit = Some(at);
+                break;
+            }
+        }
+        let got = f64::from(exit.unwrap() - 1_000_000) * 1e-6;
+        assert!((got - want).abs() <= 0.5e-6, "{got} vs {want}");
+        let mut held = particle;
+        held.bowl = Some(BowlTruth {
+            shape: BowlShape {
+                wall_angle_rad: core::f64::consts::FRAC_PI_2,
+                wall_height_m: 0.02,
+                ..truth.shape
+            },
+            ..truth
+        });
+        let mut gates = Gates::new(held, 9, 60f64.to_radians());
+        gates.drop_granule_at(0, speeds);
+        for _ in 0..5_000 {
+            assert_eq!(gates.step(speeds, 1e-3), None);
+        }
+        assert!(gates.in_bowl(), "held by the wall: still in the bowl");
     }
 }

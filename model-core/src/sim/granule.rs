@@ -12,6 +12,7 @@
 //! equilibrium radius `a = mu g / omega^2`); a moving granule that the resistance brings to a
 //! stop stops there (the equation would drag it inward, which is unphysical).
 
+use super::bowl_granule::BowlTruth;
 use crate::particle::Model;
 use crate::sim::prng::Prng;
 use crate::wire::{ParamId, ParamValues};
@@ -38,6 +39,10 @@ pub struct ParticleParams {
     pub release_spread_m: f64,
     /// Standard deviation of the exit gate's timing error, s.
     pub gate_jitter_s: f64,
+    /// `Some`: the granule follows the bowl model in this bowl instead of `model`
+    /// (`[particle] model = "bowl"`, [`super::bowl_granule`]); `mu` is then its rolling
+    /// resistance and `rim_radius_m` the bowl's bottom radius.
+    pub bowl: Option<BowlTruth>,
 }
 
 /// A `[particle]` value outside its range: which key, and the range.
@@ -64,6 +69,7 @@ impl Default for ParticleParams {
             rim_radius_m: 0.15,
             release_spread_m: 0.0,
             gate_jitter_s: 0.0,
+            bowl: None,
         }
     }
 }
@@ -118,7 +124,8 @@ impl ParticleParams {
     }
 
     /// One granule drawn from the spreads: `mu` and the start radius Gaussian, clamped to be
-    /// non-negative and inside the rim.
+    /// non-negative and inside the rim. It follows `model` (a granule in the bowl model is
+    /// drawn by [`BowlTruth::release`]).
     pub fn release(&self, rng: &mut Prng) -> Granule {
         let mu = (self.mu + self.mu_spread * gaussian(rng)).max(0.0);
         let r0 = (self.release_radius_m + self.release_spread_m * gaussian(rng))

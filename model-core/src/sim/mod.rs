@@ -9,6 +9,7 @@
 //! (second order at these speeds), gearbox backlash.
 
 pub mod assembly;
+pub mod bowl_granule;
 pub mod experiments;
 pub mod gates;
 pub mod granule;

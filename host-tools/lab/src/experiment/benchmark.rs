@@ -31,6 +31,13 @@ pub fn run(
     seeds: u32,
     out: &Path,
 ) -> Result<()> {
+    if particle.bowl.is_some() {
+        anyhow::bail!(
+            "--benchmark-seeds scores the paper's models against the rig file's [particle] truth; \
+             this rig's granules follow the bowl model ([particle] model = \"bowl\"): run the \
+             plan once and fit it with `bowl fit RESULTS --bowl-walls` (docs/experiment.md)"
+        );
+    }
     let truth = match particle.model {
         Model::Flat => "flat",
         Model::Coriolis => "coriolis",

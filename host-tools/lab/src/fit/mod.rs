@@ -170,9 +170,15 @@ fn words(status: &str) -> &str {
 
 /// Sum of squared errors of `runs` under `equation` at `mu`, s^2.
 pub fn sse(runs: &[Run], equation: Equation, mu: f64) -> f64 {
-    runs.iter()
-        .map(|r| (predict(r, equation, mu) - r.residence_s).powi(2))
-        .sum()
+    let squared = |r: &Run| (predict(r, equation, mu) - r.residence_s).powi(2);
+    match equation {
+        Equation::Paper(_) => runs.iter().map(squared).sum(),
+        // The rolling and bowl models integrate twelve releases per run (milliseconds each):
+        // spread the runs over the cores; summed in order, so the same sum as one core's.
+        Equation::Rolling | Equation::Bowl(_) => {
+            crate::parallel::parallel(runs, squared).iter().sum()
+        }
+    }
 }
 
 /// Fits one model (needs at least 3 runs); with `fit_k2`, `k2` as well (at least 4).
@@ -257,7 +263,10 @@ fn fit_mu(runs: &[Run], candidate: Candidate) -> ModelFit {
         aic: aic(s_min, n, 2),
         errors_pct,
         k2: K2::Given,
-        at_limit: at_limit(mu, ceiling),
+        // The bowl model's T stops depending on mu_s once every release rolls throughout (a
+        // plateau up to the search limit): a best mu_s there says "at least the interval's
+        // lower end", not that the model fails.
+        at_limit: at_limit(mu, ceiling) && !matches!(model, Equation::Bowl(_)),
         cannot_reproduce: None,
     }
 }

@@ -246,7 +246,7 @@ fn bowl_mean(run: &Run, wall: Wall, mu_s: f64, k2: f64) -> f64 {
     };
     let mut sum = 0.0;
     for deg in rolling::AZIMUTHS_DEG {
-        match bowl::residence(&scene, &shape, deg.to_radians(), BOWL_METHOD, limits) {
+        match bowl::residence_f64(&scene, &shape, deg.to_radians(), BOWL_METHOD, limits) {
             Ok(r) => match r.outcome {
                 BowlOutcome::Leaves {
                     residence_time_s, ..

@@ -413,6 +413,21 @@ pub fn residence<T: Real>(
     }
 }
 
+/// [`residence`] in `f64`, compiled here: a generic function is compiled (monomorphised) in the
+/// crate that calls it, so a host crate built without optimisation (`cargo test`) would run its
+/// own unoptimised copy; this one is built with model-core's optimisation (the workspace's
+/// `profile.dev.package.model-core`), several times faster in test builds. The PC's callers
+/// that run many releases (the fit, the simulated rig) use it.
+pub fn residence_f64(
+    sc: &RollingScene<f64>,
+    shape: &BowlShape<f64>,
+    beta_rad: f64,
+    method: RollingMethod<f64>,
+    limits: SystemLimits<f64>,
+) -> Result<BowlReport<f64>, BowlError> {
+    residence(sc, shape, beta_rad, method, limits)
+}
+
 /// Where a release is between its stays.
 enum Phase<T> {
     /// On the bottom from this time and state (`None`: the release itself).

@@ -239,7 +239,9 @@ pub unsafe extern "C" fn plant_release(plant: *mut SimRig, time_ticks: u32) -> i
     let Some(p) = (unsafe { plant.as_mut() }) else {
         return -1;
     };
-    p.gates.drop_granule(time_ticks);
+    // A rig file's granules in the bowl model start from the shafts' true speeds now.
+    let speeds = [0, 1].map(|axis| f64::from(p.plant.speed_rad_s(axis)));
+    p.gates.drop_granule_at(time_ticks, speeds);
     0
 }
 
