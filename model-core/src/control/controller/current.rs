@@ -34,7 +34,10 @@ impl Controller {
             reading_a,
             applied,
             a.direction,
-            a.est.at_rest(),
+            // At rest for the current per duty: no edge since it stopped, or none for so long
+            // that the estimate is zero (the precession turned by the spin's reaction keeps its
+            // last edge for seconds: its own start then taught nothing, seed 4 p10).
+            a.est.at_rest() || a.est.is_stopped(),
             speed_lo_rad_s,
             a.k.duty_per_rad_s(),
             a.k.duty_limit(),
