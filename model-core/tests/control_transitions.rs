@@ -102,3 +102,75 @@ fn slowing_to_low_speed_does_not_undershoot_far() {
         100.0 * worst
     );
 }
+
+/// family-60's plant p25 (tests/rigs/family-60.toml): heavy friction on its precession axis
+/// (Coulomb 0.0995 N m, stiction 0.1326 N m on 0.105 kg m^2) and 0.0434 N m of material its
+/// model does not know, so the duty that holds it at 0.2 rad/s is mostly load. Slowing from 4
+/// to 0.2 rad/s, the loop's gain schedule lowered the gain with the reference all the way down
+/// and the bumpless transfer moved the deceleration's "too fast" error into the integral: the
+/// load it had learned at 4 rad/s was gone, the duty fell below what holds the shaft, the shaft
+/// crawled to a stop and the expected-edge watch faulted it 7.5 s after the command. With the
+/// integral kept, the shaft still slowed to 0.11 rad/s under its load, and the observer, which
+/// had learned the deceleration as less load, expected it at 0.37 rad/s: the watch faulted the
+/// turning shaft 8 s after the command.
+#[test]
+fn a_loaded_heavy_shaft_slows_to_the_lowest_speed_without_fault() {
+    use model_core::control::{Controller, State};
+    use model_core::sim::harness::ClosedLoop;
+    use model_core::sim::plant::{Plant, PlantParams};
+
+    let mut rig = PlantParams::nominal();
+    rig.supply_v = 12.895;
+    rig.coupling = 0.591;
+    // [torque constant, inertia, viscous, Coulomb, stiction, tooth error, jitter, ripple, load]
+    let axes = [
+        [
+            1.2279, 0.10536, 0.00995, 0.0995, 0.1326, 0.0368, 0.000321, 0.002, 0.0434,
+        ],
+        [
+            1.9083, 0.03205, 0.03363, 0.3363, 0.4708, 0.0452, 0.000632, 0.0075, 0.0584,
+        ],
+    ];
+    for (a, v) in rig.axes.iter_mut().zip(axes) {
+        a.motor.torque_constant = v[0];
+        a.motor.inertia_kg_m2 = v[1];
+        a.motor.viscous_nm_s = v[2];
+        a.motor.coulomb_nm = v[3];
+        a.motor.stiction_nm = v[4];
+        a.sensor.tooth_error = v[5];
+        a.sensor.jitter_s = v[6];
+        a.ripple_nm = v[7];
+        a.load_step_nm = v[8];
+    }
+    // Held at 4 rad/s about as long as the family report's settling takes (4.83 s for this plant) and long.
+    for hold_s in [4.83f32, 12.0] {
+        let ctrl = Controller::new(ControllerConfig::nominal()).expect("nominal configuration");
+        let mut cl = ClosedLoop::new(Plant::new(rig, 1025), ctrl);
+        assert_eq!(cl.commission(300.0), State::Idle);
+        let now = cl.rig.time_s() as f32;
+        for a in cl.rig.params_mut().axes.iter_mut() {
+            a.faults.load_step_from_s = now;
+            a.faults.load_step_nm = a.load_step_nm;
+        }
+        assert!(cl.ctrl.set_motor_speeds(4.0, 4.0).is_ok() && cl.ctrl.start().is_ok());
+        cl.run(hold_s, |_| {});
+        assert_eq!(cl.ctrl.fault(), None, "while running at 4 rad/s");
+        assert!(cl.ctrl.set_motor_speeds(0.2, 0.2).is_ok());
+        let mut fault = None;
+        let mut t = 0.0f32;
+        let dt = cl.dt_s();
+        cl.run(20.0, |c| {
+            t += dt;
+            if fault.is_none() {
+                fault = c.ctrl.fault().map(|f| (f, t));
+            }
+        });
+        assert_eq!(fault, None, "held {hold_s} s: (fault, s after the command)");
+        // Not only unfaulted: the shaft turns again, recovering towards its reference.
+        let w = cl.rig.speed_rad_s(0);
+        assert!(
+            w > 0.05,
+            "held {hold_s} s: precession at {w} rad/s 20 s later"
+        );
+    }
+}

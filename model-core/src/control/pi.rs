@@ -476,25 +476,29 @@ impl SpeedLoop {
         let wc = k.scheduled_bandwidth(r_abs);
         let ki_dt = wc * k.ki_dt_per_wc;
         let kp = wc * k.kp_per_wc;
-        // Bumpless gain change: the proportional jump is absorbed by the integral.
-        self.integral += (self.kp_prev - kp) * e;
-        self.kp_prev = kp;
-
-        // r != 0 here, so its sign is the commanded direction.
-        let ff = (k.friction_duty + self.push + kick) * input.direction
-            + r * k.duty_per_rad_s
-            + input.extra_duty;
         // A "too fast" error is not integrated while the shaft slows down to a lower reference
         // (see `slowing`) nor while the stall bound is active (the shaft is slowing between
         // edges and nothing says it is still faster than the model: the error held from the
         // last window is stale). Integrated for the seconds a window lasts at low speed, the
         // deceleration's error wound the duty below friction and the shaft stalled (4 -> 0.2
         // rad/s: 2 of 60 healthy plants faulted). It still acts proportionally.
-        let e_int = if (ev.bound_active || self.slowing) && e * input.direction < 0.0 {
-            0.0
-        } else {
-            e
-        };
+        let stale_too_fast = (ev.bound_active || self.slowing) && e * input.direction < 0.0;
+        // Bumpless gain change: the proportional jump is absorbed by the integral, except that
+        // of a stale "too fast" error (above): the schedule lowers the gain with the reference
+        // all the way down a step-down, and absorbing the deceleration's error moved it into
+        // the integral for good, as integrating it would (4 -> 0.2 rad/s, family-60 p25: the
+        // integral fell from 0.013 to 0.005 duty, below the material the shaft carried, and
+        // the shaft crawled to a stop). The duty rises by the part not absorbed instead.
+        if !stale_too_fast {
+            self.integral += (self.kp_prev - kp) * e;
+        }
+        self.kp_prev = kp;
+
+        // r != 0 here, so its sign is the commanded direction.
+        let ff = (k.friction_duty + self.push + kick) * input.direction
+            + r * k.duty_per_rad_s
+            + input.extra_duty;
+        let e_int = if stale_too_fast { 0.0 } else { e };
         let candidate_i = self.integral + ki_dt * e_int;
         let unlimited = ff + kp * e + candidate_i;
         let lim = k.duty_limit;
@@ -584,6 +588,13 @@ impl SpeedLoop {
     /// current sense).
     pub fn back_emf_rad_s(&self) -> f32 {
         self.breakaway.speed_rad_s()
+    }
+
+    /// The reference came down and the loop still compares windows that began before the
+    /// model reached it (see the field of the same name): what the shaft does then is its
+    /// deceleration, not a load.
+    pub fn slowing(&self) -> bool {
+        self.slowing
     }
 
     /// The plant model's speed (the reference through the identified lag), rad/s.
