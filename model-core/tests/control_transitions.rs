@@ -102,3 +102,116 @@ fn slowing_to_low_speed_does_not_undershoot_far() {
         100.0 * worst
     );
 }
+
+/// A rig with the given supply, coupling and per-axis `[torque constant, inertia, viscous,
+/// Coulomb, stiction, tooth error, jitter, ripple, material]` (a family file's plant table).
+fn rig_from_table(
+    supply_v: f32,
+    coupling: f32,
+    axes: [[f32; 9]; 2],
+) -> model_core::sim::plant::PlantParams {
+    let mut rig = model_core::sim::plant::PlantParams::nominal();
+    rig.supply_v = supply_v;
+    rig.coupling = coupling;
+    for (a, v) in rig.axes.iter_mut().zip(axes) {
+        a.motor.torque_constant = v[0];
+        a.motor.inertia_kg_m2 = v[1];
+        a.motor.viscous_nm_s = v[2];
+        a.motor.coulomb_nm = v[3];
+        a.motor.stiction_nm = v[4];
+        a.sensor.tooth_error = v[5];
+        a.sensor.jitter_s = v[6];
+        a.ripple_nm = v[7];
+        a.load_step_nm = v[8];
+    }
+    rig
+}
+
+/// Commissions `rig`, pours its material in, runs both axes at 4 rad/s for `hold_s`, then
+/// commands 0.2 rad/s and runs 20 s: no fault, and the precession shaft turning at the end.
+fn four_to_lowest_without_fault(rig: model_core::sim::plant::PlantParams, seed: u32, hold_s: f32) {
+    use model_core::control::{Controller, State};
+    use model_core::sim::harness::ClosedLoop;
+    use model_core::sim::plant::Plant;
+
+    let ctrl = Controller::new(ControllerConfig::nominal()).expect("nominal configuration");
+    let mut cl = ClosedLoop::new(Plant::new(rig, seed), ctrl);
+    assert_eq!(cl.commission(300.0), State::Idle);
+    let now = cl.rig.time_s() as f32;
+    for a in cl.rig.params_mut().axes.iter_mut() {
+        a.faults.load_step_from_s = now;
+        a.faults.load_step_nm = a.load_step_nm;
+    }
+    assert!(cl.ctrl.set_motor_speeds(4.0, 4.0).is_ok() && cl.ctrl.start().is_ok());
+    cl.run(hold_s, |_| {});
+    assert_eq!(cl.ctrl.fault(), None, "while running at 4 rad/s");
+    assert!(cl.ctrl.set_motor_speeds(0.2, 0.2).is_ok());
+    let mut fault = None;
+    let mut t = 0.0f32;
+    let dt = cl.dt_s();
+    cl.run(20.0, |c| {
+        t += dt;
+        if fault.is_none() {
+            fault = c.ctrl.fault().map(|f| (f, t));
+        }
+    });
+    assert_eq!(fault, None, "held {hold_s} s: (fault, s after the command)");
+    // Not only unfaulted: the shaft turns again, recovering towards its reference.
+    let w = cl.rig.speed_rad_s(0);
+    assert!(
+        w > 0.05,
+        "held {hold_s} s: precession at {w} rad/s 20 s later"
+    );
+}
+
+/// family-60's plant p25 (tests/rigs/family-60.toml): heavy friction on its precession axis
+/// (Coulomb 0.0995 N m, stiction 0.1326 N m on 0.105 kg m^2) and 0.0434 N m of material its
+/// model does not know, so the duty that holds it at 0.2 rad/s is mostly load. Slowing from 4
+/// to 0.2 rad/s, the loop's gain schedule lowered the gain with the reference all the way down
+/// and the bumpless transfer moved the deceleration's "too fast" error into the integral: the
+/// load it had learned at 4 rad/s was gone, the duty fell below what holds the shaft, the shaft
+/// crawled to a stop and the expected-edge watch faulted it 7.5 s after the command. With the
+/// integral kept, the shaft still slowed to 0.11 rad/s under its load, and the observer, which
+/// had learned the deceleration as less load, expected it at 0.37 rad/s: the watch faulted the
+/// turning shaft 8 s after the command. Held at 4 rad/s as long as the family report's settling
+/// takes for this plant (4.83 s), and long.
+#[test]
+fn a_loaded_heavy_shaft_slows_to_the_lowest_speed_without_fault() {
+    let rig = rig_from_table(
+        12.895,
+        0.591,
+        [
+            [
+                1.2279, 0.10536, 0.00995, 0.0995, 0.1326, 0.0368, 0.000321, 0.002, 0.0434,
+            ],
+            [
+                1.9083, 0.03205, 0.03363, 0.3363, 0.4708, 0.0452, 0.000632, 0.0075, 0.0584,
+            ],
+        ],
+    );
+    for hold_s in [4.83f32, 12.0] {
+        four_to_lowest_without_fault(rig, 1025, hold_s);
+    }
+}
+
+/// Plant p00 of `bowl sim make-family --seed 8 --plants 60`: light friction on a heavy
+/// precession axis (Coulomb 0.03 N m, 0.119 kg m^2) whose identified slope is 5 % steep, so at
+/// 4 rad/s the integral holds -0.014 duty although the shaft carries material: carried whole
+/// down to 0.2 rad/s, the duty stayed 0.017 below what holds the shaft, it crawled, and the
+/// watch faulted it 5.6 s after the command.
+#[test]
+fn a_model_too_steep_at_the_top_does_not_starve_the_lowest_speed() {
+    let rig = rig_from_table(
+        12.086,
+        0.6,
+        [
+            [
+                1.1512, 0.11911, 0.003, 0.03, 0.04, 0.0277, 0.000118, 0.002, 0.0131,
+            ],
+            [
+                1.747, 0.01086, 0.01521, 0.1521, 0.213, 0.0322, 0.000767, 0.0065, 0.0316,
+            ],
+        ],
+    );
+    four_to_lowest_without_fault(rig, 8000, 5.91);
+}

@@ -277,6 +277,8 @@ impl Controller {
             // The observer (observer.rs) judges missing pulses by its expected angle, and is
             // driven by last tick's duty less what that held beyond the model.
             let duty = (a.duty - a.extra_duty) * a.direction;
+            // A deceleration is no load, for the observer as for the loop (observer.rs).
+            a.obs.hold_load(a.speed_loop.slowing());
             let speed = a
                 .obs
                 .track(&a.ok, &mut a.est, now_ticks, edges[i], steady_i, duty);

@@ -114,6 +114,8 @@ pub struct SpeedLoop {
     slowing: bool,
     /// Seconds since the model was last more than 2 % above the reference's magnitude.
     model_down_quiet_s: f32,
+    /// The reference's magnitude last tick, rad/s.
+    reference_abs_rad_s: f32,
     /// What the current says of this start (axes with current sense only).
     breakaway: Breakaway,
     /// The current showed the breakaway in this step (see [`SpeedLoop::take_breakaway`]).
@@ -313,6 +315,7 @@ impl SpeedLoop {
         push_sum: 0.0,
         slowing: false,
         model_down_quiet_s: 0.0,
+        reference_abs_rad_s: 0.0,
         breakaway: Breakaway::NONE,
         breakaway_news: false,
     };
@@ -346,6 +349,19 @@ impl SpeedLoop {
         {
             self.slowing = false;
         }
+        // An integral below zero says the model asks more than the shaft needs at that speed.
+        // Material only drags, so (with the identified friction duty not above the true one)
+        // that is the model's slope, `volts_per_rad_s`, too steep: an error in proportion to
+        // the speed, so on the way down it shrinks with the reference. Carried whole to the
+        // lowest speed it starved the shaft (seed 8 p00, slope 5 % steep: -0.014 duty learned
+        // at 4 rad/s, 0.017 short at 0.2 rad/s, a crawl and a false fault). Scaled, it stays a
+        // lower bound of the truth (load + slope error x speed), so it never drives harder
+        // than the shaft needs.
+        if self.slowing && self.integral * input.direction < 0.0 && r_abs < self.reference_abs_rad_s
+        {
+            self.integral *= r_abs / self.reference_abs_rad_s;
+        }
+        self.reference_abs_rad_s = r_abs;
         if let Some(ago) = ev.restarted_s_ago {
             self.model_angle_rad = rp * ago;
             self.window_open = true;
@@ -476,25 +492,29 @@ impl SpeedLoop {
         let wc = k.scheduled_bandwidth(r_abs);
         let ki_dt = wc * k.ki_dt_per_wc;
         let kp = wc * k.kp_per_wc;
-        // Bumpless gain change: the proportional jump is absorbed by the integral.
-        self.integral += (self.kp_prev - kp) * e;
-        self.kp_prev = kp;
-
-        // r != 0 here, so its sign is the commanded direction.
-        let ff = (k.friction_duty + self.push + kick) * input.direction
-            + r * k.duty_per_rad_s
-            + input.extra_duty;
         // A "too fast" error is not integrated while the shaft slows down to a lower reference
         // (see `slowing`) nor while the stall bound is active (the shaft is slowing between
         // edges and nothing says it is still faster than the model: the error held from the
         // last window is stale). Integrated for the seconds a window lasts at low speed, the
         // deceleration's error wound the duty below friction and the shaft stalled (4 -> 0.2
         // rad/s: 2 of 60 healthy plants faulted). It still acts proportionally.
-        let e_int = if (ev.bound_active || self.slowing) && e * input.direction < 0.0 {
-            0.0
-        } else {
-            e
-        };
+        let stale_too_fast = (ev.bound_active || self.slowing) && e * input.direction < 0.0;
+        // Bumpless gain change: the proportional jump is absorbed by the integral, except that
+        // of a stale "too fast" error (above): the schedule lowers the gain with the reference
+        // all the way down a step-down, and absorbing the deceleration's error moved it into
+        // the integral for good, as integrating it would (4 -> 0.2 rad/s, family-60 p25: the
+        // integral fell from 0.013 to 0.005 duty, below the material the shaft carried, and
+        // the shaft crawled to a stop). The duty rises by the part not absorbed instead.
+        if !stale_too_fast {
+            self.integral += (self.kp_prev - kp) * e;
+        }
+        self.kp_prev = kp;
+
+        // r != 0 here, so its sign is the commanded direction.
+        let ff = (k.friction_duty + self.push + kick) * input.direction
+            + r * k.duty_per_rad_s
+            + input.extra_duty;
+        let e_int = if stale_too_fast { 0.0 } else { e };
         let candidate_i = self.integral + ki_dt * e_int;
         let unlimited = ff + kp * e + candidate_i;
         let lim = k.duty_limit;
@@ -584,6 +604,13 @@ impl SpeedLoop {
     /// current sense).
     pub fn back_emf_rad_s(&self) -> f32 {
         self.breakaway.speed_rad_s()
+    }
+
+    /// The reference came down and the loop still compares windows that began before the
+    /// model reached it (see the field of the same name): what the shaft does then is its
+    /// deceleration, not a load.
+    pub fn slowing(&self) -> bool {
+        self.slowing
     }
 
     /// The plant model's speed (the reference through the identified lag), rad/s.
