@@ -142,33 +142,35 @@ impl BowlTruth {
     }
 }
 
+/// The rig's bowl for tests: 60 deg tilt, 75 mm bottom, a 60 deg wall 10 mm high, sharp
+/// corner; the granule's truth in it.
+#[cfg(test)]
+pub(crate) fn rig() -> (BowlTruth, ParticleParams) {
+    let truth = BowlTruth {
+        shape: BowlShape {
+            wall_angle_rad: 60f64.to_radians(),
+            wall_height_m: 0.01,
+            fillet_radius_m: 0.0,
+            restitution: 0.0,
+        },
+        axes_angle_rad: 60f64.to_radians(),
+        particle_radius_m: 0.003,
+        sliding_mu: 0.4,
+        sliding_mu_spread: 0.0,
+    };
+    let particle = ParticleParams {
+        mu: 0.029,
+        release_radius_m: 0.0375,
+        rim_radius_m: 0.075,
+        bowl: Some(truth),
+        ..ParticleParams::default()
+    };
+    (truth, particle)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The rig's bowl: 60 deg tilt, 75 mm bottom, a 60 deg wall 10 mm high, sharp corner.
-    fn rig() -> (BowlTruth, ParticleParams) {
-        let truth = BowlTruth {
-            shape: BowlShape {
-                wall_angle_rad: 60f64.to_radians(),
-                wall_height_m: 0.01,
-                fillet_radius_m: 0.0,
-                restitution: 0.0,
-            },
-            axes_angle_rad: 60f64.to_radians(),
-            particle_radius_m: 0.003,
-            sliding_mu: 0.4,
-            sliding_mu_spread: 0.0,
-        };
-        let particle = ParticleParams {
-            mu: 0.029,
-            release_radius_m: 0.0375,
-            rim_radius_m: 0.075,
-            bowl: Some(truth),
-            ..ParticleParams::default()
-        };
-        (truth, particle)
-    }
 
     /// A release's exit is the bowl model's own answer for the same scene and azimuth, and the
     /// drawn azimuths cover the circle.

@@ -187,25 +187,8 @@ mod tests {
     #[test]
     fn a_granule_in_the_bowl_leaves_when_the_bowl_model_says() {
         use crate::particle::bowl::BowlShape;
-        use crate::sim::bowl_granule::BowlTruth;
-        let truth = BowlTruth {
-            shape: BowlShape {
-                wall_angle_rad: 60f64.to_radians(),
-                wall_height_m: 0.01,
-                fillet_radius_m: 0.0,
-                restitution: 0.0,
-            },
-            axes_angle_rad: 60f64.to_radians(),
-            particle_radius_m: 0.003,
-            sliding_mu: 0.4,
-            sliding_mu_spread: 0.0,
-        };
-        let particle = ParticleParams {
-            release_radius_m: 0.0375,
-            rim_radius_m: 0.075,
-            bowl: Some(truth),
-            ..ParticleParams::default()
-        };
+        use crate::sim::bowl_granule::{BowlTruth, rig};
+        let (truth, particle) = rig();
         let speeds = [1.3, 1.1];
         let mut gates = Gates::new(particle, 9, 60f64.to_radians());
         // The same draw, made again from the same generator state.
