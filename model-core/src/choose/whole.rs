@@ -13,7 +13,7 @@
 //!
 //! (The paper's 1-D forms are not members here: on a tilted bowl they leave out the tilt's
 //! gravity, which is what moves the granule at the rig's tilts; `Model::Flat`/`Coriolis` stay
-//! the chooser's answer for the level bowl of the paper, [`super::choose`].)
+//! the chooser's answer for the level bowl of the paper, [`super::choose_constant`].)
 //!
 //! Every check is made before anything is integrated, at closed-form cost, so a choice never
 //! costs much more than the model it picks:
