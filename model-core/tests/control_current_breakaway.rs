@@ -3,6 +3,8 @@
 //! leaps past a low setpoint once it breaks away. Measured on the simulator's true speed, against
 //! the same plants without current sense (the pulses-only loop, unchanged).
 
+mod plant_rows;
+
 use model_core::control::breakaway::Breakaway;
 use model_core::control::{Controller, ControllerConfig, State};
 use model_core::sim::experiments::{commissioned_step, family_plant};
@@ -104,28 +106,20 @@ fn a_held_shaft_is_not_read_as_turning_and_a_turning_one_is_seen() {
 /// a heavy rod with little friction (it breaks away below the commissioning's first duty) and
 /// a stiff spin.
 fn seed4_p10() -> (PlantParams, [f32; 2]) {
-    let mut rig = PlantParams::nominal();
-    rig.supply_v = 10.841;
-    rig.coupling = 0.566;
-    // torque constant, inertia, viscous, Coulomb, stiction, tooth error, jitter, ripple
-    let axes = [
+    // torque constant, inertia, viscous, Coulomb, stiction, tooth error, jitter, ripple;
+    // the material is poured in by the caller (returned beside the plant)
+    let rig = plant_rows::rig_from_table(
+        10.841,
+        0.566,
         [
-            1.4586, 0.05005, 0.00513, 0.0513, 0.0684, 0.0193, 0.000290, 0.0020,
+            [
+                1.4586, 0.05005, 0.00513, 0.0513, 0.0684, 0.0193, 0.000290, 0.0020, 0.0,
+            ],
+            [
+                1.7605, 0.04249, 0.04873, 0.4873, 0.6822, 0.0422, 0.000367, 0.0063, 0.0,
+            ],
         ],
-        [
-            1.7605, 0.04249, 0.04873, 0.4873, 0.6822, 0.0422, 0.000367, 0.0063,
-        ],
-    ];
-    for (a, v) in rig.axes.iter_mut().zip(axes) {
-        a.motor.torque_constant = v[0];
-        a.motor.inertia_kg_m2 = v[1];
-        a.motor.viscous_nm_s = v[2];
-        a.motor.coulomb_nm = v[3];
-        a.motor.stiction_nm = v[4];
-        a.sensor.tooth_error = v[5];
-        a.sensor.jitter_s = v[6];
-        a.ripple_nm = v[7];
-    }
+    );
     (sensed(rig), [0.0173, 0.0954])
 }
 

@@ -4,6 +4,8 @@
 //! fault healthy plants: a shaft slowing towards its new reference gives intervals of two or three
 //! of its last measured periods, which were read as missing pulses.
 
+mod plant_rows;
+
 use model_core::control::ControllerConfig;
 use model_core::sim::experiments::{commissioned_transition, family_plant, rig_with_pulses};
 
@@ -103,30 +105,6 @@ fn slowing_to_low_speed_does_not_undershoot_far() {
     );
 }
 
-/// A rig with the given supply, coupling and per-axis `[torque constant, inertia, viscous,
-/// Coulomb, stiction, tooth error, jitter, ripple, material]` (a family file's plant table).
-fn rig_from_table(
-    supply_v: f32,
-    coupling: f32,
-    axes: [[f32; 9]; 2],
-) -> model_core::sim::plant::PlantParams {
-    let mut rig = model_core::sim::plant::PlantParams::nominal();
-    rig.supply_v = supply_v;
-    rig.coupling = coupling;
-    for (a, v) in rig.axes.iter_mut().zip(axes) {
-        a.motor.torque_constant = v[0];
-        a.motor.inertia_kg_m2 = v[1];
-        a.motor.viscous_nm_s = v[2];
-        a.motor.coulomb_nm = v[3];
-        a.motor.stiction_nm = v[4];
-        a.sensor.tooth_error = v[5];
-        a.sensor.jitter_s = v[6];
-        a.ripple_nm = v[7];
-        a.load_step_nm = v[8];
-    }
-    rig
-}
-
 /// Commissions `rig`, pours its material in, runs both axes at 4 rad/s for `hold_s`, then
 /// commands 0.2 rad/s and runs 20 s: no fault, and the precession shaft turning at the end.
 fn four_to_lowest_without_fault(rig: model_core::sim::plant::PlantParams, seed: u32, hold_s: f32) {
@@ -177,7 +155,7 @@ fn four_to_lowest_without_fault(rig: model_core::sim::plant::PlantParams, seed: 
 /// takes for this plant (4.83 s), and long.
 #[test]
 fn a_loaded_heavy_shaft_slows_to_the_lowest_speed_without_fault() {
-    let rig = rig_from_table(
+    let rig = plant_rows::rig_from_table(
         12.895,
         0.591,
         [
@@ -201,7 +179,7 @@ fn a_loaded_heavy_shaft_slows_to_the_lowest_speed_without_fault() {
 /// watch faulted it 5.6 s after the command.
 #[test]
 fn a_model_too_steep_at_the_top_does_not_starve_the_lowest_speed() {
-    let rig = rig_from_table(
+    let rig = plant_rows::rig_from_table(
         12.086,
         0.6,
         [
