@@ -182,7 +182,12 @@ fn bad_bowl_input_is_said_in_words() {
         (
             ["60", "0.02", "0.07"],
             vec![],
-            "the fillet between bottom and wall reaches in",
+            "already touches the corner between bottom and wall",
+        ),
+        (
+            ["60", "0.02", "0"],
+            vec!["--particle-radius-m", "0.1"],
+            "give a smaller --ri-m, --fillet-radius-m or --particle-radius-m",
         ),
         (
             ["60", "0.02", "0"],

@@ -166,9 +166,10 @@ impl Checker<'_> {
             Ok(()) => None,
             Err(BowlError::FilletReachesRelease) => Some(format!(
                 "the granule's start (release_radius_m = {} m) must lie on the flat bottom, \
-                 inside the fillet between bottom and wall (fillet_radius_m = {} m, bottom radius \
-                 {} m): give a smaller release_radius_m or fillet_radius_m",
-                p.release_radius_m, g.fillet_radius_m, g.rim_radius_m
+                 clear of the fillet between bottom and wall (fillet_radius_m = {} m, bottom \
+                 radius {} m) with the granule's radius (particle_radius_m = {} m): give a smaller \
+                 release_radius_m, fillet_radius_m or particle_radius_m",
+                p.release_radius_m, g.fillet_radius_m, g.rim_radius_m, g.particle_radius_m
             )),
             Err(BowlError::Scene(RollingError::InvalidK2)) => Some(format!(
                 "[particle] k2 = {} must be below 1 in the bowl model (a rolling sphere: 5/7 for \

@@ -179,3 +179,24 @@ fn a_family_needs_names() {
     assert_eq!(r[1].name, "b");
     assert_eq!(r[1].params.supply_v, 11.0);
 }
+
+/// A granule that starts touching the corner is refused in the rig file's own keys, the
+/// granule's radius among them (it widens the fillet the centre cannot enter).
+#[test]
+fn a_start_in_the_corner_names_every_key_that_moves_it() {
+    let e = parse(
+        "[particle]\nmodel = \"bowl\"\nrelease_radius_m = 0.07\n\
+         [bowl]\nrim_radius_m = 0.075\nwall_height_m = 0.01\nfillet_radius_m = 0.0\n\
+         particle_radius_m = 0.01\n",
+        "x.toml",
+        "x",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("release_radius_m = 0.07")
+            && e.contains("particle_radius_m = 0.01")
+            && e.contains("give a smaller release_radius_m, fillet_radius_m or particle_radius_m"),
+        "{e}"
+    );
+}

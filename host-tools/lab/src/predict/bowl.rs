@@ -71,9 +71,10 @@ pub(super) fn words(e: BowlError) -> String {
         BowlError::InvalidFillet => {
             "--fillet-radius-m must be 0 or more (0 = a sharp corner)".into()
         }
-        BowlError::FilletReachesRelease => "the fillet between bottom and wall reaches in to the \
-             release radius: give a smaller --fillet-radius-m or --ri-m (the granule starts on \
-             the flat bottom)"
+        BowlError::FilletReachesRelease => "the granule released at --ri-m already touches the \
+             corner between bottom and wall (the fillet, --fillet-radius-m, widened by the \
+             granule's radius, --particle-radius-m): give a smaller --ri-m, --fillet-radius-m or \
+             --particle-radius-m (the granule starts on the flat bottom)"
             .into(),
         BowlError::InvalidRestitution => "--restitution must lie between 0 and 1".into(),
         BowlError::InvalidHorizon => "--max-time-s must be a positive number of seconds".into(),
