@@ -204,6 +204,11 @@ fn bad_bowl_input_is_said_in_words() {
             vec!["--max-time-s", "0"],
             "--max-time-s must be a positive",
         ),
+        (
+            ["60", "0.02", "0"],
+            vec!["--method", "semi-implicit"],
+            "--method semi-implicit is not offered for the bowl model",
+        ),
     ] {
         let args = bowl_args("1", "1", "60", wall, &extra);
         let out = bowl(&args);

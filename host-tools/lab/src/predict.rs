@@ -7,7 +7,7 @@ use anyhow::{Result, anyhow};
 use model_core::particle::{self, Model, Outcome, Scene};
 
 mod batch;
-mod bowl;
+pub(crate) mod bowl;
 mod choice;
 mod ends;
 pub(crate) mod ode;
@@ -144,7 +144,7 @@ pub(crate) fn model_name(m: Model) -> &'static str {
     }
 }
 
-fn method_name(m: MethodChoice) -> &'static str {
+pub(crate) fn method_name(m: MethodChoice) -> &'static str {
     match m {
         MethodChoice::Closed => "closed",
         MethodChoice::Euler => "euler",

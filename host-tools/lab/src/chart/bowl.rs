@@ -312,7 +312,7 @@ fn bowl_mean_by(
     let (mut sum, mut n) = (0.0, 0u64);
     for deg in AZIMUTHS_DEG {
         let r = bowl::residence(s, shape, deg.to_radians(), method, limits)
-            .map_err(|e| anyhow!("release at {deg} deg: {e:?}"))?;
+            .map_err(|e| anyhow!("release at {deg} deg: {}", crate::predict::bowl::words(e)))?;
         let BowlOutcome::Leaves {
             residence_time_s, ..
         } = r.outcome

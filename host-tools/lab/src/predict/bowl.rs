@@ -61,7 +61,7 @@ impl BowlInputs {
     }
 }
 
-pub(super) fn words(e: BowlError) -> String {
+pub(crate) fn words(e: BowlError) -> String {
     match e {
         BowlError::Scene(e) => rolling::words(e),
         BowlError::InvalidWallAngle => {
@@ -442,7 +442,10 @@ pub(super) fn scene_and_shape(
             step_s: args.step_s.unwrap_or(1e-4),
         },
         other => {
-            bail!("--method {other:?} is not offered for the bowl model: use dp54 (default) or rk4")
+            bail!(
+                "--method {} is not offered for the bowl model: use dp54 (default) or rk4",
+                super::method_name(other)
+            )
         }
     };
     for (v, flag) in [

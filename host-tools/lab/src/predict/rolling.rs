@@ -197,7 +197,8 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
             step_s: args.step_s.unwrap_or(1e-3),
         },
         other => bail!(
-            "--method {other:?} is not offered for the rolling model: use dp54 (default) or rk4",
+            "--method {} is not offered for the rolling model: use dp54 (default) or rk4",
+            super::method_name(other)
         ),
     };
     let scene = RollingScene {
