@@ -389,7 +389,10 @@ fn check_from(from: f32, target: f32) -> Result<()> {
 fn check_speed(x: f32, flag: &str) -> Result<()> {
     let max = ControllerConfig::nominal().axes[0].max_speed_rad_s;
     if !(x.is_finite() && x > 0.0 && x <= max) {
-        bail!("{flag} {x} is outside 0 to {max} rad/s (the controller's speed range)");
+        bail!(
+            "{flag} {x} is outside the controller's speed range, above 0 and up to {max} rad/s; \
+             give a speed in it"
+        );
     }
     Ok(())
 }
