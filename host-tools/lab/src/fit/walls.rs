@@ -240,3 +240,114 @@ pub fn to_json(v: &WallVerdict) -> serde_json::Value {
         "ranked": ranked,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::models::{BOWL_CANDIDATES, BowlRun, Candidate, Method};
+    use super::*;
+
+    fn run(w: f64, azimuth_deg: Option<f64>) -> Run {
+        Run {
+            row: 2,
+            condition: 1,
+            residence_s: 0.17,
+            mean_rad_s: w,
+            release_radius_m: 0.0375,
+            rim_radius_m: 0.075,
+            k2: 5.0 / 7.0,
+            trace: vec![(0.0, w)],
+            method: Method::ClosedForm,
+            axes_angle_rad: 60f64.to_radians(),
+            bowl: BowlRun {
+                azimuth_rad: azimuth_deg.map(f64::to_radians),
+                ..BowlRun::default()
+            },
+        }
+    }
+
+    fn fitted(candidate: Candidate, mu: f64, aic: f64, errors_pct: Vec<f64>) -> ModelFit {
+        let rms = (errors_pct.iter().map(|e| e * e).sum::<f64>() / errors_pct.len() as f64).sqrt();
+        ModelFit {
+            candidate,
+            mu,
+            mu_ci95: (mu, mu),
+            rms_error_pct: rms,
+            aic,
+            errors_pct,
+            k2: K2::Given,
+            at_limit: false,
+            cannot_reproduce: None,
+        }
+    }
+
+    /// Two walls 3 AIC apart on runs without an azimuth: undecided, with the walls' RMS
+    /// difference and the scatter computed from the runs' errors (1.00 % and 2.00 %), the
+    /// releases that would put them 6 standard deviations apart (36 (2/1)^2 = 144), and the
+    /// advice to record the azimuth with the walls' difference at a known azimuth, which at
+    /// these walls (10 mm at mu_s 0.4 and 20 mm at 0) is larger than their means' difference.
+    #[test]
+    fn close_walls_without_azimuths_are_undecided_and_say_what_to_measure() {
+        let runs = vec![run(1.5, None), run(3.0, None), run(4.5, None)];
+        let ten = fitted(BOWL_CANDIDATES[1], 0.4, -100.0, vec![2.0, -2.0, 2.0]);
+        let twenty = fitted(BOWL_CANDIDATES[2], 0.0, -97.0, vec![3.0, -1.0, 1.0]);
+        let v = verdict(&runs, &[ten, twenty]).unwrap();
+        assert_eq!(v.preferred, None);
+        assert_eq!(v.runs_with_azimuth, 0);
+        assert_eq!(v.ranked.len(), 2);
+        assert_eq!(v.ranked[1].delta_aic, 3.0);
+        let t = &v.text;
+        assert!(
+            t.starts_with(
+                "cannot tell the bowl-wall-60deg-10mm from the bowl-wall-60deg-20mm with these 3 \
+                 runs (AIC 3.0 apart"
+            ) && t.contains("differ by 1.00 %")
+                && t.contains("scatter by 2.00 %")
+                && t.contains("record each release's azimuth")
+                && t.contains("or measure about 144 releases without it"),
+            "{t}"
+        );
+        let at = t.split("these walls differ by ").nth(1).unwrap();
+        let pct: f64 = at.split(' ').next().unwrap().parse().unwrap();
+        assert!(pct > 2.4 && pct < 20.0, "{t}");
+    }
+
+    /// A wall more than 10 AIC below the next is named with its margin; the vertical wall
+    /// that holds a release (infinite AIC) is named as unable; with no wall able to reproduce
+    /// the runs, the verdict says so.
+    #[test]
+    fn a_clear_wall_is_named_and_no_wall_is_said() {
+        let runs = vec![
+            run(1.5, Some(10.0)),
+            run(3.0, Some(200.0)),
+            run(4.5, Some(90.0)),
+        ];
+        let ten = fitted(BOWL_CANDIDATES[1], 0.4, -100.0, vec![0.1, -0.1, 0.1]);
+        let twenty = fitted(BOWL_CANDIDATES[2], 0.0, -60.0, vec![3.0, -1.0, 1.0]);
+        let vertical = fitted(
+            BOWL_CANDIDATES[3],
+            0.0,
+            f64::INFINITY,
+            vec![f64::INFINITY; 3],
+        );
+        let v = verdict(&runs, &[twenty.clone(), ten, vertical.clone()]).unwrap();
+        assert_eq!(v.preferred, Some("bowl-wall-60deg-10mm"));
+        assert_eq!(v.runs_with_azimuth, 3);
+        assert!(
+            v.text.starts_with(
+                "the bowl-wall-60deg-10mm: AIC 40.0 lower than the bowl-wall-60deg-20mm"
+            ) && v.text.contains("bowl-wall-vertical-20mm cannot"),
+            "{}",
+            v.text
+        );
+        let mut unable = twenty;
+        unable.cannot_reproduce = Some("its RMS error is too large".into());
+        let v = verdict(&runs, &[unable, vertical]).unwrap();
+        assert_eq!(v.preferred, None);
+        assert!(
+            v.text.starts_with("no wall reproduces these runs"),
+            "{}",
+            v.text
+        );
+        assert!(verdict(&runs, &[]).is_none());
+    }
+}
