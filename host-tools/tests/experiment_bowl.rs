@@ -175,7 +175,8 @@ fn wall_of(rig: &Path) -> String {
 }
 
 /// `bowl experiment` then `bowl fit --rig-file` on rigs whose true wall is the example's 60 deg
-/// wall 10 mm high, a 20 mm one, and a bare rim (18 releases each at random azimuths, which the
+/// wall 10 mm high, a 20 mm one, a bare rim, and a 45 deg wall 15 mm high that is none of the
+/// fit's standard walls (the rig file's wall joins them; 18 releases each at random azimuths, which the
 /// simulated rig records): the fit compares each release with the bowl model at its own
 /// azimuth and names the true wall decisively (`preferred` and `walls.preferred`, AIC more than
 /// 10 below every other wall), with a verdict in words; the true `mu_s` (0.4, the rig file's) is
@@ -185,14 +186,21 @@ fn wall_of(rig: &Path) -> String {
 fn a_bowl_experiment_names_its_true_wall_and_mu_s() {
     let dir = common::temp_dir("experiment-bowl-walls");
     let true_mu_s = truth().bowl.unwrap().sliding_mu;
-    for (name, height) in [
-        ("wall10", None),
-        ("wall20", Some("0.02")),
-        ("bare", Some("0.0")),
-    ] {
-        let rig = match height {
-            None => rig_path(),
-            Some(h) => rig_variant(&dir, name, &[("wall_height_m", h)]),
+    let rigs: [(&str, &[(&str, &str)]); 4] = [
+        ("wall10", &[]),
+        ("wall20", &[("wall_height_m", "0.02")]),
+        ("bare", &[("wall_height_m", "0.0")]),
+        // Not one of the fit's standard walls: the rig file's own joins them.
+        (
+            "wall45",
+            &[("wall_angle_deg", "45.0"), ("wall_height_m", "0.015")],
+        ),
+    ];
+    for (name, changes) in rigs {
+        let rig = if changes.is_empty() {
+            rig_path()
+        } else {
+            rig_variant(&dir, name, changes)
         };
         let out = experiment(&dir, &rig, 6);
         let rows = common::csv_rows(&out);
