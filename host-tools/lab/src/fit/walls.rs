@@ -1,7 +1,7 @@
 //! Which wall the measured times prefer (`bowl fit --bowl-walls`): every bowl wall fitted is
 //! ranked by its AIC, and the verdict says in words either which wall and by how much, or that
 //! these runs cannot tell the two best apart, by how much they differ against the runs' own
-//! scatter, and what to measure to tell them. Method: docs/experiment.md ("Which wall").
+//! scatter, and what to measure to tell them. Method: docs/experiment.md ("Which wall: the verdict").
 
 use serde_json::json;
 
