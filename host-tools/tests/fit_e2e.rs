@@ -67,6 +67,7 @@ fn results(name: &str, times: &[(usize, f64)]) -> PathBuf {
             trace_mean_rad_s: Some(omega),
             trace_sd_rad_s: Some(0.0),
             trace_path: trace,
+            release_azimuth_deg: None,
         })
         .unwrap();
     }

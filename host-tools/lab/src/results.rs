@@ -46,6 +46,13 @@ pub struct Row {
     pub trace_sd_rad_s: Option<f64>,
     /// The trace file, relative to the results file.
     pub trace_path: String,
+    /// Where on the bowl the granule was dropped: its azimuth from the downhill direction,
+    /// degrees (as `bowl predict --release-azimuth-deg`), when the rig knows it (a simulated rig
+    /// in the bowl model does; a rig over its serial line does not report it). Empty otherwise,
+    /// and absent from results files written before it existed. The bowl fit then compares the
+    /// release with the bowl model at its own azimuth instead of the mean over the azimuths.
+    #[serde(default)]
+    pub release_azimuth_deg: Option<f64>,
 }
 
 /// Appends rows to a results file, flushing each.

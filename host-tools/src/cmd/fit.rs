@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
-use lab::fit::models::{BOWL_CANDIDATES, CANDIDATES, Method};
+use lab::fit::models::{BowlBase, CANDIDATES, Equation, Method, Run, Wall, bowl_candidates};
 use lab::fit::stats::AIC_DECISIVE;
 use lab::fit::{
     DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit_candidates, load, to_json,
@@ -27,9 +27,10 @@ pub struct Args {
     #[arg(long)]
     pub no_charts: bool,
     /// Angle between the bowl's axis and the vertical during the runs, degrees (the rolling
-    /// model's tilt; the results file does not record it).
-    #[arg(long, default_value_t = DEFAULT_AXES_ANGLE_DEG)]
-    pub axes_angle_deg: f64,
+    /// and bowl models' tilt; the results file does not record it). Default: the rig file's
+    /// `[bowl] axes_angle_deg` with --rig-file, else 60.
+    #[arg(long)]
+    pub axes_angle_deg: Option<f64>,
     /// Fit the granule's k2 as well as mu (needs conditions spread over the speed range; the
     /// results file's k2 is the starting point).
     #[arg(long)]
@@ -49,27 +50,117 @@ pub struct Args {
     /// releases in the real bowl per run and trial).
     #[arg(long)]
     pub bowl_walls: bool,
+    /// The rig file the runs were measured on (the one `bowl experiment --rig-file` used): the
+    /// bowl model takes its `[bowl]` table (tilt, bottom radius, fillet, restitution, granule
+    /// radius) and, when its `[particle]` follows the bowl model, the rolling resistance `mu`;
+    /// its own wall joins the candidate walls. Implies --bowl-walls.
+    #[arg(long)]
+    pub rig_file: Option<PathBuf>,
+}
+
+/// What the rig file gives the bowl fit: the tilt, the shared bowl, the rig's wall and its
+/// bottom radius.
+struct RigBowl {
+    axes_angle_deg: f64,
+    base: BowlBase,
+    wall: Wall,
+    rim_radius_m: f64,
+}
+
+/// The rig file's one rig's `[bowl]` table, in plain words when it has none.
+fn read_rig_bowl(path: &Path) -> Result<RigBowl> {
+    let rigs = rig_file::load(path)?;
+    let [rig] = rigs.as_slice() else {
+        anyhow::bail!(
+            "{} holds {} rigs ([[plant]] tables); the runs were measured on one: give the rig file \
+             of that rig",
+            path.display(),
+            rigs.len()
+        );
+    };
+    let Some(b) = rig.bowl else {
+        anyhow::bail!(
+            "the rig file {} has no [bowl] table: the bowl fit takes the bowl's shape, tilt and \
+             granule from it (keys and how to measure them: docs/rigs/nominal.toml; an example: \
+             docs/rigs/bowl-60deg.toml)",
+            path.display()
+        );
+    };
+    let rolling_resistance = rig
+        .particle
+        .filter(|p| p.bowl.is_some())
+        .map_or(BowlBase::DEFAULT.rolling_resistance, |p| p.mu);
+    Ok(RigBowl {
+        axes_angle_deg: b.axes_angle_deg,
+        base: BowlBase {
+            fillet_radius_m: b.fillet_radius_m,
+            restitution: b.restitution,
+            particle_radius_m: b.particle_radius_m,
+            rolling_resistance,
+        },
+        wall: Wall {
+            angle_deg: b.wall_angle_deg,
+            height_m: b.wall_height_m,
+        },
+        rim_radius_m: b.rim_radius_m,
+    })
+}
+
+/// Gives every run the rig's bowl; refuses runs measured on another bottom radius.
+fn apply_rig_bowl(runs: &mut [Run], rig: &RigBowl, path: &Path) -> Result<()> {
+    for r in runs.iter_mut() {
+        if (r.rim_radius_m - rig.rim_radius_m).abs() > 1e-9 {
+            anyhow::bail!(
+                "results line {}: rim radius {} m, but the rig file {} has [bowl] rim_radius_m \
+                 = {} m: fit the results with the rig file they were measured on",
+                r.row,
+                r.rim_radius_m,
+                path.display(),
+                rig.rim_radius_m
+            );
+        }
+        r.bowl.base = rig.base;
+    }
+    Ok(())
 }
 
 /// `bowl fit`.
 pub fn run(args: &Args) -> Result<()> {
-    if !(args.axes_angle_deg.is_finite() && (0.0..90.0).contains(&args.axes_angle_deg)) {
+    if let Some(a) = args.axes_angle_deg
+        && !(a.is_finite() && (0.0..90.0).contains(&a))
+    {
         anyhow::bail!(
-            "--axes-angle-deg {} is not a tilt the rig can have: give 0 to below 90 degrees",
-            args.axes_angle_deg
+            "--axes-angle-deg {a} is not a tilt the rig can have: give 0 to below 90 degrees"
         );
     }
+    let rig = match &args.rig_file {
+        Some(path) => Some(read_rig_bowl(path)?),
+        None => None,
+    };
+    let axes_angle_deg = match (args.axes_angle_deg, &rig) {
+        (Some(a), Some(r)) if (a - r.axes_angle_deg).abs() > 1e-9 => anyhow::bail!(
+            "--axes-angle-deg {a} but the rig file's [bowl] axes_angle_deg is {}: the runs had \
+             one tilt; leave --axes-angle-deg out to use the rig file's",
+            r.axes_angle_deg
+        ),
+        (Some(a), _) => a,
+        (None, Some(r)) => r.axes_angle_deg,
+        (None, None) => DEFAULT_AXES_ANGLE_DEG,
+    };
     let (mut runs, excluded) = load(&args.results)?;
     for r in &mut runs {
-        r.axes_angle_rad = args.axes_angle_deg.to_radians();
+        r.axes_angle_rad = axes_angle_deg.to_radians();
+    }
+    if let (Some(rig), Some(path)) = (&rig, &args.rig_file) {
+        apply_rig_bowl(&mut runs, rig, path)?;
     }
     let mut candidates: Vec<_> = CANDIDATES
         .iter()
         .filter(|c| args.models.iter().any(|m| m == c.name))
         .copied()
         .collect();
-    if args.bowl_walls {
-        candidates.extend(BOWL_CANDIDATES);
+    if args.bowl_walls || rig.is_some() {
+        candidates.extend(bowl_candidates(rig.as_ref().map(|r| r.wall)));
     }
     let fit = fit_candidates(runs, excluded, &candidates, args.fit_k2)?;
     if !args.no_charts {
@@ -145,15 +236,17 @@ pub fn run(args: &Args) -> Result<()> {
         "preferred: {} (a model is preferred when its AIC is lower by more than {AIC_DECISIVE})",
         fit.preferred
     );
-    if let Some(m) = fit
-        .models
-        .iter()
-        .find(|m| m.candidate.name == fit.preferred)
-    {
+    // MU_PPM is the paper's and the rolling model's resistance: a bowl wall's mu_s is not it.
+    if let Some(m) = fit.models.iter().find(|m| {
+        m.candidate.name == fit.preferred && !matches!(m.candidate.equation, Equation::Bowl(_))
+    }) {
         println!(
             "apply to the rig: bowl send PORT set MU_PPM {:.0}",
             (m.mu * 1e6).round()
         );
+    }
+    if let Some(w) = &fit.walls {
+        println!("wall: {}", w.text);
     }
     print!("{}", condition_table(&fit).to_csv());
     Ok(())

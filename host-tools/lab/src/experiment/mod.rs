@@ -22,6 +22,14 @@ pub trait ReleaseRig {
     fn geometry(&self) -> (f64, f64, f64);
     /// Motor speeds for a combined bowl speed by the rig's split rule, rad/s.
     fn split(&self, bowl_rad_s: f64) -> Result<[f64; 2]>;
+    /// Angle between the vertical (precession axis) and the bowl's own axis, rad (paper Eq. 2):
+    /// the combined bowl speed of a condition given as two motor speeds is computed with it.
+    fn axes_angle_rad(&self) -> f64;
+    /// The azimuth of the last granule dropped (from the downhill direction, degrees), when the
+    /// rig knows it; `None` by default (a rig over its serial line does not report it).
+    fn last_release_azimuth_deg(&self) -> Option<f64> {
+        None
+    }
     /// Sets the motor speeds (starting the loop if idle) and waits until both measured speeds
     /// are within 2 % for a second, then `settle_s` more.
     fn settle(&mut self, targets: [f64; 2], settle_s: f64) -> Result<(), Release>;
@@ -48,10 +56,10 @@ pub fn run_plan(
             (None, Some(p), Some(s)) => [p, s],
             _ => unreachable!("plan::parse checked the condition"),
         };
-        let bowl = c.bowl_rad_s.unwrap_or_else(|| {
-            let a = std::f64::consts::FRAC_PI_3;
-            ((targets[0] * a.sin()).powi(2) + (targets[0] * a.cos() + targets[1]).powi(2)).sqrt()
-        });
+        let bowl = match c.bowl_rad_s {
+            Some(w) => w,
+            None => crate::fit::models::combined_rad_s(targets, rig.axes_angle_rad()),
+        };
         for _ in 0..c.repeats {
             run_no += 1;
             let outcome = match rig.settle(targets, plan.settle_s) {
@@ -72,10 +80,12 @@ pub fn run_plan(
                 trace_mean_rad_s: None,
                 trace_sd_rad_s: None,
                 trace_path: String::new(),
+                release_azimuth_deg: None,
             };
             let trace = match outcome {
                 Release::Left(t, trace) => {
                     row.residence_s = Some(t);
+                    row.release_azimuth_deg = rig.last_release_azimuth_deg();
                     Some(trace)
                 }
                 Release::NeverLeft(trace) => {

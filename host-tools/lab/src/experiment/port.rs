@@ -268,4 +268,9 @@ impl ReleaseRig for PortRig {
     fn stop(&mut self) {
         let _ = self.command(Rig::stop);
     }
+
+    /// The rig's AXES_MDEG parameter.
+    fn axes_angle_rad(&self) -> f64 {
+        (param(&self.params, ParamId::AxesMdeg) * 1e-3).to_radians()
+    }
 }

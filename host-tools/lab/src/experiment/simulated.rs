@@ -222,6 +222,24 @@ impl super::ReleaseRig for BackendRig {
         self.split_speeds(bowl_rad_s)
     }
 
+    /// The tilt the granules feel: the `[bowl]` table's when they follow the bowl model, else
+    /// the controller's.
+    fn axes_angle_rad(&self) -> f64 {
+        self.particle().bowl.map_or_else(
+            || f64::from(self.backend.bound().controller().config().axes_angle_rad),
+            |b| b.axes_angle_rad,
+        )
+    }
+
+    /// The simulated rig draws each bowl-model granule's azimuth and knows it.
+    fn last_release_azimuth_deg(&self) -> Option<f64> {
+        self.backend
+            .bound()
+            .injector()
+            .last_bowl_release()
+            .map(|r| r.azimuth_rad.to_degrees())
+    }
+
     fn settle(&mut self, targets: [f64; 2], settle_s: f64) -> Result<(), Release> {
         self.settle_speeds(targets, settle_s)
     }

@@ -32,6 +32,7 @@ fn run_at(p: &ParticleParams, w: f64) -> Run {
         trace: vec![(0.0, w)],
         method: Method::ClosedForm,
         axes_angle_rad: crate::fit::DEFAULT_AXES_ANGLE_DEG.to_radians(),
+        bowl: crate::fit::models::BowlRun::default(),
     }
 }
 

@@ -8,6 +8,7 @@ pub mod joint;
 pub mod models;
 pub mod robust;
 pub mod stats;
+pub mod walls;
 
 use std::path::Path;
 
@@ -17,7 +18,7 @@ use serde_json::json;
 
 use crate::results::{self, STATUS_OK};
 use models::{
-    CANDIDATES, Candidate, Equation, Method, Run, STEADY_REL_SD, mu_ceiling_for, predict,
+    BowlRun, CANDIDATES, Candidate, Equation, Method, Run, STEADY_REL_SD, mu_ceiling_for, predict,
     predict_with_k2,
 };
 use stats::{AIC_DECISIVE, aic, crossing, minimise, t_quantile_975};
@@ -80,8 +81,10 @@ pub struct Fit {
     pub outliers: Vec<robust::Outlier>,
     /// One per candidate, in [`CANDIDATES`] order.
     pub models: Vec<ModelFit>,
-    /// `flat`, `coriolis` or `undecided`.
+    /// The preferred candidate's name, or `undecided`.
     pub preferred: &'static str,
+    /// Which bowl wall the times prefer, in words (`None`: no bowl wall fitted).
+    pub walls: Option<walls::WallVerdict>,
 }
 
 /// Loads the usable runs of a results file; every other row is excluded with its reason.
@@ -138,6 +141,16 @@ pub fn load(path: &Path) -> Result<(Vec<Run>, Vec<Excluded>)> {
             exclude("the bowl was not turning during the run".into());
             continue;
         };
+        let azimuth_rad = match row.release_azimuth_deg {
+            Some(deg) if !deg.is_finite() => {
+                exclude(format!(
+                    "release azimuth {deg} degrees is not a number: give the angle from the \
+                     downhill direction in degrees, or leave it empty"
+                ));
+                continue;
+            }
+            deg => deg.map(f64::to_radians),
+        };
         let method = if sd <= STEADY_REL_SD * mean {
             Method::ClosedForm
         } else {
@@ -154,6 +167,11 @@ pub fn load(path: &Path) -> Result<(Vec<Run>, Vec<Excluded>)> {
             trace,
             method,
             axes_angle_rad: DEFAULT_AXES_ANGLE_DEG.to_radians(),
+            bowl: BowlRun {
+                speeds_rad_s: Some([row.precession_rad_s, row.spin_rad_s]),
+                azimuth_rad,
+                ..BowlRun::default()
+            },
         });
     }
     Ok((runs, excluded))
@@ -321,12 +339,14 @@ pub fn fit_candidates(
         m.cannot_reproduce = why;
     }
     let preferred = preferred_by_aic(&models);
+    let walls = walls::verdict(&runs, &models);
     Ok(Fit {
         runs,
         excluded,
         outliers,
         models,
         preferred,
+        walls,
     })
 }
 
@@ -356,13 +376,17 @@ pub fn to_json(fit: &Fit) -> serde_json::Value {
         }
         models.insert(m.candidate.name.into(), model);
     }
-    json!({
+    let mut out = json!({
         "models": models,
         "preferred": fit.preferred,
         "runs": fit.runs.len(),
         "excluded": fit.excluded,
         "outliers": fit.outliers,
-    })
+    });
+    if let Some(v) = &fit.walls {
+        out["walls"] = walls::to_json(v);
+    }
+    out
 }
 
 /// Per condition: mean measured speed, mean and standard error of the measured time, and the

@@ -83,6 +83,43 @@ pub const BOWL_CANDIDATES: [Candidate; 4] = [
     },
 ];
 
+/// The candidate name of a wall: `bowl-bare-rim`, `bowl-wall-vertical-20mm`,
+/// `bowl-wall-60deg-10mm` (the height in whole millimetres, to 0.1 mm when it has a fraction).
+pub fn wall_name(wall: Wall) -> String {
+    let mm = (wall.height_m * 1e4).round() / 10.0;
+    let deg = (wall.angle_deg * 10.0).round() / 10.0;
+    if wall.height_m <= 0.0 {
+        "bowl-bare-rim".into()
+    } else if deg == 90.0 {
+        format!("bowl-wall-vertical-{mm}mm")
+    } else {
+        format!("bowl-wall-{deg}deg-{mm}mm")
+    }
+}
+
+/// The bowl candidates: [`BOWL_CANDIDATES`], and the rig file's own wall `rig` when it is not
+/// one of them (its name leaked once per fit: a handful of bytes per command).
+pub fn bowl_candidates(rig: Option<Wall>) -> Vec<Candidate> {
+    let mut out = BOWL_CANDIDATES.to_vec();
+    if let Some(w) = rig {
+        let same = |c: &Candidate| match c.equation {
+            Equation::Bowl(o) => {
+                (o.height_m <= 0.0 && w.height_m <= 0.0)
+                    || ((o.height_m - w.height_m).abs() < 1e-9
+                        && (o.angle_deg - w.angle_deg).abs() < 1e-9)
+            }
+            _ => false,
+        };
+        if !out.iter().any(same) {
+            out.push(Candidate {
+                name: Box::leak(wall_name(w).into_boxed_str()),
+                equation: Equation::Bowl(w),
+            });
+        }
+    }
+    out
+}
+
 /// A model the fit can try: a name and an equation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Candidate {
@@ -149,6 +186,58 @@ pub struct Run {
     pub method: Method,
     /// Angle between the bowl's axis and the vertical, rad (the rolling model's tilt).
     pub axes_angle_rad: f64,
+    /// What the bowl model needs beyond the paper's: the motor speeds, the release azimuth and
+    /// the rig's bowl.
+    pub bowl: BowlRun,
+}
+
+/// A run as the bowl model sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BowlRun {
+    /// The target motor speeds `[precession, spin]`, rad/s (the results row's): scaled to the
+    /// run's measured mean combined speed. `None`: the mean speed split equally.
+    pub speeds_rad_s: Option<[f64; 2]>,
+    /// Where the granule was dropped, rad from the downhill direction (the results row's
+    /// `release_azimuth_deg`): the run is then compared with that one release. `None`: with the
+    /// mean over the twelve azimuths.
+    pub azimuth_rad: Option<f64>,
+    /// The bowl's fillet, restitution and granule, shared by every candidate wall.
+    pub base: BowlBase,
+}
+
+impl Default for BowlRun {
+    fn default() -> Self {
+        Self {
+            speeds_rad_s: None,
+            azimuth_rad: None,
+            base: BowlBase::DEFAULT,
+        }
+    }
+}
+
+/// The parts of the bowl and the granule that the candidate walls share: the rig file's
+/// `[bowl]` table (`bowl fit --rig-file`), else [`BowlBase::DEFAULT`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BowlBase {
+    /// Fillet radius between bottom and wall, m.
+    pub fillet_radius_m: f64,
+    /// Restitution of a granule against the wall.
+    pub restitution: f64,
+    /// Granule radius, m.
+    pub particle_radius_m: f64,
+    /// Rolling resistance `mu_r` (held; the fitted parameter is `mu_s`).
+    pub rolling_resistance: f64,
+}
+
+impl BowlBase {
+    /// Without a rig file: a sharp corner, restitution 0, a 3 mm granule, `mu_r`
+    /// [`BOWL_ROLLING_RESISTANCE`].
+    pub const DEFAULT: Self = Self {
+        fillet_radius_m: 0.0,
+        restitution: 0.0,
+        particle_radius_m: 0.003,
+        rolling_resistance: BOWL_ROLLING_RESISTANCE,
+    };
 }
 
 /// Predicted residence time at `mu` (for the rolling model, its rolling resistance), s;
@@ -222,13 +311,34 @@ fn rolling_mean(run: &Run, mu: f64, k2: f64) -> f64 {
 /// gate's scatter, at a third of rtol 1e-9's cost (a fit takes thousands of means).
 const BOWL_METHOD: RollingMethod<f64> = RollingMethod::Dp54 { rtol: 1e-7 };
 
-/// The bowl model's mean residence time over the azimuths at the run's mean speed with the
-/// sliding friction `mu_s`, s (infinite when a release does not leave or gives up).
+/// The bowl model's residence time for the run with the sliding friction `mu_s`, s (infinite
+/// when a release does not leave or gives up): at the run's own release azimuth when the results
+/// recorded it, else the mean over the twelve azimuths.
 fn bowl_mean(run: &Run, wall: Wall, mu_s: f64, k2: f64) -> f64 {
+    match run.bowl.azimuth_rad {
+        Some(beta) => bowl_release(run, wall, mu_s, k2, beta),
+        None => {
+            let mut sum = 0.0;
+            for deg in rolling::AZIMUTHS_DEG {
+                sum += bowl_release(run, wall, mu_s, k2, deg.to_radians());
+            }
+            sum / rolling::AZIMUTHS_DEG.len() as f64
+        }
+    }
+}
+
+/// The bowl model's residence time of one release at azimuth `azimuth_rad` (from the downhill
+/// direction) at the run's motor speeds, s (infinite when it does not leave or gives up).
+pub fn bowl_release(run: &Run, wall: Wall, mu_s: f64, k2: f64, azimuth_rad: f64) -> f64 {
+    let base = run.bowl.base;
+    let [w1, w2] = motor_speeds(run);
     let scene = RollingScene {
-        rolling_resistance: BOWL_ROLLING_RESISTANCE,
+        precession_rad_s: w1,
+        spin_rad_s: w2,
+        rolling_resistance: base.rolling_resistance,
         sliding_friction: mu_s,
         k2,
+        particle_radius_m: base.particle_radius_m,
         ri_m: run.release_radius_m,
         rim_radius_m: run.rim_radius_m,
         g_m_s2: G_M_S2,
@@ -237,26 +347,55 @@ fn bowl_mean(run: &Run, wall: Wall, mu_s: f64, k2: f64) -> f64 {
     let shape = BowlShape {
         wall_angle_rad: wall.angle_deg.to_radians(),
         wall_height_m: wall.height_m,
-        fillet_radius_m: 0.0,
-        restitution: 0.0,
+        fillet_radius_m: base.fillet_radius_m,
+        restitution: base.restitution,
     };
     let limits = SystemLimits {
         horizon_s: 20.0 * run.residence_s + 1.0,
         max_steps: 20 * ROLLING_MAX_STEPS,
     };
-    let mut sum = 0.0;
-    for deg in rolling::AZIMUTHS_DEG {
-        match bowl::residence_f64(&scene, &shape, deg.to_radians(), BOWL_METHOD, limits) {
-            Ok(r) => match r.outcome {
-                BowlOutcome::Leaves {
-                    residence_time_s, ..
-                } => sum += residence_time_s,
-                _ => return f64::INFINITY,
-            },
-            Err(_) => return f64::INFINITY,
-        }
+    match bowl::residence_f64(&scene, &shape, azimuth_rad, BOWL_METHOD, limits) {
+        Ok(r) => match r.outcome {
+            BowlOutcome::Leaves {
+                residence_time_s, ..
+            } => residence_time_s,
+            _ => f64::INFINITY,
+        },
+        Err(_) => f64::INFINITY,
     }
-    sum / rolling::AZIMUTHS_DEG.len() as f64
+}
+
+/// The combined bowl speed of motor speeds `[precession, spin]` with the axes `axes_angle_rad`
+/// apart (paper Eq. 2, `model_core::bowl`), rad/s; NaN for speeds that are not finite.
+pub fn combined_rad_s(speeds_rad_s: [f64; 2], axes_angle_rad: f64) -> f64 {
+    let speeds = model_core::bowl::MotorSpeeds {
+        precession_rad_s: speeds_rad_s[0],
+        spin_rad_s: speeds_rad_s[1],
+    };
+    model_core::bowl::combined_speed_from_trig(axes_angle_rad.cos(), axes_angle_rad.sin(), speeds)
+        .unwrap_or(f64::NAN)
+}
+
+/// The run's motor speeds `[precession, spin]`, rad/s: the row's targets scaled so their
+/// combined speed (paper Eq. 2 at the run's tilt) is the measured mean; the mean split equally
+/// when the row gave none (or targets that combine to nothing).
+pub fn motor_speeds(run: &Run) -> [f64; 2] {
+    let equal = || {
+        let s = RollingScene::equal_speeds(run.mean_rad_s, run.axes_angle_rad, run.rim_radius_m);
+        [s.precession_rad_s, s.spin_rad_s]
+    };
+    match run.bowl.speeds_rad_s {
+        Some(t) => {
+            let combined = combined_rad_s(t, run.axes_angle_rad);
+            if combined > 0.0 && combined.is_finite() {
+                let k = run.mean_rad_s / combined;
+                [t[0] * k, t[1] * k]
+            } else {
+                equal()
+            }
+        }
+        None => equal(),
+    }
 }
 
 /// The largest `mu` at which the run can leave under `equation`: for the paper's equation

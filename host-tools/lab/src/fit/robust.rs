@@ -348,6 +348,7 @@ mod tests {
             trace_mean_rad_s: Some(4.0),
             trace_sd_rad_s: Some(0.0),
             trace_path: trace_path.into(),
+            release_azimuth_deg: None,
         };
         w.push(&row(1, f64::NAN, &trace)).unwrap();
         w.push(&row(2, -0.5, &trace)).unwrap();

@@ -44,6 +44,7 @@ pub(super) fn synthetic_runs(
                 trace: vec![(0.0, w)],
                 method: Method::ClosedForm,
                 axes_angle_rad: 60f64.to_radians(),
+                bowl: models::BowlRun::default(),
             };
             run.residence_s =
                 closed_form(&run, truth.model, truth.mu, w) + sigma_s * gaussian(&mut rng);
@@ -173,6 +174,7 @@ fn drifting_speed_uses_the_integrator() {
                 trace: kept,
                 method: Method::Integrated,
                 axes_angle_rad: 60f64.to_radians(),
+                bowl: models::BowlRun::default(),
             });
         }
     }
@@ -216,6 +218,7 @@ fn rolling_truth_is_recognised() {
                 trace: vec![(0.0, w)],
                 method: Method::ClosedForm,
                 axes_angle_rad: 60f64.to_radians(),
+                bowl: models::BowlRun::default(),
             };
             run.residence_s = predict(&run, Equation::Rolling, 0.05) + 0.002 * gaussian(&mut rng);
             runs.push(run);
@@ -254,6 +257,7 @@ fn the_bowl_fit_finds_the_wall_and_mu_s() {
             trace: vec![(0.0, w)],
             method: Method::ClosedForm,
             axes_angle_rad: 60f64.to_radians(),
+            bowl: models::BowlRun::default(),
         };
         let t = predict(&run, truth.equation, 0.4);
         assert!(t.is_finite() && matches!(truth.equation, Equation::Bowl(_)));
@@ -296,6 +300,7 @@ fn the_shortest_residence_time_bounds_every_model_from_below() {
                         trace: vec![(0.0, w)],
                         method: Method::ClosedForm,
                         axes_angle_rad: angle_deg.to_radians(),
+                        bowl: models::BowlRun::default(),
                     };
                     let bound = models::shortest_residence_s(&run);
                     let mut fastest = f64::INFINITY;
@@ -356,6 +361,7 @@ fn the_shortest_residence_time_bounds_every_model_from_below() {
         trace: vec![(0.0, 7.0)],
         method: Method::ClosedForm,
         axes_angle_rad: 60f64.to_radians(),
+        bowl: models::BowlRun::default(),
     };
     let frictionless =
         predict(&rig, models::Equation::Rolling, 0.0).min(closed_form(&rig, Model::Flat, 0.0, 7.0));
