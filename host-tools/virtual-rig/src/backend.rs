@@ -48,6 +48,15 @@ impl SimulatedBackend {
             params[id.index()] = i32::from(plant_params.axes[axis].sensor.pulses_per_rev);
         }
         particle.describe_bowl(&mut params);
+        // The rig as built: granules in a rig file's bowl feel its tilt, and the controller
+        // is told the same angle (AXES_MDEG, as set once on a real rig), so that its split of
+        // the bowl speed and the granules agree (both paper Eq. 2).
+        let axes_rad = particle
+            .bowl
+            .map_or(f64::from(base.axes_angle_rad), |b| b.axes_angle_rad);
+        let (lo, hi) = ParamId::AxesMdeg.range();
+        params[ParamId::AxesMdeg.index()] =
+            ((axes_rad.to_degrees() * 1e3).round() as i32).clamp(lo, hi);
         let hello = Hello {
             reset_cause: ResetCause::Unknown,
             reset_count: 0,
@@ -61,7 +70,7 @@ impl SimulatedBackend {
                 identified: [false; 2],
             }),
             hello,
-            World::new(particle, seed, f64::from(base.axes_angle_rad)),
+            World::new(particle, seed, axes_rad),
         );
         checked.map_err(|r| anyhow!("rig parameters refused: {}", r.token()))?;
         let mut sim = Self {
@@ -160,6 +169,40 @@ mod tests {
             let v = rig.bound().param(id);
             assert!((lo..=hi).contains(&v), "{} = {v}", id.token());
         }
+    }
+
+    /// A rig whose granules sit in a bowl tilted 30 deg tells its controller 30 deg
+    /// (AXES_MDEG): the split of a bowl speed into motor speeds and the granules use one angle.
+    #[test]
+    fn the_controller_is_told_the_tilt_its_granules_feel() {
+        use model_core::particle::bowl::BowlShape;
+        use model_core::sim::bowl_granule::BowlTruth;
+        let truth = BowlTruth {
+            shape: BowlShape {
+                wall_angle_rad: 60f64.to_radians(),
+                wall_height_m: 0.01,
+                fillet_radius_m: 0.0,
+                restitution: 0.0,
+            },
+            axes_angle_rad: 30f64.to_radians(),
+            particle_radius_m: 0.003,
+            sliding_mu: 0.4,
+            sliding_mu_spread: 0.0,
+        };
+        let particle = ParticleParams {
+            mu: 0.029,
+            release_radius_m: 0.0375,
+            rim_radius_m: 0.075,
+            bowl: Some(truth),
+            ..ParticleParams::default()
+        };
+        let rig = SimulatedBackend::with_plant(PlantParams::nominal(), particle, 1).unwrap();
+        assert_eq!(rig.bound().param(ParamId::AxesMdeg), 30_000);
+        let cfg = rig.bound().controller().config();
+        assert!((cfg.axes_angle_rad - 30f32.to_radians()).abs() < 1e-6);
+        // Without a bowl the nominal 60 deg, as before.
+        let plain = SimulatedBackend::new(1).unwrap();
+        assert_eq!(plain.bound().param(ParamId::AxesMdeg), 60_000);
     }
 
     /// Setting a parameter and reading it back gives the value (a round trip through the

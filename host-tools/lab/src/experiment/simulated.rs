@@ -222,13 +222,15 @@ impl super::ReleaseRig for BackendRig {
         self.split_speeds(bowl_rad_s)
     }
 
-    /// The tilt the granules feel: the `[bowl]` table's when they follow the bowl model, else
-    /// the controller's.
+    /// The rig's AXES_MDEG parameter, as a rig over its serial line gives it: the simulated
+    /// rig sets it to the tilt its granules feel (`SimulatedBackend::with_plant`).
     fn axes_angle_rad(&self) -> f64 {
-        self.particle().bowl.map_or_else(
-            || f64::from(self.backend.bound().controller().config().axes_angle_rad),
-            |b| b.axes_angle_rad,
-        )
+        use model_core::wire::device::Backend as _;
+        let mdeg = self
+            .backend
+            .bound()
+            .param(model_core::wire::ParamId::AxesMdeg);
+        (f64::from(mdeg) * 1e-3).to_radians()
     }
 
     /// The simulated rig draws each bowl-model granule's azimuth and knows it.
