@@ -14,6 +14,10 @@
 //!   that window. `e` is then held (and filtered with the estimator's weight) until the next
 //!   window closes. Between edges, once the stall bound says the shaft is slower than its last
 //!   measurement, `e` is at least `r_p - bound`.
+//! - The window's dead time is modelled (a Smith predictor): the duty the feedback applied is
+//!   run through the same model (`c`), a window reads the load `L = model mean + c mean -
+//!   measured mean`, and `e = L - c` now, so what the correction already does is not asked for
+//!   again through the next window (docs/control.md, "From rest to 1 rad/s").
 //!
 //! # Gains
 //! The plant from duty to speed is `K / (tau s + 1)` with `K = V / volts_per_rad_s`. The PI zero
