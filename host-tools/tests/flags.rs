@@ -78,3 +78,22 @@ fn no_turning_and_no_friction_is_not_said_to_be_friction() {
     let (_, out, _) = run(&["predict", "--omega-rad-s", "3", "--mu", "0.5"]);
     assert!(out.contains("friction holds it"), "{out}");
 }
+
+#[test]
+fn a_drop_share_outside_0_to_50_pct_is_said_in_words() {
+    for bad in ["80", "-5", "NaN"] {
+        let (code, _, err) = run(&[
+            "sim",
+            "faults",
+            "--rig-file",
+            "../tests/rigs/family-60.toml",
+            "--drop-pulses-pct",
+            bad,
+        ]);
+        assert_eq!(code, Some(1), "{bad}: {err}");
+        assert!(
+            err.contains("--drop-pulses-pct must be from 0 to 50") && err.contains(bad),
+            "{bad}: {err}"
+        );
+    }
+}

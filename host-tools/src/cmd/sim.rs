@@ -55,6 +55,11 @@ pub struct FaultsArgs {
     /// gave none.
     #[arg(long)]
     current_sense: bool,
+    /// Each sensor drops this share of its pulses at random (a worn target, a marginal gap),
+    /// %, from after commissioning on; the plants are then held at speed 30 s more before the
+    /// faults are injected, and the JSON says per axis what was dropped and inferred.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    drop_pulses_pct: f32,
     /// JSON output (the only format; accepted for symmetry with the other reports).
     #[arg(long)]
     json: bool,
@@ -251,7 +256,15 @@ pub fn run(what: &What) -> Result<()> {
             check_speed(a.speed_rad_s, "--speed-rad-s")?;
             let rigs = sensed(rig_file::load(&a.rig_file)?, a.current_sense);
             check_lowest(&rigs, a.speed_rad_s, "--speed-rad-s")?;
-            let plants = parallel(&rigs, |r| sim_reports::fault_plant(r, a.speed_rad_s));
+            if !(0.0..=50.0).contains(&a.drop_pulses_pct) {
+                bail!(
+                    "--drop-pulses-pct must be from 0 to 50 (% of pulses the sensors drop; got {}): above half the pulses the controller cannot tell a dropping sensor from a dead one",
+                    a.drop_pulses_pct
+                );
+            }
+            let plants = parallel(&rigs, |r| {
+                sim_reports::fault_plant(r, a.speed_rad_s, a.drop_pulses_pct)
+            });
             let out = serde_json::json!({ "plants": plants });
             println!("{}", serde_json::to_string_pretty(&out)?);
         }

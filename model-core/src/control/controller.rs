@@ -19,10 +19,10 @@ use super::config::{ConfigError, ControllerConfig};
 use super::pi::LoopInput;
 use super::planner::{InverseFailure, ResidenceForBowlSpeed, SetpointPlanner};
 use super::supervisor::{
-    DRIVEN_BELOW_MODEL_DUTY, Fault, PAIR_RUNAWAY_MARGIN_RAD_S, PAIR_RUNAWAY_RATIO,
-    PAIR_RUNAWAY_STEADY_S, REVOLUTION_RUNAWAY_DUTY, REVOLUTION_RUNAWAY_MARGIN_RAD_S,
-    REVOLUTION_RUNAWAY_RATIO, RUNAWAY_MARGIN_RAD_S, RUNAWAY_RATIO, SETTLED_AFTER_S, State,
-    fault_code,
+    DRIVEN_BELOW_MODEL_DUTY, DROPPING_WATCH_PITCHES, Fault, PAIR_RUNAWAY_MARGIN_RAD_S,
+    PAIR_RUNAWAY_RATIO, PAIR_RUNAWAY_STEADY_S, REVOLUTION_RUNAWAY_DUTY,
+    REVOLUTION_RUNAWAY_MARGIN_RAD_S, REVOLUTION_RUNAWAY_RATIO, RUNAWAY_MARGIN_RAD_S, RUNAWAY_RATIO,
+    SETTLED_AFTER_S, State, WATCH_PITCHES, fault_code,
 };
 use crate::bowl::{MotorSpeeds, combined_speed_from_trig};
 
@@ -278,10 +278,18 @@ impl Controller {
             // driven by last tick's duty less what that held beyond the model.
             let duty = (a.duty - a.extra_duty) * a.direction;
             // A deceleration is no load, for the observer as for the loop (observer.rs).
-            a.obs.hold_load(a.speed_loop.slowing());
-            let speed = a
-                .obs
-                .track(&a.ok, &mut a.est, now_ticks, edges[i], steady_i, duty);
+            let slowing = a.speed_loop.slowing();
+            a.obs.hold_load(slowing);
+            // Missing pulses are inferred while the observer tracks, at a steady speed or once
+            // the sensor has dropped one (a drop not inferred leaves the reading outside
+            // "steady", and no later one was), never while slowing: the observer knows no
+            // stiction, and a shaft sticking on its way down to the lowest speed took two
+            // expected pitches for one (family-60 p18, 3 -> 0.2 rad/s); crawling at 0.2 rad/s,
+            // healthy shafts of family-60 did too where not steady.
+            let infer = !slowing && (steady_i || a.est.dropping());
+            let speed = a.obs.track(
+                &a.ok, &mut a.est, now_ticks, edges[i], steady_i, infer, duty,
+            );
             seen[i] = a.est.accepted_edges() != before;
             a.measured = a.direction * speed;
             if seen[i] && steady_i {
@@ -472,6 +480,11 @@ impl Controller {
             self.cfg.sensor_timeout_floor_s,
             expected_rad_s,
             a.est.rad_per_pulse(),
+            if a.est.dropping() {
+                DROPPING_WATCH_PITCHES
+            } else {
+                WATCH_PITCHES
+            },
         ) {
             self.latch(self.lost_edges_fault(i));
             return true;
@@ -540,6 +553,7 @@ impl Controller {
                         self.cfg.sensor_timeout_floor_s,
                         self.cfg.axes[i].min_speed_rad_s,
                         a.est.rad_per_pulse(),
+                        WATCH_PITCHES,
                     ) {
                         self.identify_error = Some(IdentifyError::TooFewEdges);
                         self.latch(Fault::SensorLostOrStall(i as u8));

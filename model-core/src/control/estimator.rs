@@ -30,7 +30,8 @@
 //! [`PulseSpeedEstimator::rejected_edges`]). An interval is taken as `k` = 2 or 3 pulses with
 //! the middle ones missing (counted in [`PulseSpeedEstimator::inferred_missing`]) when the
 //! shaft's observer ([`super::observer`], through [`PulseSpeedEstimator::expect_travel`])
-//! expected `k` pitches over it (within 0.3), at a steady speed: a shaft that slowed gives a
+//! expected `k` pitches over it (within 0.3), where the controller lets it judge (steady, or the
+//! sensor dropping pulses lately: [`PulseSpeedEstimator::dropping`]): a shaft that slowed gives a
 //! long interval too, but its observer, driven by the throttled duty, expected one pitch. Without
 //! an observer (the estimator on its own) the rule is the last measured period's.
 //!
@@ -58,6 +59,13 @@ pub const MAX_PULSE_PERIOD_S: f32 = 4.0;
 /// Pitches without an edge at the lowest speed after which the estimate reads zero: two, so
 /// that tooth offsets and jitter at the lowest speed never read a turning shaft as stopped.
 pub const STALL_PITCHES: f32 = 2.0;
+
+/// Pulses after an inferred missing one during which the sensor counts as dropping pulses
+/// ([`PulseSpeedEstimator::dropping`]): 21 revolutions of a 12-tooth wheel. A worn target or a
+/// marginal gap drops pulses all along; this spans five mean gaps between drops of a sensor
+/// that drops one pulse in fifty (with 64, a sensor dropping one in twenty went 64 pulses
+/// without a drop often enough that its next two in a row faulted a healthy rig).
+pub const DROP_MEMORY_PULSES: u16 = 256;
 
 /// The lowest speed an axis may be commanded to, rad/s: the configured minimum, raised to the
 /// speed whose pulse period is [`MAX_PULSE_PERIOD_S`] (`2 pi / (N * 4 s)`: 1.57 rad/s at one
@@ -148,6 +156,9 @@ pub struct PulseSpeedEstimator {
     accepted: u32,
     rejected: u32,
     missing: u32,
+    /// Pulses still to come before the sensor no longer counts as dropping (see
+    /// [`DROP_MEMORY_PULSES`]).
+    drop_memory: u16,
     late_edges: u32,
     /// The last gap measured alone (one pulse, an interval since the edge before).
     last_gap: Gap,
@@ -217,6 +228,7 @@ impl PulseSpeedEstimator {
             accepted: 0,
             rejected: 0,
             missing: 0,
+            drop_memory: 0,
             late_edges: 0,
             last_gap: Gap {
                 serial: 0,
@@ -318,16 +330,13 @@ impl PulseSpeedEstimator {
             // The observer's angle at this edge: an interval counts as `k` pulses only when the
             // observer, driven by the duty that was applied, expected `k` pitches over it. A
             // shaft slowing to a lower reference gives intervals of 2 or 3 of its last periods,
-            // but the observer, slowing with it, expected about one pitch. Only at a steady
-            // speed: the observer knows no stiction, and a shaft sticking on its way down to the
-            // lowest speed took two expected pitches for one (family-60 p18, 3 -> 0.2 rad/s).
+            // but the observer, slowing with it, expected about one pitch. When the observer
+            // says nothing (its expectation 0: not tracking, or its caller keeps it from judging:
+            // the controller lets it while steady or while the sensor drops pulses, never while
+            // slowing) the edge is one pulse.
             let since_tick = at.wrapping_sub(self.clock) as f32;
             let predicted = self.expect_pitches + self.expect_pitches_per_tick * since_tick;
-            pulses = if steady {
-                pulses_expected(predicted)
-            } else {
-                1
-            };
+            pulses = pulses_expected(predicted);
             if pulses > 1 {
                 self.missing = self.missing.wrapping_add(pulses - 1);
             }
@@ -343,7 +352,14 @@ impl PulseSpeedEstimator {
         }
         self.accepted = self.accepted.wrapping_add(1);
         self.last_edge = at;
-        self.bound_pitches = 2;
+        self.drop_memory = if pulses > 1 {
+            DROP_MEMORY_PULSES
+        } else {
+            self.drop_memory.saturating_sub(1)
+        };
+        // A sensor that drops pulses may drop two in a row: the bound then allows three
+        // pitches, so two missing pulses do not read the shaft a third slower.
+        self.bound_pitches = if self.drop_memory > 0 { 3 } else { 2 };
         self.prev_interval = self.last_interval;
         self.last_interval = dt / pulses;
         self.win_pulses += pulses;
@@ -528,6 +544,12 @@ impl PulseSpeedEstimator {
     /// Pulses inferred as missing so far.
     pub fn inferred_missing(&self) -> u32 {
         self.missing
+    }
+    /// The sensor dropped a pulse within the last [`DROP_MEMORY_PULSES`]: the next interval may
+    /// be two or three pitches (the sensor watch then waits for
+    /// [`super::supervisor::DROPPING_WATCH_PITCHES`]).
+    pub fn dropping(&self) -> bool {
+        self.drop_memory > 0
     }
     /// Edges whose timestamp was after the tick's `now` (placed at `now`).
     pub fn late_edges(&self) -> u32 {

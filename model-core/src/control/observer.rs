@@ -37,7 +37,7 @@
 //! estimator the expected angle, runs it on the tick's edges, then propagates and corrects.
 
 use super::config::AxisConfig;
-use super::estimator::PulseSpeedEstimator;
+use super::estimator::{PulseSpeedEstimator, pulses_expected};
 
 /// Share of an edge's mean-speed error the speed takes.
 pub const SPEED_GAIN: f32 = 0.5;
@@ -95,6 +95,8 @@ pub struct AngleObserver {
     innovation: f32,
     /// The load is held, not learned, at the edges (see [`AngleObserver::hold_load`]).
     load_held: bool,
+    /// The last edge was ambiguous (see [`AngleObserver::correct`]) and not learned from.
+    skipped: bool,
 }
 
 impl AngleObserver {
@@ -108,6 +110,7 @@ impl AngleObserver {
         tracked: 0,
         innovation: 0.0,
         load_held: false,
+        skipped: false,
     };
 
     /// One tick of the plant driven by `duty` (in the shaft's direction: negative brakes).
@@ -139,9 +142,18 @@ impl AngleObserver {
             return;
         }
         let interval_s = self.since_edge_s - ago_s;
-        let e = measured_pitches - self.predicted_pitches(k, ago_s);
+        let predicted = self.predicted_pitches(k, ago_s);
+        let e = measured_pitches - predicted;
         self.innovation = e;
-        if interval_s > 0.0 && e.is_finite() {
+        // An edge a whole pitch or more short of an expectation of 2 or 3 pitches, not taken
+        // as missing pulses (the observer did not track yet, or was not let judge): a dropped
+        // pulse or a shaft that lagged, no telling which. Learned from, a dropped pulse takes a
+        // quarter off the speed (e = -1 over two pitches) and puts it into the load, and the
+        // observer then misses its next edges too. Once is skipped; a shaft that really lags
+        // shows it again at the next edge, and is learned from then.
+        let ambiguous = e < -0.7 && pulses_expected(predicted) > 1 && !self.skipped;
+        self.skipped = ambiguous;
+        if interval_s > 0.0 && e.is_finite() && !ambiguous {
             let mean_error_rad_s = e * k.pitch_rad / interval_s;
             let w = self.speed_rad_s + SPEED_GAIN * mean_error_rad_s;
             self.speed_rad_s = if w > 0.0 { w } else { 0.0 };
@@ -166,11 +178,12 @@ impl AngleObserver {
     }
 
     /// One control tick of the estimator under this observer: the observer's expected angle
-    /// judges missing pulses among `edges` (once it tracks), then the plant driven by `duty`
-    /// (the duty applied since the last tick, in the shaft's direction, less what it held
-    /// beyond the identified model) is propagated to `now` and corrected by the edges. Returns
-    /// the estimator's speed (see [`PulseSpeedEstimator::tick`]).
+    /// judges missing pulses among `edges` (once it tracks, and only while `infer`), then the
+    /// plant driven by `duty` (the duty applied since the last tick, in the shaft's direction,
+    /// less what it held beyond the identified model) is propagated to `now` and corrected by
+    /// the edges. Returns the estimator's speed (see [`PulseSpeedEstimator::tick`]).
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     pub fn track(
         &mut self,
         k: &ObserverConstants,
@@ -178,9 +191,10 @@ impl AngleObserver {
         now: u32,
         edges: &[u32],
         steady: bool,
+        infer: bool,
         duty: f32,
     ) -> f32 {
-        if self.tracking() {
+        if infer && self.tracking() {
             est.expect_travel(self.since_edge_pitches, self.speed_rad_s * k.per_pitch_rad);
         } else {
             est.expect_travel(0.0, 0.0);

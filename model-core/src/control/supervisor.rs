@@ -148,6 +148,14 @@ pub fn fault_code(f: Option<Fault>) -> u8 {
 /// (docs/control.md, "Faults").
 pub const WATCH_PITCHES: f32 = 2.8;
 
+/// [`WATCH_PITCHES`] for a sensor that has dropped pulses lately (a worn target, a marginal
+/// gap: [`super::estimator::PulseSpeedEstimator::dropping`]): two in a row leave an interval of
+/// three pitches, and a tooth's offset or the shaft's own ripple lengthen it by up to the 0.3 the
+/// missing-pulse inference allows. A dead sensor then faults within 3.3 expected pulse periods
+/// of the last edge instead of 2.8 (docs/control.md, "Dropped pulses"); at 10 % of pulses dropped,
+/// two in a row came every 17 s at 3 rad/s and faulted a healthy rig at 2.8.
+pub const DROPPING_WATCH_PITCHES: f32 = 3.3;
+
 /// An edge interval faster than this many times the plant model's speed (plus the margin) is a
 /// runaway: tooth offsets (up to 10 % on one interval), a 10 % overshoot and the breakaway of a
 /// stiff shaft at the lowest speed stay inside.
@@ -216,8 +224,9 @@ impl SensorWatch {
     /// `expected_rad_s` is the speed the shaft should have now (the plant model's speed while
     /// running, so an accelerating shaft is not blamed for the reference's lead), `rad_per_pulse`
     /// the pitch. The fault comes when, with the duty above the stall threshold and no edge,
-    /// both `floor_s` has passed and the shaft should have turned three pitches: at a steady
-    /// speed that is `max(floor_s, 3 pulse periods)`.
+    /// both `floor_s` has passed and the shaft should have turned `watch_pitches` pitches
+    /// ([`WATCH_PITCHES`], or [`DROPPING_WATCH_PITCHES`] for a sensor that drops pulses): at a
+    /// steady speed that is `max(floor_s, 3 pulse periods)`.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub fn step(
@@ -229,6 +238,7 @@ impl SensorWatch {
         floor_s: f32,
         expected_rad_s: f32,
         rad_per_pulse: f32,
+        watch_pitches: f32,
     ) -> bool {
         if edge_seen || duty_abs <= stall_duty {
             *self = Self::CLEAR;
@@ -236,7 +246,7 @@ impl SensorWatch {
         }
         self.blind_s += dt_s;
         self.expected_rad += expected_rad_s.abs() * dt_s;
-        self.blind_s > floor_s && self.expected_rad > WATCH_PITCHES * rad_per_pulse
+        self.blind_s > floor_s && self.expected_rad > watch_pitches * rad_per_pulse
     }
 
     /// Clears the watch.

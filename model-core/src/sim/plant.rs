@@ -21,11 +21,17 @@ pub struct SensorParams {
     pub jitter_s: f32,
 }
 
+/// [`AxisFaults::missing_tooth`] of a whole wheel.
+pub const NO_TOOTH_MISSING: u16 = u16::MAX;
+
 /// Faults injected on one axis. Times are simulation seconds; `f32::INFINITY` = never.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AxisFaults {
     /// Probability that an edge is lost.
     pub missing_probability: f32,
+    /// A wheel with this tooth (0..pulses_per_rev, counted from the angle's zero) gone: its
+    /// edge never comes, every revolution; [`NO_TOOTH_MISSING`] = a whole wheel.
+    pub missing_tooth: u16,
     /// Probability that an edge bounces (a second edge follows after `bounce_delay_s`).
     pub bounce_probability: f32,
     /// Delay of a bounce edge, s.
@@ -52,6 +58,7 @@ impl AxisFaults {
     /// No faults.
     pub const NONE: Self = Self {
         missing_probability: 0.0,
+        missing_tooth: NO_TOOTH_MISSING,
         bounce_probability: 0.0,
         bounce_delay_s: 50e-6,
         dead_sensor_from_s: f32::INFINITY,
@@ -193,6 +200,7 @@ struct AxisSim {
     pending_bounce: Option<f64>,
     lost_overflow: u32,
     edges_emitted: u32,
+    edges_dropped: u32,
     torque_nm: f32,
     /// Sign of the last nonzero duty commanded (a shorted bridge drives that way).
     last_direction: f32,
@@ -225,6 +233,7 @@ impl Plant {
             pending_bounce: None,
             lost_overflow: 0,
             edges_emitted: 0,
+            edges_dropped: 0,
             torque_nm: 0.0,
             last_direction: 1.0,
         };
@@ -317,6 +326,11 @@ impl Plant {
     /// Edges emitted by the sensor so far (after injected faults).
     pub fn edges_emitted(&self, axis: usize) -> u32 {
         self.axes[axis].edges_emitted
+    }
+    /// Edges the sensor dropped so far ([`AxisFaults::missing_probability`] and
+    /// [`AxisFaults::missing_tooth`]; a dead sensor's are not counted).
+    pub fn edges_dropped(&self, axis: usize) -> u32 {
+        self.axes[axis].edges_dropped
     }
 
     /// Advances by one control period `dt_s` with the duties held (zero duty = coast).
@@ -431,7 +445,11 @@ impl Plant {
             if (t as f32) >= f.dead_sensor_from_s {
                 continue;
             }
-            if f.missing_probability > 0.0 && self.rng.unit() < f.missing_probability {
+            if (f.missing_probability > 0.0 && self.rng.unit() < f.missing_probability)
+                || tooth_in_rev == f.missing_tooth as u32
+            {
+                let ax = &mut self.axes[i];
+                ax.edges_dropped = ax.edges_dropped.wrapping_add(1);
                 continue;
             }
             self.push_edge(i, te.max(t0).min(t1), f);

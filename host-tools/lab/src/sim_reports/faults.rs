@@ -58,6 +58,26 @@ pub struct FaultSet {
     pub link_lost: FaultOutcome,
 }
 
+/// One axis of a plant held at speed with a sensor that drops pulses (`--drop-pulses-pct`).
+#[derive(Serialize, Debug, Clone)]
+pub struct DroppedPulses {
+    /// Pulses the sensor dropped from the start of the hold to its end (or the false fault).
+    pub dropped: u32,
+    /// Pulses the controller inferred missing meanwhile.
+    pub inferred: u32,
+    /// Mean true speed over the hold's last [`DROP_MEAN_S`] s, % from the target (None: it
+    /// faulted first).
+    pub true_speed_error_pct: Option<f64>,
+    /// Mean measured speed over the same seconds, % from the mean true speed.
+    pub reading_error_pct: Option<f64>,
+}
+
+/// Seconds the plant runs at speed with the sensor dropping pulses, after settling, before the
+/// faults are injected: at 10 % dropped and 3 rad/s, two in a row came every 17 s.
+pub const DROP_HOLD_S: f32 = 30.0;
+/// The last seconds of the hold the speed errors are taken over.
+pub const DROP_MEAN_S: f32 = 10.0;
+
 /// One plant of `bowl sim faults`.
 #[derive(Serialize, Debug, Clone)]
 pub struct PlantFaults {
@@ -67,6 +87,12 @@ pub struct PlantFaults {
     pub commissioning: String,
     /// A fault latched before any injection (a false fault).
     pub false_fault: bool,
+    /// The false fault in words (None: none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub false_fault_words: Option<String>,
+    /// With `--drop-pulses-pct`: per axis, what the dropping sensor did over the hold.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dropped_pulses: Option<[DroppedPulses; 2]>,
     /// None when commissioning refused.
     pub faults: Option<FaultSet>,
 }
@@ -80,14 +106,18 @@ enum Injected {
     LinkLost,
 }
 
-/// Runs `rig` at `speed` and injects each fault in turn on each axis.
-pub fn fault_plant(rig: &Rig, speed: f32) -> PlantFaults {
+/// Runs `rig` at `speed` and injects each fault in turn on each axis; with `drop_pct` > 0 each
+/// sensor drops that share of its pulses at random from after commissioning on, and the plant
+/// is held at speed [`DROP_HOLD_S`] s more before the injections.
+pub fn fault_plant(rig: &Rig, speed: f32, drop_pct: f32) -> PlantFaults {
     let cl = match commissioned(rig, config_for(rig)) {
         Err(reason) => {
             return PlantFaults {
                 name: rig.name.clone(),
                 commissioning: format!("refused: {reason}"),
                 false_fault: false,
+                false_fault_words: None,
+                dropped_pulses: None,
                 faults: None,
             };
         }
@@ -99,14 +129,50 @@ pub fn fault_plant(rig: &Rig, speed: f32) -> PlantFaults {
     cfg.host_timeout_s = LINK_TIMEOUT_S;
     let mut false_fault = running.ctrl.set_parameters(cfg).is_err();
     pour_material(&mut running);
+    for a in &mut running.rig.params_mut().axes {
+        a.faults.missing_probability = drop_pct / 100.0;
+    }
+    let dropped_before = [running.rig.edges_dropped(0), running.rig.edges_dropped(1)];
+    let inferred_before = running.ctrl.status().axes.map(|a| a.inferred_missing);
     false_fault |=
         running.ctrl.set_motor_speeds(speed, speed).is_err() || running.ctrl.start().is_err();
     let settle = (3.0 + 2.0 * std::f32::consts::TAU / speed).min(40.0);
-    for _ in 0..(settle / running.dt_s()) as u32 {
+    let hold = if drop_pct > 0.0 { DROP_HOLD_S } else { 0.0 };
+    let ticks = ((settle + hold) / running.dt_s()) as u32;
+    let mean_from = ((settle + hold - DROP_MEAN_S) / running.dt_s()) as u32;
+    let mut sums = [[0.0f64; 2]; 2];
+    let mut n = 0u32;
+    for tick in 0..ticks {
         running.ctrl.host_heartbeat();
         running.tick();
-        false_fault |= running.ctrl.fault().is_some();
+        if running.ctrl.fault().is_some() {
+            false_fault = true;
+            break;
+        }
+        if tick >= mean_from {
+            let st = running.ctrl.status();
+            for (i, s) in sums.iter_mut().enumerate() {
+                s[0] += running.rig.speed_rad_s(i) as f64;
+                s[1] += st.axes[i].measured_rad_s as f64;
+            }
+            n += 1;
+        }
     }
+    let false_fault_words = running.ctrl.fault().map(fault_words);
+    let dropped_pulses = (drop_pct > 0.0).then(|| {
+        let st = running.ctrl.status();
+        [0, 1].map(|i| {
+            let done = n > 0 && !false_fault;
+            let true_mean = sums[i][0] / n.max(1) as f64;
+            DroppedPulses {
+                dropped: running.rig.edges_dropped(i) - dropped_before[i],
+                inferred: st.axes[i].inferred_missing - inferred_before[i],
+                true_speed_error_pct: done.then(|| 100.0 * (true_mean / speed as f64 - 1.0)),
+                reading_error_pct: done
+                    .then(|| 100.0 * (sums[i][1] / n.max(1) as f64 / true_mean - 1.0)),
+            }
+        })
+    });
     let rate_bound = |axis: usize| {
         let n = rig.params.axes[axis].sensor.pulses_per_rev as f64;
         (3.0 * TAU / (n * speed as f64)).max(0.2)
@@ -139,6 +205,8 @@ pub fn fault_plant(rig: &Rig, speed: f32) -> PlantFaults {
         name: rig.name.clone(),
         commissioning: "ok".into(),
         false_fault,
+        false_fault_words,
+        dropped_pulses,
         faults: Some(FaultSet {
             sensor_lost: one(Injected::SensorLost),
             stall: one(Injected::Stall),
