@@ -146,3 +146,29 @@ fn a_rod_turned_by_the_spins_reaction_still_learns_its_current_per_duty() {
     let os = overshoot_pct(rig, 4010, 0.5, load);
     assert!(os[0] <= 25.0, "precession overshoot {} %", os[0]);
 }
+
+/// `bowl sim make-family --seed 6 --plants 60`'s p24 (seed 6024), current sense on both axes: a
+/// light rod whose identified breakaway duty (0.20) is ten times its friction duty. Its first
+/// edge came 35 ms into the start, before the current had confirmed the breakaway, and the edge
+/// kept half the kick in the integral as a load: 0.07 duty too much, 57.5 % past 0.5 rad/s on
+/// main. Its back-EMF speed at that edge was already above the model speed's lower band: the
+/// kick was more than it needed, and now nothing of it is kept, as at the current's breakaway.
+#[test]
+fn a_first_edge_before_the_current_confirms_the_breakaway_keeps_no_kick() {
+    let rig = sensed(plant_rows::rig_from_table(
+        10.263,
+        0.570,
+        [
+            [
+                1.8970, 0.01754, 0.00479, 0.0479, 0.0638, 0.0301, 0.000102, 0.0020, 0.0,
+            ],
+            [
+                1.9013, 0.03305, 0.00497, 0.0497, 0.0696, 0.0184, 0.000355, 0.0074, 0.0,
+            ],
+        ],
+    ));
+    let os = overshoot_pct(rig, 6024, 0.5, [0.0451, 0.0616]);
+    for (axis, os) in os.iter().enumerate() {
+        assert!(*os <= 10.0, "axis {axis}: {os} % past 0.5 rad/s");
+    }
+}
