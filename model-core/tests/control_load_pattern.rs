@@ -148,3 +148,88 @@ fn a_set_point_change_keeps_the_pattern() {
         "the pattern was restarted by the set-point change"
     );
 }
+
+/// The eccentric rig with a worn wheel: each tooth up to 8 % of a pitch off its place (the
+/// plant's hashed offsets), which gives the wheel a once-per-revolution pattern of its own.
+fn worn_eccentric_rig() -> PlantParams {
+    let mut rig = eccentric_rig();
+    for a in &mut rig.axes {
+        a.sensor.tooth_error = 0.08;
+    }
+    rig
+}
+
+/// Commissioned on `rig` (the loop's model identified, not given), then at `speed_rad_s`.
+fn commissioned(rig: PlantParams, speed_rad_s: f32) -> ClosedLoop {
+    let ctrl = Controller::new(true_model_config(&rig)).expect("the nominal configuration");
+    let mut cl = ClosedLoop::new(Plant::new(rig, 1), ctrl);
+    assert_eq!(cl.commission(300.0), model_core::control::State::Idle);
+    cl.ctrl
+        .set_motor_speeds(speed_rad_s, speed_rad_s)
+        .expect("speeds in range");
+    cl.ctrl.start().expect("starts");
+    cl
+}
+
+/// The worst 1 s mean of the spin's true speed, in % off `target`, from `from_s` after now
+/// for `for_s`.
+fn worst_mean_off_pct(cl: &mut ClosedLoop, target: f32, from_s: f32, for_s: f32) -> f64 {
+    let dt = cl.dt_s();
+    let mut angle = Vec::new();
+    cl.run(from_s + for_s + 0.5, |c| angle.push(c.rig.angle_rad(1)));
+    let half = (0.5 / dt) as usize;
+    let mut worst_pct = 0.0f64;
+    for k in (from_s / dt) as usize..angle.len() - half {
+        let w = (angle[k + half] - angle[k - half]) / (2 * half) as f64 / dt as f64;
+        worst_pct = worst_pct.max(100.0 * (w - target as f64).abs() / target as f64);
+    }
+    worst_pct
+}
+
+/// Commissioning runs two steady steps at different speeds; the wheel's pattern and the load
+/// differ in how they grow with the speed, so the two tell the load apart: the pattern found
+/// is the plant's eccentric load (its torque in duty), not the worn wheel's, before any step.
+#[test]
+fn commissioning_finds_the_load_apart_from_a_worn_wheel() {
+    let rig = worn_eccentric_rig();
+    let m = rig.axes[1].motor;
+    let expected = RIPPLE_NM * m.resistance_ohm / (m.torque_constant * rig.supply_v);
+    let cl = commissioned(rig, 3.0);
+    let (revs, amplitude) = cl.ctrl.load_pattern(1);
+    eprintln!("after commissioning: {amplitude:.5} duty (plant {expected:.5}), {revs} revs");
+    assert_eq!(revs, 0, "nothing learned in closed loop yet");
+    assert!(
+        (amplitude - expected).abs() <= 0.25 * expected,
+        "found {amplitude:.5} duty, the plant's load is {expected:.5}"
+    );
+    // The same wheel without the load: what is found is the wheel's, and small.
+    let mut rig = worn_eccentric_rig();
+    for a in &mut rig.axes {
+        a.ripple_nm = 0.0;
+    }
+    let cl = commissioned(rig, 3.0);
+    let (_, amplitude) = cl.ctrl.load_pattern(1);
+    eprintln!("no load: {amplitude:.5} duty");
+    assert!(
+        amplitude <= 0.25 * expected,
+        "found {amplitude:.5} duty with no load (the load would be {expected:.5})"
+    );
+}
+
+/// Coming down from 3 rad/s (where nothing is learned: the wheel's pattern reads as a load
+/// there) to 1 rad/s, the load found while commissioning is fed from the first revolution:
+/// the 1 s mean of the true speed is within 2 % of 1 rad/s from 3 s after the step on.
+#[test]
+fn from_three_to_one_the_load_is_fed_from_the_first_revolution() {
+    let mut cl = commissioned(worn_eccentric_rig(), 3.0);
+    cl.run(15.0, |_| {});
+    cl.ctrl
+        .set_motor_speeds(SPEED_RAD_S, SPEED_RAD_S)
+        .expect("speeds in range");
+    let worst_pct = worst_mean_off_pct(&mut cl, SPEED_RAD_S, 3.0, 7.0);
+    eprintln!("3 -> 1 rad/s: worst 1 s mean {worst_pct:.2} % off from 3 s on");
+    assert!(
+        worst_pct <= 2.0,
+        "1 s mean {worst_pct:.2} % off 1 rad/s from 3 s after the step down from 3 rad/s"
+    );
+}

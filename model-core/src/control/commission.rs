@@ -199,6 +199,8 @@ pub struct Commissioning {
     /// clock.
     reaction_done_s: Option<f32>,
     results: [Option<Identified>; 2],
+    /// See [`Commissioning::steady_step`].
+    steady_step: u8,
 }
 
 impl Commissioning {
@@ -234,7 +236,13 @@ impl Commissioning {
             reaction_fit_from_s: 0.0,
             reaction_done_s: None,
             results: [None, None],
+            steady_step: 0,
         }
+    }
+
+    /// The step (1 low, 2 high) whose duty has been held for half the step time, else 0.
+    pub fn steady_step(&self) -> u8 {
+        self.steady_step
     }
 
     /// The axis being identified and the phase.
@@ -306,6 +314,9 @@ impl Commissioning {
         // Whole revolutions: each tooth equally often in the fit.
         let min_edges = (self.cfg.min_fit_edges as u32).max(n);
         let whole = |count: u32| count >= min_edges && count.is_multiple_of(n);
+        // The steps' second halves also hold a whole revolution of gaps and their neighbours
+        // for the load pattern (load_pattern.rs tells the load from the wheel by the two).
+        let whole_steady = |count: u32| whole(count) && count >= n + 3;
         let mut duty = 0.0;
         match self.phase {
             Phase::Breakaway => {
@@ -317,7 +328,9 @@ impl Commissioning {
             }
             Phase::Low => {
                 duty = self.low_duty;
-                if t_s >= self.cfg.step_time_s && whole(self.low_fit.count()) {
+                // A whole revolution of gaps and their neighbours for the load pattern too
+                // (load_pattern.rs tells the load from the wheel by this step and the next).
+                if t_s >= self.cfg.step_time_s && whole_steady(self.low_fit.count()) {
                     self.step_at_s = t_s;
                     self.phase = Phase::High;
                     duty = self.high_duty;
@@ -325,7 +338,9 @@ impl Commissioning {
             }
             Phase::High => {
                 duty = self.high_duty;
-                if t_s - self.step_at_s >= self.cfg.step_time_s && whole(self.high_fit.count()) {
+                if t_s - self.step_at_s >= self.cfg.step_time_s
+                    && whole_steady(self.high_fit.count())
+                {
                     self.results[self.axis] = Some(self.identify()?);
                     if self.axis == 1 {
                         self.spin_high_duty = self.high_duty;
@@ -371,6 +386,12 @@ impl Commissioning {
             }
             Phase::Done => {}
         }
+        let held_s = 0.5 * self.cfg.step_time_s;
+        self.steady_step = match self.phase {
+            Phase::Low if t_s >= held_s => 1,
+            Phase::High if t_s - self.step_at_s >= held_s => 2,
+            _ => 0,
+        };
         let mut duties = [0.0; 2];
         duties[self.axis] = duty;
         if self.phase == Phase::Reaction {
