@@ -125,8 +125,6 @@ pub struct LoadPattern {
     /// The load alone, from the two steps (the wheel's pattern taken out), duty: `a cos + b
     /// sin`; fed forward until a pattern is learned in closed loop.
     prior: [f32; 2],
-    /// `sin(2 pi / N) / (2 pi / N)`: the central difference's gain on the first harmonic.
-    diff_gain: f32,
     /// The last two gaps of an unbroken chain (`chain` of them valid), oldest first.
     last: [Sample; 2],
     chain: u8,
@@ -155,11 +153,6 @@ impl LoadPattern {
             half_sin: sin_const(half),
             mean_to_middle: if half > 0.0 {
                 half / sin_const(half)
-            } else {
-                1.0
-            },
-            diff_gain: if half > 0.0 {
-                sin_const(2.0 * half) / (2.0 * half)
             } else {
                 1.0
             },
@@ -218,6 +211,8 @@ impl LoadPattern {
 
     /// Takes over what `old` (the pattern before the configuration changed, same wheel)
     /// learned while commissioning and forms the load from it with this pattern's model.
+    #[cold]
+    #[inline(never)]
     pub fn adopt(&mut self, old: &LoadPattern) {
         if old.mean_to_middle != self.mean_to_middle {
             return;
@@ -238,7 +233,9 @@ impl LoadPattern {
         }
         let (d1, d2) = (self.load_of(&lo), self.load_of(&hi));
         // g(w) = w (1 - i tau s w), s = sin(2 pi / N) / (2 pi / N) of the central difference.
-        let ts = self.duty_s_per_rad_s / self.duty_per_rad_s * self.diff_gain;
+        // sin(2h) / (2h) = cos h / (h / sin h), h half a gap.
+        let diff_gain = self.half_cos / self.mean_to_middle;
+        let ts = self.duty_s_per_rad_s / self.duty_per_rad_s * diff_gain;
         let g = |w: f32| [w, -ts * w * w];
         let (g1, g2) = (g(w1), g(w2));
         // T = (g2 D1 - g1 D2) / (g2 - g1).
@@ -271,6 +268,7 @@ impl LoadPattern {
     /// One commissioning tick on the axis under test: `applied_duty` drove the shaft since the
     /// last tick, `step` is the step (1 low, 2 high, 0 none) it belonged to. The last whole
     /// revolution of each step is kept, raw.
+    #[inline(never)]
     pub fn commission_tick(&mut self, est: &PulseSpeedEstimator, applied_duty: f32, step: u8) {
         if step != self.step {
             if step == 1 {
@@ -280,7 +278,7 @@ impl LoadPattern {
             self.break_chain();
             self.step = step;
         }
-        self.observe(est, applied_duty, 1.0, step != 0);
+        self.observe(est, applied_duty, 1.0, step != 0, step);
     }
 
     /// Revolutions learned since the pattern was last forgotten.
@@ -317,13 +315,8 @@ impl LoadPattern {
         learn: bool,
         model_rad_s: f32,
     ) -> f32 {
-        if self.step != 0 {
-            // Commissioning is over.
-            self.step = 0;
-            self.break_chain();
-        }
         let slow = model_rad_s <= LEARN_BELOW_RAD_S;
-        if !self.observe(est, applied_duty, direction, learn && slow) {
+        if !self.observe(est, applied_duty, direction, learn && slow, 0) {
             return 0.0;
         }
         let [a, b] = self.fed();
@@ -343,15 +336,17 @@ impl LoadPattern {
         a * (c * cp - s * sp) + b * (s * cp + c * sp)
     }
 
-    /// Follows the gaps and learns from them when `learn`; false while the wheel has too few
-    /// teeth to learn from.
-    #[inline(always)]
+    /// Follows the gaps and learns from them when `learn` (a revolution goes to commissioning
+    /// step `step`, 0: the loop's pattern); false while the wheel has too few teeth to learn
+    /// from.
+    #[inline(never)]
     fn observe(
         &mut self,
         est: &PulseSpeedEstimator,
         applied_duty: f32,
         direction: f32,
         learn: bool,
+        step: u8,
     ) -> bool {
         let teeth = est.teeth();
         if teeth.teeth() < 3 {
@@ -369,7 +364,7 @@ impl LoadPattern {
             let follows = gap.serial == self.seen_serial.wrapping_add(1);
             self.seen_serial = gap.serial;
             if learn && follows && gap.ticks > 0 && self.duty_ticks > 0 {
-                self.on_gap(est, gap, direction, teeth.teeth());
+                self.on_gap(est, gap, direction, teeth.teeth(), step);
             } else {
                 self.break_chain();
             }
@@ -388,7 +383,14 @@ impl LoadPattern {
     /// A gap that follows the last one, at steady speed.
     #[cold]
     #[inline(never)]
-    fn on_gap(&mut self, est: &PulseSpeedEstimator, gap: Gap, direction: f32, teeth: u16) {
+    fn on_gap(
+        &mut self,
+        est: &PulseSpeedEstimator,
+        gap: Gap,
+        direction: f32,
+        teeth: u16,
+        step: u8,
+    ) {
         let dt_s = gap.ticks as f32 * est.s_per_tick();
         let new = Sample {
             index: gap.index,
@@ -414,7 +416,7 @@ impl LoadPattern {
                 self.speed_sum += mid.speed_rad_s;
                 self.gaps += 1;
                 if self.gaps >= teeth {
-                    self.end_revolution(teeth);
+                    self.end_revolution(teeth, step);
                 }
             }
         }
@@ -423,7 +425,7 @@ impl LoadPattern {
     }
 
     /// A whole revolution of gaps summed: its harmonic goes into the pattern.
-    fn end_revolution(&mut self, teeth: u16) {
+    fn end_revolution(&mut self, teeth: u16, step: u8) {
         let scale = 2.0 * self.mean_to_middle / teeth as f32;
         let mut rev = Revolution {
             speed_rad_s: (self.speed_sum / teeth as f32).abs(),
@@ -435,7 +437,7 @@ impl LoadPattern {
         self.gaps = 0;
         self.sums = [0.0; 6];
         self.speed_sum = 0.0;
-        if let Some(slot) = self.steps.get_mut((self.step as usize).wrapping_sub(1)) {
+        if let Some(slot) = self.steps.get_mut((step as usize).wrapping_sub(1)) {
             *slot = rev;
             return;
         }
