@@ -71,6 +71,12 @@ pub const LEARN_BELOW_RAD_S: f32 = core::f32::consts::TAU / SLOWEST_LEARNED_REVO
 /// The commissioning's high step must be at least this much faster than its low step for the
 /// wheel's pattern and the load to be told apart.
 pub const SEPARATE_SPEED_RATIO: f32 = 1.3;
+/// The load found while commissioning is fed only if it is at least this share of the
+/// difference between the two steps' patterns (the wheel's share growing with the speed).
+pub const MIN_LOAD_TO_WHEEL: f32 = 0.5;
+/// A commissioning step's revolution is kept only if the speed at its first gap changed by
+/// at most this share over the revolution (the shaft settled at the step's speed).
+pub const STEADY_DRIFT: f32 = 0.01;
 /// A revolution whose pattern is larger than this (duty, amplitude) is no eccentric load (a
 /// stall, a hand on the bowl): not learned from.
 pub const MAX_AMPLITUDE_DUTY: f32 = 0.3;
@@ -118,6 +124,8 @@ pub struct LoadPattern {
     sums: [f32; 6],
     speed_sum: f32,
     gaps: u16,
+    /// The speed of this revolution's first gap, rad/s.
+    first_speed_rad_s: f32,
     /// The commissioning step being learned from (0: none, 1: low, 2: high) and the last
     /// revolution of each step.
     step: u8,
@@ -162,6 +170,7 @@ impl LoadPattern {
             sums: [0.0; 6],
             speed_sum: 0.0,
             gaps: 0,
+            first_speed_rad_s: 0.0,
             step: 0,
             steps: [Revolution {
                 speed_rad_s: 0.0,
@@ -250,7 +259,12 @@ impl LoadPattern {
             (num[1] * den[0] - num[0] * den[1]) / den2,
         ];
         let size = t[0] * t[0] + t[1] * t[1];
-        if size.is_nan() || size > MAX_AMPLITUDE_DUTY * MAX_AMPLITUDE_DUTY {
+        // The load is the small difference of two large patterns when the wheel's share
+        // dominates (a light load on a worn wheel): there a few per cent of model error in `g`
+        // is all of it, so it is fed only when it is not small against the wheel's share.
+        let (dd0, dd1) = (d2[0] - d1[0], d2[1] - d1[1]);
+        let wheel = MIN_LOAD_TO_WHEEL * MIN_LOAD_TO_WHEEL * (dd0 * dd0 + dd1 * dd1);
+        if size.is_nan() || size > MAX_AMPLITUDE_DUTY * MAX_AMPLITUDE_DUTY || size < wheel {
             return [0.0; 2];
         }
         t
@@ -413,10 +427,16 @@ impl LoadPattern {
                     self.sums[2 * k] += v * cm;
                     self.sums[2 * k + 1] += v * sm;
                 }
+                if self.gaps == 0 {
+                    self.first_speed_rad_s = mid.speed_rad_s;
+                }
                 self.speed_sum += mid.speed_rad_s;
                 self.gaps += 1;
                 if self.gaps >= teeth {
-                    self.end_revolution(teeth, step);
+                    // `new` ends at the revolution's first tooth again: the same gap a
+                    // revolution later, so the difference is the speed's drift alone.
+                    let drift = new.speed_rad_s - self.first_speed_rad_s;
+                    self.end_revolution(teeth, step, drift);
                 }
             }
         }
@@ -425,7 +445,7 @@ impl LoadPattern {
     }
 
     /// A whole revolution of gaps summed: its harmonic goes into the pattern.
-    fn end_revolution(&mut self, teeth: u16, step: u8) {
+    fn end_revolution(&mut self, teeth: u16, step: u8, drift_rad_s: f32) {
         let scale = 2.0 * self.mean_to_middle / teeth as f32;
         let mut rev = Revolution {
             speed_rad_s: (self.speed_sum / teeth as f32).abs(),
@@ -438,7 +458,11 @@ impl LoadPattern {
         self.sums = [0.0; 6];
         self.speed_sum = 0.0;
         if let Some(slot) = self.steps.get_mut((step as usize).wrapping_sub(1)) {
-            *slot = rev;
+            // Only a settled step: a shaft still approaching its speed (a slow axis half a
+            // step in) leaks its trend into the harmonic by the model's error.
+            if drift_rad_s.abs() <= STEADY_DRIFT * rev.speed_rad_s {
+                *slot = rev;
+            }
             return;
         }
         let [a, b] = self.load_of(&rev);
