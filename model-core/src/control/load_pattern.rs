@@ -76,7 +76,7 @@ pub const SEPARATE_SPEED_RATIO: f32 = 1.3;
 pub const MIN_LOAD_TO_WHEEL: f32 = 0.5;
 /// A commissioning step's revolution is kept only if the speed at its first gap changed by
 /// at most this share over the revolution (the shaft settled at the step's speed).
-pub const STEADY_DRIFT: f32 = 0.01;
+pub const STEADY_DRIFT: f32 = 0.03;
 /// A revolution whose pattern is larger than this (duty, amplitude) is no eccentric load (a
 /// stall, a hand on the bowl): not learned from.
 pub const MAX_AMPLITUDE_DUTY: f32 = 0.3;
