@@ -203,6 +203,10 @@ pub struct Commissioning {
     results: [Option<Identified>; 2],
     /// See [`Commissioning::steady_step`].
     steady_step: u8,
+    /// Pulses in this step's second half, and whether its fit is complete (the step then
+    /// holds on, its fit unchanged, until the load pattern has its revolution).
+    steady_pulses: u32,
+    fit_done: bool,
 }
 
 impl Commissioning {
@@ -239,6 +243,8 @@ impl Commissioning {
             reaction_done_s: None,
             results: [None, None],
             steady_step: 0,
+            steady_pulses: 0,
+            fit_done: false,
         }
     }
 
@@ -290,6 +296,10 @@ impl Commissioning {
         };
         // Second half of the step only: by then the speed is steady.
         if t_s - phase_start >= 0.5 * self.cfg.step_time_s {
+            self.steady_pulses += pulses;
+            if self.fit_done {
+                return;
+            }
             match self.phase {
                 Phase::Low => self.low_fit.add(t_s, angle),
                 _ => self.high_fit.add(t_s, angle),
@@ -316,9 +326,13 @@ impl Commissioning {
         // Whole revolutions: each tooth equally often in the fit.
         let min_edges = (self.cfg.min_fit_edges as u32).max(n);
         let whole = |count: u32| count >= min_edges && count.is_multiple_of(n);
-        // The steps' second halves also hold a whole revolution of gaps and their neighbours
-        // for the load pattern (load_pattern.rs tells the load from the wheel by the two).
-        let whole_steady = |count: u32| whole(count) && count >= n + 3;
+        // Once a step's fit spans whole revolutions it is complete (and unchanged from here);
+        // the step holds on until its second half also has a whole revolution of gaps and
+        // their neighbours for the load pattern (load_pattern.rs tells the load from the wheel
+        // by the two steps). The spin's steps only: the rod's high step's line is the
+        // reaction's reference (held longer, the measured reaction moved: docs/control.md),
+        // and without it its low step's revolution would serve nothing.
+        let load_ready = self.axis == 0 || self.steady_pulses >= n + 3;
         let mut duty = 0.0;
         match self.phase {
             Phase::Breakaway => {
@@ -330,9 +344,10 @@ impl Commissioning {
             }
             Phase::Low => {
                 duty = self.low_duty;
-                // A whole revolution of gaps and their neighbours for the load pattern too
-                // (load_pattern.rs tells the load from the wheel by this step and the next).
-                if t_s >= self.cfg.step_time_s && whole_steady(self.low_fit.count()) {
+                self.fit_done |= t_s >= self.cfg.step_time_s && whole(self.low_fit.count());
+                if self.fit_done && load_ready {
+                    self.fit_done = false;
+                    self.steady_pulses = 0;
                     self.step_at_s = t_s;
                     self.phase = Phase::High;
                     duty = self.high_duty;
@@ -340,9 +355,12 @@ impl Commissioning {
             }
             Phase::High => {
                 duty = self.high_duty;
-                if t_s - self.step_at_s >= self.cfg.step_time_s
-                    && whole_steady(self.high_fit.count())
-                {
+                let count = self.high_fit.count();
+                let whole_step = t_s - self.step_at_s >= self.cfg.step_time_s && whole(count);
+                self.fit_done |= whole_step;
+                if self.fit_done && load_ready {
+                    self.fit_done = false;
+                    self.steady_pulses = 0;
                     self.results[self.axis] = Some(self.identify()?);
                     if self.axis == 1 {
                         self.spin_high_duty = self.high_duty;
@@ -390,8 +408,8 @@ impl Commissioning {
         }
         let held_s = 0.5 * self.cfg.step_time_s;
         self.steady_step = match self.phase {
-            Phase::Low if t_s >= held_s => 1,
-            Phase::High if t_s - self.step_at_s >= held_s => 2,
+            Phase::Low if self.axis == 1 && t_s >= held_s => 1,
+            Phase::High if self.axis == 1 && t_s - self.step_at_s >= held_s => 2,
             _ => 0,
         };
         let mut duties = [0.0; 2];
