@@ -7,11 +7,11 @@
 //!    shaft). No edge by [`BREAKAWAY_MAX_DUTY`] refuses: the shaft is blocked or the sensor dead.
 //! 1. *Low step*: duty `max(low_duty, breakaway + 0.1)`, held at least `step_time_s` and until
 //!    the edges in the step's second half span whole revolutions (a multiple of the pulses per
-//!    revolution, at least `min_fit_edges` and one revolution and three edges, so that the
-//!    load pattern has a whole revolution of gaps and their neighbours there: load_pattern.rs
-//!    tells the load from the wheel by the two steps): each tooth enters the fit equally
-//!    often, so tooth offsets and a once-per-revolution load average out instead of biasing
-//!    the slope. A straight line fitted to (edge time, edge angle) gives the steady speed `w_L`.
+//!    revolution, at least `min_fit_edges` and one revolution): each tooth enters the fit
+//!    equally often, so tooth offsets and a once-per-revolution load average out instead of
+//!    biasing the slope. The spin's steps then hold on, the fit complete, until their second
+//!    half spans a revolution and three edges: the load pattern's revolution (load_pattern.rs
+//!    tells the load from the wheel by the two steps). A straight line fitted to (edge time, edge angle) gives the steady speed `w_L`.
 //! 2. *High step*: duty `max(high_duty, low + 0.2)` (at most 0.95), same rule, gives `w_H` and
 //!    the line's intercept.
 //! 3. *Coast*: zero duty until the estimator reads zero, then the next axis.
@@ -204,7 +204,7 @@ pub struct Commissioning {
     /// See [`Commissioning::steady_step`].
     steady_step: u8,
     /// Pulses in this step's second half, and whether its fit is complete (the step then
-    /// holds on, its fit unchanged, until the load pattern has its revolution).
+    /// holds on, its fit unchanged, until the load pattern has its revolution; the spin only).
     steady_pulses: u32,
     fit_done: bool,
 }

@@ -40,13 +40,14 @@
 //! (2 pi / N)`, the central difference's gain), so the pattern found at speed `w` is
 //! `D(w) = T + Ke/V w (1 - i tau s w) P` (coefficients `a + i b` of `a cos + b sin`): the load
 //! `T` plus a wheel's share that grows with the speed along a curve the identified model gives.
-//! Commissioning holds two duties, each for at least a whole revolution of gaps after half its
-//! step time (commission.rs); the last revolution of each is kept raw (the harmonics of the
+//! Commissioning holds two duties on the spin, each for at least a whole revolution of gaps
+//! after half its step time (commission.rs; not the rod, whose high step is the reaction's
+//! reference); the last settled revolution of each is kept raw (the harmonics of the
 //! duty, the gaps' speed and acceleration, [`LoadPattern::commission_tick`]), and once the model
 //! is identified ([`LoadPattern::adopt`]) the two `D` give `T = (g2 D1 - g1 D2) / (g2 - g1)`,
 //! `g = w (1 - i tau s w)`, when the high step is at least [`SEPARATE_SPEED_RATIO`] times the
-//! low one's speed. The rod's commissioning runs with the spin at rest, so the spin's reaction
-//! is not in it. That `T` is fed forward from the first start until a pattern is learned in
+//! low one's speed and each revolution's speed drifted by at most [`STEADY_DRIFT`]. That `T` is
+//! fed forward from the first start until a pattern is learned in
 //! closed loop, and kept through stops (the tooth map keeps its count through a stop too); a
 //! reversal, a slipped count or a new commissioning forgets it.
 
@@ -71,9 +72,6 @@ pub const LEARN_BELOW_RAD_S: f32 = core::f32::consts::TAU / SLOWEST_LEARNED_REVO
 /// The commissioning's high step must be at least this much faster than its low step for the
 /// wheel's pattern and the load to be told apart.
 pub const SEPARATE_SPEED_RATIO: f32 = 1.3;
-/// The load found while commissioning is fed only if it is at least this share of the
-/// difference between the two steps' patterns (the wheel's share growing with the speed).
-pub const MIN_LOAD_TO_WHEEL: f32 = 0.5;
 /// A commissioning step's revolution is kept only if the speed at its first gap changed by
 /// at most this share over the revolution (the shaft settled at the step's speed).
 pub const STEADY_DRIFT: f32 = 0.03;
@@ -259,12 +257,7 @@ impl LoadPattern {
             (num[1] * den[0] - num[0] * den[1]) / den2,
         ];
         let size = t[0] * t[0] + t[1] * t[1];
-        // The load is the small difference of two large patterns when the wheel's share
-        // dominates (a light load on a worn wheel): there a few per cent of model error in `g`
-        // is all of it, so it is fed only when it is not small against the wheel's share.
-        let (dd0, dd1) = (d2[0] - d1[0], d2[1] - d1[1]);
-        let wheel = MIN_LOAD_TO_WHEEL * MIN_LOAD_TO_WHEEL * (dd0 * dd0 + dd1 * dd1);
-        if size.is_nan() || size > MAX_AMPLITUDE_DUTY * MAX_AMPLITUDE_DUTY || size < wheel {
+        if size.is_nan() || size > MAX_AMPLITUDE_DUTY * MAX_AMPLITUDE_DUTY {
             return [0.0; 2];
         }
         t
