@@ -3,6 +3,8 @@
 //! is the load the plant applies (its torque in duty, from the motor's own constants), and the
 //! true speed's ripple falls once it is fed forward.
 
+mod plant_rows;
+
 use model_core::control::Controller;
 use model_core::sim::experiments::{rig_with_pulses, true_model_config};
 use model_core::sim::{ClosedLoop, Plant, PlantParams};
@@ -146,5 +148,134 @@ fn a_set_point_change_keeps_the_pattern() {
     assert!(
         cl.ctrl.load_pattern(1).0 >= learned,
         "the pattern was restarted by the set-point change"
+    );
+}
+
+/// The eccentric load on the spin only: the rod's load is not found while commissioning (its
+/// high step is the reaction's reference and is not held longer), and would ripple the spin
+/// through the coupling.
+fn spin_eccentric_rig() -> PlantParams {
+    let mut rig = eccentric_rig();
+    rig.axes[0].ripple_nm = 0.0;
+    rig
+}
+
+/// That rig with a worn wheel: each tooth up to 8 % of a pitch off its place (the plant's
+/// hashed offsets), which gives the wheel a once-per-revolution pattern of its own.
+fn worn_eccentric_rig() -> PlantParams {
+    let mut rig = spin_eccentric_rig();
+    for a in &mut rig.axes {
+        a.sensor.tooth_error = 0.08;
+    }
+    rig
+}
+
+/// Commissioned on `rig` (the loop's model identified, not given), then at `speed_rad_s`.
+fn commissioned(rig: PlantParams, speed_rad_s: f32) -> ClosedLoop {
+    let ctrl = Controller::new(true_model_config(&rig)).expect("the nominal configuration");
+    let mut cl = ClosedLoop::new(Plant::new(rig, 1), ctrl);
+    assert_eq!(cl.commission(300.0), model_core::control::State::Idle);
+    cl.ctrl
+        .set_motor_speeds(speed_rad_s, speed_rad_s)
+        .expect("speeds in range");
+    cl.ctrl.start().expect("starts");
+    cl
+}
+
+/// The worst 1 s mean of the spin's true speed, in % off `target`, from `from_s` after now
+/// for `for_s`.
+fn worst_mean_off_pct(cl: &mut ClosedLoop, target: f32, from_s: f32, for_s: f32) -> f64 {
+    let dt = cl.dt_s();
+    let mut angle = Vec::new();
+    cl.run(from_s + for_s + 0.5, |c| angle.push(c.rig.angle_rad(1)));
+    let half = (0.5 / dt) as usize;
+    let mut worst_pct = 0.0f64;
+    for k in (from_s / dt) as usize..angle.len() - half {
+        let w = (angle[k + half] - angle[k - half]) / (2 * half) as f64 / dt as f64;
+        worst_pct = worst_pct.max(100.0 * (w - target as f64).abs() / target as f64);
+    }
+    worst_pct
+}
+
+/// Commissioning runs two steady steps at different speeds; the wheel's pattern and the load
+/// differ in how they grow with the speed, so the two tell the load apart: the pattern found
+/// is the plant's eccentric load (its torque in duty), not the worn wheel's, before any step.
+#[test]
+fn commissioning_finds_the_load_apart_from_a_worn_wheel() {
+    let rig = worn_eccentric_rig();
+    let m = rig.axes[1].motor;
+    let expected = RIPPLE_NM * m.resistance_ohm / (m.torque_constant * rig.supply_v);
+    let cl = commissioned(rig, 3.0);
+    let (revs, amplitude) = cl.ctrl.load_pattern(1);
+    eprintln!("after commissioning: {amplitude:.5} duty (plant {expected:.5}), {revs} revs");
+    assert_eq!(revs, 0, "nothing learned in closed loop yet");
+    assert!(
+        (amplitude - expected).abs() <= 0.25 * expected,
+        "found {amplitude:.5} duty, the plant's load is {expected:.5}"
+    );
+    // The same wheel without the load: what is found is the wheel's, and small.
+    let mut rig = worn_eccentric_rig();
+    for a in &mut rig.axes {
+        a.ripple_nm = 0.0;
+    }
+    let cl = commissioned(rig, 3.0);
+    let (_, amplitude) = cl.ctrl.load_pattern(1);
+    eprintln!("no load: {amplitude:.5} duty");
+    assert!(
+        amplitude <= 0.25 * expected,
+        "found {amplitude:.5} duty with no load (the load would be {expected:.5})"
+    );
+}
+
+/// Coming down from 3 rad/s (where nothing is learned: the wheel's pattern reads as a load
+/// there) to 1 rad/s, the load found while commissioning is fed from the first revolution:
+/// the 1 s mean of the true speed is within 2 % of 1 rad/s from 3 s after the step on (0.42 %;
+/// 2.74 % with the commissioning's load not fed). On a wheel worn as in
+/// [`worn_eccentric_rig`] the loop's chase of the wheel's own first harmonic, which the tooth
+/// map leaves in, costs 3.14 % by itself (no load; measured, not asserted here).
+#[test]
+fn from_three_to_one_the_load_is_fed_from_the_first_revolution() {
+    let mut cl = commissioned(spin_eccentric_rig(), 3.0);
+    cl.run(15.0, |_| {});
+    cl.ctrl
+        .set_motor_speeds(SPEED_RAD_S, SPEED_RAD_S)
+        .expect("speeds in range");
+    let worst_pct = worst_mean_off_pct(&mut cl, SPEED_RAD_S, 3.0, 7.0);
+    eprintln!("3 -> 1 rad/s: worst 1 s mean {worst_pct:.2} % off from 3 s on");
+    assert!(
+        worst_pct <= 2.0,
+        "1 s mean {worst_pct:.2} % off 1 rad/s from 3 s after the step down from 3 rad/s"
+    );
+}
+
+/// A slow spin (seed-8 family plant p00's rod put on the spin axis: time constant 0.7 s, a
+/// light load 0.002 N m on a wheel 2.8 % worn) has not settled half a step into commissioning:
+/// the revolution recorded there would carry the approach's trend into the harmonic (on that
+/// rod, with no drift limit, 0.0055 duty against the plant's 0.00115). It is not kept, so
+/// nothing wrong is fed forward.
+#[test]
+fn an_unsettled_commissioning_step_gives_no_load() {
+    let rig = plant_rows::rig_from_table(
+        12.086,
+        0.6,
+        [
+            [
+                1.747, 0.01086, 0.01521, 0.1521, 0.213, 0.0322, 0.000767, 0.0, 0.0,
+            ],
+            [
+                1.1512, 0.11911, 0.003, 0.03, 0.04, 0.0277, 0.000118, 0.002, 0.0,
+            ],
+        ],
+    );
+    let m = rig.axes[1].motor;
+    let expected = 0.002 * m.resistance_ohm / (m.torque_constant * rig.supply_v);
+    let ctrl = Controller::new(true_model_config(&rig)).expect("a valid configuration");
+    let mut cl = ClosedLoop::new(Plant::new(rig, 8000), ctrl);
+    assert_eq!(cl.commission(300.0), model_core::control::State::Idle);
+    let (_, amplitude) = cl.ctrl.load_pattern(1);
+    eprintln!("slow spin: {amplitude:.5} duty (plant {expected:.5})");
+    assert!(
+        amplitude == 0.0 || (amplitude - expected).abs() <= 0.25 * expected,
+        "fed {amplitude:.5} duty, the plant's load is {expected:.5}"
     );
 }

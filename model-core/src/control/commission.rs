@@ -7,9 +7,11 @@
 //!    shaft). No edge by [`BREAKAWAY_MAX_DUTY`] refuses: the shaft is blocked or the sensor dead.
 //! 1. *Low step*: duty `max(low_duty, breakaway + 0.1)`, held at least `step_time_s` and until
 //!    the edges in the step's second half span whole revolutions (a multiple of the pulses per
-//!    revolution, at least `min_fit_edges` and one revolution): each tooth enters the fit equally
-//!    often, so tooth offsets and a once-per-revolution load average out instead of biasing
-//!    the slope. A straight line fitted to (edge time, edge angle) gives the steady speed `w_L`.
+//!    revolution, at least `min_fit_edges` and one revolution): each tooth enters the fit
+//!    equally often, so tooth offsets and a once-per-revolution load average out instead of
+//!    biasing the slope. The spin's steps then hold on, the fit complete, until their second
+//!    half spans a revolution and three edges: the load pattern's revolution (load_pattern.rs
+//!    tells the load from the wheel by the two steps). A straight line fitted to (edge time, edge angle) gives the steady speed `w_L`.
 //! 2. *High step*: duty `max(high_duty, low + 0.2)` (at most 0.95), same rule, gives `w_H` and
 //!    the line's intercept.
 //! 3. *Coast*: zero duty until the estimator reads zero, then the next axis.
@@ -199,6 +201,12 @@ pub struct Commissioning {
     /// clock.
     reaction_done_s: Option<f32>,
     results: [Option<Identified>; 2],
+    /// See [`Commissioning::steady_step`].
+    steady_step: u8,
+    /// Pulses in this step's second half, and whether its fit is complete (the step then
+    /// holds on, its fit unchanged, until the load pattern has its revolution; the spin only).
+    steady_pulses: u32,
+    fit_done: bool,
 }
 
 impl Commissioning {
@@ -234,7 +242,15 @@ impl Commissioning {
             reaction_fit_from_s: 0.0,
             reaction_done_s: None,
             results: [None, None],
+            steady_step: 0,
+            steady_pulses: 0,
+            fit_done: false,
         }
+    }
+
+    /// The step (1 low, 2 high) whose duty has been held for half the step time, else 0.
+    pub fn steady_step(&self) -> u8 {
+        self.steady_step
     }
 
     /// The axis being identified and the phase.
@@ -280,6 +296,10 @@ impl Commissioning {
         };
         // Second half of the step only: by then the speed is steady.
         if t_s - phase_start >= 0.5 * self.cfg.step_time_s {
+            self.steady_pulses += pulses;
+            if self.fit_done {
+                return;
+            }
             match self.phase {
                 Phase::Low => self.low_fit.add(t_s, angle),
                 _ => self.high_fit.add(t_s, angle),
@@ -306,6 +326,13 @@ impl Commissioning {
         // Whole revolutions: each tooth equally often in the fit.
         let min_edges = (self.cfg.min_fit_edges as u32).max(n);
         let whole = |count: u32| count >= min_edges && count.is_multiple_of(n);
+        // Once a step's fit spans whole revolutions it is complete (and unchanged from here);
+        // the step holds on until its second half also has a whole revolution of gaps and
+        // their neighbours for the load pattern (load_pattern.rs tells the load from the wheel
+        // by the two steps). The spin's steps only: the rod's high step's line is the
+        // reaction's reference (held longer, the measured reaction moved: docs/control.md),
+        // and without it its low step's revolution would serve nothing.
+        let load_ready = self.axis == 0 || self.steady_pulses >= n + 3;
         let mut duty = 0.0;
         match self.phase {
             Phase::Breakaway => {
@@ -317,7 +344,10 @@ impl Commissioning {
             }
             Phase::Low => {
                 duty = self.low_duty;
-                if t_s >= self.cfg.step_time_s && whole(self.low_fit.count()) {
+                self.fit_done |= t_s >= self.cfg.step_time_s && whole(self.low_fit.count());
+                if self.fit_done && load_ready {
+                    self.fit_done = false;
+                    self.steady_pulses = 0;
                     self.step_at_s = t_s;
                     self.phase = Phase::High;
                     duty = self.high_duty;
@@ -325,7 +355,12 @@ impl Commissioning {
             }
             Phase::High => {
                 duty = self.high_duty;
-                if t_s - self.step_at_s >= self.cfg.step_time_s && whole(self.high_fit.count()) {
+                let count = self.high_fit.count();
+                let whole_step = t_s - self.step_at_s >= self.cfg.step_time_s && whole(count);
+                self.fit_done |= whole_step;
+                if self.fit_done && load_ready {
+                    self.fit_done = false;
+                    self.steady_pulses = 0;
                     self.results[self.axis] = Some(self.identify()?);
                     if self.axis == 1 {
                         self.spin_high_duty = self.high_duty;
@@ -371,6 +406,12 @@ impl Commissioning {
             }
             Phase::Done => {}
         }
+        let held_s = 0.5 * self.cfg.step_time_s;
+        self.steady_step = match self.phase {
+            Phase::Low if self.axis == 1 && t_s >= held_s => 1,
+            Phase::High if self.axis == 1 && t_s - self.step_at_s >= held_s => 2,
+            _ => 0,
+        };
         let mut duties = [0.0; 2];
         duties[self.axis] = duty;
         if self.phase == Phase::Reaction {

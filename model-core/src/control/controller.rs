@@ -429,9 +429,11 @@ impl Controller {
         } else if r < 0.0 {
             a.direction = -1.0;
         }
-        if a.direction != was || r == 0.0 {
-            // The wheel's gaps now pass in the opposite order (or the shaft is let go: its
-            // angle may move unseen); the load pattern is learned anew.
+        if a.direction != was {
+            // The wheel's gaps now pass in the opposite order: the load pattern is learned anew.
+            a.load.forget_all();
+        } else if r == 0.0 {
+            // The shaft is let go: what the loop learned is learned anew.
             a.load.forget();
         }
         if a.direction != was {
@@ -499,6 +501,9 @@ impl Controller {
             return;
         };
         let axis = c.progress().0;
+        // The load pattern of each step, with the wheel's, for load_pattern::adopt.
+        let a = &mut self.axes[axis];
+        a.load.commission_tick(&a.est, a.duty, c.steady_step());
         let clock = self.axes[axis].est.clock_ticks();
         match c.step(
             dt,
@@ -569,14 +574,20 @@ impl Controller {
     fn rebuild_keep_state(&mut self, cfg: ControllerConfig) {
         let est = [self.axes[0].est, self.axes[1].est];
         let current = [self.axes[0].current, self.axes[1].current];
+        let load = [self.axes[0].load, self.axes[1].load];
         let identified = self.identified;
         let feedback = self.feedback;
         let supply_cut = self.supply_cut;
         *self = Self::build(cfg);
         self.supply_cut = supply_cut;
-        for (a, (e, c)) in self.axes.iter_mut().zip(est.into_iter().zip(current)) {
+        for (a, ((e, c), l)) in self
+            .axes
+            .iter_mut()
+            .zip(est.into_iter().zip(current).zip(load))
+        {
             a.est = e;
             a.current = c;
+            a.load.adopt(&l);
         }
         self.identified = identified;
         self.feedback = feedback;
