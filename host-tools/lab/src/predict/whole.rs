@@ -143,32 +143,59 @@ pub(crate) fn run_level(
                     ..*shape
                 }
             };
-            // Near the stick threshold the slide/roll switch can chatter at a loose tolerance
-            // (and, erratically, at some tight ones): a release that takes 5 000 steps (tens of
-            // times a normal one) is run again at rtol 1e-10, which gets through where the
-            // loose one did not. Once one release of the scene has needed that, the rest start
-            // there (they share the scene's threshold); so do all of them where the granule
-            // rolls at release and must slide before the rim (the switch is on every path:
-            // docs/model.md §12).
+            // Near the stick threshold the slide/roll switch can stall the integrator at a
+            // loose tolerance (and, erratically, at some tight ones): each release runs with a
+            // stall watch (`bowl::residence_or_stall`: sixteen steps in a row that do not
+            // advance the time) and at most 5 000 steps; one that stalls or takes them all is
+            // run again at a tenth of the tolerance, then at rtol 1e-10 without either limit
+            // (which gets through). The scene's later releases start at the rung that got
+            // through (they share its threshold). Where the granule rolls at release and must
+            // slide before the rim (the switch is on every path) they all start at 1e-10
+            // (docs/model.md §12).
             let quick = SystemLimits {
                 max_steps: limits.max_steps.min(5_000),
                 ..limits
             };
-            let tight = RollingMethod::Dp54 { rtol: 1e-10 };
+            let tight = 1e-10;
             let mu_s = scene.sliding_friction;
-            let mut chatters =
-                friction_needed_at_release(scene) <= mu_s && friction_needed_at_rim(scene) > mu_s;
+            let start = match method {
+                RollingMethod::Dp54 { rtol } => rtol,
+                RollingMethod::Rk4 { .. } => tight,
+            };
+            let mut rung = if friction_needed_at_release(scene) <= mu_s
+                && friction_needed_at_rim(scene) > mu_s
+            {
+                tight
+            } else {
+                start
+            };
             for &deg in betas {
                 let b = deg.to_radians();
-                let rep = if chatters {
-                    bowl::residence(scene, &shape, b, tight, limits)
-                } else {
-                    match bowl::residence(scene, &shape, b, method, quick) {
+                let rep = loop {
+                    if rung <= tight {
+                        break bowl::residence(
+                            scene,
+                            &shape,
+                            b,
+                            RollingMethod::Dp54 { rtol: tight },
+                            limits,
+                        );
+                    }
+                    match bowl::residence_or_stall(
+                        scene,
+                        &shape,
+                        b,
+                        RollingMethod::Dp54 { rtol: rung },
+                        quick,
+                    ) {
                         Err(bowl::BowlError::Scene(rolling::RollingError::Integration(_))) => {
-                            chatters = true;
-                            bowl::residence(scene, &shape, b, tight, limits)
+                            rung = if rung > 10.0 * tight {
+                                (0.1 * rung).max(tight)
+                            } else {
+                                tight
+                            };
                         }
-                        other => other,
+                        other => break other,
                     }
                 };
                 match rep {

@@ -216,6 +216,13 @@ fn cost_over(grid: &[(RollingScene<f64>, BowlShape<f64>)]) {
             };
             let err = ((mean - reference) / reference).abs();
             let ratio = cost / cheapest.0;
+            // The incline's own error and the bound the chooser holds it to (docs/model.md
+            // §12: where the incline was the cheapest but not taken, the bound is above the
+            // tolerance while the error happened to be inside it).
+            let c = choose_level(&s, &sh, tol, false);
+            let incline = c
+                .incline_mean_s
+                .map_or(f64::NAN, |m| ((m - reference) / reference).abs());
             rows += 1;
             if err > tol {
                 misses += 1;
@@ -226,11 +233,12 @@ fn cost_over(grid: &[(RollingScene<f64>, BowlShape<f64>)]) {
             worst = worst.max(ratio);
             ratios.push(ratio);
             println!(
-                "tilt {tilt:>4} w {w1:>3}/{w2:>6} mu_s {mu_s} wall {wh:>5} fillet {fillet}: tol {tol:<5} chooser {:<18} err {err:.1e} cost {:.2e} s; cheapest {} {:.2e} s; ratio {ratio:.2}",
+                "tilt {tilt:>4} w {w1:>3}/{w2:>6} mu_s {mu_s} wall {wh:>5} fillet {fillet}: tol {tol:<5} chooser {:<18} err {err:.1e} cost {:.2e} s; cheapest {} {:.2e} s; ratio {ratio:.2}; incline err {incline:.1e} estimate {:.1e}",
                 level.name(),
                 cost,
                 cheapest.1,
-                cheapest.0
+                cheapest.0,
+                c.rotation_estimate
             );
         }
     }
@@ -243,7 +251,8 @@ fn cost_over(grid: &[(RollingScene<f64>, BowlShape<f64>)]) {
 
 /// The chatter handling of `run_level` gives the bowl model's answer: a scene where the granule
 /// rolls at release and must slide before the rim (run at rtol 1e-10 from the start), and a
-/// wall where two releases chatter at 1e-6 (run again at 1e-10, the rest after them too):
+/// wall where two releases stall at 1e-6 (found by the stall watch, run again at 1e-7, the
+/// rest after them too):
 /// every release leaves, each within 1e-4 of the bowl model at rtol 1e-10 run release by
 /// release.
 #[test]
