@@ -8,7 +8,7 @@ use model_core::choose::whole::{
     Fails, LEVELS, Level, WholeChoice, choose_level, friction_needed_at_release,
     friction_needed_at_rim, incline_release_s,
 };
-use model_core::ode::system::SystemLimits;
+use model_core::ode::system::{SystemError, SystemLimits};
 use model_core::particle::bowl::{self, BowlOutcome, BowlShape};
 use model_core::particle::rolling::{self, MAX_STEPS, RollingMethod, RollingOutcome, RollingScene};
 use serde_json::{Value, json};
@@ -146,11 +146,13 @@ pub(crate) fn run_level(
             // Near the stick threshold the slide/roll switch can stall the integrator at a
             // loose tolerance (and, erratically, at some tight ones): each release runs with a
             // stall watch (`bowl::residence_or_stall`: sixteen steps in a row that do not
-            // advance the time) and at most 5 000 steps; one that stalls or takes them all is
-            // run again at a tenth of the tolerance, then at rtol 1e-10 without either limit
-            // (which gets through). The scene's later releases start at the rung that got
-            // through (they share its threshold). Where the granule rolls at release and must
-            // slide before the rim (the switch is on every path) they all start at 1e-10
+            // advance the time) and at most 5 000 steps; one that stalls is run again at a
+            // tenth of the tolerance, and the scene's later releases start there (they share
+            // its threshold); one that takes all the steps is run at rtol 1e-10 without either
+            // limit (which gets through), and once two have, so are the later ones (a scene
+            // whose releases all take that long, e.g. held in a wall's corner, pays the loose
+            // run twice, not twelve times). Where the granule rolls at release and must slide
+            // before the rim (the switch is on every path) they all start at 1e-10
             // (docs/model.md §12).
             let quick = SystemLimits {
                 max_steps: limits.max_steps.min(5_000),
@@ -169,10 +171,14 @@ pub(crate) fn run_level(
             } else {
                 start
             };
+            let mut capped = 0;
             for &deg in betas {
                 let b = deg.to_radians();
+                // This release's rung: a stall lowers the scene's; 5 000 steps only its own,
+                // the scene's from the second release that takes them.
+                let mut own = rung;
                 let rep = loop {
-                    if rung <= tight {
+                    if own <= tight {
                         break bowl::residence(
                             scene,
                             &shape,
@@ -185,15 +191,28 @@ pub(crate) fn run_level(
                         scene,
                         &shape,
                         b,
-                        RollingMethod::Dp54 { rtol: rung },
+                        RollingMethod::Dp54 { rtol: own },
                         quick,
                     ) {
-                        Err(bowl::BowlError::Scene(rolling::RollingError::Integration(_))) => {
-                            rung = if rung > 10.0 * tight {
-                                (0.1 * rung).max(tight)
-                            } else {
+                        // A stall is the loose tolerance's own: a tenth of it gets past.
+                        Err(bowl::BowlError::Scene(rolling::RollingError::Integration(
+                            SystemError::Stalled,
+                        ))) => {
+                            own = if 0.1 * own <= 1.5 * tight {
                                 tight
+                            } else {
+                                0.1 * own
                             };
+                            rung = own;
+                        }
+                        // 5 000 steps without a stall: the cost is erratic in the tolerance
+                        // there (a tenth can take ten times the steps); 1e-10 gets through.
+                        Err(bowl::BowlError::Scene(rolling::RollingError::Integration(_))) => {
+                            own = tight;
+                            capped += 1;
+                            if capped >= 2 {
+                                rung = tight;
+                            }
                         }
                         other => break other,
                     }
