@@ -98,7 +98,6 @@ pub(crate) fn run_level(
             }
         }
         Level::Rolling => {
-            let mut worst: f64 = 0.0;
             for &deg in betas {
                 let rep = match rolling::residence_within(scene, deg.to_radians(), method, limits) {
                     Ok(rep) => rep,
@@ -111,27 +110,27 @@ pub(crate) fn run_level(
                     }
                 };
                 match rep.outcome {
+                    // The first release that needs more than mu_s hands over: the rest of
+                    // the rolling runs would be thrown away with it.
                     RollingOutcome::Leaves {
-                        residence_time_s,
-                        max_friction_ratio,
-                        ..
-                    } => {
-                        worst = worst.max(max_friction_ratio);
-                        times.push((deg, Some(residence_time_s)));
+                        max_friction_ratio, ..
+                    } if max_friction_ratio > scene.sliding_friction => {
+                        return Ok(Err(format!(
+                            "it rolled at release but slides later: rolling needed \
+                             {max_friction_ratio:.3} of the normal force at {deg} deg, the \
+                             contact gives mu_s = {}",
+                            scene.sliding_friction
+                        )));
                     }
+                    RollingOutcome::Leaves {
+                        residence_time_s, ..
+                    } => times.push((deg, Some(residence_time_s))),
                     RollingOutcome::LiftsOff { .. } => {
                         why.push("the normal force reaches zero (it would fly)".to_string());
                         times.push((deg, None));
                     }
                     _ => times.push((deg, None)),
                 }
-            }
-            if worst > scene.sliding_friction {
-                return Ok(Err(format!(
-                    "it rolled at release but slides later: rolling needed {worst:.3} of the \
-                     normal force, the contact gives mu_s = {}",
-                    scene.sliding_friction
-                )));
             }
         }
         Level::RollingOrSliding | Level::Bowl => {
