@@ -308,3 +308,28 @@ fn chattering_scenes_still_answer_within_the_tolerance() {
         }
     }
 }
+
+/// The rolling level hands over at the first release whose rolling run needs more friction
+/// than the contact gives (30 deg, 1.8 rad/s, mu_s 0.2: rolls at release, needs 0.195 at the
+/// rim by the estimate, more on some paths): the answer names that release, found here by
+/// running the rolling model release by release.
+#[test]
+fn the_rolling_level_hands_over_at_the_first_release_that_slides() {
+    let s = rig(30.0, 1.8, 1.8, 0.2);
+    let m = RollingMethod::Dp54 { rtol: 1e-6 };
+    let first = AZIMUTHS
+        .iter()
+        .find(|deg| {
+            let r = rolling::residence_within(&s, deg.to_radians(), m, LIMITS).unwrap();
+            matches!(r.outcome, RollingOutcome::Leaves { max_friction_ratio, .. } if max_friction_ratio > 0.2)
+        })
+        .expect("some release slides");
+    let why = run_level(Level::Rolling, &s, &shape(90.0, 0.0), &AZIMUTHS, m, LIMITS)
+        .unwrap()
+        .err()
+        .expect("the rolling level gives up");
+    assert!(
+        why.contains("slides later") && why.contains(&format!("at {first} deg")),
+        "{why}"
+    );
+}
