@@ -157,12 +157,14 @@ pub(crate) fn run_level(
                 max_steps: limits.max_steps.min(5_000),
                 ..limits
             };
-            let tight = 1e-10;
-            let mu_s = scene.sliding_friction;
+            // The chooser runs DP5(4) (`integrator_rtol`); a fixed-step method is not a rung.
             let start = match method {
                 RollingMethod::Dp54 { rtol } => rtol,
-                RollingMethod::Rk4 { .. } => tight,
+                RollingMethod::Rk4 { .. } => 1e-10,
             };
+            // The last rung: 1e-10, or the asked tolerance where that is tighter.
+            let tight = start.min(1e-10);
+            let mu_s = scene.sliding_friction;
             let mut rung = if friction_needed_at_release(scene) <= mu_s
                 && friction_needed_at_rim(scene) > mu_s
             {
