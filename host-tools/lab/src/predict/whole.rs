@@ -143,16 +143,20 @@ pub(crate) fn run_level(
                 }
             };
             // Near the stick threshold the slide/roll switch can stall the integrator at a
-            // loose tolerance: each release runs with a stall watch (`bowl::residence_or_stall`:
-            // sixteen steps in a row that do not advance the time), which finds it in tens of
-            // steps, so no tighter step cap is needed (a release that does not stall makes
-            // progress, and its tolerance's cost is erratic: 6 948 steps at 1e-6, 206 941 at
-            // 1e-10 for one release, 10 691 and 1 552 for another; docs/model.md §12). One that
-            // stalls is run again at a tenth of the tolerance, and the scene's later releases
-            // start there (they share its threshold); one that takes every step the caller
-            // allows is run at rtol 1e-10, and once two have, so are the later ones. Where the
-            // granule rolls at release and must slide before the rim (the switch is on every
-            // path) they all start at 1e-10.
+            // loose tolerance (and, erratically, at some tight ones): each release runs with a
+            // stall watch (`bowl::residence_or_stall`: sixteen steps in a row that do not
+            // advance the time) and at most 5 000 steps; one that stalls is run again at a
+            // tenth of the tolerance, and the scene's later releases start there (they share
+            // its threshold); one that takes all the steps is run at rtol 1e-10 without either
+            // limit (which gets through), and once two have, so are the later ones (a scene
+            // whose releases all take that long, e.g. held in a wall's corner, pays the loose
+            // run twice, not twelve times). Where the granule rolls at release and must slide
+            // before the rim (the switch is on every path) they all start at 1e-10
+            // (docs/model.md §12).
+            let quick = SystemLimits {
+                max_steps: limits.max_steps.min(5_000),
+                ..limits
+            };
             // The chooser runs DP5(4) (`integrator_rtol`); a fixed-step method is not a rung.
             let start = match method {
                 RollingMethod::Dp54 { rtol } => rtol,
@@ -171,8 +175,8 @@ pub(crate) fn run_level(
             let mut capped = 0;
             for &deg in betas {
                 let b = deg.to_radians();
-                // This release's rung: a stall lowers the scene's; the step limit only its own,
-                // the scene's from the second release that meets it.
+                // This release's rung: a stall lowers the scene's; 5 000 steps only its own,
+                // the scene's from the second release that takes them.
                 let mut own = rung;
                 let rep = loop {
                     if own <= tight {
@@ -189,7 +193,7 @@ pub(crate) fn run_level(
                         &shape,
                         b,
                         RollingMethod::Dp54 { rtol: own },
-                        limits,
+                        quick,
                     ) {
                         // A stall is the loose tolerance's own: a tenth of it gets past.
                         Err(bowl::BowlError::Scene(rolling::RollingError::Integration(
@@ -202,8 +206,8 @@ pub(crate) fn run_level(
                             };
                             rung = own;
                         }
-                        // The step limit without a stall: 1e-10, which gets through where
-                        // looser ones crawl.
+                        // 5 000 steps without a stall: the cost is erratic in the tolerance
+                        // there (a tenth can take ten times the steps); 1e-10 gets through.
                         Err(bowl::BowlError::Scene(rolling::RollingError::Integration(_))) => {
                             own = tight;
                             capped += 1;
