@@ -383,7 +383,11 @@ fn stall_watch_fires_only_where_the_unwatched_run_fails() {
                     continue;
                 }
                 stalls += 1;
-                let plain = bowl::residence(&s, &sh, b, m, LIMITS);
+                let long = SystemLimits {
+                    horizon_s: 10.0,
+                    max_steps: 200_000,
+                };
+                let plain = bowl::residence(&s, &sh, b, m, long);
                 println!(
                     "stall: tilt {:.0} w {}/{} mu_s {} wall {} at {deg} deg, rtol {rtol:e}; unwatched: {plain:?}",
                     s.axes_angle_rad.to_degrees(),
