@@ -107,6 +107,40 @@ fn a_steep_wall_holds_the_granule_and_says_so() {
     );
 }
 
+/// A release that stalls at a loose tolerance (a 60 deg wall at 45 deg tilt, 1.8 rad/s, mu_s
+/// 0.2, released at 30 deg, rtol 1e-6: steps that no longer advance the time, docs/model.md
+/// §12) is reported as such with the advice that gets past it, and at that advice (1e-7) it
+/// leaves.
+#[test]
+fn a_stalled_release_says_a_tighter_tolerance_gets_past_it() {
+    let args = |tol| {
+        bowl_args(
+            "1.8",
+            "1.8",
+            "45",
+            ["60", "0.02", "0"],
+            &[
+                "--sliding-mu",
+                "0.2",
+                "--release-azimuth-deg",
+                "30",
+                "--tol",
+                tol,
+                "--json",
+            ],
+        )
+    };
+    let v = json(&args("1e-6"));
+    assert_eq!(v["valid"], false, "{v}");
+    let why = v["invalid_reason"].as_str().unwrap();
+    assert!(
+        why.contains("stalled at a roll/slide switch") && why.contains("a tighter --tol"),
+        "{why}"
+    );
+    let v = json(&args("1e-7"));
+    assert_eq!(v["releases_leaving"], 1, "{v}");
+}
+
 /// A flared wall (60 deg, 20 mm) keeps the granule longer than a bare rim, and it leaves over
 /// the lip at `R + H cot 60`.
 #[test]

@@ -47,6 +47,9 @@ pub enum SystemError {
     NotFinite,
     /// A step size or tolerance was not positive and finite.
     InvalidStep,
+    /// A run watched for stalls took steps in a row that do not advance the time (the
+    /// roll/slide switch stalling at a loose tolerance: `particle::rolling::modes::StallWatch`).
+    Stalled,
 }
 
 /// What a run did besides its ending: its cost.

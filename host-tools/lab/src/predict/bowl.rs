@@ -152,14 +152,22 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
     let betas = azimuths(r.release_azimuth_deg())?;
     let mut rows = Vec::new();
     // A release the integrator gives up on (the step cap, e.g. a granule chattering at the
-    // stick threshold in a corner) is reported as such; the others still count.
+    // stick threshold in a corner, or a stall: steps that no longer advance the time, found
+    // by the stall watch in tens of steps instead of at the cap, docs/model.md §12) is
+    // reported as such; the others still count.
     let mut gave_up = Vec::new();
+    let mut stalled = 0;
     for &deg in &betas {
-        match bowl::residence(&scene, &shape, deg.to_radians(), method, limits) {
+        match bowl::residence_or_stall(&scene, &shape, deg.to_radians(), method, limits) {
             Ok(rep) => rows.push((deg, rep)),
             Err(
                 e @ BowlError::Scene(model_core::particle::rolling::RollingError::Integration(_)),
             ) => {
+                if e == BowlError::Scene(model_core::particle::rolling::RollingError::Integration(
+                    model_core::ode::system::SystemError::Stalled,
+                )) {
+                    stalled += 1;
+                }
                 gave_up.push((deg, words(e)));
             }
             Err(e) => bail!("release at {deg} deg: {}", words(e)),
@@ -190,9 +198,16 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
         ));
     }
     if !gave_up.is_empty() {
+        // A stall is the loose tolerance's own (a tighter one gets past it); the step cap
+        // is met by long runs, which a shorter horizon or a looser tolerance shortens.
+        let advice = if stalled == gave_up.len() {
+            "a tighter --tol (1e-7 or below) may get through"
+        } else {
+            "a shorter --max-time-s or a looser --tol may get through"
+        };
         why.push(format!(
             "the integration gave up on {} of {releases} releases ({}), so they have no \
-             residence time; a shorter --max-time-s or a looser --tol may get through",
+             residence time; {advice}",
             gave_up.len(),
             gave_up[0].1
         ));

@@ -130,6 +130,11 @@ pub fn words(e: RollingError) -> String {
         RollingError::Integration(SystemError::InvalidStep) => {
             "--step-s and --tol must be positive numbers".into()
         }
+        RollingError::Integration(SystemError::Stalled) => {
+            "the integration stalled at a roll/slide switch (steps that do not advance the \
+             time): give a tighter --tol"
+                .into()
+        }
     }
 }
 

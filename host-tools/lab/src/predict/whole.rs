@@ -8,7 +8,7 @@ use model_core::choose::whole::{
     Fails, LEVELS, Level, WholeChoice, choose_level, friction_needed_at_release,
     friction_needed_at_rim, incline_release_s,
 };
-use model_core::ode::system::SystemLimits;
+use model_core::ode::system::{SystemError, SystemLimits};
 use model_core::particle::bowl::{self, BowlOutcome, BowlShape};
 use model_core::particle::rolling::{self, MAX_STEPS, RollingMethod, RollingOutcome, RollingScene};
 use serde_json::{Value, json};
@@ -98,7 +98,6 @@ pub(crate) fn run_level(
             }
         }
         Level::Rolling => {
-            let mut worst: f64 = 0.0;
             for &deg in betas {
                 let rep = match rolling::residence_within(scene, deg.to_radians(), method, limits) {
                     Ok(rep) => rep,
@@ -111,27 +110,27 @@ pub(crate) fn run_level(
                     }
                 };
                 match rep.outcome {
+                    // The first release that needs more than mu_s hands over: the rest of
+                    // the rolling runs would be thrown away with it.
                     RollingOutcome::Leaves {
-                        residence_time_s,
-                        max_friction_ratio,
-                        ..
-                    } => {
-                        worst = worst.max(max_friction_ratio);
-                        times.push((deg, Some(residence_time_s)));
+                        max_friction_ratio, ..
+                    } if max_friction_ratio > scene.sliding_friction => {
+                        return Ok(Err(format!(
+                            "it rolled at release but slides later: rolling needed \
+                             {max_friction_ratio:.3} of the normal force at {deg} deg, the \
+                             contact gives mu_s = {}",
+                            scene.sliding_friction
+                        )));
                     }
+                    RollingOutcome::Leaves {
+                        residence_time_s, ..
+                    } => times.push((deg, Some(residence_time_s))),
                     RollingOutcome::LiftsOff { .. } => {
                         why.push("the normal force reaches zero (it would fly)".to_string());
                         times.push((deg, None));
                     }
                     _ => times.push((deg, None)),
                 }
-            }
-            if worst > scene.sliding_friction {
-                return Ok(Err(format!(
-                    "it rolled at release but slides later: rolling needed {worst:.3} of the \
-                     normal force, the contact gives mu_s = {}",
-                    scene.sliding_friction
-                )));
             }
         }
         Level::RollingOrSliding | Level::Bowl => {
@@ -143,32 +142,80 @@ pub(crate) fn run_level(
                     ..*shape
                 }
             };
-            // Near the stick threshold the slide/roll switch can chatter at a loose tolerance
-            // (and, erratically, at some tight ones): a release that takes 5 000 steps (tens of
-            // times a normal one) is run again at rtol 1e-10, which gets through where the
-            // loose one did not. Once one release of the scene has needed that, the rest start
-            // there (they share the scene's threshold); so do all of them where the granule
-            // rolls at release and must slide before the rim (the switch is on every path:
-            // docs/model.md §12).
+            // Near the stick threshold the slide/roll switch can stall the integrator at a
+            // loose tolerance (and, erratically, at some tight ones): each release runs with a
+            // stall watch (`bowl::residence_or_stall`: sixteen steps in a row that do not
+            // advance the time) and at most 5 000 steps; one that stalls is run again at a
+            // tenth of the tolerance, and the scene's later releases start there (they share
+            // its threshold); one that takes all the steps is run at rtol 1e-10 without either
+            // limit (which gets through), and once two have, so are the later ones (a scene
+            // whose releases all take that long, e.g. held in a wall's corner, pays the loose
+            // run twice, not twelve times). Where the granule rolls at release and must slide
+            // before the rim (the switch is on every path) they all start at 1e-10
+            // (docs/model.md §12).
             let quick = SystemLimits {
                 max_steps: limits.max_steps.min(5_000),
                 ..limits
             };
-            let tight = RollingMethod::Dp54 { rtol: 1e-10 };
+            // The chooser runs DP5(4) (`integrator_rtol`); a fixed-step method is not a rung.
+            let start = match method {
+                RollingMethod::Dp54 { rtol } => rtol,
+                RollingMethod::Rk4 { .. } => 1e-10,
+            };
+            // The last rung: 1e-10, or the asked tolerance where that is tighter.
+            let tight = start.min(1e-10);
             let mu_s = scene.sliding_friction;
-            let mut chatters =
-                friction_needed_at_release(scene) <= mu_s && friction_needed_at_rim(scene) > mu_s;
+            let mut rung = if friction_needed_at_release(scene) <= mu_s
+                && friction_needed_at_rim(scene) > mu_s
+            {
+                tight
+            } else {
+                start
+            };
+            let mut capped = 0;
             for &deg in betas {
                 let b = deg.to_radians();
-                let rep = if chatters {
-                    bowl::residence(scene, &shape, b, tight, limits)
-                } else {
-                    match bowl::residence(scene, &shape, b, method, quick) {
-                        Err(bowl::BowlError::Scene(rolling::RollingError::Integration(_))) => {
-                            chatters = true;
-                            bowl::residence(scene, &shape, b, tight, limits)
+                // This release's rung: a stall lowers the scene's; 5 000 steps only its own,
+                // the scene's from the second release that takes them.
+                let mut own = rung;
+                let rep = loop {
+                    if own <= tight {
+                        break bowl::residence(
+                            scene,
+                            &shape,
+                            b,
+                            RollingMethod::Dp54 { rtol: tight },
+                            limits,
+                        );
+                    }
+                    match bowl::residence_or_stall(
+                        scene,
+                        &shape,
+                        b,
+                        RollingMethod::Dp54 { rtol: own },
+                        quick,
+                    ) {
+                        // A stall is the loose tolerance's own: a tenth of it gets past.
+                        Err(bowl::BowlError::Scene(rolling::RollingError::Integration(
+                            SystemError::Stalled,
+                        ))) => {
+                            own = if 0.1 * own <= 1.5 * tight {
+                                tight
+                            } else {
+                                0.1 * own
+                            };
+                            rung = own;
                         }
-                        other => other,
+                        // 5 000 steps without a stall: the cost is erratic in the tolerance
+                        // there (a tenth can take ten times the steps); 1e-10 gets through.
+                        Err(bowl::BowlError::Scene(rolling::RollingError::Integration(_))) => {
+                            own = tight;
+                            capped += 1;
+                            if capped >= 2 {
+                                rung = tight;
+                            }
+                        }
+                        other => break other,
                     }
                 };
                 match rep {

@@ -194,6 +194,38 @@ pub fn residence<T: Real>(
     method: RollingMethod<T>,
     limits: SystemLimits<T>,
 ) -> Result<BowlReport<T>, BowlError> {
+    residence_watching(sc, shape, beta_rad, method, limits, None)
+}
+
+/// How many accepted steps in a row, each advancing the time by less than
+/// [`crate::particle::rolling::modes::STALL_STEP`] of the scene's time scale, count as a stall for
+/// [`residence_or_stall`].
+pub const STALL_STEPS: u32 = 16;
+
+/// [`residence`] that gives up early ([`SystemError::Stalled`]) where a segment stalls:
+/// [`STALL_STEPS`] accepted steps in a row that do not advance the time. At a loose tolerance
+/// the roll/slide switch on the wall can stall the integrator at one instant until the step cap
+/// (a 60 deg wall at 45 deg tilt, 1.8 rad/s, mu_s 0.2, rtol 1e-6: 30 steps to 0.2449 s, then
+/// none gets past it; docs/model.md §12); a caller that can run the release again at a tighter
+/// tolerance learns it after tens of steps instead of thousands.
+pub fn residence_or_stall<T: Real>(
+    sc: &RollingScene<T>,
+    shape: &BowlShape<T>,
+    beta_rad: T,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+) -> Result<BowlReport<T>, BowlError> {
+    residence_watching(sc, shape, beta_rad, method, limits, Some(STALL_STEPS))
+}
+
+fn residence_watching<T: Real>(
+    sc: &RollingScene<T>,
+    shape: &BowlShape<T>,
+    beta_rad: T,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+    stall_steps: Option<u32>,
+) -> Result<BowlReport<T>, BowlError> {
     shape.validate(sc)?;
     if !(limits.horizon_s.is_finite() && limits.horizon_s > T::ZERO) {
         return Err(BowlError::InvalidHorizon);
@@ -246,10 +278,14 @@ pub fn residence<T: Real>(
         phase = match phase {
             Phase::Bottom(t, from) => {
                 let on_bottom = match from {
-                    None => crate::particle::rolling::modes::roll_or_slide_within(
-                        &bottom, beta_rad, method, limits,
+                    None => crate::particle::rolling::modes::roll_or_slide_watching(
+                        &bottom,
+                        beta_rad,
+                        method,
+                        limits,
+                        stall_steps,
                     ),
-                    Some(y) => run_from(&bottom, t, y, method, remaining),
+                    Some(y) => run_from(&bottom, t, y, method, remaining, stall_steps),
                 }
                 .map_err(BowlError::Scene)?;
                 report.add(&on_bottom.tally);
@@ -346,8 +382,17 @@ pub fn residence<T: Real>(
                 let Some(m) = meridian else {
                     return Ok(report);
                 };
-                let w = stay(sc, &m, t, entry, method, remaining, MAX_SWITCHES)
-                    .map_err(BowlError::Scene)?;
+                let w = stay(
+                    sc,
+                    &m,
+                    t,
+                    entry,
+                    method,
+                    remaining,
+                    MAX_SWITCHES,
+                    stall_steps,
+                )
+                .map_err(BowlError::Scene)?;
                 report.add(&w.tally);
                 report.on_wall_s += w.tally.regime.roll_s + w.tally.regime.slide_s;
                 match w.end {

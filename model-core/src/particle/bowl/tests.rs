@@ -386,3 +386,64 @@ fn the_corners_rebound_hops_as_on_an_incline() {
         assert_eq!(r.landings, want_landings);
     }
 }
+
+/// The stall watch (`residence_or_stall`, docs/model.md §12): at rtol 1e-6 a release on a 60 deg
+/// wall at 45 deg tilt, 1.8 rad/s, mu_s 0.2 stalls at 0.2449 s (steps that no longer advance the
+/// time) after about 30 steps; unwatched it burns any step cap (5 000 here), watched it says
+/// so within 200 steps. A tighter run gets through, and where nothing stalls (every release
+/// of this scene at 1e-7 and 1e-10, a 10 deg bowl whose granule changes mode over a thousand
+/// times in its wall's corner, a scene that slides) the watched run is the unwatched one, to
+/// the bit.
+#[test]
+fn a_stalled_release_is_found_within_200_steps() {
+    use crate::particle::rolling::AZIMUTHS_DEG;
+    let rig = |tilt: f64, w: f64, mu_s: f64| RollingScene {
+        sliding_friction: mu_s,
+        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
+    };
+    let wall = shape(60.0, 0.02, 0.0);
+    let s = rig(45.0, 1.8, 0.2);
+    let b = AZIMUTHS_DEG[1].to_radians();
+    let loose = RollingMethod::Dp54 { rtol: 1e-6 };
+    let capped = |max_steps| SystemLimits {
+        horizon_s: 10.0,
+        max_steps,
+    };
+    let stalled = BowlError::Scene(RollingError::Integration(SystemError::Stalled));
+    let step_limit = BowlError::Scene(RollingError::Integration(SystemError::StepLimit));
+    assert_eq!(
+        residence(&s, &wall, b, loose, capped(5_000)),
+        Err(step_limit)
+    );
+    assert_eq!(
+        residence_or_stall(&s, &wall, b, loose, capped(200)),
+        Err(stalled)
+    );
+    let tight = residence(
+        &s,
+        &wall,
+        b,
+        RollingMethod::Dp54 { rtol: 1e-7 },
+        capped(5_000),
+    );
+    assert!(
+        matches!(tight, Ok(r) if matches!(r.outcome, BowlOutcome::Leaves { .. })),
+        "{tight:?}"
+    );
+    for (s, rtols) in [
+        (s, [1e-7, 1e-10]),
+        (rig(10.0, 1.8, 0.4), [1e-6, 1e-7]),
+        (rig(60.0, 3.6, 0.2), [1e-6, 1e-10]),
+    ] {
+        for rtol in rtols {
+            for deg in AZIMUTHS_DEG {
+                let m = RollingMethod::Dp54 { rtol };
+                let b = deg.to_radians();
+                let plain = residence(&s, &wall, b, m, capped(200_000));
+                let watched = residence_or_stall(&s, &wall, b, m, capped(200_000));
+                assert!(plain.is_ok(), "{deg} deg at {rtol:e}: {plain:?}");
+                assert_eq!(watched, plain, "{deg} deg at {rtol:e}");
+            }
+        }
+    }
+}

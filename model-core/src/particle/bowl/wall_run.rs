@@ -4,14 +4,13 @@
 //! contact's changes (rolling needing more than `mu_s N`; the slip ending).
 
 use core::cell::Cell;
-use core::ops::ControlFlow;
 
 use super::wall::{Contact, Meridian, WallState, wall_forces};
 use crate::Real;
-use crate::ode::system::SystemLimits;
+use crate::ode::system::{SystemError, SystemLimits};
 use crate::particle::rolling::equations::AT_REST_M_S;
 use crate::particle::rolling::modes::{
-    Mode, Tally, fired, follow_slip, scene_scales, segment, stuck_m_s,
+    Mode, StallWatch, Tally, fired, follow_slip, scene_scales, segment, stuck_m_s,
 };
 use crate::particle::rolling::{RollingError, RollingMethod, RollingScene};
 
@@ -138,7 +137,10 @@ fn no_slip<T: Real>(sc: &RollingScene<T>, m: &Meridian<T>, t: T, y: &WallState<T
     out
 }
 
-/// Follows the granule on the wall from `(t0, y0)` until it leaves the wall.
+/// Follows the granule on the wall from `(t0, y0)` until it leaves the wall. With
+/// `stall_steps`, a stay that stalls gives up (`SystemError::Stalled`)
+/// ([`crate::particle::rolling::modes::StallWatch`], [`super::residence_or_stall`]).
+#[allow(clippy::too_many_arguments)]
 pub fn stay<T: Real>(
     sc: &RollingScene<T>,
     m: &Meridian<T>,
@@ -147,6 +149,7 @@ pub fn stay<T: Real>(
     method: RollingMethod<T>,
     limits: SystemLimits<T>,
     max_switches: u32,
+    stall_steps: Option<u32>,
 ) -> Result<WallStay<T>, RollingError> {
     let (refs, scales) = scene_scales(sc);
     let mut out = WallStay {
@@ -156,6 +159,8 @@ pub fn stay<T: Real>(
     let (mut t, mut y) = (t0, y0);
     let mut must_slide = false;
     let mut previous: Option<Mode> = None;
+    // One watch over the whole stay (as the bottom's `run_from`).
+    let watch = StallWatch::new(stall_steps, scales, t0);
     loop {
         let remaining = out.tally.remaining(limits, max_switches)?;
         let Some(contact) = next_contact(sc, m, t, &y, must_slide) else {
@@ -197,13 +202,16 @@ pub fn stay<T: Real>(
                     let s = wall_forces(sc, m, t, y, now(dir.get())).slip_m_s;
                     follow_slip(&s, &dir, &armed, stuck_m_s(refs.1));
                 }
-                ControlFlow::Continue(())
+                watch.step(t)
             },
             remaining,
         )?
         else {
             return Ok(out);
         };
+        if watch.step(te).is_break() {
+            return Err(RollingError::Integration(SystemError::Stalled));
+        }
         let e = events(
             sc,
             m,

@@ -15,7 +15,6 @@
 //!   either mode.
 
 use core::cell::Cell;
-use core::convert::Infallible;
 use core::ops::ControlFlow;
 
 use super::equations::{AT_REST_M_S, forces};
@@ -180,6 +179,61 @@ pub fn roll_or_slide_within<T: Real>(
     method: RollingMethod<T>,
     limits: SystemLimits<T>,
 ) -> Result<ModesReport<T>, RollingError> {
+    roll_or_slide_watching(scene, beta_rad, method, limits, None)
+}
+
+/// A step that advances the time by less than this fraction of the scene's time scale (its
+/// length over its speed, `1 / max(|Omega|, 1 rad/s)`: 0.1-1 s) makes no progress. A real
+/// step, even one cut short to locate an event, is far longer at rtol 1e-6 to 1e-10; a run
+/// stalled at a slide/roll switch takes steps of ~1e-16 s (docs/model.md §12).
+pub const STALL_STEP: f64 = 1e-9;
+
+/// Watches a segment's accepted steps for a stall: `steps` in a row, each shorter than
+/// [`STALL_STEP`] of the time scale (`None`: never).
+pub(crate) struct StallWatch<T> {
+    steps: Option<u32>,
+    dt: T,
+    last_t: Cell<T>,
+    run: Cell<u32>,
+}
+
+impl<T: Real> StallWatch<T> {
+    /// A watch from `t0` at the scene's `scales` (length, speed).
+    pub(crate) fn new(steps: Option<u32>, scales: (T, T), t0: T) -> Self {
+        Self {
+            steps,
+            dt: T::from_f64(STALL_STEP) * scales.0 / scales.1,
+            last_t: Cell::new(t0),
+            run: Cell::new(0),
+        }
+    }
+
+    /// After an accepted step to `t`: break once the run of tiny steps is long enough.
+    pub(crate) fn step(&self, t: T) -> ControlFlow<()> {
+        let Some(n) = self.steps else {
+            return ControlFlow::Continue(());
+        };
+        let tiny = (t - self.last_t.get()).abs() < self.dt;
+        self.last_t.set(t);
+        let run = if tiny { self.run.get() + 1 } else { 0 };
+        self.run.set(run);
+        if run >= n {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
+
+/// [`roll_or_slide_within`] that gives up ([`SystemError::Stalled`]) once the run stalls
+/// (`stall_steps`: see [`StallWatch`]; `None`: never).
+pub(crate) fn roll_or_slide_watching<T: Real>(
+    scene: &RollingScene<T>,
+    beta_rad: T,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+    stall_steps: Option<u32>,
+) -> Result<ModesReport<T>, RollingError> {
     let y0 = release(scene, beta_rad)?;
     let start = forces(scene, T::ZERO, &y0);
     let (ft, normal) = needed_friction_m_s2(scene, T::ZERO, &from_rolling(&y0));
@@ -194,7 +248,14 @@ pub fn roll_or_slide_within<T: Real>(
             end_state: from_rolling(&y0),
         });
     }
-    run_from(scene, T::ZERO, from_rolling(&y0), method, limits)
+    run_from(
+        scene,
+        T::ZERO,
+        from_rolling(&y0),
+        method,
+        limits,
+        stall_steps,
+    )
 }
 
 /// Which mode a state at `t` is in, and for a slide the direction its slip takes.
@@ -350,7 +411,7 @@ pub(crate) fn segment<T: Real, const N: usize>(
     method: RollingMethod<T>,
     scales: (T, T),
     event: impl Fn(T, &[T; N]) -> T,
-    check: impl FnMut(T, &[T; N]) -> ControlFlow<Infallible>,
+    check: impl FnMut(T, &[T; N]) -> ControlFlow<()>,
     limits: SystemLimits<T>,
 ) -> Result<Option<(T, [T; N])>, RollingError> {
     let (length, speed) = scales;
@@ -379,18 +440,21 @@ pub(crate) fn segment<T: Real, const N: usize>(
             tally.spend(mode, limits.horizon_s - t0);
             Ok(None)
         }
-        Ended::Stopped { why, .. } => match why {},
+        // The check gave up on the run (a stall: [`StallWatch`]).
+        Ended::Stopped { .. } => Err(RollingError::Integration(SystemError::Stalled)),
     }
 }
 
 /// The run from a state at `t0` in the sliding form (a rolling state has no slip), whatever
-/// its mode; the modes and their events as the module says.
+/// its mode; the modes and their events as the module says; a stalled segment gives up
+/// (`stall_steps`: see [`StallWatch`]).
 pub(crate) fn run_from<T: Real>(
     scene: &RollingScene<T>,
     t0: T,
     y0: SlideState<T>,
     method: RollingMethod<T>,
     limits: SystemLimits<T>,
+    stall_steps: Option<u32>,
 ) -> Result<ModesReport<T>, RollingError> {
     let (refs, scales) = scene_scales(scene);
     let reference = refs.0;
@@ -404,6 +468,9 @@ pub(crate) fn run_from<T: Real>(
     let (mut t, mut y) = (t0, y0);
     let mut previous: Option<Mode> = None;
     let mut must_slide = false;
+    // One watch over the whole run: a stall can be one segment's steps or a run of segments
+    // that each end where they start.
+    let watch = StallWatch::new(stall_steps, scales, t0);
     loop {
         let remaining = report.tally.remaining(limits, MAX_SWITCHES)?;
         let (ended, which) = match next_mode(scene, t, &y, must_slide) {
@@ -422,7 +489,7 @@ pub(crate) fn run_from<T: Real>(
                     method,
                     scales,
                     |t, y: &[T; 5]| max3(roll_events(scene, t, y, reference)),
-                    |_, _| ControlFlow::Continue(()),
+                    |t, _| watch.step(t),
                     remaining,
                 )?
                 else {
@@ -449,9 +516,9 @@ pub(crate) fn run_from<T: Real>(
                     |t, y: &SlideState<T>| {
                         max3(slide_events(scene, t, y, dir.get(), armed.get(), refs))
                     },
-                    |_, y: &SlideState<T>| {
+                    |t, y: &SlideState<T>| {
                         follow_slip(&slip_m_s(y), &dir, &armed, stuck);
-                        ControlFlow::Continue(())
+                        watch.step(t)
                     },
                     remaining,
                 )?
@@ -470,6 +537,9 @@ pub(crate) fn run_from<T: Real>(
             }
         };
         let (te, ye, ux, uy) = ended;
+        if watch.step(te).is_break() {
+            return Err(RollingError::Integration(SystemError::Stalled));
+        }
         if which != 1 {
             report.end_state = ye;
         }

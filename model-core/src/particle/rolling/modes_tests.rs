@@ -218,7 +218,7 @@ fn a_thrown_granule_rolls_after_its_slip_is_gone() {
             horizon_s: 60.0,
             max_steps: 100_000,
         };
-        let r = run_from(&s, 0.0, y0, FINE, limits).unwrap();
+        let r = run_from(&s, 0.0, y0, FINE, limits, None).unwrap();
         assert!(
             ((r.tally.regime.slide_s - t_star) / t_star).abs() < 1e-9,
             "{r:?}"
