@@ -86,9 +86,7 @@ pub struct AxisConfig {
     /// Upper bound of the closed-loop bandwidth, rad/s.
     pub bandwidth_rad_s: f32,
     /// Bandwidth allowed per pulse per second: `wc <= per_pulse_bandwidth * pulse_rate_hz`.
-    /// Sparse pulses are a sampled measurement; this keeps the loop well inside it. Nominal 1:
-    /// 0.5 while the loop held each window's error through the next window (a dead time the
-    /// loop now models, pi.rs), which rang from 1 up (docs/control.md, stability map).
+    /// Sparse pulses are a sampled measurement; this keeps the loop well inside it.
     pub per_pulse_bandwidth: f32,
     /// Setpoint ramp, rad/s^2.
     pub accel_limit_rad_s2: f32,
@@ -161,7 +159,7 @@ impl AxisConfig {
                 reaction_duty_s2_per_rad: 0.0,
             },
             bandwidth_rad_s: 8.0,
-            per_pulse_bandwidth: 1.0,
+            per_pulse_bandwidth: 0.5,
             accel_limit_rad_s2: 6.0,
             duty_limit: 0.95,
             duty_slew_per_s: 4.0,

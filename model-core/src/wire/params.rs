@@ -90,9 +90,9 @@ parameter_table! {
     /// Spin speed-loop bandwidth.
     Bandwidth2MradS: "BW2_MRAD_S", "mrad/s", range (10, 1_000_000), default 8_000;
     /// Precession loop bandwidth per pulse rate (caps the bandwidth at low speed).
-    PerPulse1Milli: "PER_PULSE1_MILLI", "1/1000", range (10, 10_000), default 1000;
+    PerPulse1Milli: "PER_PULSE1_MILLI", "1/1000", range (10, 10_000), default 500;
     /// Spin loop bandwidth per pulse rate.
-    PerPulse2Milli: "PER_PULSE2_MILLI", "1/1000", range (10, 10_000), default 1000;
+    PerPulse2Milli: "PER_PULSE2_MILLI", "1/1000", range (10, 10_000), default 500;
     /// Precession speed limit (setpoints above it are rejected).
     SpeedMax1MradS: "SPEED_MAX1_MRAD_S", "mrad/s", range (0, i16::MAX as i32), default 4_000;
     /// Spin speed limit.
