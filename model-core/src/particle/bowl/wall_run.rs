@@ -139,7 +139,7 @@ fn no_slip<T: Real>(sc: &RollingScene<T>, m: &Meridian<T>, t: T, y: &WallState<T
 
 /// Follows the granule on the wall from `(t0, y0)` until it leaves the wall. With
 /// `stall_steps`, a stay that stalls gives up (`SystemError::Stalled`)
-/// ([`crate::particle::rolling::modes::StallWatch`], [`super::residence_or_stall`]).
+/// (`rolling::modes::StallWatch`, [`super::residence_or_stall`]).
 #[allow(clippy::too_many_arguments)]
 pub fn stay<T: Real>(
     sc: &RollingScene<T>,
