@@ -156,6 +156,14 @@ impl Breakaway {
         FUSED_BANDWIDTH_RAD_S * dt_s * duty_per_rad_s * err
     }
 
+    /// The first edge came before the current confirmed the breakaway (the back-EMF speed
+    /// still below its threshold, or not yet for [`BREAKAWAY_CONFIRM`] samples): the edge
+    /// proves it, and the band of [`Breakaway::fused_integral_step`] holds from here to the
+    /// first measurement as it does after a breakaway the current saw.
+    pub fn confirm(&mut self) {
+        self.released = true;
+    }
+
     /// The current showed the breakaway of this start.
     pub fn released(&self) -> bool {
         self.released

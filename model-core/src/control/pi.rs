@@ -328,6 +328,14 @@ impl SpeedLoop {
                     self.push.max(k.kick_level(r_abs))
                 };
                 self.integral += PUSH_KEPT * started_by * input.direction;
+                if input.torque_duty.is_some() {
+                    // The edge proves the breakaway: the back-EMF band holds the integral from
+                    // here to the first measurement, as after one the current confirmed. Left
+                    // unconfirmed, a spin whose first tooth came 10 ms before the third sample
+                    // above the threshold crawled at 0.2 of 0.5 rad/s with no band, until the
+                    // push drove it 50 % past (family-60 p10).
+                    self.breakaway.confirm();
+                }
             }
             self.push = 0.0;
             self.push_sum = 0.0;
