@@ -39,6 +39,12 @@ pub trait ReleaseRig {
     fn stop(&mut self);
 }
 
+/// The angle between the axes from the rig's AXES_MDEG parameter (millidegrees), rad: how
+/// both rigs, over the wire and simulated, read it.
+fn axes_angle_rad(axes_mdeg: f64) -> f64 {
+    (axes_mdeg * 1e-3).to_radians()
+}
+
 /// Runs every release of `plan` on `rig`, writing each row as it is measured; returns the
 /// number of releases. A progress bar on standard error when `progress`.
 pub fn run_plan(

@@ -243,7 +243,7 @@ impl ReleaseRig for PortRig {
     }
 
     fn split(&self, bowl_rad_s: f64) -> Result<[f64; 2]> {
-        let angle = param(&self.params, ParamId::AxesMdeg) * 1e-3 * std::f64::consts::PI / 180.0;
+        let angle = self.axes_angle_rad();
         let ratio = param(&self.params, ParamId::RatioPpm) * 1e-6;
         let s = model_core::control::planner::split_combined(
             bowl_rad_s as f32,
@@ -271,6 +271,6 @@ impl ReleaseRig for PortRig {
 
     /// The rig's AXES_MDEG parameter.
     fn axes_angle_rad(&self) -> f64 {
-        (param(&self.params, ParamId::AxesMdeg) * 1e-3).to_radians()
+        super::axes_angle_rad(param(&self.params, ParamId::AxesMdeg))
     }
 }

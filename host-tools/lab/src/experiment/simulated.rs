@@ -230,7 +230,7 @@ impl super::ReleaseRig for BackendRig {
             .backend
             .bound()
             .param(model_core::wire::ParamId::AxesMdeg);
-        (f64::from(mdeg) * 1e-3).to_radians()
+        super::axes_angle_rad(f64::from(mdeg))
     }
 
     /// The simulated rig draws each bowl-model granule's azimuth and knows it.
