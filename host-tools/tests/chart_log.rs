@@ -30,9 +30,40 @@ fn a_monitor_log_is_drawn_with_its_link_events() {
         for label in ["port open", "monitor end", "measured", "PC clock"] {
             assert!(svg.contains(label), "{axis}: no {label:?} in the chart");
         }
+        // A run without a fault marks none.
+        assert!(
+            !svg.contains("fault:") && !svg.contains("fault cleared"),
+            "{axis}: a fault marked in a run without one"
+        );
         let png = std::fs::read(dir.join(format!("run-{axis}.png"))).unwrap();
         assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     }
+    // A fault in the log (the CSV's word for it) is marked in words where it came and went.
+    let text = std::fs::read_to_string(&log).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let telemetry: Vec<usize> = (1..lines.len())
+        .filter(|&i| lines[i].split(',').nth(4) == Some("none"))
+        .collect();
+    assert!(telemetry.len() > 20, "{} telemetry rows", telemetry.len());
+    for &i in &telemetry[10..15] {
+        lines[i] = lines[i].replacen(",none,", ",no-pulses-spin,", 1);
+    }
+    let faulted = dir.join("faulted.csv");
+    std::fs::write(&faulted, lines.join("\n") + "\n").unwrap();
+    let drawn = bowl(&[
+        "chart",
+        "log",
+        "--csv",
+        faulted.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(drawn.status.success(), "{}", stdout(&drawn));
+    let svg = std::fs::read_to_string(dir.join("run-spin.svg")).unwrap();
+    assert!(
+        svg.contains("fault: spin motor: no sensor pulses") && svg.contains("fault cleared"),
+        "the fault is not marked in words"
+    );
     // A file that is not a telemetry log is refused in plain words.
     let other = dir.join("other.csv");
     std::fs::write(&other, "a,b\n1,2\n").unwrap();

@@ -146,7 +146,7 @@ fn the_fast_demo_ends_by_itself_and_says_what_ran() {
 fn the_injected_fault_stops_both_motors_within_the_sensor_timeout() {
     let (dir, _, summary) = demo_run();
     let fault = &summary["fault"];
-    assert_eq!(fault["fault"], "SensorLostOrStallSpin");
+    assert_eq!(fault["fault"], "no-pulses-spin");
     assert_eq!(summary["checks"]["fault_stopped_both_motors"], true);
     // Detected within the controller's sensor timeout window (computed from the pulse period).
     let detect = f(&fault["detection_s"]);
@@ -168,7 +168,7 @@ fn the_injected_fault_stops_both_motors_within_the_sensor_timeout() {
     let clear = mark_ms(summary, "fault cleared");
     let first = rows
         .iter()
-        .position(|r| r.time_ms > inject && r.fault != "None")
+        .position(|r| r.time_ms > inject && r.fault != "none")
         .expect("a faulted frame");
     let faulted: Vec<&Row> = rows[first..]
         .iter()
@@ -178,7 +178,7 @@ fn the_injected_fault_stops_both_motors_within_the_sensor_timeout() {
     assert!(
         faulted
             .iter()
-            .all(|r| r.state == "Faulted" && r.duty_bp == [0.0, 0.0])
+            .all(|r| r.state == "faulted" && r.duty_bp == [0.0, 0.0])
     );
     let before = rows.iter().rev().find(|r| r.time_ms <= inject).unwrap();
     assert!(

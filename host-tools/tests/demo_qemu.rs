@@ -73,7 +73,7 @@ fn the_demo_runs_on_the_emulated_board_or_says_why_not() {
     }
     assert_eq!(summary["ended_at_rest"], true);
     let fault = &summary["fault"];
-    assert_eq!(fault["fault"], "SensorLostOrStallSpin");
+    assert_eq!(fault["fault"], "no-pulses-spin");
     let detect = fault["detection_s"].as_f64().unwrap();
     let lo = fault["expected_detection_s"][0].as_f64().unwrap();
     let hi = fault["expected_detection_s"][1].as_f64().unwrap();

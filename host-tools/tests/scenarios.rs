@@ -112,9 +112,9 @@ fn a_wrong_expectation_fails_and_says_where() {
         let running = s
             .expects
             .iter_mut()
-            .find(|e| e.state == ["Running"])
-            .expect("speed-up.toml expects Running");
-        running.state = vec!["Idle".into()];
+            .find(|e| e.state == ["running"])
+            .expect("speed-up.toml expects running");
+        running.state = vec!["idle".into()];
     });
     let _ = std::fs::remove_dir_all(&dir);
     let text = found.join("\n");
@@ -123,7 +123,7 @@ fn a_wrong_expectation_fails_and_says_where() {
         text.contains("tests/scenarios/speed-up.toml")
             && text.contains("prec_measured_mrad_s in [")
             && text.contains("command `speed 3000 3000`: expected the answer RANGE, got done")
-            && text.contains("expected state Idle, got Running"),
+            && text.contains("expected state idle, got running"),
         "{text}"
     );
 }
@@ -134,12 +134,21 @@ fn a_scenario_that_checks_nothing_or_outside_its_run_is_refused() {
     let cases = [
         ("seconds = 5\ndescription = \"x\"\n", "no [[expect]]"),
         (
-            "seconds = 5\ndescription = \"x\"\n[[expect]]\nwhat = \"w\"\nfrom_ms = 0\nto_ms = 9000\nfault = \"None\"\n",
+            "seconds = 5\ndescription = \"x\"\n[[expect]]\nwhat = \"w\"\nfrom_ms = 0\nto_ms = 9000\nfault = \"none\"\n",
             "not inside the run",
         ),
         (
             "seconds = 5\ndescription = \"x\"\n[[expect]]\nwhat = \"w\"\nfrom_ms = 0\nto_ms = 1000\nstate = [\"Runing\"]\n",
             "unknown state Runing",
+        ),
+        (
+            // The words of the CSV and `bowl send status`, not the code's names.
+            "seconds = 5\ndescription = \"x\"\n[[expect]]\nwhat = \"w\"\nfrom_ms = 0\nto_ms = 1000\nstate = [\"Running\"]\n",
+            "unknown state Running",
+        ),
+        (
+            "seconds = 5\ndescription = \"x\"\n[[expect]]\nwhat = \"w\"\nfrom_ms = 0\nto_ms = 1000\nfault = \"SensorLostOrStallSpin\"\n",
+            "unknown fault SensorLostOrStallSpin",
         ),
         (
             "seconds = 5\ndescription = \"x\"\n[[expect]]\nwhat = \"w\"\nfrom_ms = 0\nto_ms = 1000\n",

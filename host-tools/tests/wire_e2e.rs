@@ -290,12 +290,12 @@ fn an_injected_sensor_fault_stops_both_motors_and_is_reported() {
     assert_eq!(s["frames_missing"], 0, "{s}");
     let text = std::fs::read_to_string(&csv).unwrap();
     let rows = csv_cells(&text);
-    let faulted: Vec<&Vec<&str>> = rows.iter().filter(|r| r[3] == "Faulted").collect();
+    let faulted: Vec<&Vec<&str>> = rows.iter().filter(|r| r[3] == "faulted").collect();
     assert!(!faulted.is_empty(), "the lost spin sensor is detected");
     let first_fault_ms: u64 = faulted[0][1].parse().unwrap();
     assert!((4000..6000).contains(&first_fault_ms), "{first_fault_ms}");
     for r in &faulted {
-        assert_eq!(r[4], "SensorLostOrStallSpin");
+        assert_eq!(r[4], "no-pulses-spin");
         assert_eq!(
             (r[7], r[11]),
             ("0", "0"),
@@ -305,7 +305,7 @@ fn an_injected_sensor_fault_stops_both_motors_and_is_reported() {
     // Before the fault the rig ran with both motors driven.
     assert!(
         rows.iter()
-            .any(|r| r[3] == "Running" && r[7] != "0" && r[11] != "0")
+            .any(|r| r[3] == "running" && r[7] != "0" && r[11] != "0")
     );
     // START while faulted is refused with a reason.
     let raw = std::fs::read(&capture).unwrap();
@@ -359,7 +359,7 @@ fn a_residence_time_target_is_reached_in_closed_loop() {
     let rows = csv_cells(&text);
     let tail = &rows[rows.len() - 100..];
     for r in tail {
-        assert_eq!(r[3], "Running", "{r:?}");
+        assert_eq!(r[3], "running", "{r:?}");
         let t_ms: f64 = r[15].parse().unwrap();
         assert!((t_ms - 700.0).abs() < 21.0, "{r:?}");
     }

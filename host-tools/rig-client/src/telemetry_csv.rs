@@ -65,12 +65,12 @@ pub fn write_row(
 ) -> Result<()> {
     writeln!(
         out,
-        "{},{},{},{:?},{:?},{},{},{},{},{},{},{},{},{},{},{},{},",
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},",
         boot,
         t.time_ms,
         t.seq,
-        t.state,
-        t.fault,
+        crate::words::state_token(t.state),
+        crate::words::fault_token(t.fault),
         t.precession.set_mrad_s,
         t.precession.measured_mrad_s,
         t.precession.duty_bp,

@@ -19,8 +19,8 @@
 //! what = "settled at 3 rad/s"   # said in a failure
 //! from_ms = 4000                # held on every telemetry frame from ..= to (device time)
 //! to_ms = 12000
-//! state = ["Running"]           # allowed states (the CSV's `state` spellings)
-//! fault = "None"                # the CSV's `fault` spelling
+//! state = ["running"]           # allowed states (the CSV's `state` words)
+//! fault = "none"                # the CSV's `fault` word
 //! telemetry_hz = [45, 55]       # frames per second over the span
 //! [expect.window]               # any numeric CSV column: [lo, hi], inclusive
 //! prec_measured_mrad_s = [2940, 3060]
@@ -77,11 +77,11 @@ pub struct Expect {
     pub from_ms: u32,
     /// Span end, device ms (inclusive).
     pub to_ms: u32,
-    /// The states allowed (`Idle`, `Commissioning`, `SpinningUp`, `Running`, `Stopping`,
-    /// `Faulted`).
+    /// The states allowed (`idle`, `commissioning`, `spinning-up`, `running`, `stopping`,
+    /// `faulted`: the words `bowl send status` and the CSV use).
     #[serde(default)]
     pub state: Vec<String>,
-    /// The fault code (`None`, `SensorLostOrStallSpin`, ...).
+    /// The fault (`none`, `no-pulses-spin`, ...: the CSV's and `bowl send status`'s words).
     pub fault: Option<String>,
     /// Telemetry frames per second over the span, [lo, hi].
     pub telemetry_hz: Option<[f64; 2]>,
@@ -97,13 +97,21 @@ pub type Answer = String;
 pub type Row = HashMap<String, String>;
 
 const STATES: [&str; 6] = [
-    "Idle",
-    "Commissioning",
-    "SpinningUp",
-    "Running",
-    "Stopping",
-    "Faulted",
+    "idle",
+    "commissioning",
+    "spinning-up",
+    "running",
+    "stopping",
+    "faulted",
 ];
+
+/// Every fault's word, as the CSV writes it.
+fn fault_words() -> Vec<&'static str> {
+    (0..=i64::from(u8::MAX))
+        .filter_map(model_core::wire::FaultCode::from_code)
+        .map(rig_client::words::fault_token)
+        .collect()
+}
 
 /// The workspace's `tests/scenarios` folder.
 pub fn folder() -> PathBuf {
@@ -157,6 +165,13 @@ pub fn load(path: &Path) -> Result<Scenario, String> {
             return bad(format!(
                 "`{}`: unknown state {st} (one of {STATES:?})",
                 e.what
+            ));
+        }
+        if let Some(f) = e.fault.as_deref().filter(|f| !fault_words().contains(f)) {
+            return bad(format!(
+                "`{}`: unknown fault {f} (one of {:?})",
+                e.what,
+                fault_words()
             ));
         }
         let windows = e.window.values().map(|w| [w[0] as f64, w[1] as f64]);

@@ -120,7 +120,9 @@ fn read(path: &Path) -> Result<(Vec<Row>, bool)> {
 fn figure(rows: &[Row], axis: usize, file: &str, wall_clock: bool) -> Figure {
     let (name, symbol) = [("precession", "w1"), ("spin", "w2")][axis];
     let (mut set, mut measured, mut vlines) = (Vec::new(), Vec::new(), Vec::new());
-    let mut last_fault = "None".to_string();
+    // The CSV's fault word (`none`, `no-pulses-spin`, ...); logs written before the words
+    // spelled them `None`, `SensorLostOrStallSpin`: a change is a change either way.
+    let mut last_fault = "none".to_string();
     for row in rows {
         match row {
             Row::Telemetry {
@@ -131,13 +133,13 @@ fn figure(rows: &[Row], axis: usize, file: &str, wall_clock: bool) -> Figure {
             } => {
                 set.push((*t_s, s[axis]));
                 measured.push((*t_s, m[axis]));
-                if *fault != last_fault {
+                if !fault.eq_ignore_ascii_case(&last_fault) {
                     vlines.push(VLine {
                         x: *t_s,
-                        label: if fault == "None" {
-                            "fault cleared".into()
-                        } else {
-                            format!("fault: {fault}")
+                        label: match rig_client::words::fault_from_token(fault) {
+                            _ if fault.eq_ignore_ascii_case("none") => "fault cleared".into(),
+                            Some(code) => format!("fault: {}", rig_client::words::fault(code)),
+                            None => format!("fault: {fault}"),
                         },
                         color: FAULT_COLOUR,
                     });
