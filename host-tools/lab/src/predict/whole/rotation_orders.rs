@@ -67,6 +67,8 @@ struct Orders {
     estimate: f64,
     /// `|T(w1, w2) - T(-w1, -w2)| / T` of the mean (zero but for the integrator).
     mirror: f64,
+    /// `c2` from the closed form of `model_core::choose::incline_rotation` (rolling only).
+    closed: f64,
 }
 
 fn scaled(s: &RollingScene<f64>, k: f64) -> RollingScene<f64> {
@@ -103,6 +105,8 @@ fn orders(name: &str, kind: Kind, r: Row) -> Option<Orders> {
     let c2 = (4.0 * e - q) / 3.0;
     let corrected = t0 * (1.0 + c2);
     let (tilt, w1, w2, mu_s, ri, rim) = r;
+    let closed =
+        model_core::choose::incline_rotation::mean_second_order(&s).map_or(f64::NAN, |m| m.1);
     let o = Orders {
         kind,
         label: format!("{tilt} deg, {w1}/{w2} rad/s, mu_s {mu_s}, ri {ri}, R {rim}"),
@@ -113,9 +117,10 @@ fn orders(name: &str, kind: Kind, r: Row) -> Option<Orders> {
         corrected_err: ((corrected - t) / t).abs(),
         estimate: rotation_estimate(&s, t0),
         mirror,
+        closed,
     };
     println!(
-        "ORDERS,{name},{tilt},{w1},{w2},{mu_s},{ri},{rim},mode {},rim need {:.4},F {:.4},err {:.3e},D(1) {:.3e},c2 {:.3e},corrected err {:.3e},estimate {:.3e},mirror {mirror:.1e},odd per release {odd:.3e}",
+        "ORDERS,{name},{tilt},{w1},{w2},{mu_s},{ri},{rim},mode {},rim need {:.4},F {:.4},err {:.3e},D(1) {:.3e},c2 {:.3e},corrected err {:.3e},estimate {:.3e},mirror {mirror:.1e},odd per release {odd:.3e},closed c2 {closed:.3e}",
         o.mode,
         friction_needed_at_rim(&s) / mu_s,
         o.form,
@@ -253,6 +258,17 @@ fn rotation_orders() {
         n(Kind::Fit),
         n(Kind::Held)
     );
+    // The closed form against the measured c2 where the incline rolls and is not near the stick
+    // threshold at rest (modes 0 and 2: T is smooth in the speeds there).
+    let worst = rows
+        .iter()
+        .filter(|o| o.mode == 0 || o.mode == 2)
+        .map(|o| ((o.closed - o.c2) / o.c2).abs())
+        .fold(0.0, f64::max);
+    let n_rolling = rows.iter().filter(|o| o.mode == 0 || o.mode == 2).count();
+    println!(
+        "closed-form c2 against the measured one, {n_rolling} rolling scenes: largest relative difference {worst:.2e}"
+    );
     // Today's three modes, and the near-threshold one split (at rest / at the rim).
     let three = |o: &Orders| o.mode.min(2);
     let four = |o: &Orders| o.mode;
@@ -350,6 +366,11 @@ fn rotation_orders() {
             })
             .fold(f64::INFINITY, f64::min)
     };
+    let second = time(&|| {
+        std::hint::black_box(model_core::choose::incline_rotation::mean_second_order(
+            std::hint::black_box(&s),
+        ));
+    });
     let incline = time(&|| {
         std::hint::black_box(incline_mean_s(std::hint::black_box(&s)));
     });
@@ -361,7 +382,10 @@ fn rotation_orders() {
             false,
         ));
     });
-    println!("the incline {incline:.2e} s, the choice (with it) {choice:.2e} s per call");
+    println!(
+        "the incline {incline:.2e} s, the choice (with it) {choice:.2e} s, the closed-form second \
+         order {second:.2e} s per call"
+    );
     // The mirror holds on every scene to the integrator's tolerance (rtol 1e-10 per release;
     // 1.9e-8 and 6.7e-8 where the granule switches between rolling and sliding, whose time
     // the integrator locates less exactly): the mean's first-order part is zero.
@@ -397,5 +421,30 @@ fn the_mean_over_releases_is_even_in_the_speeds() {
         // The single releases do move at first order: their odd part is far from zero.
         let odd = (plus[3] - minus[3]).abs() / plus[3];
         assert!(odd > 1e-3, "{r:?}: {odd}");
+    }
+}
+
+/// The closed-form second order (model-core `choose::incline_rotation`) against the disc at
+/// small speeds, where the incline rolls: `(T(s w) - T_incline) / T_incline / s^2` at `s` = 1/4
+/// and 1/8 (Richardson) equals the closed form's `mean T2 / mean T0` to 1e-3 on the cost grid's
+/// rolling rows (30 deg, 1.8 rad/s, mu_s 0.2; 45 deg, 3.6 rad/s, mu_s 0.4), a low tilt with the
+/// spin opposite, and a release near the axis.
+#[test]
+fn the_closed_form_second_order_is_the_discs() {
+    for r in [
+        (30.0, 1.8, 1.8, 0.2, 0.0375, 0.075),
+        (45.0, 3.6, 3.6, 0.4, 0.0375, 0.075),
+        (10.0, 1.0, -0.75, 0.4, 0.0375, 0.075),
+        (60.0, 2.5, 2.5, 0.6, 0.02, 0.1),
+    ] {
+        let s = scene(r);
+        assert_ne!(mode_of(&s), 1, "{r:?} slides");
+        let (t0, closed) = model_core::choose::incline_rotation::mean_second_order(&s).unwrap();
+        let d = |k: f64| (mean(&disc_times_s(&scaled(&s, k)).unwrap()) - t0) / t0 / (k * k);
+        let measured = (4.0 * d(0.125) - d(0.25)) / 3.0;
+        assert!(
+            (closed - measured).abs() <= 1e-3 * measured.abs(),
+            "{r:?}: closed {closed:e}, measured {measured:e}"
+        );
     }
 }
