@@ -12,7 +12,7 @@
 //! turns with the velocity: `v1' + lambda v1 / t = B t`, `B = k2 G w2 + (1 + k2) Oz A`, so
 //! `v1 = B t^2 / (2 + lambda)`, `y1 = B t^3 / (3 (2 + lambda))`; the spin `sig1 = w1 s A t^2/2`.
 //! To second order, across the path `b2' + lambda b2 / t = k2 |Omega|^2 p0y`, so
-//! `y2 = k2 |Omega|^2 p0y t^2 / (2 (1 + lambda))`; along it `a2' = c0 + c2 t^2` with the terms
+//! `y2 = k2 |Omega|^2 p0y t^2 / (2 (1 + lambda))`; along it `a2' = q0 + q2 t^2` with the terms
 //! listed in [`release_second_order_s`]. The exit time from `|x(T)| = R` to second order:
 //! `T1 = -g1 / f0'`, `T2 = -(f0'' T1^2 / 2 + g1' T1 + g2) / f0'` with `f0 = |x0|^2`,
 //! `g1 = 2 p0y y1`, `g2 = 2 P X2 + 2 p0y y2 + y1^2`, `P = x0 . d`.
@@ -61,17 +61,17 @@ pub fn release_second_order_s<T: Real>(scene: &RollingScene<T>, beta_rad: T) -> 
     let y1_k = v1_k / T::from_f64(3.0); // y1 = y1_k t^3
     // Second order across the path: y2 = y2_k t^2.
     let y2_k = k2 * omega2 * p0y / (T::TWO * (T::ONE + lambda));
-    // Second order along d: a2' = c0 + c2 t^2, from (x = p0x - A t^2/2 the e1 coordinate):
+    // Second order along d: a2' = q0 + q2 t^2, from (x = p0x - A t^2/2 the e1 coordinate):
     //   -k2 [G w2^2 t^2/2 + Oz^2 x - w1 s Oz a + w1 w2 s a]          (gravity turning, -C, -E)
     //   -(1 - k2) [w1^2 s^2 A t^2/2 + a w1 w2 s]                       (spin sig1 Ox, Euler)
     //   -k2 mu_r [(w1 w2 s + Oz w1 s) x - w1^2 s^2 a + 2 w1 s v1
     //             - 2 w1 s w2 A t^2 - Nn v1^2 / (2 A^2 t^2)]           (normal force, direction)
     //   -(1 + k2) Oz v1                                                (gyroscopic on v1)
     let n_x = w1 * w2 * s + oz * w1 * s; // N2's coefficient of x
-    let c0 = -k2 * (oz * oz * p0x - w1 * s * oz * a + w1 * w2 * s * a)
+    let q0 = -k2 * (oz * oz * p0x - w1 * s * oz * a + w1 * w2 * s * a)
         - (T::ONE - k2) * a * w1 * w2 * s
         - k2 * mu_r * (n_x * p0x - w1 * w1 * s * s * a);
-    let c2 = -k2 * (big_g * w2 * w2 * half - oz * oz * drive * half)
+    let q2 = -k2 * (big_g * w2 * w2 * half - oz * oz * drive * half)
         - (T::ONE - k2) * w1 * w1 * s * s * drive * half
         - k2 * mu_r
             * (-n_x * drive * half + T::TWO * w1 * s * v1_k
@@ -85,7 +85,7 @@ pub fn release_second_order_s<T: Real>(scene: &RollingScene<T>, beta_rad: T) -> 
     let f2 = T::TWO * drive * drive * t * t + T::TWO * drive * big_p;
     let y1 = y1_k * t * t * t;
     let v1 = v1_k * t * t;
-    let x2 = c0 * t * t * half + c2 * t * t * t * t / T::from_f64(12.0);
+    let x2 = q0 * t * t * half + q2 * t * t * t * t / T::from_f64(12.0);
     let y2 = y2_k * t * t;
     let g1 = T::TWO * p0y * y1;
     let g1d = T::TWO * p0y * v1;
