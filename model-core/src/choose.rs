@@ -304,6 +304,7 @@ fn dp<T: Real>(rtol: T, scene: &Scene<T>) -> Method<T> {
 }
 
 pub mod cost;
+pub mod incline_rotation;
 mod pilot;
 mod spread;
 pub mod table;

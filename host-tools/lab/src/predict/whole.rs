@@ -376,4 +376,6 @@ fn report(
 #[cfg(test)]
 mod rotation_fit;
 #[cfg(test)]
+mod rotation_orders;
+#[cfg(test)]
 mod tests;

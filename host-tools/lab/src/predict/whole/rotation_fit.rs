@@ -5,9 +5,9 @@
 use super::*;
 
 /// One scene of a grid: tilt (deg), w1, w2 (rad/s), mu_s, ri, R (m).
-type Row = (f64, f64, f64, f64, f64, f64);
+pub(super) type Row = (f64, f64, f64, f64, f64, f64);
 
-fn scene((tilt, w1, w2, mu_s, ri, rim): Row) -> RollingScene<f64> {
+pub(super) fn scene((tilt, w1, w2, mu_s, ri, rim): Row) -> RollingScene<f64> {
     RollingScene {
         sliding_friction: mu_s,
         ri_m: ri,
@@ -17,7 +17,16 @@ fn scene((tilt, w1, w2, mu_s, ri, rim): Row) -> RollingScene<f64> {
 
 /// The rolling-or-sliding disc's mean `T` over the twelve releases at DP5(4) rtol 1e-10 (the
 /// reference the rotation estimate is fitted against); None unless every release leaves.
-fn disc_mean_s(s: &RollingScene<f64>) -> Option<f64> {
+pub(super) fn disc_mean_s(s: &RollingScene<f64>) -> Option<f64> {
+    let t = disc_times_s(s)?;
+    Some(t.iter().sum::<f64>() / t.len() as f64)
+}
+
+/// The rolling-or-sliding disc's `T` per release (in [`AZIMUTHS_DEG`] order) at DP5(4) rtol
+/// 1e-10; None unless every release leaves.
+///
+/// [`AZIMUTHS_DEG`]: model_core::particle::rolling::AZIMUTHS_DEG
+pub(super) fn disc_times_s(s: &RollingScene<f64>) -> Option<Vec<f64>> {
     let betas = model_core::particle::rolling::AZIMUTHS_DEG.to_vec();
     let limits = SystemLimits {
         horizon_s: 20.0,
@@ -34,7 +43,51 @@ fn disc_mean_s(s: &RollingScene<f64>) -> Option<f64> {
         return None;
     };
     let left: Vec<f64> = a.times.iter().filter_map(|t| t.1).collect();
-    (left.len() == betas.len()).then(|| left.iter().sum::<f64>() / left.len() as f64)
+    (left.len() == betas.len()).then_some(left)
+}
+
+/// The fitting grid of the rotation estimate (294 scenes, docs/model.md §12): tilt 5-75 deg,
+/// 0.25-3.6 rad/s equal, unequal and opposite, mu_s 0.2-0.6, `ri/R` 0.2-0.7.
+pub(super) fn fitting_grid() -> Vec<Row> {
+    let mut fit = Vec::new();
+    for tilt in [5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0] {
+        for w in [0.25, 0.5, 1.0, 1.8, 2.5, 3.6] {
+            for (mu_s, ri, rim) in [
+                (0.4, 0.0375, 0.075),
+                (0.2, 0.075, 0.15),
+                (0.6, 0.02, 0.1),
+                (0.3, 0.03, 0.1),
+                (0.5, 0.07, 0.1),
+            ] {
+                fit.push((tilt, w, w, mu_s, ri, rim));
+            }
+            // Unequal and opposite speeds.
+            fit.push((tilt, w, -0.75 * w, 0.4, 0.0375, 0.075));
+            fit.push((tilt, 0.5 * w, w, 0.2, 0.0375, 0.075));
+        }
+    }
+    fit
+}
+
+/// The held-out grid (119 scenes with a disc answer of 120): tilt 15-70 deg, 0.8-3 rad/s,
+/// spin -1.3 w1, mu_s 0.25-0.5, `ri/R` 0.15-0.8.
+pub(super) fn held_out_grid() -> Vec<Row> {
+    let mut held = Vec::new();
+    for tilt in [15.0, 25.0, 40.0, 50.0, 70.0] {
+        for w in [0.8, 1.3, 2.2, 3.0] {
+            for (mu_s, ri, rim) in [
+                (0.3, 0.0375, 0.075),
+                (0.5, 0.05, 0.12),
+                (0.35, 0.03, 0.09),
+                (0.4, 0.015, 0.1),
+                (0.25, 0.06, 0.075),
+            ] {
+                held.push((tilt, w, w, mu_s, ri, rim));
+            }
+            held.push((tilt, w, -1.3 * w, 0.45, 0.04, 0.1));
+        }
+    }
+    held
 }
 
 /// Per scene: the incline's error in the mean `T` against the disc (relative, absolute value),
@@ -75,24 +128,7 @@ fn dump(name: &str, rows: &[Row]) -> Vec<(f64, f64, f64)> {
 #[ignore]
 fn rotation_fit_data() {
     use model_core::choose::whole::{ROTATION_K, ROTATION_K_NEAR_SLIDING, ROTATION_K_SLIDING};
-    let mut fit = Vec::new();
-    for tilt in [5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 75.0] {
-        for w in [0.25, 0.5, 1.0, 1.8, 2.5, 3.6] {
-            for (mu_s, ri, rim) in [
-                (0.4, 0.0375, 0.075),
-                (0.2, 0.075, 0.15),
-                (0.6, 0.02, 0.1),
-                (0.3, 0.03, 0.1),
-                (0.5, 0.07, 0.1),
-            ] {
-                fit.push((tilt, w, w, mu_s, ri, rim));
-            }
-            // Unequal and opposite speeds.
-            fit.push((tilt, w, -0.75 * w, 0.4, 0.0375, 0.075));
-            fit.push((tilt, 0.5 * w, w, 0.2, 0.0375, 0.075));
-        }
-    }
-    let fit = dump("fit", &fit);
+    let fit = dump("fit", &fitting_grid());
     // The largest ratio of error to form among the fitting scenes of one constant (mode).
     let fitted = |k: f64| {
         fit.iter()
@@ -100,22 +136,7 @@ fn rotation_fit_data() {
             .map(|r| r.0 / r.1)
             .fold(0.0, f64::max)
     };
-    let mut held = Vec::new();
-    for tilt in [15.0, 25.0, 40.0, 50.0, 70.0] {
-        for w in [0.8, 1.3, 2.2, 3.0] {
-            for (mu_s, ri, rim) in [
-                (0.3, 0.0375, 0.075),
-                (0.5, 0.05, 0.12),
-                (0.35, 0.03, 0.09),
-                (0.4, 0.015, 0.1),
-                (0.25, 0.06, 0.075),
-            ] {
-                held.push((tilt, w, w, mu_s, ri, rim));
-            }
-            held.push((tilt, w, -1.3 * w, 0.45, 0.04, 0.1));
-        }
-    }
-    let held = dump("held", &held);
+    let held = dump("held", &held_out_grid());
     let covered = held
         .iter()
         .filter(|r| r.2 * r.1 <= 0.1)

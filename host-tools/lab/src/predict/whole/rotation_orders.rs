@@ -1,0 +1,450 @@
+//! What a perturbation of the incline in the bowl's rotation could give the chooser
+//! (docs/model.md §12, "The four rotation rows"), measured before building one: the rotation's
+//! first-order part and its exact second-order part, per scene of the rotation estimate's
+//! fitting and held-out grids, against the rolling-or-sliding disc at rtol 1e-10.
+//!
+//! - **First order.** Mirroring the scene in the plane of the bowl's axis and the downhill
+//!   direction at release turns `beta` into `-beta` and both speeds into their negatives, so
+//!   `T(beta, w1, w2) = T(-beta, -w1, -w2)`; the twelve azimuths are symmetric, so the mean
+//!   over them is even in the speeds: its first-order part is zero on every scene. A
+//!   first-order correction (the Coriolis and gyroscopic terms along the incline's path, and
+//!   the turning downhill direction) moves single releases (their odd part, printed) and
+//!   leaves the mean as it is. Checked here: the mean at `(w1, w2)` and at `(-w1, -w2)` agree
+//!   to the integrator's tolerance.
+//! - **Second order.** `D(s) = (T(s w1, s w2) - T_incline) / T_incline` is even in `s`:
+//!   `D(s) = c2 s^2 + c4 s^4 + ...`. `c2` (Richardson from `s` = 1/4 and 1/8) is what an exact
+//!   second-order perturbation of the incline would give at the scene, the best any such closed
+//!   form can do. Two uses, each fitted per incline mode on the fitting grid as `ROTATION_K` is
+//!   (today's three modes, and with the near-threshold one split by [`mode_of`]) and checked on
+//!   the held-out grid and the cost grids' bare rims:
+//!   (a) the corrected incline `T_incline (1 + c2)`, its error bounded by `K4 F^2`
+//!   (`F` = [`rotation_form`], the rotation's size; the remainder is fourth order);
+//!   (b) the plain incline, its error bounded by `|c2| + K4 F^2`.
+//!
+//! `c2` comes from integrating the disc here: this measures what a closed form would give,
+//! it is not one (docs/model.md §12 says what is not built).
+//!
+//! `cargo test --release -p lab whole::rotation_orders -- --ignored --nocapture` (with §12's
+//! `--config` flags; prints `ORDERS,...` per scene, the counts per tolerance, the bounds on
+//! the cost grids' rotation rows and the incline's and the choice's cost).
+//!
+//! [`rotation_form`]: model_core::choose::whole::rotation_form
+
+use model_core::choose::whole::{
+    friction_needed_at_rim, incline_mean_s, rotation_constant, rotation_estimate, rotation_form,
+};
+
+use super::rotation_fit::{Row, disc_times_s, fitting_grid, held_out_grid, scene};
+use super::*;
+
+/// Which grid a scene is from.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Fit,
+    Held,
+    /// The cost grids' rotation rows (docs/model.md §12).
+    Row,
+    /// The cost grids' bare-rim scenes (docs/model.md §12).
+    Cost,
+}
+
+/// One scene's orders.
+struct Orders {
+    kind: Kind,
+    /// The scene, for the printout.
+    label: String,
+    /// The incline's mode ([`mode_of`]).
+    mode: usize,
+    /// `F`, the rotation estimate's form.
+    form: f64,
+    /// The incline's relative error against the disc (absolute value).
+    err: f64,
+    /// `c2`, the exact second-order part of `(T - T_incline) / T_incline`.
+    c2: f64,
+    /// The corrected incline's relative error against the disc (absolute value).
+    corrected_err: f64,
+    /// Today's estimate (`rotation_estimate`).
+    estimate: f64,
+    /// `|T(w1, w2) - T(-w1, -w2)| / T` of the mean (zero but for the integrator).
+    mirror: f64,
+    /// `c2` from the closed form of `model_core::choose::incline_rotation` (rolling only).
+    closed: f64,
+}
+
+fn scaled(s: &RollingScene<f64>, k: f64) -> RollingScene<f64> {
+    RollingScene {
+        precession_rad_s: k * s.precession_rad_s,
+        spin_rad_s: k * s.spin_rad_s,
+        ..*s
+    }
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+fn orders(name: &str, kind: Kind, r: Row) -> Option<Orders> {
+    let s = scene(r);
+    let t0 = incline_mean_s(&s)?;
+    let plus = disc_times_s(&s)?;
+    let minus = disc_times_s(&scaled(&s, -1.0))?;
+    let quarter = mean(&disc_times_s(&scaled(&s, 0.25))?);
+    let eighth = mean(&disc_times_s(&scaled(&s, 0.125))?);
+    let t = mean(&plus);
+    // The mirror: the mean is even in the speeds.
+    let mirror = (t - mean(&minus)).abs() / t;
+    // The odd part per release: what a first-order correction would move.
+    let odd = plus
+        .iter()
+        .zip(&minus)
+        .map(|(p, m)| (p - m).abs() / 2.0 / t0)
+        .fold(0.0, f64::max);
+    let d = |tm: f64| (tm - t0) / t0;
+    // D(s)/s^2 = c2 + c4 s^2: Richardson from s = 1/4 and 1/8.
+    let (q, e) = (d(quarter) / 0.0625, d(eighth) / 0.015625);
+    let c2 = (4.0 * e - q) / 3.0;
+    let corrected = t0 * (1.0 + c2);
+    let (tilt, w1, w2, mu_s, ri, rim) = r;
+    let closed =
+        model_core::choose::incline_rotation::mean_second_order(&s).map_or(f64::NAN, |m| m.1);
+    let o = Orders {
+        kind,
+        label: format!("{tilt} deg, {w1}/{w2} rad/s, mu_s {mu_s}, ri {ri}, R {rim}"),
+        mode: mode_of(&s),
+        form: rotation_form(&s, t0),
+        err: ((t0 - t) / t).abs(),
+        c2,
+        corrected_err: ((corrected - t) / t).abs(),
+        estimate: rotation_estimate(&s, t0),
+        mirror,
+        closed,
+    };
+    println!(
+        "ORDERS,{name},{tilt},{w1},{w2},{mu_s},{ri},{rim},mode {},rim need {:.4},F {:.4},err {:.3e},D(1) {:.3e},c2 {:.3e},corrected err {:.3e},estimate {:.3e},mirror {mirror:.1e},odd per release {odd:.3e},closed c2 {closed:.3e}",
+        o.mode,
+        friction_needed_at_rim(&s) / mu_s,
+        o.form,
+        o.err,
+        d(t),
+        o.c2,
+        o.corrected_err,
+        o.estimate
+    );
+    Some(o)
+}
+
+/// The incline's modes as the rotation estimate has them (0 rolls to the rim, 1 slides, 2 near
+/// the stick threshold), with the last split in two: 2 where the rotation brings the granule
+/// near it at the rim, 3 where the incline itself is near it at rest (rolling needs more than
+/// [`NEAR_SLIDING`] of `mu_s` without any rotation).
+///
+/// [`NEAR_SLIDING`]: model_core::choose::whole::NEAR_SLIDING
+fn mode_of(s: &RollingScene<f64>) -> usize {
+    use model_core::choose::whole::{
+        NEAR_SLIDING, ROTATION_K_NEAR_SLIDING, ROTATION_K_SLIDING, incline_friction_needed,
+    };
+    let k = rotation_constant(s);
+    if k == ROTATION_K_SLIDING {
+        1
+    } else if k == ROTATION_K_NEAR_SLIDING {
+        if incline_friction_needed(s) > NEAR_SLIDING * s.sliding_friction {
+            3
+        } else {
+            2
+        }
+    } else {
+        0
+    }
+}
+
+/// Per mode key, the constant `K4` of a bound `K4 F^2`: the least that covers `need` on every
+/// fitting scene of that key.
+fn fitted(
+    rows: &[Orders],
+    key: &dyn Fn(&Orders) -> usize,
+    need: &dyn Fn(&Orders) -> f64,
+) -> [f64; 4] {
+    let mut k = [0.0f64; 4];
+    for o in rows.iter().filter(|o| o.kind == Kind::Fit) {
+        let r = need(o) / (o.form * o.form);
+        if r.is_finite() {
+            k[key(o)] = k[key(o)].max(r);
+        }
+    }
+    k
+}
+
+/// Per tolerance: in how many scenes the bounded level is taken, of those where its error is
+/// within the tolerance, and how many are taken beyond it.
+fn counts(
+    rows: &[Orders],
+    kind: Kind,
+    err: &dyn Fn(&Orders) -> f64,
+    bound: &dyn Fn(&Orders) -> f64,
+) -> String {
+    let rows: Vec<&Orders> = rows.iter().filter(|o| o.kind == kind).collect();
+    let cover = rows
+        .iter()
+        .filter(|o| bound(o) <= 0.1)
+        .map(|o| err(o) / bound(o))
+        .fold(0.0, f64::max);
+    let per_tol = [0.05, 0.01, 0.001]
+        .iter()
+        .map(|&tol| {
+            let ok = rows.iter().filter(|o| err(o) <= tol).count();
+            let taken = rows.iter().filter(|o| bound(o) <= tol).count();
+            let beyond = rows
+                .iter()
+                .filter(|o| bound(o) <= tol && err(o) > tol)
+                .count();
+            format!("{tol}: {taken} of {ok} ({beyond} beyond)")
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    format!("{per_tol}; largest error / bound {cover:.3}")
+}
+
+/// The measurement (see the module's text).
+#[test]
+#[ignore]
+fn rotation_orders() {
+    let mut rows = Vec::new();
+    for r in fitting_grid() {
+        rows.extend(orders("fit", Kind::Fit, r));
+    }
+    for r in held_out_grid() {
+        rows.extend(orders("held", Kind::Held, r));
+    }
+    // The cost grid's four rotation rows and the held-out cost grid's three (docs/model.md
+    // §12), bare rims.
+    for r in [
+        (30.0, 1.8, 1.8, 0.2, 0.0375, 0.075),
+        (30.0, 3.6, 3.6, 0.2, 0.0375, 0.075),
+        (45.0, 3.6, 3.6, 0.4, 0.0375, 0.075),
+        (60.0, 3.6, 3.6, 0.4, 0.0375, 0.075),
+        (50.0, 0.8, 0.8, 0.3, 0.0375, 0.075),
+        (50.0, 2.5, -1.875, 0.3, 0.0375, 0.075),
+        (50.0, 2.5, 2.5, 0.3, 0.0375, 0.075),
+    ] {
+        rows.extend(orders("row", Kind::Row, r));
+    }
+    // The cost grid's and the held-out cost grid's bare rims (75 mm, ri 37.5 mm).
+    for tilt in [10.0, 30.0, 45.0, 60.0] {
+        for w in [0.5, 1.8, 3.6] {
+            for mu_s in [0.2, 0.4, 0.6] {
+                rows.extend(orders(
+                    "cost",
+                    Kind::Cost,
+                    (tilt, w, w, mu_s, 0.0375, 0.075),
+                ));
+            }
+        }
+    }
+    for tilt in [20.0, 50.0, 70.0] {
+        for (w1, w2) in [(0.8, 0.8), (2.5, 2.5), (2.5, -1.875)] {
+            for mu_s in [0.3, 0.5] {
+                rows.extend(orders(
+                    "cost",
+                    Kind::Cost,
+                    (tilt, w1, w2, mu_s, 0.0375, 0.075),
+                ));
+            }
+        }
+    }
+    let n = |k: Kind| rows.iter().filter(|o| o.kind == k).count();
+    let mirror = rows.iter().map(|o| o.mirror).fold(0.0, f64::max);
+    println!(
+        "{} fitting and {} held-out scenes; the mean at (w1, w2) against (-w1, -w2): {mirror:.1e}",
+        n(Kind::Fit),
+        n(Kind::Held)
+    );
+    // The closed form against the measured c2 where the incline rolls and is not near the stick
+    // threshold at rest (modes 0 and 2: T is smooth in the speeds there).
+    let worst = rows
+        .iter()
+        .filter(|o| o.mode == 0 || o.mode == 2)
+        .map(|o| ((o.closed - o.c2) / o.c2).abs())
+        .fold(0.0, f64::max);
+    let n_rolling = rows.iter().filter(|o| o.mode == 0 || o.mode == 2).count();
+    println!(
+        "closed-form c2 against the measured one, {n_rolling} rolling scenes: largest relative difference {worst:.2e}"
+    );
+    // Today's three modes, and the near-threshold one split (at rest / at the rim).
+    let three = |o: &Orders| o.mode.min(2);
+    let four = |o: &Orders| o.mode;
+    let plain = |o: &Orders| o.err;
+    let corr = |o: &Orders| o.corrected_err;
+    let today = |o: &Orders| o.estimate;
+    println!(
+        "today's estimate: fitting {}; held-out {}; rows {}",
+        counts(&rows, Kind::Fit, &plain, &today),
+        counts(&rows, Kind::Held, &plain, &today),
+        counts(&rows, Kind::Row, &plain, &today)
+    );
+    for (split, key) in [
+        ("three modes", &three as &dyn Fn(&Orders) -> usize),
+        ("four modes", &four),
+    ] {
+        // (a) the corrected incline, bounded by K4 F^2.
+        let ka = fitted(&rows, key, &corr);
+        let bound_a = |o: &Orders| ka[key(o)] * o.form * o.form;
+        // (b) the plain incline, bounded by |c2| + K4 F^2.
+        let kb = fitted(&rows, key, &|o: &Orders| (o.err - o.c2.abs()).max(0.0));
+        let bound_b = |o: &Orders| o.c2.abs() + kb[key(o)] * o.form * o.form;
+        let show = |k: &[f64]| {
+            k.iter()
+                .map(|k| format!("{k:.2e}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        println!("{split}: K4 (a) {}, (b) {}", show(&ka), show(&kb));
+        for (name, kind) in [
+            ("fitting", Kind::Fit),
+            ("held-out", Kind::Held),
+            ("rows", Kind::Row),
+            ("cost grids' bare rims", Kind::Cost),
+        ] {
+            println!(
+                "  {name}: (a) corrected {}",
+                counts(&rows, kind, &corr, &bound_a)
+            );
+            println!(
+                "  {name}: (b) |c2| + K4 F^2 {}",
+                counts(&rows, kind, &plain, &bound_b)
+            );
+            // Either: the plain incline where (b) takes it, else the corrected one where (a)
+            // does; against today's estimate.
+            let per_tol = [0.05, 0.01, 0.001]
+                .iter()
+                .map(|&tol| {
+                    let rs = rows.iter().filter(|o| o.kind == kind);
+                    let today_n = rs.clone().filter(|o| today(o) <= tol).count();
+                    let either = rs
+                        .clone()
+                        .filter(|o| bound_b(o) <= tol || bound_a(o) <= tol);
+                    let beyond = either
+                        .clone()
+                        .filter(|o| {
+                            if bound_b(o) <= tol {
+                                o.err > tol
+                            } else {
+                                o.corrected_err > tol
+                            }
+                        })
+                        .count();
+                    format!(
+                        "{tol}: {} (today {today_n}, {beyond} beyond)",
+                        either.count()
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join(", ");
+            println!("  {name}: taken by (b) or (a) {per_tol}");
+        }
+        for o in rows.iter().filter(|o| o.kind == Kind::Row) {
+            println!(
+                "  row {}: bound (a) {:.2e} (its error {:.2e}), (b) {:.2e} (its error {:.2e})",
+                o.label,
+                bound_a(o),
+                o.corrected_err,
+                bound_b(o),
+                o.err
+            );
+        }
+    }
+    // What a bound may cost on the rows it is to take: within 1.25x of the plain incline
+    // leaves a quarter of the incline's own time (1000 calls, best of 5).
+    let s = scene((60.0, 3.6, 3.6, 0.4, 0.0375, 0.075));
+    let time = |f: &dyn Fn()| {
+        (0..5)
+            .map(|_| {
+                let t0 = std::time::Instant::now();
+                for _ in 0..1000 {
+                    f();
+                }
+                t0.elapsed().as_secs_f64() / 1000.0
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let second = time(&|| {
+        std::hint::black_box(model_core::choose::incline_rotation::mean_second_order(
+            std::hint::black_box(&s),
+        ));
+    });
+    let incline = time(&|| {
+        std::hint::black_box(incline_mean_s(std::hint::black_box(&s)));
+    });
+    let choice = time(&|| {
+        std::hint::black_box(choose_level(
+            std::hint::black_box(&s),
+            &BowlShape::bare_rim(),
+            0.01,
+            false,
+        ));
+    });
+    println!(
+        "the incline {incline:.2e} s, the choice (with it) {choice:.2e} s, the closed-form second \
+         order {second:.2e} s per call"
+    );
+    // The mirror holds on every scene to the integrator's tolerance (rtol 1e-10 per release;
+    // 1.9e-8 and 6.7e-8 where the granule switches between rolling and sliding, whose time
+    // the integrator locates less exactly): the mean's first-order part is zero.
+    assert!(
+        mirror < 1e-6,
+        "the mean is not even in the speeds: {mirror:e}"
+    );
+}
+
+/// The mirror behind the first-order claim, on two scenes of the cost grid's rotation rows:
+/// each release at `(w1, w2)` is the mirrored release at `(-w1, -w2)`, so the mean over the
+/// twelve azimuths is even in the speeds, while single releases move at first order.
+#[test]
+fn the_mean_over_releases_is_even_in_the_speeds() {
+    for r in [
+        (30.0, 1.8, 1.8, 0.2, 0.0375, 0.075),
+        (50.0, 2.5, -1.875, 0.3, 0.0375, 0.075),
+    ] {
+        let s = scene(r);
+        let plus = disc_times_s(&s).unwrap();
+        let minus = disc_times_s(&scaled(&s, -1.0)).unwrap();
+        let n = plus.len();
+        for (i, p) in plus.iter().enumerate() {
+            // Azimuth i * 30 deg mirrors to (12 - i) * 30 deg.
+            let m = minus[(n - i) % n];
+            assert!(
+                (p - m).abs() <= 1e-8 * p,
+                "{r:?} at {} deg: {p} vs {m}",
+                30 * i
+            );
+        }
+        assert!((mean(&plus) - mean(&minus)).abs() <= 1e-8 * mean(&plus));
+        // The single releases do move at first order: their odd part is far from zero.
+        let odd = (plus[3] - minus[3]).abs() / plus[3];
+        assert!(odd > 1e-3, "{r:?}: {odd}");
+    }
+}
+
+/// The closed-form second order (model-core `choose::incline_rotation`) against the disc at
+/// small speeds, where the incline rolls: `(T(s w) - T_incline) / T_incline / s^2` at `s` = 1/4
+/// and 1/8 (Richardson) equals the closed form's `mean T2 / mean T0` to 1e-3 on the cost grid's
+/// rolling rows (30 deg, 1.8 rad/s, mu_s 0.2; 45 deg, 3.6 rad/s, mu_s 0.4), a low tilt with the
+/// spin opposite, and a release near the axis.
+#[test]
+fn the_closed_form_second_order_is_the_discs() {
+    for r in [
+        (30.0, 1.8, 1.8, 0.2, 0.0375, 0.075),
+        (45.0, 3.6, 3.6, 0.4, 0.0375, 0.075),
+        (10.0, 1.0, -0.75, 0.4, 0.0375, 0.075),
+        (60.0, 2.5, 2.5, 0.6, 0.02, 0.1),
+    ] {
+        let s = scene(r);
+        assert_ne!(mode_of(&s), 1, "{r:?} slides");
+        let (t0, closed) = model_core::choose::incline_rotation::mean_second_order(&s).unwrap();
+        let d = |k: f64| (mean(&disc_times_s(&scaled(&s, k)).unwrap()) - t0) / t0 / (k * k);
+        let measured = (4.0 * d(0.125) - d(0.25)) / 3.0;
+        assert!(
+            (closed - measured).abs() <= 1e-3 * measured.abs(),
+            "{r:?}: closed {closed:e}, measured {measured:e}"
+        );
+    }
+}
