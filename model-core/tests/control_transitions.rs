@@ -193,3 +193,28 @@ fn a_model_too_steep_at_the_top_does_not_starve_the_lowest_speed() {
     );
     four_to_lowest_without_fault(rig, 8000, 5.91);
 }
+
+/// Plant p37 of `bowl sim make-family --seed 7 --plants 60`: heavy friction on a heavy
+/// precession axis (Coulomb 0.098 N m, stiction 0.131 N m on 0.099 kg m^2, 10 V supply).
+/// Slowing from 4 to 0.2 rad/s it crawls at 0.10 rad/s, below what its 12 pulses measure, and
+/// the loop pushes it off the crawl: it leaps to 0.6..0.7 rad/s, past the runaway bound of a
+/// 0.2 rad/s model (1.2 x 0.2 + 0.3), and the over-speed rule faulted it 13.8 s after the
+/// command. The runaway is judged against what the applied duty drives too
+/// (`supervisor::edge_runaway`). Held at 4 rad/s as long as the family report's settling takes
+/// for this plant (4.78 s).
+#[test]
+fn a_heavy_shaft_pushed_off_its_crawl_is_no_runaway() {
+    let rig = plant_rows::rig_from_table(
+        10.006,
+        0.405,
+        [
+            [
+                1.1526, 0.09904, 0.00984, 0.0984, 0.1312, 0.0465, 0.000803, 0.002, 0.0305,
+            ],
+            [
+                1.6131, 0.01629, 0.00529, 0.0529, 0.0741, 0.0223, 0.000136, 0.0066, 0.0566,
+            ],
+        ],
+    );
+    four_to_lowest_without_fault(rig, 7037, 4.78);
+}

@@ -21,8 +21,8 @@ use super::planner::{InverseFailure, ResidenceForBowlSpeed, SetpointPlanner};
 use super::supervisor::{
     DRIVEN_BELOW_MODEL_DUTY, DROPPING_WATCH_PITCHES, Fault, PAIR_RUNAWAY_MARGIN_RAD_S,
     PAIR_RUNAWAY_RATIO, PAIR_RUNAWAY_STEADY_S, REVOLUTION_RUNAWAY_DUTY,
-    REVOLUTION_RUNAWAY_MARGIN_RAD_S, REVOLUTION_RUNAWAY_RATIO, RUNAWAY_MARGIN_RAD_S, RUNAWAY_RATIO,
-    SETTLED_AFTER_S, State, WATCH_PITCHES, fault_code,
+    REVOLUTION_RUNAWAY_MARGIN_RAD_S, REVOLUTION_RUNAWAY_RATIO, SETTLED_AFTER_S, State,
+    WATCH_PITCHES, edge_runaway, fault_code,
 };
 use crate::bowl::{MotorSpeeds, combined_speed_from_trig};
 
@@ -299,7 +299,7 @@ impl Controller {
             // edge that came far sooner than the plant model expects faults at once, without
             // waiting for the filtered speed to reach the absolute limit.
             let runaway = self.reached && seen[i] && {
-                a.est.edge_speed_rad_s() > RUNAWAY_RATIO * model + RUNAWAY_MARGIN_RAD_S
+                edge_runaway(a.est.edge_speed_rad_s(), model, a.obs.driven_rad_s())
                     || (model > a.k.pair_runaway_above_rad_s()
                         && near_top_runaway(a, model, steady[i]))
             };

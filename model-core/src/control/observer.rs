@@ -97,6 +97,9 @@ pub struct AngleObserver {
     load_held: bool,
     /// The last edge was ambiguous (see [`AngleObserver::correct`]) and not learned from.
     skipped: bool,
+    /// The speed the applied duty drives the identified plant to with the learned load, but
+    /// without the edges' corrections of the speed, rad/s: see [`AngleObserver::driven_rad_s`].
+    driven_rad_s: f32,
 }
 
 impl AngleObserver {
@@ -111,6 +114,7 @@ impl AngleObserver {
         innovation: 0.0,
         load_held: false,
         skipped: false,
+        driven_rad_s: 0.0,
     };
 
     /// One tick of the plant driven by `duty` (in the shaft's direction: negative brakes).
@@ -122,6 +126,10 @@ impl AngleObserver {
         self.speed_rad_s = if w > 0.0 { w } else { 0.0 };
         self.since_edge_pitches += self.speed_rad_s * k.dt_s * k.per_pitch_rad;
         self.since_edge_s += k.dt_s;
+        // The duty's own speed with the load learned so far (held while slowing): what the
+        // shaft runs at under a steady duty, and above it while the loop pushes.
+        let v = self.driven_rad_s + (target - self.driven_rad_s) * k.alpha;
+        self.driven_rad_s = if v > 0.0 { v } else { 0.0 };
     }
 
     /// The first edge after rest, `ago_s` before now: the angle's reference, no innovation.
@@ -226,6 +234,15 @@ impl AngleObserver {
     /// Speed, rad/s (magnitude).
     pub fn speed_rad_s(&self) -> f32 {
         self.speed_rad_s
+    }
+    /// The speed the duty the loop applied drives the identified plant to, through its lag,
+    /// rad/s: the observer's propagation with the load it learned but without the edges'
+    /// corrections of its speed. At a steady duty it is the speed the shaft holds; the edges
+    /// do not pull it along, so a shaft driven by something other than the loop (a bridge stuck
+    /// on) runs away from it, while a shaft the loop itself pushed (a breakaway push from a
+    /// crawl) is expected as fast as that push drives it.
+    pub fn driven_rad_s(&self) -> f32 {
+        self.driven_rad_s
     }
     /// Load the model does not know, duty.
     pub fn load_duty(&self) -> f32 {

@@ -162,6 +162,20 @@ pub const DROPPING_WATCH_PITCHES: f32 = 3.3;
 pub const RUNAWAY_RATIO: f32 = 1.2;
 /// See [`RUNAWAY_RATIO`], rad/s.
 pub const RUNAWAY_MARGIN_RAD_S: f32 = 0.3;
+
+/// Whether an edge interval's speed `edge_rad_s` is a runaway: faster than [`RUNAWAY_RATIO`]
+/// times (plus [`RUNAWAY_MARGIN_RAD_S`]) what the shaft may run at, the larger of the plant
+/// model's speed `model_rad_s` (the reference through the identified lag) and `driven_rad_s`,
+/// what the duty the loop applied drives the identified plant to
+/// ([`super::observer::AngleObserver::driven_rad_s`]). The second is the observer's
+/// expectation of a shaft the loop itself pushed: a heavy-friction shaft that crawled below its
+/// lowest speed after a step down and was pushed off its crawl leaps well past the reference
+/// (seed 7 p37 at 4 -> 0.2 rad/s: 0.62 rad/s under a 0.25 push, against 0.54 allowed by the
+/// model alone), while a bridge stuck on drives the shaft past what the loop's (then
+/// falling) duty drives.
+pub fn edge_runaway(edge_rad_s: f32, model_rad_s: f32, driven_rad_s: f32) -> bool {
+    edge_rad_s > RUNAWAY_RATIO * model_rad_s.abs().max(driven_rad_s) + RUNAWAY_MARGIN_RAD_S
+}
 /// Near the top speed, where full duty (a bridge stuck on) drives the shaft to less than
 /// [`RUNAWAY_RATIO`] allows, the last two edge intervals together faster than this many times
 /// the model's speed (plus the margin), at a steady reference, are a runaway too: tooth offsets
