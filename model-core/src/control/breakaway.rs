@@ -6,11 +6,14 @@
 //! `L di/dt = V d - R i - k w`), so `i = (V d - k w) / R`: with `g = V / R` (times the sense
 //! chain's gain; the supervisor's [`CurrentWatch`](super::supervisor::CurrentWatch) learns it,
 //! and the offset, once, and the controller hands the loop `c = i / g`, the current as the duty
-//! that drives it into a held shaft) the back-EMF speed is `w = (d - c) / (k / V)`. The loop
-//! knows `volts_per_rad_s / V`, which also holds the viscous share (`k + R b / k`): the speed
-//! read is low by that share (4.5 % on the nominal motor, up to 12 % on the family), so it is
-//! used for what a few percent do not change: the breakaway, and a dead band around the model
-//! speed between the breakaway and the first valid measurement from the edges.
+//! that drives it into a held shaft) the back-EMF speed is `w = (d - c) / (k / V)`. The loop's
+//! `k / V` is learned where the edges measure the speed ([`BackEmfScale`]: commissioning's
+//! steady steps, then every steady run); the identified `volts_per_rad_s / V` also holds the
+//! viscous share (`k + R b / k`, 4.5 % on the nominal motor) and the identification's error,
+//! and read through it the speed was 4 to 22 % low on the family. What is left is the current
+//! per duty's error (a few percent of the current, a large share of it at low speed), so the
+//! back-EMF speed serves for what a few percent do not change: the breakaway, and a dead band
+//! around the model speed between the breakaway and the first valid measurement from the edges.
 
 /// Weight of a new sample in the back-EMF speed's running mean (5 ms at 1 kHz: a tenth of a
 /// nominal shaft's time constant; the 10 mA noise of one sample is 0.03 rad/s, 0.01 after it).
@@ -45,6 +48,96 @@ pub const FIT_PRIOR_DUTY2: f32 = 0.01;
 /// Share of the identified friction duty below which a shaft is certainly held (stiction is at
 /// least Coulomb friction, and material only adds to it): its current fits the held ratio.
 pub const FIT_BELOW_FRICTION: f32 = 0.9;
+
+/// The back-EMF is learned only from speeds the edges measure at or above this, rad/s: there
+/// the back-EMF is most of the duty, so the current per duty's error (up to 25 % of the
+/// current) moves it by a few percent at most; and the lowest speeds give windows of a second.
+pub const SCALE_FROM_RAD_S: f32 = 1.0;
+/// ... while the duty has stayed within this of its running mean for [`SCALE_HELD_S`]: a
+/// shaft that accelerates is ahead of the edges' window mean (commissioning's reaction ramps
+/// the spin's duty by 0.2 a second, 0.01 off its 50 ms mean: wound into the fit, that ramp
+/// made it worse than the identified model).
+pub const SCALE_DUTY_BAND: f32 = 0.003;
+/// Seconds the duty must have held (see [`SCALE_DUTY_BAND`]).
+pub const SCALE_HELD_S: f32 = 0.5;
+/// Weight of a sample in the duty's running mean (50 ms at 1 kHz).
+pub const SCALE_MEAN_WEIGHT: f32 = 0.02;
+/// Samples of learning before the learned back-EMF replaces the identified model (a second:
+/// the 10 mA noise of one sample averages out).
+pub const SCALE_LEARNED_AFTER: u32 = 1000;
+/// The learned back-EMF is kept between the identified `volts_per_rad_s / V` (which also holds
+/// the viscous share: the back-EMF is below it) and that over this factor (a sense chain gone
+/// wrong must not move the band far from the model).
+pub const SCALE_RANGE: f32 = 1.25;
+
+/// The back-EMF duty per rad/s as the current shows it where the edges measure the speed:
+/// `d - c = e w` (least squares through zero over steady samples, commissioning's steps
+/// first, then every steady run; `c` the current as the duty that drives it into a held
+/// shaft, `w` the edges' speed). The identified `volts_per_rad_s` also holds the viscous share
+/// and the identification's error: read through it, the back-EMF speed was 4 to 22 % low on
+/// the family (docs/control.md, "The back-EMF learned at measured speeds"). A fit of the held
+/// ratio beside it (`c = a (d - e w)`) was tried: the steps' duties are nearly in proportion
+/// to their speeds, and it traded one for the other.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BackEmfScale {
+    /// Sums over the learned samples of `w^2` and `(d - c) w`, scaled by 1e-3.
+    ww: f32,
+    emf_w: f32,
+    /// Running mean of the duty, and how long it has stayed near it, s.
+    mean_duty: f32,
+    held_s: f32,
+    /// Samples learned from.
+    learned: u32,
+}
+
+impl BackEmfScale {
+    /// Nothing learned.
+    pub const NONE: Self = Self {
+        ww: 0.0,
+        emf_w: 0.0,
+        mean_duty: 0.0,
+        held_s: 0.0,
+        learned: 0,
+    };
+
+    /// One sample: `applied` duty and current `torque_duty` (both in the commanded direction,
+    /// see [`Breakaway::sample`]) and the edges' speed `measured_rad_s` in that direction (0
+    /// when there is no valid measurement), every `dt_s`.
+    pub fn sample(&mut self, applied: f32, torque_duty: f32, measured_rad_s: f32, dt_s: f32) {
+        if !(torque_duty.is_finite() && applied.is_finite() && measured_rad_s.is_finite()) {
+            return;
+        }
+        self.mean_duty += (applied - self.mean_duty) * SCALE_MEAN_WEIGHT;
+        self.held_s = if (applied - self.mean_duty).abs() <= SCALE_DUTY_BAND {
+            self.held_s + dt_s
+        } else {
+            0.0
+        };
+        if self.held_s < SCALE_HELD_S || measured_rad_s < SCALE_FROM_RAD_S {
+            return;
+        }
+        // Scaled so that hours of samples stay well inside f32.
+        self.ww += 1e-3 * measured_rad_s * measured_rad_s;
+        self.emf_w += 1e-3 * (applied - torque_duty) * measured_rad_s;
+        self.learned = self.learned.saturating_add(1);
+    }
+
+    /// The back-EMF duty per rad/s: the learned one once [`SCALE_LEARNED_AFTER`] samples
+    /// taught it (within [`SCALE_RANGE`] below `identified`), else `identified`.
+    pub fn duty_per_rad_s(&self, identified: f32) -> f32 {
+        if self.learned < SCALE_LEARNED_AFTER || self.ww <= 0.0 {
+            return identified;
+        }
+        let e = self.emf_w / self.ww;
+        if !e.is_finite() || e > identified {
+            identified
+        } else if e < identified / SCALE_RANGE {
+            identified / SCALE_RANGE
+        } else {
+            e
+        }
+    }
+}
 
 /// What the current says of one start.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -574,19 +574,22 @@ impl Controller {
     fn rebuild_keep_state(&mut self, cfg: ControllerConfig) {
         let est = [self.axes[0].est, self.axes[1].est];
         let current = [self.axes[0].current, self.axes[1].current];
+        let emf = [self.axes[0].emf, self.axes[1].emf];
         let load = [self.axes[0].load, self.axes[1].load];
         let identified = self.identified;
         let feedback = self.feedback;
         let supply_cut = self.supply_cut;
         *self = Self::build(cfg);
         self.supply_cut = supply_cut;
-        for (a, ((e, c), l)) in self
+        for (a, (((e, c), l), m)) in self
             .axes
             .iter_mut()
-            .zip(est.into_iter().zip(current).zip(load))
+            .zip(est.into_iter().zip(current).zip(load).zip(emf))
         {
             a.est = e;
             a.current = c;
+            // The back-EMF learned in commissioning's steady runs (breakaway.rs).
+            a.emf = m;
             a.load.adopt(&l);
         }
         self.identified = identified;

@@ -122,6 +122,9 @@ pub struct SpeedLoop {
     breakaway: Breakaway,
     /// The current showed the breakaway in this step (see [`SpeedLoop::take_breakaway`]).
     breakaway_news: bool,
+    /// The back-EMF duty per rad/s the current sense learned (0: not given, the identified
+    /// model's); set before each step (see [`SpeedLoop::set_back_emf_duty_per_rad_s`]).
+    emf_duty_per_rad_s: f32,
 }
 
 /// Inputs of one loop step.
@@ -169,6 +172,7 @@ impl SpeedLoop {
         reference_abs_rad_s: 0.0,
         breakaway: Breakaway::NONE,
         breakaway_news: false,
+        emf_duty_per_rad_s: 0.0,
     };
 
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
@@ -437,10 +441,15 @@ impl SpeedLoop {
     ) -> bool {
         let applied = self.duty * input.direction;
         let was_released = self.breakaway.released();
+        let emf = if self.emf_duty_per_rad_s > 0.0 {
+            self.emf_duty_per_rad_s
+        } else {
+            k.duty_per_rad_s
+        };
         let released = self.breakaway.sample(
             applied,
             torque_duty,
-            (k.duty_per_rad_s, k.friction_duty),
+            (emf, k.friction_duty),
             (starting, starting),
             r_abs,
         );
@@ -468,6 +477,13 @@ impl SpeedLoop {
             self.integral = clamp(self.integral + step * input.direction, k.duty_limit);
         }
         released
+    }
+
+    /// The back-EMF duty per rad/s the current sense learned at measured speeds
+    /// ([`BackEmfScale`](super::breakaway::BackEmfScale)), for the back-EMF speed of the next
+    /// step; the controller sets it before each step on axes with current sense.
+    pub fn set_back_emf_duty_per_rad_s(&mut self, duty_per_rad_s: f32) {
+        self.emf_duty_per_rad_s = duty_per_rad_s;
     }
 
     /// Whether the current showed the breakaway since the last call (once per start).

@@ -1,5 +1,6 @@
 //! One motor axis's runtime state inside the controller.
 
+use crate::control::breakaway::BackEmfScale;
 use crate::control::config::{AxisConfig, ControllerConfig};
 use crate::control::estimator::PulseSpeedEstimator;
 use crate::control::load_pattern::LoadPattern;
@@ -33,6 +34,9 @@ pub(super) struct AxisState {
     pub(super) steady: bool,
     /// The current sense's offset, current per duty and back-EMF (none: never sampled).
     pub(super) current: CurrentWatch,
+    /// The back-EMF per rad/s the current shows at speeds the edges measure (kept across
+    /// starts; breakaway.rs).
+    pub(super) emf: BackEmfScale,
     /// This tick's current reading as the duty that drives it into a held shaft, for the loop
     /// (see `LoopInput::torque_duty`); taken by the loop each tick.
     pub(super) torque_duty: Option<f32>,
@@ -60,6 +64,7 @@ impl AxisState {
             load: LoadPattern::new(a, cfg.supply_v),
             steady: false,
             current: CurrentWatch::NEW,
+            emf: BackEmfScale::NONE,
             torque_duty: None,
             obs: AngleObserver::REST,
             ok: ObserverConstants::new(a, dt_s, cfg.supply_v),

@@ -19,6 +19,14 @@ impl Controller {
         let g = a.current.amps_per_duty();
         a.torque_duty = (g > 0.0 && reading_a.abs() <= CURRENT_READING_LIMIT_A)
             .then(|| (reading_a - a.current.offset_a()) * a.direction / g);
+        if let Some(c) = a.torque_duty {
+            // The back-EMF per rad/s where the edges measure the speed (commissioning's steady
+            // runs, then every steady run), for the loop's back-EMF speed at the next start.
+            let measured = if a.est.is_valid() { a.measured } else { 0.0 };
+            a.emf.sample(applied * a.direction, c, measured, self.dt_s);
+        }
+        let emf_duty_per_rad_s = a.emf.duty_per_rad_s(a.k.duty_per_rad_s());
+        a.speed_loop.set_back_emf_duty_per_rad_s(emf_duty_per_rad_s);
         let model = a.speed_loop.model_rad_s().abs();
         let share = if a.steady {
             BACK_EMF_STEADY_SHARE
