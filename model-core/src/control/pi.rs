@@ -52,7 +52,10 @@
 //!   load the model does not know (material poured in since commissioning). Keeping only what
 //!   was found beyond the kick left loaded shafts crawling below 0.2 rad/s until the watch
 //!   faulted them (2 to 6 healthy plants per 60-plant family); keeping half the kick costs
-//!   overshoot on an unloaded shaft (35 % on the nominal rig at 0.5 rad/s).
+//!   overshoot on an unloaded shaft (35 % on the nominal rig at 0.5 rad/s). A kick kept at a
+//!   first edge that came while the planner still ramped the reference up follows, until the
+//!   first measurement, the kick the rising reference still needs (docs/control.md, "From rest
+//!   to 1 rad/s: the floor of a start from pulses").
 //! - The crawl's reading: a loaded shaft may crawl between its first and second edge, and the
 //!   push rises again. When that window closes with the push on, its mean speed against the
 //!   mean duty that drove it reads the load the model does not know, and the integral takes
