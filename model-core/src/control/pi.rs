@@ -52,7 +52,10 @@
 //!   load the model does not know (material poured in since commissioning). Keeping only what
 //!   was found beyond the kick left loaded shafts crawling below 0.2 rad/s until the watch
 //!   faulted them (2 to 6 healthy plants per 60-plant family); keeping half the kick costs
-//!   overshoot on an unloaded shaft (35 % on the nominal rig at 0.5 rad/s).
+//!   overshoot on an unloaded shaft (35 % on the nominal rig at 0.5 rad/s). A kick kept at a
+//!   first edge that came while the planner still ramped the reference up follows, until the
+//!   first measurement, the kick the rising reference still needs (docs/control.md, "From rest
+//!   to 1 rad/s: the floor of a start from pulses").
 //! - The crawl's reading: a loaded shaft may crawl between its first and second edge, and the
 //!   push rises again. When that window closes with the push on, its mean speed against the
 //!   mean duty that drove it reads the load the model does not know, and the integral takes
@@ -111,6 +114,9 @@ pub struct SpeedLoop {
     moved: bool,
     kick_rad_s: f32,
     push_sum: f32,
+    /// The kick's share the integral kept at the first edge, until the first measurement
+    /// (duty, magnitude; see `kept_kick` in [`SpeedLoop::step`]).
+    kept_kick: f32,
     /// The model has been above the reference (the reference came down) since the start of
     /// the newest window: that window's "too fast" is the slowing down, not a load.
     slowing: bool,
@@ -167,6 +173,7 @@ impl SpeedLoop {
         moved: false,
         kick_rad_s: 0.0,
         push_sum: 0.0,
+        kept_kick: 0.0,
         slowing: false,
         model_down_quiet_s: 0.0,
         reference_abs_rad_s: 0.0,
@@ -303,6 +310,9 @@ impl SpeedLoop {
                     self.push.max(k.kick_level(r_abs))
                 };
                 self.integral += PUSH_KEPT * started_by * input.direction;
+                if started_by > self.push {
+                    self.kept_kick = PUSH_KEPT * started_by;
+                }
                 if input.torque_duty.is_some() {
                     // The edge proves the breakaway: the back-EMF band holds the integral from
                     // here to the first measurement, as after one the current confirmed. Left
@@ -317,6 +327,21 @@ impl SpeedLoop {
         }
         if !rest {
             self.moved = true;
+        }
+        // The kick kept at a first edge that came while the planner still ramped the reference
+        // up is half of what the reference then needed above its feedforward; the reference
+        // needs less as it rises (`kick_level` falls with it), and so does what is kept, until
+        // the first measurement hands the integral to the loop. Kept whole, half the kick at
+        // 0.33 of 1 rad/s held family-60 p28's precession 17 % past 1 rad/s until then (the
+        // kick at 1 rad/s: 0.004 duty; kept: 0.034).
+        if self.kept_kick > 0.0 {
+            let now = PUSH_KEPT * k.kick_level(r_abs);
+            if input.measurement_valid {
+                self.kept_kick = 0.0;
+            } else if now < self.kept_kick {
+                self.integral -= (self.kept_kick - now) * input.direction;
+                self.kept_kick = now;
+            }
         }
         // Push a shaft that should have given an edge by now: from rest before it first moved,
         // or crawling between its first and second edge (no measurement yet). Never a shaft
