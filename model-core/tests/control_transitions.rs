@@ -249,3 +249,32 @@ fn from_rest_to_one_rad_s_the_window_lag_does_not_overshoot() {
         );
     }
 }
+
+/// From rest to the lowest speed on the nominal rig: the kick breaks stiction and half of it
+/// stays in the integral at the first edge (so a loaded shaft does not stick again), which
+/// on this unloaded rig drives the precession to 0.52 rad/s. With the window's dead time
+/// modelled, the loop removes that at its scheduled bandwidth (0.19 rad/s at 0.2 rad/s, a 5 s
+/// time constant): 76 % above the target over the step's steady window, still 0.24 rad/s 13 s
+/// after the command. The first measurement of a kick-started shaft now reads the load
+/// instead (pi.rs, `take_start_load`): both axes within 10 % over the steady window (3.0 % and
+/// 1.3 % measured; before the correction model the held error's push gave 64 % and 42 %).
+#[test]
+fn from_rest_to_the_lowest_speed_the_kept_kick_is_read_away() {
+    let o = commissioned_transition(
+        rig_with_pulses(12),
+        ControllerConfig::nominal(),
+        1,
+        0.0,
+        0.2,
+        true,
+        [0.0; 2],
+    );
+    assert!(o.commissioned && o.fault.is_none(), "{:?}", o.fault);
+    for (axis, r) in o.reports.iter().enumerate() {
+        assert!(
+            r.steady_state_error <= 0.10,
+            "axis {axis}: {:.1} % off 0.2 rad/s over the steady window",
+            100.0 * r.steady_state_error
+        );
+    }
+}

@@ -61,6 +61,13 @@
 //!   up while the push had already started the shaft: 15..25 % too fast for 5 s on loaded
 //!   spin axes, which at a pulse a second the loop corrects only slowly.
 //!
+//! - The start's reading: the first measurement of a shaft the kick started (not the push),
+//!   over a window of at least [`CRAWL_READ_MIN_S`], reads the load against the model with
+//!   the correction, and the integral takes it at once: what was kept of the kick is replaced
+//!   by what the shaft needs, where the loop at its low-speed bandwidth took 10 s and more.
+//!   A pushed shaft's first window carries its leap (stored in stiction the model does not
+//!   know) and is left to the loop.
+//!
 //! - With current sense (breakaway.rs): the back-EMF shows the breakaway at once, where the
 //!   first edge may come a second later. The kick then lasts until the current shows it (not
 //!   until the model says it should have), kick and push drop there to feedforward + integral
@@ -128,6 +135,11 @@ pub struct SpeedLoop {
     /// identified lag), and its angle over the estimator's current window, rad.
     correction_rad_s: f32,
     correction_angle_rad: f32,
+    /// The shaft started from rest (its first edge) and no window has been read since: the
+    /// next one reads the load at once (see `step`).
+    start_reading: bool,
+    /// The push has been on since the shaft was last at rest (the kick did not start it).
+    pushed: bool,
     /// The current showed the breakaway in this step (see [`SpeedLoop::take_breakaway`]).
     breakaway_news: bool,
 }
@@ -180,6 +192,8 @@ impl SpeedLoop {
         correction_duty: 0.0,
         correction_rad_s: 0.0,
         correction_angle_rad: 0.0,
+        start_reading: false,
+        pushed: false,
     };
 
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
@@ -266,7 +280,11 @@ impl SpeedLoop {
             } else {
                 self.error = sample + correction_mean;
                 self.have_error = true;
+                if self.start_reading && w.span_s >= CRAWL_READ_MIN_S && input.feedback {
+                    self.take_start_load(k, c, input.direction);
+                }
             }
+            self.start_reading = false;
             self.model_angle_rad = rp * w.ago_s;
             self.correction_angle_rad = c * w.ago_s;
         }
@@ -339,6 +357,7 @@ impl SpeedLoop {
             }
             self.push = 0.0;
             self.push_sum = 0.0;
+            self.start_reading = !self.pushed;
         }
         if !rest {
             self.moved = true;
@@ -380,6 +399,7 @@ impl SpeedLoop {
                 self.push = kick_level;
             }
             self.push += k.push_per_rad_tick * r_abs;
+            self.pushed = true;
             self.push_sum += self.push;
         }
         // The stall bound is only active with a valid measurement, and counts only from an
@@ -450,6 +470,24 @@ impl SpeedLoop {
             + (1.0 - reading) * PUSH_KEPT * self.push * direction;
         self.push_sum = 0.0;
         self.push = 0.0;
+    }
+
+    /// The first measurement of a start, over a window of at least [`CRAWL_READ_MIN_S`]: the
+    /// integral takes the load it reads at once (`L - c` as duty, the error the loop would
+    /// otherwise remove at its bandwidth). What started the shaft (half the kick or the push,
+    /// kept at its first edge so that a loaded shaft does not stick again) is then replaced by
+    /// what the window shows the shaft needs. Left to the loop, an unloaded shaft ran on the
+    /// kept kick at the scheduled bandwidth's pace: at 0.2 rad/s (0.19 rad/s of bandwidth, a
+    /// 5 s time constant) the nominal rig's stiction leap to 0.52 rad/s was still 0.24 rad/s
+    /// 13 s after the command. Before the dead time was modelled the held error did this
+    /// job by accident (the integral ran on for the whole next window); the window's load
+    /// reading does it on purpose. Only long windows (low speed, where the loop is slow and
+    /// the shaft's lag is short against the window) are read; a short one through which the
+    /// shaft still accelerates is left to the loop, as at the crawl's reading.
+    #[cold]
+    #[inline(never)]
+    fn take_start_load(&mut self, k: &LoopConstants, c: f32, direction: f32) {
+        self.integral += (self.error - c) * k.duty_per_rad_s * direction;
     }
 
     /// One current sample (see [`LoopInput::torque_duty`]): the breakaway watch, and between
