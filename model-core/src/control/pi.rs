@@ -484,8 +484,7 @@ impl SpeedLoop {
     /// reading does it on purpose. Only long windows (low speed, where the loop is slow and
     /// the shaft's lag is short against the window) are read; a short one through which the
     /// shaft still accelerates is left to the loop, as at the crawl's reading.
-    #[cold]
-    #[inline(never)]
+    #[inline(always)]
     fn take_start_load(&mut self, k: &LoopConstants, c: f32, direction: f32) {
         self.integral += (self.error - c) * k.duty_per_rad_s * direction;
     }
