@@ -85,7 +85,7 @@ fn settling_chart_meets_the_targets_and_shows_the_pulse_rate_limit() {
 }
 
 #[test]
-fn stability_chart_shows_the_schedule_keeps_the_sparse_pulse_loop_below_5_pct() {
+fn stability_chart_shows_the_sparse_pulse_loop_below_5_pct() {
     let rows = chart("control-stability");
     let find = |gain: &str, scheduled: &str| {
         rows.iter()
@@ -103,16 +103,15 @@ fn stability_chart_shows_the_schedule_keeps_the_sparse_pulse_loop_below_5_pct() 
     // The nominal loop holds 0.5 rad/s with no limit cycle above 5 % and no fault.
     assert!(num(r, "half_peak_to_peak_pct") <= 5.0, "{r:?}");
     assert_eq!(r["fault_code"], "0");
-    // At higher gains the schedule still keeps it quiet, while the same gain unscheduled
-    // (the bandwidth of 3 rad/s kept at 0.5 rad/s) cycles above 5 % or faults.
+    // At higher gains the schedule keeps it quiet, and so does the same gain unscheduled (the
+    // bandwidth of 3 rad/s kept at 0.5 rad/s): that cycled above 5 % or faulted while the loop
+    // held each window's error through the next window, a dead time the loop now models
+    // (model-core pi.rs; docs/control.md, "From rest to 1 rad/s").
     for gain in ["1", "2"] {
-        let s = find(gain, "true");
-        assert!(num(s, "half_peak_to_peak_pct") <= 5.0, "{s:?}");
-        assert_eq!(s["fault_code"], "0", "{s:?}");
-        let u = find(gain, "false");
-        assert!(
-            num(u, "half_peak_to_peak_pct") > 5.0 || u["fault_code"] != "0",
-            "{u:?}"
-        );
+        for scheduled in ["true", "false"] {
+            let s = find(gain, scheduled);
+            assert!(num(s, "half_peak_to_peak_pct") <= 5.0, "{s:?}");
+            assert_eq!(s["fault_code"], "0", "{s:?}");
+        }
     }
 }

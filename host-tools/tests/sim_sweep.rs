@@ -46,7 +46,7 @@ fn settling_against_pulses_per_rev() {
 }
 
 #[test]
-fn stability_map_shows_the_schedule_keeps_the_low_speed_loop_quiet() {
+fn stability_map_shows_the_low_speed_loop_quiet_at_every_gain() {
     let rows = csv(&["sim", "stability", "--pulses-per-rev", "12"]);
     assert_eq!(rows[0][5], "half_peak_to_peak_pct");
     let find = |n: &str, ppb: &str, sched: &str| {
@@ -59,10 +59,12 @@ fn stability_map_shows_the_schedule_keeps_the_low_speed_loop_quiet() {
     let nominal = find("12", "0.5", "true");
     assert!(nominal[5].parse::<f64>().unwrap() <= 5.0, "{nominal:?}");
     assert_eq!(nominal[6], "0");
-    // The same per-pulse gain 1, unscheduled, cycles or faults.
-    let fixed = find("12", "1", "false");
-    assert!(
-        fixed[5].parse::<f64>().unwrap() > 10.0 || fixed[6] != "0",
-        "{fixed:?}"
-    );
+    // With the window's dead time modelled (pi.rs, the correction model) the loop no longer
+    // needs the schedule on the nominal rig: per-pulse gain 1 unscheduled, which cycled at
+    // 77 % or faulted before, and 4, are as quiet (docs/control.md, "From rest to 1 rad/s").
+    for ppb in ["1", "4"] {
+        let fixed = find("12", ppb, "false");
+        assert!(fixed[5].parse::<f64>().unwrap() <= 5.0, "{fixed:?}");
+        assert_eq!(fixed[6], "0", "{fixed:?}");
+    }
 }

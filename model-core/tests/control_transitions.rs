@@ -257,3 +257,88 @@ fn a_first_edge_during_the_ramp_keeps_only_the_kick_the_target_needs() {
         100.0 * over
     );
 }
+
+/// From rest to 1 rad/s a window closes up to a pitch (0.52 s at 12 pulses a revolution) after
+/// the speed it measures. Held as the shortfall against the reference alone, each window's
+/// error kept the integral rising for the whole next window on a shaft already at its speed,
+/// and the shaft passed the target by 2 to 6 % (2 % settling after 3 s on most of family-60's
+/// axes). With the correction's own effect modelled (the loop's dead time taken out by the
+/// identified model) these two family-60 axes stay within 4 %: p25's precession (4.24 %
+/// before, 1.2 % with it) and p04's spin (5.18 % before, under 2.5 % with it alone, 3.5 % since
+/// commissioning holds the spin's steps for a revolution to find the eccentric load: its
+/// identified model moved, and without the eccentric load it passes by 2.8 %), each loaded
+/// with the material its model does not know.
+#[test]
+fn from_rest_to_one_rad_s_the_window_lag_does_not_overshoot() {
+    let p25 = plant_rows::rig_from_table(
+        12.895,
+        0.591,
+        [
+            [
+                1.2279, 0.10536, 0.00995, 0.0995, 0.1326, 0.0368, 0.000321, 0.002, 0.0434,
+            ],
+            [
+                1.9083, 0.03205, 0.03363, 0.3363, 0.4708, 0.0452, 0.000632, 0.0075, 0.0584,
+            ],
+        ],
+    );
+    let p04 = plant_rows::rig_from_table(
+        10.905,
+        0.537,
+        [
+            [
+                1.493, 0.0201, 0.00758, 0.0758, 0.1011, 0.036, 0.000757, 0.002, 0.0115,
+            ],
+            [
+                1.421, 0.04287, 0.00939, 0.0939, 0.1314, 0.039, 0.000928, 0.0025, 0.0724,
+            ],
+        ],
+    );
+    for (name, rig, seed, axis) in [("p25", p25, 1025u32, 0usize), ("p04", p04, 1004, 1)] {
+        let load = [rig.axes[0].load_step_nm, rig.axes[1].load_step_nm];
+        // At the per-pulse bandwidth the loop had while the dead time was in it (0.5): the
+        // window's lag alone, not the faster loop the model now allows.
+        let mut cfg = ControllerConfig::nominal();
+        for a in cfg.axes.iter_mut() {
+            a.per_pulse_bandwidth = 0.5;
+        }
+        let o = commissioned_transition(rig, cfg, seed, 0.0, 1.0, true, load);
+        assert!(o.commissioned && o.fault.is_none(), "{name}: {:?}", o.fault);
+        // From rest the report's overshoot (a fraction of the change) is % of the target.
+        let past = o.reports[axis].overshoot;
+        assert!(
+            past <= 0.04,
+            "{name} axis {axis}: {:.2} % past 1 rad/s",
+            100.0 * past
+        );
+    }
+}
+
+/// From rest to the lowest speed on the nominal rig: the kick breaks stiction and half of it
+/// stays in the integral at the first edge (so a loaded shaft does not stick again), which
+/// on this unloaded rig drives the precession to 0.52 rad/s. With the window's dead time
+/// modelled, the loop removes that at its scheduled bandwidth (0.19 rad/s at 0.2 rad/s, a 5 s
+/// time constant): 76 % above the target over the step's steady window, still 0.24 rad/s 13 s
+/// after the command. The first measurement of a kick-started shaft now reads the load
+/// instead (pi.rs, `take_start_load`): both axes within 10 % over the steady window (3.0 % and
+/// 1.3 % measured; before the correction model the held error's push gave 64 % and 42 %).
+#[test]
+fn from_rest_to_the_lowest_speed_the_kept_kick_is_read_away() {
+    let o = commissioned_transition(
+        rig_with_pulses(12),
+        ControllerConfig::nominal(),
+        1,
+        0.0,
+        0.2,
+        true,
+        [0.0; 2],
+    );
+    assert!(o.commissioned && o.fault.is_none(), "{:?}", o.fault);
+    for (axis, r) in o.reports.iter().enumerate() {
+        assert!(
+            r.steady_state_error <= 0.10,
+            "axis {axis}: {:.1} % off 0.2 rad/s over the steady window",
+            100.0 * r.steady_state_error
+        );
+    }
+}
