@@ -402,7 +402,8 @@ pub(crate) fn follow_slip<T: Real, const N: usize>(
 /// The slip of a state (m/s), linear in it.
 pub(crate) type SlipOf<T, const N: usize> = fn(&[T; N]) -> [T; 2];
 
-/// The slip's error in a step of a slide, against [`SLIP_RTOL`] times `rtol` of the slip itself
+/// The slip's error in a step of a slide in which it grows, against [`SLIP_RTOL`] times `rtol`
+/// of the slip itself
 /// (`slip`: the slip of a state, linear in it, so that the slip of the step's error estimate `e`
 /// is the slip's error). The friction acts against the slip's direction, which turns at
 /// `|A_perp| / |v_c|` (the free slip's acceleration across it over the slip): the slide's
@@ -418,8 +419,14 @@ fn slip_error<T: Real, const N: usize>(
     (e, y, y1): (&[T; N], &[T; N], &[T; N]),
 ) -> T {
     let norm = |v: [T; 2]| (v[0] * v[0] + v[1] * v[1]).sqrt();
-    let size = norm(slip(y)).max(norm(slip(y1)));
-    norm(slip(e)) / (T::from_f64(SLIP_RTOL) * rtol * size + T::from_f64(SLIP_ATOL_M_S))
+    let (before, after) = (norm(slip(y)), norm(slip(y1)));
+    if after <= before {
+        // A shrinking slip is left to the components' tolerances: held to its own, the steps
+        // would shrink with it while its direction turns on the way to sticking, where the
+        // slip-end event (its reversal within a step) finds the stick at any step.
+        return T::ZERO;
+    }
+    norm(slip(e)) / (T::from_f64(SLIP_RTOL) * rtol * after + T::from_f64(SLIP_ATOL_M_S))
 }
 
 /// The slip's relative tolerance as a multiple of the run's `rtol`: its direction to 1e-4 rad at
