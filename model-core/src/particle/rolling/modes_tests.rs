@@ -310,7 +310,7 @@ proptest::proptest! {
 }
 
 /// A slide from rest just past the stick threshold (45 deg, 3.6 rad/s, mu_s 0.2, the release at
-/// 180 deg: its slip grows at about 0.1 m/s^2 against a friction of 1.6 m/s^2) used to cost
+/// 180 deg: at rtol 1e-10 its slip grows at about 0.12 m/s^2 against a friction of 1.57 m/s^2) used to cost
 /// 2 709 steps at rtol 1e-6, 23 110 at 1e-7 and over 200 000 at 1e-8 against 493 at 1e-10:
 /// the loose steps left the slip's direction off and its stiff relaxation held them at ~1e-5 s
 /// (docs/model.md §12). With the slip held to its own tolerance each looser run is cheaper
