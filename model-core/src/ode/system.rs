@@ -153,7 +153,17 @@ pub fn dp54<T: Real, const N: usize, S>(
     check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
     limits: SystemLimits<T>,
 ) -> Result<Run<T, N, S>, SystemError> {
-    dp54_with(f, t0, y0, rtol, atol, h0, &on_state(event), check, limits)
+    dp54_with(
+        f,
+        t0,
+        y0,
+        (rtol, atol),
+        h0,
+        &on_state(event),
+        check,
+        |_: &[T; N], _: &[T; N], _: &[T; N]| T::ZERO,
+        limits,
+    )
 }
 
 /// A value-only event as `(g, g')` along `(dt, dy)` (per unit theta of a step), for
@@ -180,17 +190,20 @@ pub(crate) fn timed<T: Real, const N: usize>(
     }
 }
 
-/// [`dp54`] with an event of the time, the state and the step's direction (as [`timed`] makes).
+/// [`dp54`] with an event of the time, the state and the step's direction (as [`timed`] makes),
+/// and a further error measure `extra(e, y, y1)` of a step from `y` to `y1` with the error
+/// estimate `e` (already divided by its tolerance, 0 for none): the step is accepted where both
+/// it and the components' error norm are within 1, and its size follows the larger.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn dp54_with<T: Real, const N: usize, S>(
     mut f: impl FnMut(T, &[T; N]) -> [T; N],
     t0: T,
     y0: [T; N],
-    rtol: T,
-    atol: [T; N],
+    (rtol, atol): (T, [T; N]),
     h0: T,
     event: &impl Fn(T, &[T; N], T, &[T; N]) -> (T, T),
     mut check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
+    extra: impl Fn(&[T; N], &[T; N], &[T; N]) -> T,
     limits: SystemLimits<T>,
 ) -> Result<Run<T, N, S>, SystemError> {
     if !(rtol > T::ZERO && rtol.is_finite() && h0 > T::ZERO && h0.is_finite()) {
@@ -231,18 +244,21 @@ pub(crate) fn dp54_with<T: Real, const N: usize, S>(
         k[6] = f(t + h, &y1);
         evaluations += 6;
         let mut err2 = T::ZERO;
+        let mut errs = [T::ZERO; N];
         for i in 0..N {
             let mut e = T::ZERO;
             for s in 0..7 {
                 e += h * t_of::<T>(E[s]) * k[s][i];
             }
+            errs[i] = e;
             let sc = atol[i] + rtol * y[i].abs().max(y1[i].abs());
             err2 += (e / sc) * (e / sc);
         }
-        if !(finite(&y1) && err2.is_finite()) {
+        let more = extra(&errs, &y, &y1);
+        if !(finite(&y1) && err2.is_finite() && more.is_finite()) {
             return Err(SystemError::NotFinite);
         }
-        let err = (err2 / T::from_f64(N as f64)).sqrt();
+        let err = (err2 / T::from_f64(N as f64)).sqrt().max(more);
         let factor = step_factor(err);
         if err > T::ONE {
             h *= factor.min(T::ONE);

@@ -204,6 +204,7 @@ pub fn stay<T: Real>(
                 }
                 watch.step(t)
             },
+            None,
             remaining,
         )?
         else {

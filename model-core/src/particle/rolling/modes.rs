@@ -399,9 +399,49 @@ pub(crate) fn follow_slip<T: Real, const N: usize>(
     }
 }
 
+/// The slip of a state (m/s), linear in it.
+pub(crate) type SlipOf<T, const N: usize> = fn(&[T; N]) -> [T; 2];
+
+/// The slip's error in a step of a slide in which it grows, against [`SLIP_RTOL`] times `rtol`
+/// of the slip itself
+/// (`slip`: the slip of a state, linear in it, so that the slip of the step's error estimate `e`
+/// is the slip's error). The friction acts against the slip's direction, which turns at
+/// `|A_perp| / |v_c|` (the free slip's acceleration across it over the slip): the slide's
+/// right-hand side is stiff while the slip is small. The components' own tolerances
+/// (`rtol` of the scene's speed) say nothing of that direction while the slip is below them, and
+/// a loose step can leave it off by tens of degrees, the stiff relaxation then holding the step
+/// at its stability limit and the slip at about that step's friction impulse, neither growing:
+/// a slide from rest at 45 deg, 3.6 rad/s, mu_s 0.2 (release at 180 deg) took 2 709 steps at rtol
+/// 1e-6, 23 110 at 1e-7, more than 200 000 at 1e-8, and 493 at 1e-10 (docs/model.md §12).
+fn slip_error<T: Real, const N: usize>(
+    slip: SlipOf<T, N>,
+    rtol: T,
+    (e, y, y1): (&[T; N], &[T; N], &[T; N]),
+) -> T {
+    let norm = |v: [T; 2]| (v[0] * v[0] + v[1] * v[1]).sqrt();
+    let (before, after) = (norm(slip(y)), norm(slip(y1)));
+    if after <= before {
+        // A shrinking slip is left to the components' tolerances: held to its own, the steps
+        // would shrink with it while its direction turns on the way to sticking, where the
+        // slip-end event (its reversal within a step) finds the stick at any step.
+        return T::ZERO;
+    }
+    norm(slip(e)) / (T::from_f64(SLIP_RTOL) * rtol * after + T::from_f64(SLIP_ATOL_M_S))
+}
+
+/// The slip's relative tolerance as a multiple of the run's `rtol`: its direction to 1e-4 rad at
+/// rtol 1e-6 (1 and 10 gave the same fix at up to twice the steps elsewhere, docs/model.md §12).
+pub(crate) const SLIP_RTOL: f64 = 100.0;
+
+/// A slip error below this is always accepted, m/s: below [`AT_REST_M_S`], where the friction's
+/// direction stops following the slip, and far above the rounding of the slip's components
+/// (about 1e-16 of the scene's speed), so a slip at rest asks for no step it cannot take.
+pub(crate) const SLIP_ATOL_M_S: f64 = 1e-9;
+
 /// Integrates one segment in `mode` from `(t0, y0)` with the method, stopping at the first
 /// event, and adds its cost and its time to `tally`: the event's time and state, or `None` at
-/// the horizon.
+/// the horizon. `slip`: a slide's slip (linear in the state), held to [`slip_error`]'s
+/// tolerance besides the components' (`None` where the contact does not slip).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn segment<T: Real, const N: usize>(
     tally: &mut Tally<T>,
@@ -412,6 +452,7 @@ pub(crate) fn segment<T: Real, const N: usize>(
     scales: (T, T),
     event: impl Fn(T, &[T; N]) -> T,
     check: impl FnMut(T, &[T; N]) -> ControlFlow<()>,
+    slip: Option<SlipOf<T, N>>,
     limits: SystemLimits<T>,
 ) -> Result<Option<(T, [T; N])>, RollingError> {
     let (length, speed) = scales;
@@ -422,7 +463,20 @@ pub(crate) fn segment<T: Real, const N: usize>(
             let atol: [T; N] =
                 core::array::from_fn(|i| if i < 2 { rtol * length } else { rtol * speed });
             let h0 = T::from_f64(1e-3) * length / speed;
-            system::dp54_with(rhs, t0, y0, rtol, atol, h0, &event, check, limits)
+            let slip_error = |e: &[T; N], y: &[T; N], y1: &[T; N]| {
+                slip.map_or(T::ZERO, |slip| slip_error(slip, rtol, (e, y, y1)))
+            };
+            system::dp54_with(
+                rhs,
+                t0,
+                y0,
+                (rtol, atol),
+                h0,
+                &event,
+                check,
+                slip_error,
+                limits,
+            )
         }
         RollingMethod::Rk4 { step_s } => {
             system::rk4_with(rhs, t0, y0, step_s, &event, check, limits)
@@ -490,6 +544,7 @@ pub(crate) fn run_from<T: Real>(
                     scales,
                     |t, y: &[T; 5]| max3(roll_events(scene, t, y, reference)),
                     |t, _| watch.step(t),
+                    None,
                     remaining,
                 )?
                 else {
@@ -520,6 +575,7 @@ pub(crate) fn run_from<T: Real>(
                         follow_slip(&slip_m_s(y), &dir, &armed, stuck);
                         watch.step(t)
                     },
+                    Some(slip_m_s::<T>),
                     remaining,
                 )?
                 else {
