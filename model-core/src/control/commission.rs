@@ -189,8 +189,6 @@ pub struct Commissioning {
     pulses_per_rev: [u32; 2],
     duty: f32,
     breakaway_duty: f32,
-    /// Sensor pitch of the axis under test, rad (from its first edge).
-    pitch_rad: f32,
     low_duty: f32,
     high_duty: f32,
     /// The spin's high duty, applied again during the reaction phase.
@@ -237,7 +235,6 @@ impl Commissioning {
             pulses_per_rev: [pulses_per_rev[0] as u32, pulses_per_rev[1] as u32],
             duty: BREAKAWAY_START_DUTY,
             breakaway_duty: 0.0,
-            pitch_rad: 0.0,
             low_duty: cfg.low_duty,
             high_duty: cfg.high_duty,
             spin_high_duty: 0.0,
@@ -276,7 +273,6 @@ impl Commissioning {
         if self.phase == Phase::Breakaway {
             // Moving: the low step starts now, from this edge's angle.
             self.breakaway_duty = self.duty;
-            self.pitch_rad = rad_per_pulse;
             self.low_duty = self.cfg.low_duty.max(self.duty + 0.1).min(TOP_DUTY - 0.2);
             self.high_duty = self.cfg.high_duty.max(self.low_duty + 0.2).min(TOP_DUTY);
             self.phase = Phase::Low;
@@ -493,12 +489,8 @@ impl Commissioning {
             volts_per_rad_s: a,
             friction_duty,
             time_constant_s: tau,
-            breakaway_duty: 0.0,
+            breakaway_duty: self.breakaway_duty,
             reaction_duty_s2_per_rad: 0.0,
-        };
-        let model = MotorModel {
-            breakaway_duty: self.breakaway_from_first_edge(&model),
-            ..model
         };
         model
             .validate(self.axis as u8)
@@ -508,56 +500,6 @@ impl Commissioning {
             low_speed_rad_s: w_l,
             high_speed_rad_s: w_h,
         })
-    }
-}
-
-impl Commissioning {
-    /// The duty at which the shaft broke away, from the search's duty at its first edge and
-    /// the identified model. The search's duty kept rising while the shaft travelled to its
-    /// first edge (up to a pitch, longer than the plant's lag with sparse pulses), so the duty
-    /// at the edge overstates the breakaway by the rise during that travel (3x on family-60's
-    /// p29). Breaking away at `d_b` on the ramp `d = d_b + r s` against the kinetic friction
-    /// `c`, the first-order plant `tau dw/ds + w = K (d - c)` (K = V / a) travels
-    /// `theta(s) = K [(d_b - c)(s - tau E) + r (s^2/2 - tau s + tau^2 E)]`, `E = 1 - e^(-s/tau)`,
-    /// in the `s` seconds to the edge. The edge's angle from the rest position is unknown,
-    /// uniform on a pitch, and at most the travel of the earliest possible breakaway: its median
-    /// is half the smaller of the two. `s` solves `theta(s) = that` with `d_b = d_edge - r s`
-    /// (theta rises with `s`: breaking away earlier on the same ramp travels further), by
-    /// bisection; `d_b` stays between the friction duty (static friction is at least the
-    /// kinetic) or the search's start and the duty at the edge.
-    fn breakaway_from_first_edge(&self, model: &MotorModel) -> f32 {
-        let d_edge = self.breakaway_duty;
-        let r = search_rate_per_s(self.pulses_per_rev[self.axis].max(1));
-        let c = model.friction_duty;
-        let tau = model.time_constant_s.max(1e-3);
-        let k = self.supply_v / model.volts_per_rad_s;
-        let floor = c.max(BREAKAWAY_START_DUTY);
-        let s_max = (d_edge - floor) / r;
-        let target = 0.5 * self.pitch_rad;
-        if !(s_max > 0.0 && k.is_finite() && k > 0.0 && target > 0.0 && tau.is_finite()) {
-            return d_edge;
-        }
-        let travel = |s: f32| {
-            let e = 1.0 - libm::expf(-s / tau);
-            let d_b = d_edge - r * s;
-            k * ((d_b - c) * (s - tau * e) + r * (0.5 * s * s - tau * s + tau * tau * e))
-        };
-        // The edge cannot lie beyond the travel of the earliest breakaway: the angle is
-        // uniform on what is left, and its median is half of that.
-        let target = target.min(0.5 * travel(s_max));
-        if target.is_nan() || target <= 0.0 {
-            return d_edge;
-        }
-        let (mut lo, mut hi) = (0.0f32, s_max);
-        for _ in 0..24 {
-            let mid = 0.5 * (lo + hi);
-            if travel(mid) < target {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        (d_edge - r * 0.5 * (lo + hi)).clamp(floor, d_edge)
     }
 }
 
