@@ -1,4 +1,4 @@
-//! `bowl sim sweep` and `bowl sim stability`: the CSV charts.
+//! `bowl sim sweep`, `bowl sim stability` and `bowl sim trace`: the CSV charts.
 
 mod common;
 
@@ -67,4 +67,28 @@ fn stability_map_shows_the_low_speed_loop_quiet_at_every_gain() {
         assert!(fixed[5].parse::<f64>().unwrap() <= 5.0, "{fixed:?}");
         assert_eq!(fixed[6], "0", "{fixed:?}");
     }
+}
+
+/// `sim trace --from-rad-s`: the trace starts at the step's command with the shafts settled at
+/// the starting speed (the true speeds, not the reference, say so) and ends at the target.
+#[test]
+fn trace_from_a_speed_starts_settled_there() {
+    let rows = csv(&["sim", "trace", "--from-rad-s", "3", "--target-rad-s", "1"]);
+    assert_eq!(rows[0][1], "true_prec");
+    let speed = |r: &Vec<String>, i: usize| r[i].parse::<f64>().unwrap();
+    let first = &rows[1];
+    let last = rows.last().unwrap();
+    for i in [1, 2] {
+        assert!((speed(first, i) - 3.0).abs() < 0.06 * 3.0, "{first:?}");
+        assert!((speed(last, i) - 1.0).abs() < 0.05, "{last:?}");
+    }
+    assert!(rows[1..].iter().all(|r| r[10] == "0"), "a fault latched");
+    // No step: refused in words.
+    let out = bowl(&["sim", "trace", "--from-rad-s", "1", "--target-rad-s", "1"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("--from-rad-s 1 equals --target-rad-s"),
+        "{err}"
+    );
 }

@@ -91,6 +91,10 @@ pub struct TraceArgs {
     /// Step target, rad/s.
     #[arg(long, default_value_t = 3.0)]
     target_rad_s: f32,
+    /// Both axes first settle at this speed, then step to --target-rad-s (0 = from rest),
+    /// rad/s; the trace starts at the step's command.
+    #[arg(long, default_value_t = 0.0)]
+    from_rad_s: f32,
 }
 
 #[derive(clap::Args, Clone)]
@@ -330,7 +334,9 @@ pub fn run(what: &What) -> Result<()> {
                 }
                 None => None,
             };
-            trace(a.common.seed, a.plant, rig, a.target_rad_s)
+            check_speed(a.target_rad_s, "--target-rad-s")?;
+            check_from(a.from_rad_s, a.target_rad_s)?;
+            trace(a.common.seed, a.plant, rig, (a.from_rad_s, a.target_rad_s));
         }
     }
     Ok(())

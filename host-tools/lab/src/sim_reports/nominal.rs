@@ -307,7 +307,12 @@ pub fn stability(seed: u32, speed: f32, only: Option<u16>, tick_hz: u32) {
     }
 }
 
-pub fn trace(seed: u32, plant: Option<u32>, from_file: Option<rig_file::Rig>, target: f32) {
+pub fn trace(
+    seed: u32,
+    plant: Option<u32>,
+    from_file: Option<rig_file::Rig>,
+    (from, target): (f32, f32),
+) {
     let mut cfg = ControllerConfig::nominal();
     let (rig, rig_seed, load) = match plant {
         _ if from_file.is_some() => {
@@ -350,6 +355,15 @@ pub fn trace(seed: u32, plant: Option<u32>, from_file: Option<rig_file::Rig>, ta
     for (a, l) in cl.rig.params_mut().axes.iter_mut().zip(load) {
         a.faults.load_step_from_s = now;
         a.faults.load_step_nm = l;
+    }
+    if from > 0.0 {
+        // Settled at the starting speed first (as `sim family --from-rad-s`); the trace's
+        // time counts from the step's command.
+        let _ = cl.ctrl.set_motor_speeds(from, from);
+        let _ = cl.ctrl.start();
+        if super::step::settle_at(&mut cl, from) {
+            eprintln!("faulted while settling at {from} rad/s");
+        }
     }
     let _ = cl.ctrl.set_motor_speeds(target, target);
     let _ = cl.ctrl.start();

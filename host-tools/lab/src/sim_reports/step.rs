@@ -192,7 +192,7 @@ const SETTLE_AT_FROM_MAX_S: f32 = 120.0;
 /// Runs a started loop at its speed until both axes have settled there: the controller says
 /// Running and the true speed, averaged over one revolution of each shaft, is within 2 % of
 /// `speed` (5 % below 1 rad/s), or [`SETTLE_AT_FROM_MAX_S`] has passed. True if a fault latched.
-fn settle_at(cl: &mut ClosedLoop, speed: f32) -> bool {
+pub(crate) fn settle_at(cl: &mut ClosedLoop, speed: f32) -> bool {
     let dt = cl.dt_s();
     let band = band_for(speed) as f32;
     let rev_s = std::f32::consts::TAU / speed;
