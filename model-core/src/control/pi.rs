@@ -80,7 +80,9 @@
 //!
 //! Both only start a shaft from rest: once the loop has seen it move, a shaft that goes quiet is
 //! not pushed (a dead sensor on a turning shaft would otherwise run it away before the
-//! supervisor's expected-edge watch faults it). "From rest" is the loop's view: no window closed
+//! supervisor's expected-edge watch faults it), except at the bottom of a step-down, where the
+//! integral learned at the higher speed can leave a healthy shaft stopped (`quiet` in
+//! [`SpeedLoop::step`]; docs/control.md, "A shaft that went quiet"). "From rest" is the loop's view: no window closed
 //! since the loop started, whatever edge the estimator still holds from before (a restart after
 //! a fault or a zero reference, see `rest` in [`SpeedLoop::step`]).
 
@@ -99,6 +101,11 @@ pub const PUSH_SPAN_DUTY: f32 = 0.12;
 /// The shaft counts as stuck once the plant model has turned this many pitches since the last
 /// edge without a new one (a shaft following the model would have given one).
 pub const STUCK_PITCHES: f32 = 1.2;
+/// A shaft that moved counts as quiet (see `quiet` in [`SpeedLoop::step`]) once the plant model
+/// has turned this many pitches since the last edge: at most half the model's speed. At
+/// [`STUCK_PITCHES`] it also pushed shafts dipping 15..20 % under 0.5 rad/s after a step-down,
+/// whose next edge was coming (family-60 4 -> 0.5: 5 % settled <= 10 s 100 -> 97.5 %).
+pub const QUIET_PITCHES: f32 = 1.5;
 /// Share of what started the shaft (the push, or the kick) the integral keeps once it moves.
 pub const PUSH_KEPT: f32 = 0.5;
 /// The shortest window after a crawl that reads the load, s: a crawl (a shaft below a third
@@ -147,6 +154,8 @@ pub struct SpeedLoop {
     start_reading: bool,
     /// The push has been on since the shaft was last at rest (the kick did not start it).
     pushed: bool,
+    /// The reference has come down since the loop started (see `quiet` in [`SpeedLoop::step`]).
+    stepped_down: bool,
     /// The current showed the breakaway in this step (see [`SpeedLoop::take_breakaway`]).
     breakaway_news: bool,
     /// The back-EMF duty per rad/s the current sense learned (0: not given, the identified
@@ -206,6 +215,7 @@ impl SpeedLoop {
         correction_angle_rad: 0.0,
         start_reading: false,
         pushed: false,
+        stepped_down: false,
     };
 
     /// One fixed-rate step; returns the duty in `[-duty_limit, duty_limit]`.
@@ -235,6 +245,7 @@ impl SpeedLoop {
         // not a load the integral should hold.
         if rp.abs() > 1.02 * r_abs {
             self.slowing = true;
+            self.stepped_down = true;
             self.model_down_quiet_s = 0.0;
         } else {
             self.model_down_quiet_s += k.dt_s;
@@ -276,6 +287,13 @@ impl SpeedLoop {
             let sample = model_mean - input.direction * w.raw_speed_rad_s;
             let correction_mean = (self.correction_angle_rad - c * w.ago_s) / w.span_s;
             if self.have_error {
+                // A quiet shaft the push (`quiet` below) turned again: half of it stays, as
+                // after a first edge from rest; the loop corrects the rest.
+                if self.push != 0.0 {
+                    self.integral += PUSH_KEPT * self.push * input.direction;
+                    self.push = 0.0;
+                    self.push_sum = 0.0;
+                }
                 // The load the model does not know, as the speed it costs: the window's
                 // shortfall against the model *with* the correction applied through it.
                 self.error += k.filter_weight * (sample + correction_mean - self.error);
@@ -404,6 +422,22 @@ impl SpeedLoop {
         // supervisor's to judge, and pushing it would run away a shaft with a dead sensor.
         let starting = rest && !self.moved && !released;
         let crawling = !input.at_rest && !input.measurement_valid && !released;
+        // A shaft that went quiet at the bottom of a step-down: it moved, the model has
+        // reached the lower reference, the stall bound is active, and the model has turned
+        // [`QUIET_PITCHES`] past the last edge. The integral learned at the higher speed carries the
+        // identified slope's error there (docs/control.md, "Step-downs to the lowest speed"):
+        // a healthy shaft stopped under it (seed 14 p05, 0.053 duty where 0.077 holds 0.2
+        // rad/s) and nothing started it again before the expected-edge watch faulted it. It
+        // gets the push a start gets, from the kick's level; a dead sensor is still the
+        // watch's to fault (the push spans the same pitches the start's does).
+        let quiet = self.stepped_down
+            && self.model_angle_rad.abs() > QUIET_PITCHES * k.stuck_angle_rad / STUCK_PITCHES
+            && self.moved
+            && !rest
+            && input.measurement_valid
+            && ev.bound_active
+            && self.model_down_quiet_s > 0.0
+            && !released;
         // The kick: from rest, the identified breakaway duty, just long enough for the model
         // driven by it to reach the reference; then the feedforward holds Coulomb friction.
         // Stiction needs more than sliding does, and a gradual push overshoots it by as much
@@ -424,7 +458,7 @@ impl SpeedLoop {
                     (applied_excess - self.kick_rad_s * k.duty_per_rad_s) * k.kick_gain_per_tick;
             }
         }
-        if (starting || crawling)
+        if (starting || crawling || quiet)
             && input.feedback
             && self.model_angle_rad.abs() > k.stuck_angle_rad
             && self.push < 1.0
