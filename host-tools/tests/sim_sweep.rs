@@ -92,3 +92,36 @@ fn trace_from_a_speed_starts_settled_there() {
         "{err}"
     );
 }
+
+/// Issue 27: seed 14's plant p05 (commissioning identified its precession slope 19 % steep)
+/// stopped at the bottom of a 4 -> 0.2 rad/s step-down and was never pushed again; the
+/// expected-edge watch faulted a healthy plant 8.9 s in (docs/control.md, "A shaft that went
+/// quiet"). It must run to the end of the trace, near 0.2 rad/s.
+#[test]
+fn a_shaft_stopped_after_a_step_down_turns_again() {
+    let out = bowl(&["sim", "make-family", "--seed", "14", "--plants", "60"]);
+    assert!(out.status.success());
+    let path = std::env::temp_dir().join(format!("sim-sweep-quiet-{}.toml", std::process::id()));
+    std::fs::write(&path, &out.stdout).unwrap();
+    let file = path.to_str().unwrap();
+    let rows = csv(&[
+        "sim",
+        "trace",
+        "--rig-file",
+        file,
+        "--name",
+        "p05",
+        "--from-rad-s",
+        "4",
+        "--target-rad-s",
+        "0.2",
+    ]);
+    let _ = std::fs::remove_file(&path);
+    assert_eq!(rows[0][10], "fault");
+    assert!(rows[1..].iter().all(|r| r[10] == "0"), "a fault latched");
+    let last = rows.last().unwrap();
+    let t: f64 = last[0].parse().unwrap();
+    let prec: f64 = last[1].parse().unwrap();
+    assert!(t > 60.0, "{last:?}");
+    assert!((prec - 0.2).abs() < 0.02, "{last:?}");
+}
