@@ -104,11 +104,14 @@ pub fn fault_token(f: FaultCode) -> &'static str {
     }
 }
 
+/// Every fault the wire knows, in code order.
+pub fn all_faults() -> impl Iterator<Item = FaultCode> {
+    (0..=i64::from(u8::MAX)).filter_map(FaultCode::from_code)
+}
+
 /// The fault a CSV's `fault` cell names ([`fault_token`]'s word), if any.
 pub fn fault_from_token(word: &str) -> Option<FaultCode> {
-    (0..=i64::from(u8::MAX))
-        .filter_map(FaultCode::from_code)
-        .find(|&f| fault_token(f) == word)
+    all_faults().find(|&f| fault_token(f) == word)
 }
 
 /// A reset cause as one lower-case word for `key=value` lines (see [`state_token`]).

@@ -105,14 +105,6 @@ const STATES: [&str; 6] = [
     "faulted",
 ];
 
-/// Every fault's word, as the CSV writes it.
-fn fault_words() -> Vec<&'static str> {
-    (0..=i64::from(u8::MAX))
-        .filter_map(model_core::wire::FaultCode::from_code)
-        .map(rig_client::words::fault_token)
-        .collect()
-}
-
 /// The workspace's `tests/scenarios` folder.
 pub fn folder() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/scenarios")
@@ -167,11 +159,17 @@ pub fn load(path: &Path) -> Result<Scenario, String> {
                 e.what
             ));
         }
-        if let Some(f) = e.fault.as_deref().filter(|f| !fault_words().contains(f)) {
+        if let Some(f) = e
+            .fault
+            .as_deref()
+            .filter(|f| rig_client::words::fault_from_token(f).is_none())
+        {
+            let words: Vec<&str> = rig_client::words::all_faults()
+                .map(rig_client::words::fault_token)
+                .collect();
             return bad(format!(
-                "`{}`: unknown fault {f} (one of {:?})",
-                e.what,
-                fault_words()
+                "`{}`: unknown fault {f} (one of {words:?})",
+                e.what
             ));
         }
         let windows = e.window.values().map(|w| [w[0] as f64, w[1] as f64]);

@@ -22,7 +22,7 @@
 //! has its own dynamics (not here), and the rod offset is left out (`L = 0`).
 
 use crate::Real;
-use crate::particle::rolling::{AZIMUTHS_DEG, RollingScene};
+use crate::particle::rolling::{AZIMUTHS_DEG, RollingScene, incline_residence_s};
 
 /// The rolling incline's release at `beta_rad`: `(T0, T1, T2)`, its exit time at rest and the
 /// rotation's first- and second-order corrections (s); `None` when the incline does not drive
@@ -46,9 +46,9 @@ pub fn release_second_order_s<T: Real>(scene: &RollingScene<T>, beta_rad: T) -> 
     let p0d = ri * beta_rad.cos();
     let p0y = -ri * beta_rad.sin();
     let p0x = -p0d;
-    let path = -p0d + (rim * rim - p0y * p0y).max(T::ZERO).sqrt();
-    let t0 = (T::TWO * path / drive).sqrt();
-    if !t0.is_finite() || t0 <= T::ZERO {
+    // The incline's own exit time (its path to the rim and drive are the ones above).
+    let t0 = incline_residence_s(scene, beta_rad)?;
+    if t0 <= T::ZERO {
         return None;
     }
     let oz = w1 * c + w2;
