@@ -114,6 +114,15 @@ pub const PUSH_KEPT: f32 = 0.5;
 /// the ramp (0.5 s), through which the shaft was still accelerating: read as load, that
 /// inertia cost overshoot (an unseen family's worst 4.3 -> 7.1 % at 3 rad/s).
 pub const CRAWL_READ_MIN_S: f32 = 0.6;
+/// The shortest first window of a kick-started shaft that reads the load (`take_start_load`),
+/// s: a pitch of a 12-pulse wheel at up to 1 rad/s (0.52 s; the first measurement there spans
+/// one pitch at the ~0.9 rad/s the shaft has reached, 0.55-0.6 s). At the crawl's 0.6 s most
+/// of those windows were left to the loop, whose bandwidth at 1 rad/s (about 1 rad/s) took the
+/// last 5 % of an unknown load 2-4 s to remove: family-60 0 -> 1 rad/s within 2 % by 3 s on
+/// 72.5 % of axes, 80.8 % at 0.5 s (0.4 s: 79.2 %; docs/control.md, "The spin released at the
+/// precession's first edge"). Windows at 2 rad/s and above (0.26 s or less) are still left to
+/// the loop: the shaft may still accelerate through them.
+pub const START_READ_MIN_S: f32 = 0.5;
 
 /// State of one axis's loop.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -310,7 +319,7 @@ impl SpeedLoop {
             } else {
                 self.error = sample + correction_mean;
                 self.have_error = true;
-                if self.start_reading && w.span_s >= CRAWL_READ_MIN_S && input.feedback {
+                if self.start_reading && w.span_s >= START_READ_MIN_S && input.feedback {
                     self.take_start_load(k, c, input.direction);
                 }
             }
@@ -628,6 +637,12 @@ impl SpeedLoop {
     /// current sense).
     pub fn back_emf_rad_s(&self) -> f32 {
         self.breakaway.speed_rad_s()
+    }
+
+    /// True once the loop has seen the shaft move since it started (an edge after the loop left
+    /// rest; see `rest` in [`SpeedLoop::step`]): the shaft turns under its own motor.
+    pub fn moved(&self) -> bool {
+        self.moved
     }
 
     /// The reference came down and the loop still compares windows that began before the

@@ -49,9 +49,10 @@ pub fn split_combined(
 ///
 /// Two rules beyond the ramps, both because the sensors cannot see direction:
 /// - A reversal ramps to zero and holds there until the axis's estimator reads zero.
-/// - The spin axis starts ramping only once the precession axis is established (valid
-///   measurement at least half its ramped reference, or its ramp finished for a second when the
-///   pulses are too sparse to measure that soon), if precession is asked to turn at all.
+/// - The spin axis starts ramping only once the precession axis is established (its loop has
+///   seen it turn, or a valid measurement at least half its ramped reference, or its ramp
+///   finished for a second when the pulses are too sparse to measure that soon), if precession
+///   is asked to turn at all.
 ///   The spin motor rides on the rod: its accelerating torque reacts on the precession axis.
 ///   Started together, a lightly loaded precession axis can be dragged *backwards* before its
 ///   own motor gets going, and a direction-blind loop would then read that as forward motion.
@@ -107,7 +108,7 @@ impl SetpointPlanner {
 
     /// Advances the ramps by `dt_s`. `max_step` is the largest change per step of each axis,
     /// `stopped` says whether each axis's estimator reads zero, `precession_established`
-    /// whether the precession axis turns at at least half its ramped reference.
+    /// whether the precession axis turns under its own motor (see the type's docs).
     #[inline(always)]
     pub fn step(
         &mut self,
