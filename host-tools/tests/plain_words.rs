@@ -4,7 +4,7 @@
 
 use model_core::control::{ConfigError, Rejection, State as ControllerState};
 use model_core::wire::{DeviceState, FaultCode, ResetCause};
-use rig_client::words::{fault, fault_token, reset_cause, reset_cause_token, state, state_token};
+use rig_client::words::{fault, fault_token, reset_cause, reset_cause_token};
 use virtual_rig::controller_words::{config, rejection};
 
 /// Every fault code the wire defines (read from the enum, so a new one is checked too).
@@ -29,7 +29,18 @@ fn plain_words_only() {
     for f in faults() {
         assert!(!camel(fault(f)), "{f:?}");
     }
-    assert!(!camel(state(DeviceState::SpinningUp)));
+    // Every state, as the controller has it and as the wire carries it: one table of words.
+    for s in [
+        ControllerState::Idle,
+        ControllerState::Commissioning,
+        ControllerState::SpinningUp,
+        ControllerState::Running,
+        ControllerState::Stopping,
+        ControllerState::Fault,
+    ] {
+        let d = DeviceState::from(s);
+        assert!(!camel(d.words()) && !camel(d.token()), "{s:?}");
+    }
     // The key=value tokens: one lower-case word each, distinct within their kind.
     let token = |t: &str| !t.is_empty() && t.chars().all(|c| c.is_ascii_lowercase() || c == '-');
     let faults: Vec<&str> = faults().into_iter().map(fault_token).collect();
@@ -42,7 +53,7 @@ fn plain_words_only() {
         DeviceState::Faulted,
     ]
     .into_iter()
-    .map(state_token)
+    .map(DeviceState::token)
     .collect();
     let causes: Vec<&str> = [
         ResetCause::PowerOn,

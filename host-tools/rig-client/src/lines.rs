@@ -69,14 +69,14 @@ pub fn describe(frame: &Frame) -> String {
         }
         Frame::Status { id, status: s } => format!(
             "status (id {id}): state={} fault={} reset_cause={} reset_count={} uptime_ms={} telemetry_hz={} flags={} ({}; {}; last reset: {}{})",
-            words::state_token(s.state),
+            s.state.token(),
             words::fault_token(s.fault),
             words::reset_cause_token(s.reset_cause),
             s.reset_count,
             s.uptime_ms,
             s.telemetry_hz,
             s.flags,
-            words::state(s.state),
+            s.state.words(),
             words::fault(s.fault),
             words::reset_cause(s.reset_cause),
             status_flag_words(s.flags)
@@ -127,7 +127,7 @@ pub fn describe(frame: &Frame) -> String {
         Frame::Telemetry(t) => format!(
             "telemetry (not an answer): t={:.3} s, {}",
             f64::from(t.time_ms) / 1000.0,
-            words::state(t.state)
+            t.state.words()
         ),
         Frame::Hello(_) => "the rig's hello (it has just started; not an answer)".into(),
         Frame::Command { id, .. } => {

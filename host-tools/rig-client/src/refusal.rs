@@ -106,7 +106,7 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
         return format!(
             "the rig is {}: {} changes only while the rig is idle or faulted (it rebuilds the \
              controller); stop the motors first (`bowl send PORT stop`), then set it",
-            words::state(s.state),
+            s.state.words(),
             p.token()
         );
     }
@@ -127,13 +127,13 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
         let states: Vec<&str> = (0..=5)
             .filter_map(D::from_code)
             .filter(|&state| kind.states().contains(state))
-            .map(words::state_token)
+            .map(D::token)
             .collect();
         format!(" (`{command}` is taken while {})", states.join(", "))
     });
     format!(
         "the rig is {}: {todo}{}",
-        words::state(s.state),
+        s.state.words(),
         allowed.unwrap_or_default()
     )
 }

@@ -69,7 +69,7 @@ pub fn write_row(
         boot,
         t.time_ms,
         t.seq,
-        crate::words::state_token(t.state),
+        t.state.token(),
         crate::words::fault_token(t.fault),
         t.precession.set_mrad_s,
         t.precession.measured_mrad_s,

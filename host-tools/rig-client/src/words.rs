@@ -1,20 +1,9 @@
-//! The rig's states, faults and reset causes in plain words, for everything a person reads
-//! (monitor, send, commission, demo); the wire's tokens and codes stay in logs and JSON keys.
+//! The rig's faults and reset causes in plain words, for everything a person reads (monitor,
+//! send, commission, demo), and as `key=value` tokens; the states' words are the state's own
+//! (`DeviceState::words`, `DeviceState::token`, beside the state in `model_core::wire`).
 //! The controller's own refusals are the virtual rig's (`virtual_rig::controller_words`).
 
-use model_core::wire::{DeviceState, FaultCode, ResetCause};
-
-/// The device's state.
-pub fn state(s: DeviceState) -> &'static str {
-    match s {
-        DeviceState::Idle => "idle",
-        DeviceState::Commissioning => "commissioning",
-        DeviceState::SpinningUp => "spinning up",
-        DeviceState::Running => "running",
-        DeviceState::Stopping => "stopping",
-        DeviceState::Faulted => "faulted (motors off)",
-    }
-}
+use model_core::wire::{FaultCode, ResetCause};
 
 /// A fault, with what it means at the rig.
 pub fn fault(f: FaultCode) -> &'static str {
@@ -69,20 +58,7 @@ pub fn reset_cause(r: ResetCause) -> &'static str {
     }
 }
 
-/// The device's state as one lower-case word for `key=value` lines (`bowl send status`), which
-/// scripts read: the same states as [`state`], without its explanations.
-pub fn state_token(s: DeviceState) -> &'static str {
-    match s {
-        DeviceState::Idle => "idle",
-        DeviceState::Commissioning => "commissioning",
-        DeviceState::SpinningUp => "spinning-up",
-        DeviceState::Running => "running",
-        DeviceState::Stopping => "stopping",
-        DeviceState::Faulted => "faulted",
-    }
-}
-
-/// A fault as one lower-case word for `key=value` lines (see [`state_token`]).
+/// A fault as one lower-case word for `key=value` lines (see `DeviceState::token`).
 pub fn fault_token(f: FaultCode) -> &'static str {
     match f {
         FaultCode::None => "none",
@@ -114,7 +90,7 @@ pub fn fault_from_token(word: &str) -> Option<FaultCode> {
     all_faults().find(|&f| fault_token(f) == word)
 }
 
-/// A reset cause as one lower-case word for `key=value` lines (see [`state_token`]).
+/// A reset cause as one lower-case word for `key=value` lines (see `DeviceState::token`).
 pub fn reset_cause_token(r: ResetCause) -> &'static str {
     match r {
         ResetCause::PowerOn => "power-on",

@@ -262,7 +262,7 @@ pub fn run(args: &Args) -> Result<i32> {
         End::OtherState(state) => {
             bail!(
                 "commissioning ended with the rig {} (another PC may have sent a command)",
-                rig_client::words::state(state)
+                state.words()
             )
         }
         End::Timeout => {

@@ -274,10 +274,7 @@ fn banner<'a>(
         ));
     }
     if let Some(t) = view.latest.filter(|_| view.connected && silence.is_none()) {
-        spans.push(Span::raw(format!(
-            "  state {}  ",
-            rig_client::words::state(t.state)
-        )));
+        spans.push(Span::raw(format!("  state {}  ", t.state.words())));
     }
     // Board conditions the rig reported (defaults instead of the saved parameters, the
     // internal oscillator): on the banner for as long as they hold, not only as an event.

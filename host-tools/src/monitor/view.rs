@@ -223,7 +223,7 @@ impl View {
                 "t={:.3}s seq={} state={} fault={} w1={:.3}/{:.3} w2={:.3}/{:.3} rad/s bowl={:.3} rad/s T_flat={} T_cor={}",
                 f64::from(t.time_ms) / 1000.0,
                 t.seq,
-                rig_client::words::state(t.state),
+                t.state.words(),
                 rig_client::words::fault(t.fault),
                 f64::from(t.precession.measured_mrad_s) / 1000.0,
                 f64::from(t.precession.set_mrad_s) / 1000.0,
@@ -263,7 +263,7 @@ impl View {
                     "device time {:>12.3} s   seq {:>5}   state {}   fault: {}\n\n",
                     f64::from(t.time_ms) / 1000.0,
                     t.seq,
-                    rig_client::words::state(t.state),
+                    t.state.words(),
                     rig_client::words::fault(t.fault)
                 );
                 s += "              set rad/s  measured rad/s   duty %   pulses\n";

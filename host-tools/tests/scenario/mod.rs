@@ -96,14 +96,13 @@ pub type Answer = String;
 /// One telemetry row of `bowl replay --csv`: column name -> cell.
 pub type Row = HashMap<String, String>;
 
-const STATES: [&str; 6] = [
-    "idle",
-    "commissioning",
-    "spinning-up",
-    "running",
-    "stopping",
-    "faulted",
-];
+/// The state words a scenario may expect: the rig's own tokens (`DeviceState::token`).
+fn states() -> Vec<&'static str> {
+    (0..=5)
+        .filter_map(model_core::wire::DeviceState::from_code)
+        .map(model_core::wire::DeviceState::token)
+        .collect()
+}
 
 /// The workspace's `tests/scenarios` folder.
 pub fn folder() -> PathBuf {
@@ -153,9 +152,10 @@ pub fn load(path: &Path) -> Result<Scenario, String> {
                 e.what, e.from_ms, e.to_ms
             ));
         }
-        if let Some(st) = e.state.iter().find(|st| !STATES.contains(&st.as_str())) {
+        let known = states();
+        if let Some(st) = e.state.iter().find(|st| !known.contains(&st.as_str())) {
             return bad(format!(
-                "`{}`: unknown state {st} (one of {STATES:?})",
+                "`{}`: unknown state {st} (one of {known:?})",
                 e.what
             ));
         }

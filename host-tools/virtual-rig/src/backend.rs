@@ -85,7 +85,7 @@ impl SimulatedBackend {
             AssemblyError::Ended(state, why) => anyhow!(
                 "commissioning on the simulated plant ended {} ({}): check the rig's motor, \
                  supply and friction values",
-                crate::controller_words::controller_state(state),
+                model_core::wire::DeviceState::from(state).words(),
                 why.map_or("no reason given", |e| e.reason())
             ),
         })?;

@@ -2,7 +2,8 @@
 //! file or the rig's parameters), a command it refused, its state. Used where the controller runs
 //! on the PC (the virtual rig, the lab's reports and experiments).
 
-use model_core::control::{ConfigError, Rejection, State as ControllerState};
+use model_core::control::{ConfigError, Rejection};
+use model_core::wire::DeviceState;
 
 const AXES: [&str; 2] = ["precession", "spin"];
 
@@ -59,22 +60,10 @@ pub fn rejection(e: Rejection) -> String {
         Rejection::InvalidResidenceTime => "the residence time must lie in 1 us ..= 1e6 s".into(),
         Rejection::Inverse(_) => "no bowl speed gives that residence time".into(),
         Rejection::SplitFailed => "the bowl speed cannot be split into motor speeds".into(),
-        Rejection::WrongState(s) => format!("not allowed while {}", controller_state(s)),
+        Rejection::WrongState(s) => format!("not allowed while {}", DeviceState::from(s).words()),
         Rejection::Faulted(_) => "the rig is faulted: clear the fault first".into(),
         Rejection::NotFaulted => "there is no fault to clear".into(),
         Rejection::InvalidConfig(c) => config(c),
         Rejection::InvalidTuning => "the loop tuning is out of range".into(),
-    }
-}
-
-/// The controller's state in plain words.
-pub fn controller_state(s: ControllerState) -> &'static str {
-    match s {
-        ControllerState::Idle => "idle",
-        ControllerState::Commissioning => "commissioning",
-        ControllerState::SpinningUp => "spinning up",
-        ControllerState::Running => "running",
-        ControllerState::Stopping => "stopping",
-        ControllerState::Fault => "faulted",
     }
 }

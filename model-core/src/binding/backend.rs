@@ -99,14 +99,17 @@ fn fault_code(f: Option<Fault>) -> FaultCode {
     }
 }
 
-fn device_state(s: State) -> DeviceState {
-    match s {
-        State::Idle => DeviceState::Idle,
-        State::Commissioning => DeviceState::Commissioning,
-        State::SpinningUp => DeviceState::SpinningUp,
-        State::Running => DeviceState::Running,
-        State::Stopping => DeviceState::Stopping,
-        State::Fault => DeviceState::Faulted,
+/// The controller's state as the wire carries it (the same states; the wire says `Faulted`).
+impl From<State> for DeviceState {
+    fn from(s: State) -> Self {
+        match s {
+            State::Idle => DeviceState::Idle,
+            State::Commissioning => DeviceState::Commissioning,
+            State::SpinningUp => DeviceState::SpinningUp,
+            State::Running => DeviceState::Running,
+            State::Stopping => DeviceState::Stopping,
+            State::Fault => DeviceState::Faulted,
+        }
     }
 }
 
@@ -285,7 +288,7 @@ impl<I: Injector> Backend for ControllerBackend<I> {
         Telemetry {
             time_ms: self.now_ms,
             seq: 0,
-            state: device_state(s.state),
+            state: s.state.into(),
             fault: fault_code(s.fault),
             precession: motor(0),
             spin: motor(1),

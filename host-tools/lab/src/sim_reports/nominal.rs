@@ -5,6 +5,7 @@
 use model_core::control::{Controller, ControllerConfig, Fault};
 use model_core::sim::experiments::{self, STEP_RUN_S, family_plant, rig_with_pulses};
 use model_core::sim::{ClosedLoop, Plant, PlantParams, StepReport};
+use model_core::wire::{DeviceState, FaultCode};
 use serde::Serialize;
 
 use crate::sim_reports;
@@ -261,7 +262,7 @@ pub fn commission_report(seed: u32) -> CommissionJson {
         })
         .collect();
     CommissionJson {
-        state: virtual_rig::controller_words::controller_state(state).to_string(),
+        state: DeviceState::from(state).words().to_string(),
         duration_s: cl.rig.time_s() as f32,
         axes,
     }
@@ -330,10 +331,7 @@ pub fn trace(
     let ctrl = Controller::new(cfg).expect("valid");
     let mut cl = ClosedLoop::new(Plant::new(rig, rig_seed), ctrl);
     let state = cl.commission(300.0);
-    eprintln!(
-        "commissioning: {}",
-        virtual_rig::controller_words::controller_state(state)
-    );
+    eprintln!("commissioning: {}", DeviceState::from(state).words());
     for (name, id) in ["precession", "spin"].iter().zip(cl.ctrl.identified()) {
         match id {
             Some(id) => {
@@ -377,7 +375,7 @@ pub fn trace(
         if k.is_multiple_of(10) {
             let s = c.ctrl.status();
             println!(
-                "{:.3},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:?},{}",
+                "{:.3},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{},{}",
                 k as f32 * dt,
                 c.rig.speed_rad_s(0),
                 c.rig.speed_rad_s(1),
@@ -387,8 +385,10 @@ pub fn trace(
                 s.axes[1].reference_rad_s,
                 s.axes[0].duty,
                 s.axes[1].duty,
-                s.state,
-                s.fault_code
+                DeviceState::from(s.state).token(),
+                // The same words as `bowl send status` and `bowl replay --csv`.
+                FaultCode::from_code(i64::from(s.fault_code))
+                    .map_or("unknown", rig_client::words::fault_token)
             );
         }
     });

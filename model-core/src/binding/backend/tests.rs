@@ -210,7 +210,7 @@ fn state_and_fault_names_keep_the_controller_codes() {
         State::Stopping,
         State::Fault,
     ] {
-        assert_eq!(device_state(state).code(), state as u8, "{state:?}");
+        assert_eq!(DeviceState::from(state).code(), state as u8, "{state:?}");
     }
     for fault in [
         Fault::SensorLostOrStall(0),
