@@ -23,6 +23,7 @@ mod whole;
 
 pub use bowl::BowlInputs;
 pub use ends::{Ends, Leaves};
+pub use refusals::ode as ode_words;
 pub use refusals::scene as scene_words;
 pub use rolling::RollingInputs;
 pub use rolling::words as rolling_words;

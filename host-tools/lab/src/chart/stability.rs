@@ -155,13 +155,16 @@ pub fn chart() -> anyhow::Result<(Figure, Table)> {
                             "other",
                             f64::NAN,
                             Some(rep.rhs_evaluations),
-                            format!("{other:?}"),
+                            super::workprec::methods::ode_outcome_note(&other),
                         ),
                     },
-                    Err(particle::OdeError::BeyondStabilityLimit) => {
-                        ("refused", f64::NAN, None, "BeyondStabilityLimit".into())
-                    }
-                    Err(e) => ("error", f64::NAN, None, format!("{e:?}")),
+                    Err(particle::OdeError::BeyondStabilityLimit) => (
+                        "refused",
+                        f64::NAN,
+                        None,
+                        "beyond the method's stability limit".into(),
+                    ),
+                    Err(e) => ("error", f64::NAN, None, crate::predict::ode_words(e)),
                 };
                 table.row(vec![
                     sc.name.into(),

@@ -174,16 +174,14 @@ fn ode_run<T: Real>(m: &Method, s: &Scene<T>, model: Model) -> Run {
     };
     match particle::integrate_constant(s, model, method) {
         Ok(rep) => {
-            let (time_s, note) = match rep.outcome {
+            let time_s = match rep.outcome {
                 ode::OdeOutcome::Leaves {
                     residence_time_s, ..
-                } => (Some(residence_time_s.to_f64()), "leaves".to_string()),
-                ode::OdeOutcome::AlreadyAtRim { .. } => (Some(0.0), "at-rim".into()),
-                ode::OdeOutcome::NeverLeaves => (None, "never-leaves".into()),
-                ode::OdeOutcome::NotLeftBy { horizon_s, .. } => {
-                    (None, format!("not-left-by {:.3e} s", horizon_s.to_f64()))
-                }
+                } => Some(residence_time_s.to_f64()),
+                ode::OdeOutcome::AlreadyAtRim { .. } => Some(0.0),
+                _ => None,
             };
+            let note = ode_outcome_note(&rep.outcome);
             Run {
                 inputs,
                 time_s,
@@ -195,7 +193,7 @@ fn ode_run<T: Real>(m: &Method, s: &Scene<T>, model: Model) -> Run {
             inputs,
             time_s: None,
             rhs_evals: None,
-            note: format!("refused: {e:?}"),
+            note: format!("refused: {}", crate::predict::ode_words(e)),
         },
     }
 }
@@ -327,5 +325,18 @@ pub(super) fn ref_time(s: &Scene<f64>, model: Model) -> Option<f64> {
         RefOutcome::Leaves { time_s, .. } => Some(time_s),
         RefOutcome::AtRim => Some(0.0),
         RefOutcome::NeverLeaves => None,
+    }
+}
+
+/// An integration's outcome as the charts' CSV notes say it (`leaves`, `at-rim`,
+/// `never-leaves`, `not-left-by T s`), never a Rust name.
+pub(crate) fn ode_outcome_note<T: Real>(o: &ode::OdeOutcome<T>) -> String {
+    match o {
+        ode::OdeOutcome::Leaves { .. } => "leaves".into(),
+        ode::OdeOutcome::AlreadyAtRim { .. } => "at-rim".into(),
+        ode::OdeOutcome::NeverLeaves => "never-leaves".into(),
+        ode::OdeOutcome::NotLeftBy { horizon_s, .. } => {
+            format!("not-left-by {:.3e} s", horizon_s.to_f64())
+        }
     }
 }

@@ -17,7 +17,7 @@ use super::qemu_log::Counts;
 use super::table::Table;
 use super::timing::Budget;
 
-mod methods;
+pub(crate) mod methods;
 
 pub use methods::*;
 
