@@ -102,7 +102,7 @@ fn trace_from_a_speed_starts_settled_there() {
     );
 }
 
-/// Issue 27: seed 14's plant p05 (commissioning identified its precession slope 19 % steep)
+/// Issue 27: seed 14's plant p05 (the integral learned at 4 rad/s too small for 0.2 rad/s)
 /// stopped at the bottom of a 4 -> 0.2 rad/s step-down and was never pushed again; the
 /// expected-edge watch faulted a healthy plant 8.9 s in (docs/control.md, "A shaft that went
 /// quiet"). It must run to the end of the trace, near 0.2 rad/s.

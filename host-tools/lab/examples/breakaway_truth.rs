@@ -1,11 +1,22 @@
-//! The commissioned breakaway duty against the plant's truth (static friction in duty,
-//! `Ts R / (k V)`), per axis of every plant of a rig file (issue 27, docs/control.md
-//! "The breakaway duty from the first edge").
+//! The commissioned motor model against the plant's truth, per axis of every plant of a rig
+//! file (issue 27, docs/control.md "The breakaway duty from the first edge" and "The spin
+//! released at the precession's first edge"): the breakaway duty against static friction in duty
+//! (`Ts R / (k V)`), and the slope, friction duty and time constant against
+//! `MotorParams::ideal_model`. The controller's volts are duty times its configured supply; the
+//! slope's ratio is also given times `supply_v / configured`, in duty, the unit the loop uses.
 //!
 //! `cargo run -p lab --release --example breakaway_truth -- FILE` prints one CSV row per axis
-//! and, on stderr, the ratio's spread per axis.
+//! and, on stderr, each ratio's spread per axis.
 
 use lab::sim_reports::{commissioned, config_for};
+
+const RATIOS: [&str; 5] = [
+    "breakaway duty",
+    "slope",
+    "slope in duty",
+    "friction duty",
+    "time constant",
+];
 
 fn main() {
     let Some(path) = std::env::args().nth(1) else {
@@ -20,48 +31,64 @@ fn main() {
         }
     };
     println!(
-        "plant,axis,breakaway_duty,true_breakaway_duty,friction_duty,ratio,volts_per_rad_s,time_constant_s"
+        "plant,axis,breakaway_duty,true_breakaway_duty,volts_per_rad_s,true_volts_per_rad_s,\
+         friction_duty,true_friction_duty,time_constant_s,true_time_constant_s"
     );
-    let mut ratios: [Vec<f32>; 2] = [Vec::new(), Vec::new()];
+    let mut ratios: [[Vec<f32>; RATIOS.len()]; 2] = Default::default();
     for rig in &rigs {
-        let Ok(cl) = commissioned(rig, config_for(rig)) else {
+        let cfg = config_for(rig);
+        let configured_v = cfg.supply_v;
+        let Ok(cl) = commissioned(rig, cfg) else {
             println!("{},refused", rig.name);
             continue;
         };
+        let supply_v = rig.params.supply_v;
         for (i, id) in cl.ctrl.identified().iter().enumerate() {
             let Some(id) = id else { continue };
-            let truth = rig.params.axes[i]
-                .motor
-                .ideal_breakaway_duty(rig.params.supply_v);
+            let motor = rig.params.axes[i].motor;
+            let breakaway = motor.ideal_breakaway_duty(supply_v);
+            let (a, c, tau) = motor.ideal_model(supply_v);
             let m = id.model;
-            let ratio = m.breakaway_duty / truth;
-            ratios[i].push(ratio);
+            let r = [
+                m.breakaway_duty / breakaway,
+                m.volts_per_rad_s / a,
+                m.volts_per_rad_s / a * supply_v / configured_v,
+                m.friction_duty / c,
+                m.time_constant_s / tau,
+            ];
+            for (all, x) in ratios[i].iter_mut().zip(r) {
+                all.push(x);
+            }
             println!(
-                "{},{},{:.4},{:.4},{:.4},{:.3},{:.4},{:.4}",
+                "{},{},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}",
                 rig.name,
                 i,
                 m.breakaway_duty,
-                truth,
-                m.friction_duty,
-                ratio,
+                breakaway,
                 m.volts_per_rad_s,
-                m.time_constant_s
+                a,
+                m.friction_duty,
+                c,
+                m.time_constant_s,
+                tau
             );
         }
     }
-    for (i, r) in ratios.iter_mut().enumerate() {
-        r.sort_by(f32::total_cmp);
-        if r.is_empty() {
-            continue;
+    for (i, axis) in ratios.iter_mut().enumerate() {
+        for (name, r) in RATIOS.iter().zip(axis) {
+            r.sort_by(f32::total_cmp);
+            if r.is_empty() {
+                continue;
+            }
+            let q = |f: f32| r[((r.len() - 1) as f32 * f).round() as usize];
+            eprintln!(
+                "axis {i} {name}: identified/true min {:.3} median {:.3} max {:.3}; below truth {} of {}",
+                q(0.0),
+                q(0.5),
+                q(1.0),
+                r.iter().filter(|&&x| x < 1.0).count(),
+                r.len()
+            );
         }
-        let q = |f: f32| r[((r.len() - 1) as f32 * f).round() as usize];
-        eprintln!(
-            "axis {i}: identified/true min {:.3} median {:.3} max {:.3}; below truth {} of {}",
-            q(0.0),
-            q(0.5),
-            q(1.0),
-            r.iter().filter(|&&x| x < 1.0).count(),
-            r.len()
-        );
     }
 }
