@@ -639,10 +639,12 @@ impl SpeedLoop {
         self.breakaway.speed_rad_s()
     }
 
-    /// True once the loop has seen the shaft move since it started (an edge after the loop left
-    /// rest; see `rest` in [`SpeedLoop::step`]): the shaft turns under its own motor.
-    pub fn moved(&self) -> bool {
-        self.moved
+    /// True once the loop has seen the shaft turn under its own motor since it started: an
+    /// edge after the loop left rest (see `rest` in [`SpeedLoop::step`]), or, with current
+    /// sense, the back-EMF of its breakaway (breakaway.rs; a shaft dragged backwards would
+    /// raise the current, not lower it).
+    pub fn turning(&self) -> bool {
+        self.moved || self.breakaway.released()
     }
 
     /// The reference came down and the loop still compares windows that began before the
