@@ -5,12 +5,12 @@
 
 use core::cell::Cell;
 
-use super::wall::{Contact, Meridian, WallState, wall_forces};
+use super::wall::{Contact, Meridian, WallState, slip_of, wall_forces};
 use crate::Real;
 use crate::ode::system::{SystemError, SystemLimits};
 use crate::particle::rolling::equations::AT_REST_M_S;
 use crate::particle::rolling::modes::{
-    Mode, StallWatch, Tally, fired, follow_slip, scene_scales, segment, stuck_m_s,
+    Mode, SlipOf, StallWatch, Tally, fired, follow_slip, scene_scales, segment, stuck_m_s,
 };
 use crate::particle::rolling::{RollingError, RollingMethod, RollingScene};
 
@@ -204,7 +204,8 @@ pub fn stay<T: Real>(
                 }
                 watch.step(t)
             },
-            None,
+            // A slide's slip held to its own tolerance, as on the bottom.
+            (!rolling).then_some(SlipOf::OfState(&|y: &WallState<T>| slip_of(m, y))),
             remaining,
         )?
         else {
