@@ -459,7 +459,7 @@ fn the_stall_watch_breaks_on_steps_that_do_not_advance_the_time() {
 /// run at 1e-10: the releases that stalled at 1e-6 (45 deg tilt, 1.8 rad/s, mu_s 0.2 at 30 deg;
 /// 3.6 rad/s, mu_s 0.6 at 30 and 60 deg) and the granule held in the corner at 10 deg,
 /// 3.6 rad/s, mu_s 0.2 (its twelve releases 1 025 058 steps at 1e-6 with five failing, 275 782
-/// at 1e-7 with one failing, 231 434 at 1e-10; now 89 270, 107 754 and 231 434).
+/// at 1e-7 with one failing, 231 434 at 1e-10; now 89 778, 120 135 and 224 912).
 #[test]
 fn a_loose_tolerance_is_not_dearer_on_the_wall() {
     use crate::particle::rolling::AZIMUTHS_DEG;
