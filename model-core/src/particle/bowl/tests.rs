@@ -537,3 +537,37 @@ fn a_loose_tolerance_is_not_dearer_on_the_wall() {
     }
     assert!(last < 100_000, "{last} steps at 1e-6");
 }
+
+/// Two segments that ended at their own start (docs/model.md §12, "The wall's slide at its stick
+/// threshold"): a granule coming off a 5 mm fillet onto the bottom moving inwards was handed
+/// over exactly at the seam, where both sides' events were already at zero, and went bottom ->
+/// wall -> bottom at one instant (20 deg, 0.8 rad/s, mu_s 0.3, a 70 deg wall 15 mm high, release
+/// at 0 deg, rtol 1e-6: 2 000 000 steps at 0.3175 s); a wall slide restarted from exactly no
+/// slip ended at its first rounding (with the handover fixed and this not: 30 deg, 0.5 rad/s,
+/// mu_s 0.2, the 60 deg wall, release at 330 deg, rtol 1e-8: 199 456 restarts at 0.743 s). Both now answer in a few thousand steps,
+/// held by the wall as at rtol 1e-10.
+#[test]
+fn a_granule_at_the_seam_or_a_fresh_slide_does_not_stall() {
+    let rig = |tilt: f64, w: f64, mu_s: f64| RollingScene {
+        sliding_friction: mu_s,
+        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
+    };
+    let lim = SystemLimits {
+        horizon_s: 10.0,
+        max_steps: 50_000,
+    };
+    for (s, sh, deg, rtol) in [
+        (rig(20.0, 0.8, 0.3), shape(70.0, 0.015, 0.005), 0.0, 1e-6),
+        (rig(30.0, 0.5, 0.2), shape(60.0, 0.02, 0.0), 330.0, 1e-8),
+    ] {
+        let b = f64::to_radians(deg);
+        for rtol in [rtol, 1e-10] {
+            let m = RollingMethod::Dp54 { rtol };
+            let r = residence(&s, &sh, b, m, lim);
+            assert!(
+                matches!(r, Ok(r) if matches!(r.outcome, BowlOutcome::Inside { .. })),
+                "{deg} deg at {rtol:e}: {r:?}"
+            );
+        }
+    }
+}
