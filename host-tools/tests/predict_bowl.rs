@@ -107,12 +107,13 @@ fn a_steep_wall_holds_the_granule_and_says_so() {
     );
 }
 
-/// A release that stalls at a loose tolerance (a 60 deg wall at 45 deg tilt, 1.8 rad/s, mu_s
-/// 0.2, released at 30 deg, rtol 1e-6: steps that no longer advance the time, docs/model.md
-/// §12) is reported as such with the advice that gets past it, and at that advice (1e-7) it
-/// leaves.
+/// A release that stalled at a loose tolerance (a 60 deg wall at 45 deg tilt, 1.8 rad/s, mu_s
+/// 0.2, released at 30 deg, rtol 1e-6: steps that no longer advance the time, said as "the
+/// integration stalled at a roll/slide switch ... give a tighter --tol") leaves there now that
+/// the wall's slip has its own error control (docs/model.md §12), at the `T` of the run at
+/// 1e-7 within 1e-4.
 #[test]
-fn a_stalled_release_says_a_tighter_tolerance_gets_past_it() {
+fn a_release_that_stalled_at_a_loose_tolerance_now_leaves() {
     let args = |tol| {
         bowl_args(
             "1.8",
@@ -130,15 +131,18 @@ fn a_stalled_release_says_a_tighter_tolerance_gets_past_it() {
             ],
         )
     };
-    let v = json(&args("1e-6"));
-    assert_eq!(v["valid"], false, "{v}");
-    let why = v["invalid_reason"].as_str().unwrap();
+    let (loose, tight) = (json(&args("1e-6")), json(&args("1e-7")));
+    for v in [&loose, &tight] {
+        assert_eq!(v["valid"], true, "{v}");
+        assert_eq!(v["releases_leaving"], 1, "{v}");
+    }
+    let t = |v: &serde_json::Value| v["residence_time_mean_s"].as_f64().unwrap();
     assert!(
-        why.contains("stalled at a roll/slide switch") && why.contains("a tighter --tol"),
-        "{why}"
+        (t(&loose) - t(&tight)).abs() <= 1e-4 * t(&tight),
+        "{} vs {}",
+        t(&loose),
+        t(&tight)
     );
-    let v = json(&args("1e-7"));
-    assert_eq!(v["releases_leaving"], 1, "{v}");
 }
 
 /// A flared wall (60 deg, 20 mm) keeps the granule longer than a bare rim, and it leaves over

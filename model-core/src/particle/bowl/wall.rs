@@ -277,6 +277,25 @@ pub fn wall_forces<T: Real>(
     }
 }
 
+/// The contact point's slip `u - s x n` of a wall state, m/s (as [`wall_forces`] gives it,
+/// without the forces): not linear in the state, since `u` and `n` turn with the position.
+pub fn slip_of<T: Real>(m: &Meridian<T>, y: &WallState<T>) -> [T; 3] {
+    let en = (y[1] * y[1] + y[2] * y[2]).sqrt().max(T::EPSILON);
+    let (ex, ey) = (y[1] / en, y[2] / en);
+    let p = m.at(y[0]);
+    let rho = p.pos[0];
+    let [rp, zp] = p.tangent;
+    let (sd, pd) = (y[3], y[4]);
+    let u = [
+        sd * rp * ex - rho * pd * ey,
+        sd * rp * ey + rho * pd * ex,
+        sd * zp,
+    ];
+    let n = [-zp * ex, -zp * ey, rp];
+    let sn = cross(&[y[5], y[6], y[7]], &n);
+    core::array::from_fn(|i| u[i] - sn[i])
+}
+
 /// A state on the bottom `[x, y, ux, uy, sx, sy, sz]` at the fillet's start radius as a wall
 /// state (`s = 0`).
 pub fn onto_wall<T: Real>(m: &Meridian<T>, y: &[T; 7]) -> WallState<T> {

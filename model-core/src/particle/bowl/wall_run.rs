@@ -5,12 +5,12 @@
 
 use core::cell::Cell;
 
-use super::wall::{Contact, Meridian, WallState, wall_forces};
+use super::wall::{Contact, Meridian, WallState, slip_of, wall_forces};
 use crate::Real;
 use crate::ode::system::{SystemError, SystemLimits};
 use crate::particle::rolling::equations::AT_REST_M_S;
 use crate::particle::rolling::modes::{
-    Mode, StallWatch, Tally, fired, follow_slip, scene_scales, segment, stuck_m_s,
+    Mode, SlipOf, StallWatch, Tally, fired, follow_slip, scene_scales, segment, stuck_m_s,
 };
 use crate::particle::rolling::{RollingError, RollingMethod, RollingScene};
 
@@ -59,10 +59,17 @@ fn events<T: Real>(
         Contact::Slide(d) => {
             let s = f.slip_m_s;
             let reversed = -(s[0] * d[0] + s[1] * d[1] + s[2] * d[2]);
+            // A slide that has not yet been above the stuck threshold ends where its slip has
+            // turned against the friction by more than that threshold, not at its first
+            // rounding: a slide restarted from no slip (`no_slip`, exact only to rounding on
+            // the wall) has its slip at zero or a rounding against the friction, so the end
+            // was already at zero at the segment's start, and a step that ended with the slip
+            // reversed was located there: the stay restarted from the same state at the same
+            // instant, one step each, without end (docs/model.md §12).
             let stuck = if armed {
                 reversed.max(stuck_m_s(speed_ref) - norm(&s))
             } else {
-                reversed
+                reversed - stuck_m_s(speed_ref)
             };
             stuck / speed_ref
         }
@@ -204,7 +211,8 @@ pub fn stay<T: Real>(
                 }
                 watch.step(t)
             },
-            None,
+            // A slide's slip held to its own tolerance, as on the bottom.
+            (!rolling).then_some(SlipOf::OfState(&|y: &WallState<T>| slip_of(m, y))),
             remaining,
         )?
         else {

@@ -399,34 +399,57 @@ pub(crate) fn follow_slip<T: Real, const N: usize>(
     }
 }
 
-/// The slip of a state (m/s), linear in it.
-pub(crate) type SlipOf<T, const N: usize> = fn(&[T; N]) -> [T; 2];
+/// The slip of a state (m/s): on the bottom linear in it (`Linear`: the slip of a step's error
+/// estimate is the slip's error), on the wall not (`OfState`: its velocity and the spin's part
+/// `s x n` depend on where on the meridian it is; the slip's error is then the difference of the
+/// slips of the step's two solutions, the 5th- and the embedded 4th-order one).
+#[derive(Clone, Copy)]
+pub(crate) enum SlipOf<'a, T, const N: usize> {
+    /// Linear in the state.
+    Linear(fn(&[T; N]) -> [T; 2]),
+    /// Any function of the state.
+    OfState(&'a dyn Fn(&[T; N]) -> [T; 3]),
+}
 
 /// The slip's error in a step of a slide in which it grows, against [`SLIP_RTOL`] times `rtol`
-/// of the slip itself
-/// (`slip`: the slip of a state, linear in it, so that the slip of the step's error estimate `e`
-/// is the slip's error). The friction acts against the slip's direction, which turns at
-/// `|A_perp| / |v_c|` (the free slip's acceleration across it over the slip): the slide's
-/// right-hand side is stiff while the slip is small. The components' own tolerances
-/// (`rtol` of the scene's speed) say nothing of that direction while the slip is below them, and
-/// a loose step can leave it off by tens of degrees, the stiff relaxation then holding the step
-/// at its stability limit and the slip at about that step's friction impulse, neither growing:
-/// a slide from rest at 45 deg, 3.6 rad/s, mu_s 0.2 (release at 180 deg) took 2 709 steps at rtol
-/// 1e-6, 23 110 at 1e-7, more than 200 000 at 1e-8, and 493 at 1e-10 (docs/model.md §12).
+/// of the slip itself (`e`: the step's error estimate, `y` and `y1` its start and end). The
+/// friction acts against the slip's direction, which turns at `|A_perp| / |v_c|` (the free
+/// slip's acceleration across it over the slip): the slide's right-hand side is stiff while the
+/// slip is small. The components' own tolerances (`rtol` of the scene's speed) say nothing of
+/// that direction while the slip is below them, and a loose step can leave it off by tens of
+/// degrees, the stiff relaxation then holding the step at its stability limit and the slip at
+/// about that step's friction impulse, neither growing: a slide from rest at 45 deg, 3.6 rad/s,
+/// mu_s 0.2 (release at 180 deg) took 2 709 steps at rtol 1e-6, 23 110 at 1e-7, more than
+/// 200 000 at 1e-8, and 493 at 1e-10. On the wall the same direction error turns the slip
+/// against the friction within a step or two, which ends the slide as a stick: a granule at the
+/// stick threshold in the wall's corner then changed mode every few microseconds and failed
+/// (docs/model.md §12).
 fn slip_error<T: Real, const N: usize>(
-    slip: SlipOf<T, N>,
+    slip: SlipOf<'_, T, N>,
     rtol: T,
     (e, y, y1): (&[T; N], &[T; N], &[T; N]),
 ) -> T {
-    let norm = |v: [T; 2]| (v[0] * v[0] + v[1] * v[1]).sqrt();
-    let (before, after) = (norm(slip(y)), norm(slip(y1)));
+    let norm = |v: [T; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let (before, after, error) = match slip {
+        SlipOf::Linear(f) => {
+            let flat = |v: [T; 2]| [v[0], v[1], T::ZERO];
+            (flat(f(y)), flat(f(y1)), flat(f(e)))
+        }
+        SlipOf::OfState(f) => {
+            let end = f(y1);
+            let lower: [T; N] = core::array::from_fn(|i| y1[i] - e[i]);
+            let other = f(&lower);
+            (f(y), end, core::array::from_fn(|i| end[i] - other[i]))
+        }
+    };
+    let (before, after) = (norm(before), norm(after));
     if after <= before {
         // A shrinking slip is left to the components' tolerances: held to its own, the steps
         // would shrink with it while its direction turns on the way to sticking, where the
         // slip-end event (its reversal within a step) finds the stick at any step.
         return T::ZERO;
     }
-    norm(slip(e)) / (T::from_f64(SLIP_RTOL) * rtol * after + T::from_f64(SLIP_ATOL_M_S))
+    norm(error) / (T::from_f64(SLIP_RTOL) * rtol * after + T::from_f64(SLIP_ATOL_M_S))
 }
 
 /// The slip's relative tolerance as a multiple of the run's `rtol`: its direction to 1e-4 rad at
@@ -440,8 +463,8 @@ pub(crate) const SLIP_ATOL_M_S: f64 = 1e-9;
 
 /// Integrates one segment in `mode` from `(t0, y0)` with the method, stopping at the first
 /// event, and adds its cost and its time to `tally`: the event's time and state, or `None` at
-/// the horizon. `slip`: a slide's slip (linear in the state), held to [`slip_error`]'s
-/// tolerance besides the components' (`None` where the contact does not slip).
+/// the horizon. `slip`: a slide's slip, held to [`slip_error`]'s tolerance besides the
+/// components' (`None` where the contact does not slip).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn segment<T: Real, const N: usize>(
     tally: &mut Tally<T>,
@@ -452,7 +475,7 @@ pub(crate) fn segment<T: Real, const N: usize>(
     scales: (T, T),
     event: impl Fn(T, &[T; N]) -> T,
     check: impl FnMut(T, &[T; N]) -> ControlFlow<()>,
-    slip: Option<SlipOf<T, N>>,
+    slip: Option<SlipOf<'_, T, N>>,
     limits: SystemLimits<T>,
 ) -> Result<Option<(T, [T; N])>, RollingError> {
     let (length, speed) = scales;
@@ -575,7 +598,7 @@ pub(crate) fn run_from<T: Real>(
                         follow_slip(&slip_m_s(y), &dir, &armed, stuck);
                         watch.step(t)
                     },
-                    Some(slip_m_s::<T>),
+                    Some(SlipOf::Linear(slip_m_s::<T>)),
                     remaining,
                 )?
                 else {

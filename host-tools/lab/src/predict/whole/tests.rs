@@ -253,9 +253,10 @@ fn cost_over(grid: &[(RollingScene<f64>, BowlShape<f64>)]) {
 
 /// The chatter handling of `run_level` gives the bowl model's answer: a scene where the granule
 /// rolls at release and must slide before the rim (run at rtol 1e-10 from the start), and a
-/// wall where two releases stall at 1e-6 and one where one release does (found by the stall
-/// watch, run again at 1e-7, the rest after them too; `model-core`'s
-/// `bowl::tests::a_stalled_release_is_found_within_200_steps` checks the watch itself):
+/// wall where two releases stalled at 1e-6 and one where one release did (before the wall's
+/// slip had its own error control, docs/model.md §12; the stall watch is still run, and
+/// `model-core`'s `bowl::tests::the_stall_watch_breaks_on_steps_that_do_not_advance_the_time`
+/// checks it):
 /// every release leaves, each within 1e-4 of the bowl model at rtol 1e-10 run release by
 /// release.
 #[test]
