@@ -56,3 +56,5 @@ mkdir -p docs/charts/bowl
 "$bowl" chart bowl-residence --out docs/charts/bowl/residence-60.svg
 "$bowl" chart bowl-residence --axes-angle-deg 30 --out docs/charts/bowl/residence-30.svg
 "$bowl" chart bowl-regimes --out docs/charts/bowl/regimes.svg
+"$bowl" chart bowl-regime-map --out docs/charts/bowl/regime-map.svg
+"$bowl" chart bowl-work-precision --out docs/charts/bowl/work-precision.svg
