@@ -1,30 +1,35 @@
 //! The top-level controller: both axes, the supervisor, the planner and commissioning.
 //!
-//! - this file: the state, its construction, the control tick and the telemetry snapshot;
+//! - this file: the state, its construction and the control tick;
 //! - [`axis`]: one motor axis's runtime state (estimator, loop, sensor watch, outputs);
 //! - [`commands`]: the host's commands, each of which also counts as hearing from the host;
-//! - [`current`]: the current sense's samples, trips and the supply cut.
+//! - [`current`]: the current sense's samples, trips and the supply cut;
+//! - [`commissioning`]: the tick while commissioning runs, and its end;
+//! - [`status`]: what the controller tells: its state, fault, models and the telemetry snapshot.
 
 mod axis;
 mod commands;
+mod commissioning;
 mod current;
+mod status;
+
+pub use status::{AxisStatus, Status};
 
 use super::const_trig::{cos_const, sin_const};
 
 use axis::AxisState;
 use commands::HostWatch;
 
-use super::commission::{Commissioning, Identified, IdentifyError, Phase};
+use super::commission::{Commissioning, Identified, IdentifyError};
 use super::config::{ConfigError, ControllerConfig};
 use super::pi::LoopInput;
-use super::planner::{InverseFailure, ResidenceForBowlSpeed, SetpointPlanner};
+use super::planner::{InverseFailure, SetpointPlanner};
 use super::supervisor::{
     DRIVEN_BELOW_MODEL_DUTY, DROPPING_WATCH_PITCHES, Fault, PAIR_RUNAWAY_MARGIN_RAD_S,
     PAIR_RUNAWAY_RATIO, PAIR_RUNAWAY_STEADY_S, REVOLUTION_RUNAWAY_DUTY,
     REVOLUTION_RUNAWAY_MARGIN_RAD_S, REVOLUTION_RUNAWAY_RATIO, SETTLED_AFTER_S, State,
-    WATCH_PITCHES, edge_runaway, fault_code,
+    WATCH_PITCHES, edge_runaway,
 };
-use crate::bowl::{MotorSpeeds, combined_speed_from_trig};
 
 /// Why a command was refused. A refused command changes nothing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -54,46 +59,6 @@ pub enum Rejection {
     /// Loop tuning values out of range (bandwidth in (0.01, 1000] rad/s, per-pulse bandwidth
     /// in (0.01, 10]).
     InvalidTuning,
-}
-
-/// Per-axis part of the status snapshot.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct AxisStatus {
-    /// Commanded target, rad/s (signed).
-    pub target_rad_s: f32,
-    /// Ramped reference the loop follows now, rad/s.
-    pub reference_rad_s: f32,
-    /// Measured speed with the commanded sign, rad/s.
-    pub measured_rad_s: f32,
-    /// Duty applied, -1..=1 (0 = bridge coasting).
-    pub duty: f32,
-    /// Edges accepted since start (wrapping).
-    pub pulses: u32,
-    /// Edges rejected as bounces.
-    pub rejected_edges: u32,
-    /// Pulses inferred as missing.
-    pub inferred_missing: u32,
-    /// The estimator has a valid measurement.
-    pub measurement_valid: bool,
-}
-
-/// A snapshot of the controller for telemetry.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Status {
-    /// Operating state.
-    pub state: State,
-    /// Latched fault, if any.
-    pub fault: Option<Fault>,
-    /// Fault code (0 = none), see [`Fault::code`].
-    pub fault_code: u8,
-    /// Per axis, indexed by `PRECESSION` and `SPIN`.
-    pub axes: [AxisStatus; 2],
-    /// Combined bowl speed of the targets (Eq. 2), rad/s.
-    pub combined_target_rad_s: f32,
-    /// Combined bowl speed of the measured speeds (Eq. 2), rad/s.
-    pub combined_measured_rad_s: f32,
 }
 
 /// The rig's controller. See the module docs of [`crate::control`] for the contract.
@@ -316,41 +281,6 @@ impl Controller {
         self.after_tick(dt)
     }
 
-    /// The tick while commissioning: the estimators also feed the identification routine.
-    #[inline(never)]
-    fn tick_commissioning(&mut self, now_ticks: u32, edges: [&[u32]; 2]) -> [f32; 2] {
-        let dt = self.dt_s;
-        let mut seen = [false; 2];
-        let comm_axis = match &self.commissioning {
-            Some(c) => c.progress().0,
-            None => 2,
-        };
-        for i in 0..2 {
-            let a = &mut self.axes[i];
-            let rad_per_pulse = a.est.rad_per_pulse();
-            let mut comm = if i == comm_axis {
-                self.commissioning.as_mut()
-            } else {
-                None
-            };
-            let seen_i = &mut seen[i];
-            let speed = a.est.tick(now_ticks, edges[i], false, |at, pulses| {
-                *seen_i = true;
-                if let Some(c) = comm.as_deref_mut() {
-                    c.on_edge(at, pulses, rad_per_pulse);
-                }
-            });
-            a.measured = a.direction * speed;
-            if speed > self.cfg.axes[i].overspeed_rad_s {
-                self.latch(Fault::Overspeed(i as u8));
-            }
-        }
-        if self.state == State::Commissioning {
-            self.commission_step(dt, &seen);
-        }
-        self.after_tick(dt)
-    }
-
     /// Host-silence watch and the final say of a latched fault, common to both ticks.
     #[inline(always)]
     fn after_tick(&mut self, dt: f32) -> [f32; 2] {
@@ -504,81 +434,6 @@ impl Controller {
         false
     }
 
-    #[inline(never)]
-    fn commission_step(&mut self, dt: f32, seen: &[bool; 2]) {
-        let Some(c) = self.commissioning.as_mut() else {
-            self.state = State::Idle;
-            return;
-        };
-        let axis = c.progress().0;
-        // The load pattern of each step, with the wheel's, for load_pattern::adopt.
-        let a = &mut self.axes[axis];
-        a.load.commission_tick(&a.est, a.duty, c.steady_step());
-        let clock = self.axes[axis].est.clock_ticks();
-        match c.step(
-            dt,
-            clock,
-            self.axes[0].est.is_stopped() && self.axes[1].est.is_stopped(),
-        ) {
-            Err(e) => {
-                self.identify_error = Some(e);
-                self.commissioning = None;
-                // No edge at any duty: a dead sensor or a blocked shaft, the same fault as
-                // in closed loop; anything else leaves the configuration unidentified.
-                self.latch(if e == IdentifyError::NoBreakaway {
-                    Fault::SensorLostOrStall(axis as u8)
-                } else {
-                    Fault::InvalidConfiguration
-                });
-            }
-            Ok(duties) => {
-                self.axes[0].duty = duties[0];
-                self.axes[1].duty = duties[1];
-                if c.progress().1 == Phase::Done {
-                    let results = c.results();
-                    self.commissioning = None;
-                    self.identified = results;
-                    let mut cfg = self.cfg;
-                    for (i, r) in results.iter().enumerate() {
-                        if let Some(r) = r {
-                            cfg.axes[i].model = r.model;
-                        }
-                    }
-                    match cfg.validate() {
-                        Ok(()) => {
-                            self.rebuild_keep_state(cfg);
-                            self.state = State::Idle;
-                        }
-                        Err(e) => {
-                            self.config_error = Some(e);
-                            self.latch(Fault::InvalidConfiguration);
-                        }
-                    }
-                    return;
-                }
-                // Blocked shaft or dead sensor during identification: the expected period is
-                // unknown, so allow 3 periods at the lowest speed.
-                for (i, &seen_i) in seen.iter().enumerate() {
-                    let a = &mut self.axes[i];
-                    if a.watch.step(
-                        dt,
-                        a.duty.abs(),
-                        self.cfg.stall_duty,
-                        seen_i,
-                        self.cfg.sensor_timeout_floor_s,
-                        self.cfg.axes[i].min_speed_rad_s,
-                        a.est.rad_per_pulse(),
-                        WATCH_PITCHES,
-                    ) {
-                        self.identify_error = Some(IdentifyError::TooFewEdges);
-                        self.latch(Fault::SensorLostOrStall(i as u8));
-                        return;
-                    }
-                }
-            }
-        }
-    }
-
     /// Replaces the configuration, keeping the estimators' clocks.
     #[inline(never)]
     fn rebuild_keep_state(&mut self, cfg: ControllerConfig) {
@@ -632,96 +487,5 @@ impl Controller {
     /// enough). On by default.
     pub fn set_feedback_enabled(&mut self, on: bool) {
         self.feedback = on;
-    }
-
-    /// Operating state.
-    pub fn state(&self) -> State {
-        self.state
-    }
-
-    /// Latched fault, if any.
-    pub fn fault(&self) -> Option<Fault> {
-        self.fault
-    }
-
-    /// The configuration in force (with identified models after commissioning).
-    pub fn config(&self) -> &ControllerConfig {
-        &self.cfg
-    }
-
-    /// The speed loop's gains on `axis` at its bandwidth ceiling (the schedule lowers both in
-    /// proportion at sparse pulses): `(kp, ki)` in duty per rad/s and duty per rad.
-    pub fn loop_gains(&self, axis: usize) -> Option<(f32, f32)> {
-        let k = &self.axes.get(axis)?.k;
-        let wc = super::pi::bandwidth_ceiling_rad_s(self.cfg.axes.get(axis)?);
-        Some((k.kp(wc), k.ki_per_s(wc)))
-    }
-
-    /// The once-per-revolution load learned on `axis` (0 = precession, 1 = spin): revolutions
-    /// learned since it was last forgotten and the pattern's amplitude, duty (see
-    /// [`super::load_pattern`]). `(0, 0.0)` for an axis out of range.
-    pub fn load_pattern(&self, axis: usize) -> (u16, f32) {
-        self.axes.get(axis).map_or((0, 0.0), |a| {
-            (a.load.revolutions_learned(), a.load.amplitude_duty())
-        })
-    }
-
-    /// Results of the last commissioning run, per axis.
-    pub fn identified(&self) -> [Option<Identified>; 2] {
-        self.identified
-    }
-
-    /// Why the last commissioning run failed, if it did.
-    pub fn identify_error(&self) -> Option<IdentifyError> {
-        self.identify_error
-    }
-
-    /// Status snapshot for telemetry (computes Eq. 2; call at telemetry rate, not per tick).
-    pub fn status(&self) -> Status {
-        let targets = self.planner.targets();
-        let ramped = self.planner.ramped();
-        let mut axes = [AxisStatus::default(); 2];
-        for (i, (out, a)) in axes.iter_mut().zip(&self.axes).enumerate() {
-            *out = AxisStatus {
-                target_rad_s: targets[i],
-                reference_rad_s: ramped[i],
-                measured_rad_s: a.measured,
-                duty: a.duty,
-                pulses: a.est.accepted_edges(),
-                rejected_edges: a.est.rejected_edges(),
-                inferred_missing: a.est.inferred_missing(),
-                measurement_valid: a.est.is_valid(),
-            };
-        }
-        let combined = |w: [f32; 2]| {
-            combined_speed_from_trig(
-                self.cos_axes,
-                self.sin_axes,
-                MotorSpeeds {
-                    precession_rad_s: w[0],
-                    spin_rad_s: w[1],
-                },
-            )
-            .unwrap_or(0.0)
-        };
-        Status {
-            state: self.state,
-            fault: self.fault,
-            fault_code: fault_code(self.fault),
-            axes,
-            combined_target_rad_s: combined(targets),
-            combined_measured_rad_s: combined([self.axes[0].measured, self.axes[1].measured]),
-        }
-    }
-
-    /// Predicted residence time at the measured combined bowl speed, s, from a forward particle
-    /// model (flat or Coriolis). For telemetry: call at the telemetry rate, never per tick.
-    pub fn predicted_residence_time_s(&self, model: &dyn ResidenceForBowlSpeed) -> Option<f32> {
-        let w = self.status().combined_measured_rad_s;
-        if w > 0.0 {
-            model.residence_time_s(w)
-        } else {
-            None
-        }
     }
 }
