@@ -24,14 +24,6 @@
 //!    holds its duty (a coasting light rod would be driven over its speed limit by a heavy
 //!    bowl's slowing down), and both coast.
 //!
-//! 5. *Slow breakaway searches* (after both axes are identified, the precession's then the
-//!    spin's): from the identified friction duty the duty rises [`CREEP_SLOWER`] times slower
-//!    than in step 0 until an edge, the shaft coasts to rest just past that tooth, and a second
-//!    such search runs to the next edge. Its travel is then known (a pitch less the coast), so
-//!    the rise during it is taken out with the identified model (`breakaway_after_pitch`): the
-//!    first search's duty overstated the breakaway 1.6-2.5x (median over a family), by the
-//!    rise during the unknown travel to its first tooth.
-//!
 //! # What is estimated
 //! - Steady state `d V = a |w| + c`: two points give the effective back-EMF constant
 //!   `a = V (d_H - d_L) / (w_H - w_L)` (V per rad/s; it includes viscous friction, see
@@ -61,9 +53,6 @@ use super::config::{CommissioningConfig, MotorModel};
 pub const BREAKAWAY_RATE_PER_S: f32 = 0.2;
 /// The breakaway search starts at this duty.
 pub const BREAKAWAY_START_DUTY: f32 = 0.05;
-/// The second, slow breakaway search (after the axis is identified) rises this many times
-/// slower than the first.
-pub const CREEP_SLOWER: f32 = 8.0;
 /// The breakaway search gives up at this duty.
 pub const BREAKAWAY_MAX_DUTY: f32 = 0.9;
 /// The spin's duty ramp while the reaction is measured, s.
@@ -200,8 +189,6 @@ pub struct Commissioning {
     pulses_per_rev: [u32; 2],
     duty: f32,
     breakaway_duty: f32,
-    /// Edges of this axis's slow searches (`CREEP_SLOWER`): 2 when done.
-    crept: u8,
     low_duty: f32,
     high_duty: f32,
     /// The spin's high duty, applied again during the reaction phase.
@@ -248,7 +235,6 @@ impl Commissioning {
             pulses_per_rev: [pulses_per_rev[0] as u32, pulses_per_rev[1] as u32],
             duty: BREAKAWAY_START_DUTY,
             breakaway_duty: 0.0,
-            crept: 0,
             low_duty: cfg.low_duty,
             high_duty: cfg.high_duty,
             spin_high_duty: 0.0,
@@ -272,12 +258,6 @@ impl Commissioning {
         (self.axis, self.phase)
     }
 
-    /// In the slow search: its duty jumps to the friction duty and the shaft may creep
-    /// without an edge, so it teaches no current per duty (supervisor.rs).
-    pub fn creeping(&self) -> bool {
-        self.phase == Phase::Breakaway && self.results[self.axis].is_some()
-    }
-
     /// Results so far.
     pub fn results(&self) -> [Option<Identified>; 2] {
         self.results
@@ -290,23 +270,6 @@ impl Commissioning {
             return;
         }
         let Some(t0) = self.t0_ticks else { return };
-        if self.phase == Phase::Breakaway && self.results[self.axis].is_some() {
-            // A slow search's edge: the first leaves the shaft just past a tooth, so the
-            // second's travel is a pitch less the coast, and its duty is corrected for the
-            // rise during that travel (`breakaway_after_pitch`).
-            let d = if self.crept == 0 {
-                self.duty
-            } else {
-                self.breakaway_after_pitch(rad_per_pulse)
-            };
-            if let Some(r) = self.results[self.axis].as_mut() {
-                r.model.breakaway_duty = d;
-            }
-            self.crept += 1;
-            self.phase = Phase::Coast;
-            self.coast_s = 0.0;
-            return;
-        }
         if self.phase == Phase::Breakaway {
             // Moving: the low step starts now, from this edge's angle.
             self.breakaway_duty = self.duty;
@@ -373,27 +336,9 @@ impl Commissioning {
         let mut duty = 0.0;
         match self.phase {
             Phase::Breakaway => {
-                if let Some(r) = self.results[self.axis] {
-                    // The slow search, from the identified friction duty (static friction
-                    // is at least the kinetic). The first stops at the fast search's edge at
-                    // most; the second's travel is a whole pitch, and may need more.
-                    let m = r.model;
-                    self.duty = m.friction_duty + search_rate_per_s(n) / CREEP_SLOWER * t_s;
-                    let cap = if self.crept == 0 {
-                        m.breakaway_duty
-                    } else {
-                        TOP_DUTY
-                    };
-                    if self.duty >= cap {
-                        self.crept = 2;
-                        self.phase = Phase::Coast;
-                        self.coast_s = 0.0;
-                    }
-                } else {
-                    self.duty = BREAKAWAY_START_DUTY + search_rate_per_s(n) * t_s;
-                    if self.duty > BREAKAWAY_MAX_DUTY {
-                        return Err(IdentifyError::NoBreakaway);
-                    }
+                self.duty = BREAKAWAY_START_DUTY + search_rate_per_s(n) * t_s;
+                if self.duty > BREAKAWAY_MAX_DUTY {
+                    return Err(IdentifyError::NoBreakaway);
                 }
                 duty = self.duty;
             }
@@ -444,20 +389,8 @@ impl Commissioning {
             }
             Phase::Coast => {
                 self.coast_s += dt_s;
-                // After a slow search the estimator reads zero at once (one edge measures no
-                // speed): the shaft creeping past it coasts until friction alone stops it,
-                // `w tau / (K c) = tau (d - c) / c` (`breakaway_after_pitch`), five time
-                // constants at least, 5 s at most.
-                let wait_s = match self.results[self.axis] {
-                    Some(r) if self.crept > 0 => {
-                        let m = r.model;
-                        let by_friction = m.breakaway_duty / m.friction_duty - 1.0;
-                        m.time_constant_s * by_friction.max(5.0)
-                    }
-                    _ => 0.05,
-                };
-                if stopped && self.coast_s > wait_s.min(5.0) {
-                    if self.results[0].is_none() {
+                if stopped && self.coast_s > 0.05 {
+                    if self.axis == 1 {
                         self.axis = 0;
                         self.phase = Phase::Breakaway;
                         self.duty = BREAKAWAY_START_DUTY;
@@ -466,17 +399,6 @@ impl Commissioning {
                         self.angle_pulses = 0;
                         self.low_fit = LineFit::default();
                         self.high_fit = LineFit::default();
-                    } else if self.crept < 2 || self.axis == 0 {
-                        // The slow searches, the precession's then the spin's, once both
-                        // are identified (module docs, step 5): a spin search's end that
-                        // came before the rod's would turn it through that search unseen.
-                        if self.crept == 2 {
-                            self.axis = 1;
-                            self.crept = 0;
-                        }
-                        self.phase = Phase::Breakaway;
-                        self.t0_ticks = None;
-                        self.total_s = 0.0;
                     } else {
                         self.phase = Phase::Done;
                     }
@@ -578,57 +500,6 @@ impl Commissioning {
             low_speed_rad_s: w_l,
             high_speed_rad_s: w_h,
         })
-    }
-}
-
-impl Commissioning {
-    /// The second slow search's breakaway duty from its edge's duty `self.duty`. Its shaft
-    /// rested where the first one's coast left it: a tooth, then the coast's travel `delta`.
-    /// The coasting bridge brakes with no back-EMF, so friction alone stops the shaft: from
-    /// the quasi-static speed `w = K (d1 - c)` at the first edge (`K = V / a`) at the
-    /// deceleration `K c / tau` (the identified model's friction torque over its inertia),
-    /// `delta = w^2 tau / (2 K c)` (viscous friction only shortens it: `delta` errs large, and
-    /// the duty high). Breaking away at `d_b` on the ramp
-    /// `d = d_b + r s`, the identified first-order plant `tau dw/ds + w = K (d - c)` travels
-    /// `pitch - delta` in the `s` seconds to the edge; the travel rises with `s` (breaking
-    /// away earlier on the same ramp travels further), so `s` by bisection, `d_b = d - r s`,
-    /// at least the friction duty (static friction is at least the kinetic). The plant is
-    /// integrated by backward Euler, as the loop's model is.
-    fn breakaway_after_pitch(&self, pitch_rad: f32) -> f32 {
-        let Some(r) = self.results[self.axis] else {
-            return self.duty;
-        };
-        let m = r.model;
-        let (d, c, tau) = (self.duty, m.friction_duty, m.time_constant_s);
-        let rate = search_rate_per_s(self.pulses_per_rev[self.axis].max(1)) / CREEP_SLOWER;
-        let k = self.supply_v / m.volts_per_rad_s;
-        // `w0` at duty `d0` rising at `rate` for `s` seconds (the shaft stops, never reverses).
-        let travel = |w0: f32, d0: f32, rate: f32, s: f32| {
-            let h = s / 64.0;
-            let (mut w, mut theta) = (w0, 0.0);
-            for i in 0..64 {
-                let drive = k * (d0 + rate * h * (i + 1) as f32 - c);
-                w = ((w * tau + h * drive) / (tau + h)).max(0.0);
-                theta += w * h;
-            }
-            theta
-        };
-        let d1 = m.breakaway_duty;
-        let target = pitch_rad - 0.5 * k * (d1 - c) * (d1 - c) * tau / c;
-        let s_max = (d - c) / rate;
-        if !(s_max > 0.0 && target > 0.0 && k.is_finite()) {
-            return d;
-        }
-        let (mut lo, mut hi) = (0.0f32, s_max);
-        for _ in 0..20 {
-            let mid = 0.5 * (lo + hi);
-            if travel(0.0, d - rate * mid, rate, mid) < target {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        (d - rate * 0.5 * (lo + hi)).max(c).min(d)
     }
 }
 

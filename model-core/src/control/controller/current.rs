@@ -13,7 +13,6 @@ impl Controller {
     /// only boards with current sense pay for it.
     #[inline(never)]
     pub(super) fn current_sample(&mut self, i: usize, reading_a: f32, applied: f32) {
-        let creeping = self.commissioning.as_ref().is_some_and(|c| c.creeping());
         let a = &mut self.axes[i];
         // The loop's view of the reading (breakaway.rs): the current as the duty that drives it
         // into a held shaft, once the watch has learned the offset and the current per duty.
@@ -46,8 +45,7 @@ impl Controller {
             // At rest for the current per duty: no edge since it stopped, or none for so long
             // that the estimate is zero (the precession turned by the spin's reaction keeps its
             // last edge for seconds: its own start then taught nothing, seed 4 p10).
-            // Not in commissioning's slow breakaway search (commission.rs).
-            (a.est.at_rest() || a.est.is_stopped()) && !creeping,
+            a.est.at_rest() || a.est.is_stopped(),
             speed_lo_rad_s,
             a.k.duty_per_rad_s(),
             a.k.duty_limit(),
