@@ -90,6 +90,7 @@ use super::breakaway::{Breakaway, FUSED_BAND_SHARE};
 use super::estimator::WindowEvents;
 
 mod constants;
+mod start;
 pub use constants::{LoopConstants, SCHEDULE_TOP_RAD_S, bandwidth_ceiling_rad_s};
 
 /// Duty the push adds above the kick's level by the time the expected-edge watch would fault
@@ -532,111 +533,6 @@ impl SpeedLoop {
         self.correction_duty = next - ff;
         self.duty = next;
         next
-    }
-
-    /// The integral takes the load read from a crawl window of `span_s` seconds whose model
-    /// mean exceeded the measured mean by `sample` rad/s; the push ends. A window shorter than
-    /// [`CRAWL_READ_MIN_S`] was no crawl: half the push stays, as after the first edge. Rare
-    /// (once per start of a loaded shaft), so kept out of the tick's common path; the choice
-    /// is a product, not a branch (a branch here cost the common path two instructions, over
-    /// the tick budget).
-    #[cold]
-    #[inline(never)]
-    fn take_crawl_load(&mut self, k: &LoopConstants, span_s: f32, sample: f32, direction: f32) {
-        let reading = if span_s >= CRAWL_READ_MIN_S { 1.0 } else { 0.0 };
-        let mean_push = self.push_sum * k.dt_s / span_s;
-        self.integral += reading * (mean_push * direction + sample * k.duty_per_rad_s)
-            + (1.0 - reading) * PUSH_KEPT * self.push * direction;
-        self.push_sum = 0.0;
-        self.push = 0.0;
-    }
-
-    /// The first measurement of a start, over a window of at least [`CRAWL_READ_MIN_S`]: the
-    /// integral takes the load it reads at once (`L - c` as duty, the error the loop would
-    /// otherwise remove at its bandwidth). What started the shaft (half the kick or the push,
-    /// kept at its first edge so that a loaded shaft does not stick again) is then replaced by
-    /// what the window shows the shaft needs. Left to the loop, an unloaded shaft ran on the
-    /// kept kick at the scheduled bandwidth's pace: at 0.2 rad/s (0.19 rad/s of bandwidth, a
-    /// 5 s time constant) the nominal rig's stiction leap to 0.52 rad/s was still 0.24 rad/s
-    /// 13 s after the command. Before the dead time was modelled the held error did this
-    /// job by accident (the integral ran on for the whole next window); the window's load
-    /// reading does it on purpose. Only long windows (low speed, where the loop is slow and
-    /// the shaft's lag is short against the window) are read; a short one through which the
-    /// shaft still accelerates is left to the loop, as at the crawl's reading.
-    #[inline(always)]
-    fn take_start_load(&mut self, k: &LoopConstants, c: f32, direction: f32) {
-        self.integral += (self.error - c) * k.duty_per_rad_s * direction;
-    }
-
-    /// One current sample (see [`LoopInput::torque_duty`]): the breakaway watch, and between
-    /// the breakaway and the first measurement the integral held to the back-EMF speed's band.
-    /// Returns whether the current said the shaft broke away. Out of line: only axes with
-    /// current sense pay for it.
-    #[inline(never)]
-    fn sample_current(
-        &mut self,
-        k: &LoopConstants,
-        input: LoopInput,
-        torque_duty: f32,
-        starting: bool,
-        r_abs: f32,
-    ) -> bool {
-        let applied = self.duty * input.direction;
-        let was_released = self.breakaway.released();
-        let emf = if self.emf_duty_per_rad_s > 0.0 {
-            self.emf_duty_per_rad_s
-        } else {
-            k.duty_per_rad_s
-        };
-        let released = self.breakaway.sample(
-            applied,
-            torque_duty,
-            (emf, k.friction_duty),
-            (starting, starting),
-            r_abs,
-        );
-        if released && !was_released && self.push != 0.0 {
-            // The kick did not start it, the push did: load the model does not know holds the
-            // shaft back (material), and half of the push stays in the integral as at the first
-            // edge. Dropped to the feedforward, such shafts crawled until the expected-edge
-            // watch faulted them (4 of 480 plants at 0 -> 0.5 rad/s).
-            self.integral += PUSH_KEPT * self.push * input.direction;
-        }
-        if released && !was_released {
-            self.breakaway_news = true;
-        }
-        if released {
-            // The push has done its work.
-            self.push = 0.0;
-            self.push_sum = 0.0;
-        }
-        if released && input.feedback && !input.measurement_valid && !self.slowing {
-            let step = self.breakaway.fused_integral_step(
-                (self.model_rad_s.abs(), r_abs),
-                k.duty_per_rad_s,
-                k.dt_s,
-            );
-            self.integral = clamp(self.integral + step * input.direction, k.duty_limit);
-        }
-        released
-    }
-
-    /// The back-EMF duty per rad/s the current sense learned at measured speeds
-    /// ([`BackEmfScale`](super::breakaway::BackEmfScale)), for the back-EMF speed of the next
-    /// step; the controller sets it before each step on axes with current sense.
-    pub fn set_back_emf_duty_per_rad_s(&mut self, duty_per_rad_s: f32) {
-        self.emf_duty_per_rad_s = duty_per_rad_s;
-    }
-
-    /// Whether the current showed the breakaway since the last call (once per start).
-    pub fn take_breakaway(&mut self) -> bool {
-        core::mem::replace(&mut self.breakaway_news, false)
-    }
-
-    /// The back-EMF speed the current shows, rad/s in the commanded direction (0 without
-    /// current sense).
-    pub fn back_emf_rad_s(&self) -> f32 {
-        self.breakaway.speed_rad_s()
     }
 
     /// True once the loop has seen the shaft turn under its own motor since it started: an
