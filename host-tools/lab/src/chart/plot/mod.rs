@@ -297,18 +297,16 @@ impl Figure {
             for part in parts {
                 match s.mark {
                     Mark::Line | Mark::LinePoints => {
-                        chart
-                            .draw_series(LineSeries::new(part.clone(), c.stroke_width(2)))
-                            .map_err(be)?;
+                        for path in strokes(part, |p| chart.backend_coord(p)) {
+                            chart
+                                .draw_series(LineSeries::new(path, c.stroke_width(2)))
+                                .map_err(be)?;
+                        }
                     }
                     Mark::Dashed | Mark::DashedPoints => {
+                        let path = strokes(part, |p| chart.backend_coord(p)).concat();
                         chart
-                            .draw_series(DashedLineSeries::new(
-                                part.clone(),
-                                8,
-                                5,
-                                c.stroke_width(2),
-                            ))
+                            .draw_series(DashedLineSeries::new(path, 8, 5, c.stroke_width(2)))
                             .map_err(be)?;
                     }
                     Mark::Points | Mark::Crosses => {}
@@ -404,6 +402,44 @@ impl Figure {
         }
         Ok(())
     }
+}
+
+/// A line's points as the strokes to draw: one point per pixel (a run of samples on one pixel,
+/// 2 250 telemetry frames across 800 pixels, gives zero-length segments), and a new stroke
+/// wherever the line turns back by more than 120 degrees (a speed that steps down and is
+/// corrected up within a pixel column). The bitmap backend joins a wide stroke's segments by
+/// intersecting their edges, and two nearly opposite segments meet far away: a spike to the
+/// plot's edge, seen in the demo's speed charts at a step. Neighbouring strokes share their end
+/// point, so the line stays unbroken.
+fn strokes(part: &[(f64, f64)], pixel: impl Fn(&(f64, f64)) -> (i32, i32)) -> Vec<Vec<(f64, f64)>> {
+    let mut pts: Vec<((f64, f64), (i32, i32))> = Vec::with_capacity(part.len());
+    for p in part {
+        let px = pixel(p);
+        if pts.last().is_some_and(|l| l.1 == px) {
+            continue;
+        }
+        pts.push((*p, px));
+    }
+    let mut out = Vec::new();
+    let mut cur: Vec<(f64, f64)> = Vec::new();
+    for (i, &(p, px)) in pts.iter().enumerate() {
+        cur.push(p);
+        let (Some(prev), Some(next)) = (i.checked_sub(1).map(|k| pts[k].1), pts.get(i + 1)) else {
+            continue;
+        };
+        let a = (f64::from(px.0 - prev.0), f64::from(px.1 - prev.1));
+        let b = (f64::from(next.1.0 - px.0), f64::from(next.1.1 - px.1));
+        let dot = a.0 * b.0 + a.1 * b.1;
+        let norms = (a.0.hypot(a.1) * b.0.hypot(b.1)).max(f64::MIN_POSITIVE);
+        if dot / norms < -0.5 {
+            out.push(std::mem::take(&mut cur));
+            cur.push(p);
+        }
+    }
+    if !cur.is_empty() {
+        out.push(cur);
+    }
+    out
 }
 
 #[cfg(test)]

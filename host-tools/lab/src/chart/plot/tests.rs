@@ -187,3 +187,32 @@ fn empty_figure_is_an_error_not_a_panic() {
     let r = f.write_svg(&dir.join(format!("bowl-empty-{}.svg", std::process::id())));
     assert!(matches!(r, Err(PlotError::NoData)));
 }
+
+/// A line is drawn as strokes with one point per pixel, split where it turns back by more than
+/// 120 degrees (the bitmap backend's wide joins of nearly opposite segments spiked to the plot's
+/// edge: the demo's spin chart at its step down), each stroke ending where the next begins.
+#[test]
+fn a_line_that_turns_back_is_drawn_as_strokes_without_repeated_pixels() {
+    // Pixels: the data's x and y rounded (1 data unit = 1 pixel).
+    let px = |p: &(f64, f64)| (p.0.round() as i32, p.1.round() as i32);
+    let line = [
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (1.2, 0.1), // the same pixel as (1, 0): left out
+        (2.0, 0.0),
+        (3.0, 45.0), // down...
+        (3.0, 35.0), // ...and back up in the same column: a new stroke from (3, 45)
+        (4.0, 35.0),
+    ];
+    let s = super::strokes(&line, px);
+    assert_eq!(
+        s,
+        vec![
+            vec![(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 45.0)],
+            vec![(3.0, 45.0), (3.0, 35.0), (4.0, 35.0)],
+        ]
+    );
+    // A right angle is no reversal: one stroke.
+    let corner = [(0.0, 0.0), (5.0, 0.0), (5.0, 5.0)];
+    assert_eq!(super::strokes(&corner, px).len(), 1);
+}
