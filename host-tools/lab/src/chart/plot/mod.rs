@@ -303,11 +303,14 @@ impl Figure {
                                 .map_err(be)?;
                         }
                     }
+                    // Stroke by stroke as the solid line: joined again, each split point would
+                    // repeat and give the zero-length segment `strokes` removes.
                     Mark::Dashed | Mark::DashedPoints => {
-                        let path = strokes(part, |p| chart.backend_coord(p)).concat();
-                        chart
-                            .draw_series(DashedLineSeries::new(path, 8, 5, c.stroke_width(2)))
-                            .map_err(be)?;
+                        for path in strokes(part, |p| chart.backend_coord(p)) {
+                            chart
+                                .draw_series(DashedLineSeries::new(path, 8, 5, c.stroke_width(2)))
+                                .map_err(be)?;
+                        }
                     }
                     Mark::Points | Mark::Crosses => {}
                 }
