@@ -1,13 +1,12 @@
-//! The words people read: the rig's states, faults and reset causes (`rig_client::words`) and the
-//! controller's refusals (`virtual_rig::controller_words`) are plain words, never Rust names; the
+//! The words people read: the rig's states, faults and reset causes (`model_core::wire::words`)
+//! and the controller's refusals (`virtual_rig::controller_words`) are plain words, never Rust names; the
 //! `key=value` tokens are one lower-case word each, distinct within their kind.
 
 use model_core::control::{ConfigError, Rejection, State as ControllerState};
 use model_core::wire::{DeviceState, FaultCode, ResetCause};
-use rig_client::words::{fault, fault_token, reset_cause, reset_cause_token};
 use virtual_rig::controller_words::{config, rejection};
 
-/// Every fault code the wire defines (read from the enum, so a new one is checked too).
+/// Every fault code the wire defines (read from the codes, so a new one is checked too).
 fn faults() -> Vec<FaultCode> {
     (0..=255).filter_map(FaultCode::from_code).collect()
 }
@@ -27,7 +26,7 @@ fn plain_words_only() {
     };
     assert!(camel("state SpinningUp") && !camel("10 kHz"));
     for f in faults() {
-        assert!(!camel(fault(f)), "{f:?}");
+        assert!(!camel(f.words()), "{f:?}");
     }
     // Every state, as the controller has it and as the wire carries it: one table of words.
     for s in [
@@ -43,7 +42,7 @@ fn plain_words_only() {
     }
     // The key=value tokens: one lower-case word each, distinct within their kind.
     let token = |t: &str| !t.is_empty() && t.chars().all(|c| c.is_ascii_lowercase() || c == '-');
-    let faults: Vec<&str> = faults().into_iter().map(fault_token).collect();
+    let faults: Vec<&str> = faults().into_iter().map(FaultCode::token).collect();
     let states: Vec<&str> = [
         DeviceState::Idle,
         DeviceState::Commissioning,
@@ -65,7 +64,7 @@ fn plain_words_only() {
         ResetCause::Unknown,
     ]
     .into_iter()
-    .map(reset_cause_token)
+    .map(ResetCause::token)
     .collect();
     for kind in [faults, states, causes] {
         assert!(kind.iter().all(|t| token(t)), "{kind:?}");
@@ -74,7 +73,7 @@ fn plain_words_only() {
         unique.dedup();
         assert_eq!(unique.len(), kind.len(), "{kind:?}");
     }
-    assert!(!camel(reset_cause(ResetCause::IndependentWatchdog)));
+    assert!(!camel(ResetCause::IndependentWatchdog.words()));
     use model_core::control::InverseFailure;
     let configs = [
         ConfigError::TickRate,

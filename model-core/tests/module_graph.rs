@@ -36,6 +36,7 @@ const WIRE: &[(&str, &[&str])] = &[
     ("wire", &[]),
     ("crc", &[]),
     ("types", &[]),
+    ("words", &["types"]),
     ("params", &["types"]),
     ("commands", &["params", "types"]),
     ("frame", &["commands", "params", "types"]),

@@ -5,9 +5,9 @@
 //! read), `link` (the port, or the socket of the monitor that holds it), `relay` (the monitor's
 //! side of that socket), `request` (the one request loop: id matching, resends), `rig` (the
 //! typed rig: `Rig::speed`, `Rig::status`, ...), `lines` (command lines built from words and
-//! checked, answers described), `words` (the rig's states and faults in words), `integer`,
-//! `command_words` and `refusal` (a refused command in particulars), `telemetry_csv` (the CSV
-//! log), `decode_stats` (the decoder's counters as JSON).
+//! checked, answers described; the rig's states and faults in words are the types' own,
+//! `model_core::wire::words`), `integer`, `command_words` and `refusal` (a refused command in
+//! particulars), `telemetry_csv` (the CSV log), `decode_stats` (the decoder's counters as JSON).
 
 pub mod command_words;
 pub mod decode_stats;
@@ -20,4 +20,3 @@ pub mod rig;
 pub mod serial;
 pub mod telemetry_csv;
 pub mod unreadable;
-pub mod words;

@@ -3,8 +3,6 @@
 
 use model_core::wire::{Command, Frame, MAX_FRAME_LEN, ParamId, Reason, encode};
 
-use crate::words;
-
 /// Builds the command line `$C1,id,WORD,fields...*CRC\r\n` from the words a person typed,
 /// judged by the command table (`Command::from_words`), so a command the rig would refuse as
 /// malformed or out of range whatever its settings never leaves the PC (a speed below 0: every
@@ -70,15 +68,15 @@ pub fn describe(frame: &Frame) -> String {
         Frame::Status { id, status: s } => format!(
             "status (id {id}): state={} fault={} reset_cause={} reset_count={} uptime_ms={} telemetry_hz={} flags={} ({}; {}; last reset: {}{})",
             s.state.token(),
-            words::fault_token(s.fault),
-            words::reset_cause_token(s.reset_cause),
+            s.fault.token(),
+            s.reset_cause.token(),
             s.reset_count,
             s.uptime_ms,
             s.telemetry_hz,
             s.flags,
             s.state.words(),
-            words::fault(s.fault),
-            words::reset_cause(s.reset_cause),
+            s.fault.words(),
+            s.reset_cause.words(),
             status_flag_words(s.flags)
                 .map(|w| format!("; {w}"))
                 .unwrap_or_default(),

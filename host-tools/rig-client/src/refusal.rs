@@ -18,7 +18,6 @@ use model_core::wire::{Command, CommandKind, Frame, ParamId, ParamValues, Reason
 use crate::lines::command_line;
 use crate::link::Link;
 use crate::request::transact;
-use crate::words;
 
 /// The particulars of a refusal of `words` (the command as typed), asking the rig what it
 /// needs through `link`; `None` when there is nothing to add to the reason's own words.
@@ -113,7 +112,7 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
     let todo = match s.state {
         D::Faulted => format!(
             "{}; clear it first (`bowl send PORT clear`)",
-            words::fault(s.fault)
+            s.fault.words()
         ),
         D::Commissioning => "wait for commissioning to end".to_string(),
         D::Running | D::SpinningUp if command == "commission" => {

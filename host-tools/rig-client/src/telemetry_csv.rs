@@ -70,7 +70,7 @@ pub fn write_row(
         t.time_ms,
         t.seq,
         t.state.token(),
-        crate::words::fault_token(t.fault),
+        t.fault.token(),
         t.precession.set_mrad_s,
         t.precession.measured_mrad_s,
         t.precession.duty_bp,

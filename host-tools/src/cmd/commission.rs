@@ -252,11 +252,7 @@ pub fn run(args: &Args) -> Result<i32> {
         End::Idle => exit_code::OK,
         End::Fault(fault) => {
             report.result = "fault";
-            report.fault = Some(format!(
-                "{} (code {})",
-                rig_client::words::fault(fault),
-                fault.code()
-            ));
+            report.fault = Some(format!("{} (code {})", fault.words(), fault.code()));
             exit_code::REFUSED
         }
         End::OtherState(state) => {

@@ -59,8 +59,8 @@ fn fault_reaction(
     let precession_at_clear = after.last().map(|t| measured(t, 0)).unwrap_or(f64::NAN);
     FaultReaction {
         injected_at_s: seconds(inject.at_ms),
-        fault: detected.map(|t| rig_client::words::fault_token(t.fault).to_string()),
-        fault_text: detected.map(|t| rig_client::words::fault(t.fault).to_string()),
+        fault: detected.map(|t| t.fault.token().to_string()),
+        fault_text: detected.map(|t| t.fault.words().to_string()),
         detection_s: detected.map(since),
         expected_detection_s: expected,
         motors_off_s: off.map(since),

@@ -34,7 +34,7 @@ fn markers(marks: &[Mark], tel: &[Telemetry]) -> Vec<VLine> {
     if let Some(t) = tel.iter().find(|t| t.fault != FaultCode::None) {
         v.push(VLine {
             x: t_s(t),
-            label: format!("fault detected: {}", rig_client::words::fault(t.fault)),
+            label: format!("fault detected: {}", t.fault.words()),
             color: FAULT_COLOUR,
         });
     }

@@ -208,7 +208,7 @@ fn steps(
             s.event(format!(
                 "fault detected at t={:.3} s: {}",
                 f64::from(at) / 1000.0,
-                rig_client::words::fault(fault)
+                fault.words()
             ));
             let already_off = s.latest().is_some_and(motors_off);
             let off = if already_off {

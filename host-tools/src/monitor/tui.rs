@@ -313,7 +313,7 @@ fn fault_line(view: &View, stale: bool) -> (String, Style) {
             format!(
                 " FAULT {}: the rig stopped the motors. {}. Type `:clear` once the cause is fixed",
                 t.fault.code(),
-                rig_client::words::fault(t.fault)
+                t.fault.words()
             ),
             Style::default()
                 .fg(Color::White)

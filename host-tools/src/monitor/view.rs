@@ -167,7 +167,7 @@ impl View {
                     plain,
                     format!(
                         "rig booted: reset cause {}, reset count {}",
-                        rig_client::words::reset_cause(h.reset_cause),
+                        h.reset_cause.words(),
                         h.reset_count
                     ),
                 );
@@ -224,7 +224,7 @@ impl View {
                 f64::from(t.time_ms) / 1000.0,
                 t.seq,
                 t.state.words(),
-                rig_client::words::fault(t.fault),
+                t.fault.words(),
                 f64::from(t.precession.measured_mrad_s) / 1000.0,
                 f64::from(t.precession.set_mrad_s) / 1000.0,
                 f64::from(t.spin.measured_mrad_s) / 1000.0,
@@ -264,7 +264,7 @@ impl View {
                     f64::from(t.time_ms) / 1000.0,
                     t.seq,
                     t.state.words(),
-                    rig_client::words::fault(t.fault)
+                    t.fault.words()
                 );
                 s += "              set rad/s  measured rad/s   duty %   pulses\n";
                 for (name, m) in [("precession w1", t.precession), ("spin       w2", t.spin)] {
@@ -291,7 +291,7 @@ impl View {
         if let Some(h) = self.hello {
             s += &format!(
                 "\nlast boot: reset cause {}, reset count {}\n",
-                rig_client::words::reset_cause(h.reset_cause),
+                h.reset_cause.words(),
                 h.reset_count
             );
         }

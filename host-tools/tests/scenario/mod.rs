@@ -31,7 +31,7 @@ use std::collections::BTreeMap;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use model_core::wire::{Decoder, Frame};
+use model_core::wire::{Decoder, DeviceState, FaultCode, Frame};
 use serde::Deserialize;
 
 /// One scenario file.
@@ -98,10 +98,7 @@ pub type Row = HashMap<String, String>;
 
 /// The state words a scenario may expect: the rig's own tokens (`DeviceState::token`).
 fn states() -> Vec<&'static str> {
-    (0..=5)
-        .filter_map(model_core::wire::DeviceState::from_code)
-        .map(model_core::wire::DeviceState::token)
-        .collect()
+    DeviceState::ALL.iter().map(|s| s.token()).collect()
 }
 
 /// The workspace's `tests/scenarios` folder.
@@ -162,11 +159,9 @@ pub fn load(path: &Path) -> Result<Scenario, String> {
         if let Some(f) = e
             .fault
             .as_deref()
-            .filter(|f| rig_client::words::fault_from_token(f).is_none())
+            .filter(|f| FaultCode::from_token(f).is_none())
         {
-            let words: Vec<&str> = rig_client::words::all_faults()
-                .map(rig_client::words::fault_token)
-                .collect();
+            let words: Vec<&str> = FaultCode::ALL.iter().map(|f| f.token()).collect();
             return bad(format!(
                 "`{}`: unknown fault {f} (one of {words:?})",
                 e.what

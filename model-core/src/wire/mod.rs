@@ -12,6 +12,8 @@
 //! [`MAX_TELEMETRY_LEN`] bytes: 50 frames/s use 48 % of a 115 200 baud link.
 //!
 //! - [`types`]: the plain data (telemetry, status, states, reasons);
+//! - [`words`]: the states, faults and reset causes in words (tokens for scripts, words for a
+//!   person), methods of the types;
 //! - [`params`]: the settable parameters, one table (token, unit, range, default);
 //! - [`commands`]: the commands, one table (token, fields with units and ranges, answer, the
 //!   states that allow it);
@@ -30,6 +32,7 @@ pub mod params;
 pub mod stream;
 pub mod typed;
 pub mod types;
+pub mod words;
 
 pub use commands::{
     Answer, COMMAND_COUNT, Command, CommandKind, Field, FieldKind, FieldProblem, MAX_FIELDS, States,

@@ -27,34 +27,6 @@ pub enum DeviceState {
     Faulted = 5,
 }
 
-impl DeviceState {
-    /// The state as one lower-case word for `key=value` lines, CSV columns and scenario files
-    /// (`bowl send status`, `bowl replay --csv`), which scripts read.
-    pub const fn token(self) -> &'static str {
-        match self {
-            DeviceState::Idle => "idle",
-            DeviceState::Commissioning => "commissioning",
-            DeviceState::SpinningUp => "spinning-up",
-            DeviceState::Running => "running",
-            DeviceState::Stopping => "stopping",
-            DeviceState::Faulted => "faulted",
-        }
-    }
-
-    /// The state in plain words for a person (the monitor, the virtual rig's refusals): the
-    /// same states as [`DeviceState::token`], the fault's consequence said.
-    pub const fn words(self) -> &'static str {
-        match self {
-            DeviceState::Idle => "idle",
-            DeviceState::Commissioning => "commissioning",
-            DeviceState::SpinningUp => "spinning up",
-            DeviceState::Running => "running",
-            DeviceState::Stopping => "stopping",
-            DeviceState::Faulted => "faulted (motors off)",
-        }
-    }
-}
-
 /// Why the rig stopped itself (0 = no fault; the numbers are the controller's fault codes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -363,6 +335,8 @@ macro_rules! code_enum {
                 $(if code == $ty::$variant as i64 { return Some($ty::$variant); })*
                 None
             }
+            /// Every value, in code order (the same list as [`Self::from_code`] reads).
+            pub const ALL: &'static [Self] = &[$($ty::$variant),*];
         }
     };
 }

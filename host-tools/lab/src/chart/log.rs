@@ -9,6 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
+use model_core::wire::FaultCode;
 
 use super::plot::{Figure, Mark, Scale, Series, VLine};
 
@@ -136,9 +137,9 @@ fn figure(rows: &[Row], axis: usize, file: &str, wall_clock: bool) -> Figure {
                 if !fault.eq_ignore_ascii_case(&last_fault) {
                     vlines.push(VLine {
                         x: *t_s,
-                        label: match rig_client::words::fault_from_token(fault) {
+                        label: match FaultCode::from_token(fault) {
                             _ if fault.eq_ignore_ascii_case("none") => "fault cleared".into(),
-                            Some(code) => format!("fault: {}", rig_client::words::fault(code)),
+                            Some(code) => format!("fault: {}", code.words()),
                             None => format!("fault: {fault}"),
                         },
                         color: FAULT_COLOUR,

@@ -72,7 +72,7 @@ impl PortRig {
             bail!(
                 "{port}: the rig is stopped by a fault ({}); check the rig, clear it with \
                  `bowl send {port} clear` and run the plan again",
-                rig_client::words::fault(status.fault)
+                status.fault.words()
             );
         }
         Ok(rig)
@@ -119,7 +119,7 @@ impl PortRig {
     fn fault(&mut self) -> Result<Option<String>> {
         match self.latest {
             Some(t) if t.state == DeviceState::Faulted => {
-                let words = rig_client::words::fault(t.fault).to_string();
+                let words = t.fault.words().to_string();
                 self.command(Rig::clear)?;
                 self.latest = None;
                 Ok(Some(words))

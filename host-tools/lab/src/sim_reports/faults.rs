@@ -4,7 +4,6 @@
 use model_core::control::Fault;
 use model_core::sim::ClosedLoop;
 use model_core::wire::FaultCode;
-use rig_client::words;
 use rig_file::Rig;
 use serde::Serialize;
 use std::f64::consts::TAU;
@@ -287,6 +286,6 @@ fn inject(mut cl: ClosedLoop, what: Injected, axis: usize, bound_s: f64) -> Faul
 fn fault_words(f: Fault) -> String {
     FaultCode::from_code(f.code().into()).map_or_else(
         || format!("fault code {}", f.code()),
-        |c| words::fault(c).to_string(),
+        |c| c.words().to_string(),
     )
 }

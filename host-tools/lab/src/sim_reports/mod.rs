@@ -5,6 +5,7 @@
 
 use model_core::control::{Controller, ControllerConfig, State};
 use model_core::sim::{ClosedLoop, Plant};
+use model_core::wire::FaultCode;
 use rig_file::Rig;
 
 mod faults;
@@ -47,8 +48,8 @@ pub fn commissioned(rig: &Rig, cfg: ControllerConfig) -> Result<ClosedLoop, Stri
             None => match cl.ctrl.fault() {
                 Some(f) => format!(
                     "{} during identification",
-                    model_core::wire::FaultCode::from_code(i64::from(f.code()))
-                        .map_or("an unknown fault", rig_client::words::fault)
+                    FaultCode::from_code(i64::from(f.code()))
+                        .map_or("an unknown fault", FaultCode::words)
                 ),
                 None => "did not finish".to_string(),
             },

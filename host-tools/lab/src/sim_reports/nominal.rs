@@ -387,8 +387,7 @@ pub fn trace(
                 s.axes[1].duty,
                 DeviceState::from(s.state).token(),
                 // The same words as `bowl send status` and `bowl replay --csv`.
-                FaultCode::from_code(i64::from(s.fault_code))
-                    .map_or("unknown", rig_client::words::fault_token)
+                FaultCode::from_code(i64::from(s.fault_code)).map_or("unknown", FaultCode::token)
             );
         }
     });

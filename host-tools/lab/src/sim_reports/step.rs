@@ -273,7 +273,7 @@ fn step(mut cl: ClosedLoop, from: f32, target: f32) -> StepRun {
         cl.ctrl
             .fault()
             .and_then(|f| FaultCode::from_code(i64::from(f.code())))
-            .map(rig_client::words::fault_token),
+            .map(FaultCode::token),
         fault_at,
     )
 }
