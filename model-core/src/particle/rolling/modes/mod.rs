@@ -1,0 +1,300 @@
+//! The granule that rolls or slides on the flat bottom of the tilted, precessing bowl
+//! (docs/model.md §10): it rolls ([`super::equations`], rolling resistance as there) while the
+//! friction rolling needs stays within `mu_s N`, and slides ([`super::slide`], Coulomb friction
+//! `mu_s N` against the slip, the spin driven by its torque) otherwise. Each change of mode is an
+//! event of the project's integrators ([`crate::ode::system`]), located on the step's
+//! interpolant like the rim, and the run restarts from there in the other mode, so no step
+//! straddles a kink of the right-hand side:
+//!
+//! * roll -> slide where `|f_t| - mu_s N` reaches zero from below; the slip then starts
+//!   against `f_t` (a friction short of `f_t` by `df` gives `dv_c/dt = -df / (m (1 - k2))`);
+//! * slide -> roll where the slip reaches zero (its component along its last direction turns
+//!   negative), if rolling then needs no more than `mu_s N`; otherwise the granule keeps sliding
+//!   against the friction rolling would need;
+//! * the rim (the centre's contact point at radius `R`) and lift-off (`N` reaching zero) in
+//!   either mode.
+//!
+//! The run of modes on the bottom is here; what it gives and costs is `report.rs`, the parts the
+//! wall's run (`bowl::wall_run`) shares with it are `segments.rs` (one segment between events)
+//! and `slip.rs` (a slide's slip: its direction, its end, its error), and the watch that gives up
+//! on a stalled run is `stall.rs`.
+
+mod report;
+mod segments;
+mod slip;
+mod stall;
+
+use core::cell::Cell;
+
+pub use report::{Mode, ModesOutcome, ModesReport, Regime, Tally};
+pub(crate) use segments::{fired, max3, scene_scales, segment};
+pub(crate) use slip::{SlipOf, follow_slip, stuck_m_s};
+pub use stall::STALL_STEP;
+pub(crate) use stall::StallWatch;
+
+use super::equations::{AT_REST_M_S, forces};
+use super::slide::{
+    SlideState, from_rolling, needed_friction_m_s2, slide_forces, slip_m_s, to_rolling,
+};
+use super::{RollingError, RollingMethod, RollingScene, SystemLimits, default_limits, release};
+use crate::Real;
+use crate::ode::system::SystemError;
+
+/// The most changes of mode one release may take: a granule at the stick-slip threshold can
+/// switch at every step; beyond this it is reported as a step limit, not followed forever.
+pub const MAX_SWITCHES: u32 = 100_000;
+
+/// One release at azimuth `beta_rad` (as [`super::residence`]: at rest in the bowl at `ri`,
+/// `(x, y) = ri (-cos beta, -sin beta)`), rolling or sliding, within [`super::HORIZON_S`] and
+/// [`super::MAX_STEPS`].
+pub fn residence_roll_or_slide<T: Real>(
+    scene: &RollingScene<T>,
+    beta_rad: T,
+    method: RollingMethod<T>,
+) -> Result<ModesReport<T>, RollingError> {
+    roll_or_slide_within(scene, beta_rad, method, default_limits())
+}
+
+/// [`residence_roll_or_slide`] within the caller's horizon and step cap.
+pub fn roll_or_slide_within<T: Real>(
+    scene: &RollingScene<T>,
+    beta_rad: T,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+) -> Result<ModesReport<T>, RollingError> {
+    roll_or_slide_watching(scene, beta_rad, method, limits, None)
+}
+
+/// [`roll_or_slide_within`] that gives up ([`SystemError::Stalled`]) once the run stalls
+/// (`stall_steps`: see [`StallWatch`]; `None`: never).
+pub(crate) fn roll_or_slide_watching<T: Real>(
+    scene: &RollingScene<T>,
+    beta_rad: T,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+    stall_steps: Option<u32>,
+) -> Result<ModesReport<T>, RollingError> {
+    let y0 = release(scene, beta_rad)?;
+    let start = forces(scene, T::ZERO, &y0);
+    let (ft, normal) = needed_friction_m_s2(scene, T::ZERO, &from_rolling(&y0));
+    let fits = (ft[0] * ft[0] + ft[1] * ft[1]).sqrt() <= scene.sliding_friction * normal;
+    if start.held && fits && scene.stationary() {
+        return Ok(ModesReport {
+            outcome: ModesOutcome::Held,
+            tally: Tally {
+                evaluations: 1,
+                ..Tally::new()
+            },
+            end_state: from_rolling(&y0),
+        });
+    }
+    run_from(
+        scene,
+        T::ZERO,
+        from_rolling(&y0),
+        method,
+        limits,
+        stall_steps,
+    )
+}
+
+/// Which mode a state at `t` is in, and for a slide the direction its slip takes.
+enum Next<T> {
+    Roll([T; 5]),
+    Slide(SlideState<T>, [T; 2]),
+    LiftsOff,
+}
+
+/// `must_slide`: the roll -> slide event just fired, located where rolling needs `mu_s N` to
+/// the location's accuracy; judging again there could find it a hair below and roll on from
+/// the same instant, one step at a time.
+fn next_mode<T: Real>(
+    scene: &RollingScene<T>,
+    t: T,
+    y: &SlideState<T>,
+    must_slide: bool,
+) -> Next<T> {
+    let slip = slip_m_s(y);
+    let speed = (slip[0] * slip[0] + slip[1] * slip[1]).sqrt();
+    if speed > T::from_f64(AT_REST_M_S) {
+        return Next::Slide(*y, [slip[0] / speed, slip[1] / speed]);
+    }
+    let rolling = to_rolling(y);
+    let no_slip = from_rolling(&rolling);
+    let (ft, normal) = needed_friction_m_s2(scene, t, &no_slip);
+    if normal <= T::ZERO {
+        return Next::LiftsOff;
+    }
+    let need = (ft[0] * ft[0] + ft[1] * ft[1]).sqrt();
+    let fits = need <= scene.sliding_friction * normal;
+    if (fits && !must_slide) || need <= T::ZERO {
+        return Next::Roll(rolling);
+    }
+    // Rolling needs more than the contact gives: the slip starts against that friction.
+    Next::Slide(no_slip, [-ft[0] / need, -ft[1] / need])
+}
+
+/// The rolling state's roll -> slide, rim and lift-off events, each made dimensionless and
+/// negative inside: the run stops where the first of them reaches zero.
+fn roll_events<T: Real>(scene: &RollingScene<T>, t: T, y: &[T; 5], reference: T) -> [T; 3] {
+    let (ft, normal) = needed_friction_m_s2(scene, t, &from_rolling(y));
+    let rim = scene.rim_radius_m;
+    [
+        (y[0] * y[0] + y[1] * y[1]) / (rim * rim) - T::ONE,
+        ((ft[0] * ft[0] + ft[1] * ft[1]).sqrt() - scene.sliding_friction * normal) / reference,
+        -normal / reference,
+    ]
+}
+
+/// The sliding state's rim, slip-end and lift-off events (as [`roll_events`]). The slip ends
+/// where it turns against its last direction (it passes through zero in a step) or, once it
+/// has been above twice [`slip::STUCK`] roundings (`armed`), where it falls below that: a slip
+/// that shrinks while its direction turns (the needed friction near `mu_s N`) makes the
+/// equations stiff as it vanishes (the direction turns at a rate `|f| / |v_c|`), so the steps
+/// shrink with it and it would never be reached by steps alone.
+fn slide_events<T: Real>(
+    scene: &RollingScene<T>,
+    t: T,
+    y: &SlideState<T>,
+    dir: [T; 2],
+    armed: bool,
+    refs: (T, T),
+) -> [T; 3] {
+    let (reference, speed_ref) = refs;
+    let f = slide_forces(scene, t, y, dir);
+    let rim = scene.rim_radius_m;
+    let slip = f.slip_m_s;
+    let reversed = -(slip[0] * dir[0] + slip[1] * dir[1]);
+    let stuck = if armed {
+        let speed = (slip[0] * slip[0] + slip[1] * slip[1]).sqrt();
+        reversed.max(stuck_m_s(speed_ref) - speed)
+    } else {
+        reversed
+    };
+    [
+        (y[0] * y[0] + y[1] * y[1]) / (rim * rim) - T::ONE,
+        stuck / speed_ref,
+        -f.normal_m_s2 / reference,
+    ]
+}
+
+/// The run from a state at `t0` in the sliding form (a rolling state has no slip), whatever
+/// its mode; the modes and their events as the module says; a stalled segment gives up
+/// (`stall_steps`: see [`StallWatch`]).
+pub(crate) fn run_from<T: Real>(
+    scene: &RollingScene<T>,
+    t0: T,
+    y0: SlideState<T>,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+    stall_steps: Option<u32>,
+) -> Result<ModesReport<T>, RollingError> {
+    let (refs, scales) = scene_scales(scene);
+    let reference = refs.0;
+    let mut report = ModesReport {
+        outcome: ModesOutcome::Inside {
+            horizon_s: limits.horizon_s,
+        },
+        tally: Tally::new(),
+        end_state: y0,
+    };
+    let (mut t, mut y) = (t0, y0);
+    let mut previous: Option<Mode> = None;
+    let mut must_slide = false;
+    // One watch over the whole run: a stall can be one segment's steps or a run of segments
+    // that each end where they start.
+    let watch = StallWatch::new(stall_steps, scales, t0);
+    loop {
+        let remaining = report.tally.remaining(limits, MAX_SWITCHES)?;
+        let (ended, which) = match next_mode(scene, t, &y, must_slide) {
+            Next::LiftsOff => {
+                report.outcome = ModesOutcome::LiftsOff { time_s: t };
+                report.end_state = y;
+                return Ok(report);
+            }
+            Next::Roll(yr) => {
+                report.tally.enter(&mut previous, Mode::Roll);
+                let Some((te, ye)) = segment(
+                    &mut report.tally,
+                    Mode::Roll,
+                    |t, y: &[T; 5]| forces(scene, t, y).derivative,
+                    (t, yr),
+                    method,
+                    scales,
+                    |t, y: &[T; 5]| max3(roll_events(scene, t, y, reference)),
+                    |t, _| watch.step(t),
+                    None,
+                    remaining,
+                )?
+                else {
+                    return Ok(report);
+                };
+                let which = fired(&roll_events(scene, te, &ye, reference));
+                ((te, from_rolling(&ye), ye[2], ye[3]), which)
+            }
+            Next::Slide(ys, dir0) => {
+                report.tally.enter(&mut previous, Mode::Slide);
+                let dir = Cell::new(dir0);
+                let slip0 = slip_m_s(&ys);
+                let stuck = stuck_m_s(refs.1);
+                let armed = Cell::new(
+                    slip0[0] * slip0[0] + slip0[1] * slip0[1] > T::from_f64(4.0) * stuck * stuck,
+                );
+                let Some((te, ye)) = segment(
+                    &mut report.tally,
+                    Mode::Slide,
+                    |t, y: &SlideState<T>| slide_forces(scene, t, y, dir.get()).derivative,
+                    (t, ys),
+                    method,
+                    scales,
+                    |t, y: &SlideState<T>| {
+                        max3(slide_events(scene, t, y, dir.get(), armed.get(), refs))
+                    },
+                    |t, y: &SlideState<T>| {
+                        follow_slip(&slip_m_s(y), &dir, &armed, stuck);
+                        watch.step(t)
+                    },
+                    Some(SlipOf::Linear(slip_m_s::<T>)),
+                    remaining,
+                )?
+                else {
+                    return Ok(report);
+                };
+                let events = slide_events(scene, te, &ye, dir.get(), armed.get(), refs);
+                let mut ye = ye;
+                if fired(&events) == 1 {
+                    // The slip is zero here to the location's accuracy: make it
+                    // exactly so (rolling), keeping the translation.
+                    ye[4] = -ye[3];
+                    ye[5] = ye[2];
+                }
+                ((te, ye, ye[2], ye[3]), fired(&events))
+            }
+        };
+        let (te, ye, ux, uy) = ended;
+        if watch.step(te).is_break() {
+            return Err(RollingError::Integration(SystemError::Stalled));
+        }
+        if which != 1 {
+            report.end_state = ye;
+        }
+        match which {
+            0 => {
+                report.outcome = ModesOutcome::Leaves {
+                    residence_time_s: te - t0,
+                    exit_speed_m_s: (ux * ux + uy * uy).sqrt(),
+                };
+                return Ok(report);
+            }
+            2 => {
+                report.outcome = ModesOutcome::LiftsOff { time_s: te };
+                return Ok(report);
+            }
+            _ => {
+                must_slide = previous == Some(Mode::Roll);
+                t = te;
+                y = ye;
+            }
+        }
+    }
+}

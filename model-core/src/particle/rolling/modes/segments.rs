@@ -1,0 +1,101 @@
+//! One segment of a run between changes of mode, shared by the bottom's run and the wall's
+//! (`bowl::wall_run`): integrated by the project's integrators ([`crate::ode::system`]) until
+//! its first event, with the scene's scales for the tolerances and the events, and which of the
+//! events fired.
+
+use core::ops::ControlFlow;
+
+use super::report::{Mode, Tally};
+use super::slip::{SlipOf, slip_error};
+use crate::Real;
+use crate::ode::system::{self, Ended, SystemError};
+use crate::particle::rolling::{RollingError, RollingMethod, RollingScene, SystemLimits};
+
+pub(crate) fn max3<T: Real>(v: [T; 3]) -> T {
+    v[0].max(v[1]).max(v[2])
+}
+
+/// The event of the three that fired: the one closest to zero from below (the others are
+/// still negative where the first reaches zero).
+pub(crate) fn fired<T: Real>(v: &[T]) -> usize {
+    let mut best = 0;
+    for i in 1..v.len() {
+        if v[i] > v[best] {
+            best = i;
+        }
+    }
+    best
+}
+
+/// Scales of a scene: `refs`, the acceleration and speed that make the events dimensionless,
+/// and `scales`, the length and speed of the integrator's tolerances (see [`segment`]).
+pub(crate) fn scene_scales<T: Real>(scene: &RollingScene<T>) -> ((T, T), (T, T)) {
+    let rim = scene.rim_radius_m;
+    let spin = scene.combined_speed_rad_s();
+    let w1l = scene.precession_rad_s * scene.precession_rad_s * scene.rod_length_m;
+    // Scales that make the events dimensionless: accelerations and speeds of the scene.
+    let reference = scene.g_m_s2 + spin * spin * rim + w1l + T::ONE;
+    let refs = (reference, (reference * rim).sqrt());
+    (refs, (rim, rim * spin.max(T::ONE)))
+}
+
+/// Integrates one segment in `mode` from `(t0, y0)` with the method, stopping at the first
+/// event, and adds its cost and its time to `tally`: the event's time and state, or `None` at
+/// the horizon. `slip`: a slide's slip, held to [`slip_error`]'s tolerance besides the
+/// components' (`None` where the contact does not slip).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn segment<T: Real, const N: usize>(
+    tally: &mut Tally<T>,
+    mode: Mode,
+    rhs: impl FnMut(T, &[T; N]) -> [T; N],
+    (t0, y0): (T, [T; N]),
+    method: RollingMethod<T>,
+    scales: (T, T),
+    event: impl Fn(T, &[T; N]) -> T,
+    check: impl FnMut(T, &[T; N]) -> ControlFlow<()>,
+    slip: Option<SlipOf<'_, T, N>>,
+    limits: SystemLimits<T>,
+) -> Result<Option<(T, [T; N])>, RollingError> {
+    let (length, speed) = scales;
+    let event = system::timed(event);
+    let run = match method {
+        RollingMethod::Dp54 { rtol } => {
+            // Lengths, velocities and spins at their own scales (as the rolling model's runs).
+            let atol: [T; N] =
+                core::array::from_fn(|i| if i < 2 { rtol * length } else { rtol * speed });
+            let h0 = T::from_f64(1e-3) * length / speed;
+            let slip_error = |e: &[T; N], y: &[T; N], y1: &[T; N]| {
+                slip.map_or(T::ZERO, |slip| slip_error(slip, rtol, (e, y, y1)))
+            };
+            system::dp54_with(
+                rhs,
+                t0,
+                y0,
+                (rtol, atol),
+                h0,
+                &event,
+                check,
+                slip_error,
+                limits,
+            )
+        }
+        RollingMethod::Rk4 { step_s } => {
+            system::rk4_with(rhs, t0, y0, step_s, &event, check, limits)
+        }
+    }
+    .map_err(RollingError::Integration)?;
+    tally.evaluations = tally.evaluations.saturating_add(run.evaluations);
+    tally.steps = tally.steps.saturating_add(run.steps);
+    match run.ended {
+        Ended::Event { t, y } => {
+            tally.spend(mode, t - t0);
+            Ok(Some((t, y)))
+        }
+        Ended::Horizon { .. } => {
+            tally.spend(mode, limits.horizon_s - t0);
+            Ok(None)
+        }
+        // The check gave up on the run (a stall: [`StallWatch`]).
+        Ended::Stopped { .. } => Err(RollingError::Integration(SystemError::Stalled)),
+    }
+}

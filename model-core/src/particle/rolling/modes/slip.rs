@@ -1,0 +1,104 @@
+//! A slide's slip, shared by the bottom's run and the wall's (`bowl::wall_run`): where the slip
+//! counts as ended ([`stuck_m_s`]), how the friction's direction follows it ([`follow_slip`]),
+//! and the tolerance its error is held to ([`slip_error`]): near zero the slide's right-hand
+//! side is stiff, and the components' own tolerances say nothing of the slip's direction.
+
+use core::cell::Cell;
+
+use crate::Real;
+use crate::particle::rolling::equations::AT_REST_M_S;
+
+/// The slip below which a slide has ended, in units of the scene's speed: a few roundings of
+/// it, so that the end is located as exactly as the slip's zero itself (a slip that falls
+/// linearly at `mu_s g / (1 - k2)` reaches this 1e-16 s before its zero).
+pub(super) const STUCK: f64 = 64.0;
+
+pub(crate) fn stuck_m_s<T: Real>(speed_ref: T) -> T {
+    T::from_f64(STUCK) * T::EPSILON * speed_ref
+}
+
+fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
+    a.iter().zip(b).fold(T::ZERO, |acc, (x, y)| acc + *x * *y)
+}
+
+/// After an accepted step of a slide with the slip `s` (`stuck`: [`stuck_m_s`]): arms the
+/// slip-end event once the slip has been above twice `stuck`, and turns the friction's
+/// direction `dir` to the slip's for the next step while it still goes along `dir` (the
+/// friction opposes it).
+pub(crate) fn follow_slip<T: Real, const N: usize>(
+    s: &[T; N],
+    dir: &Cell<[T; N]>,
+    armed: &Cell<bool>,
+    stuck: T,
+) {
+    let d = dir.get();
+    let speed = dot(s, s).sqrt();
+    if speed > T::TWO * stuck {
+        armed.set(true);
+    }
+    if speed > T::from_f64(AT_REST_M_S) && dot(s, &d) > T::ZERO {
+        dir.set(core::array::from_fn(|i| s[i] / speed));
+    }
+}
+
+/// The slip of a state (m/s): on the bottom linear in it (`Linear`: the slip of a step's error
+/// estimate is the slip's error), on the wall not (`OfState`: its velocity and the spin's part
+/// `s x n` depend on where on the meridian it is; the slip's error is then the difference of the
+/// slips of the step's two solutions, the 5th- and the embedded 4th-order one).
+#[derive(Clone, Copy)]
+pub(crate) enum SlipOf<'a, T, const N: usize> {
+    /// Linear in the state.
+    Linear(fn(&[T; N]) -> [T; 2]),
+    /// Any function of the state.
+    OfState(&'a dyn Fn(&[T; N]) -> [T; 3]),
+}
+
+/// The slip's error in a step of a slide in which it grows, against [`SLIP_RTOL`] times `rtol`
+/// of the slip itself (`e`: the step's error estimate, `y` and `y1` its start and end). The
+/// friction acts against the slip's direction, which turns at `|A_perp| / |v_c|` (the free
+/// slip's acceleration across it over the slip): the slide's right-hand side is stiff while the
+/// slip is small. The components' own tolerances (`rtol` of the scene's speed) say nothing of
+/// that direction while the slip is below them, and a loose step can leave it off by tens of
+/// degrees, the stiff relaxation then holding the step at its stability limit and the slip at
+/// about that step's friction impulse, neither growing: a slide from rest at 45 deg, 3.6 rad/s,
+/// mu_s 0.2 (release at 180 deg) took 2 709 steps at rtol 1e-6, 23 110 at 1e-7, more than
+/// 200 000 at 1e-8, and 493 at 1e-10. On the wall the same direction error turns the slip
+/// against the friction within a step or two, which ends the slide as a stick: a granule at the
+/// stick threshold in the wall's corner then changed mode every few microseconds and failed
+/// (docs/model.md §12).
+pub(super) fn slip_error<T: Real, const N: usize>(
+    slip: SlipOf<'_, T, N>,
+    rtol: T,
+    (e, y, y1): (&[T; N], &[T; N], &[T; N]),
+) -> T {
+    let norm = |v: [T; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let (before, after, error) = match slip {
+        SlipOf::Linear(f) => {
+            let flat = |v: [T; 2]| [v[0], v[1], T::ZERO];
+            (flat(f(y)), flat(f(y1)), flat(f(e)))
+        }
+        SlipOf::OfState(f) => {
+            let end = f(y1);
+            let lower: [T; N] = core::array::from_fn(|i| y1[i] - e[i]);
+            let other = f(&lower);
+            (f(y), end, core::array::from_fn(|i| end[i] - other[i]))
+        }
+    };
+    let (before, after) = (norm(before), norm(after));
+    if after <= before {
+        // A shrinking slip is left to the components' tolerances: held to its own, the steps
+        // would shrink with it while its direction turns on the way to sticking, where the
+        // slip-end event (its reversal within a step) finds the stick at any step.
+        return T::ZERO;
+    }
+    norm(error) / (T::from_f64(SLIP_RTOL) * rtol * after + T::from_f64(SLIP_ATOL_M_S))
+}
+
+/// The slip's relative tolerance as a multiple of the run's `rtol`: its direction to 1e-4 rad at
+/// rtol 1e-6 (1 and 10 gave the same fix at up to twice the steps elsewhere, docs/model.md §12).
+pub(crate) const SLIP_RTOL: f64 = 100.0;
+
+/// A slip error below this is always accepted, m/s: below [`AT_REST_M_S`], where the friction's
+/// direction stops following the slip, and far above the rounding of the slip's components
+/// (about 1e-16 of the scene's speed), so a slip at rest asks for no step it cannot take.
+pub(crate) const SLIP_ATOL_M_S: f64 = 1e-9;
