@@ -2,6 +2,7 @@
 //! grid lives in `model-core/tests/`.
 
 use super::*;
+use crate::Real;
 use proptest::prelude::*;
 
 /// Uniform numbers in [0, 1) from a 64-bit LCG seeded with `seed`: reproducible random
