@@ -168,7 +168,7 @@ impl Controller {
             cfg,
             dt_s,
             axes: [
-                AxisState::new(&cfg, &a0, dt_s),
+                AxisState::new(&cfg, &a0, dt_s).about_the_vertical(),
                 AxisState::new(&cfg, &a1, dt_s),
             ],
             planner: SetpointPlanner::REST,

@@ -5,6 +5,7 @@
 use super::Controller;
 use crate::control::commission::{IdentifyError, Phase};
 use crate::control::supervisor::{Fault, State, WATCH_PITCHES};
+use crate::control::teeth::WARM_UP_REVS;
 
 impl Controller {
     /// The tick while commissioning: the estimators also feed the identification routine.
@@ -12,9 +13,9 @@ impl Controller {
     pub(super) fn tick_commissioning(&mut self, now_ticks: u32, edges: [&[u32]; 2]) -> [f32; 2] {
         let dt = self.dt_s;
         let mut seen = [false; 2];
-        let comm_axis = match &self.commissioning {
-            Some(c) => c.progress().0,
-            None => 2,
+        let (comm_axis, wheels) = match &self.commissioning {
+            Some(c) => (c.progress().0, c.wheels_steady()),
+            None => (2, false),
         };
         for i in 0..2 {
             let a = &mut self.axes[i];
@@ -25,7 +26,7 @@ impl Controller {
                 None
             };
             let seen_i = &mut seen[i];
-            let speed = a.est.tick(now_ticks, edges[i], false, |at, pulses| {
+            let speed = a.est.tick(now_ticks, edges[i], wheels, |at, pulses| {
                 *seen_i = true;
                 if let Some(c) = comm.as_deref_mut() {
                     c.on_edge(at, pulses, rad_per_pulse);
@@ -53,10 +54,17 @@ impl Controller {
         let a = &mut self.axes[axis];
         a.load.commission_tick(&a.est, a.duty, c.steady_step());
         let clock = self.axes[axis].est.clock_ticks();
+        // A wheel is learned once its map is in use (its warm-up learned); a wheel the map
+        // does not count is not waited for.
+        let learned = |a: &super::axis::AxisState| {
+            let t = a.est.teeth();
+            t.teeth() < 3 || t.revolutions_learned() >= WARM_UP_REVS
+        };
         match c.step(
             dt,
             clock,
             self.axes[0].est.is_stopped() && self.axes[1].est.is_stopped(),
+            learned(&self.axes[0]) && learned(&self.axes[1]),
         ) {
             Err(e) => {
                 self.identify_error = Some(e);

@@ -109,6 +109,11 @@ impl PulseSpeedEstimator {
     pub fn forget_teeth(&mut self) {
         self.teeth.forget();
     }
+    /// The wheel turns about the vertical ([`ToothMap::about_the_vertical`]).
+    pub const fn about_the_vertical(mut self) -> Self {
+        self.teeth = self.teeth.about_the_vertical();
+        self
+    }
     /// Revolutions of tooth offsets learned since the last [`Self::forget_teeth`].
     pub fn teeth_revolutions_learned(&self) -> u16 {
         self.teeth.revolutions_learned()
