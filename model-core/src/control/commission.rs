@@ -409,8 +409,7 @@ impl Commissioning {
                     // Both shafts steady at their high duties: held on until both wheels are
                     // learned (or the hold's limit), so the first start reads its teeth.
                     if self.fit_done
-                        && (wheels_learned
-                            || t_s >= self.reaction_fit_from_s + WHEEL_HOLD_MAX_S)
+                        && (wheels_learned || t_s >= self.reaction_fit_from_s + WHEEL_HOLD_MAX_S)
                     {
                         self.reaction_done_s = Some(t_s);
                     }

@@ -47,7 +47,7 @@ const SLIP_MISFIT_RATIO: f32 = 1.5;
 const MISFIT_FLOOR: f32 = 1e-6;
 
 /// Revolutions learned before the fractions are used, and before a bad fit can reset them.
-pub const WARM_UP_REVS: u16 = 2;
+const WARM_UP_REVS: u16 = 2;
 
 /// Learned gap lengths of one wheel.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -151,9 +151,16 @@ impl ToothMap {
     /// puts no once-per-revolution torque on it, so the whole pattern, its first harmonic
     /// too, is the wheel's and is taken out (left in, the loop chases it and the rod's
     /// true speed ripples once per revolution, +/-2.5 % at 1 rad/s on family-60).
-    pub const fn about_the_vertical(mut self) -> Self {
+    pub const fn about_the_vertical(&mut self) {
         self.keeps_first_harmonic = false;
-        self
+    }
+
+    /// The map is learned: in use (its warm-up revolutions learned) and averaged over one
+    /// revolution more (the first revolution counts whole, with its edge jitter: up to 1 ms,
+    /// 1 % of a gap at 5 rad/s on 12 teeth), or it counts no wheel (too few teeth for the
+    /// first harmonic, or too many to learn) and never will be.
+    pub fn learned(&self) -> bool {
+        self.teeth < 3 || self.revs_learned > WARM_UP_REVS
     }
 
     /// Forgets what was learned (the wheel turns the other way, or the count may have slipped).

@@ -72,12 +72,6 @@ impl AxisState {
         }
     }
 
-    /// The precession's axis: its shaft turns about the vertical (teeth.rs).
-    pub(super) const fn about_the_vertical(mut self) -> Self {
-        self.est = self.est.about_the_vertical();
-        self
-    }
-
     /// Loop and sensor watch back to rest (a fresh start).
     pub(super) const fn rest_loop(&mut self) {
         self.speed_loop = SpeedLoop::REST;

@@ -5,7 +5,6 @@
 use super::Controller;
 use crate::control::commission::{IdentifyError, Phase};
 use crate::control::supervisor::{Fault, State, WATCH_PITCHES};
-use crate::control::teeth::WARM_UP_REVS;
 
 impl Controller {
     /// The tick while commissioning: the estimators also feed the identification routine.
@@ -26,7 +25,8 @@ impl Controller {
                 None
             };
             let seen_i = &mut seen[i];
-            let speed = a.est.tick(now_ticks, edges[i], wheels, |at, pulses| {
+            a.est.learn_teeth(wheels);
+            let speed = a.est.tick(now_ticks, edges[i], false, |at, pulses| {
                 *seen_i = true;
                 if let Some(c) = comm.as_deref_mut() {
                     c.on_edge(at, pulses, rad_per_pulse);
@@ -54,17 +54,11 @@ impl Controller {
         let a = &mut self.axes[axis];
         a.load.commission_tick(&a.est, a.duty, c.steady_step());
         let clock = self.axes[axis].est.clock_ticks();
-        // A wheel is learned once its map is in use (its warm-up learned); a wheel the map
-        // does not count is not waited for.
-        let learned = |a: &super::axis::AxisState| {
-            let t = a.est.teeth();
-            t.teeth() < 3 || t.revolutions_learned() >= WARM_UP_REVS
-        };
         match c.step(
             dt,
             clock,
             self.axes[0].est.is_stopped() && self.axes[1].est.is_stopped(),
-            learned(&self.axes[0]) && learned(&self.axes[1]),
+            self.axes[0].est.teeth().learned() && self.axes[1].est.teeth().learned(),
         ) {
             Err(e) => {
                 self.identify_error = Some(e);
