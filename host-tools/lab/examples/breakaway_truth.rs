@@ -35,6 +35,7 @@ fn main() {
          friction_duty,true_friction_duty,time_constant_s,true_time_constant_s"
     );
     let mut ratios: [[Vec<f32>; RATIOS.len()]; 2] = Default::default();
+    let mut took_s = Vec::new();
     for rig in &rigs {
         let cfg = config_for(rig);
         let configured_v = cfg.supply_v;
@@ -42,6 +43,7 @@ fn main() {
             println!("{},refused", rig.name);
             continue;
         };
+        took_s.push(cl.rig.time_s());
         let supply_v = rig.params.supply_v;
         for (i, id) in cl.ctrl.identified().iter().enumerate() {
             let Some(id) = id else { continue };
@@ -90,5 +92,13 @@ fn main() {
                 r.len()
             );
         }
+    }
+    took_s.sort_by(f64::total_cmp);
+    if let (Some(lo), Some(hi)) = (took_s.first(), took_s.last()) {
+        eprintln!(
+            "commissioning took {lo:.1}-{hi:.1} s (median {:.1} s) over {} plants",
+            took_s[took_s.len() / 2],
+            took_s.len()
+        );
     }
 }

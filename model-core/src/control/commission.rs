@@ -57,6 +57,9 @@ pub const BREAKAWAY_START_DUTY: f32 = 0.05;
 pub const BREAKAWAY_MAX_DUTY: f32 = 0.9;
 /// The spin's duty ramp while the reaction is measured, s.
 pub const REACTION_RAMP_S: f32 = 2.0;
+/// Longest hold at both high duties after the reaction's fit starts, waiting for the tooth
+/// maps (a wheel too slow or too fine to learn does not hold commissioning up longer), s.
+pub const WHEEL_HOLD_MAX_S: f32 = 10.0;
 /// Largest duty of the high step.
 const TOP_DUTY: f32 = 0.95;
 
@@ -207,6 +210,8 @@ pub struct Commissioning {
     /// holds on, its fit unchanged, until the load pattern has its revolution; the spin only).
     steady_pulses: u32,
     fit_done: bool,
+    /// See [`Commissioning::wheels_steady`].
+    wheels_steady: bool,
 }
 
 impl Commissioning {
@@ -245,12 +250,21 @@ impl Commissioning {
             steady_step: 0,
             steady_pulses: 0,
             fit_done: false,
+            wheels_steady: false,
         }
     }
 
     /// The step (1 low, 2 high) whose duty has been held for half the step time, else 0.
     pub fn steady_step(&self) -> u8 {
         self.steady_step
+    }
+
+    /// Both shafts run steady at their high duties (the reaction's settled part and the hold
+    /// after it): the tooth maps learn the wheels (teeth.rs) here, so that the first start
+    /// after commissioning already reads each gap at its length; before this the map needs
+    /// about three revolutions of a start's steady speed (6.3 s each at 1 rad/s).
+    pub fn wheels_steady(&self) -> bool {
+        self.wheels_steady
     }
 
     /// The axis being identified and the phase.
@@ -284,7 +298,9 @@ impl Commissioning {
         self.angle_pulses += pulses;
         let angle = self.angle_pulses as f32 * rad_per_pulse;
         if self.phase == Phase::Reaction {
-            if t_s >= self.reaction_fit_from_s {
+            // Until the reaction is measured (`fit_done`); the hold for the wheels after it
+            // adds nothing to its line.
+            if t_s >= self.reaction_fit_from_s && !self.fit_done {
                 self.reaction_fit.add(t_s, angle);
             }
             return;
@@ -308,13 +324,15 @@ impl Commissioning {
     }
 
     /// Advances by `dt_s`; `clock_ticks` is the estimator's extended clock now, `stopped` is
-    /// true when both axes' estimators read zero. Returns the duties to apply, or the error that ends the
+    /// true when both axes' estimators read zero, `wheels_learned` when both tooth maps have
+    /// learned their wheels ([`Self::wheels_steady`]). Returns the duties to apply, or the error that ends the
     /// routine.
     pub fn step(
         &mut self,
         dt_s: f32,
         clock_ticks: u32,
         stopped: bool,
+        wheels_learned: bool,
     ) -> Result<[f32; 2], IdentifyError> {
         self.total_s += dt_s;
         if self.total_s > self.cfg.timeout_s {
@@ -380,11 +398,21 @@ impl Commissioning {
                         self.coast_s = 0.0;
                         duty = 0.0;
                     }
-                } else if t_s >= self.reaction_fit_from_s + 0.5 * self.cfg.step_time_s
-                    && whole(self.reaction_fit.count())
-                {
-                    self.measure_reaction();
-                    self.reaction_done_s = Some(t_s);
+                } else {
+                    if !self.fit_done
+                        && t_s >= self.reaction_fit_from_s + 0.5 * self.cfg.step_time_s
+                        && whole(self.reaction_fit.count())
+                    {
+                        self.measure_reaction();
+                        self.fit_done = true;
+                    }
+                    // Both shafts steady at their high duties: held on until both wheels are
+                    // learned (or the hold's limit), so the first start reads its teeth.
+                    if self.fit_done
+                        && (wheels_learned || t_s >= self.reaction_fit_from_s + WHEEL_HOLD_MAX_S)
+                    {
+                        self.reaction_done_s = Some(t_s);
+                    }
                 }
             }
             Phase::Coast => {
@@ -406,6 +434,9 @@ impl Commissioning {
             }
             Phase::Done => {}
         }
+        self.wheels_steady = self.phase == Phase::Reaction
+            && self.reaction_done_s.is_none()
+            && t_s >= self.reaction_fit_from_s;
         let held_s = 0.5 * self.cfg.step_time_s;
         self.steady_step = match self.phase {
             Phase::Low if self.axis == 1 && t_s >= held_s => 1,

@@ -164,7 +164,7 @@ impl Controller {
         let dt_s = 1.0 / cfg.tick_hz as f32;
         let a0 = cfg.axes[0];
         let a1 = cfg.axes[1];
-        Self {
+        let mut c = Self {
             cfg,
             dt_s,
             axes: [
@@ -185,7 +185,10 @@ impl Controller {
             decouple_duty_per_rad_s: decouple_duty_per_rad_s(&cfg),
             reached: false,
             supply_cut: false,
-        }
+        };
+        // The precession's shaft turns about the vertical (teeth.rs).
+        c.axes[0].est.about_the_vertical();
+        c
     }
 
     /// One control tick, called at exactly `tick_hz`.

@@ -128,6 +128,9 @@ pub struct PulseSpeedEstimator {
     /// The window's angle in pitches, by the learned gap lengths.
     win_pitches: f32,
     teeth: ToothMap,
+    /// The tooth map learns whatever the caller's `steady` says (commissioning's hold at
+    /// both high duties: [`Self::learn_teeth`]).
+    learn_teeth: bool,
     valid: bool,
     raw_period_ticks: f32,
     lockout_now: u32,
@@ -209,6 +212,7 @@ impl PulseSpeedEstimator {
             win_pulses: 0,
             win_pitches: 0.0,
             teeth: ToothMap::new(axis.pulses_per_rev, ticks_per_s),
+            learn_teeth: false,
             valid: false,
             raw_period_ticks: 0.0,
             lockout_now: (0.5 * min_period_s * ticks_per_s) as u32,
@@ -365,7 +369,7 @@ impl PulseSpeedEstimator {
         self.prev_interval = self.last_interval;
         self.last_interval = dt / pulses;
         self.win_pulses += pulses;
-        let pitches = self.teeth.edge(dt, pulses, steady);
+        let pitches = self.teeth.edge(dt, pulses, steady || self.learn_teeth);
         self.win_pitches += pitches;
         self.tick_pitches += pitches;
         self.tick_edges += 1;

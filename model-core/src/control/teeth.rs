@@ -88,6 +88,9 @@ pub struct ToothMap {
     /// so a tick that handles edges never also learns.
     pending: [(u16, u32); PENDING],
     pending_len: u8,
+    /// The pattern's first harmonic is left in (the wheel's shaft may carry a
+    /// once-per-revolution load: the spin's tilted bowl); false about the vertical.
+    keeps_first_harmonic: bool,
 }
 
 /// Gaps that wait to be learned from; more than a few only wait when edges come in consecutive
@@ -140,7 +143,24 @@ impl ToothMap {
             gaps_this_rev: 0,
             pending: [(0, 0); PENDING],
             pending_len: 0,
+            keeps_first_harmonic: true,
         }
+    }
+
+    /// The map of a wheel on a shaft turning about the vertical (the precession): gravity
+    /// puts no once-per-revolution torque on it, so the whole pattern, its first harmonic
+    /// too, is the wheel's and is taken out (left in, the loop chases it and the rod's
+    /// true speed ripples once per revolution, +/-2.5 % at 1 rad/s on family-60).
+    pub const fn about_the_vertical(&mut self) {
+        self.keeps_first_harmonic = false;
+    }
+
+    /// The map is learned: in use (its warm-up revolutions learned) and averaged over one
+    /// revolution more (the first revolution counts whole, with its edge jitter: up to 1 ms,
+    /// 1 % of a gap at 5 rad/s on 12 teeth), or it counts no wheel (too few teeth for the
+    /// first harmonic, or too many to learn) and never will be.
+    pub fn learned(&self) -> bool {
+        self.teeth < 3 || self.revs_learned > WARM_UP_REVS
     }
 
     /// Forgets what was learned (the wheel turns the other way, or the count may have slipped).
@@ -320,7 +340,7 @@ impl ToothMap {
             self.revs_learned = self.revs_learned.saturating_add(1);
             self.weight = (1.0 / (f32::from(self.revs_learned) + 1.0)).max(LEARN_WEIGHT);
             self.scale = n as f32 / sum;
-            let h = if n >= 3 {
+            let h = if n >= 3 && self.keeps_first_harmonic {
                 2.0 / n as f32 * self.scale
             } else {
                 0.0

@@ -12,9 +12,9 @@ impl Controller {
     pub(super) fn tick_commissioning(&mut self, now_ticks: u32, edges: [&[u32]; 2]) -> [f32; 2] {
         let dt = self.dt_s;
         let mut seen = [false; 2];
-        let comm_axis = match &self.commissioning {
-            Some(c) => c.progress().0,
-            None => 2,
+        let (comm_axis, wheels) = match &self.commissioning {
+            Some(c) => (c.progress().0, c.wheels_steady()),
+            None => (2, false),
         };
         for i in 0..2 {
             let a = &mut self.axes[i];
@@ -25,6 +25,7 @@ impl Controller {
                 None
             };
             let seen_i = &mut seen[i];
+            a.est.learn_teeth(wheels);
             let speed = a.est.tick(now_ticks, edges[i], false, |at, pulses| {
                 *seen_i = true;
                 if let Some(c) = comm.as_deref_mut() {
@@ -57,6 +58,7 @@ impl Controller {
             dt,
             clock,
             self.axes[0].est.is_stopped() && self.axes[1].est.is_stopped(),
+            self.axes[0].est.teeth().learned() && self.axes[1].est.teeth().learned(),
         ) {
             Err(e) => {
                 self.identify_error = Some(e);

@@ -82,6 +82,14 @@ impl Controller {
         })
     }
 
+    /// Revolutions of the sensor wheel's tooth offsets learned on `axis` (teeth.rs; from 2
+    /// the estimator counts each gap at its learned length). 0 for an axis out of range.
+    pub fn wheel_revolutions_learned(&self, axis: usize) -> u16 {
+        self.axes
+            .get(axis)
+            .map_or(0, |a| a.est.teeth_revolutions_learned())
+    }
+
     /// Results of the last commissioning run, per axis.
     pub fn identified(&self) -> [Option<Identified>; 2] {
         self.identified

@@ -109,6 +109,15 @@ impl PulseSpeedEstimator {
     pub fn forget_teeth(&mut self) {
         self.teeth.forget();
     }
+    /// The tooth map learns from every single-pulse gap while `on` (the shaft held at a steady
+    /// duty by commissioning), whatever the tick's `steady` says of the rest.
+    pub fn learn_teeth(&mut self, on: bool) {
+        self.learn_teeth = on;
+    }
+    /// The wheel turns about the vertical ([`ToothMap::about_the_vertical`]).
+    pub const fn about_the_vertical(&mut self) {
+        self.teeth.about_the_vertical();
+    }
     /// Revolutions of tooth offsets learned since the last [`Self::forget_teeth`].
     pub fn teeth_revolutions_learned(&self) -> u16 {
         self.teeth.revolutions_learned()
