@@ -72,8 +72,9 @@ fn progress_is_in_the_units_of_the_result() {
     assert_eq!(text.matches("bandwidth 8.000 rad/s").count(), 2, "{text}");
 }
 
-/// A rig that is running refuses COMMISSION (STATE): exit 2, and it keeps running; a rig whose
-/// sensor is lost fails commissioning with a fault: exit 4, the fault named.
+/// A rig that is running refuses COMMISSION (STATE): exit 1, the reason explained in words, and
+/// it keeps running; a rig whose sensor is lost fails commissioning with a fault: exit 4, the
+/// fault named.
 #[test]
 fn refusal_and_fault_give_distinct_non_zero_exits() {
     let sim = Sim::start(&["--seconds", "120"]);
@@ -90,6 +91,15 @@ fn refusal_and_fault_give_distinct_non_zero_exits() {
     let got = last_json(&out);
     assert_eq!(got["result"], "rejected");
     assert_eq!(got["reason"], "STATE");
+    // In words: the reason's token read back as the reason (`Reason::from_token`), explained.
+    let out = bowl(&["commission", &sim.path]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let text = common::stdout(&out);
+    let want = format!(
+        "COMMISSION rejected: STATE - {}",
+        rig_client::lines::explain(model_core::wire::Reason::State)
+    );
+    assert!(text.contains(&want), "{text}");
 
     send(&["stop"]);
     std::thread::sleep(std::time::Duration::from_secs(3));

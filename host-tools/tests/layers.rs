@@ -5,6 +5,7 @@
 //!   model-core; lab may use rig-client and virtual-rig; rig-client and virtual-rig use neither
 //!   lab nor each other; nothing in the product uses the test crate;
 //! - every path ARCHITECTURE.md names exists;
+//! - every arrow ARCHITECTURE.md draws between a crate's modules is one the crate has;
 //! - no source file of the four crates is over 500 lines (a file with one job).
 
 #[path = "../../tests/support/graph.rs"]
@@ -236,6 +237,55 @@ fn every_path_architecture_md_names_exists() {
     assert!(
         missing.is_empty(),
         "ARCHITECTURE.md names paths that do not exist: {missing:?}"
+    );
+}
+
+/// The arrows ARCHITECTURE.md draws inside each crate ("Module imports inside each crate":
+/// `` - `rig-client`: `link -> serial`; ... ``) are arrows of the crate as it is, between
+/// modules it has (a module renamed or gone leaves its name in the prose otherwise).
+#[test]
+fn the_module_arrows_architecture_md_draws_exist() {
+    let text = std::fs::read_to_string(root().join("ARCHITECTURE.md")).unwrap();
+    let section = text
+        .split_once("Module imports inside each crate")
+        .expect("ARCHITECTURE.md: no \"Module imports inside each crate\" list")
+        .1;
+    let mut drawn = 0;
+    let mut wrong = Vec::new();
+    // The bullets: `- `crate`: ...` and their continuation lines, up to the first blank line.
+    let mut graph = None;
+    // (the rest of the heading's line, `A -> B`, explains the notation)
+    for line in section.lines().skip(1).skip_while(|l| l.trim().is_empty()) {
+        if line.trim().is_empty() {
+            break;
+        }
+        if let Some(rest) = line.strip_prefix("- `") {
+            let name = &rest[..rest.find('`').unwrap()];
+            let (_, dir) = CRATES
+                .iter()
+                .find(|(n, _)| *n == name)
+                .unwrap_or_else(|| panic!("ARCHITECTURE.md draws arrows of `{name}`, no crate"));
+            graph = Some(module_graph(&root().join(dir)));
+        }
+        let graph = graph
+            .as_ref()
+            .expect("an arrow before the first crate's bullet");
+        for quoted in line.split('`').skip(1).step_by(2) {
+            let Some((from, to)) = quoted.split_once(" -> ") else {
+                continue;
+            };
+            for to in to.split(", ") {
+                drawn += 1;
+                if !graph.get(from).is_some_and(|t| t.contains(to)) {
+                    wrong.push(format!("{from} -> {to}"));
+                }
+            }
+        }
+    }
+    assert!(drawn > 10, "only {drawn} arrows found in ARCHITECTURE.md");
+    assert!(
+        wrong.is_empty(),
+        "ARCHITECTURE.md draws arrows the crates do not have: {wrong:?}"
     );
 }
 

@@ -190,3 +190,19 @@ proptest! {
         }
     }
 }
+
+/// Every refusal reason's wire token reads back as that reason (one table both ways); a word
+/// that is not a token, in another case or with a space, names none.
+#[test]
+fn reason_tokens_read_back() {
+    let mut tokens: Vec<&str> = Reason::ALL.iter().map(|r| r.token()).collect();
+    for &r in Reason::ALL.iter() {
+        assert_eq!(Reason::from_token(r.token().as_bytes()), Some(r), "{r:?}");
+    }
+    tokens.sort_unstable();
+    tokens.dedup();
+    assert_eq!(tokens.len(), Reason::ALL.len(), "two reasons share a token");
+    for word in ["", "range", "Range", "RANGE ", "OK", "NONE"] {
+        assert_eq!(Reason::from_token(word.as_bytes()), None, "{word:?}");
+    }
+}

@@ -6,7 +6,7 @@
 //! side of that socket), `request` (the one request loop: id matching, resends), `rig` (the
 //! typed rig: `Rig::speed`, `Rig::status`, ...), `lines` (command lines built from words and
 //! checked, answers described; the rig's states and faults in words are the types' own,
-//! `model_core::wire::words`), `integer`, `command_words` and `refusal` (a refused command in
+//! `model_core::wire::words`), `command_words` and `refusal` (a refused command in
 //! particulars), `telemetry_csv` (the CSV log), `decode_stats` (the decoder's counters as JSON).
 
 pub mod command_words;

@@ -183,7 +183,10 @@ fn print(report: &Report, json: bool) -> Result<()> {
         "rejected" => println!(
             "COMMISSION rejected: {} - {}",
             report.reason.unwrap_or("?"),
-            report.reason.and_then(reason_of).map_or("", explain)
+            report
+                .reason
+                .and_then(|t| Reason::from_token(t.as_bytes()))
+                .map_or("", explain)
         ),
         other => println!("commissioning: {other} after {:.1} s", report.seconds),
     }
@@ -208,10 +211,6 @@ fn print(report: &Report, json: bool) -> Result<()> {
         );
     }
     Ok(())
-}
-
-fn reason_of(token: &str) -> Option<Reason> {
-    Reason::ALL.iter().copied().find(|r| r.token() == token)
 }
 
 /// Runs `bowl commission`; returns the process exit status.

@@ -77,7 +77,39 @@ fn geometry_words(e: BowlError) -> &'static str {
         BowlError::NegativeTargetSpeed => "the bowl speed to split must be 0 or more (rad/s)",
         BowlError::InvalidRatio => "--ratio must be a finite number, 0 or more",
         BowlError::InvalidAxesAngle => {
-            "the angle between the axes must lie in [0, 180) degrees (at 180 the axes oppose and              equal speeds cancel)"
+            "the angle between the axes must lie in [0, 180) degrees (at 180 the axes oppose and \
+             equal speeds cancel)"
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every refusal reads as one line of plain words: no run of spaces (a string continued
+    /// onto the next source line without its `\` keeps the indentation), no space at either
+    /// end, no Rust name.
+    #[test]
+    fn every_refusal_is_plain_words() {
+        let all = [
+            BowlError::NonFiniteSpeed,
+            BowlError::NegativeTargetSpeed,
+            BowlError::InvalidRatio,
+            BowlError::InvalidAxesAngle,
+        ];
+        for e in all {
+            // A new refusal fails to compile here until it is listed above.
+            match e {
+                BowlError::NonFiniteSpeed
+                | BowlError::NegativeTargetSpeed
+                | BowlError::InvalidRatio
+                | BowlError::InvalidAxesAngle => {}
+            }
+            let text = geometry_words(e);
+            assert!(!text.contains("  "), "{e:?}: {text:?}");
+            assert_eq!(text.trim(), text, "{e:?}");
+            assert!(!text.contains(&format!("{e:?}")), "{e:?}: {text:?}");
         }
     }
 }

@@ -16,7 +16,8 @@ pub fn config(e: ConfigError) -> String {
     match e {
         ConfigError::TickRate => "the control tick rate must lie in 100 Hz ..= 10 kHz".into(),
         ConfigError::Timer => {
-            "the capture timer must run at 10 kHz or more (10 counts per control tick at least)              and be 16 or 32 bits wide (timer_hz, timer_bits)"
+            "the capture timer must run at 10 kHz or more (10 counts per control tick at least) \
+             and be 16 or 32 bits wide (timer_hz, timer_bits)"
                 .into()
         }
         ConfigError::SupplyVoltage => "the supply voltage must lie in 1 ..= 60 V (supply_v)".into(),
@@ -29,15 +30,18 @@ pub fn config(e: ConfigError) -> String {
             axis(a)
         ),
         ConfigError::MotorModel(a) => format!(
-            "the {} axis's motor model is implausible (volts per rad/s in (0, 100], friction              duty in [0, 0.9], time constant in (0, 10] s): commission it again",
+            "the {} axis's motor model is implausible (volts per rad/s in (0, 100], friction \
+             duty in [0, 0.9], time constant in (0, 10] s): commission it again",
             axis(a)
         ),
         ConfigError::LoopParameter(a) => format!(
-            "a loop setting of the {} axis is out of range (bandwidth, per-pulse bandwidth,              acceleration limit, duty limit)",
+            "a loop setting of the {} axis is out of range (bandwidth, per-pulse bandwidth, \
+             acceleration limit, duty limit)",
             axis(a)
         ),
         ConfigError::Supervisor => {
-            "a supervisor threshold is out of range (stall duty, sensor timeout, link timeout)".into()
+            "a supervisor threshold is out of range (stall duty, sensor timeout, link timeout)"
+                .into()
         }
         ConfigError::Geometry => {
             "the spin/precession ratio or the angle between the axes is invalid".into()
@@ -65,5 +69,124 @@ pub fn rejection(e: Rejection) -> String {
         Rejection::NotFaulted => "there is no fault to clear".into(),
         Rejection::InvalidConfig(c) => config(c),
         Rejection::InvalidTuning => "the loop tuning is out of range".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use model_core::control::{Fault, InverseFailure, State};
+
+    /// Every refused configuration, each axis's where it names one (a new kind fails to compile
+    /// in the match until it is listed).
+    fn every_config_error() -> Vec<ConfigError> {
+        let all: Vec<ConfigError> = [0, 1]
+            .into_iter()
+            .flat_map(|a| {
+                [
+                    ConfigError::PulsesPerRev(a),
+                    ConfigError::SpeedLimits(a),
+                    ConfigError::MotorModel(a),
+                    ConfigError::LoopParameter(a),
+                ]
+            })
+            .chain([
+                ConfigError::TickRate,
+                ConfigError::Timer,
+                ConfigError::SupplyVoltage,
+                ConfigError::Supervisor,
+                ConfigError::Geometry,
+                ConfigError::Commissioning,
+            ])
+            .collect();
+        for e in &all {
+            match e {
+                ConfigError::TickRate
+                | ConfigError::Timer
+                | ConfigError::SupplyVoltage
+                | ConfigError::PulsesPerRev(_)
+                | ConfigError::SpeedLimits(_)
+                | ConfigError::MotorModel(_)
+                | ConfigError::LoopParameter(_)
+                | ConfigError::Supervisor
+                | ConfigError::Geometry
+                | ConfigError::Commissioning => {}
+            }
+        }
+        all
+    }
+
+    /// Every refused command, with every state, a fault and every inverse failure it carries.
+    fn every_rejection() -> Vec<Rejection> {
+        let states = [
+            State::Idle,
+            State::Commissioning,
+            State::SpinningUp,
+            State::Running,
+            State::Stopping,
+            State::Fault,
+        ];
+        let mut all = vec![
+            Rejection::NotFinite,
+            Rejection::InvalidResidenceTime,
+            Rejection::Inverse(InverseFailure::Unreachable),
+            Rejection::Inverse(InverseFailure::ModelRejected),
+            Rejection::SplitFailed,
+            Rejection::Faulted(Fault::Stall(1)),
+            Rejection::NotFaulted,
+            Rejection::InvalidTuning,
+        ];
+        for a in [0, 1] {
+            all.extend([Rejection::AboveMaxSpeed(a), Rejection::BelowMinSpeed(a)]);
+        }
+        all.extend(states.map(Rejection::WrongState));
+        all.extend(
+            every_config_error()
+                .into_iter()
+                .map(Rejection::InvalidConfig),
+        );
+        for r in &all {
+            match r {
+                Rejection::NotFinite
+                | Rejection::AboveMaxSpeed(_)
+                | Rejection::BelowMinSpeed(_)
+                | Rejection::InvalidResidenceTime
+                | Rejection::Inverse(InverseFailure::Unreachable | InverseFailure::ModelRejected)
+                | Rejection::SplitFailed
+                | Rejection::WrongState(_)
+                | Rejection::Faulted(_)
+                | Rejection::NotFaulted
+                | Rejection::InvalidConfig(_)
+                | Rejection::InvalidTuning => {}
+            }
+        }
+        all
+    }
+
+    /// Every message reads as one line of plain words: no run of spaces (a string continued
+    /// onto the next source line without its `\` keeps the indentation), no space at either
+    /// end, and none of the Rust names its value prints with `{:?}`.
+    #[test]
+    fn every_message_is_plain_words() {
+        let messages = every_config_error()
+            .into_iter()
+            .map(|e| (format!("{e:?}"), config(e)))
+            .chain(
+                every_rejection()
+                    .into_iter()
+                    .map(|r| (format!("{r:?}"), rejection(r))),
+            );
+        for (debug, text) in messages {
+            assert!(!text.contains("  "), "{debug}: {text:?}");
+            assert_eq!(text.trim(), text, "{debug}");
+            assert!(!text.is_empty(), "{debug}");
+            let words: Vec<&str> = text.split(|c: char| !c.is_alphanumeric()).collect();
+            for name in debug
+                .split(|c: char| !c.is_alphanumeric())
+                .filter(|w| w.starts_with(char::is_uppercase))
+            {
+                assert!(!words.contains(&name), "{debug} named in {text:?}");
+            }
+        }
     }
 }

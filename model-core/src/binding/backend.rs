@@ -78,24 +78,15 @@ fn reason(r: Rejection) -> Reason {
     }
 }
 
-fn fault_code(f: Option<Fault>) -> FaultCode {
-    match f {
-        None => FaultCode::None,
-        Some(Fault::SensorLostOrStall(0)) => FaultCode::SensorLostOrStallPrecession,
-        Some(Fault::SensorLostOrStall(_)) => FaultCode::SensorLostOrStallSpin,
-        Some(Fault::Overspeed(0)) => FaultCode::OverspeedPrecession,
-        Some(Fault::Overspeed(_)) => FaultCode::OverspeedSpin,
-        Some(Fault::HostSilent) => FaultCode::HostSilent,
-        Some(Fault::InvalidConfiguration) => FaultCode::InvalidConfiguration,
-        Some(Fault::SensorLost(0)) => FaultCode::SensorLostPrecession,
-        Some(Fault::SensorLost(_)) => FaultCode::SensorLostSpin,
-        Some(Fault::Stall(0)) => FaultCode::StallPrecession,
-        Some(Fault::Stall(_)) => FaultCode::StallSpin,
-        Some(Fault::OverCurrent(0)) => FaultCode::OverCurrentPrecession,
-        Some(Fault::OverCurrent(_)) => FaultCode::OverCurrentSpin,
-        Some(Fault::CurrentAboveModel(0)) => FaultCode::CurrentAboveModelPrecession,
-        Some(Fault::CurrentAboveModel(_)) => FaultCode::CurrentAboveModelSpin,
-        Some(Fault::HardwareStop) => FaultCode::HardwareStop,
+/// The controller's fault as the wire carries it: its telemetry code ([`Fault::code`], the one
+/// numbering) read as the wire's [`FaultCode`] (no fault is [`FaultCode::None`]). Every fault's
+/// code is one the wire names (`state_and_fault_names_keep_the_controller_codes`); a code it
+/// did not name would still say the rig faulted, as [`FaultCode::InvalidConfiguration`] does
+/// for a fault state without a latched fault (`Controller`'s `latched`).
+impl From<Option<Fault>> for FaultCode {
+    fn from(f: Option<Fault>) -> Self {
+        FaultCode::from_code(crate::control::supervisor::fault_code(f).into())
+            .unwrap_or(FaultCode::InvalidConfiguration)
     }
 }
 
@@ -289,7 +280,7 @@ impl<I: Injector> Backend for ControllerBackend<I> {
             time_ms: self.now_ms,
             seq: 0,
             state: s.state.into(),
-            fault: fault_code(s.fault),
+            fault: s.fault.into(),
             precession: motor(0),
             spin: motor(1),
             bowl_mrad_s: round(s.combined_measured_rad_s * 1000.0) as u16,

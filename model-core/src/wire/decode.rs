@@ -306,8 +306,7 @@ fn parse_payload(payload: &[u8]) -> Result<Frame, FrameError> {
         },
         b'R' => Frame::Reject {
             id: u16_field(&mut f)?,
-            reason: token_of(f.next_token()?, &Reason::ALL, Reason::token)
-                .ok_or(FrameError::Malformed)?,
+            reason: Reason::from_token(f.next_token()?).ok_or(FrameError::Malformed)?,
         },
         b'S' => Frame::Status {
             id: u16_field(&mut f)?,

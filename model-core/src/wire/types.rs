@@ -321,6 +321,14 @@ impl Reason {
             Reason::Internal => "INTERNAL",
         }
     }
+    /// The reason a wire token names (a REJECT frame's field, a report's `reason`), if any: the
+    /// same table as [`Reason::token`].
+    pub fn from_token(token: &[u8]) -> Option<Reason> {
+        Reason::ALL
+            .iter()
+            .copied()
+            .find(|r| r.token().as_bytes() == token)
+    }
 }
 
 macro_rules! code_enum {

@@ -12,6 +12,7 @@ pub mod suggest;
 use std::io::Write;
 
 use anyhow::Result;
+use model_core::wire::{DeviceState, FaultCode};
 
 use crate::results::{self, Row, Writer};
 use simulated::Release;
@@ -37,6 +38,13 @@ pub trait ReleaseRig {
     fn release(&mut self) -> Release;
     /// Stops the motors.
     fn stop(&mut self);
+}
+
+/// A fault a rig reports, in the words the results file writes (the monitor's and `bowl send
+/// status`'s, [`FaultCode::words`]): its state and fault code as its telemetry carries them, so
+/// both rigs, over the wire and simulated, say the same; none unless the rig is faulted.
+fn reported_fault(state: DeviceState, fault: FaultCode) -> Option<String> {
+    (state == DeviceState::Faulted).then(|| fault.words().to_string())
 }
 
 /// The angle between the axes from the rig's AXES_MDEG parameter (millidegrees), rad: how

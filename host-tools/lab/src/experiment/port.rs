@@ -117,15 +117,15 @@ impl PortRig {
 
     /// A fault the rig reports, in words (and cleared, so the next release may run).
     fn fault(&mut self) -> Result<Option<String>> {
-        match self.latest {
-            Some(t) if t.state == DeviceState::Faulted => {
-                let words = t.fault.words().to_string();
-                self.command(Rig::clear)?;
-                self.latest = None;
-                Ok(Some(words))
-            }
-            _ => Ok(None),
-        }
+        let Some(words) = self
+            .latest
+            .and_then(|t| super::reported_fault(t.state, t.fault))
+        else {
+            return Ok(None);
+        };
+        self.command(Rig::clear)?;
+        self.latest = None;
+        Ok(Some(words))
     }
 
     fn settle_inner(&mut self, targets: [f64; 2], settle_s: f64) -> Result<Result<(), Release>> {

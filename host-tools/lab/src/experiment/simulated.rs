@@ -6,7 +6,6 @@
 
 use anyhow::{Result, anyhow};
 use model_core::control::State;
-use model_core::control::supervisor::Fault;
 use model_core::sim::PlantParams;
 use model_core::sim::granule::ParticleParams;
 use model_core::wire::GateKind;
@@ -36,27 +35,6 @@ pub enum Release {
     NotSettled,
     /// The controller faulted (its fault named).
     MotorFault(String),
-}
-
-/// A fault in plain words for the results file.
-fn fault_words(fault: Option<Fault>) -> String {
-    let axis = |a: u8| if a == 0 { "precession" } else { "spin" };
-    match fault {
-        Some(Fault::SensorLostOrStall(a)) => format!("{} sensor lost or shaft stalled", axis(a)),
-        Some(Fault::Overspeed(a)) => format!("{} over speed", axis(a)),
-        Some(Fault::HostSilent) => "host silent".into(),
-        Some(Fault::SensorLost(a)) => format!("{} sensor lost", axis(a)),
-        Some(Fault::Stall(a)) => format!("{} shaft stalled", axis(a)),
-        Some(Fault::OverCurrent(a)) => format!("{} over current", axis(a)),
-        Some(Fault::CurrentAboveModel(a)) => {
-            format!(
-                "{} current above the model (bridge stuck on or shorted, or shaft stopped dead)",
-                axis(a)
-            )
-        }
-        Some(Fault::HardwareStop) => "hardware stop (break input)".into(),
-        Some(Fault::InvalidConfiguration) | None => "invalid configuration".into(),
-    }
 }
 
 /// The experiment's rig on a `SimulatedBackend` driven directly (no protocol device between):
@@ -113,9 +91,11 @@ impl BackendRig {
         self.backend.advance_to_ms(self.now_ms);
     }
 
+    /// A fault the controller latched, in the words a rig over its serial line gives for it:
+    /// its state and fault as the rig's telemetry carries them (the binding's conversions).
     fn fault(&self) -> Option<String> {
         let c = self.backend.bound().controller();
-        (c.state() == State::Fault).then(|| fault_words(c.fault()))
+        super::reported_fault(c.state().into(), c.fault().into())
     }
 
     fn clear_fault(&mut self) {

@@ -1,11 +1,13 @@
 //! The whole loop on the simulated rig: a plan run, its results fitted (`crate::fit`); and the
 //! suggested plan against the fit's models.
 
+use model_core::control::{Fault, State};
 use model_core::particle::Model;
 use model_core::sim::granule::ParticleParams;
+use model_core::wire::FaultCode;
 
-use super::simulated::BackendRig;
-use super::{plan, run_plan};
+use super::simulated::{BackendRig, Release};
+use super::{ReleaseRig as _, plan, run_plan};
 use crate::fit::models::closed_form;
 use crate::fit::tests::{fit_paper, fitted, synthetic};
 use crate::fit::{Excluded, charts, load, to_json};
@@ -107,11 +109,74 @@ fn stalled_motor_is_excluded_with_its_reason() {
     assert_eq!(excluded.len(), 1);
     let reason = &excluded[0].reason;
     assert!(
-        reason == "the controller stopped the motors on a fault: spin sensor lost or shaft stalled"
+        reason
+            == &format!(
+                "the controller stopped the motors on a fault: {}",
+                FaultCode::SensorLostOrStallSpin.words()
+            )
             || reason.starts_with("the speeds never settled"),
         "{reason}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The simulated rig writes a fault in the words a rig over its serial line writes for it: the
+/// fault the rig's own telemetry frame carries (what the firmware sends, decoded as the port's
+/// rig reads it), in [`FaultCode::words`]. The reference is a twin of the simulated rig driven
+/// through the protocol's `Backend`, as the firmware drives it, until its telemetry says faulted.
+#[test]
+fn a_simulated_fault_is_written_as_a_real_rig_reports_it() {
+    use model_core::wire::device::Backend as _;
+    use model_core::wire::{DeviceState, Frame, Injection, ParamId};
+    let (plant, particle, seed) = (
+        model_core::sim::PlantParams::nominal(),
+        ParticleParams::default(),
+        2,
+    );
+    for injection in [Injection::StallSpin, Injection::SensorLostPrecession] {
+        let mut rig = BackendRig::new(plant, particle, seed).unwrap();
+        rig.inject(injection).unwrap();
+        let targets = rig.split(4.0).unwrap();
+        let written = match rig.settle(targets, 0.5) {
+            Err(Release::MotorFault(words)) => words,
+            other => panic!("{injection:?}: no fault: {other:?}"),
+        };
+
+        let mut twin = virtual_rig::SimulatedBackend::with_plant(plant, particle, seed).unwrap();
+        let b = twin.bound_mut();
+        b.set_param(ParamId::LinkTimeoutMs, 0).unwrap();
+        b.inject(injection).unwrap();
+        let mrad = |w: f64| (w * 1000.0).round() as i16;
+        b.set_speeds(mrad(targets[0]), mrad(targets[1])).unwrap();
+        b.start().unwrap();
+        let mut reported = None;
+        for ms in 1..=30_000 {
+            twin.advance_to_ms(ms);
+            // The telemetry frame as the rig sends it and the port's rig decodes it.
+            let mut bytes = [0; model_core::wire::MAX_FRAME_LEN];
+            let n =
+                model_core::wire::encode(&Frame::Telemetry(twin.bound().telemetry()), &mut bytes)
+                    .unwrap();
+            let Ok(Frame::Telemetry(t)) = model_core::wire::decode_frame(&bytes[..n]) else {
+                panic!("telemetry does not read back");
+            };
+            if t.state == DeviceState::Faulted {
+                reported = Some(t.fault);
+                break;
+            }
+        }
+        let reported = reported.unwrap_or_else(|| panic!("{injection:?}: the twin never faulted"));
+        assert_ne!(reported, FaultCode::None);
+        assert_eq!(written, reported.words(), "{injection:?}");
+    }
+    // A faulted state without a latched fault (the controller latches both together) is
+    // written as the wire says no fault, not as some other fault.
+    let words = super::reported_fault(State::Fault.into(), None::<Fault>.into());
+    assert_eq!(words.as_deref(), Some(FaultCode::None.words()));
+    assert_eq!(
+        super::reported_fault(State::Running.into(), None::<Fault>.into()),
+        None
+    );
 }
 
 /// The suggested plan has conditions where the granule leaves under both models, and its

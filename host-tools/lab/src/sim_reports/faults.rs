@@ -157,7 +157,10 @@ pub fn fault_plant(rig: &Rig, speed: f32, drop_pct: f32) -> PlantFaults {
             n += 1;
         }
     }
-    let false_fault_words = running.ctrl.fault().map(fault_words);
+    let false_fault_words = running
+        .ctrl
+        .fault()
+        .map(|f| FaultCode::from(Some(f)).words().to_string());
     let dropped_pulses = (drop_pct > 0.0).then(|| {
         let st = running.ctrl.status();
         [0, 1].map(|i| {
@@ -278,14 +281,6 @@ fn inject(mut cl: ClosedLoop, what: Injected, axis: usize, bound_s: f64) -> Faul
         peak_until_drive_off_rad_s: peak_until_drive_off,
         supply_cut: cl.rig.supply_is_cut(),
         detected_by: fault.map(|f| f.detected_by().word()),
-        fault: fault.map(fault_words),
+        fault: fault.map(|f| FaultCode::from(Some(f)).words().to_string()),
     }
-}
-
-/// A fault in the words the monitor and `bowl send status` use (by its telemetry code).
-fn fault_words(f: Fault) -> String {
-    FaultCode::from_code(f.code().into()).map_or_else(
-        || format!("fault code {}", f.code()),
-        |c| c.words().to_string(),
-    )
 }

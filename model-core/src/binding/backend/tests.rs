@@ -212,25 +212,58 @@ fn state_and_fault_names_keep_the_controller_codes() {
     ] {
         assert_eq!(DeviceState::from(state).code(), state as u8, "{state:?}");
     }
-    for fault in [
-        Fault::SensorLostOrStall(0),
-        Fault::SensorLostOrStall(1),
-        Fault::Overspeed(0),
-        Fault::Overspeed(1),
-        Fault::HostSilent,
-        Fault::InvalidConfiguration,
-        Fault::SensorLost(0),
-        Fault::SensorLost(1),
-        Fault::Stall(0),
-        Fault::Stall(1),
-        Fault::OverCurrent(0),
-        Fault::OverCurrent(1),
-        Fault::CurrentAboveModel(0),
-        Fault::CurrentAboveModel(1),
-    ] {
-        assert_eq!(fault_code(Some(fault)).code(), fault.code(), "{fault:?}");
+    // Each fault and the wire fault named for it, written out here as the reference (a new
+    // fault fails to compile in `listed` until it has its row).
+    let table = [
+        (
+            Fault::SensorLostOrStall(0),
+            FaultCode::SensorLostOrStallPrecession,
+        ),
+        (
+            Fault::SensorLostOrStall(1),
+            FaultCode::SensorLostOrStallSpin,
+        ),
+        (Fault::Overspeed(0), FaultCode::OverspeedPrecession),
+        (Fault::Overspeed(1), FaultCode::OverspeedSpin),
+        (Fault::HostSilent, FaultCode::HostSilent),
+        (Fault::InvalidConfiguration, FaultCode::InvalidConfiguration),
+        (Fault::SensorLost(0), FaultCode::SensorLostPrecession),
+        (Fault::SensorLost(1), FaultCode::SensorLostSpin),
+        (Fault::Stall(0), FaultCode::StallPrecession),
+        (Fault::Stall(1), FaultCode::StallSpin),
+        (Fault::OverCurrent(0), FaultCode::OverCurrentPrecession),
+        (Fault::OverCurrent(1), FaultCode::OverCurrentSpin),
+        (
+            Fault::CurrentAboveModel(0),
+            FaultCode::CurrentAboveModelPrecession,
+        ),
+        (
+            Fault::CurrentAboveModel(1),
+            FaultCode::CurrentAboveModelSpin,
+        ),
+        (Fault::HardwareStop, FaultCode::HardwareStop),
+    ];
+    let listed = |f: Fault| match f {
+        Fault::SensorLostOrStall(_)
+        | Fault::Overspeed(_)
+        | Fault::HostSilent
+        | Fault::InvalidConfiguration
+        | Fault::SensorLost(_)
+        | Fault::Stall(_)
+        | Fault::OverCurrent(_)
+        | Fault::CurrentAboveModel(_)
+        | Fault::HardwareStop => table.iter().any(|&(g, _)| g == f),
+    };
+    for &(fault, wire) in &table {
+        assert!(listed(fault));
+        assert_eq!(FaultCode::from(Some(fault)), wire, "{fault:?}");
+        assert_eq!(wire.code(), fault.code(), "{fault:?}");
     }
-    assert_eq!(fault_code(None), FaultCode::None);
+    // An axis index past the spin's is the spin's, as `Fault::code` reads it.
+    assert_eq!(FaultCode::from(Some(Fault::Stall(7))), FaultCode::StallSpin);
+    // Every wire fault but "none" is some controller fault's.
+    assert_eq!(table.len(), FaultCode::ALL.len() - 1);
+    assert_eq!(FaultCode::from(None), FaultCode::None);
 }
 
 /// MODELS reports the models in force and the PI gains that follow from them (the loop's
