@@ -192,3 +192,40 @@ fn commissioning_learns_the_wheels_so_the_first_start_reads_its_teeth() {
         assert!(*w < limit, "axis {i}: read up to {:.2} % off", 100.0 * w);
     }
 }
+
+/// Each step's speed is read from a tooth round to the same tooth (commission.rs,
+/// `LineFit::solve_span`): whatever the teeth's offsets, the identified slope in duty per rad/s
+/// and the friction duty are the plant's. A least-squares line over the steps' one or two
+/// revolutions read the speeds 0.2-0.6 % off (teeth up to 5 % of a pitch off), the slope up to
+/// 2.6 % and the friction duty up to half off.
+#[test]
+fn the_steps_speeds_are_read_across_whole_revolutions_whatever_the_teeth() {
+    let (mut worst_slope, mut worst_friction) = (0.0f32, 0.0f32);
+    for i in 0..8 {
+        let (mut rig, _) = family_plant(1, i);
+        for a in &mut rig.axes {
+            a.sensor.tooth_error = 0.05;
+        }
+        let cl = commission(rig, 20 + i);
+        assert_commissioned(&cl, "teeth 5 % off");
+        let configured_v = cl.ctrl.config().supply_v;
+        for axis in 0..2 {
+            let m = cl.ctrl.identified()[axis].expect("identified").model;
+            let (a, c, _) = rig.axes[axis].motor.ideal_model(rig.supply_v);
+            // Duty per rad/s: the controller's volts are duty times its configured supply.
+            let slope = (m.volts_per_rad_s / configured_v) / (a / rig.supply_v);
+            worst_slope = worst_slope.max((slope - 1.0).abs());
+            worst_friction = worst_friction.max((m.friction_duty - c).abs() / c);
+        }
+    }
+    assert!(
+        worst_slope < 0.005,
+        "slope up to {:.2} % off",
+        100.0 * worst_slope
+    );
+    assert!(
+        worst_friction < 0.03,
+        "friction duty up to {:.1} % off",
+        100.0 * worst_friction
+    );
+}
