@@ -152,8 +152,9 @@ pub struct SpeedLoop {
     reference_abs_rad_s: f32,
     /// What the current says of this start (axes with current sense only).
     breakaway: Breakaway,
-    /// The duty the feedback applied last tick beyond the feedforward, kick and push (the
-    /// clamp and the slew limit included).
+    /// The duty applied last tick beyond the feedforward and the push: the feedback's (the
+    /// clamp and the slew limit included) and the kick's, which the plant model does not
+    /// know either.
     correction_duty: f32,
     /// The speed that correction has given the plant model, rad/s (the correction through the
     /// identified lag), and its angle over the estimator's current window, rad.
@@ -530,7 +531,12 @@ impl SpeedLoop {
         if (unlimited - next) * e <= 0.0 {
             self.integral = candidate_i;
         }
-        self.correction_duty = next - ff;
+        // The kick is in the correction's history: the plant model (the reference through the
+        // lag) does not know it, and a start's first window spans the speed it gave. Left out,
+        // that speed read as a negative load at the start's reading and dropped the duty below
+        // what the shaft needs (family-60 p02's rod: 0.227 for 0.235, 2 % settled at 3.2 s;
+        // docs/control.md, "The kick in the start's first window").
+        self.correction_duty = next - ff + kick * input.direction;
         self.duty = next;
         next
     }
