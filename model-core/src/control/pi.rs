@@ -535,8 +535,16 @@ impl SpeedLoop {
         // lag) does not know it, and a start's first window spans the speed it gave. Left out,
         // that speed read as a negative load at the start's reading and dropped the duty below
         // what the shaft needs (family-60 p02's rod: 0.227 for 0.235, 2 % settled at 3.2 s;
-        // docs/control.md, "The kick in the start's first window").
-        self.correction_duty = next - ff + kick * input.direction;
+        // docs/control.md, "The kick in the start's first window"). Not with current sense:
+        // there the kick lasts until the current shows the breakaway, so it held a shaft that
+        // did not move and gave it no speed (in the history, 0 -> 1 rad/s on family-60 within
+        // 5 % past it 100 -> 98.3 %).
+        let kick_history = if input.torque_duty.is_none() {
+            kick
+        } else {
+            0.0
+        };
+        self.correction_duty = next - ff + kick_history * input.direction;
         self.duty = next;
         next
     }
