@@ -242,7 +242,10 @@ pub fn run(args: &Args) -> Result<i32> {
         }
     }
     if !args.json {
-        eprintln!("commissioning: the rig drives each motor with open-loop duty steps");
+        eprintln!(
+            "commissioning: the rig drives each motor with open-loop duty steps, then runs both \
+             at speed until it has learned both sensor wheels (about 45 s; keep clear)"
+        );
     }
     let started = Instant::now();
     let end = follow(&mut rig, Duration::from_secs_f64(args.timeout_s), args.json)?;
