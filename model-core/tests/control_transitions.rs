@@ -412,16 +412,25 @@ fn from_rest_the_first_window_reads_the_kick_it_spans() {
             ],
         ],
     );
-    let load = [p02.axes[0].load_step_nm, p02.axes[1].load_step_nm];
-    let o = commissioned_transition(p02, ControllerConfig::nominal(), 1002, 0.0, 1.0, true, load);
-    assert!(o.commissioned && o.fault.is_none(), "{:?}", o.fault);
-    let rod = o.reports[0];
+    let rod = rod_from_rest_to_1_rad_s(p02, 1002);
     assert!(
         rod.settled && rod.settling_time_s <= 2.0,
         "the rod settled within 2 % of 1 rad/s at {:.2} s (settled: {})",
         rod.settling_time_s,
         rod.settled
     );
+}
+
+/// Commissions `rig` (seed `seed`), pours its material in and steps both axes from rest to
+/// 1 rad/s with no fault: the rod's step report.
+fn rod_from_rest_to_1_rad_s(
+    rig: model_core::sim::PlantParams,
+    seed: u32,
+) -> model_core::sim::StepReport {
+    let load = [rig.axes[0].load_step_nm, rig.axes[1].load_step_nm];
+    let o = commissioned_transition(rig, ControllerConfig::nominal(), seed, 0.0, 1.0, true, load);
+    assert!(o.commissioned && o.fault.is_none(), "{:?}", o.fault);
+    o.reports[0]
 }
 
 /// A kick far above what the shaft needs (commissioning's breakaway duty is 2-3x the truth)
@@ -446,10 +455,7 @@ fn from_rest_a_rod_the_kick_drove_past_the_target_is_read_at_its_first_window() 
             ],
         ],
     );
-    let load = [p29.axes[0].load_step_nm, p29.axes[1].load_step_nm];
-    let o = commissioned_transition(p29, ControllerConfig::nominal(), 1029, 0.0, 1.0, true, load);
-    assert!(o.commissioned && o.fault.is_none(), "{:?}", o.fault);
-    let rod = o.reports[0];
+    let rod = rod_from_rest_to_1_rad_s(p29, 1029);
     assert!(
         rod.settled && rod.settling_time_s <= 3.0,
         "the rod settled within 2 % of 1 rad/s at {:.2} s (settled: {})",
