@@ -229,3 +229,43 @@ fn the_steps_speeds_are_read_across_whole_revolutions_whatever_the_teeth() {
         100.0 * worst_friction
     );
 }
+
+/// STOP while commissioning holds both shafts for the wheels ends the learning with it: the
+/// shafts coasting down afterwards are not steady, and a map learned from a deceleration would
+/// read as a tooth pattern. (The estimators' learning was left on by a STOP there, and the
+/// coast went into the maps.)
+#[test]
+fn a_stop_during_the_wheels_hold_ends_their_learning() {
+    let mut rig = rig_with_pulses(12);
+    for a in &mut rig.axes {
+        a.sensor.tooth_error = 0.05;
+    }
+    let mut cfg = ControllerConfig::nominal();
+    for i in 0..2 {
+        cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
+    }
+    let mut cl = ClosedLoop::new(Plant::new(rig, 3), Controller::new(cfg).unwrap());
+    assert!(cl.ctrl.start_commissioning().is_ok());
+    // Into the hold: the rod's map has learned a revolution there.
+    let mut held = false;
+    for _ in 0..(120.0 / cl.dt_s()) as u32 {
+        cl.tick();
+        if cl.ctrl.wheel_revolutions_learned(0) >= 1 {
+            held = true;
+            break;
+        }
+    }
+    assert!(
+        held && cl.ctrl.state() == State::Commissioning,
+        "never reached the hold"
+    );
+    assert!(cl.ctrl.stop().is_ok());
+    let learned = [0, 1].map(|i| cl.ctrl.wheel_revolutions_learned(i));
+    cl.run(15.0, |_| {});
+    assert_eq!(cl.ctrl.state(), State::Idle);
+    assert_eq!(
+        [0, 1].map(|i| cl.ctrl.wheel_revolutions_learned(i)),
+        learned,
+        "revolutions learned while coasting after the STOP"
+    );
+}

@@ -128,8 +128,8 @@ pub struct PulseSpeedEstimator {
     /// The window's angle in pitches, by the learned gap lengths.
     win_pitches: f32,
     teeth: ToothMap,
-    /// The tooth map learns whatever the caller's `steady` says (commissioning's hold at
-    /// both high duties: [`Self::learn_teeth`]).
+    /// The tooth map learns this tick whatever the caller's `steady` says (commissioning's
+    /// hold at both high duties: [`Self::learn_teeth`]); cleared at the end of each tick.
     learn_teeth: bool,
     valid: bool,
     raw_period_ticks: f32,
@@ -285,6 +285,9 @@ impl PulseSpeedEstimator {
             // A tick without an edge has time to learn the wheel's gaps.
             self.teeth.learn_pending();
         }
+        // For this tick only: commissioning sets it before each tick of its hold, so nothing
+        // that ends commissioning (a STOP, a fault) can leave the map learning.
+        self.learn_teeth = false;
         self.clock = self.clock.wrapping_add(span);
         self.prev_now = now;
         // 2 since the last edge only while steady throughout (an edge sets 2).

@@ -109,8 +109,8 @@ impl PulseSpeedEstimator {
     pub fn forget_teeth(&mut self) {
         self.teeth.forget();
     }
-    /// The tooth map learns from every single-pulse gap while `on` (the shaft held at a steady
-    /// duty by commissioning), whatever the tick's `steady` says of the rest.
+    /// The tooth map learns from every single-pulse gap of the next tick if `on` (the shaft
+    /// held at a steady duty by commissioning), whatever the tick's `steady` says of the rest.
     pub fn learn_teeth(&mut self, on: bool) {
         self.learn_teeth = on;
     }
