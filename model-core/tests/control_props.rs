@@ -106,7 +106,7 @@ proptest! {
         for (x, y) in points {
             f.add(x, y);
         }
-        if let Some((b, m)) = f.solve() {
+        if let Some((b, m)) = f.solve_span() {
             prop_assert!(b.is_finite() && m.is_finite());
         }
     }

@@ -65,15 +65,14 @@ pub const WHEEL_HOLD_MAX_S: f32 = 10.0;
 /// Largest duty of the high step.
 const TOP_DUTY: f32 = 0.95;
 
-/// Least-squares straight line `y = b + m x`, accumulated without storage, with its first
-/// and last points (for the slope across whole revolutions, [`LineFit::solve_span`]).
+/// A straight line `y = b + m x` through points accumulated without storage: the slope from
+/// the first point to the last, the intercept the least-squares one for it
+/// ([`LineFit::solve_span`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LineFit {
     n: f32,
     sx: f32,
     sy: f32,
-    sxx: f32,
-    sxy: f32,
     first: (f32, f32),
     last: (f32, f32),
 }
@@ -89,8 +88,6 @@ impl LineFit {
         self.n += 1.0;
         self.sx += x;
         self.sy += y;
-        self.sxx += x * x;
-        self.sxy += x * y;
     }
 
     /// `(intercept, slope)` with the slope from the first point to the last, the intercept
@@ -115,28 +112,10 @@ impl LineFit {
             None
         }
     }
+
     /// Number of points.
     pub fn count(&self) -> u32 {
         self.n as u32
-    }
-    /// `(intercept, slope)`, or `None` with fewer than 2 distinct abscissae.
-    pub fn solve(&self) -> Option<(f32, f32)> {
-        if self.n < 2.0 {
-            return None;
-        }
-        let mx = self.sx / self.n;
-        let my = self.sy / self.n;
-        let var = self.sxx / self.n - mx * mx;
-        if var.partial_cmp(&(1e-12 * (1.0 + mx * mx))) != Some(core::cmp::Ordering::Greater) {
-            return None;
-        }
-        let m = (self.sxy / self.n - mx * my) / var;
-        let b = my - m * mx;
-        if m.is_finite() && b.is_finite() {
-            Some((b, m))
-        } else {
-            None
-        }
     }
 }
 
