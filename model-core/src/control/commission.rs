@@ -212,8 +212,8 @@ pub struct Commissioning {
     reaction_fit: LineFit,
     /// From the spin step, s on the precession's clock: when the fit starts.
     reaction_fit_from_s: f32,
-    /// When the spin's ramp down started (the reaction is measured), s on the precession's
-    /// clock.
+    /// When the spin's ramp down started (the reaction measured, `fit_done`, and the wheels
+    /// learned or the hold's limit reached), s on the precession's clock.
     reaction_done_s: Option<f32>,
     results: [Option<Identified>; 2],
     /// See [`Commissioning::steady_step`].
