@@ -73,8 +73,9 @@ fn progress_is_in_the_units_of_the_result() {
 }
 
 /// A rig that is running refuses COMMISSION (STATE): exit 1, the reason explained in words, and
-/// it keeps running; a rig whose sensor is lost fails commissioning with a fault: exit 4, the
-/// fault named.
+/// it keeps running; a rig whose sensor is lost fails commissioning with a fault: exit 1 too (a
+/// run that faulted is a failed run, docs/console.md "Exit codes"; 4 is a timeout), told apart by
+/// the JSON's `result` (`rejected` or `fault`) and the fault named.
 #[test]
 fn refusal_and_fault_give_distinct_non_zero_exits() {
     let sim = Sim::start(&["--seconds", "120"]);
