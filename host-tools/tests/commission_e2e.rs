@@ -77,7 +77,7 @@ fn progress_is_in_the_units_of_the_result() {
 /// run that faulted is a failed run, docs/console.md "Exit codes"; 4 is a timeout), told apart by
 /// the JSON's `result` (`rejected` or `fault`) and the fault named.
 #[test]
-fn refusal_and_fault_give_distinct_non_zero_exits() {
+fn refusal_and_fault_both_exit_1_told_apart_by_their_result() {
     let sim = Sim::start(&["--seconds", "120"]);
     let send = |words: &[&str]| {
         let mut args = vec!["send", sim.path.as_str()];
