@@ -470,7 +470,7 @@ fn from_rest_a_rod_the_kick_drove_past_the_target_is_read_at_its_first_window() 
 /// edges a second: seed 5 p11's spin (`bowl sim make-family --seed 5 --plants 60`) measured 0.82
 /// rad/s at 1.93 s, 0.86 at 2.53 s, and settled within 2 % of 1 rad/s at 3.95 s. Its second
 /// window, past the leap, now reads the load at once (pi.rs, `late_reading`; docs/control.md,
-/// "A pushed start reads its second window").
+/// "... a pushed start reads its second window").
 #[test]
 fn from_rest_a_pushed_spin_reads_the_load_at_its_second_window() {
     let p11 = plant_rows::rig_from_table(

@@ -308,7 +308,7 @@ impl SpeedLoop {
             // A pushed start's second window (`late_reading`) is read as a first one: past
             // the leap its first window carried, it reads the load the loop would otherwise
             // close at its bandwidth, about 1 rad/s at 1 rad/s (seed 5 p11's spin: 2 % settled
-            // at 3.95 -> 2.82 s; docs/control.md, "A pushed start reads its second window").
+            // at 3.95 -> 2.82 s; docs/control.md, "... a pushed start reads its second window").
             self.have_error &= !self.start_reading;
             if self.have_error {
                 // A quiet shaft the push (`quiet` below) turned again: half of it stays, as
