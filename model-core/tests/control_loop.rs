@@ -137,6 +137,7 @@ fn anti_windup_holds_the_integral_when_the_output_saturates() {
         extra_duty: 0.0,
         at_rest: false,
         torque_duty: None,
+        early_edge_drops_kick: false,
     };
     l.step(&k, input(sample(0.0, 4.0)));
     for i in 0..30_000 {

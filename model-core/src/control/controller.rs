@@ -399,6 +399,8 @@ impl Controller {
             extra_duty,
             at_rest: a.est.at_rest(),
             torque_duty: a.torque_duty.take(),
+            // The rod only (pi.rs, `early`).
+            early_edge_drops_kick: i == 0,
         };
         let duty = a.speed_loop.step(&a.k, input);
         a.duty = duty;

@@ -204,6 +204,9 @@ pub struct LoopInput {
     /// a held shaft (`(i - offset) / g`, in the commanded direction; breakaway.rs); None
     /// without current sense or before the supervisor learned the offset and `g`.
     pub torque_duty: Option<f32>,
+    /// A first edge that does not show the shaft behind its model keeps nothing of the kick
+    /// (the rod: see `early` in [`SpeedLoop::step`]).
+    pub early_edge_drops_kick: bool,
 }
 
 impl SpeedLoop {
@@ -287,6 +290,9 @@ impl SpeedLoop {
             self.integral *= r_abs / self.reference_abs_rad_s;
         }
         self.reference_abs_rad_s = r_abs;
+        // The model's travel since the loop left rest, the kick's speed included (see `early`
+        // at the first edge below), before a first edge restarts the count.
+        let travel_rad = (self.model_angle_rad + self.correction_angle_rad) * input.direction;
         if let Some(ago) = ev.restarted_s_ago {
             self.model_angle_rad = rp * ago;
             self.correction_angle_rad = c * ago;
@@ -395,7 +401,18 @@ impl SpeedLoop {
                 let turning = input.torque_duty.is_some()
                     && self.breakaway.speed_rad_s()
                         > (1.0 - FUSED_BAND_SHARE) * self.model_rad_s.abs();
-                let started_by = if turning {
+                // Without current sense, a rod's first edge that came before the model (the
+                // kick's speed included) had turned a pitch does not show the shaft behind it:
+                // the kick is not kept (half a push is). A light rod the kick ran to 1 rad/s
+                // before its first tooth kept half of a breakaway duty commissioning read 2-3x
+                // high until its first measurement: 20 % past 1 rad/s (seed 5 p44). Not the
+                // spin: loaded with the bowl's material, spins then crawled and were pushed
+                // (0 -> 0.5 rad/s within 5 % by 8 s two axes fewer on two families;
+                // docs/control.md, "The rod's kept kick from rest").
+                let early = input.early_edge_drops_kick
+                    && input.torque_duty.is_none()
+                    && travel_rad < k.stuck_angle_rad / STUCK_PITCHES;
+                let started_by = if turning || early {
                     self.push
                 } else {
                     self.push.max(k.kick_level(r_abs))
