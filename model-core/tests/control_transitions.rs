@@ -530,6 +530,8 @@ fn from_rest_the_eccentric_load_is_fed_from_the_first_edge() {
         spin.settling_time_s,
         spin.overshoot * 100.0,
         spin.settled
+    );
+}
 
 /// A light rod the kick ran to 1 rad/s before its first tooth (seed 5 p44: true breakaway about
 /// 0.07 duty, commissioning's 0.193): half the kick was kept at that edge (0.031 duty) until its
