@@ -8,7 +8,8 @@
 //! 1. *Low step*: duty `max(low_duty, breakaway + 0.1)`, held at least `step_time_s` and until
 //!    the edges in the step's second half run from a tooth round to the same tooth again
 //!    (whole revolutions of gaps, more than `min_fit_edges` edges and at least one
-//!    revolution): the angle between the first and the last over their time is the step's
+//!    revolution; a slow shaft's fit starts [`SETTLE_TAUS`] of its time constants after the
+//!    step instead, the step held on for it): the angle between the first and the last over their time is the step's
 //!    mean speed exactly, whatever the teeth's offsets and a once-per-revolution load
 //!    ([`LineFit::solve_span`]; a least-squares slope over one or two revolutions is tilted
 //!    by the tooth pattern). The spin's steps then hold on, the fit complete, until their second
@@ -64,6 +65,14 @@ pub const REACTION_RAMP_S: f32 = 2.0;
 pub const WHEEL_HOLD_MAX_S: f32 = 10.0;
 /// Largest duty of the high step.
 const TOP_DUTY: f32 = 0.95;
+/// A step's fit starts at least this many of the shaft's time constants after the step: its
+/// speed is then within e^-5 (0.7 %) of the step's change from the steady one. From half the
+/// step time alone, a heavy rod (tau 0.4-0.7 s) was fitted while still accelerating: its time
+/// constant identified 0.63-0.80 of the truth and its friction duty 3-16 % off (docs/control.md).
+const SETTLE_TAUS: f32 = 5.0;
+/// The latest a step's fit starts after the step, s (a time constant beyond a second and a half
+/// is no gearmotor's; the step is not held up longer for it).
+const SETTLE_MAX_S: f32 = 8.0;
 
 /// A straight line `y = b + m x` through points accumulated without storage: the slope from
 /// the first point to the last, the intercept the least-squares one for it
@@ -198,6 +207,9 @@ pub struct Commissioning {
     coast_s: f32,
     total_s: f32,
     step_at_s: f32,
+    /// When this step's fit starts, s on the axis's clock: half the step time after the step,
+    /// later for a slow shaft ([`SETTLE_TAUS`]).
+    fit_from_s: f32,
     angle_pulses: u32,
     low_fit: LineFit,
     high_fit: LineFit,
@@ -246,6 +258,7 @@ impl Commissioning {
             coast_s: 0.0,
             total_s: 0.0,
             step_at_s: 0.0,
+            fit_from_s: 0.0,
             angle_pulses: 0,
             low_fit: LineFit::default(),
             high_fit: LineFit::default(),
@@ -302,6 +315,7 @@ impl Commissioning {
             self.low_duty = self.cfg.low_duty.max(self.duty + 0.1).min(TOP_DUTY - 0.2);
             self.high_duty = self.cfg.high_duty.max(self.low_duty + 0.2).min(TOP_DUTY);
             self.phase = Phase::Low;
+            self.fit_from_s = 0.5 * self.cfg.step_time_s;
             self.t0_ticks = Some(at_ticks);
             self.angle_pulses = 0;
             return;
@@ -317,13 +331,8 @@ impl Commissioning {
             }
             return;
         }
-        let phase_start = if self.phase == Phase::Low {
-            0.0
-        } else {
-            self.step_at_s
-        };
-        // Second half of the step only: by then the speed is steady.
-        if t_s - phase_start >= 0.5 * self.cfg.step_time_s {
+        // From the step's second half only (later for a slow shaft): by then the speed is steady.
+        if t_s >= self.fit_from_s {
             self.steady_pulses += pulses;
             if self.fit_done {
                 return;
@@ -376,11 +385,18 @@ impl Commissioning {
             }
             Phase::Low => {
                 duty = self.low_duty;
-                self.fit_done |= t_s >= self.cfg.step_time_s && same_tooth(self.low_fit.count());
+                if !self.fit_done && t_s >= self.cfg.step_time_s && same_tooth(self.low_fit.count())
+                {
+                    // From the crawl the search left it at (about rest), the line's intercept
+                    // lags the step by `w_L tau`: a lower bound of the time constant.
+                    let tau = self.low_fit.solve_span().map_or(0.0, |(b, w)| -b / w);
+                    self.fit_done = self.settled(0.0, tau);
+                }
                 if self.fit_done && load_ready {
                     self.fit_done = false;
                     self.steady_pulses = 0;
                     self.step_at_s = t_s;
+                    self.fit_from_s = t_s + 0.5 * self.cfg.step_time_s;
                     self.phase = Phase::High;
                     duty = self.high_duty;
                 }
@@ -388,8 +404,13 @@ impl Commissioning {
             Phase::High => {
                 duty = self.high_duty;
                 let count = self.high_fit.count();
-                let whole_step = t_s - self.step_at_s >= self.cfg.step_time_s && same_tooth(count);
-                self.fit_done |= whole_step;
+                if !self.fit_done
+                    && t_s - self.step_at_s >= self.cfg.step_time_s
+                    && same_tooth(count)
+                {
+                    let tau = self.step_lines().map_or(0.0, |l| l.2);
+                    self.fit_done = self.settled(self.step_at_s, tau);
+                }
                 if self.fit_done && load_ready {
                     self.fit_done = false;
                     self.steady_pulses = 0;
@@ -451,10 +472,9 @@ impl Commissioning {
         self.wheels_steady = self.phase == Phase::Reaction
             && self.reaction_done_s.is_none()
             && t_s >= self.reaction_fit_from_s;
-        let held_s = 0.5 * self.cfg.step_time_s;
         self.steady_step = match self.phase {
-            Phase::Low if self.axis == 1 && t_s >= held_s => 1,
-            Phase::High if self.axis == 1 && t_s - self.step_at_s >= held_s => 2,
+            Phase::Low if self.axis == 1 && t_s >= self.fit_from_s => 1,
+            Phase::High if self.axis == 1 && t_s >= self.fit_from_s => 2,
             _ => 0,
         };
         let mut duties = [0.0; 2];
@@ -509,15 +529,40 @@ impl Commissioning {
         }
     }
 
+    /// Whether a complete fit stands: it started at least [`SETTLE_TAUS`] time constants
+    /// `tau_s` after its step at `step_s` (or [`SETTLE_MAX_S`]). If not, the step holds on and
+    /// its fit starts again from there (a revolution or so more).
+    fn settled(&mut self, step_s: f32, tau_s: f32) -> bool {
+        let from_s = step_s + (SETTLE_TAUS * tau_s).min(SETTLE_MAX_S);
+        // Not `from_s <= fit_from_s`: a time constant that is no number stands as well.
+        if !(from_s > self.fit_from_s) {
+            return true;
+        }
+        self.fit_from_s = from_s;
+        self.steady_pulses = 0;
+        if self.phase == Phase::Low {
+            self.low_fit = LineFit::default();
+        } else {
+            self.high_fit = LineFit::default();
+        }
+        false
+    }
+
+    /// The two steps' steady speeds `w_L`, `w_H` and the time constant from their lines (module
+    /// docs), `None` without both lines.
+    fn step_lines(&self) -> Option<(f32, f32, f32)> {
+        let (b_l, w_l) = self.low_fit.solve_span()?;
+        let (b_h, w_h) = self.high_fit.solve_span()?;
+        let t_s = self.step_at_s;
+        Some((
+            w_l,
+            w_h,
+            ((b_l + w_l * t_s) - (b_h + w_h * t_s)) / (w_h - w_l),
+        ))
+    }
+
     fn identify(&self) -> Result<Identified, IdentifyError> {
-        let (b_l, w_l) = self
-            .low_fit
-            .solve_span()
-            .ok_or(IdentifyError::TooFewEdges)?;
-        let (b_h, w_h) = self
-            .high_fit
-            .solve_span()
-            .ok_or(IdentifyError::TooFewEdges)?;
+        let (w_l, w_h, mut tau) = self.step_lines().ok_or(IdentifyError::TooFewEdges)?;
         let increased = w_l > 0.0 && w_h > w_l * 1.05;
         if !increased {
             return Err(IdentifyError::NoSpeedIncrease);
@@ -530,8 +575,6 @@ impl Commissioning {
         if friction_duty < 0.0 && friction_duty > -0.02 {
             friction_duty = 0.0;
         }
-        let t_s = self.step_at_s;
-        let mut tau = ((b_l + w_l * t_s) - (b_h + w_h * t_s)) / (w_h - w_l);
         // Below a millisecond the estimate is noise; the loop design only needs its order.
         if tau < 1e-3 && tau > -0.02 {
             tau = 1e-3;
