@@ -107,7 +107,9 @@ impl LineFit {
     /// offsets and a once-per-revolution load: the least-squares slope over one or two
     /// revolutions is not (it weighs the ends, so a tooth pattern tilts it: 0.2-0.6 % of the
     /// speed on family-60, more than 1 % on the slope between two steps), and its f32 sums of
-    /// squares over 20 s lose a few parts in 10^4 as well.
+    /// squares over 20 s lose a few parts in 10^4 as well. (One copy for its callers: the
+    /// firmware's flash.)
+    #[inline(never)]
     pub fn solve_span(&self) -> Option<(f32, f32)> {
         let dx = self.last.0 - self.first.0;
         if self.n < 2.0 || dx.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
