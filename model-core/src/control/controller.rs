@@ -328,14 +328,29 @@ impl Controller {
                 || (p.est.is_valid() && p.measured.abs() >= 0.5 * r0.abs())
                 || self.planner.steady_s()[0] > 1.0);
         let ramped = self.planner.step(dt, max_step, stopped, established);
-        // Spin first: its model's acceleration feeds the precession axis's decoupling.
+        // Spin first: its expected acceleration feeds the precession axis's decoupling.
         if self.axis_loop(1, ramped[1], 0.0, seen[1], dt) {
             return;
         }
-        // The spin's accelerating torque reacts on the rod; the spin model accelerates at
-        // (r - r_p) / tau2.
+        // The spin's accelerating torque reacts on the rod. Its acceleration times tau2 is
+        // expected where both its model (`(r - r_p) / tau2`) and the duty it was just given
+        // through its identified plant (its observer, with the speed and load its edges showed)
+        // say it accelerates, as the smaller of the two: a spin its stiction or material holds
+        // back accelerates less than its model, and the model's reaction drove the rod ahead;
+        // the observer alone (it knows no stiction, and learns the material slowly) fed the rod
+        // a reaction the spin did not have (docs/control.md, "The rod decoupled by what the
+        // spin does").
         let s = &self.axes[1];
-        let decouple = self.decouple_duty_per_rad_s * (ramped[1] - s.speed_loop.model_rad_s());
+        let duty = (s.duty - s.extra_duty) * s.direction;
+        let by_duty = s.direction * s.obs.drive_rad_s(&s.ok, duty);
+        let by_model = ramped[1] - s.speed_loop.model_rad_s();
+        let lag = if by_duty * by_model > 0.0 {
+            // The smaller in magnitude (`clamp` would bring a panic path into the tick).
+            by_model.min(by_duty.abs()).max(-by_duty.abs())
+        } else {
+            0.0
+        };
+        let decouple = self.decouple_duty_per_rad_s * lag;
         if self.axis_loop(0, ramped[0], decouple, seen[0], dt) {
             return;
         }

@@ -244,6 +244,14 @@ impl AngleObserver {
     pub fn driven_rad_s(&self) -> f32 {
         self.driven_rad_s
     }
+    /// The speed `duty` (in the shaft's direction, less what it holds beyond the identified
+    /// model) drives the identified plant towards, less the speed now, rad/s: the shaft's
+    /// expected acceleration times its time constant, with the load its edges showed and its
+    /// speed as they corrected it.
+    #[inline(always)]
+    pub fn drive_rad_s(&self, k: &ObserverConstants, duty: f32) -> f32 {
+        (duty - k.friction_duty - self.load_duty) / k.duty_per_rad_s - self.speed_rad_s
+    }
     /// Load the model does not know, duty.
     pub fn load_duty(&self) -> f32 {
         self.load_duty
