@@ -53,6 +53,14 @@ enum Kind {
     Cost,
 }
 
+/// Each grid with the name its counts are printed under.
+const GRIDS: [(&str, Kind); 4] = [
+    ("fitting", Kind::Fit),
+    ("held-out", Kind::Held),
+    ("rows", Kind::Row),
+    ("cost grids' bare rims", Kind::Cost),
+];
+
 /// One scene's orders.
 struct Orders {
     kind: Kind,
@@ -298,12 +306,7 @@ fn rotation_orders() {
                 .join(" ")
         };
         println!("{split}: K4 (a) {}, (b) {}", show(&ka), show(&kb));
-        for (name, kind) in [
-            ("fitting", Kind::Fit),
-            ("held-out", Kind::Held),
-            ("rows", Kind::Row),
-            ("cost grids' bare rims", Kind::Cost),
-        ] {
+        for (name, kind) in GRIDS {
             println!(
                 "  {name}: (a) corrected {}",
                 counts(&rows, kind, &corr, &bound_a)
@@ -369,12 +372,7 @@ fn rotation_orders() {
     let chooser = |o: &Orders| o.chooser_bound;
     let either = |o: &Orders| o.estimate.min(o.chooser_bound);
     let mut beyond = 0;
-    for (name, kind) in [
-        ("fitting", Kind::Fit),
-        ("held-out", Kind::Held),
-        ("rows", Kind::Row),
-        ("cost grids' bare rims", Kind::Cost),
-    ] {
+    for (name, kind) in GRIDS {
         println!(
             "  {name}: the chooser's bound alone {}",
             counts(&rows, kind, &plain, &chooser)
