@@ -155,3 +155,33 @@ fn opposite_speeds_at_a_low_tilt_do_not_take_the_incline() {
     ]);
     within(&v, r["residence_time_mean_s"].as_f64().unwrap(), 0.05);
 }
+
+#[test]
+fn a_rolling_row_the_estimate_refuses_takes_the_incline_by_its_second_order() {
+    // 30 deg, 1.8 rad/s, mu_s 0.2, 1 %: the a-priori estimate says 2.1 %, the incline is 0.53 %
+    // off (docs/model.md §12, "The four rotation rows"); the rotation's second order along the
+    // rolling path (+0.52 %) and its remainder bound it at 0.70 %: the incline, in words.
+    let (v, r) = chosen_and_reference("30", "1.8", "0.2", "0.01", &[]);
+    assert_eq!(v["chosen"], "incline", "{v}");
+    assert!(v["rotation_estimate_rel"].as_f64().unwrap() > 0.01, "{v}");
+    let bound = v["rotation_second_order_bound_rel"].as_f64().unwrap();
+    assert!(bound <= 0.01, "{v}");
+    let why = v["why"].as_str().unwrap();
+    assert!(
+        why.contains("by the rotation's second order") && why.contains("a-priori estimate"),
+        "{v}"
+    );
+    assert_eq!(v["not_cheaper"].as_array().unwrap().len(), 0, "{v}");
+    // The bound holds against the bowl model run independently at rtol 1e-10.
+    let t = v["residence_time_mean_s"].as_f64().unwrap();
+    assert!((t - r).abs() <= bound * r, "{t} vs {r}, bound {bound}");
+    within(&v, r, 0.01);
+    // At 0.1 % the bound is above the tolerance: refused, and the reason says both.
+    let (v, r) = chosen_and_reference("30", "1.8", "0.2", "0.001", &[]);
+    assert_ne!(v["chosen"], "incline", "{v}");
+    assert!(
+        reasons(&v).contains("its second order along the incline's path bounds it at"),
+        "{v}"
+    );
+    within(&v, r, 0.001);
+}

@@ -431,10 +431,29 @@ fn rod_from_rest_to_1_rad_s(
     rig: model_core::sim::PlantParams,
     seed: u32,
 ) -> model_core::sim::StepReport {
+    from_rest_to_1_rad_s(rig, seed)[0]
+}
+
+/// As [`rod_from_rest_to_1_rad_s`], both axes' step reports.
+fn from_rest_to_1_rad_s(
+    rig: model_core::sim::PlantParams,
+    seed: u32,
+) -> [model_core::sim::StepReport; 2] {
     let load = [rig.axes[0].load_step_nm, rig.axes[1].load_step_nm];
     let o = commissioned_transition(rig, ControllerConfig::nominal(), seed, 0.0, 1.0, true, load);
     assert!(o.commissioned && o.fault.is_none(), "{:?}", o.fault);
-    o.reports[0]
+    o.reports
+}
+
+/// `axis` settled within 2 % of 1 rad/s by `within_s` and never passed it by more than 2 %.
+fn assert_settled_within_2_pct_by(r: model_core::sim::StepReport, within_s: f32, axis: &str) {
+    assert!(
+        r.settled && r.settling_time_s <= within_s && r.overshoot <= 0.02,
+        "{axis} settled within 2 % of 1 rad/s at {:.2} s, {:.2} % past it (settled: {})",
+        r.settling_time_s,
+        r.overshoot * 100.0,
+        r.settled
+    );
 }
 
 /// A kick far above what the shaft needs (commissioning's breakaway duty is 2-3x the truth)
@@ -489,17 +508,8 @@ fn from_rest_a_pushed_spin_reads_the_load_at_its_second_window() {
             ],
         ],
     );
-    let load = [p11.axes[0].load_step_nm, p11.axes[1].load_step_nm];
-    let o = commissioned_transition(p11, ControllerConfig::nominal(), 5011, 0.0, 1.0, true, load);
-    assert!(o.commissioned && o.fault.is_none(), "{:?}", o.fault);
-    let spin = o.reports[1];
-    assert!(
-        spin.settled && spin.settling_time_s <= 3.0 && spin.overshoot <= 0.02,
-        "the spin settled within 2 % of 1 rad/s at {:.2} s, {:.2} % past it (settled: {})",
-        spin.settling_time_s,
-        spin.overshoot * 100.0,
-        spin.settled
-    );
+    let spin = from_rest_to_1_rad_s(p11, 5011)[1];
+    assert_settled_within_2_pct_by(spin, 3.0, "the spin");
 }
 
 /// The once-per-revolution load (load_pattern.rs) found while commissioning was fed forward
@@ -524,17 +534,8 @@ fn from_rest_the_eccentric_load_is_fed_from_the_first_edge() {
             ],
         ],
     );
-    let load = [p24.axes[0].load_step_nm, p24.axes[1].load_step_nm];
-    let o = commissioned_transition(p24, ControllerConfig::nominal(), 8024, 0.0, 1.0, true, load);
-    assert!(o.commissioned && o.fault.is_none(), "{:?}", o.fault);
-    let spin = o.reports[1];
-    assert!(
-        spin.settled && spin.settling_time_s <= 2.7 && spin.overshoot <= 0.02,
-        "the spin settled within 2 % of 1 rad/s at {:.2} s, {:.2} % past it (settled: {})",
-        spin.settling_time_s,
-        spin.overshoot * 100.0,
-        spin.settled
-    );
+    let spin = from_rest_to_1_rad_s(p24, 8024)[1];
+    assert_settled_within_2_pct_by(spin, 2.7, "the spin");
 }
 
 /// A light rod the kick ran to 1 rad/s before its first tooth (seed 5 p44: true breakaway about

@@ -19,93 +19,201 @@
 //!
 //! The mean over the twelve azimuths has no first-order part (the mirror, §12), so the rolling
 //! incline's mean moves by `mean T2` to second order. Rolling only: a sliding incline's slip
-//! has its own dynamics (not here), and the rod offset is left out (`L = 0`).
+//! has its own dynamics (not here), and the rod offset is left out (`L = 0`). The chooser
+//! (`whole::second_order_bound`) runs [`mean_second_order_from`] where its a-priori rotation
+//! estimate refuses the incline.
 
 use crate::Real;
 use crate::particle::rolling::{AZIMUTHS_DEG, RollingScene, incline_residence_s};
+
+/// `(cos beta, sin beta)` of [`AZIMUTHS_DEG`] (every 30 deg), exact to the last bit of `f64`
+/// (`libm`'s `sin`/`cos` cost about 20 ns each: 24 of them would be most of the chooser's
+/// budget for the second order, docs/model.md §12).
+const AZIMUTH_COS_SIN: [(f64, f64); 12] = {
+    const H: f64 = 0.866_025_403_784_438_6; // sqrt(3)/2
+    [
+        (1.0, 0.0),
+        (H, 0.5),
+        (0.5, H),
+        (0.0, 1.0),
+        (-0.5, H),
+        (-H, 0.5),
+        (-1.0, 0.0),
+        (-H, -0.5),
+        (-0.5, -H),
+        (0.0, -1.0),
+        (0.5, -H),
+        (H, -0.5),
+    ]
+};
+
+/// The scene's part of the orders (independent of the release), computed once per scene.
+struct Orders<T> {
+    drive: T,
+    /// `1 / drive`.
+    inv_drive: T,
+    ri: T,
+    /// `v1 = v1_k t^2`.
+    v1_k: T,
+    /// `y1 = y1_k t^3`.
+    y1_k: T,
+    /// `y2 = y2_k p0y t^2`.
+    y2_k: T,
+    /// `q0 = q0_c - q0_x p0d` (`p0x = -p0d`).
+    q0_x: T,
+    q0_c: T,
+    /// `q2 / 12`: `x2 = q0 t^2/2 + q2 t^4/12`.
+    q2_12: T,
+}
+
+impl<T: Real> Orders<T> {
+    /// `None` when the incline does not drive the granule or the release is not inside the rim.
+    /// `(s, c)`: the tilt's sine and cosine.
+    fn new(scene: &RollingScene<T>, s: T, c: T) -> Option<Self> {
+        let g = scene.g_m_s2;
+        let (k2, mu_r, a) = (scene.k2, scene.rolling_resistance, scene.particle_radius_m);
+        let (w1, w2) = (scene.precession_rad_s, scene.spin_rad_s);
+        let (big_g, nn) = (g * s, g * c);
+        let drive = k2 * (big_g - mu_r * nn);
+        if drive.is_nan() || drive <= T::ZERO {
+            return None;
+        }
+        let (ri, rim) = (scene.ri_m, scene.rim_radius_m);
+        // Also catches a NaN radius.
+        if ri.is_nan() || rim.is_nan() || ri.abs() >= rim {
+            return None;
+        }
+        let oz = w1 * c + w2;
+        let omega2 = w1 * w1 * s * s + oz * oz;
+        let inv_drive = T::ONE / drive;
+        let lambda = k2 * mu_r * nn * inv_drive;
+        let half = T::HALF;
+        // First order across the path.
+        let b = k2 * big_g * w2 + (T::ONE + k2) * oz * drive;
+        // One division for both: 1 / ((2 + lambda) (1 + lambda)).
+        let r = T::ONE / ((T::TWO + lambda) * (T::ONE + lambda));
+        let v1_k = b * (T::ONE + lambda) * r;
+        let y1_k = v1_k * T::from_f64(1.0 / 3.0);
+        // Second order across the path: y2 = k2 |Omega|^2 p0y t^2 / (2 (1 + lambda)).
+        let y2_k = k2 * omega2 * (T::TWO + lambda) * r * half;
+        // Second order along d: a2' = q0 + q2 t^2, from (x = p0x - A t^2/2 the e1 coordinate):
+        //   -k2 [G w2^2 t^2/2 + Oz^2 x - w1 s Oz a + w1 w2 s a]          (gravity turning, -C, -E)
+        //   -(1 - k2) [w1^2 s^2 A t^2/2 + a w1 w2 s]                       (spin sig1 Ox, Euler)
+        //   -k2 mu_r [(w1 w2 s + Oz w1 s) x - w1^2 s^2 a + 2 w1 s v1
+        //             - 2 w1 s w2 A t^2 - Nn v1^2 / (2 A^2 t^2)]           (normal force, direction)
+        //   -(1 + k2) Oz v1                                                (gyroscopic on v1)
+        let n_x = w1 * w2 * s + oz * w1 * s; // N2's coefficient of x
+        let q0_x = -k2 * oz * oz - k2 * mu_r * n_x;
+        let q0_c = -k2 * (-w1 * s * oz * a + w1 * w2 * s * a) - (T::ONE - k2) * a * w1 * w2 * s
+            + k2 * mu_r * w1 * w1 * s * s * a;
+        let q2 = -k2 * (big_g * w2 * w2 * half - oz * oz * drive * half)
+            - (T::ONE - k2) * w1 * w1 * s * s * drive * half
+            - k2 * mu_r
+                * (-n_x * drive * half + T::TWO * w1 * s * v1_k
+                    - T::TWO * w1 * s * w2 * drive
+                    - nn * v1_k * v1_k * half * inv_drive * inv_drive)
+            - (T::ONE + k2) * oz * v1_k;
+        Some(Orders {
+            drive,
+            inv_drive,
+            ri,
+            v1_k,
+            y1_k,
+            y2_k,
+            q0_x,
+            q0_c,
+            q2_12: q2 * T::from_f64(1.0 / 12.0),
+        })
+    }
+
+    /// The release at `(cos beta, sin beta)` whose incline time is `t` (`T0`): `(T1, T2)`,
+    /// unchecked (the callers check that what comes out is finite). No square root (the
+    /// incline's time gives the path: at the exit `x0 . d = p0d + A t^2/2`) and one division:
+    /// the chooser runs this on seven releases (the mirror pairs share `T2`).
+    #[inline(always)]
+    fn terms(&self, cb: T, sb: T, t: T) -> (T, T) {
+        let (drive, ri, half, two) = (self.drive, self.ri, T::HALF, T::TWO);
+        // Release: p0 = ri (-cos beta, -sin beta); along d = -e1 its coordinate is ri cos beta.
+        let p0d = ri * cb;
+        let p0y = -ri * sb;
+        let tt = t * t;
+        // P = x0 . d at the exit; f0' = 2 P A t, f0'' = 2 A (A t^2 + P).
+        let big_p = p0d + drive * tt * half;
+        // 1 / f0' = inv / (2 A). (One inverse of the seven products instead, measured: no
+        // faster.)
+        let inv = T::ONE / (big_p * t);
+        let f2 = two * drive * (drive * tt + big_p);
+        let y1 = self.y1_k * tt * t;
+        let v1 = self.v1_k * tt;
+        let q0 = self.q0_c - self.q0_x * p0d;
+        let x2 = tt * (q0 * half + self.q2_12 * tt);
+        let y2 = self.y2_k * p0y * tt;
+        let g1d = two * p0y * v1;
+        let g2 = two * (big_p * x2 + p0y * y2) + y1 * y1;
+        // T1 = -g1 / f0' with g1 = 2 p0y y1.
+        let t1 = -p0y * y1 * inv * self.inv_drive;
+        let t2 = -(f2 * t1 * t1 * half + g1d * t1 + g2) * inv * half * self.inv_drive;
+        (t1, t2)
+    }
+}
 
 /// The rolling incline's release at `beta_rad`: `(T0, T1, T2)`, its exit time at rest and the
 /// rotation's first- and second-order corrections (s); `None` when the incline does not drive
 /// the granule or the release is not inside the rim.
 pub fn release_second_order_s<T: Real>(scene: &RollingScene<T>, beta_rad: T) -> Option<(T, T, T)> {
-    let (s, c) = (scene.axes_angle_rad.sin(), scene.axes_angle_rad.cos());
-    let g = scene.g_m_s2;
-    let (k2, mu_r, a) = (scene.k2, scene.rolling_resistance, scene.particle_radius_m);
-    let (w1, w2) = (scene.precession_rad_s, scene.spin_rad_s);
-    let (big_g, nn) = (g * s, g * c);
-    let drive = k2 * (big_g - mu_r * nn);
-    if drive.is_nan() || drive <= T::ZERO {
-        return None;
-    }
-    let (ri, rim) = (scene.ri_m, scene.rim_radius_m);
-    // Also catches a NaN radius.
-    if ri.is_nan() || rim.is_nan() || ri.abs() >= rim {
-        return None;
-    }
-    // Release: p0 = ri (-cos beta, -sin beta); along d = -e1 its coordinate is ri cos beta.
-    let p0d = ri * beta_rad.cos();
-    let p0y = -ri * beta_rad.sin();
-    let p0x = -p0d;
-    // The incline's own exit time (its path to the rim and drive are the ones above).
-    let t0 = incline_residence_s(scene, beta_rad)?;
-    if t0 <= T::ZERO {
-        return None;
-    }
-    let oz = w1 * c + w2;
-    let omega2 = w1 * w1 * s * s + oz * oz;
-    let lambda = k2 * mu_r * nn / drive;
-    let half = T::HALF;
-    // First order across the path.
-    let b = k2 * big_g * w2 + (T::ONE + k2) * oz * drive;
-    let v1_k = b / (T::TWO + lambda); // v1 = v1_k t^2
-    let y1_k = v1_k / T::from_f64(3.0); // y1 = y1_k t^3
-    // Second order across the path: y2 = y2_k t^2.
-    let y2_k = k2 * omega2 * p0y / (T::TWO * (T::ONE + lambda));
-    // Second order along d: a2' = q0 + q2 t^2, from (x = p0x - A t^2/2 the e1 coordinate):
-    //   -k2 [G w2^2 t^2/2 + Oz^2 x - w1 s Oz a + w1 w2 s a]          (gravity turning, -C, -E)
-    //   -(1 - k2) [w1^2 s^2 A t^2/2 + a w1 w2 s]                       (spin sig1 Ox, Euler)
-    //   -k2 mu_r [(w1 w2 s + Oz w1 s) x - w1^2 s^2 a + 2 w1 s v1
-    //             - 2 w1 s w2 A t^2 - Nn v1^2 / (2 A^2 t^2)]           (normal force, direction)
-    //   -(1 + k2) Oz v1                                                (gyroscopic on v1)
-    let n_x = w1 * w2 * s + oz * w1 * s; // N2's coefficient of x
-    let q0 = -k2 * (oz * oz * p0x - w1 * s * oz * a + w1 * w2 * s * a)
-        - (T::ONE - k2) * a * w1 * w2 * s
-        - k2 * mu_r * (n_x * p0x - w1 * w1 * s * s * a);
-    let q2 = -k2 * (big_g * w2 * w2 * half - oz * oz * drive * half)
-        - (T::ONE - k2) * w1 * w1 * s * s * drive * half
-        - k2 * mu_r
-            * (-n_x * drive * half + T::TWO * w1 * s * v1_k
-                - T::TWO * w1 * s * w2 * drive
-                - nn * v1_k * v1_k / (T::TWO * drive * drive))
-        - (T::ONE + k2) * oz * v1_k;
-    // Exit time.
-    let t = t0;
-    let big_p = p0d + drive * t * t * half;
-    let f1 = T::TWO * big_p * drive * t;
-    let f2 = T::TWO * drive * drive * t * t + T::TWO * drive * big_p;
-    let y1 = y1_k * t * t * t;
-    let v1 = v1_k * t * t;
-    let x2 = q0 * t * t * half + q2 * t * t * t * t / T::from_f64(12.0);
-    let y2 = y2_k * t * t;
-    let g1 = T::TWO * p0y * y1;
-    let g1d = T::TWO * p0y * v1;
-    let g2 = T::TWO * big_p * x2 + T::TWO * p0y * y2 + y1 * y1;
-    if f1 <= T::ZERO {
-        return None;
-    }
-    let t1 = -g1 / f1;
-    let t2 = -(f2 * t1 * t1 * half + g1d * t1 + g2) / f1;
-    (t1.is_finite() && t2.is_finite()).then_some((t0, t1, t2))
+    let th = scene.axes_angle_rad;
+    let orders = Orders::new(scene, th.sin(), th.cos())?;
+    let t = incline_residence_s(scene, beta_rad)?;
+    let (t1, t2) = orders.terms(beta_rad.cos(), beta_rad.sin(), t);
+    (t > T::ZERO && t1.is_finite() && t2.is_finite()).then_some((t, t1, t2))
 }
 
 /// The rolling incline's mean over [`AZIMUTHS_DEG`] and the rotation's second-order change of
 /// it, relative: `(mean T0, mean T2 / mean T0)`.
 pub fn mean_second_order<T: Real>(scene: &RollingScene<T>) -> Option<(T, T)> {
-    let (mut t0, mut t2) = (T::ZERO, T::ZERO);
-    for deg in AZIMUTHS_DEG {
-        let (a, _, c) = release_second_order_s(scene, T::from_f64(deg.to_radians()))?;
-        t0 += a;
-        t2 += c;
+    let mut times = [T::ZERO; 12];
+    for (t, deg) in times.iter_mut().zip(AZIMUTHS_DEG) {
+        *t = incline_residence_s(scene, T::from_f64(deg.to_radians()))?;
+    }
+    mean_second_order_from(scene, &times)
+}
+
+/// [`mean_second_order`] from the rolling incline's own times at [`AZIMUTHS_DEG`] (the
+/// chooser has them from the incline it has just computed): the scene's part once, then
+/// seven releases, no trigonometry (the azimuths' from a table), no square root, one division
+/// each. `T2` is even in `sin beta` (`T1` is odd, and enters squared or times the odd `g1'`),
+/// and the azimuths at `beta` and `-beta` have the same path and time, so the pairs 30/330 to
+/// 150/210 deg count twice. (Built to cost at most a fifth of the incline, docs/model.md §12.)
+pub fn mean_second_order_from<T: Real>(scene: &RollingScene<T>, times: &[T; 12]) -> Option<(T, T)> {
+    let th = scene.axes_angle_rad;
+    tilted_second_order(scene, th.sin(), th.cos(), times)
+}
+
+/// [`mean_second_order_from`] with the tilt's sine `s` and cosine `c` already computed (the
+/// chooser's).
+pub(crate) fn tilted_second_order<T: Real>(
+    scene: &RollingScene<T>,
+    s: T,
+    c: T,
+    times: &[T; 12],
+) -> Option<(T, T)> {
+    let orders = Orders::new(scene, s, c)?;
+    // Branch-free: every time finite and positive, checked together.
+    let mut t0 = T::ZERO;
+    let mut ok = true;
+    for &t in times {
+        ok &= t.is_finite() & (t > T::ZERO);
+        t0 += t;
+    }
+    if !ok {
+        return None;
+    }
+    // Azimuths 0 to 180 deg; 30 to 150 stand for their mirrors 330 to 210 too.
+    const WEIGHT: [f64; 7] = [1.0, 2.0, 2.0, 2.0, 2.0, 2.0, 1.0];
+    let mut t2 = T::ZERO;
+    for ((&(cb, sb), &t), w) in AZIMUTH_COS_SIN.iter().zip(times).zip(WEIGHT) {
+        let (_, c) = orders.terms(T::from_f64(cb), T::from_f64(sb), t);
+        t2 += T::from_f64(w) * c;
     }
     let n = T::from_f64(AZIMUTHS_DEG.len() as f64);
     let (mean, rel) = (t0 / n, t2 / t0);

@@ -94,3 +94,55 @@ proptest::proptest! {
         }
     }
 }
+
+#[test]
+fn the_azimuth_table_is_the_azimuths_trigonometry() {
+    for (deg, (c, s)) in AZIMUTHS_DEG.iter().zip(AZIMUTH_COS_SIN) {
+        let b = deg.to_radians();
+        assert!(
+            (b.cos() - c).abs() <= 1e-15 && (b.sin() - s).abs() <= 1e-15,
+            "{deg}"
+        );
+    }
+    // The mean from the table is the mean of the releases at the azimuths' own angles.
+    let s = rig(45.0, 3.6, 3.6);
+    let (mean, rel) = mean_second_order(&s).unwrap();
+    let (mut t0, mut t2) = (0.0, 0.0);
+    for deg in AZIMUTHS_DEG {
+        let (a, _, c) = release_second_order_s(&s, deg.to_radians()).unwrap();
+        t0 += a;
+        t2 += c;
+    }
+    assert!((mean - t0 / 12.0).abs() <= 1e-14 * mean);
+    assert!(
+        (rel - t2 / t0).abs() <= 1e-12 * rel.abs(),
+        "{rel} {}",
+        t2 / t0
+    );
+}
+
+#[test]
+fn the_seven_release_pass_is_the_release_by_release_one_at_any_scale() {
+    // The mirror pairs counted twice from the incline's times give the release-by-release sum,
+    // for a bowl a million times smaller to a thousand times larger.
+    for scale in [1.0, 1e-3, 1e3, 1e-6] {
+        let s = RollingScene {
+            ri_m: 0.0375 * scale,
+            rim_radius_m: 0.075 * scale,
+            particle_radius_m: 0.0025 * scale,
+            ..rig(30.0, 1.8, -0.9)
+        };
+        let (_, rel) = mean_second_order(&s).unwrap();
+        let (mut t0, mut t2) = (0.0, 0.0);
+        for deg in AZIMUTHS_DEG {
+            let (a, _, c) = release_second_order_s(&s, deg.to_radians()).unwrap();
+            t0 += a;
+            t2 += c;
+        }
+        assert!(
+            (rel - t2 / t0).abs() <= 1e-12 * rel.abs(),
+            "{scale}: {rel} {}",
+            t2 / t0
+        );
+    }
+}

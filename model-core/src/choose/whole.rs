@@ -26,7 +26,10 @@
 //! - **the rotation** (the incline): the bowl's rotation changes `T` by about
 //!   `K (|Omega|^2 + 2 w1^2) T_incline^2 ri / (R - ri)` ([`rotation_estimate`]); `K` is measured
 //!   per mode over a grid of scenes and checked on another (docs/model.md §12), and the incline is
-//!   taken when that estimate is within the tolerance. Single releases differ far more than
+//!   taken when that estimate is within the tolerance. Where it is not and the incline rolls,
+//!   the rotation's second order along the incline's path ([`second_order_bound`], from the
+//!   incline's own times) bounds its error by `|c2| + K4 F^2`, and takes it when that is within.
+//!   Single releases differ far more than
 //!   their mean (the rotation turns each path), so the incline is only offered for the mean.
 //!
 //! A granule that rolls at release may still start to slide later; the rolling level says so
@@ -35,6 +38,8 @@
 use crate::Real;
 use crate::particle::bowl::BowlShape;
 use crate::particle::rolling::{AZIMUTHS_DEG, RollingScene, incline_residence_s};
+
+use super::incline_rotation::tilted_second_order;
 
 /// A level of the hierarchy, cheapest first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -109,8 +114,12 @@ pub struct WholeChoice<T> {
     pub level: Level,
     /// For each level below it (in [`LEVELS`] order), why not; `None` at and above `level`.
     pub cheaper_fail: [Option<Fails<T>>; 4],
-    /// The incline's estimated relative error from the rotation.
+    /// The incline's estimated relative error from the rotation (a priori, [`rotation_estimate`]).
     pub rotation_estimate: T,
+    /// Where that estimate is above the tolerance and the incline rolls: the rotation's second
+    /// order and the bound it gives ([`second_order_bound`]); the incline is taken when that
+    /// bound is within the tolerance.
+    pub second_order: Option<SecondOrder<T>>,
     /// The friction rolling needs at release (worst azimuth), as a fraction of `N`.
     pub friction_needed: T,
     /// The incline's mean `T` over [`AZIMUTHS_DEG`], s (computed for the choice: when the
@@ -184,20 +193,132 @@ pub fn rotation_estimate<T: Real>(scene: &RollingScene<T>, incline_mean_s: T) ->
 
 /// The constant of [`rotation_estimate`] for the incline's mode at the scene.
 pub fn rotation_constant<T: Real>(scene: &RollingScene<T>) -> T {
+    mode_constant(incline_mode(scene))
+}
+
+/// [`rotation_estimate`] with the incline's mode already known.
+fn estimate_in<T: Real>(
+    scene: &RollingScene<T>,
+    tilt: Tilt<T>,
+    incline_mean_s: T,
+    mode: InclineMode,
+) -> T {
+    mode_constant::<T>(mode) * form_in(scene, tilt, incline_mean_s)
+        + T::from_f64(ROTATION_K_ROD) * rod_form(scene, incline_mean_s)
+}
+
+fn mode_constant<T: Real>(mode: InclineMode) -> T {
+    T::from_f64(match mode {
+        InclineMode::Slides => ROTATION_K_SLIDING,
+        InclineMode::NearAtRim | InclineMode::NearAtRest => ROTATION_K_NEAR_SLIDING,
+        InclineMode::Rolls => ROTATION_K,
+    })
+}
+
+/// The incline's mode at the scene, as the rotation's bounds have it (docs/model.md §12).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InclineMode {
+    /// It rolls, and keeps rolling to the rim (rolling needs at most [`NEAR_SLIDING`] of
+    /// `mu_s` there, [`friction_needed_at_rim`]).
+    Rolls,
+    /// It slides (`(1 - k2) tan th > mu_s`).
+    Slides,
+    /// It rolls, and only the rotation brings it near or past the stick threshold at the rim.
+    NearAtRim,
+    /// It rolls, but is near the stick threshold already at rest (`(1 - k2) tan th` above
+    /// [`NEAR_SLIDING`] of `mu_s`): any rotation makes it slide part of the way, and `T` is
+    /// not smooth in the speeds.
+    NearAtRest,
+}
+
+/// The incline's mode at the scene ([`InclineMode`]).
+pub fn incline_mode<T: Real>(scene: &RollingScene<T>) -> InclineMode {
+    mode_in(scene, Tilt::of(scene))
+}
+
+fn mode_in<T: Real>(scene: &RollingScene<T>, tilt: Tilt<T>) -> InclineMode {
     let mu_s = scene.sliding_friction;
-    let k = if incline_friction_needed(scene) > mu_s {
-        ROTATION_K_SLIDING
-    } else if friction_needed_at_rim(scene) > T::from_f64(NEAR_SLIDING) * mu_s {
-        ROTATION_K_NEAR_SLIDING
+    let near = T::from_f64(NEAR_SLIDING) * mu_s;
+    let at_rest = (T::ONE - scene.k2) * tilt.sin / tilt.cos;
+    if at_rest > mu_s {
+        InclineMode::Slides
+    } else if needed_at(scene, tilt, scene.rim_radius_m) > near {
+        if at_rest > near {
+            InclineMode::NearAtRest
+        } else {
+            InclineMode::NearAtRim
+        }
     } else {
-        ROTATION_K
+        InclineMode::Rolls
+    }
+}
+
+/// `K4` of the second-order bound ([`second_order_bound`]) where the incline rolls to the rim:
+/// the least that covers `err - |c2|` per unit of `F^2` ([`rotation_form`] squared) over those
+/// scenes of the fitting grid (the rotation estimate's 294 scenes; `c2` the closed form's,
+/// [`mean_second_order_from`](super::incline_rotation::mean_second_order_from); the error
+/// against the rolling-or-sliding disc): 6.93e-4, rounded up (docs/model.md §12, `lab`
+/// `whole::rotation_orders::rotation_orders`, which fits it, asserts this covers it and that
+/// no fitting or held-out scene is taken beyond a tolerance).
+pub const SECOND_ORDER_K4: f64 = 0.0007;
+
+/// [`SECOND_ORDER_K4`] where only the rotation brings the granule near the stick threshold at
+/// the rim ([`InclineMode::NearAtRim`]): 3.14e-3 on the fitting grid, rounded up.
+pub const SECOND_ORDER_K4_NEAR_RIM: f64 = 0.0032;
+
+/// The rotation's second order along the rolling incline's path, and the bound it gives the
+/// plain incline's error.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SecondOrder<T> {
+    /// `c2`: the rotation's second-order change of the incline's mean `T` (relative,
+    /// [`mean_second_order_from`](super::incline_rotation::mean_second_order_from); the first order is zero in the mean).
+    pub c2: T,
+    /// The bound on the plain incline's error: `|c2| + K4 F^2`.
+    pub bound: T,
+}
+
+/// The bound [`SecondOrder`] on the plain incline's relative error in the mean `T`, where the
+/// incline rolls ([`InclineMode::Rolls`] or [`InclineMode::NearAtRim`]) and the bowl turns on
+/// its own axis (no rod offset); `None` elsewhere (a sliding incline's slip has its own
+/// dynamics, not written; near the threshold at rest `T` is not smooth in the speeds).
+/// `times` are the incline's at [`AZIMUTHS_DEG`] ([`incline_times_s`]).
+pub fn second_order_bound<T: Real>(
+    scene: &RollingScene<T>,
+    times: &[T; 12],
+    incline_mean_s: T,
+    mode: InclineMode,
+) -> Option<SecondOrder<T>> {
+    bound_in(scene, Tilt::of(scene), times, incline_mean_s, mode)
+}
+
+fn bound_in<T: Real>(
+    scene: &RollingScene<T>,
+    tilt: Tilt<T>,
+    times: &[T; 12],
+    incline_mean_s: T,
+    mode: InclineMode,
+) -> Option<SecondOrder<T>> {
+    let k4 = match mode {
+        InclineMode::Rolls => SECOND_ORDER_K4,
+        InclineMode::NearAtRim => SECOND_ORDER_K4_NEAR_RIM,
+        InclineMode::Slides | InclineMode::NearAtRest => return None,
     };
-    T::from_f64(k)
+    if scene.rod_length_m != T::ZERO {
+        return None;
+    }
+    let (_, c2) = tilted_second_order(scene, tilt.sin, tilt.cos, times)?;
+    let f = form_in(scene, tilt, incline_mean_s);
+    let bound = c2.abs() + T::from_f64(k4) * f * f;
+    bound.is_finite().then_some(SecondOrder { c2, bound })
 }
 
 /// [`rotation_estimate`] without its constant: `(|Omega|^2 + 2 w1^2) T^2 ri / (R - ri)`.
 pub fn rotation_form<T: Real>(scene: &RollingScene<T>, incline_mean_s: T) -> T {
-    let w = scene.combined_speed_rad_s();
+    form_in(scene, Tilt::of(scene), incline_mean_s)
+}
+
+fn form_in<T: Real>(scene: &RollingScene<T>, tilt: Tilt<T>, incline_mean_s: T) -> T {
+    let w = tilt.combined_speed(scene);
     let w1 = scene.precession_rad_s;
     let path = scene.rim_radius_m - scene.ri_m;
     // Also catches a NaN path.
@@ -211,18 +332,32 @@ pub fn rotation_form<T: Real>(scene: &RollingScene<T>, incline_mean_s: T) -> T {
 /// The incline's mean residence time over the release azimuths (rolling or sliding as its
 /// friction allows), s; `None` when it does not move the granule.
 pub fn incline_mean_s<T: Real>(scene: &RollingScene<T>) -> Option<T> {
-    let mut sum = T::ZERO;
-    for deg in AZIMUTHS_DEG {
-        sum += incline_release_s(scene, T::from_f64(deg.to_radians()))?;
+    incline_times_s(scene).map(|t| mean_of(&t))
+}
+
+/// The incline's residence time at each of [`AZIMUTHS_DEG`] ([`incline_release_s`]), s; `None`
+/// when it does not move the granule.
+pub fn incline_times_s<T: Real>(scene: &RollingScene<T>) -> Option<[T; 12]> {
+    let mut times = [T::ZERO; 12];
+    for (t, deg) in times.iter_mut().zip(AZIMUTHS_DEG) {
+        *t = incline_release_s(scene, T::from_f64(deg.to_radians()))?;
     }
-    Some(sum / T::from_f64(AZIMUTHS_DEG.len() as f64))
+    Some(times)
+}
+
+fn mean_of<T: Real>(times: &[T; 12]) -> T {
+    let mut sum = T::ZERO;
+    for &t in times {
+        sum += t;
+    }
+    sum / T::from_f64(AZIMUTHS_DEG.len() as f64)
 }
 
 /// The friction rolling down the incline needs, as a fraction of the normal force:
 /// `(1 - k2) tan th` (resistance aside, as the slide test of §10).
 pub fn incline_friction_needed<T: Real>(scene: &RollingScene<T>) -> T {
-    let th = scene.axes_angle_rad;
-    (T::ONE - scene.k2) * th.sin() / th.cos()
+    let tilt = Tilt::of(scene);
+    (T::ONE - scene.k2) * tilt.sin / tilt.cos
 }
 
 /// One release down the incline: rolling, or sliding where rolling needs more than `mu_s`.
@@ -246,11 +381,41 @@ pub fn incline_release_s<T: Real>(scene: &RollingScene<T>, beta_rad: T) -> Optio
 /// (the centrifugal push `omega^2 ri` is taken by the contact like gravity's in-plane part,
 /// `(1 - k2)` of it).
 pub fn friction_needed_at_release<T: Real>(scene: &RollingScene<T>) -> T {
-    let th = scene.axes_angle_rad;
-    let w = scene.combined_speed_rad_s();
+    needed_at(scene, Tilt::of(scene), scene.ri_m)
+}
+
+/// The tilt's sine and cosine, computed once per choice (every check needs them; `libm`'s
+/// calls, repeated in each, were a tenth of the incline's own cost).
+#[derive(Clone, Copy)]
+struct Tilt<T> {
+    sin: T,
+    cos: T,
+}
+
+impl<T: Real> Tilt<T> {
+    fn of(scene: &RollingScene<T>) -> Self {
+        let th = scene.axes_angle_rad;
+        Tilt {
+            sin: th.sin(),
+            cos: th.cos(),
+        }
+    }
+
+    /// [`RollingScene::combined_speed_rad_s`].
+    fn combined_speed(self, scene: &RollingScene<T>) -> T {
+        let (w1, w2) = (scene.precession_rad_s, scene.spin_rad_s);
+        (w1 * w1 + w2 * w2 + T::TWO * w1 * w2 * self.cos)
+            .max(T::ZERO)
+            .sqrt()
+    }
+}
+
+/// [`friction_needed_at_release`] for a release at `radius_m`.
+fn needed_at<T: Real>(scene: &RollingScene<T>, tilt: Tilt<T>, radius_m: T) -> T {
+    let w = tilt.combined_speed(scene);
     let g = scene.g_m_s2;
-    let in_plane = g * th.sin() + w * w * scene.ri_m;
-    let normal = g * th.cos();
+    let in_plane = g * tilt.sin + w * w * radius_m;
+    let normal = g * tilt.cos;
     if normal <= T::ZERO {
         return T::from_f64(f64::INFINITY);
     }
@@ -278,8 +443,10 @@ pub fn choose_level<T: Real>(
     each_release: bool,
 ) -> WholeChoice<T> {
     let mut fails = [None; 4];
-    let needed = friction_needed_at_release(scene);
+    let tilt = Tilt::of(scene);
+    let needed = needed_at(scene, tilt, scene.ri_m);
     let mut rotation_estimate = T::from_f64(f64::INFINITY);
+    let mut second_order = None;
     // The rotation estimate is calibrated where it is at most 10 % (docs/model.md §12); a
     // tolerance above that would reach beyond it.
     let tolerance = tolerance.min(T::from_f64(0.1));
@@ -298,28 +465,43 @@ pub fn choose_level<T: Real>(
             level: Level::Bowl,
             cheaper_fail: fails,
             rotation_estimate,
+            second_order,
             friction_needed: needed,
             incline_mean_s: None,
         };
     }
     let slides = needed > scene.sliding_friction;
     // The incline: its own friction check is inside it; the rotation decides.
-    let incline = incline_mean_s(scene);
-    fails[0] = match incline {
-        None => Some(Fails::NoDrive),
-        Some(_) if each_release => Some(Fails::EachRelease),
-        Some(t) => {
-            rotation_estimate = self::rotation_estimate(scene, t);
-            (rotation_estimate > tolerance).then_some(Fails::Rotation {
-                estimate: rotation_estimate,
-            })
+    let times = incline_times_s(scene);
+    let incline = times.as_ref().map(mean_of);
+    fails[0] = match (incline, times) {
+        (Some(_), _) if each_release => Some(Fails::EachRelease),
+        (Some(t), Some(times)) => {
+            let mode = mode_in(scene, tilt);
+            rotation_estimate = estimate_in(scene, tilt, t, mode);
+            if rotation_estimate > tolerance {
+                // The a-priori estimate refuses it: the rotation's second order along the
+                // incline's path may still bound it within (docs/model.md §12, "The four
+                // rotation rows"); only here, so the rows taken by the estimate pay nothing.
+                second_order = bound_in(scene, tilt, &times, t, mode);
+                match second_order {
+                    Some(b) if b.bound <= tolerance => None,
+                    _ => Some(Fails::Rotation {
+                        estimate: rotation_estimate,
+                    }),
+                }
+            } else {
+                None
+            }
         }
+        _ => Some(Fails::NoDrive),
     };
     if fails[0].is_none() {
         return WholeChoice {
             level: Level::Incline,
             cheaper_fail: fails,
             rotation_estimate,
+            second_order,
             friction_needed: needed,
             incline_mean_s: incline,
         };
@@ -333,6 +515,7 @@ pub fn choose_level<T: Real>(
             level: Level::RollingOrSliding,
             cheaper_fail: fails,
             rotation_estimate,
+            second_order,
             friction_needed: needed,
             incline_mean_s: incline,
         };
@@ -341,146 +524,12 @@ pub fn choose_level<T: Real>(
         level: Level::Rolling,
         cheaper_fail: fails,
         rotation_estimate,
+        second_order,
         friction_needed: needed,
         incline_mean_s: incline,
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn rig(tilt_deg: f64, w: f64) -> RollingScene<f64> {
-        RollingScene::with_speeds(w, w, tilt_deg.to_radians(), 0.075)
-    }
-
-    fn bare() -> BowlShape<f64> {
-        BowlShape {
-            wall_angle_rad: core::f64::consts::FRAC_PI_2,
-            wall_height_m: 0.0,
-            fillet_radius_m: 0.0,
-            restitution: 0.5,
-        }
-    }
-
-    #[test]
-    fn the_sliding_incline_is_its_closed_form() {
-        // 60 deg, mu_s 0.4: (2/7) tan 60 = 0.495 > 0.4, so it slides at g (sin - 0.4 cos).
-        let s = rig(60.0, 0.0);
-        let beta = 0.0f64;
-        let a = 9.81 * (60f64.to_radians().sin() - 0.4 * 60f64.to_radians().cos());
-        let path = -0.0375 + 0.075; // downhill release: straight out
-        let t = (2.0 * path / a).sqrt();
-        let got = incline_release_s(&s, beta).unwrap();
-        assert!((got - t).abs() < 1e-12 * t, "{got} vs {t}");
-        // 30 deg: (2/7) tan 30 = 0.165 < 0.4: rolls at 5/7 g (sin - 0.029 cos).
-        let s = rig(30.0, 0.0);
-        let a = 5.0 / 7.0 * 9.81 * (30f64.to_radians().sin() - 0.029 * 30f64.to_radians().cos());
-        let t = (2.0 * path / a).sqrt();
-        let got = incline_release_s(&s, beta).unwrap();
-        assert!((got - t).abs() < 1e-12 * t, "{got} vs {t}");
-    }
-
-    #[test]
-    fn a_wall_needs_the_bowl_and_says_where_its_lip_is() {
-        let shape = BowlShape {
-            wall_angle_rad: 60f64.to_radians(),
-            wall_height_m: 0.02,
-            ..bare()
-        };
-        let c = choose_level(&rig(60.0, 2.0), &shape, 0.5, false);
-        assert_eq!(c.level, Level::Bowl);
-        let Some(Fails::Wall { lip_m, rim_m, .. }) = c.cheaper_fail[0] else {
-            panic!("{c:?}");
-        };
-        assert!((lip_m - (0.075 + 0.02 / 3f64.sqrt())).abs() < 1e-12 && rim_m == 0.075);
-        assert!(c.cheaper_fail[3].is_none());
-    }
-
-    #[test]
-    fn tight_tolerances_at_the_rigs_tilt_need_the_sliding_disc() {
-        let c = choose_level(&rig(60.0, 2.0), &bare(), 1e-4, false);
-        assert_eq!(c.level, Level::RollingOrSliding);
-        assert!(matches!(c.cheaper_fail[0], Some(Fails::Rotation { .. })));
-        assert!(matches!(c.cheaper_fail[1], Some(Fails::Slides { .. })));
-        // At 30 deg it rolls.
-        let c = choose_level(&rig(30.0, 2.0), &bare(), 1e-4, false);
-        assert_eq!(c.level, Level::Rolling);
-        // Single releases never take the incline.
-        let c = choose_level(&rig(60.0, 0.5), &bare(), 0.5, true);
-        assert_eq!(c.cheaper_fail[0], Some(Fails::EachRelease));
-    }
-
-    #[test]
-    fn opposite_speeds_at_a_low_tilt_refuse_the_incline() {
-        // 5 deg, w1 3.6, w2 -2.7 rad/s: |Omega| is 0.9 rad/s but the precession turns the
-        // downhill direction; the incline is 7.2 % off the disc (docs/model.md §12), so a 5 %
-        // tolerance must not take it (K (Omega T)^2 alone said 0.7 %).
-        let s = RollingScene {
-            spin_rad_s: -2.7,
-            ..rig(5.0, 3.6)
-        };
-        let c = choose_level(&s, &bare(), 0.05, false);
-        assert!(
-            matches!(c.cheaper_fail[0], Some(Fails::Rotation { estimate }) if estimate > 0.072),
-            "{c:?}"
-        );
-        // A release near the rim is moved more by the rotation than one near the axis.
-        let near_rim = RollingScene {
-            ri_m: 0.06,
-            ..rig(30.0, 1.0)
-        };
-        let near_axis = RollingScene {
-            ri_m: 0.015,
-            ..rig(30.0, 1.0)
-        };
-        let t = |s: &RollingScene<f64>| rotation_estimate(s, incline_mean_s(s).unwrap());
-        assert!(t(&near_rim) > 4.0 * t(&near_axis));
-        // No path inside the rim: no estimate that could take the incline.
-        let outside = RollingScene {
-            ri_m: 0.075,
-            ..rig(30.0, 1.0)
-        };
-        assert!(rotation_estimate(&outside, 0.1).is_infinite());
-    }
-
-    #[test]
-    fn a_rod_offset_refuses_the_incline_where_its_circling_matters() {
-        // 60 deg at 1.8 rad/s: the incline is 0.21 % off on the axis, 6.3 % with the bowl's
-        // centre 0.3 m off it (docs/model.md §12): 5 % is met on the axis, not off it.
-        let on_axis = rig(60.0, 1.8);
-        assert_eq!(
-            choose_level(&on_axis, &bare(), 0.05, false).level,
-            Level::Incline
-        );
-        let off = RollingScene {
-            rod_length_m: 0.3,
-            ..on_axis
-        };
-        let c = choose_level(&off, &bare(), 0.05, false);
-        assert!(
-            matches!(c.cheaper_fail[0], Some(Fails::Rotation { estimate }) if estimate > 0.063),
-            "{c:?}"
-        );
-    }
-
-    #[test]
-    fn a_switch_on_the_way_out_is_seen_before_the_run() {
-        // 60 deg at 3.6 rad/s: rolling needs 0.580 at release and 0.664 at the rim.
-        let s = RollingScene {
-            sliding_friction: 0.6,
-            ..rig(60.0, 3.6)
-        };
-        let (a, b) = (friction_needed_at_release(&s), friction_needed_at_rim(&s));
-        assert!(
-            (a - 0.580).abs() < 1e-3 && (b - 0.664).abs() < 1e-3,
-            "{a} {b}"
-        );
-    }
-
-    #[test]
-    fn a_loose_tolerance_takes_the_incline() {
-        let c = choose_level(&rig(60.0, 0.5), &bare(), 0.05, false);
-        assert_eq!(c.level, Level::Incline, "{c:?}");
-    }
-}
+#[path = "whole_tests.rs"]
+mod tests;

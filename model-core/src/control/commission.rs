@@ -69,10 +69,10 @@ const TOP_DUTY: f32 = 0.95;
 /// speed is then within e^-5 (0.7 %) of the step's change from the steady one. From half the
 /// step time alone, a heavy rod (tau 0.4-0.7 s) was fitted while still accelerating: its time
 /// constant identified 0.63-0.80 of the truth and its friction duty 3-16 % off (docs/control.md).
-const SETTLE_TAUS: f32 = 5.0;
+pub const SETTLE_TAUS: f32 = 5.0;
 /// The latest a step's fit starts after the step, s (a time constant beyond a second and a half
 /// is no gearmotor's; the step is not held up longer for it).
-const SETTLE_MAX_S: f32 = 8.0;
+pub const SETTLE_MAX_S: f32 = 8.0;
 
 /// A straight line `y = b + m x` through points accumulated without storage: the slope from
 /// the first point to the last, the intercept the least-squares one for it
@@ -536,8 +536,8 @@ impl Commissioning {
     /// its fit starts again from there (a revolution or so more).
     fn settled(&mut self, step_s: f32, tau_s: f32) -> bool {
         let from_s = step_s + (SETTLE_TAUS * tau_s).min(SETTLE_MAX_S);
-        // Not `from_s <= fit_from_s`: a time constant that is no number stands as well.
-        if !(from_s > self.fit_from_s) {
+        // A time constant that is no number stands as well.
+        if from_s.is_nan() || from_s <= self.fit_from_s {
             return true;
         }
         self.fit_from_s = from_s;

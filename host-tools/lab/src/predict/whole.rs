@@ -69,6 +69,26 @@ pub fn fails_words(f: &Fails<f64>, tolerance: f64) -> String {
     }
 }
 
+/// Why the incline holds, in words: the a-priori estimate, or where that is above the
+/// tolerance, the rotation's second order along the incline's path and its bound.
+fn incline_words(choice: &WholeChoice<f64>) -> String {
+    match choice.second_order {
+        Some(b) => format!(
+            "the cheapest model, and within the tolerance by the rotation's second order: along \
+             the incline's rolling path the bowl's rotation changes T by {:+.3} %, so the \
+             incline is off by at most {:.3} % (the a-priori estimate, {:.3} %, was above the \
+             tolerance)",
+            100.0 * b.c2,
+            100.0 * b.bound,
+            100.0 * choice.rotation_estimate
+        ),
+        None => format!(
+            "the cheapest model, and within the tolerance: the rotation changes T by up to {:.3} %",
+            100.0 * choice.rotation_estimate
+        ),
+    }
+}
+
 /// What the chosen level gave.
 pub(crate) struct Answer {
     level: Level,
@@ -312,14 +332,23 @@ fn report(
     let rejected: Vec<(Level, String)> = LEVELS
         .iter()
         .zip(choice.cheaper_fail)
-        .filter_map(|(l, f)| f.map(|f| (*l, fails_words(&f, tolerance))))
+        .filter_map(|(l, f)| {
+            f.map(|f| {
+                let mut w = fails_words(&f, tolerance);
+                if let (Fails::Rotation { .. }, Some(b)) = (f, choice.second_order) {
+                    w.push_str(&format!(
+                        "; its second order along the incline's path bounds it at {:.2} %, \
+                         also above",
+                        100.0 * b.bound
+                    ));
+                }
+                (*l, w)
+            })
+        })
         .chain(a.escalated.as_ref().map(|w| (Level::Rolling, w.clone())))
         .collect();
     let why = if rejected.is_empty() {
-        format!(
-            "the cheapest model, and within the tolerance: the rotation changes T by up to {:.3} %",
-            100.0 * choice.rotation_estimate
-        )
+        incline_words(choice)
     } else {
         let (l, w) = &rejected[rejected.len() - 1];
         format!("not the {} model: {w}", l.name())
@@ -332,6 +361,8 @@ fn report(
             "why": why,
             "not_cheaper": rejected.iter().map(|(l, w)| json!({"model": l.name(), "why": w})).collect::<Vec<Value>>(),
             "rotation_estimate_rel": choice.rotation_estimate.is_finite().then_some(choice.rotation_estimate),
+            "rotation_second_order_rel": choice.second_order.map(|b| b.c2),
+            "rotation_second_order_bound_rel": choice.second_order.map(|b| b.bound),
             "friction_needed_at_release": choice.friction_needed,
             "residence_time_mean_s": mean, "residence_time_min_s": min,
             "residence_time_max_s": max, "releases": a.times.len(),
@@ -358,8 +389,8 @@ fn report(
     }
     if a.level == Level::Incline {
         println!(
-            "  the incline holds: the bowl's rotation changes T by up to {:.3} % (docs/model.md §12)",
-            100.0 * choice.rotation_estimate
+            "  the incline holds: {} (docs/model.md §12)",
+            incline_words(choice)
         );
     }
     match (mean, min, max) {

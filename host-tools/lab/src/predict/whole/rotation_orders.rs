@@ -21,8 +21,12 @@
 //!   (`F` = [`rotation_form`], the rotation's size; the remainder is fourth order);
 //!   (b) the plain incline, its error bounded by `|c2| + K4 F^2`.
 //!
-//! `c2` comes from integrating the disc here: this measures what a closed form would give,
-//! it is not one (docs/model.md §12 says what is not built).
+//! `c2` comes from integrating the disc here: this measures what a closed form would give.
+//! The closed form (model-core `choose::incline_rotation`, rolling only) is what the chooser
+//! runs where the a-priori estimate refuses the incline: (b) with the closed-form `c2`, its
+//! `K4` per mode fitted here on the fitting grid (model-core's `SECOND_ORDER_K4` and
+//! `SECOND_ORDER_K4_NEAR_RIM` must cover it), and no scene of the fitting or held-out grids
+//! taken beyond a tolerance (asserted).
 //!
 //! `cargo test --release -p lab whole::rotation_orders -- --ignored --nocapture` (with §12's
 //! `--config` flags; prints `ORDERS,...` per scene, the counts per tolerance, the bounds on
@@ -31,7 +35,8 @@
 //! [`rotation_form`]: model_core::choose::whole::rotation_form
 
 use model_core::choose::whole::{
-    friction_needed_at_rim, incline_mean_s, rotation_constant, rotation_estimate, rotation_form,
+    InclineMode, SECOND_ORDER_K4, SECOND_ORDER_K4_NEAR_RIM, friction_needed_at_rim, incline_mean_s,
+    incline_mode, incline_times_s, rotation_estimate, rotation_form, second_order_bound,
 };
 
 use super::rotation_fit::{Row, disc_times_s, fitting_grid, held_out_grid, scene};
@@ -47,6 +52,14 @@ enum Kind {
     /// The cost grids' bare-rim scenes (docs/model.md §12).
     Cost,
 }
+
+/// Each grid with the name its counts are printed under.
+const GRIDS: [(&str, Kind); 4] = [
+    ("fitting", Kind::Fit),
+    ("held-out", Kind::Held),
+    ("rows", Kind::Row),
+    ("cost grids' bare rims", Kind::Cost),
+];
 
 /// One scene's orders.
 struct Orders {
@@ -69,6 +82,9 @@ struct Orders {
     mirror: f64,
     /// `c2` from the closed form of `model_core::choose::incline_rotation` (rolling only).
     closed: f64,
+    /// The chooser's bound on the plain incline's error from the closed form
+    /// (`second_order_bound`; infinite where it gives none).
+    chooser_bound: f64,
 }
 
 fn scaled(s: &RollingScene<f64>, k: f64) -> RollingScene<f64> {
@@ -118,6 +134,9 @@ fn orders(name: &str, kind: Kind, r: Row) -> Option<Orders> {
         estimate: rotation_estimate(&s, t0),
         mirror,
         closed,
+        chooser_bound: incline_times_s(&s)
+            .and_then(|ts| second_order_bound(&s, &ts, t0, incline_mode(&s)))
+            .map_or(f64::INFINITY, |b| b.bound),
     };
     println!(
         "ORDERS,{name},{tilt},{w1},{w2},{mu_s},{ri},{rim},mode {},rim need {:.4},F {:.4},err {:.3e},D(1) {:.3e},c2 {:.3e},corrected err {:.3e},estimate {:.3e},mirror {mirror:.1e},odd per release {odd:.3e},closed c2 {closed:.3e}",
@@ -135,25 +154,14 @@ fn orders(name: &str, kind: Kind, r: Row) -> Option<Orders> {
 
 /// The incline's modes as the rotation estimate has them (0 rolls to the rim, 1 slides, 2 near
 /// the stick threshold), with the last split in two: 2 where the rotation brings the granule
-/// near it at the rim, 3 where the incline itself is near it at rest (rolling needs more than
-/// [`NEAR_SLIDING`] of `mu_s` without any rotation).
-///
-/// [`NEAR_SLIDING`]: model_core::choose::whole::NEAR_SLIDING
+/// near it at the rim, 3 where the incline itself is near it at rest (model-core
+/// `choose::whole::incline_mode`).
 fn mode_of(s: &RollingScene<f64>) -> usize {
-    use model_core::choose::whole::{
-        NEAR_SLIDING, ROTATION_K_NEAR_SLIDING, ROTATION_K_SLIDING, incline_friction_needed,
-    };
-    let k = rotation_constant(s);
-    if k == ROTATION_K_SLIDING {
-        1
-    } else if k == ROTATION_K_NEAR_SLIDING {
-        if incline_friction_needed(s) > NEAR_SLIDING * s.sliding_friction {
-            3
-        } else {
-            2
-        }
-    } else {
-        0
+    match incline_mode(s) {
+        InclineMode::Rolls => 0,
+        InclineMode::Slides => 1,
+        InclineMode::NearAtRim => 2,
+        InclineMode::NearAtRest => 3,
     }
 }
 
@@ -298,12 +306,7 @@ fn rotation_orders() {
                 .join(" ")
         };
         println!("{split}: K4 (a) {}, (b) {}", show(&ka), show(&kb));
-        for (name, kind) in [
-            ("fitting", Kind::Fit),
-            ("held-out", Kind::Held),
-            ("rows", Kind::Row),
-            ("cost grids' bare rims", Kind::Cost),
-        ] {
+        for (name, kind) in GRIDS {
             println!(
                 "  {name}: (a) corrected {}",
                 counts(&rows, kind, &corr, &bound_a)
@@ -352,6 +355,49 @@ fn rotation_orders() {
             );
         }
     }
+    // The chooser's bound (model-core `second_order_bound`): (b) with the closed-form c2, where
+    // the incline rolls to the rim or only the rotation brings it near the threshold there.
+    // Its K4 per mode is fitted here on the fitting grid; model-core's constants must cover it.
+    let kc = fitted(&rows, &four, &|o: &Orders| {
+        if o.closed.is_finite() {
+            (o.err - o.closed.abs()).max(0.0)
+        } else {
+            f64::NAN
+        }
+    });
+    println!(
+        "the chooser's bound |c2 closed| + K4 F^2: K4 fitted {:.3e} (rolls), {:.3e} (near at the rim); model-core {SECOND_ORDER_K4:e}, {SECOND_ORDER_K4_NEAR_RIM:e}",
+        kc[0], kc[2]
+    );
+    let chooser = |o: &Orders| o.chooser_bound;
+    let either = |o: &Orders| o.estimate.min(o.chooser_bound);
+    let mut beyond = 0;
+    for (name, kind) in GRIDS {
+        println!(
+            "  {name}: the chooser's bound alone {}",
+            counts(&rows, kind, &plain, &chooser)
+        );
+        println!(
+            "  {name}: the chooser (estimate, else the bound) {}; today {}",
+            counts(&rows, kind, &plain, &either),
+            counts(&rows, kind, &plain, &today)
+        );
+        beyond += rows
+            .iter()
+            .filter(|o| o.kind == kind && (kind == Kind::Fit || kind == Kind::Held))
+            .filter(|o| {
+                [0.05, 0.01, 0.001]
+                    .iter()
+                    .any(|&t| either(o) <= t && o.err > t)
+            })
+            .count();
+    }
+    for o in rows.iter().filter(|o| o.kind == Kind::Row) {
+        println!(
+            "  row {}: the chooser's bound {:.2e} (c2 closed {:.2e}, the error {:.2e})",
+            o.label, o.chooser_bound, o.closed, o.err
+        );
+    }
     // What a bound may cost on the rows it is to take: within 1.25x of the plain incline
     // leaves a quarter of the incline's own time (1000 calls, best of 5).
     let s = scene((60.0, 3.6, 3.6, 0.4, 0.0375, 0.075));
@@ -366,10 +412,15 @@ fn rotation_orders() {
             })
             .fold(f64::INFINITY, f64::min)
     };
+    // The second order as the chooser runs it: from the incline's own times.
+    let times = incline_times_s(&s).unwrap();
     let second = time(&|| {
-        std::hint::black_box(model_core::choose::incline_rotation::mean_second_order(
-            std::hint::black_box(&s),
-        ));
+        std::hint::black_box(
+            model_core::choose::incline_rotation::mean_second_order_from(
+                std::hint::black_box(&s),
+                &times,
+            ),
+        );
     });
     let incline = time(&|| {
         std::hint::black_box(incline_mean_s(std::hint::black_box(&s)));
@@ -382,9 +433,38 @@ fn rotation_orders() {
             false,
         ));
     });
+    // A rolling row the a-priori estimate refuses at 1 % and the second order takes: the
+    // choice there runs the incline, its checks and the second order.
+    let r = scene((30.0, 1.8, 1.8, 0.2, 0.0375, 0.075));
+    let incline_r = time(&|| {
+        std::hint::black_box(incline_mean_s(std::hint::black_box(&r)));
+    });
+    let choice_r = time(&|| {
+        std::hint::black_box(choose_level(
+            std::hint::black_box(&r),
+            &BowlShape::bare_rim(),
+            0.01,
+            false,
+        ));
+    });
+    assert!(
+        choose_level(&r, &BowlShape::bare_rim(), 0.01, false)
+            .second_order
+            .is_some()
+    );
     println!(
         "the incline {incline:.2e} s, the choice (with it) {choice:.2e} s, the closed-form second \
-         order {second:.2e} s per call"
+         order from the incline's times {second:.2e} s per call; on 30 deg, 1.8 rad/s, mu_s 0.2 at 1 %: the incline \
+         {incline_r:.2e} s, the choice taking it by the second order {choice_r:.2e} s ({:.2}x)",
+        choice_r / incline_r
+    );
+    assert!(
+        kc[0] <= SECOND_ORDER_K4 && kc[2] <= SECOND_ORDER_K4_NEAR_RIM,
+        "model-core's K4 does not cover the fitting grid: {kc:?}"
+    );
+    assert_eq!(
+        beyond, 0,
+        "taken beyond the tolerance on the fitting or held-out grid"
     );
     // The mirror holds on every scene to the integrator's tolerance (rtol 1e-10 per release;
     // 1.9e-8 and 6.7e-8 where the granule switches between rolling and sliding, whose time
