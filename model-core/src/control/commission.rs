@@ -52,6 +52,10 @@
 
 use super::config::{CommissioningConfig, MotorModel};
 
+mod fit;
+mod line_fit;
+pub use line_fit::LineFit;
+
 /// Duty rise of the breakaway search, per second.
 pub const BREAKAWAY_RATE_PER_S: f32 = 0.2;
 /// The breakaway search starts at this duty.
@@ -73,62 +77,6 @@ pub const SETTLE_TAUS: f32 = 5.0;
 /// The latest a step's fit starts after the step, s (a time constant beyond a second and a half
 /// is no gearmotor's; the step is not held up longer for it).
 pub const SETTLE_MAX_S: f32 = 8.0;
-
-/// A straight line `y = b + m x` through points accumulated without storage: the slope from
-/// the first point to the last, the intercept the least-squares one for it
-/// ([`LineFit::solve_span`]).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct LineFit {
-    n: f32,
-    sx: f32,
-    sy: f32,
-    first: (f32, f32),
-    last: (f32, f32),
-}
-
-impl LineFit {
-    /// Adds a point (one copy for the three fits: the firmware's flash).
-    #[inline(never)]
-    pub fn add(&mut self, x: f32, y: f32) {
-        if self.n == 0.0 {
-            self.first = (x, y);
-        }
-        self.last = (x, y);
-        self.n += 1.0;
-        self.sx += x;
-        self.sy += y;
-    }
-
-    /// `(intercept, slope)` with the slope from the first point to the last, the intercept
-    /// the least-squares one for that slope; `None` with fewer than 2 distinct abscissae.
-    ///
-    /// For edges of a shaft at a steady speed whose first and last are of the same tooth
-    /// (whole revolutions apart) this slope is the mean speed exactly, whatever the teeth's
-    /// offsets and a once-per-revolution load: the least-squares slope over one or two
-    /// revolutions is not (it weighs the ends, so a tooth pattern tilts it: 0.2-0.6 % of the
-    /// speed on family-60, more than 1 % on the slope between two steps), and its f32 sums of
-    /// squares over 20 s lose a few parts in 10^4 as well. (One copy for its callers: the
-    /// firmware's flash.)
-    #[inline(never)]
-    pub fn solve_span(&self) -> Option<(f32, f32)> {
-        let dx = self.last.0 - self.first.0;
-        if self.n < 2.0 || dx.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
-            return None;
-        }
-        let m = (self.last.1 - self.first.1) / dx;
-        let b = (self.sy - m * self.sx) / self.n;
-        if m.is_finite() && b.is_finite() {
-            Some((b, m))
-        } else {
-            None
-        }
-    }
-
-    /// Number of points.
-    pub fn count(&self) -> u32 {
-        self.n as u32
-    }
-}
 
 /// Where the routine stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -489,113 +437,6 @@ impl Commissioning {
             duties[1] = self.spin_high_duty * ramp.clamp(0.0, 1.0);
         }
         Ok(duties)
-    }
-
-    /// The spin's ramp starts at `t_s` (the precession's clock); the fit starts once the ramp
-    /// is done and both axes have settled (five time constants of each, at least the step
-    /// time).
-    fn start_reaction(&mut self, t_s: f32) {
-        let tau = |i: usize| {
-            self.results[i]
-                .map(|r| r.model.time_constant_s)
-                .unwrap_or(0.0)
-        };
-        let settle_s = 5.0 * (tau(0) + tau(1));
-        self.step_at_s = t_s;
-        self.reaction_fit_from_s = t_s + REACTION_RAMP_S + settle_s.max(self.cfg.step_time_s);
-        self.reaction_fit = LineFit::default();
-        self.reaction_done_s = None;
-        self.phase = Phase::Reaction;
-    }
-
-    /// `g = -dtheta1 / (K1 dw2)` (module docs) into the precession's model; left at 0 (the
-    /// geometry's estimate) when a fit fails or the result is not plausible.
-    fn measure_reaction(&mut self) {
-        let (Some(before), Some(after), Some(spin), Some(prec)) = (
-            self.high_fit.solve_span(),
-            self.reaction_fit.solve_span(),
-            self.results[1],
-            self.results[0].as_mut(),
-        ) else {
-            return;
-        };
-        // Where the spin accelerated: the middle of its ramp (should the precession's speed
-        // differ slightly before and after, the lines' gap is taken there).
-        let t = self.step_at_s + 0.5 * REACTION_RAMP_S;
-        let lost_rad = (after.0 + after.1 * t) - (before.0 + before.1 * t);
-        let gain = self.supply_v / prec.model.volts_per_rad_s;
-        let g = -lost_rad / (gain * spin.high_speed_rad_s);
-        if g.is_finite() && g.abs() <= 1.0 {
-            // Exactly 0 means "not measured".
-            prec.model.reaction_duty_s2_per_rad = if g == 0.0 { f32::MIN_POSITIVE } else { g };
-        }
-    }
-
-    /// Whether a complete fit stands: it started at least [`SETTLE_TAUS`] time constants
-    /// `tau_s` after its step at `step_s` (or [`SETTLE_MAX_S`]). If not, the step holds on and
-    /// its fit starts again from there (a revolution or so more).
-    fn settled(&mut self, step_s: f32, tau_s: f32) -> bool {
-        let from_s = step_s + (SETTLE_TAUS * tau_s).min(SETTLE_MAX_S);
-        // A time constant that is no number stands as well.
-        if from_s.is_nan() || from_s <= self.fit_from_s {
-            return true;
-        }
-        self.fit_from_s = from_s;
-        self.steady_pulses = 0;
-        if self.phase == Phase::Low {
-            self.low_fit = LineFit::default();
-        } else {
-            self.high_fit = LineFit::default();
-        }
-        false
-    }
-
-    /// The two steps' steady speeds `w_L`, `w_H` and the time constant from their lines (module
-    /// docs), `None` without both lines.
-    fn step_lines(&self) -> Option<(f32, f32, f32)> {
-        let (b_l, w_l) = self.low_fit.solve_span()?;
-        let (b_h, w_h) = self.high_fit.solve_span()?;
-        let t_s = self.step_at_s;
-        Some((
-            w_l,
-            w_h,
-            ((b_l + w_l * t_s) - (b_h + w_h * t_s)) / (w_h - w_l),
-        ))
-    }
-
-    fn identify(&self) -> Result<Identified, IdentifyError> {
-        let (w_l, w_h, mut tau) = self.step_lines().ok_or(IdentifyError::TooFewEdges)?;
-        let increased = w_l > 0.0 && w_h > w_l * 1.05;
-        if !increased {
-            return Err(IdentifyError::NoSpeedIncrease);
-        }
-        let v = self.supply_v;
-        let (d_l, d_h) = (self.low_duty, self.high_duty);
-        let a = v * (d_h - d_l) / (w_h - w_l);
-        let mut friction_duty = d_l - a * w_l / v;
-        // A slightly negative offset is fit noise around zero friction.
-        if friction_duty < 0.0 && friction_duty > -0.02 {
-            friction_duty = 0.0;
-        }
-        // Below a millisecond the estimate is noise; the loop design only needs its order.
-        if tau < 1e-3 && tau > -0.02 {
-            tau = 1e-3;
-        }
-        let model = MotorModel {
-            volts_per_rad_s: a,
-            friction_duty,
-            time_constant_s: tau,
-            breakaway_duty: self.breakaway_duty,
-            reaction_duty_s2_per_rad: 0.0,
-        };
-        model
-            .validate(self.axis as u8)
-            .map_err(|_| IdentifyError::Implausible)?;
-        Ok(Identified {
-            model,
-            low_speed_rad_s: w_l,
-            high_speed_rad_s: w_h,
-        })
     }
 }
 

@@ -63,15 +63,13 @@
 //!   it at once. Fed to the loop as an error instead, the crawl's low mean wound the integral
 //!   up while the push had already started the shaft: 15..25 % too fast for 5 s on loaded
 //!   spin axes, which at a pulse a second the loop corrects only slowly.
-//!
 //! - The start's reading: the first measurement of a shaft the kick started (not the push),
-//!   over a window of at least [`CRAWL_READ_MIN_S`], reads the load against the model with
+//!   over a window of at least [`START_READ_MIN_S`], reads the load against the model with
 //!   the correction, and the integral takes it at once: what was kept of the kick is replaced
 //!   by what the shaft needs, where the loop at its low-speed bandwidth took 10 s and more.
 //!   A pushed shaft's first window carries its leap (stored in stiction the model does not
 //!   know) and is left to the loop, unless the current showed its breakaway (the push ended
-//!   there, and the back-EMF band held the shaft until the edge).
-//!
+//!   there, and the back-EMF band held the shaft until the edge); its second window is read.
 //! - With current sense (breakaway.rs): the back-EMF shows the breakaway at once, where the
 //!   first edge may come a second later. The kick then lasts until the current shows it (not
 //!   until the model says it should have), kick and push drop there to feedforward + integral
@@ -91,43 +89,12 @@ use super::estimator::WindowEvents;
 
 mod constants;
 mod start;
+mod tuning;
+mod window;
 pub use constants::{LoopConstants, SCHEDULE_TOP_RAD_S, bandwidth_ceiling_rad_s};
-
-/// Duty the push adds above the kick's level by the time the expected-edge watch would fault
-/// (from [`STUCK_PITCHES`] to the watch's pitches of model travel): it rises in proportion to
-/// the reference, slowly where pulses are sparse and there is time, fast where the watch is
-/// quick, so a healthy shaft carrying material the model does not know starts before the watch
-/// faults it.
-pub const PUSH_SPAN_DUTY: f32 = 0.12;
-/// The shaft counts as stuck once the plant model has turned this many pitches since the last
-/// edge without a new one (a shaft following the model would have given one).
-pub const STUCK_PITCHES: f32 = 1.2;
-/// A shaft that moved counts as quiet (see `quiet` in [`SpeedLoop::step`]) once the plant model
-/// has turned this many pitches since the last edge: at most half the model's speed. At
-/// [`STUCK_PITCHES`] it also pushed shafts dipping 15..20 % under 0.5 rad/s after a step-down,
-/// whose next edge was coming (family-60 4 -> 0.5: 5 % settled <= 10 s 100 -> 97.5 %).
-pub const QUIET_PITCHES: f32 = 1.5;
-/// Share of what started the shaft (the push, or the kick) the integral keeps once it moves.
-pub const PUSH_KEPT: f32 = 0.5;
-/// The shortest window after a crawl that reads the load, s: a crawl (a shaft below a third
-/// of its setpoint, the first two edges at least a second apart at 0.5 rad/s and 12 pulses a
-/// revolution) against the windows of a start at 3 rad/s (0.17 s) or of a shaft that ran with
-/// the ramp (0.5 s), through which the shaft was still accelerating: read as load, that
-/// inertia cost overshoot (an unseen family's worst 4.3 -> 7.1 % at 3 rad/s).
-pub const CRAWL_READ_MIN_S: f32 = 0.6;
-/// The shortest first window of a kick-started shaft that reads the load (`take_start_load`),
-/// s: a pitch of a 12-pulse wheel at up to 1 rad/s (0.52 s; the first measurement there spans
-/// one pitch at the ~0.9 rad/s the shaft has reached, 0.55-0.6 s). At the crawl's 0.6 s most
-/// of those windows were left to the loop, whose bandwidth at 1 rad/s (about 1 rad/s) took the
-/// last 5 % of an unknown load 2-4 s to remove: family-60 0 -> 1 rad/s within 2 % by 3 s on
-/// 72.5 % of axes, 80.8 % at 0.5 s (0.4 s: 79.2 %; docs/control.md, "The spin released at the
-/// precession's first edge"). Since the kick is in the correction's history, 0.4 s: the
-/// 0.4-0.5 s windows are those of light shafts the kick drove past 1 rad/s before their first
-/// measurement, and read they take the kept kick away at once (family-60 p29's rod, 2 % settled
-/// at 4.6 -> 2.6 s; docs/control.md, "The kick in the start's first window"). Windows at 2 rad/s
-/// and above (0.26 s or less) are still left to the loop: the shaft may still accelerate
-/// through them (0.25 s measured worse at 0 -> 2 and 0 -> 3 rad/s).
-pub const START_READ_MIN_S: f32 = 0.4;
+pub use tuning::{
+    CRAWL_READ_MIN_S, PUSH_KEPT, PUSH_SPAN_DUTY, QUIET_PITCHES, START_READ_MIN_S, STUCK_PITCHES,
+};
 
 /// State of one axis's loop.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -308,46 +275,7 @@ impl SpeedLoop {
         } else if let Some(w) = ev.closed
             && w.span_s > 0.0
         {
-            let model_mean = (self.model_angle_rad - rp * w.ago_s) / w.span_s;
-            let sample = model_mean - input.direction * w.raw_speed_rad_s;
-            let correction_mean = (self.correction_angle_rad - c * w.ago_s) / w.span_s;
-            // A pushed start's second window (`late_reading`) is read as a first one: past
-            // the leap its first window carried, it reads the load the loop would otherwise
-            // close at its bandwidth, about 1 rad/s at 1 rad/s (seed 5 p11's spin: 2 % settled
-            // at 3.95 -> 2.82 s; docs/control.md, "... a pushed start reads its second window").
-            self.have_error &= !self.start_reading;
-            if self.have_error {
-                // A quiet shaft the push (`quiet` below) turned again: half of it stays, as
-                // after a first edge from rest; the loop corrects the rest.
-                if self.push != 0.0 {
-                    self.integral += PUSH_KEPT * self.push * input.direction;
-                    self.push = 0.0;
-                    self.push_sum = 0.0;
-                }
-                // The load the model does not know, as the speed it costs: the window's
-                // shortfall against the model *with* the correction applied through it.
-                self.error += k.filter_weight * (sample + correction_mean - self.error);
-            } else if self.push != 0.0 {
-                // The first window after a crawl (no error then: no measurement) closed while
-                // the push was on: the shaft slid through it under a known mean duty at a
-                // measured mean speed, which reads the load the model does not know
-                // (`d = ff(w) + load`, the plant's lag being short against a window). Through
-                // the crawl the duty was the feedforward, the integral and the push: the load
-                // is the integral, the push's mean, and the duty of the speed the model
-                // expected but did not get. That is what the integral must hold; the push has
-                // done its work, and the error starts afresh with the next window.
-                self.take_crawl_load(k, w.span_s, sample, input.direction);
-            } else {
-                self.error = sample + correction_mean;
-                self.have_error = true;
-                if self.start_reading && w.span_s >= START_READ_MIN_S && input.feedback {
-                    self.take_start_load(k, c, input.direction);
-                }
-            }
-            self.start_reading = self.late_reading;
-            self.late_reading = false;
-            self.model_angle_rad = rp * w.ago_s;
-            self.correction_angle_rad = c * w.ago_s;
+            self.read_window(k, &input, w, rp, c);
         }
         // The error is that load less what the correction already gives the shaft now (a
         // Smith predictor: the window's dead time is taken out of the loop by the model).
@@ -364,21 +292,15 @@ impl SpeedLoop {
             self.error = 0.0;
             e = 0.0;
         }
-        // The first edge from rest: what started the shaft (the kick, or the push beyond it)
-        // held stiction and whatever load the model does not know; half of it stays in the
-        // integral (the loop corrects the rest either way), so a loaded shaft at low speed does
-        // not stick again at once. (The first measurement after a crawl reads the load itself,
-        // above.)
-        //
-        // "From rest" is the loop's view: no window closed since the loop started. A shaft let
-        // go by a fault, a STOP or a zero reference may have stopped between two edges while
-        // the estimator, which calls it stopped only after two pitches at the lowest speed
-        // (8 s at 12 pulses a revolution), still holds the edge from before: its reading is
-        // then only the stall bound, an upper bound from an old edge. Restarted from there, it
-        // got no kick and no push, and the loop integrated the model against that bound until
-        // the first edge came (up to a pitch of travel later): 13 to 31 % overshoot at 2 rad/s
-        // on the nominal rig and the seeded family, a false runaway fault on the emulated Black
-        // Pill (issue 27). It starts like a shaft at rest instead.
+        // The first edge from rest (`first_edge`, start.rs). "From rest" is the loop's view: no
+        // window closed since the loop started. A shaft let go by a fault, a STOP or a zero
+        // reference may have stopped between two edges while the estimator, which calls it stopped
+        // only after two pitches at the lowest speed (8 s at 12 pulses a revolution), still holds
+        // the edge from before: its reading is then only the stall bound, an upper bound from an
+        // old edge. Restarted from there, it got no kick and no push, and the loop integrated the
+        // model against that bound until the first edge came (up to a pitch of travel later): 13 to
+        // 31 % overshoot at 2 rad/s on the nominal rig and the seeded family, a false runaway fault
+        // on the emulated Black Pill (issue 27). It starts like a shaft at rest instead.
         let rest = input.at_rest || !self.window_open;
         // With current sense, the back-EMF shows the breakaway at once (breakaway.rs): the kick
         // and the push stop there, and what started the shaft is not kept (the current showed
@@ -389,57 +311,7 @@ impl SpeedLoop {
         };
         let first_edge = !rest && !self.moved;
         if first_edge {
-            if !released {
-                // With current sense, a first edge that comes before the current confirmed
-                // the breakaway, on a shaft whose back-EMF speed already keeps up with the
-                // model's (above the fused band's lower edge): what started it was more than
-                // it needed and no load holds it back, so as at the current's breakaway the
-                // kick is not kept, only half of a push. Kept, a light rod that reached its
-                // first tooth 35 ms into the start leapt 57 % past 0.5 rad/s (seed 6 p24). A
-                // shaft behind the model (a loaded spin that slows after its first edge, or a
-                // current per duty learned low) keeps it as before.
-                let turning = input.torque_duty.is_some()
-                    && self.breakaway.speed_rad_s()
-                        > (1.0 - FUSED_BAND_SHARE) * self.model_rad_s.abs();
-                // Without current sense, a rod's first edge that came before the model (the
-                // kick's speed included) had turned a pitch does not show the shaft behind it:
-                // the kick is not kept (half a push is). A light rod the kick ran to 1 rad/s
-                // before its first tooth kept half of a breakaway duty commissioning read 2-3x
-                // high until its first measurement: 20 % past 1 rad/s (seed 5 p44). Not the
-                // spin: loaded with the bowl's material, spins then crawled and were pushed
-                // (0 -> 0.5 rad/s within 5 % by 8 s two axes fewer on two families;
-                // docs/control.md, "The rod's kept kick from rest").
-                let early = input.early_edge_drops_kick
-                    && input.torque_duty.is_none()
-                    && travel_rad < k.stuck_angle_rad / STUCK_PITCHES;
-                let started_by = if turning || early {
-                    self.push
-                } else {
-                    self.push.max(k.kick_level(r_abs))
-                };
-                self.integral += PUSH_KEPT * started_by * input.direction;
-                if started_by > self.push {
-                    self.kept_kick = PUSH_KEPT * started_by;
-                }
-                if input.torque_duty.is_some() {
-                    // The edge proves the breakaway: the back-EMF band holds the integral from
-                    // here to the first measurement, as after one the current confirmed. Left
-                    // unconfirmed, a spin whose first tooth came 10 ms before the third sample
-                    // above the threshold crawled at 0.2 of 0.5 rad/s with no band, until the
-                    // push drove it 50 % past (family-60 p10).
-                    self.breakaway.confirm();
-                }
-            }
-            self.push = 0.0;
-            self.push_sum = 0.0;
-            // The start's reading (`take_start_load`) is left out after a push: its first
-            // window carries the leap of stiction the push overcame. Not when the current saw
-            // the breakaway: the push ended there and the back-EMF band held the shaft near the
-            // model to this edge, so the window reads the load. Left out, family-60 p13's
-            // loaded spin (the push started it 2.5 s in) left the band phase at 0.37 of
-            // 0.5 rad/s and the edges' loop took it into 5 % at 10.4 s (now 9.0 s).
-            self.start_reading = !self.pushed || released;
-            self.late_reading = !self.start_reading;
+            self.first_edge(k, &input, released, travel_rad, r_abs);
         }
         if !rest {
             self.moved = true;

@@ -3,9 +3,78 @@
 //! what the current tells the controller. The rules they follow are the module's "Breaking
 //! stiction" ([`super`]).
 
-use super::{CRAWL_READ_MIN_S, LoopConstants, LoopInput, PUSH_KEPT, SpeedLoop, clamp};
+use super::{
+    CRAWL_READ_MIN_S, FUSED_BAND_SHARE, LoopConstants, LoopInput, PUSH_KEPT, STUCK_PITCHES,
+    SpeedLoop, clamp,
+};
 
 impl SpeedLoop {
+    /// The first edge from rest (the loop's view, see `rest` in [`SpeedLoop::step`]): what
+    /// started the shaft (the kick, or the push beyond it) held stiction and whatever load the
+    /// model does not know; half of it stays in the integral, unless the current or the edge's
+    /// timing shows that it was more than the shaft needed. `released`: the current showed the
+    /// breakaway this tick; `travel_rad`: the model's travel since rest, the kick's included.
+    #[inline(always)]
+    pub(super) fn first_edge(
+        &mut self,
+        k: &LoopConstants,
+        input: &LoopInput,
+        released: bool,
+        travel_rad: f32,
+        r_abs: f32,
+    ) {
+        if !released {
+            // With current sense, a first edge that comes before the current confirmed
+            // the breakaway, on a shaft whose back-EMF speed already keeps up with the
+            // model's (above the fused band's lower edge): what started it was more than
+            // it needed and no load holds it back, so as at the current's breakaway the
+            // kick is not kept, only half of a push. Kept, a light rod that reached its
+            // first tooth 35 ms into the start leapt 57 % past 0.5 rad/s (seed 6 p24). A
+            // shaft behind the model (a loaded spin that slows after its first edge, or a
+            // current per duty learned low) keeps it as before.
+            let turning = input.torque_duty.is_some()
+                && self.breakaway.speed_rad_s() > (1.0 - FUSED_BAND_SHARE) * self.model_rad_s.abs();
+            // Without current sense, a rod's first edge that came before the model (the
+            // kick's speed included) had turned a pitch does not show the shaft behind it:
+            // the kick is not kept (half a push is). A light rod the kick ran to 1 rad/s
+            // before its first tooth kept half of a breakaway duty commissioning read 2-3x
+            // high until its first measurement: 20 % past 1 rad/s (seed 5 p44). Not the
+            // spin: loaded with the bowl's material, spins then crawled and were pushed
+            // (0 -> 0.5 rad/s within 5 % by 8 s two axes fewer on two families;
+            // docs/control.md, "The rod's kept kick from rest").
+            let early = input.early_edge_drops_kick
+                && input.torque_duty.is_none()
+                && travel_rad < k.stuck_angle_rad / STUCK_PITCHES;
+            let started_by = if turning || early {
+                self.push
+            } else {
+                self.push.max(k.kick_level(r_abs))
+            };
+            self.integral += PUSH_KEPT * started_by * input.direction;
+            if started_by > self.push {
+                self.kept_kick = PUSH_KEPT * started_by;
+            }
+            if input.torque_duty.is_some() {
+                // The edge proves the breakaway: the back-EMF band holds the integral from
+                // here to the first measurement, as after one the current confirmed. Left
+                // unconfirmed, a spin whose first tooth came 10 ms before the third sample
+                // above the threshold crawled at 0.2 of 0.5 rad/s with no band, until the
+                // push drove it 50 % past (family-60 p10).
+                self.breakaway.confirm();
+            }
+        }
+        self.push = 0.0;
+        self.push_sum = 0.0;
+        // The start's reading (`take_start_load`) is left out after a push: its first
+        // window carries the leap of stiction the push overcame. Not when the current saw
+        // the breakaway: the push ended there and the back-EMF band held the shaft near the
+        // model to this edge, so the window reads the load. Left out, family-60 p13's
+        // loaded spin (the push started it 2.5 s in) left the band phase at 0.37 of
+        // 0.5 rad/s and the edges' loop took it into 5 % at 10.4 s (now 9.0 s).
+        self.start_reading = !self.pushed || released;
+        self.late_reading = !self.start_reading;
+    }
+
     /// The integral takes the load read from a crawl window of `span_s` seconds whose model
     /// mean exceeded the measured mean by `sample` rad/s; the push ends. A window shorter than
     /// [`CRAWL_READ_MIN_S`] was no crawl: half the push stays, as after the first edge. Rare

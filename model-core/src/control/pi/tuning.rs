@@ -1,0 +1,40 @@
+//! The start's and the step-down's tuning: how hard a shaft at rest is pushed, when it counts
+//! as stuck or quiet, what the integral keeps of what started it, and which first windows read
+//! the load. Each value says what it was measured against (the rules are [`super`]'s "Breaking
+//! stiction").
+/// Duty the push adds above the kick's level by the time the expected-edge watch would fault
+/// (from [`STUCK_PITCHES`] to the watch's pitches of model travel): it rises in proportion to
+/// the reference, slowly where pulses are sparse and there is time, fast where the watch is
+/// quick, so a healthy shaft carrying material the model does not know starts before the watch
+/// faults it.
+pub const PUSH_SPAN_DUTY: f32 = 0.12;
+/// The shaft counts as stuck once the plant model has turned this many pitches since the last
+/// edge without a new one (a shaft following the model would have given one).
+pub const STUCK_PITCHES: f32 = 1.2;
+/// A shaft that moved counts as quiet (see `quiet` in
+/// [`SpeedLoop::step`](super::SpeedLoop::step)) once the plant model has turned this many
+/// pitches since the last edge: at most half the model's speed. At
+/// [`STUCK_PITCHES`] it also pushed shafts dipping 15..20 % under 0.5 rad/s after a step-down,
+/// whose next edge was coming (family-60 4 -> 0.5: 5 % settled <= 10 s 100 -> 97.5 %).
+pub const QUIET_PITCHES: f32 = 1.5;
+/// Share of what started the shaft (the push, or the kick) the integral keeps once it moves.
+pub const PUSH_KEPT: f32 = 0.5;
+/// The shortest window after a crawl that reads the load, s: a crawl (a shaft below a third
+/// of its setpoint, the first two edges at least a second apart at 0.5 rad/s and 12 pulses a
+/// revolution) against the windows of a start at 3 rad/s (0.17 s) or of a shaft that ran with
+/// the ramp (0.5 s), through which the shaft was still accelerating: read as load, that
+/// inertia cost overshoot (an unseen family's worst 4.3 -> 7.1 % at 3 rad/s).
+pub const CRAWL_READ_MIN_S: f32 = 0.6;
+/// The shortest first window of a kick-started shaft that reads the load (`take_start_load`),
+/// s: a pitch of a 12-pulse wheel at up to 1 rad/s (0.52 s; the first measurement there spans
+/// one pitch at the ~0.9 rad/s the shaft has reached, 0.55-0.6 s). At the crawl's 0.6 s most
+/// of those windows were left to the loop, whose bandwidth at 1 rad/s (about 1 rad/s) took the
+/// last 5 % of an unknown load 2-4 s to remove: family-60 0 -> 1 rad/s within 2 % by 3 s on
+/// 72.5 % of axes, 80.8 % at 0.5 s (0.4 s: 79.2 %; docs/control.md, "The spin released at the
+/// precession's first edge"). Since the kick is in the correction's history, 0.4 s: the
+/// 0.4-0.5 s windows are those of light shafts the kick drove past 1 rad/s before their first
+/// measurement, and read they take the kept kick away at once (family-60 p29's rod, 2 % settled
+/// at 4.6 -> 2.6 s; docs/control.md, "The kick in the start's first window"). Windows at 2 rad/s
+/// and above (0.26 s or less) are still left to the loop: the shaft may still accelerate
+/// through them (0.25 s measured worse at 0 -> 2 and 0 -> 3 rad/s).
+pub const START_READ_MIN_S: f32 = 0.4;

@@ -1,0 +1,61 @@
+//! A closed window of the estimator, read against the plant model (the Smith predictor of
+//! [`super`]'s "Structure"): the load the model does not know, and at a start the readings that
+//! hand the integral what the shaft needs (the crawl's, the start's).
+
+use super::{LoopConstants, LoopInput, PUSH_KEPT, START_READ_MIN_S, SpeedLoop};
+use crate::control::estimator::WindowSample;
+
+impl SpeedLoop {
+    /// The window `w` closed with the model at `rp` and the correction's speed at `c` (rad/s);
+    /// the model's and the correction's angles restart at its end.
+    #[inline(always)]
+    pub(super) fn read_window(
+        &mut self,
+        k: &LoopConstants,
+        input: &LoopInput,
+        w: WindowSample,
+        rp: f32,
+        c: f32,
+    ) {
+        let model_mean = (self.model_angle_rad - rp * w.ago_s) / w.span_s;
+        let sample = model_mean - input.direction * w.raw_speed_rad_s;
+        let correction_mean = (self.correction_angle_rad - c * w.ago_s) / w.span_s;
+        // A pushed start's second window (`late_reading`) is read as a first one: past
+        // the leap its first window carried, it reads the load the loop would otherwise
+        // close at its bandwidth, about 1 rad/s at 1 rad/s (seed 5 p11's spin: 2 % settled
+        // at 3.95 -> 2.82 s; docs/control.md, "... a pushed start reads its second window").
+        self.have_error &= !self.start_reading;
+        if self.have_error {
+            // A quiet shaft the push (`quiet` below) turned again: half of it stays, as
+            // after a first edge from rest; the loop corrects the rest.
+            if self.push != 0.0 {
+                self.integral += PUSH_KEPT * self.push * input.direction;
+                self.push = 0.0;
+                self.push_sum = 0.0;
+            }
+            // The load the model does not know, as the speed it costs: the window's
+            // shortfall against the model *with* the correction applied through it.
+            self.error += k.filter_weight * (sample + correction_mean - self.error);
+        } else if self.push != 0.0 {
+            // The first window after a crawl (no error then: no measurement) closed while
+            // the push was on: the shaft slid through it under a known mean duty at a
+            // measured mean speed, which reads the load the model does not know
+            // (`d = ff(w) + load`, the plant's lag being short against a window). Through
+            // the crawl the duty was the feedforward, the integral and the push: the load
+            // is the integral, the push's mean, and the duty of the speed the model
+            // expected but did not get. That is what the integral must hold; the push has
+            // done its work, and the error starts afresh with the next window.
+            self.take_crawl_load(k, w.span_s, sample, input.direction);
+        } else {
+            self.error = sample + correction_mean;
+            self.have_error = true;
+            if self.start_reading && w.span_s >= START_READ_MIN_S && input.feedback {
+                self.take_start_load(k, c, input.direction);
+            }
+        }
+        self.start_reading = self.late_reading;
+        self.late_reading = false;
+        self.model_angle_rad = rp * w.ago_s;
+        self.correction_angle_rad = c * w.ago_s;
+    }
+}
