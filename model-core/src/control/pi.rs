@@ -275,7 +275,7 @@ impl SpeedLoop {
         } else if let Some(w) = ev.closed
             && w.span_s > 0.0
         {
-            self.read_window(k, &input, w, rp, c);
+            self.read_window(k, input, w, rp, c);
         }
         // The error is that load less what the correction already gives the shaft now (a
         // Smith predictor: the window's dead time is taken out of the loop by the model).
@@ -311,7 +311,7 @@ impl SpeedLoop {
         };
         let first_edge = !rest && !self.moved;
         if first_edge {
-            self.first_edge(k, &input, released, travel_rad, r_abs);
+            self.first_edge(k, input, released, travel_rad, r_abs);
         }
         if !rest {
             self.moved = true;

@@ -18,7 +18,7 @@ impl SpeedLoop {
     pub(super) fn first_edge(
         &mut self,
         k: &LoopConstants,
-        input: &LoopInput,
+        input: LoopInput,
         released: bool,
         travel_rad: f32,
         r_abs: f32,

@@ -12,7 +12,7 @@ impl SpeedLoop {
     pub(super) fn read_window(
         &mut self,
         k: &LoopConstants,
-        input: &LoopInput,
+        input: LoopInput,
         w: WindowSample,
         rp: f32,
         c: f32,
