@@ -187,8 +187,7 @@ pub fn rod_form<T: Real>(scene: &RollingScene<T>, incline_mean_s: T) -> T {
 /// [`ROTATION_K`]) and its centre's circling at the rod offset ([`ROTATION_K_ROD`]); infinite
 /// when the release is not inside the rim.
 pub fn rotation_estimate<T: Real>(scene: &RollingScene<T>, incline_mean_s: T) -> T {
-    rotation_constant(scene) * rotation_form(scene, incline_mean_s)
-        + T::from_f64(ROTATION_K_ROD) * rod_form(scene, incline_mean_s)
+    estimate_in(scene, Tilt::of(scene), incline_mean_s, incline_mode(scene))
 }
 
 /// The constant of [`rotation_estimate`] for the incline's mode at the scene.
@@ -203,8 +202,15 @@ fn estimate_in<T: Real>(
     incline_mean_s: T,
     mode: InclineMode,
 ) -> T {
-    mode_constant::<T>(mode) * form_in(scene, tilt, incline_mean_s)
-        + T::from_f64(ROTATION_K_ROD) * rod_form(scene, incline_mean_s)
+    let estimate = mode_constant::<T>(mode) * form_in(scene, tilt, incline_mean_s)
+        + T::from_f64(ROTATION_K_ROD) * rod_form(scene, incline_mean_s);
+    // A speed whose square overflows times a release at the centre (`inf * 0`) bounds nothing:
+    // infinite, so the incline is not taken and no NaN is reported.
+    if estimate.is_nan() {
+        T::from_f64(f64::INFINITY)
+    } else {
+        estimate
+    }
 }
 
 fn mode_constant<T: Real>(mode: InclineMode) -> T {
