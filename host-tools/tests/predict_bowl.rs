@@ -247,6 +247,18 @@ fn bad_bowl_input_is_said_in_words() {
             vec!["--method", "semi-implicit"],
             "--method semi-implicit is not offered for the bowl model",
         ),
+        // A speed whose square overflows: it used to reach the integrator and come back as
+        // "--step-s and --tol must be positive numbers", flags the user never gave.
+        (
+            ["60", "0.02", "0"],
+            vec!["--spin-rad-s", "-1e200"],
+            "--spin-rad-s is outside the magnitudes the model computes with (0, or 1e-75 to 1e75",
+        ),
+        (
+            ["60", "0.02", "0"],
+            vec!["--precession-rad-s", "1e-100"],
+            "--precession-rad-s is outside the magnitudes",
+        ),
     ] {
         let args = bowl_args("1", "1", "60", wall, &extra);
         let out = bowl(&args);
@@ -254,6 +266,26 @@ fn bad_bowl_input_is_said_in_words() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(want), "{args:?}: {err}");
         assert!(!err.contains("Invalid"), "no Rust names: {err}");
+    }
+    // The same refusal through the chooser (`--model auto`, the default) and the rolling model.
+    for model in ["auto", "rolling"] {
+        let out = bowl(&[
+            "predict",
+            "--model",
+            model,
+            "--axes-angle-deg",
+            "60",
+            "--precession-rad-s",
+            "1e200",
+            "--spin-rad-s",
+            "1",
+        ]);
+        assert_eq!(out.status.code(), Some(1), "{model}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--precession-rad-s is outside the magnitudes"),
+            "{model}: {err}"
+        );
     }
     let out = bowl(&["predict", "--model", "bowl", "--axes-angle-deg", "60"]);
     assert_eq!(out.status.code(), Some(1));

@@ -51,6 +51,7 @@ fn check<T: Copy + PartialOrd + core::fmt::Debug + Into<f64>>(
     level: Level,
     cheaper_fail_set: [bool; 4],
     rotation_estimate: T,
+    friction_needed: T,
     incline_mean_s: Option<T>,
     second_order: Option<(T, T)>,
 ) -> Result<(), TestCaseError> {
@@ -68,6 +69,7 @@ fn check<T: Copy + PartialOrd + core::fmt::Debug + Into<f64>>(
         );
     }
     prop_assert!(!rotation_estimate.into().is_nan(), "estimate NaN");
+    prop_assert!(!friction_needed.into().is_nan(), "friction needed NaN");
     if let Some(t) = incline_mean_s {
         let t: f64 = t.into();
         prop_assert!(t.is_finite() && t >= 0.0, "incline mean {t}");
@@ -104,6 +106,7 @@ proptest! {
             c.level,
             c.cheaper_fail.map(|f| f.is_some()),
             c.rotation_estimate,
+            c.friction_needed,
             c.incline_mean_s,
             c.second_order.map(|s| (s.c2, s.bound)),
         )?;
@@ -137,6 +140,7 @@ proptest! {
                 c.level,
                 c.cheaper_fail.map(|f| f.is_some()),
                 c.rotation_estimate,
+            c.friction_needed,
                 c.incline_mean_s,
                 c.second_order.map(|s| (s.c2, s.bound)),
             )?;
@@ -186,6 +190,7 @@ proptest! {
             c.level,
             c.cheaper_fail.map(|f| f.is_some()),
             c.rotation_estimate,
+            c.friction_needed,
             c.incline_mean_s,
             c.second_order.map(|s| (s.c2, s.bound)),
         )?;

@@ -425,7 +425,14 @@ fn needed_at<T: Real>(scene: &RollingScene<T>, tilt: Tilt<T>, radius_m: T) -> T 
     if normal <= T::ZERO {
         return T::from_f64(f64::INFINITY);
     }
-    (T::ONE - scene.k2) * in_plane / normal
+    let needed = (T::ONE - scene.k2) * in_plane / normal;
+    // A speed whose square overflows at a release at the centre (`inf * 0`): the need is not
+    // known, so rolling is not assumed.
+    if needed.is_nan() {
+        T::from_f64(f64::INFINITY)
+    } else {
+        needed
+    }
 }
 
 /// The friction rolling needs at the bottom's rim, as [`friction_needed_at_release`] with the

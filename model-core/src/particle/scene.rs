@@ -112,7 +112,7 @@ pub fn magnitude_limits<T: Real>() -> (T, T) {
 
 /// `x` is 0 or within [`magnitude_limits`] (false for NaN, infinities and negative values).
 #[inline(always)]
-fn within_magnitudes<T: Real>(x: T) -> bool {
+pub(crate) fn within_magnitudes<T: Real>(x: T) -> bool {
     let (low, high) = magnitude_limits::<T>();
     (x == T::ZERO) | ((x >= low) & (x <= high))
 }

@@ -21,6 +21,7 @@ use core::ops::ControlFlow;
 use crate::Real;
 pub use crate::ode::system::SystemLimits;
 use crate::ode::system::{self, Ended, SystemError};
+use crate::particle::scene::within_magnitudes;
 use equations::{AT_REST_M_S, State, forces};
 
 /// A scene of the rolling model. SI units; angles in radians.
@@ -121,8 +122,26 @@ impl<T: Real> RollingScene<T> {
                 RollingError::InvalidRimRadius,
             ),
         ];
-        match checks.iter().find(|(ok, _)| !ok) {
-            Some((_, e)) => Err(*e),
+        if let Some((_, e)) = checks.iter().find(|(ok, _)| !ok) {
+            return Err(*e);
+        }
+        // The 1-D scene's magnitude limits (`SceneError::ExtremeMagnitude`): the rolling model
+        // squares the speeds and multiplies them by lengths and times (`omega^2 R`, the step
+        // size from `1 / |Omega|`), so a speed of 1e200 rad/s overflowed into a refusal that
+        // blamed `--step-s` and `--tol`.
+        let magnitudes = [
+            (self.precession_rad_s.abs(), RollingInput::Precession),
+            (self.spin_rad_s.abs(), RollingInput::Spin),
+            (self.rolling_resistance, RollingInput::Resistance),
+            (self.sliding_friction, RollingInput::SlidingFriction),
+            (self.g_m_s2, RollingInput::Gravity),
+            (self.particle_radius_m, RollingInput::ParticleRadius),
+            (self.rod_length_m, RollingInput::RodLength),
+            (self.ri_m, RollingInput::StartRadius),
+            (self.rim_radius_m, RollingInput::RimRadius),
+        ];
+        match magnitudes.iter().find(|(v, _)| !within_magnitudes(*v)) {
+            Some((_, input)) => Err(RollingError::ExtremeMagnitude(*input)),
             None => Ok(()),
         }
     }
@@ -142,6 +161,30 @@ impl<T: Real> RollingScene<T> {
         self.precession_rad_s == T::ZERO
             || (self.axes_angle_rad == T::ZERO && self.rod_length_m == T::ZERO)
     }
+}
+
+/// One input of a [`RollingScene`], as an [`RollingError::ExtremeMagnitude`] refusal names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RollingInput {
+    /// `precession_rad_s`.
+    Precession,
+    /// `spin_rad_s`.
+    Spin,
+    /// `rolling_resistance`.
+    Resistance,
+    /// `sliding_friction`.
+    SlidingFriction,
+    /// `g_m_s2`.
+    Gravity,
+    /// `particle_radius_m`.
+    ParticleRadius,
+    /// `rod_length_m`.
+    RodLength,
+    /// `ri_m`.
+    StartRadius,
+    /// `rim_radius_m`.
+    RimRadius,
 }
 
 /// Why the rolling model gave no answer.
@@ -172,6 +215,10 @@ pub enum RollingError {
     InvalidRimRadius,
     /// The release azimuth was not finite.
     InvalidAzimuth,
+    /// A valid input outside the magnitudes the model computes with
+    /// ([`magnitude_limits`](crate::particle::magnitude_limits): nonzero and below `1e-75` or
+    /// above `1e75` in f64; none in f32): refused rather than answered; rescale the units.
+    ExtremeMagnitude(RollingInput),
     /// The integration failed (step cap, a non-finite state, an invalid step).
     Integration(SystemError),
 }

@@ -261,6 +261,57 @@ fn bad_inputs_are_named() {
         residence(&s, f64::NAN, FINE),
         Err(RollingError::InvalidAzimuth)
     );
+    // Finite but beyond the magnitudes the model computes with (the 1-D scene's limits):
+    // refused with the input named, where a speed of 1e200 rad/s used to overflow the step size
+    // into an integration error. Zero and the limits themselves are accepted.
+    use crate::particle::rolling::RollingInput;
+    let (low, high) = crate::particle::magnitude_limits::<f64>();
+    for (bad, input) in [
+        (
+            RollingScene {
+                spin_rad_s: -1e200,
+                ..s
+            },
+            RollingInput::Spin,
+        ),
+        (
+            RollingScene {
+                precession_rad_s: 1e-100,
+                ..s
+            },
+            RollingInput::Precession,
+        ),
+        (RollingScene { g_m_s2: 1e80, ..s }, RollingInput::Gravity),
+        (
+            RollingScene {
+                rim_radius_m: 1e76,
+                ..s
+            },
+            RollingInput::RimRadius,
+        ),
+    ] {
+        assert_eq!(bad.validate(), Err(RollingError::ExtremeMagnitude(input)));
+        assert_eq!(
+            residence(&bad, 0.0, FINE),
+            Err(RollingError::ExtremeMagnitude(input))
+        );
+    }
+    for ok in [
+        RollingScene {
+            spin_rad_s: 0.0,
+            ..s
+        },
+        RollingScene {
+            spin_rad_s: -high,
+            ..s
+        },
+        RollingScene {
+            precession_rad_s: low,
+            ..s
+        },
+    ] {
+        assert_eq!(ok.validate(), Ok(()), "{ok:?}");
+    }
 }
 
 mod no_panic {
