@@ -362,11 +362,19 @@ impl SpeedLoop {
         // ends there), not until the model says it should have: a shaft the kick did not
         // start (material since commissioning) is not left at the feedforward until the push.
         let kick_on = self.kick_rad_s < r_abs || input.torque_duty.is_some();
-        if starting && input.feedback && self.push == 0.0 && kick_on {
-            kick = k.kick_level(r_abs);
+        if starting && input.feedback && self.push == 0.0 {
+            if kick_on {
+                kick = k.kick_level(r_abs);
+            }
             // Driven by the applied duty (the slew limit holds it back at first) above
             // friction: the true breakaway lies below the identified one (the search's duty
-            // kept rising until the first edge), so the shaft may already slide.
+            // kept rising until the first edge), so the shaft may already slide. Run on every
+            // tick of the start, the kick's off ones too: once it reached the ramping
+            // reference, the kick went off and on from tick to tick while the model stood
+            // still, the slew limit held the duty at the breakaway's, and a light rod whose
+            // breakaway commissioning read 3.4x high ran on to 18 % past 1 rad/s before its
+            // first edge (family-60 p29; docs/control.md, "The kick's model runs through the
+            // whole start").
             let applied_excess = self.duty.abs() - k.friction_duty;
             if applied_excess > 0.0 {
                 self.kick_rad_s +=
