@@ -3,33 +3,10 @@
 //! integral is set so that the correction is that load (docs/control.md, "A load read through
 //! the shaft's lag").
 
+mod from_rest;
 mod plant_rows;
 
-use model_core::control::ControllerConfig;
-use model_core::sim::experiments::commissioned_transition;
-
-/// Commissions `rig` (seed `seed`), pours its material in and steps both axes from rest to
-/// 1 rad/s with no fault: the rod's step report.
-fn rod_from_rest_to_1_rad_s(
-    rig: model_core::sim::PlantParams,
-    seed: u32,
-) -> model_core::sim::StepReport {
-    let load = [rig.axes[0].load_step_nm, rig.axes[1].load_step_nm];
-    let o = commissioned_transition(rig, ControllerConfig::nominal(), seed, 0.0, 1.0, true, load);
-    assert!(o.commissioned && o.fault.is_none(), "{:?}", o.fault);
-    o.reports[0]
-}
-
-/// The rod settled within 2 % of 1 rad/s by `within_s` and never passed it by more than 2 %.
-fn assert_rod_settled_by(r: model_core::sim::StepReport, within_s: f32) {
-    assert!(
-        r.settled && r.settling_time_s <= within_s && r.overshoot <= 0.02,
-        "the rod settled within 2 % of 1 rad/s at {:.2} s, {:.2} % past it (settled: {})",
-        r.settling_time_s,
-        r.overshoot * 100.0,
-        r.settled
-    );
-}
+use from_rest::{assert_settled_within_2_pct_by, rod_from_rest_to_1_rad_s};
 
 /// Seed 8 p00 (`bowl sim make-family --seed 8`): a heavy rod (tau 0.7 s) the kick took to
 /// 0.96 rad/s before its first measurement. Its first window read the load right (0.070 rad/s
@@ -50,7 +27,7 @@ fn from_rest_a_heavy_rod_takes_the_load_with_the_kick_still_in_it() {
             ],
         ],
     );
-    assert_rod_settled_by(rod_from_rest_to_1_rad_s(p00, 8000), 3.0);
+    assert_settled_within_2_pct_by(rod_from_rest_to_1_rad_s(p00, 8000), 3.0, "the rod");
 }
 
 /// Seed 4 p00: a heavy rod (tau 0.52 s) carrying 0.045 N m of material from the start. Its first
@@ -71,5 +48,5 @@ fn from_rest_a_heavy_rods_load_is_read_through_its_lag() {
             ],
         ],
     );
-    assert_rod_settled_by(rod_from_rest_to_1_rad_s(p00, 4000), 3.5);
+    assert_settled_within_2_pct_by(rod_from_rest_to_1_rad_s(p00, 4000), 3.5, "the rod");
 }
