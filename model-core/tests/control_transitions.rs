@@ -4,6 +4,7 @@
 //! fault healthy plants: a shaft slowing towards its new reference gives intervals of two or three
 //! of its last measured periods, which were read as missing pulses.
 
+mod from_rest;
 mod plant_rows;
 
 use model_core::control::ControllerConfig;
@@ -416,43 +417,12 @@ fn from_rest_the_first_window_reads_the_kick_it_spans() {
             ],
         ],
     );
-    let rod = rod_from_rest_to_1_rad_s(p02, 1002);
+    let rod = from_rest::rod_from_rest_to_1_rad_s(p02, 1002);
     assert!(
         rod.settled && rod.settling_time_s <= 2.2,
         "the rod settled within 2 % of 1 rad/s at {:.2} s (settled: {})",
         rod.settling_time_s,
         rod.settled
-    );
-}
-
-/// Commissions `rig` (seed `seed`), pours its material in and steps both axes from rest to
-/// 1 rad/s with no fault: the rod's step report.
-fn rod_from_rest_to_1_rad_s(
-    rig: model_core::sim::PlantParams,
-    seed: u32,
-) -> model_core::sim::StepReport {
-    from_rest_to_1_rad_s(rig, seed)[0]
-}
-
-/// As [`rod_from_rest_to_1_rad_s`], both axes' step reports.
-fn from_rest_to_1_rad_s(
-    rig: model_core::sim::PlantParams,
-    seed: u32,
-) -> [model_core::sim::StepReport; 2] {
-    let load = [rig.axes[0].load_step_nm, rig.axes[1].load_step_nm];
-    let o = commissioned_transition(rig, ControllerConfig::nominal(), seed, 0.0, 1.0, true, load);
-    assert!(o.commissioned && o.fault.is_none(), "{:?}", o.fault);
-    o.reports
-}
-
-/// `axis` settled within 2 % of 1 rad/s by `within_s` and never passed it by more than 2 %.
-fn assert_settled_within_2_pct_by(r: model_core::sim::StepReport, within_s: f32, axis: &str) {
-    assert!(
-        r.settled && r.settling_time_s <= within_s && r.overshoot <= 0.02,
-        "{axis} settled within 2 % of 1 rad/s at {:.2} s, {:.2} % past it (settled: {})",
-        r.settling_time_s,
-        r.overshoot * 100.0,
-        r.settled
     );
 }
 
@@ -478,7 +448,7 @@ fn from_rest_a_rod_the_kick_drove_past_the_target_is_read_at_its_first_window() 
             ],
         ],
     );
-    let rod = rod_from_rest_to_1_rad_s(p29, 1029);
+    let rod = from_rest::rod_from_rest_to_1_rad_s(p29, 1029);
     assert!(
         rod.settled && rod.settling_time_s <= 3.0,
         "the rod settled within 2 % of 1 rad/s at {:.2} s (settled: {})",
@@ -508,8 +478,8 @@ fn from_rest_a_pushed_spin_reads_the_load_at_its_second_window() {
             ],
         ],
     );
-    let spin = from_rest_to_1_rad_s(p11, 5011)[1];
-    assert_settled_within_2_pct_by(spin, 3.0, "the spin");
+    let spin = from_rest::from_rest_to_1_rad_s(p11, 5011)[1];
+    from_rest::assert_settled_within_2_pct_by(spin, 3.0, "the spin");
 }
 
 /// The once-per-revolution load (load_pattern.rs) found while commissioning was fed forward
@@ -534,8 +504,8 @@ fn from_rest_the_eccentric_load_is_fed_from_the_first_edge() {
             ],
         ],
     );
-    let spin = from_rest_to_1_rad_s(p24, 8024)[1];
-    assert_settled_within_2_pct_by(spin, 2.7, "the spin");
+    let spin = from_rest::from_rest_to_1_rad_s(p24, 8024)[1];
+    from_rest::assert_settled_within_2_pct_by(spin, 2.7, "the spin");
 }
 
 /// A light rod the kick ran to 1 rad/s before its first tooth (seed 5 p44: true breakaway about
@@ -558,7 +528,7 @@ fn from_rest_a_first_edge_that_does_not_show_the_rod_behind_keeps_no_kick() {
             ],
         ],
     );
-    let rod = rod_from_rest_to_1_rad_s(p44, 5044);
+    let rod = from_rest::rod_from_rest_to_1_rad_s(p44, 5044);
     assert!(
         rod.overshoot <= 0.05,
         "the rod passed 1 rad/s by {:.1} %",
@@ -614,7 +584,7 @@ fn from_rest_the_rod_is_decoupled_by_what_the_spin_does() {
             ],
         ],
     );
-    let rod = rod_from_rest_to_1_rad_s(p04, 1004);
+    let rod = from_rest::rod_from_rest_to_1_rad_s(p04, 1004);
     assert!(
         rod.overshoot <= 0.015 && rod.settled && rod.settling_time_s <= 2.2,
         "the rod overshot 1 rad/s by {:.1} % and settled within 2 % at {:.2} s (settled: {})",

@@ -131,6 +131,12 @@ pub struct SpeedLoop {
     /// identified lag), and its angle over the estimator's current window, rad.
     correction_rad_s: f32,
     correction_angle_rad: f32,
+    /// The share of a load's steady speed deficit the shaft shows by now, since the loop left
+    /// rest: a load that acts from the start slows the shaft through the identified lag,
+    /// `1 - exp(-t / tau)` (a unit step through the plant model), and its integral over the
+    /// estimator's current window, s (see `read_window`, window.rs).
+    load_lag: f32,
+    load_lag_angle: f32,
     /// The shaft started from rest (its first edge) and no window has been read since: the
     /// next one reads the load at once (see `step`).
     start_reading: bool,
@@ -201,6 +207,8 @@ impl SpeedLoop {
         correction_duty: 0.0,
         correction_rad_s: 0.0,
         correction_angle_rad: 0.0,
+        load_lag: 0.0,
+        load_lag_angle: 0.0,
         start_reading: false,
         late_reading: false,
         pushed: false,
@@ -227,6 +235,13 @@ impl SpeedLoop {
             self.correction_duty * k.kick_gain_per_tick - self.correction_rad_s * k.model_alpha;
         let c = self.correction_rad_s;
         self.correction_angle_rad += c * k.dt_s;
+        // A shaft already turning when the loop started (a coasting restart: the estimator
+        // holds its edges) has carried its load all along: its whole deficit shows.
+        if self.reference_abs_rad_s == 0.0 && !input.at_rest {
+            self.load_lag = 1.0;
+        }
+        self.load_lag += (1.0 - self.load_lag) * k.model_alpha;
+        self.load_lag_angle += self.load_lag * k.dt_s;
         let ev = input.events;
         // Slowing down: the model above the reference. Its windows, and every window that
         // began before the model came down to the reference, compare a shaft that decelerates
@@ -263,6 +278,7 @@ impl SpeedLoop {
         if let Some(ago) = ev.restarted_s_ago {
             self.model_angle_rad = rp * ago;
             self.correction_angle_rad = c * ago;
+            self.load_lag_angle = self.load_lag * ago;
             self.window_open = true;
         }
         if let Some(w) = ev.closed
@@ -271,6 +287,7 @@ impl SpeedLoop {
             // The loop started in the middle of a window: compare from the next one on.
             self.model_angle_rad = rp * w.ago_s;
             self.correction_angle_rad = c * w.ago_s;
+            self.load_lag_angle = self.load_lag * w.ago_s;
             self.window_open = true;
         } else if let Some(w) = ev.closed
             && w.span_s > 0.0

@@ -98,9 +98,9 @@ impl SpeedLoop {
         self.push = 0.0;
     }
 
-    /// The first measurement of a start, over a window of at least [`CRAWL_READ_MIN_S`]: the
-    /// integral takes the load it reads at once (`L - c` as duty, the error the loop would
-    /// otherwise remove at its bandwidth). What started the shaft (half the kick or the push,
+    /// The first measurement of a start, over a window of at least [`START_READ_MIN_S`](super::START_READ_MIN_S): the
+    /// integral takes the load it reads at once (the error the loop would otherwise remove at
+    /// its bandwidth; how, below). What started the shaft (half the kick or the push,
     /// kept at its first edge so that a loaded shaft does not stick again) is then replaced by
     /// what the window shows the shaft needs. Left to the loop, an unloaded shaft ran on the
     /// kept kick at the scheduled bandwidth's pace: at 0.2 rad/s (0.19 rad/s of bandwidth, a
@@ -110,9 +110,32 @@ impl SpeedLoop {
     /// reading does it on purpose. Only long windows (low speed, where the loop is slow and
     /// the shaft's lag is short against the window) are read; a short one through which the
     /// shaft still accelerates is left to the loop, as at the crawl's reading.
+    ///
+    /// Without current sense the integral is set so that the correction this tick, the
+    /// integral and the proportional part on `e = L - c`, is the load read, `L` as duty. The
+    /// PI's zero cancels the plant's pole only from a state where the integral matches what
+    /// the shaft already carries: a kick whose speed `c` still decays (a heavy rod, tau
+    /// 0.5-0.7 s, read 0.7 s after its kick) left the integral at `L - c` and the rest to the
+    /// loop's slow mode, at its bandwidth (about 1 rad/s at 1 rad/s): seed 8 p00's rod read
+    /// `L` = 0.070 rad/s, took -0.009 duty and settled within 2 % at 5.1 s. Set so, the
+    /// correction stays `L` while `c` comes to it through the shaft's own lag (the
+    /// closed loop's modes are the plant's `1 / tau` and the bandwidth; this start excites
+    /// only the first). With current sense the back-EMF band held the integral to the shaft
+    /// up to here and the kick is not in the correction's history: the integral takes the
+    /// reading's error as before (docs/control.md, "A load read through the shaft's lag").
     #[inline(always)]
-    pub(super) fn take_start_load(&mut self, k: &LoopConstants, c: f32, direction: f32) {
-        self.integral += (self.error - c) * k.duty_per_rad_s * direction;
+    pub(super) fn take_start_load(&mut self, k: &LoopConstants, input: LoopInput, c: f32) {
+        // `error` and `c` are signed speeds (the window's sample is the model's signed mean
+        // less `direction` times the measured magnitude), as the integral is a signed duty:
+        // no further `direction` (multiplied by it, a start in reverse took the reading with
+        // the wrong sign; `a_loaded_shaft_that_crawls_takes_its_load_from_the_crawl_not_by_
+        // overshooting` at -0.5 rad/s stopped the shaft once the reading set the integral).
+        if input.torque_duty.is_none() {
+            let kp = k.kp(k.scheduled_bandwidth(input.reference_rad_s.abs()));
+            self.integral = self.error * k.duty_per_rad_s - kp * (self.error - c);
+        } else {
+            self.integral += (self.error - c) * k.duty_per_rad_s;
+        }
     }
 
     /// One current sample (see [`LoopInput::torque_duty`]): the breakaway watch, and between

@@ -47,15 +47,62 @@ impl SpeedLoop {
             // done its work, and the error starts afresh with the next window.
             self.take_crawl_load(k, w.span_s, sample, input.direction);
         } else {
-            self.error = sample + correction_mean;
-            self.have_error = true;
-            if self.start_reading && w.span_s >= START_READ_MIN_S && input.feedback {
-                self.take_start_load(k, c, input.direction);
-            }
+            self.read_first_window(k, input, w, c, sample + correction_mean);
         }
         self.start_reading = self.late_reading;
         self.late_reading = false;
         self.model_angle_rad = rp * w.ago_s;
         self.correction_angle_rad = c * w.ago_s;
+        self.load_lag_angle = self.load_lag * w.ago_s;
+    }
+
+    /// The first window read since the loop left rest (or lost its measurement), whose
+    /// shortfall against the model with the correction is `shortfall` (rad/s): the error
+    /// starts from the load it reads, and a start's reading hands it to the integral. A load
+    /// acting from the start shows only the share of its steady deficit the shaft's lag has
+    /// let through (`load_lag`), and the Smith predictor's `L` (a steady offset) read it short
+    /// by that share: 0.8 of it in a heavy rod's first window (tau 0.52 s, window 0.55-1.27 s;
+    /// seed 4 p00's rod read 0.198 rad/s, its loop settled at 0.26). The share is the window's
+    /// mean of a unit load through the identified lag; counted from the loop's start, when the
+    /// shaft may have started later, it is an upper bound, so the load read stays a lower
+    /// bound of the lag model's. Not with current sense: the back-EMF band held the integral
+    /// to the shaft since its breakaway, taking the load in as it showed (docs/control.md, "A
+    /// load read through the shaft's lag"). Once per start, so out of the tick's common path.
+    #[cold]
+    #[inline(never)]
+    fn read_first_window(
+        &mut self,
+        k: &LoopConstants,
+        input: LoopInput,
+        w: WindowSample,
+        c: f32,
+        shortfall: f32,
+    ) {
+        let shown = if input.torque_duty.is_none() {
+            self.load_shown_share(w)
+        } else {
+            1.0
+        };
+        self.error = shortfall / shown;
+        self.have_error = true;
+        if self.start_reading && w.span_s >= START_READ_MIN_S && input.feedback {
+            self.take_start_load(k, input, c);
+        }
+    }
+
+    /// The mean over window `w` of the share of a load's steady deficit the shaft showed
+    /// (`load_lag`), at least a half: the reading is never more than doubled (the first
+    /// window read comes a pitch after the first edge, where the share of the heaviest rods,
+    /// tau 0.7 s, is about 0.55).
+    #[inline(always)]
+    fn load_shown_share(&self, w: WindowSample) -> f32 {
+        let share = (self.load_lag_angle - self.load_lag * w.ago_s) / w.span_s;
+        if share > 1.0 {
+            1.0
+        } else if share > 0.5 {
+            share
+        } else {
+            0.5
+        }
     }
 }
