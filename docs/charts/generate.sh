@@ -37,6 +37,8 @@ done
 "$bowl" chart control-stability --out docs/charts/control-stability.svg
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --out docs/charts/control-family.svg
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --target-rad-s 0.5 --out docs/charts/control-family-low.svg
+# From rest to 1 rad/s, the start the tightest targets name (docs/control.md, "Transitions").
+"$bowl" chart family --rig-file tests/rigs/family-60.toml --target-rad-s 1 --out docs/charts/control-family-1.svg
 # Slowing down while running (docs/control.md, "Transitions").
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --from-rad-s 3 --target-rad-s 1 --out docs/charts/control-family-down.svg
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --from-rad-s 3 --target-rad-s 0.5 --out docs/charts/control-family-down-low.svg
