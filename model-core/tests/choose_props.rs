@@ -4,7 +4,8 @@
 //! the flags first, but the library is public): a scene it cannot judge must still come back
 //! as a choice, never a NaN presented as an answer.
 
-use model_core::choose::whole::{LEVELS, Level, choose_level};
+use model_core::Real;
+use model_core::choose::whole::{LEVELS, Level, WholeChoice, choose_level};
 use model_core::particle::bowl::BowlShape;
 use model_core::particle::rolling::RollingScene;
 use proptest::prelude::*;
@@ -24,7 +25,7 @@ fn any_finite() -> impl Strategy<Value = f64> {
     ]
 }
 
-fn scene(v: &[f64; 11]) -> RollingScene<f64> {
+fn scene<T: Copy>(v: &[T; 11]) -> RollingScene<T> {
     RollingScene {
         precession_rad_s: v[0],
         spin_rad_s: v[1],
@@ -38,6 +39,35 @@ fn scene(v: &[f64; 11]) -> RollingScene<f64> {
         ri_m: v[9],
         rim_radius_m: v[10],
     }
+}
+
+fn shape<T: Copy>(w: &[T; 4]) -> BowlShape<T> {
+    BowlShape {
+        wall_angle_rad: w[0],
+        wall_height_m: w[1],
+        fillet_radius_m: w[2],
+        restitution: w[3],
+    }
+}
+
+/// [`check`] of the chooser's answer at `scene` and `shape`.
+fn choose_and_check<T: Real + Into<f64> + core::fmt::Debug>(
+    scene: &RollingScene<T>,
+    shape: &BowlShape<T>,
+    tolerance: T,
+    each_release: bool,
+) -> Result<WholeChoice<T>, TestCaseError> {
+    let c = choose_level(scene, shape, tolerance, each_release);
+    check(
+        shape.validate(scene).is_ok(),
+        c.level,
+        c.cheaper_fail.map(|f| f.is_some()),
+        c.rotation_estimate,
+        c.friction_needed,
+        c.incline_mean_s,
+        c.second_order.map(|s| (s.c2, s.bound)),
+    )?;
+    Ok(c)
 }
 
 /// What must hold of any choice: the level is one of [`LEVELS`]; the levels below it each say
@@ -93,57 +123,13 @@ proptest! {
         tolerance in any_finite(),
         each_release in any::<bool>(),
     ) {
-        let shape = BowlShape {
-            wall_angle_rad: wall[0],
-            wall_height_m: wall[1],
-            fillet_radius_m: wall[2],
-            restitution: wall[3],
-        };
-        let s = scene(&v);
-        let c = choose_level(&s, &shape, tolerance, each_release);
-        check(
-            shape.validate(&s).is_ok(),
-            c.level,
-            c.cheaper_fail.map(|f| f.is_some()),
-            c.rotation_estimate,
-            c.friction_needed,
-            c.incline_mean_s,
-            c.second_order.map(|s| (s.c2, s.bound)),
-        )?;
+        choose_and_check(&scene(&v), &shape(&wall), tolerance, each_release)?;
         // The same scene in f32 (values beyond f32's range become infinite there, which is
         // not finite input: those are left to the f64 run).
         let v32 = v.map(|x| x as f32);
         let w32 = wall.map(|x| x as f32);
         if v32.iter().chain(&w32).all(|x| x.is_finite()) && (tolerance as f32).is_finite() {
-            let s = RollingScene {
-                precession_rad_s: v32[0],
-                spin_rad_s: v32[1],
-                axes_angle_rad: v32[2],
-                rolling_resistance: v32[3],
-                sliding_friction: v32[4],
-                g_m_s2: v32[5],
-                k2: v32[6],
-                particle_radius_m: v32[7],
-                rod_length_m: v32[8],
-                ri_m: v32[9],
-                rim_radius_m: v32[10],
-            };
-            let shape = BowlShape {
-                wall_angle_rad: w32[0],
-                wall_height_m: w32[1],
-                fillet_radius_m: w32[2],
-                restitution: w32[3],
-            };
-            let c = choose_level(&s, &shape, tolerance as f32, each_release);
-            check(
-                shape.validate(&s).is_ok(),
-                c.level,
-                c.cheaper_fail.map(|f| f.is_some()),
-                c.rotation_estimate,
-            c.friction_needed,
-                c.incline_mean_s,
-                c.second_order.map(|s| (s.c2, s.bound)),
-            )?;
+            choose_and_check(&scene(&v32), &shape(&w32), tolerance as f32, each_release)?;
         }
     }
 
@@ -184,16 +170,7 @@ proptest! {
             restitution: 0.5,
         };
         prop_assume!(shape.validate(&s).is_ok());
-        let c = choose_level(&s, &shape, tolerance, each_release);
-        check(
-            true,
-            c.level,
-            c.cheaper_fail.map(|f| f.is_some()),
-            c.rotation_estimate,
-            c.friction_needed,
-            c.incline_mean_s,
-            c.second_order.map(|s| (s.c2, s.bound)),
-        )?;
+        let c = choose_and_check(&s, &shape, tolerance, each_release)?;
         if c.level == Level::Incline {
             prop_assert!(c.incline_mean_s.is_some(), "the incline chosen without its mean");
         }

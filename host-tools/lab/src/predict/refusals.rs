@@ -4,6 +4,17 @@
 use model_core::particle::OdeError;
 use model_core::particle::{Input, InverseError, Scene, SceneError, magnitude_limits};
 
+/// A `flag` whose value is outside [`magnitude_limits`], in words (the 1-D scene's and the
+/// tilted bowl's refusal alike).
+pub fn extreme_magnitude(flag: &str) -> String {
+    let (low, high) = magnitude_limits::<f64>();
+    format!(
+        "{flag} is outside the magnitudes the model computes with (0, or {low:e} to {high:e} in \
+         size): products of the inputs would underflow or overflow f64 and the answer could \
+         come out the wrong way round; rescale the units (or pass 0)"
+    )
+}
+
 /// Why a scene was refused.
 pub fn scene(e: SceneError) -> String {
     match e {
@@ -16,22 +27,14 @@ pub fn scene(e: SceneError) -> String {
         SceneError::InvalidStartRadius => "--ri-m must be 0 or more (the start radius, m)".into(),
         SceneError::InvalidRimRadius => "--rim-radius-m must be 0 or more (m)".into(),
         SceneError::InvalidTime => "the time must be 0 or more".into(),
-        SceneError::ExtremeMagnitude(input) => {
-            let (low, high) = magnitude_limits::<f64>();
-            let flag = match input {
-                Input::Omega => "--omega-rad-s",
-                Input::Resistance => "--mu",
-                Input::Gravity => "--g",
-                Input::K2 => "--k2",
-                Input::StartRadius => "--ri-m",
-                Input::RimRadius => "--rim-radius-m",
-            };
-            format!(
-                "{flag} is outside the magnitudes the model computes with (0, or {low:e} to \
-                 {high:e}): products of the inputs would underflow or overflow f64 and the \
-                 answer could come out the wrong way round; rescale the units (or pass 0)"
-            )
-        }
+        SceneError::ExtremeMagnitude(input) => extreme_magnitude(match input {
+            Input::Omega => "--omega-rad-s",
+            Input::Resistance => "--mu",
+            Input::Gravity => "--g",
+            Input::K2 => "--k2",
+            Input::StartRadius => "--ri-m",
+            Input::RimRadius => "--rim-radius-m",
+        }),
         SceneError::OutOfRange => {
             "the numbers overflow the arithmetic for this scene (absurd magnitudes): rescale the \
              units"

@@ -4,7 +4,6 @@
 
 use anyhow::{Result, bail};
 use model_core::ode::system::SystemError;
-use model_core::particle::magnitude_limits;
 use model_core::particle::rolling::hierarchy::{Wanted, tolerance_from_resistance_uncertainty};
 use model_core::particle::rolling::{
     self, AZIMUTHS_DEG, RollingError, RollingInput, RollingMethod, RollingOutcome, RollingScene,
@@ -118,25 +117,17 @@ pub fn words(e: RollingError) -> String {
                 .into()
         }
         RollingError::InvalidAzimuth => "--release-azimuth-deg must be a finite number".into(),
-        RollingError::ExtremeMagnitude(input) => {
-            let (low, high) = magnitude_limits::<f64>();
-            let flag = match input {
-                RollingInput::Precession => "--precession-rad-s",
-                RollingInput::Spin => "--spin-rad-s",
-                RollingInput::Resistance => "--mu",
-                RollingInput::SlidingFriction => "--sliding-mu",
-                RollingInput::Gravity => "--g",
-                RollingInput::ParticleRadius => "--particle-radius-m",
-                RollingInput::RodLength => "--rod-offset-m",
-                RollingInput::StartRadius => "--ri-m",
-                RollingInput::RimRadius => "--rim-radius-m",
-            };
-            format!(
-                "{flag} is outside the magnitudes the model computes with (0, or {low:e} to \
-                 {high:e} in size): products of the inputs would underflow or overflow f64; \
-                 rescale the units (or pass 0)"
-            )
-        }
+        RollingError::ExtremeMagnitude(input) => super::refusals::extreme_magnitude(match input {
+            RollingInput::Precession => "--precession-rad-s",
+            RollingInput::Spin => "--spin-rad-s",
+            RollingInput::Resistance => "--mu",
+            RollingInput::SlidingFriction => "--sliding-mu",
+            RollingInput::Gravity => "--g",
+            RollingInput::ParticleRadius => "--particle-radius-m",
+            RollingInput::RodLength => "--rod-offset-m",
+            RollingInput::StartRadius => "--ri-m",
+            RollingInput::RimRadius => "--rim-radius-m",
+        }),
         RollingError::Integration(SystemError::StepLimit) => {
             "the integration took too many steps: try --method dp54 with a looser --tol, or a \
              larger --step-s"
