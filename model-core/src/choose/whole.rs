@@ -187,7 +187,8 @@ pub fn rod_form<T: Real>(scene: &RollingScene<T>, incline_mean_s: T) -> T {
 /// [`ROTATION_K`]) and its centre's circling at the rod offset ([`ROTATION_K_ROD`]); infinite
 /// when the release is not inside the rim.
 pub fn rotation_estimate<T: Real>(scene: &RollingScene<T>, incline_mean_s: T) -> T {
-    estimate_in(scene, Tilt::of(scene), incline_mean_s, incline_mode(scene))
+    let tilt = Tilt::of(scene);
+    estimate_in(scene, tilt, incline_mean_s, mode_in(scene, tilt))
 }
 
 /// The constant of [`rotation_estimate`] for the incline's mode at the scene.
