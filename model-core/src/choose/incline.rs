@@ -90,20 +90,19 @@ impl<T: Real> Tilt<T> {
         }
     }
 
-    /// [`RollingScene::combined_speed_rad_s`].
-    pub(crate) fn combined_speed(self, scene: &RollingScene<T>) -> T {
+    /// [`RollingScene::combined_speed_rad_s`] squared (every check needs only the square: no
+    /// square root).
+    pub(crate) fn combined_speed_sq(self, scene: &RollingScene<T>) -> T {
         let (w1, w2) = (scene.precession_rad_s, scene.spin_rad_s);
-        (w1 * w1 + w2 * w2 + T::TWO * w1 * w2 * self.cos)
-            .max(T::ZERO)
-            .sqrt()
+        (w1 * w1 + w2 * w2 + T::TWO * w1 * w2 * self.cos).max(T::ZERO)
     }
 }
 
 /// [`friction_needed_at_release`] for a release at `radius_m`.
 pub(crate) fn needed_at<T: Real>(scene: &RollingScene<T>, tilt: Tilt<T>, radius_m: T) -> T {
-    let w = tilt.combined_speed(scene);
+    let w_sq = tilt.combined_speed_sq(scene);
     let g = scene.g_m_s2;
-    let in_plane = g * tilt.sin + w * w * radius_m;
+    let in_plane = g * tilt.sin + w_sq * radius_m;
     let normal = g * tilt.cos;
     if normal <= T::ZERO {
         return T::from_f64(f64::INFINITY);

@@ -262,7 +262,7 @@ pub fn rotation_form<T: Real>(scene: &RollingScene<T>, incline_mean_s: T) -> T {
 }
 
 fn form_in<T: Real>(scene: &RollingScene<T>, tilt: Tilt<T>, incline_mean_s: T) -> T {
-    let w = tilt.combined_speed(scene);
+    let w_sq = tilt.combined_speed_sq(scene);
     let w1 = scene.precession_rad_s;
     let path = scene.rim_radius_m - scene.ri_m;
     // Also catches a NaN path.
@@ -270,5 +270,5 @@ fn form_in<T: Real>(scene: &RollingScene<T>, tilt: Tilt<T>, incline_mean_s: T) -
         return T::from_f64(f64::INFINITY);
     }
     let offset = scene.ri_m.abs() / path;
-    (w * w + T::TWO * w1 * w1) * incline_mean_s * incline_mean_s * offset
+    (w_sq + T::TWO * w1 * w1) * incline_mean_s * incline_mean_s * offset
 }
