@@ -226,6 +226,30 @@ fn a_sliding_scene_takes_the_incline_corrected_by_its_second_order() {
     assert_eq!(per.len(), 12);
     let mean = per.iter().sum::<f64>() / 12.0;
     assert!((mean - t).abs() <= 1e-12 * t, "{mean} vs {t}");
+    // Releases picked by hand are single releases: the incline's bounds are for the mean over
+    // the twelve azimuths, so it is not offered, in words.
+    let v = json(&[
+        "predict",
+        "--axes-angle-deg",
+        "60",
+        "--precession-rad-s",
+        "2.0",
+        "--spin-rad-s",
+        "2.0",
+        "--sliding-mu",
+        "0.4",
+        "--rim-radius-m",
+        "0.075",
+        "--ri-m",
+        "0.0375",
+        "--release-azimuth-deg",
+        "30,90",
+        "--tolerance",
+        "0.001",
+        "--json",
+    ]);
+    assert_ne!(v["chosen"], "incline", "{v}");
+    assert!(reasons(&v).contains("single releases are wanted"), "{v}");
     // At 3.6 rad/s some releases stick and roll part of the way (the bowl model's regimes):
     // no second order is offered, in words, and the disc answers.
     let (v, r) = chosen_and_reference("60", "3.6", "0.4", "0.01", &[]);
