@@ -60,3 +60,4 @@ mkdir -p docs/charts/bowl
 "$bowl" chart bowl-regimes --out docs/charts/bowl/regimes.svg
 "$bowl" chart bowl-regime-map --out docs/charts/bowl/regime-map.svg
 "$bowl" chart bowl-work-precision --out docs/charts/bowl/work-precision.svg
+"$bowl" chart hierarchy-work-precision --out docs/charts/bowl/hierarchy-work-precision.svg

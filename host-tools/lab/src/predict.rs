@@ -19,7 +19,7 @@ mod target;
 mod throughput;
 mod trace;
 mod validity;
-mod whole;
+pub(crate) mod whole;
 
 pub use bowl::BowlInputs;
 pub use ends::{Ends, Leaves};

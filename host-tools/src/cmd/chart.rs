@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Subcommand;
 use lab::chart::{
-    bowl, chooser, control, costs, error_table, family, figures, log, plot, qemu_log, rolling, say,
-    scipy, stability, suffixed, table, timing, workprec,
+    bowl, chooser, control, costs, error_table, family, figures, hierarchy, log, plot, qemu_log,
+    rolling, say, scipy, stability, suffixed, table, timing, workprec,
 };
 
 /// Which chart to draw.
@@ -54,6 +54,9 @@ enum Which {
     BowlRegimeMap(Out),
     /// Bowl model: work-precision of DP5(4) and RK4 with the wall and with flights.
     BowlWorkPrecision(Out),
+    /// The whole hierarchy on the tilted bowl (incline, incline corrected, rolling,
+    /// rolling-or-sliding, bowl) and the chooser's picks: error against host time.
+    HierarchyWorkPrecision(Out),
     /// Rolling model: the twelve releases' paths on the bowl bottom.
     RollingPaths(Out),
     /// Rolling model: each simpler member's difference from the full model (the hierarchy map).
@@ -413,6 +416,10 @@ pub fn run(args: &Args) -> Result<()> {
         }
         Which::BowlWorkPrecision(out) => {
             let (f, t) = bowl::work_precision()?;
+            write_all(out, &f, &t)
+        }
+        Which::HierarchyWorkPrecision(out) => {
+            let (f, t) = hierarchy::work_precision()?;
             write_all(out, &f, &t)
         }
         Which::RollingPaths(out) => {

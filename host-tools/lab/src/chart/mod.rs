@@ -11,6 +11,7 @@ pub mod costs;
 pub mod error_table;
 pub mod family;
 pub mod figures;
+pub mod hierarchy;
 pub mod log;
 pub mod plot;
 pub mod qemu_log;
