@@ -32,6 +32,19 @@ fn the_mean_over_releases_is_even_in_the_speeds() {
     }
 }
 
+/// The closed form's `c2` against the disc's measured at small speeds, to 1e-3: `(T(s w) -
+/// T_incline) / T_incline / s^2` at `s` = 1/4 and 1/8, Richardson.
+fn closed_against_measured(r: Row, s: &RollingScene<f64>) {
+    let (t0, closed) = model_core::choose::incline_rotation::mean_second_order(s).unwrap();
+    let d = |k: f64| (mean(&disc_times_s(&scaled(s, k)).unwrap()) - t0) / t0 / (k * k);
+    let measured = (4.0 * d(0.125) - d(0.25)) / 3.0;
+    println!("{r:?}: closed {closed:e}, measured {measured:e}");
+    assert!(
+        (closed - measured).abs() <= 1e-3 * measured.abs(),
+        "{r:?}: closed {closed:e}, measured {measured:e}"
+    );
+}
+
 /// The closed-form second order (model-core `choose::incline_rotation`) against the disc at
 /// small speeds, where the incline rolls: `(T(s w) - T_incline) / T_incline / s^2` at `s` = 1/4
 /// and 1/8 (Richardson) equals the closed form's `mean T2 / mean T0` to 1e-3 on the cost grid's
@@ -47,13 +60,7 @@ fn the_closed_form_second_order_is_the_discs() {
     ] {
         let s = scene(r);
         assert_ne!(mode_of(&s), 1, "{r:?} slides");
-        let (t0, closed) = model_core::choose::incline_rotation::mean_second_order(&s).unwrap();
-        let d = |k: f64| (mean(&disc_times_s(&scaled(&s, k)).unwrap()) - t0) / t0 / (k * k);
-        let measured = (4.0 * d(0.125) - d(0.25)) / 3.0;
-        assert!(
-            (closed - measured).abs() <= 1e-3 * measured.abs(),
-            "{r:?}: closed {closed:e}, measured {measured:e}"
-        );
+        closed_against_measured(r, &s);
     }
 }
 
@@ -72,14 +79,7 @@ fn the_closed_form_sliding_second_order_is_the_discs() {
     ] {
         let s = scene(r);
         assert_eq!(mode_of(&s), 1, "{r:?} does not slide");
-        let (t0, closed) = model_core::choose::incline_rotation::mean_second_order(&s).unwrap();
-        let d = |k: f64| (mean(&disc_times_s(&scaled(&s, k)).unwrap()) - t0) / t0 / (k * k);
-        let measured = (4.0 * d(0.125) - d(0.25)) / 3.0;
-        println!("{r:?}: closed {closed:e}, measured {measured:e}");
-        assert!(
-            (closed - measured).abs() <= 1e-3 * measured.abs(),
-            "{r:?}: closed {closed:e}, measured {measured:e}"
-        );
+        closed_against_measured(r, &s);
     }
 }
 
