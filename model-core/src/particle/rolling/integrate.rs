@@ -19,7 +19,8 @@ fn rim_event<T: Real>(y: &State<T>, dy: &State<T>) -> (T, T) {
     )
 }
 
-/// One release at azimuth `beta_rad` (as `release` places it). Gives up after [`HORIZON_S`] and [`MAX_STEPS`].
+/// One release at azimuth `beta_rad` (as `release` places it). Gives up after
+/// [`HORIZON_S`](super::HORIZON_S) and [`MAX_STEPS`](super::MAX_STEPS).
 pub fn residence<T: Real>(
     scene: &RollingScene<T>,
     beta_rad: T,
