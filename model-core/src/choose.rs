@@ -304,8 +304,10 @@ fn dp<T: Real>(rtol: T, scene: &Scene<T>) -> Method<T> {
 }
 
 pub mod cost;
+pub mod incline;
 pub mod incline_rotation;
 mod pilot;
+pub mod rotation_bound;
 mod spread;
 pub mod table;
 mod trace;

@@ -65,7 +65,7 @@ fn choose_and_check<T: Real + Into<f64> + core::fmt::Debug>(
         c.rotation_estimate,
         c.friction_needed,
         c.incline_mean_s,
-        c.second_order.map(|s| (s.c2, s.bound)),
+        c.second_order.map(|s| (s.c2, s.bound, s.corrected_bound)),
     )?;
     Ok(c)
 }
@@ -83,7 +83,7 @@ fn check<T: Copy + PartialOrd + core::fmt::Debug + Into<f64>>(
     rotation_estimate: T,
     friction_needed: T,
     incline_mean_s: Option<T>,
-    second_order: Option<(T, T)>,
+    second_order: Option<(T, T, T)>,
 ) -> Result<(), TestCaseError> {
     let at = LEVELS.iter().position(|&l| l == level);
     prop_assert!(at.is_some(), "{level:?} not a level");
@@ -105,10 +105,10 @@ fn check<T: Copy + PartialOrd + core::fmt::Debug + Into<f64>>(
         prop_assert!(t.is_finite() && t >= 0.0, "incline mean {t}");
         prop_assert!(!valid || t > 0.0, "incline mean {t} on a valid scene");
     }
-    if let Some((c2, bound)) = second_order {
+    if let Some((c2, bound, corrected)) = second_order {
         prop_assert!(
-            c2.into().is_finite() && bound.into().is_finite(),
-            "{c2:?} {bound:?}"
+            c2.into().is_finite() && bound.into().is_finite() && corrected.into().is_finite(),
+            "{c2:?} {bound:?} {corrected:?}"
         );
     }
     Ok(())

@@ -1,5 +1,6 @@
-//! The bowl's rotation as a perturbation of the rolling incline, to second order in the speeds
-//! (docs/model.md §12, "The four rotation rows"): the incline's path is known in closed form
+//! The bowl's rotation as a perturbation of the incline (rolling, and sliding below), to second
+//! order in the speeds (docs/model.md §12, "The four rotation rows"): the incline's path is
+//! known in closed form
 //! (`x0 = p0 + A t^2/2 d`, `A = k2 g (sin th - mu_r cos th)`, `d` downhill at release), and the
 //! rotation's terms of §9's equations (the gyroscopic `(1 + k2) Oz J u`, the downhill
 //! direction turning at `w2`, the spin `sig`, the Euler and centripetal terms, the normal
@@ -18,13 +19,16 @@
 //! `g1 = 2 p0y y1`, `g2 = 2 P X2 + 2 p0y y2 + y1^2`, `P = x0 . d`.
 //!
 //! The mean over the twelve azimuths has no first-order part (the mirror, §12), so the rolling
-//! incline's mean moves by `mean T2` to second order. Rolling only: a sliding incline's slip
-//! has its own dynamics (not here), and the rod offset is left out (`L = 0`). The chooser
+//! incline's mean moves by `mean T2` to second order. Where the incline slides the same holds
+//! along the sliding incline's path, with the slip's own turning (`Orders::sliding`); the rod
+//! offset is left out (`L = 0`). The chooser
 //! (`whole::second_order_bound`) runs [`mean_second_order_from`] where its a-priori rotation
 //! estimate refuses the incline.
 
 use crate::Real;
-use crate::particle::rolling::{AZIMUTHS_DEG, RollingScene, incline_residence_s};
+use crate::particle::rolling::{AZIMUTHS_DEG, RollingScene};
+
+use super::incline::{incline_release_s, slides_in};
 
 /// `(cos beta, sin beta)` of [`AZIMUTHS_DEG`] (every 30 deg), exact to the last bit of `f64`
 /// (`libm`'s `sin`/`cos` cost about 20 ns each: 24 of them would be most of the chooser's
@@ -53,7 +57,7 @@ struct Orders<T> {
     /// `1 / drive`.
     inv_drive: T,
     ri: T,
-    /// `v1 = v1_k t^2`.
+    /// `y1' = v1_k t^2` (rolling: the slip-free velocity across; sliding: the granule's).
     v1_k: T,
     /// `y1 = y1_k t^3`.
     y1_k: T,
@@ -67,9 +71,20 @@ struct Orders<T> {
 }
 
 impl<T: Real> Orders<T> {
-    /// `None` when the incline does not drive the granule or the release is not inside the rim.
-    /// `(s, c)`: the tilt's sine and cosine.
+    /// The incline's orders in its mode at the scene (rolling, or sliding where rolling needs
+    /// more friction than `mu_s`, as [`incline_release_s`] has it). `None` when the incline
+    /// does not drive the granule or the release is not inside the rim. `(s, c)`: the tilt's
+    /// sine and cosine.
     fn new(scene: &RollingScene<T>, s: T, c: T) -> Option<Self> {
+        if slides_in(scene, s, c) {
+            Self::sliding(scene, s, c)
+        } else {
+            Self::rolling(scene, s, c)
+        }
+    }
+
+    /// The rolling incline's orders (the module's text).
+    fn rolling(scene: &RollingScene<T>, s: T, c: T) -> Option<Self> {
         let g = scene.g_m_s2;
         let (k2, mu_r, a) = (scene.k2, scene.rolling_resistance, scene.particle_radius_m);
         let (w1, w2) = (scene.precession_rad_s, scene.spin_rad_s);
@@ -126,6 +141,75 @@ impl<T: Real> Orders<T> {
         })
     }
 
+    /// The sliding incline's orders (docs/model.md §12, "The sliding incline's second
+    /// order"; derived as the rolling ones, checked against the disc in `lab`'s
+    /// `whole::rotation_orders`). The granule slides down `d = -e1` at `A = g (sin th - mu_s
+    /// cos th)` from rest, its contact slipping at `U t` with `U = A - kappa mu_s Nn`
+    /// (`kappa = k2 / (1 - k2)`: the friction torque spins the sphere up, `kappa` of the
+    /// friction per unit mass at its surface); `U > 0` is the sliding condition itself. The
+    /// slip's direction turns with the rotation: across the path its component `v` obeys
+    /// `v' + lambda v / t = P(t)`, `lambda = (1 + kappa) mu_s Nn / U`, so each order is a
+    /// polynomial in `t` again.
+    /// - First order across: `v1 = B t^2 / (2 + lambda)` with
+    ///   `B = G w2 + Oz (2 A - kappa mu_s Nn)`; the granule's `uy1 = Kuy t^2`,
+    ///   `Kuy = (G w2 + 2 Oz A) / 2 - mu_s Nn B / (2 U (2 + lambda))`, `y1 = Kuy t^3 / 3`.
+    /// - Second order across: `y2 = |Omega|^2 (1 - mu_s Nn / (U (1 + lambda))) p0y t^2 / 2`.
+    /// - Second order along `e1`: `x2 = q0 t^2 / 2 + q4 t^4 / 24`,
+    ///   `q0 = (Oz^2 + mu_s s w1 (c w1 + 2 w2)) p0x - a s w1^2 (c + mu_s s)` (the rolling
+    ///   form's with `k2 = 1`), `q4 = -mu_s Nn (B / (2 + lambda))^2 / U^2 + 4 Kuy (Oz + mu_s s
+    ///   w1) - g H`, `H = c s w1 (c w1 + 2 w2) + mu_s (s^2 w1 (c w1 + 6 w2) - c Oz^2)
+    ///   - mu_s^2 c s w1 (c w1 + 6 w2)`.
+    ///
+    /// The exit time's orders are then the rolling incline's ([`Orders::terms`]).
+    fn sliding(scene: &RollingScene<T>, s: T, c: T) -> Option<Self> {
+        let g = scene.g_m_s2;
+        let (k2, mu, a) = (scene.k2, scene.sliding_friction, scene.particle_radius_m);
+        let (w1, w2) = (scene.precession_rad_s, scene.spin_rad_s);
+        let (big_g, nn) = (g * s, g * c);
+        let mu_n = mu * nn;
+        let drive = big_g - mu_n;
+        // A sphere's `k2` is below 1 (a point mass would have no spin to drive).
+        let kappa = k2 / (T::ONE - k2);
+        let slip = drive - kappa * mu_n;
+        // Also catches NaNs: no drive, or no slip to turn (not sliding).
+        if !(drive > T::ZERO && slip > T::ZERO && kappa.is_finite()) {
+            return None;
+        }
+        let (ri, rim) = (scene.ri_m, scene.rim_radius_m);
+        if ri.is_nan() || rim.is_nan() || ri.abs() >= rim {
+            return None;
+        }
+        let (half, two) = (T::HALF, T::TWO);
+        let oz = w1 * c + w2;
+        let omega2 = w1 * w1 * s * s + oz * oz;
+        let inv_slip = T::ONE / slip;
+        let n_u = mu_n * inv_slip;
+        let lambda = (T::ONE + kappa) * n_u;
+        // First order across the path.
+        let b = big_g * w2 + oz * (two * drive - kappa * mu_n);
+        let v1 = b / (two + lambda);
+        let k_uy = ((big_g * w2 + two * oz * drive) - n_u * v1) * half;
+        // Second order across the path.
+        let y2_k = omega2 * (T::ONE - n_u / (T::ONE + lambda)) * half;
+        // Second order along e1 (see above); `q0_x`, `q0_c` and `q2_12` are along d = -e1.
+        let c_w1 = c * w1;
+        let h = c * s * w1 * (c_w1 + two * w2)
+            + mu * (s * s * w1 * (c_w1 + T::from_f64(6.0) * w2) - c * oz * oz)
+            - mu * mu * c * s * w1 * (c_w1 + T::from_f64(6.0) * w2);
+        let q4 = -n_u * v1 * v1 * inv_slip + T::from_f64(4.0) * k_uy * (oz + mu * s * w1) - g * h;
+        Some(Orders {
+            drive,
+            inv_drive: T::ONE / drive,
+            ri,
+            v1_k: k_uy,
+            y1_k: k_uy * T::from_f64(1.0 / 3.0),
+            y2_k,
+            q0_x: -(oz * oz + mu * s * w1 * (c_w1 + two * w2)),
+            q0_c: a * s * w1 * w1 * (c + mu * s),
+            q2_12: -q4 * T::from_f64(1.0 / 24.0),
+        })
+    }
+
     /// The release at `(cos beta, sin beta)` whose incline time is `t` (`T0`): `(T1, T2)`,
     /// unchecked (the callers check that what comes out is finite). No square root (the
     /// incline's time gives the path: at the exit `x0 . d = p0d + A t^2/2`) and one division:
@@ -157,23 +241,23 @@ impl<T: Real> Orders<T> {
     }
 }
 
-/// The rolling incline's release at `beta_rad`: `(T0, T1, T2)`, its exit time at rest and the
+/// The incline's release at `beta_rad` (rolling or sliding, [`incline_release_s`]): `(T0, T1, T2)`, its exit time at rest and the
 /// rotation's first- and second-order corrections (s); `None` when the incline does not drive
 /// the granule or the release is not inside the rim.
 pub fn release_second_order_s<T: Real>(scene: &RollingScene<T>, beta_rad: T) -> Option<(T, T, T)> {
     let th = scene.axes_angle_rad;
     let orders = Orders::new(scene, th.sin(), th.cos())?;
-    let t = incline_residence_s(scene, beta_rad)?;
+    let t = incline_release_s(scene, beta_rad)?;
     let (t1, t2) = orders.terms(beta_rad.cos(), beta_rad.sin(), t);
     (t > T::ZERO && t1.is_finite() && t2.is_finite()).then_some((t, t1, t2))
 }
 
-/// The rolling incline's mean over [`AZIMUTHS_DEG`] and the rotation's second-order change of
+/// The incline's mean over [`AZIMUTHS_DEG`] (rolling or sliding) and the rotation's second-order change of
 /// it, relative: `(mean T0, mean T2 / mean T0)`.
 pub fn mean_second_order<T: Real>(scene: &RollingScene<T>) -> Option<(T, T)> {
     let mut times = [T::ZERO; 12];
     for (t, deg) in times.iter_mut().zip(AZIMUTHS_DEG) {
-        *t = incline_residence_s(scene, T::from_f64(deg.to_radians()))?;
+        *t = incline_release_s(scene, T::from_f64(deg.to_radians()))?;
     }
     mean_second_order_from(scene, &times)
 }

@@ -146,3 +146,47 @@ fn the_seven_release_pass_is_the_release_by_release_one_at_any_scale() {
         );
     }
 }
+
+/// The sliding incline's orders (`Orders::sliding`) against their own limits: at rest the
+/// sliding incline with no correction; the mirror; `T1` linear and `T2` quadratic in the
+/// speeds. The closed form against the disc is `lab`'s
+/// `whole::rotation_orders::checks::the_closed_form_sliding_second_order_is_the_discs`.
+#[test]
+fn the_sliding_incline_keeps_the_limits() {
+    let sliding = |w1: f64, w2: f64| RollingScene {
+        sliding_friction: 0.4,
+        ..rig(60.0, w1, w2)
+    };
+    let s = sliding(0.0, 0.0);
+    assert!(crate::choose::incline::slides_in(
+        &s,
+        60f64.to_radians().sin(),
+        0.5
+    ));
+    // The sliding incline's time: the rolling form with k2 = 1 and mu_s for the resistance.
+    let bare = RollingScene {
+        k2: 1.0,
+        rolling_resistance: 0.4,
+        ..s
+    };
+    for deg in AZIMUTHS_DEG {
+        let b = deg.to_radians();
+        let (t0, t1, t2) = release_second_order_s(&s, b).unwrap();
+        let want = incline_residence_s(&bare, b).unwrap();
+        assert!((t0 - want).abs() <= 1e-12 * want, "{deg}: {t0} vs {want}");
+        assert_eq!((t1, t2), (0.0, 0.0));
+    }
+    let (a, m) = (sliding(2.0, -1.5), sliding(-2.0, 1.5));
+    for deg in [30.0f64, 90.0, 150.0] {
+        let (_, a1, a2) = release_second_order_s(&a, deg.to_radians()).unwrap();
+        let (_, b1, b2) = release_second_order_s(&m, (-deg).to_radians()).unwrap();
+        assert!(
+            a1 != 0.0 && (a1 - b1).abs() <= 1e-12 * a1.abs(),
+            "{a1} {b1}"
+        );
+        assert!((a2 - b2).abs() <= 1e-12 * a2.abs(), "{a2} {b2}");
+        let (_, d1, d2) = release_second_order_s(&sliding(4.0, -3.0), deg.to_radians()).unwrap();
+        assert!((d1 - 2.0 * a1).abs() <= 1e-12 * d1.abs());
+        assert!((d2 - 4.0 * a2).abs() <= 1e-12 * d2.abs());
+    }
+}

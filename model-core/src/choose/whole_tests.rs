@@ -145,25 +145,64 @@ fn a_rolling_row_the_estimate_refuses_is_taken_by_the_second_order() {
     assert!(c.rotation_estimate > 0.02, "{c:?}");
     let b = c.second_order.unwrap();
     assert!((b.c2 + 0.0052).abs() < 1e-4 && b.bound < 0.0071, "{b:?}");
+    assert!(!b.corrected, "{b:?}");
     assert_eq!(c.cheaper_fail, [None; 4]);
+    let plain = incline_mean_s(&s).unwrap();
+    assert_eq!(c.incline_mean_s, Some(plain));
+    // At 0.5 % the plain incline's bound is above, the corrected one's (K4c F^2, 0.42 %)
+    // within: the incline, its mean corrected by c2.
     let c = choose_level(&s, &bare(), 0.005, false);
+    let b = c.second_order.unwrap();
+    assert!(
+        b.bound > 0.005 && b.corrected_bound <= 0.005 && b.corrected,
+        "{b:?}"
+    );
+    assert_eq!(c.level, Level::Incline, "{c:?}");
+    let corrected = c.incline_mean_s.unwrap();
+    assert!(
+        (corrected - plain * (1.0 + b.c2)).abs() <= 1e-15 * plain,
+        "{c:?}"
+    );
+    // At 0.1 % neither holds.
+    let c = choose_level(&s, &bare(), 0.001, false);
     assert!(
         matches!(c.cheaper_fail[0], Some(Fails::Rotation { .. })),
         "{c:?}"
     );
-    assert!(c.second_order.is_some());
+    assert!(c.second_order.is_some_and(|b| !b.corrected));
+    assert_eq!(c.incline_mean_s, Some(plain));
     // Where the estimate already takes it, the second order is not computed.
     let c = choose_level(&s, &bare(), 0.05, false);
     assert_eq!((c.level, c.second_order), (Level::Incline, None));
-    // Where it slides (60 deg, 3.6 rad/s, mu_s 0.4) or sits off the rod, there is none.
+    // Where it slides all the way (60 deg, 2.0 rad/s, mu_s 0.4), the sliding incline's own
+    // second order: -0.27 %, the plain bound 0.30 %, the corrected one 0.036 %: taken
+    // corrected at 0.1 %.
     let slides = RollingScene {
+        sliding_friction: 0.4,
+        ..rig(60.0, 2.0)
+    };
+    assert_eq!(incline_mode(&slides), InclineMode::Slides);
+    assert!(!may_stick(&slides));
+    let c = choose_level(&slides, &bare(), 0.001, false);
+    let b = c.second_order.unwrap();
+    assert!((b.c2 + 0.00268).abs() < 1e-5, "{b:?}");
+    assert!(
+        b.bound > 0.001 && b.corrected_bound < 0.0004 && b.corrected,
+        "{b:?}"
+    );
+    assert_eq!(c.level, Level::Incline, "{c:?}");
+    // At 3.6 rad/s the rotation may bring it to stick (some releases roll part of the way):
+    // none.
+    let sticks = RollingScene {
         sliding_friction: 0.4,
         ..rig(60.0, 3.6)
     };
+    assert!(may_stick(&sticks));
     assert_eq!(
-        choose_level(&slides, &bare(), 0.01, false).second_order,
+        choose_level(&sticks, &bare(), 0.01, false).second_order,
         None
     );
+    // Off the rod there is none.
     let off = RollingScene {
         rod_length_m: 0.1,
         ..s

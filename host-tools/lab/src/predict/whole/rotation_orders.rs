@@ -35,7 +35,8 @@
 //! [`rotation_form`]: model_core::choose::whole::rotation_form
 
 use model_core::choose::whole::{
-    InclineMode, SECOND_ORDER_K4, SECOND_ORDER_K4_NEAR_RIM, friction_needed_at_rim, incline_mean_s,
+    CORRECTED_K4, CORRECTED_K4_NEAR_RIM, CORRECTED_K4_SLIDING, InclineMode, SECOND_ORDER_K4,
+    SECOND_ORDER_K4_NEAR_RIM, SECOND_ORDER_K4_SLIDING, friction_needed_at_rim, incline_mean_s,
     incline_mode, incline_times_s, rotation_estimate, rotation_form, second_order_bound,
 };
 
@@ -85,6 +86,11 @@ struct Orders {
     /// The chooser's bound on the plain incline's error from the closed form
     /// (`second_order_bound`; infinite where it gives none).
     chooser_bound: f64,
+    /// The incline corrected by the closed-form `c2`: its relative error against the disc.
+    closed_corrected_err: f64,
+    /// The chooser's bound on that error (`second_order_bound`'s `corrected_bound`; infinite
+    /// where it gives none).
+    chooser_corrected_bound: f64,
 }
 
 fn scaled(s: &RollingScene<f64>, k: f64) -> RollingScene<f64> {
@@ -123,6 +129,8 @@ fn orders(name: &str, kind: Kind, r: Row) -> Option<Orders> {
     let (tilt, w1, w2, mu_s, ri, rim) = r;
     let closed =
         model_core::choose::incline_rotation::mean_second_order(&s).map_or(f64::NAN, |m| m.1);
+    let bound =
+        incline_times_s(&s).and_then(|ts| second_order_bound(&s, &ts, t0, incline_mode(&s)));
     let o = Orders {
         kind,
         label: format!("{tilt} deg, {w1}/{w2} rad/s, mu_s {mu_s}, ri {ri}, R {rim}"),
@@ -134,12 +142,12 @@ fn orders(name: &str, kind: Kind, r: Row) -> Option<Orders> {
         estimate: rotation_estimate(&s, t0),
         mirror,
         closed,
-        chooser_bound: incline_times_s(&s)
-            .and_then(|ts| second_order_bound(&s, &ts, t0, incline_mode(&s)))
-            .map_or(f64::INFINITY, |b| b.bound),
+        chooser_bound: bound.map_or(f64::INFINITY, |b| b.bound),
+        closed_corrected_err: ((t0 * (1.0 + closed) - t) / t).abs(),
+        chooser_corrected_bound: bound.map_or(f64::INFINITY, |b| b.corrected_bound),
     };
     println!(
-        "ORDERS,{name},{tilt},{w1},{w2},{mu_s},{ri},{rim},mode {},rim need {:.4},F {:.4},err {:.3e},D(1) {:.3e},c2 {:.3e},corrected err {:.3e},estimate {:.3e},mirror {mirror:.1e},odd per release {odd:.3e},closed c2 {closed:.3e}",
+        "ORDERS,{name},{tilt},{w1},{w2},{mu_s},{ri},{rim},mode {},rim need {:.4},F {:.4},err {:.3e},D(1) {:.3e},c2 {:.3e},corrected err {:.3e},estimate {:.3e},mirror {mirror:.1e},odd per release {odd:.3e},closed c2 {closed:.3e},need at rest {:.4},closed corrected err {:.3e},chooser corrected bound {:.3e}",
         o.mode,
         friction_needed_at_rim(&s) / mu_s,
         o.form,
@@ -147,7 +155,10 @@ fn orders(name: &str, kind: Kind, r: Row) -> Option<Orders> {
         d(t),
         o.c2,
         o.corrected_err,
-        o.estimate
+        o.estimate,
+        model_core::choose::whole::incline_friction_needed(&s) / mu_s,
+        o.closed_corrected_err,
+        o.chooser_corrected_bound
     );
     Some(o)
 }
@@ -266,17 +277,18 @@ fn rotation_orders() {
         n(Kind::Fit),
         n(Kind::Held)
     );
-    // The closed form against the measured c2 where the incline rolls and is not near the stick
-    // threshold at rest (modes 0 and 2: T is smooth in the speeds there).
-    let worst = rows
-        .iter()
-        .filter(|o| o.mode == 0 || o.mode == 2)
-        .map(|o| ((o.closed - o.c2) / o.c2).abs())
-        .fold(0.0, f64::max);
-    let n_rolling = rows.iter().filter(|o| o.mode == 0 || o.mode == 2).count();
-    println!(
-        "closed-form c2 against the measured one, {n_rolling} rolling scenes: largest relative difference {worst:.2e}"
-    );
+    // The closed form against the measured c2 where the incline is not near the stick threshold
+    // at rest (modes 0, 1 and 2: T is smooth in the speeds there), rolling and sliding apart.
+    for (name, modes) in [("rolling", [0, 2]), ("sliding", [1, 1])] {
+        let of_mode = || rows.iter().filter(|o| modes.contains(&o.mode));
+        let worst = of_mode()
+            .map(|o| ((o.closed - o.c2) / o.c2).abs())
+            .fold(0.0, f64::max);
+        println!(
+            "closed-form c2 against the measured one, {} {name} scenes: largest relative difference {worst:.2e}",
+            of_mode().count()
+        );
+    }
     // Today's three modes, and the near-threshold one split (at rest / at the rim).
     let three = |o: &Orders| o.mode.min(2);
     let four = |o: &Orders| o.mode;
@@ -358,19 +370,45 @@ fn rotation_orders() {
     // The chooser's bound (model-core `second_order_bound`): (b) with the closed-form c2, where
     // the incline rolls to the rim or only the rotation brings it near the threshold there.
     // Its K4 per mode is fitted here on the fitting grid; model-core's constants must cover it.
+    // Fitted where the chooser offers the bound (not where a sliding granule may stick,
+    // `may_stick`).
     let kc = fitted(&rows, &four, &|o: &Orders| {
-        if o.closed.is_finite() {
+        if o.chooser_bound.is_finite() {
             (o.err - o.closed.abs()).max(0.0)
         } else {
             f64::NAN
         }
     });
     println!(
-        "the chooser's bound |c2 closed| + K4 F^2: K4 fitted {:.3e} (rolls), {:.3e} (near at the rim); model-core {SECOND_ORDER_K4:e}, {SECOND_ORDER_K4_NEAR_RIM:e}",
-        kc[0], kc[2]
+        "the chooser's bound |c2 closed| + K4 F^2: K4 fitted {:.3e} (rolls), {:.3e} (slides), {:.3e} (near at the rim); model-core {SECOND_ORDER_K4:e}, {SECOND_ORDER_K4_SLIDING:e}, {SECOND_ORDER_K4_NEAR_RIM:e}",
+        kc[0], kc[1], kc[2]
+    );
+    // The corrected incline's K4 per mode, fitted as above with the closed-form c2.
+    let kcc = fitted(&rows, &four, &|o: &Orders| {
+        if o.chooser_bound.is_finite() {
+            o.closed_corrected_err
+        } else {
+            f64::NAN
+        }
+    });
+    println!(
+        "the chooser's corrected incline, bound K4c F^2: K4c fitted {:.3e} (rolls), {:.3e} (slides), {:.3e} (near at the rim); model-core {CORRECTED_K4:e}, {CORRECTED_K4_SLIDING:e}, {CORRECTED_K4_NEAR_RIM:e}",
+        kcc[0], kcc[1], kcc[2]
     );
     let chooser = |o: &Orders| o.chooser_bound;
     let either = |o: &Orders| o.estimate.min(o.chooser_bound);
+    // The chooser's rule at `tol` (`choose_level`): the plain incline where the estimate or the
+    // second order's bound holds, else the corrected one where its bound does; `Some(error)`
+    // of what it takes.
+    let takes = |o: &Orders, tol: f64| {
+        if either(o) <= tol {
+            Some(o.err)
+        } else if o.chooser_corrected_bound <= tol {
+            Some(o.closed_corrected_err)
+        } else {
+            None
+        }
+    };
     let mut beyond = 0;
     for (name, kind) in GRIDS {
         println!(
@@ -382,85 +420,50 @@ fn rotation_orders() {
             counts(&rows, kind, &plain, &either),
             counts(&rows, kind, &plain, &today)
         );
+        let per_tol = [0.05, 0.01, 0.001]
+            .iter()
+            .map(|&tol| {
+                let rs = || rows.iter().filter(|o| o.kind == kind);
+                let plain = rs().filter(|o| either(o) <= tol).count();
+                let all = rs().filter(|o| takes(o, tol).is_some()).count();
+                let out = rs()
+                    .filter(|o| takes(o, tol).is_some_and(|e| e > tol))
+                    .count();
+                format!("{tol}: {all} ({plain} plain, {out} beyond)")
+            })
+            .collect::<Vec<_>>()
+            .join(", ");
+        println!("  {name}: the chooser, the corrected incline too: {per_tol}");
         beyond += rows
             .iter()
             .filter(|o| o.kind == kind && (kind == Kind::Fit || kind == Kind::Held))
             .filter(|o| {
                 [0.05, 0.01, 0.001]
                     .iter()
-                    .any(|&t| either(o) <= t && o.err > t)
+                    .any(|&t| takes(o, t).is_some_and(|e| e > t))
             })
             .count();
     }
     for o in rows.iter().filter(|o| o.kind == Kind::Row) {
         println!(
-            "  row {}: the chooser's bound {:.2e} (c2 closed {:.2e}, the error {:.2e})",
-            o.label, o.chooser_bound, o.closed, o.err
+            "  row {}: the chooser's bound {:.2e} (c2 closed {:.2e}, the error {:.2e}); corrected {:.2e} (the error {:.2e})",
+            o.label,
+            o.chooser_bound,
+            o.closed,
+            o.err,
+            o.chooser_corrected_bound,
+            o.closed_corrected_err
         );
     }
-    // What a bound may cost on the rows it is to take: within 1.25x of the plain incline
-    // leaves a quarter of the incline's own time (1000 calls, best of 5).
-    let s = scene((60.0, 3.6, 3.6, 0.4, 0.0375, 0.075));
-    let time = |f: &dyn Fn()| {
-        (0..5)
-            .map(|_| {
-                let t0 = std::time::Instant::now();
-                for _ in 0..1000 {
-                    f();
-                }
-                t0.elapsed().as_secs_f64() / 1000.0
-            })
-            .fold(f64::INFINITY, f64::min)
-    };
-    // The second order as the chooser runs it: from the incline's own times.
-    let times = incline_times_s(&s).unwrap();
-    let second = time(&|| {
-        std::hint::black_box(
-            model_core::choose::incline_rotation::mean_second_order_from(
-                std::hint::black_box(&s),
-                &times,
-            ),
-        );
-    });
-    let incline = time(&|| {
-        std::hint::black_box(incline_mean_s(std::hint::black_box(&s)));
-    });
-    let choice = time(&|| {
-        std::hint::black_box(choose_level(
-            std::hint::black_box(&s),
-            &BowlShape::bare_rim(),
-            0.01,
-            false,
-        ));
-    });
-    // A rolling row the a-priori estimate refuses at 1 % and the second order takes: the
-    // choice there runs the incline, its checks and the second order.
-    let r = scene((30.0, 1.8, 1.8, 0.2, 0.0375, 0.075));
-    let incline_r = time(&|| {
-        std::hint::black_box(incline_mean_s(std::hint::black_box(&r)));
-    });
-    let choice_r = time(&|| {
-        std::hint::black_box(choose_level(
-            std::hint::black_box(&r),
-            &BowlShape::bare_rim(),
-            0.01,
-            false,
-        ));
-    });
+    costs();
     assert!(
-        choose_level(&r, &BowlShape::bare_rim(), 0.01, false)
-            .second_order
-            .is_some()
-    );
-    println!(
-        "the incline {incline:.2e} s, the choice (with it) {choice:.2e} s, the closed-form second \
-         order from the incline's times {second:.2e} s per call; on 30 deg, 1.8 rad/s, mu_s 0.2 at 1 %: the incline \
-         {incline_r:.2e} s, the choice taking it by the second order {choice_r:.2e} s ({:.2}x)",
-        choice_r / incline_r
-    );
-    assert!(
-        kc[0] <= SECOND_ORDER_K4 && kc[2] <= SECOND_ORDER_K4_NEAR_RIM,
-        "model-core's K4 does not cover the fitting grid: {kc:?}"
+        kc[0] <= SECOND_ORDER_K4
+            && kc[1] <= SECOND_ORDER_K4_SLIDING
+            && kc[2] <= SECOND_ORDER_K4_NEAR_RIM
+            && kcc[0] <= CORRECTED_K4
+            && kcc[1] <= CORRECTED_K4_SLIDING
+            && kcc[2] <= CORRECTED_K4_NEAR_RIM,
+        "model-core's K4 does not cover the fitting grid: {kc:?} {kcc:?}"
     );
     assert_eq!(
         beyond, 0,
@@ -477,3 +480,6 @@ fn rotation_orders() {
 
 // The two checks behind the claims above (the mirror, the closed form against the disc).
 mod checks;
+// What the bounds cost where they take the incline.
+mod costs;
+use costs::costs;

@@ -56,3 +56,73 @@ fn the_closed_form_second_order_is_the_discs() {
         );
     }
 }
+
+/// The sliding incline's closed-form second order (model-core `choose::incline_rotation`,
+/// `Orders::sliding`) against the disc at small speeds, as the rolling one above: the cost
+/// grid's sliding row (60 deg, 3.6 rad/s, mu_s 0.4), the held-out cost grid's three (50 deg,
+/// mu_s 0.3: equal, opposite and slow speeds), and a steep tilt with a release near the axis.
+#[test]
+fn the_closed_form_sliding_second_order_is_the_discs() {
+    for r in [
+        (60.0, 3.6, 3.6, 0.4, 0.0375, 0.075),
+        (50.0, 0.8, 0.8, 0.3, 0.0375, 0.075),
+        (50.0, 2.5, -1.875, 0.3, 0.0375, 0.075),
+        (50.0, 2.5, 2.5, 0.3, 0.0375, 0.075),
+        (75.0, 1.0, -0.75, 0.6, 0.02, 0.1),
+    ] {
+        let s = scene(r);
+        assert_eq!(mode_of(&s), 1, "{r:?} does not slide");
+        let (t0, closed) = model_core::choose::incline_rotation::mean_second_order(&s).unwrap();
+        let d = |k: f64| (mean(&disc_times_s(&scaled(&s, k)).unwrap()) - t0) / t0 / (k * k);
+        let measured = (4.0 * d(0.125) - d(0.25)) / 3.0;
+        println!("{r:?}: closed {closed:e}, measured {measured:e}");
+        assert!(
+            (closed - measured).abs() <= 1e-3 * measured.abs(),
+            "{r:?}: closed {closed:e}, measured {measured:e}"
+        );
+    }
+}
+
+/// `may_stick` against the bowl model (a bare rim, rtol 1e-10): on sliding scenes of the grids,
+/// those where some release rolls for part of its way are said to possibly stick, and those it
+/// clears slide all the way in every release. The scenes: the cost grid's 60 deg, 3.6 rad/s,
+/// mu_s 0.4 and the held-out one's 50 deg, 2.5 rad/s, mu_s 0.3 (both stick), 45 deg at 3.6
+/// rad/s on a wide bowl (sticks), and four that slide all the way (the cleared, and one the
+/// check flags without a stick: it is a bound, not an equivalence).
+#[test]
+fn a_sliding_granule_that_sticks_on_its_way_is_flagged() {
+    use model_core::choose::whole::may_stick;
+    use model_core::particle::bowl::{BowlOutcome, residence};
+    for (r, sticks, flagged) in [
+        ((60.0, 3.6, 3.6, 0.4, 0.0375, 0.075), true, true),
+        ((50.0, 2.5, 2.5, 0.3, 0.0375, 0.075), true, true),
+        ((45.0, 3.6, 3.6, 0.2, 0.075, 0.15), true, true),
+        ((60.0, 2.0, 2.0, 0.4, 0.0375, 0.075), false, false),
+        ((70.0, 3.0, 3.0, 0.4, 0.015, 0.1), false, false),
+        ((50.0, 2.5, -1.875, 0.3, 0.0375, 0.075), false, false),
+        ((45.0, 3.6, 3.6, 0.2, 0.0375, 0.075), false, true),
+    ] {
+        let s = scene(r);
+        assert_eq!(mode_of(&s), 1, "{r:?} does not slide at rest");
+        let limits = model_core::ode::system::SystemLimits {
+            horizon_s: 5.0,
+            max_steps: 2_000_000,
+        };
+        let rolled = model_core::particle::rolling::AZIMUTHS_DEG
+            .iter()
+            .any(|deg| {
+                let rep = residence(
+                    &s,
+                    &BowlShape::bare_rim(),
+                    deg.to_radians(),
+                    RollingMethod::Dp54 { rtol: 1e-10 },
+                    limits,
+                )
+                .unwrap();
+                assert!(matches!(rep.outcome, BowlOutcome::Leaves { .. }), "{r:?}");
+                rep.regime.roll_s > 0.0
+            });
+        assert_eq!(rolled, sticks, "{r:?}: rolled part of the way {rolled}");
+        assert_eq!(may_stick(&s), flagged, "{r:?}");
+    }
+}
