@@ -13,7 +13,7 @@
 //! knows and checks.
 
 use super::params::ParamId;
-use super::types::{DeviceState, Injection, RESIDENCE_MAX_MS, Reason, ResidenceModel};
+use super::types::{DeviceState, Injection, RESIDENCE_MAX_MS, ResidenceModel};
 
 mod parse;
 pub use parse::{FieldProblem, parse_int};

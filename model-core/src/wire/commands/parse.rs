@@ -1,7 +1,9 @@
 //! Reading commands from text: the command a token names, one field's value from its token,
 //! and the range checks the decoder and the encoder share (the table is [`super`]'s).
 
-use super::{Command, CommandKind, Field, FieldKind, ParamId, Reason};
+use crate::wire::commands::{Command, CommandKind, Field, FieldKind};
+use crate::wire::params::ParamId;
+use crate::wire::types::Reason;
 
 impl CommandKind {
     /// The command with this wire token (exact, upper case).
