@@ -39,6 +39,8 @@ const WIRE: &[(&str, &[&str])] = &[
     ("words", &["types"]),
     ("params", &["types"]),
     ("commands", &["params", "types"]),
+    // commands/parse.rs: the commands' field parsing and range checks, a part of `commands`.
+    ("parse", &["commands", "params", "types"]),
     ("frame", &["commands", "params", "types"]),
     (
         "encode",

@@ -1,7 +1,11 @@
 //! The rolling model against its limits with closed forms (docs/model.md §9) and against the
 //! reference values of the tilted rig.
 
+use core::ops::ControlFlow;
+
+use super::equations::forces;
 use super::*;
+use crate::ode::system::{self, Ended};
 
 const FINE: RollingMethod<f64> = RollingMethod::Dp54 { rtol: 1e-12 };
 

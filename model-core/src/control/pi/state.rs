@@ -1,0 +1,128 @@
+//! The loop's state, its rest, and what the controller reads of it; the step that moves it,
+//! [`SpeedLoop::step`], is [`super`]'s.
+
+use super::Breakaway;
+
+/// State of one axis's loop.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SpeedLoop {
+    pub(super) integral: f32,
+    pub(super) duty: f32,
+    pub(super) model_rad_s: f32,
+    pub(super) model_angle_rad: f32,
+    pub(super) window_open: bool,
+    pub(super) have_error: bool,
+    pub(super) error: f32,
+    pub(super) kp_prev: f32,
+    pub(super) push: f32,
+    pub(super) moved: bool,
+    pub(super) kick_rad_s: f32,
+    pub(super) push_sum: f32,
+    /// The kick's share the integral kept at the first edge, until the first measurement
+    /// (duty, magnitude; see `kept_kick` in [`SpeedLoop::step`]).
+    pub(super) kept_kick: f32,
+    /// The model has been above the reference (the reference came down) since the start of
+    /// the newest window: that window's "too fast" is the slowing down, not a load.
+    pub(super) slowing: bool,
+    /// Seconds since the model was last more than 2 % above the reference's magnitude.
+    pub(super) model_down_quiet_s: f32,
+    /// The reference's magnitude last tick, rad/s.
+    pub(super) reference_abs_rad_s: f32,
+    /// What the current says of this start (axes with current sense only).
+    pub(super) breakaway: Breakaway,
+    /// The duty applied last tick beyond the feedforward and the push: the feedback's (the
+    /// clamp and the slew limit included) and the kick's, which the plant model does not
+    /// know either.
+    pub(super) correction_duty: f32,
+    /// The speed that correction has given the plant model, rad/s (the correction through the
+    /// identified lag), and its angle over the estimator's current window, rad.
+    pub(super) correction_rad_s: f32,
+    pub(super) correction_angle_rad: f32,
+    /// The share of a load's steady speed deficit the shaft shows by now, since the loop left
+    /// rest: a load that acts from the start slows the shaft through the identified lag,
+    /// `1 - exp(-t / tau)` (a unit step through the plant model), and its integral over the
+    /// estimator's current window, s (see `read_window`, window.rs).
+    pub(super) load_lag: f32,
+    pub(super) load_lag_angle: f32,
+    /// The shaft started from rest (its first edge) and no window has been read since: the
+    /// next one reads the load at once (see `step`).
+    pub(super) start_reading: bool,
+    /// The push started the shaft, so its first window is not read (`start_reading`): the
+    /// second one is, once that window has closed.
+    pub(super) late_reading: bool,
+    /// The push has been on since the shaft was last at rest (the kick did not start it).
+    pub(super) pushed: bool,
+    /// The reference has come down since the loop started (see `quiet` in [`SpeedLoop::step`]).
+    pub(super) stepped_down: bool,
+    /// The current showed the breakaway in this step (see [`SpeedLoop::take_breakaway`]).
+    pub(super) breakaway_news: bool,
+    /// The back-EMF duty per rad/s the current sense learned (0: not given, the identified
+    /// model's); set before each step (see [`SpeedLoop::set_back_emf_duty_per_rad_s`]).
+    pub(super) emf_duty_per_rad_s: f32,
+}
+
+impl SpeedLoop {
+    /// At rest: zero output, zero integral.
+    pub const REST: Self = Self {
+        integral: 0.0,
+        duty: 0.0,
+        model_rad_s: 0.0,
+        model_angle_rad: 0.0,
+        window_open: false,
+        have_error: false,
+        error: 0.0,
+        kp_prev: 0.0,
+        push: 0.0,
+        moved: false,
+        kick_rad_s: 0.0,
+        push_sum: 0.0,
+        kept_kick: 0.0,
+        slowing: false,
+        model_down_quiet_s: 0.0,
+        reference_abs_rad_s: 0.0,
+        breakaway: Breakaway::NONE,
+        breakaway_news: false,
+        emf_duty_per_rad_s: 0.0,
+        correction_duty: 0.0,
+        correction_rad_s: 0.0,
+        correction_angle_rad: 0.0,
+        load_lag: 0.0,
+        load_lag_angle: 0.0,
+        start_reading: false,
+        late_reading: false,
+        pushed: false,
+        stepped_down: false,
+    };
+
+    /// True once the loop has seen the shaft turn under its own motor since it started: an
+    /// edge after the loop left rest (see `rest` in [`SpeedLoop::step`]), or, with current
+    /// sense, the back-EMF of its breakaway (breakaway.rs; a shaft dragged backwards would
+    /// raise the current, not lower it).
+    pub fn turning(&self) -> bool {
+        self.moved || self.breakaway.released()
+    }
+
+    /// The reference came down and the loop still compares windows that began before the
+    /// model reached it (see the field of the same name): what the shaft does then is its
+    /// deceleration, not a load.
+    pub fn slowing(&self) -> bool {
+        self.slowing
+    }
+
+    /// The plant model's speed (the reference through the identified lag), rad/s.
+    pub fn model_rad_s(&self) -> f32 {
+        self.model_rad_s
+    }
+    /// The last output duty.
+    pub fn duty(&self) -> f32 {
+        self.duty
+    }
+    /// The integral term (duty).
+    pub fn integral(&self) -> f32 {
+        self.integral
+    }
+    /// Back to rest (zero output, zero integral).
+    pub fn reset(&mut self) {
+        *self = Self::REST;
+    }
+}

@@ -1,0 +1,92 @@
+//! The shape's geometry against a scene: the bare rim, the centre's meridian on the fillet and
+//! the wall, whether the corner is sharp, and the checks of [`BowlShape`]'s values.
+
+use super::wall::Meridian;
+use super::{BowlError, BowlShape};
+use crate::Real;
+use crate::particle::rolling::RollingScene;
+
+/// The radius, in units of the rim's, of the fillet a sharp corner is given for a granule that
+/// stays in it.
+const SHARP_FILLET: f64 = 1e-2;
+
+impl<T: Real> BowlShape<T> {
+    /// A bare rim at `R` (no wall).
+    pub fn bare_rim() -> Self {
+        Self {
+            wall_angle_rad: T::from_f64(core::f64::consts::FRAC_PI_2),
+            wall_height_m: T::ZERO,
+            fillet_radius_m: T::ZERO,
+            restitution: T::HALF,
+        }
+    }
+
+    /// The centre's meridian on the wall for this scene (`None`: a bare rim).
+    pub fn meridian(&self, sc: &RollingScene<T>) -> Option<Meridian<T>> {
+        if self.wall_height_m <= T::ZERO {
+            return None;
+        }
+        let a = sc.particle_radius_m;
+        let rim = sc.rim_radius_m;
+        // A corner sharper than the granule (F <= a) is an impact (`sharp_corner`); the
+        // granule that stays in it then sits in a fillet of a hundredth of the rim's radius,
+        // which stands in for touching the bottom and the wall at once.
+        let rc = (self.fillet_radius_m - a).max(rim * T::from_f64(SHARP_FILLET));
+        let fillet = rc + a;
+        let alpha = self.wall_angle_rad;
+        let (sa, ca) = (alpha.sin(), alpha.cos());
+        // tan(alpha/2) = sin alpha / (1 + cos alpha).
+        let half_tan = sa / (T::ONE + ca);
+        let rho_b = rim - fillet * half_tan;
+        let lip = rim + self.wall_height_m * ca / sa;
+        // The centre when the contact is at the edge, and how far along the cone that is from
+        // the fillet's end (0 if the fillet rises above the wall: then the pivot starts there).
+        let top = [lip - a * sa, self.wall_height_m + a * ca];
+        let arc_end = [rho_b + rc * sa, a + rc * (T::ONE - ca)];
+        let along = ((top[0] - arc_end[0]) * ca + (top[1] - arc_end[1]) * sa).max(T::ZERO);
+        Some(Meridian {
+            rho_b_m: rho_b,
+            z0_m: a,
+            arc_radius_m: rc,
+            alpha_rad: alpha,
+            lip_m: lip,
+            top_s: rc * alpha + along,
+            pivot_m: a.max(rim * T::from_f64(1e-6)),
+        })
+    }
+
+    /// Whether the corner is sharper than the granule: then reaching it is an impact.
+    pub fn sharp_corner(&self, sc: &RollingScene<T>) -> bool {
+        self.fillet_radius_m - sc.particle_radius_m <= sc.rim_radius_m * T::from_f64(SHARP_FILLET)
+    }
+
+    /// Checks the shape against the scene; the first bad value is named.
+    pub fn validate(&self, sc: &RollingScene<T>) -> Result<(), BowlError> {
+        sc.validate().map_err(BowlError::Scene)?;
+        let right = T::from_f64(core::f64::consts::FRAC_PI_2);
+        if !(self.wall_angle_rad.is_finite()
+            && self.wall_angle_rad > T::ZERO
+            && self.wall_angle_rad <= right)
+        {
+            return Err(BowlError::InvalidWallAngle);
+        }
+        if !self.wall_height_m.is_nonneg_finite() {
+            return Err(BowlError::InvalidWallHeight);
+        }
+        if !self.fillet_radius_m.is_nonneg_finite() {
+            return Err(BowlError::InvalidFillet);
+        }
+        if !(self.restitution.is_finite()
+            && self.restitution >= T::ZERO
+            && self.restitution <= T::ONE)
+        {
+            return Err(BowlError::InvalidRestitution);
+        }
+        if let Some(m) = self.meridian(sc)
+            && (m.rho_b_m <= sc.ri_m || m.rho_b_m.is_nan())
+        {
+            return Err(BowlError::FilletReachesRelease);
+        }
+        Ok(())
+    }
+}
