@@ -19,8 +19,9 @@ use super::incline_rotation::tilted_second_order;
 /// rad/s); `ri / (R - ri)` is the release's offset against its path (the rotation moves a
 /// granule released near the rim most: 40-fold from `ri/R` 0.2 to 0.7 at one `(Omega T)^2`).
 /// `K` by the incline's mode: this one where it rolls and keeps rolling to the rim (rolling
-/// needs at most 0.95 `mu_s` there, [`friction_needed_at_rim`](super::incline::friction_needed_at_rim)); 0.0108 (rounded up) is the
-/// largest ratio of the incline's error (against the rolling-or-sliding disc) to the form over
+/// needs at most 0.95 `mu_s` there,
+/// [`friction_needed_at_rim`](super::incline::friction_needed_at_rim)); 0.0108 (rounded up) is
+/// the largest ratio of the incline's error (against the rolling-or-sliding disc) to the form over
 /// those scenes of the fitting grid (294 scenes: tilt 5-75 deg, 0.25-3.6 rad/s, equal, unequal
 /// and opposite speeds, mu_s 0.2-0.6, `ri/R` 0.2-0.7). On the held-out grid (119 other scenes:
 /// tilt 15-70 deg, 0.8-3 rad/s, spin -1.3 w1, mu_s 0.25-0.5, `ri/R` 0.15-0.8) no error exceeds
@@ -40,7 +41,8 @@ pub const ROTATION_K_NEAR_SLIDING: f64 = 0.028;
 
 /// How near the stick threshold a rolling incline's granule may come at the rim (rolling needs
 /// this fraction of `mu_s N` there) and still count as rolling all the way for
-/// [`ROTATION_K`].
+/// [`ROTATION_K`]; and for a sliding one, the least friction rolling would need at the rim may
+/// come down to `mu_s` over this and still count as sliding all the way ([`may_stick`]).
 pub const NEAR_SLIDING: f64 = 0.95;
 
 /// What the bowl's centre circling the precession axis at the rod offset `L` adds to the
