@@ -66,4 +66,6 @@ pub enum Model {
 }
 
 #[cfg(test)]
+mod precision_tests;
+#[cfg(test)]
 pub(crate) mod tests;
