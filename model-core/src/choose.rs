@@ -327,3 +327,5 @@ pub use trace::{
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod trace_tests;
