@@ -429,4 +429,6 @@ enum Phase<T> {
 #[cfg(test)]
 mod flight_tests;
 #[cfg(test)]
+mod stall_tests;
+#[cfg(test)]
 mod tests;

@@ -11,7 +11,7 @@ use crate::particle::rolling::equations::forces;
 use crate::particle::rolling::modes::{ModesOutcome, residence_roll_or_slide};
 use crate::particle::rolling::slide::{from_rolling, slide_forces};
 
-const FINE: RollingMethod<f64> = RollingMethod::Dp54 { rtol: 1e-11 };
+pub(super) const FINE: RollingMethod<f64> = RollingMethod::Dp54 { rtol: 1e-11 };
 
 fn limits(horizon_s: f64) -> SystemLimits<f64> {
     SystemLimits {
@@ -20,7 +20,7 @@ fn limits(horizon_s: f64) -> SystemLimits<f64> {
     }
 }
 
-fn shape(alpha_deg: f64, h: f64, f: f64) -> BowlShape<f64> {
+pub(super) fn shape(alpha_deg: f64, h: f64, f: f64) -> BowlShape<f64> {
     BowlShape {
         wall_angle_rad: alpha_deg.to_radians(),
         wall_height_m: h,
@@ -384,190 +384,5 @@ fn the_corners_rebound_hops_as_on_an_incline() {
             r.flight_s
         );
         assert_eq!(r.landings, want_landings);
-    }
-}
-
-/// The stall watch (`residence_or_stall`, docs/model.md §12) breaks after
-/// [`STALL_STEPS`] accepted steps in a row that each advance the time by less than
-/// [`crate::particle::rolling::modes::STALL_STEP`] of the scene's time scale, and a real step
-/// starts its count again. Where nothing stalls the watched run is the unwatched one, to the
-/// bit: every release of the 60 deg wall at 45 deg tilt, 1.8 rad/s, mu_s 0.2 at 1e-6, 1e-7 and
-/// 1e-10 (at 1e-6 its release at 30 deg stalled before the wall's slip had its own error
-/// control: 30 steps to 0.2449 s, then none got past it), of a 10 deg bowl whose granule
-/// changes mode over a hundred times in its wall's corner, and of a scene that slides.
-#[test]
-fn the_stall_watch_breaks_on_steps_that_do_not_advance_the_time() {
-    use crate::particle::rolling::AZIMUTHS_DEG;
-    use crate::particle::rolling::modes::{STALL_STEP, StallWatch};
-    let (length, speed) = (0.075, 0.27);
-    let tiny = 0.5 * STALL_STEP * length / speed;
-    let watch = StallWatch::new(Some(STALL_STEPS), (length, speed), 1.0);
-    let mut t = 1.0;
-    for _ in 0..3 {
-        for _ in 1..STALL_STEPS {
-            t += tiny;
-            assert!(watch.step(t).is_continue(), "{t}");
-        }
-        // A real step: the count starts again.
-        t += 1e-4;
-        assert!(watch.step(t).is_continue());
-    }
-    for _ in 1..STALL_STEPS {
-        t += tiny;
-        assert!(watch.step(t).is_continue());
-    }
-    assert!(watch.step(t + tiny).is_break());
-    assert!(
-        StallWatch::new(None, (length, speed), 1.0)
-            .step(1.0)
-            .is_continue()
-    );
-    let rig = |tilt: f64, w: f64, mu_s: f64| RollingScene {
-        sliding_friction: mu_s,
-        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
-    };
-    let wall = shape(60.0, 0.02, 0.0);
-    let capped = |max_steps| SystemLimits {
-        horizon_s: 10.0,
-        max_steps,
-    };
-    for (s, rtols) in [
-        (rig(45.0, 1.8, 0.2), &[1e-6, 1e-7, 1e-10][..]),
-        (rig(10.0, 1.8, 0.4), &[1e-6, 1e-7]),
-        (rig(60.0, 3.6, 0.2), &[1e-6, 1e-10]),
-    ] {
-        for &rtol in rtols {
-            for deg in AZIMUTHS_DEG {
-                let m = RollingMethod::Dp54 { rtol };
-                let b = deg.to_radians();
-                let plain = residence(&s, &wall, b, m, capped(200_000));
-                let watched = residence_or_stall(&s, &wall, b, m, capped(200_000));
-                assert!(plain.is_ok(), "{deg} deg at {rtol:e}: {plain:?}");
-                assert_eq!(watched, plain, "{deg} deg at {rtol:e}");
-            }
-        }
-    }
-}
-
-/// The wall's slide holds its slip to its own tolerance, as the bottom's (docs/model.md §12):
-/// before, a slide that starts from no slip at the stick threshold on the wall left the slip's
-/// direction tens of degrees off at a loose tolerance, the slip turned against the friction
-/// within a step or two and the slide ended as a stick, thousands of times, until a restart
-/// ended where it began and the run stalled. On a 60 deg wall 20 mm high (75 mm bottom) every
-/// release now answers at every tolerance, the leaving ones within `100 rtol` of the run at
-/// 1e-11, and no looser run costs more than 1.25 times the next tighter one nor more than the
-/// run at 1e-10: the releases that stalled at 1e-6 (45 deg tilt, 1.8 rad/s, mu_s 0.2 at 30 deg;
-/// 3.6 rad/s, mu_s 0.6 at 30 and 60 deg) and the granule held in the corner at 10 deg,
-/// 3.6 rad/s, mu_s 0.2 (its twelve releases 1 025 058 steps at 1e-6 with five failing, 275 782
-/// at 1e-7 with one failing, 231 434 at 1e-10; now 89 778, 120 135 and 224 912).
-#[test]
-fn a_loose_tolerance_is_not_dearer_on_the_wall() {
-    use crate::particle::rolling::AZIMUTHS_DEG;
-    let rig = |tilt: f64, w: f64, mu_s: f64| RollingScene {
-        sliding_friction: mu_s,
-        ri_m: 0.0375,
-        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
-    };
-    let wall = shape(60.0, 0.02, 0.0);
-    let lim = SystemLimits {
-        horizon_s: 10.0,
-        max_steps: 200_000,
-    };
-    let rtols = [1e-10, 1e-9, 1e-8, 1e-7, 1e-6];
-    for (s, deg) in [
-        (rig(45.0, 1.8, 0.2), 30.0),
-        (rig(45.0, 3.6, 0.6), 30.0),
-        (rig(45.0, 3.6, 0.6), 60.0),
-    ] {
-        let b = f64::to_radians(deg);
-        let leaves = |r: Result<BowlReport<f64>, BowlError>| match r {
-            Ok(BowlReport {
-                outcome:
-                    BowlOutcome::Leaves {
-                        residence_time_s, ..
-                    },
-                steps,
-                ..
-            }) => (residence_time_s, steps),
-            other => panic!("{deg} deg: {other:?}"),
-        };
-        let (reference, _) = leaves(residence(&s, &wall, b, FINE, lim));
-        let mut tighter = (u32::MAX, u32::MAX);
-        for rtol in rtols {
-            let (t, steps) = leaves(residence(&s, &wall, b, RollingMethod::Dp54 { rtol }, lim));
-            assert!(
-                (t - reference).abs() <= 100.0 * rtol * reference,
-                "{deg} deg at {rtol:e}: T {t} against {reference}"
-            );
-            let (last, at_1e10) = tighter;
-            assert!(
-                f64::from(steps) <= 1.25 * f64::from(last) && steps <= at_1e10,
-                "{deg} deg at {rtol:e}: {steps} steps, the tighter run {last}, 1e-10 {at_1e10}"
-            );
-            tighter = (steps, if at_1e10 == u32::MAX { steps } else { at_1e10 });
-        }
-    }
-    // Held in the corner: every release at every tolerance stays inside (as at 1e-10), and the
-    // twelve cost less the looser the tolerance.
-    let s = rig(10.0, 3.6, 0.2);
-    let mut last = u32::MAX;
-    for rtol in [1e-10, 1e-7, 1e-6] {
-        let mut total = 0;
-        for deg in AZIMUTHS_DEG {
-            let r = residence(
-                &s,
-                &wall,
-                deg.to_radians(),
-                RollingMethod::Dp54 { rtol },
-                lim,
-            );
-            let r = r.unwrap_or_else(|e| panic!("{deg} deg at {rtol:e}: {e:?}"));
-            assert!(
-                matches!(r.outcome, BowlOutcome::Inside { .. }),
-                "{deg} deg at {rtol:e}: {:?}",
-                r.outcome
-            );
-            total += r.steps;
-        }
-        assert!(
-            total < last,
-            "{rtol:e}: {total} steps, the tighter run {last}"
-        );
-        last = total;
-    }
-    assert!(last < 100_000, "{last} steps at 1e-6");
-}
-
-/// Two segments that ended at their own start (docs/model.md §12, "The wall's slide at its stick
-/// threshold"): a granule coming off a 5 mm fillet onto the bottom moving inwards was handed
-/// over exactly at the seam, where both sides' events were already at zero, and went bottom ->
-/// wall -> bottom at one instant (20 deg, 0.8 rad/s, mu_s 0.3, a 70 deg wall 15 mm high, release
-/// at 0 deg, rtol 1e-6: 2 000 000 steps at 0.3175 s); a wall slide restarted from exactly no
-/// slip ended at its first rounding (with the handover fixed and this not: 30 deg, 0.5 rad/s,
-/// mu_s 0.2, the 60 deg wall, release at 330 deg, rtol 1e-8: 199 456 restarts at 0.743 s). Both now answer in a few thousand steps,
-/// held by the wall as at rtol 1e-10.
-#[test]
-fn a_granule_at_the_seam_or_a_fresh_slide_does_not_stall() {
-    let rig = |tilt: f64, w: f64, mu_s: f64| RollingScene {
-        sliding_friction: mu_s,
-        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
-    };
-    let lim = SystemLimits {
-        horizon_s: 10.0,
-        max_steps: 50_000,
-    };
-    for (s, sh, deg, rtol) in [
-        (rig(20.0, 0.8, 0.3), shape(70.0, 0.015, 0.005), 0.0, 1e-6),
-        (rig(30.0, 0.5, 0.2), shape(60.0, 0.02, 0.0), 330.0, 1e-8),
-    ] {
-        let b = f64::to_radians(deg);
-        for rtol in [rtol, 1e-10] {
-            let m = RollingMethod::Dp54 { rtol };
-            let r = residence(&s, &sh, b, m, lim);
-            assert!(
-                matches!(r, Ok(r) if matches!(r.outcome, BowlOutcome::Inside { .. })),
-                "{deg} deg at {rtol:e}: {r:?}"
-            );
-        }
     }
 }
