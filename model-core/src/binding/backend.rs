@@ -444,4 +444,6 @@ impl<I: Injector> Backend for ControllerBackend<I> {
 }
 
 #[cfg(test)]
+mod rtime_tests;
+#[cfg(test)]
 mod tests;
