@@ -209,6 +209,12 @@ pub fn last_json(o: &Output) -> serde_json::Value {
     serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"))
 }
 
+/// A path `name` in the temporary folder, named after `bowl predict` and this process (the
+/// `bowl predict` tests' scratch files).
+pub fn temp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("bowl-predict-{}-{name}", std::process::id()))
+}
+
 /// An empty scratch directory named after the test and this process.
 pub fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("bowl-test-{name}-{}", std::process::id()));
