@@ -57,6 +57,34 @@ pub fn predict_args<'a>(scene: &[(&'a str, &'a str)], extra: &[&'a str]) -> Vec<
     v
 }
 
+/// `bowl predict --model bowl`: issue 30's command line with the scene's speeds, tilt and wall;
+/// a flag in `extra` replaces the default one.
+pub fn bowl_args<'a>(
+    w1: &'a str,
+    w2: &'a str,
+    th: &'a str,
+    wall: [&'a str; 3],
+    extra: &[&'a str],
+) -> Vec<&'a str> {
+    let scene = [
+        ("--model", "bowl"),
+        ("--axes-angle-deg", th),
+        ("--precession-rad-s", w1),
+        ("--spin-rad-s", w2),
+        ("--rim-radius-m", "0.075"),
+        ("--ri-m", "0.0375"),
+        ("--particle-radius-m", "0.003"),
+        ("--mu", "0.029"),
+        ("--sliding-mu", "0.4"),
+        ("--restitution", "0.5"),
+        ("--wall-angle-deg", wall[0]),
+        ("--wall-height-m", wall[1]),
+        ("--fillet-radius-m", wall[2]),
+        ("--max-time-s", "3"),
+    ];
+    predict_args(&scene, extra)
+}
+
 /// The speed of each axis on the tilted rig, as a flag's value: |Omega| 3.6 rad/s with
 /// w1 = w2 and the axes 60 deg apart, `3.6 / sqrt(2 (1 + cos 60))`.
 pub fn rig_axis_speed() -> String {
