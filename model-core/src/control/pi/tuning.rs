@@ -6,8 +6,12 @@
 /// (from [`STUCK_PITCHES`] to the watch's pitches of model travel): it rises in proportion to
 /// the reference, slowly where pulses are sparse and there is time, fast where the watch is
 /// quick, so a healthy shaft carrying material the model does not know starts before the watch
-/// faults it.
-pub const PUSH_SPAN_DUTY: f32 = 0.12;
+/// faults it. What the push adds after a loaded shaft breaks away, until its first edge, is
+/// this rate times that time (seed 7 p24's spin: broke away at 0.43 duty 1.60 s into the
+/// start, its first edge at 1.97 s): at 0.12 that spin peaked 19 % past 1 rad/s, at 0.09
+/// 11 %. 0.09 still starts every loaded shaft of family-60, seeds 3..9, 14, 21 and 22 before
+/// the watch (no false fault in any start or step-down, docs/control.md, "The push's span").
+pub const PUSH_SPAN_DUTY: f32 = 0.09;
 /// The shaft counts as stuck once the plant model has turned this many pitches since the last
 /// edge without a new one (a shaft following the model would have given one).
 pub const STUCK_PITCHES: f32 = 1.2;
