@@ -3,10 +3,8 @@
 //! where the chooser lands at 5 %, 1 % and 0.1 %. The closed forms (the incline, and the
 //! incline corrected by the rotation's second order) are single points; the integrated levels
 //! (rolling, rolling-or-sliding, the bowl) a line each over DP5(4)'s tolerance. Host time is
-//! the best of several runs (of 1000 calls for a closed form): it moves with the machine's
-//! load, the order of the members does not.
-
-use std::time::Instant;
+//! the median over batches of calls (`timing::ns_per_call`, as the other work-precision
+//! charts): it moves with the machine's load, the order of the members does not.
 
 use anyhow::Result;
 use model_core::choose::incline_rotation::mean_second_order;
@@ -17,7 +15,8 @@ use model_core::particle::rolling::{AZIMUTHS_DEG, MAX_STEPS, RollingMethod, Roll
 
 use super::plot::{Figure, Mark, Scale, Series};
 use super::table::Table;
-use crate::predict::whole::{integrator_rtol, run_level};
+use super::timing::{Budget, ns_per_call};
+use crate::predict::whole::{integrator_rtol, run_chosen, run_level};
 
 /// How long a release is followed, s.
 const LIMITS: SystemLimits<f64> = SystemLimits {
@@ -32,44 +31,42 @@ const INTEGRATED: [(Level, usize); 3] = [
     (Level::Bowl, 4),
 ];
 
-/// Best time of `reps` runs of `f`, s.
-fn best_of(reps: usize, mut f: impl FnMut()) -> f64 {
-    (0..reps)
-        .map(|_| {
-            let t0 = Instant::now();
-            f();
-            t0.elapsed().as_secs_f64()
-        })
-        .fold(f64::INFINITY, f64::min)
+/// Time per call of `f`, s (`timing::ns_per_call`'s median over batches, as the other
+/// work-precision charts).
+fn per_call<R>(f: impl FnMut() -> R) -> f64 {
+    ns_per_call(Budget::FULL, f).median_ns * 1e-9
 }
 
-/// A closed form's time per call, s: 1000 calls together, best of 5.
-fn per_call(mut f: impl FnMut()) -> f64 {
-    best_of(5, || {
-        for _ in 0..1000 {
-            f();
-        }
-    }) / 1000.0
-}
-
-/// The mean over the twelve releases of `level` at DP5(4) `rtol` and its time (best of 3);
-/// `None` where it gives no answer (the rolling model finds the granule slides, or a release
-/// does not leave).
-fn level_mean(level: Level, s: &RollingScene<f64>, rtol: f64) -> Result<Option<(f64, f64)>> {
+/// The mean over the twelve releases of `level` at DP5(4) `rtol` and its time per call, and
+/// whether the rolling model gave up for the disc (`run_chosen`, as `bowl predict` runs a
+/// choice; `escalate` false: the level alone); `None` where it gives no answer (a release does
+/// not leave, or the level alone gives none).
+fn level_mean(
+    level: Level,
+    s: &RollingScene<f64>,
+    rtol: f64,
+    escalate: bool,
+) -> Result<Option<(f64, f64, bool)>> {
     let betas = AZIMUTHS_DEG.to_vec();
     let method = RollingMethod::Dp54 { rtol };
     let bare = BowlShape::bare_rim();
-    let Ok(answer) = run_level(level, s, &bare, &betas, method, LIMITS)? else {
+    let run = || {
+        if escalate {
+            run_chosen(level, s, &bare, &betas, method, LIMITS)
+        } else {
+            run_level(level, s, &bare, &betas, method, LIMITS)
+        }
+    };
+    let Ok(answer) = run()? else {
         return Ok(None);
     };
     let left: Vec<f64> = answer.times.iter().filter_map(|t| t.1).collect();
     if left.len() < betas.len() {
         return Ok(None);
     }
-    let time = best_of(3, || {
-        let _ = std::hint::black_box(run_level(level, s, &bare, &betas, method, LIMITS));
-    });
-    Ok(Some((left.iter().sum::<f64>() / left.len() as f64, time)))
+    let time = per_call(run);
+    let mean = left.iter().sum::<f64>() / left.len() as f64;
+    Ok(Some((mean, time, answer.escalated.is_some())))
 }
 
 /// The chart on two bare-rim scenes: the rig's tilt where the granule slides all the way
@@ -98,7 +95,7 @@ pub fn work_precision() -> Result<(Figure, Table)> {
         ]);
     };
     for (si, (name, s)) in scenes.iter().enumerate() {
-        let Some((reference, _)) = level_mean(Level::Bowl, s, 1e-12)? else {
+        let Some((reference, ..)) = level_mean(Level::Bowl, s, 1e-12, false)? else {
             anyhow::bail!("the bowl model gives no reference at {name}");
         };
         let err = |t: f64| ((t - reference) / reference).abs().max(1e-17);
@@ -112,7 +109,7 @@ pub fn work_precision() -> Result<(Figure, Table)> {
             let mut points = Vec::new();
             for k in 3..=10 {
                 let rtol = 10f64.powi(-k);
-                if let Some((t, cost)) = level_mean(level, s, rtol)? {
+                if let Some((t, cost, _)) = level_mean(level, s, rtol, false)? {
                     points.push((cost, err(t)));
                     row(
                         &mut table,
@@ -185,36 +182,17 @@ pub fn work_precision() -> Result<(Figure, Table)> {
                     false,
                 ));
             });
-            let mut escalated = false;
-            let (t, cost) = if c.level == Level::Incline {
-                (c.incline_mean_s.unwrap_or(f64::NAN), choice)
+            let (t, cost, escalated) = if c.level == Level::Incline {
+                (c.incline_mean_s.unwrap_or(f64::NAN), choice, false)
             } else {
-                // As `bowl predict`: where the rolling model finds the granule slides later,
-                // the rolling-or-sliding disc answers after it (both runs counted).
-                let rtol = integrator_rtol(tol);
-                let first = level_mean(c.level, s, rtol)?;
-                let Some((t, cost)) = (match first {
-                    Some(answer) => Some(answer),
-                    None if c.level == Level::Rolling => {
-                        let given_up = best_of(3, || {
-                            let _ = std::hint::black_box(run_level(
-                                Level::Rolling,
-                                s,
-                                &BowlShape::bare_rim(),
-                                &AZIMUTHS_DEG,
-                                RollingMethod::Dp54 { rtol },
-                                LIMITS,
-                            ));
-                        });
-                        escalated = true;
-                        level_mean(Level::RollingOrSliding, s, rtol)?
-                            .map(|(t, cost)| (t, cost + given_up))
-                    }
-                    None => None,
-                }) else {
+                // As `bowl predict` runs it (`run_chosen`): where the rolling model finds the
+                // granule slides later, the disc answers after it, both runs timed.
+                let Some((t, cost, escalated)) =
+                    level_mean(c.level, s, integrator_rtol(tol), true)?
+                else {
                     continue;
                 };
-                (t, cost + choice)
+                (t, cost + choice, escalated)
             };
             let what = match c.second_order {
                 Some(b) if c.level == Level::Incline && b.corrected => "incline corrected",

@@ -105,12 +105,12 @@ fn incline_words(choice: &WholeChoice<f64>) -> String {
 
 /// What the chosen level gave.
 pub(crate) struct Answer {
-    level: Level,
+    pub(crate) level: Level,
     /// Per release: azimuth, T (None: did not leave).
     pub(crate) times: Vec<(f64, Option<f64>)>,
     validity: Validity,
     /// Why the first level run was given up for this one, if it was.
-    escalated: Option<String>,
+    pub(crate) escalated: Option<String>,
 }
 
 /// Runs `level` on the releases; `None` when it holds no answer (the rolling model found the
@@ -291,6 +291,31 @@ pub(crate) fn run_level(
     }))
 }
 
+/// Runs the chosen `level`, and where it holds no answer (the rolling model found the granule
+/// slides later) the rolling-or-sliding disc after it, with the reason in `escalated`: what
+/// `bowl predict` runs, and what the chooser's cost is measured on. `Err(why)` where the disc
+/// too gives none.
+pub(crate) fn run_chosen(
+    level: Level,
+    scene: &RollingScene<f64>,
+    shape: &BowlShape<f64>,
+    betas: &[f64],
+    method: RollingMethod<f64>,
+    limits: SystemLimits<f64>,
+) -> Result<std::result::Result<Answer, String>> {
+    match run_level(level, scene, shape, betas, method, limits)? {
+        Ok(a) => Ok(Ok(a)),
+        Err(why) => Ok(
+            run_level(Level::RollingOrSliding, scene, shape, betas, method, limits)?.map(
+                |mut a| {
+                    a.escalated = Some(why);
+                    a
+                },
+            ),
+        ),
+    }
+}
+
 /// Runs the chooser and the model it picks.
 pub fn run(args: &Inputs) -> Result<()> {
     let setup = bowl_cli::scene_and_shape(args, &args.rolling, &args.bowl)?;
@@ -312,22 +337,8 @@ pub fn run(args: &Inputs) -> Result<()> {
         horizon_s: args.bowl.max_time_s,
         max_steps: MAX_STEPS,
     };
-    let mut answer = match run_level(choice.level, &scene, &shape, &betas, method, limits)? {
-        Ok(a) => a,
-        Err(why) => {
-            let mut a = run_level(
-                Level::RollingOrSliding,
-                &scene,
-                &shape,
-                &betas,
-                method,
-                limits,
-            )?
-            .map_err(anyhow::Error::msg)?;
-            a.escalated = Some(why);
-            a
-        }
-    };
+    let mut answer = run_chosen(choice.level, &scene, &shape, &betas, method, limits)?
+        .map_err(anyhow::Error::msg)?;
     if answer.level == Level::Incline {
         answer.validity = Validity::valid();
         if choice.second_order.is_some_and(|b| b.corrected) {

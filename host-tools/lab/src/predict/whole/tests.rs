@@ -99,12 +99,7 @@ fn chooser(
         let (level, mean) = {
             let betas = AZIMUTHS.to_vec();
             let m = RollingMethod::Dp54 { rtol };
-            let a = match run_level(c.level, s, sh, &betas, m, LIMITS).ok()? {
-                Ok(a) => a,
-                Err(_) => run_level(Level::RollingOrSliding, s, sh, &betas, m, LIMITS)
-                    .ok()?
-                    .ok()?,
-            };
+            let a = run_chosen(c.level, s, sh, &betas, m, LIMITS).ok()?.ok()?;
             let left: Vec<f64> = a.times.iter().filter_map(|t| t.1).collect();
             if left.len() < betas.len() {
                 return None;
