@@ -289,7 +289,15 @@ impl Controller {
         let duty = (s.duty - s.extra_duty) * s.direction;
         let by_duty = s.direction * s.obs.drive_rad_s(&s.ok, duty);
         let by_model = ramped[1] - s.speed_loop.model_rad_s();
-        let lag = if by_duty * by_model > 0.0 {
+        // With current sense a spin at rest whose current has not shown its breakaway is
+        // held (by stiction, or material the model does not know): its motor's torque and
+        // what holds it cancel on the rod, so there is no reaction to decouple. Fed, a fast
+        // rod ran 13 % past 1 rad/s while its spin's material held it for a second (seed 3
+        // p19; docs/control.md, "A start read the same way with current sense"). Without
+        // current sense nothing tells a held spin from one that starts until its first edge,
+        // which comes after the acceleration the decoupling is for.
+        let held = s.current.amps_per_duty() > 0.0 && !s.speed_loop.turning();
+        let lag = if by_duty * by_model > 0.0 && !held {
             // The smaller in magnitude (`clamp` would bring a panic path into the tick).
             by_model.min(by_duty.abs()).max(-by_duty.abs())
         } else {

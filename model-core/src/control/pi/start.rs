@@ -111,7 +111,7 @@ impl SpeedLoop {
     /// the shaft's lag is short against the window) are read; a short one through which the
     /// shaft still accelerates is left to the loop, as at the crawl's reading.
     ///
-    /// Without current sense the integral is set so that the correction this tick, the
+    /// The integral is set so that the correction this tick, the
     /// integral and the proportional part on `e = L - c`, is the load read, `L` as duty. The
     /// PI's zero cancels the plant's pole only from a state where the integral matches what
     /// the shaft already carries: a kick whose speed `c` still decays (a heavy rod, tau
@@ -120,9 +120,12 @@ impl SpeedLoop {
     /// `L` = 0.070 rad/s, took -0.009 duty and settled within 2 % at 5.1 s. Set so, the
     /// correction stays `L` while `c` comes to it through the shaft's own lag (the
     /// closed loop's modes are the plant's `1 / tau` and the bandwidth; this start excites
-    /// only the first). With current sense the back-EMF band held the integral to the shaft
-    /// up to here and the kick is not in the correction's history: the integral takes the
-    /// reading's error as before (docs/control.md, "A load read through the shaft's lag").
+    /// only the first). With current sense too: the back-EMF band had been thought to hold
+    /// the integral to the shaft up to here, and the integral took the reading's error on top
+    /// of what it held; the band leaves a shaft that lags its model by its load alone, and
+    /// the proportional part then drove a loaded spin past its target (family-60 p10's spin
+    /// 4.8 % over 1 rad/s, 2 % settled at 3.9 s; docs/control.md, "A start read the same way
+    /// with current sense").
     #[inline(always)]
     pub(super) fn take_start_load(&mut self, k: &LoopConstants, input: LoopInput, c: f32) {
         // `error` and `c` are signed speeds (the window's sample is the model's signed mean
@@ -130,12 +133,8 @@ impl SpeedLoop {
         // no further `direction` (multiplied by it, a start in reverse took the reading with
         // the wrong sign; `a_loaded_shaft_that_crawls_takes_its_load_from_the_crawl_not_by_
         // overshooting` at -0.5 rad/s stopped the shaft once the reading set the integral).
-        if input.torque_duty.is_none() {
-            let kp = k.kp(k.scheduled_bandwidth(input.reference_rad_s.abs()));
-            self.integral = self.error * k.duty_per_rad_s - kp * (self.error - c);
-        } else {
-            self.integral += (self.error - c) * k.duty_per_rad_s;
-        }
+        let kp = k.kp(k.scheduled_bandwidth(input.reference_rad_s.abs()));
+        self.integral = self.error * k.duty_per_rad_s - kp * (self.error - c);
     }
 
     /// One current sample (see [`LoopInput::torque_duty`]): the breakaway watch, and between

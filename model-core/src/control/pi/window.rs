@@ -65,9 +65,12 @@ impl SpeedLoop {
     /// seed 4 p00's rod read 0.198 rad/s, its loop settled at 0.26). The share is the window's
     /// mean of a unit load through the identified lag; counted from the loop's start, when the
     /// shaft may have started later, it is an upper bound, so the load read stays a lower
-    /// bound of the lag model's. Not with current sense: the back-EMF band held the integral
-    /// to the shaft since its breakaway, taking the load in as it showed (docs/control.md, "A
-    /// load read through the shaft's lag"). Once per start, so out of the tick's common path.
+    /// bound of the lag model's (docs/control.md, "A load read through the shaft's lag"). With
+    /// current sense too: the back-EMF band was thought to take the load in as it showed, but
+    /// a heavy rod within the band lags its model by its load through its lag all the same
+    /// (seed 3 p14's rod read 0.02 of its 0.24 rad/s and settled within 2 % at 4.4 s; docs/control.md,
+    /// "A start read the same way with current sense"). Once per start, so out of the tick's
+    /// common path.
     #[cold]
     #[inline(never)]
     fn read_first_window(
@@ -78,12 +81,7 @@ impl SpeedLoop {
         c: f32,
         shortfall: f32,
     ) {
-        let shown = if input.torque_duty.is_none() {
-            self.load_shown_share(w)
-        } else {
-            1.0
-        };
-        self.error = shortfall / shown;
+        self.error = shortfall / self.load_shown_share(w);
         self.have_error = true;
         if self.start_reading && w.span_s >= START_READ_MIN_S && input.feedback {
             self.take_start_load(k, input, c);

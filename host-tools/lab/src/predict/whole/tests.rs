@@ -55,10 +55,12 @@ fn mean_and_cost(
     Some((mean?, best))
 }
 
-/// The time of one call of `f`, s: 1000 calls timed together, best of 5 (a closed form takes
-/// well under a microsecond; one block caught by another process would count tenfold).
+/// The time of one call of `f`, s: 1000 calls timed together, best of 25 (a closed form takes
+/// well under a microsecond; one block caught by another process would count tenfold). Best
+/// of 5, the same closed form timed twice in one run differed by up to 1.56x (the incline at
+/// 60 deg, 0.5 rad/s, mu_s 0.4), which alone put rows past 1.25x.
 fn nanos(mut f: impl FnMut()) -> f64 {
-    (0..5)
+    (0..25)
         .map(|_| {
             let t0 = Instant::now();
             for _ in 0..1000 {
