@@ -42,6 +42,7 @@ done
 # Slowing down while running (docs/control.md, "Transitions").
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --from-rad-s 3 --target-rad-s 1 --out docs/charts/control-family-down.svg
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --from-rad-s 3 --target-rad-s 0.5 --out docs/charts/control-family-down-low.svg
+"$bowl" chart family --rig-file tests/rigs/family-60.toml --target-rad-s 1 --current-sense --out docs/charts/control-family-1-current.svg
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --target-rad-s 0.5 --current-sense --out docs/charts/control-family-low-current.svg
 "$bowl" chart family --rig-file tests/rigs/family-60.toml --from-rad-s 3 --target-rad-s 0.5 --current-sense --out docs/charts/control-family-down-low-current.svg
 # The rolling model of the tilted, precessing bowl (docs/model.md section 9).
