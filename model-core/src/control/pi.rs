@@ -95,7 +95,8 @@ mod window;
 pub use constants::{LoopConstants, SCHEDULE_TOP_RAD_S, bandwidth_ceiling_rad_s};
 pub use state::SpeedLoop;
 pub use tuning::{
-    CRAWL_READ_MIN_S, PUSH_KEPT, PUSH_SPAN_DUTY, QUIET_PITCHES, START_READ_MIN_S, STUCK_PITCHES,
+    CRAWL_READ_MIN_S, PUSH_KEPT, PUSH_SPAN_DUTY, QUIET_PITCHES, SECOND_READING_MISMATCH_SHARE,
+    START_READ_MIN_S, STUCK_PITCHES,
 };
 
 /// Inputs of one loop step.
@@ -154,6 +155,8 @@ impl SpeedLoop {
         }
         self.load_lag += (1.0 - self.load_lag) * k.model_alpha;
         self.load_lag_angle += self.load_lag * k.dt_s;
+        self.start_lag -= self.start_lag * k.model_alpha;
+        self.start_lag_angle += self.start_lag * k.dt_s;
         let ev = input.events;
         // Slowing down: the model above the reference. Its windows, and every window that
         // began before the model came down to the reference, compare a shaft that decelerates
@@ -191,6 +194,10 @@ impl SpeedLoop {
             self.model_angle_rad = rp * ago;
             self.correction_angle_rad = c * ago;
             self.load_lag_angle = self.load_lag * ago;
+            // The shaft's mismatch against its model starts here (the kick's true leap is not
+            // the model's), and decays through the lag.
+            self.start_lag = 1.0;
+            self.start_lag_angle = ago;
             self.window_open = true;
         }
         if let Some(w) = ev.closed
@@ -200,6 +207,7 @@ impl SpeedLoop {
             self.model_angle_rad = rp * w.ago_s;
             self.correction_angle_rad = c * w.ago_s;
             self.load_lag_angle = self.load_lag * w.ago_s;
+            self.start_lag_angle = self.start_lag * w.ago_s;
             self.window_open = true;
         } else if let Some(w) = ev.closed
             && w.span_s > 0.0

@@ -44,6 +44,15 @@ pub struct SpeedLoop {
     /// estimator's current window, s (see `read_window`, window.rs).
     pub(super) load_lag: f32,
     pub(super) load_lag_angle: f32,
+    /// What is left of the shaft's mismatch against its model at its first edge from rest,
+    /// decaying through the identified lag (`exp(-t / tau)`), and its integral over the
+    /// estimator's current window, s (see `read_second_window`, window.rs).
+    pub(super) start_lag: f32,
+    pub(super) start_lag_angle: f32,
+    /// The start's first reading, `[shortfall, load share, mismatch share]` of its window,
+    /// kept for the second (`read_second_window`), which is due while `second_reading` is set.
+    pub(super) first_reading: [f32; 3],
+    pub(super) second_reading: bool,
     /// The shaft started from rest (its first edge) and no window has been read since: the
     /// next one reads the load at once (see `step`).
     pub(super) start_reading: bool,
@@ -88,6 +97,10 @@ impl SpeedLoop {
         correction_angle_rad: 0.0,
         load_lag: 0.0,
         load_lag_angle: 0.0,
+        start_lag: 0.0,
+        start_lag_angle: 0.0,
+        first_reading: [0.0; 3],
+        second_reading: false,
         start_reading: false,
         late_reading: false,
         pushed: false,

@@ -42,3 +42,12 @@ pub const CRAWL_READ_MIN_S: f32 = 0.6;
 /// and above (0.26 s or less) are still left to the loop: the shaft may still accelerate
 /// through them (0.25 s measured worse at 0 -> 2 and 0 -> 3 rad/s).
 pub const START_READ_MIN_S: f32 = 0.4;
+/// The least share of a start's first window that the shaft's mismatch against its model at
+/// its first edge (decaying through the identified lag from there) makes up, for the start's
+/// second reading (`read_second_window`): heavy shafts, whose first window is mostly their
+/// start's transient. Below it the second reading is the second window read alone, which on
+/// light shafts is the eccentric load's and the teeth's noise (every start's second window read
+/// as a first: family-60 within 2 % by 3 s 100 -> 96.7 %; docs/control.md, "The start's second
+/// reading"). At 0.15 and 0.25 the eleven families' shares summed 1074.1 and 1075.0, at 0.35
+/// 1076.7 (1069.9 without the second reading).
+pub const SECOND_READING_MISMATCH_SHARE: f32 = 0.35;
