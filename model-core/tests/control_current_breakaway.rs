@@ -5,17 +5,12 @@
 
 mod plant_rows;
 
+use plant_rows::sensed;
+
 use model_core::control::breakaway::{BackEmfScale, Breakaway};
 use model_core::control::{Controller, ControllerConfig, State};
 use model_core::sim::experiments::{commissioned_step, family_plant};
 use model_core::sim::{ClosedLoop, CurrentSense, Plant, PlantParams};
-
-fn sensed(mut rig: PlantParams) -> PlantParams {
-    for a in &mut rig.axes {
-        a.current_sense = CurrentSense::TYPICAL;
-    }
-    rig
-}
 
 /// Overshoot of both axes, % of the target, of the commissioned 0 -> `target` step.
 fn overshoot_pct(rig: PlantParams, seed: u32, target: f32, load: [f32; 2]) -> [f32; 2] {

@@ -9,14 +9,7 @@
 mod from_rest;
 mod plant_rows;
 
-use model_core::sim::{CurrentSense, PlantParams};
-
-fn sensed(mut rig: PlantParams) -> PlantParams {
-    for a in &mut rig.axes {
-        a.current_sense = CurrentSense::TYPICAL;
-    }
-    rig
-}
+use plant_rows::sensed;
 
 /// Seed 3's p19 (`bowl sim make-family --seed 3 --plants 60`): its spin's material held it for
 /// a second after the command, while the decoupling fed the fast rod (time constant 0.07 s) the

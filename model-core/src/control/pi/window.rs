@@ -87,10 +87,11 @@ impl SpeedLoop {
         c: f32,
         shortfall: f32,
     ) {
-        self.error = shortfall / self.load_shown_share(w);
+        let [load_share, mismatch_share] = self.shares(w);
+        self.error = shortfall / shown_share(load_share);
         self.have_error = true;
         if self.start_reading && w.span_s >= START_READ_MIN_S && input.feedback {
-            self.first_reading = [shortfall, self.shares(w)[0], self.shares(w)[1]];
+            self.first_reading = [shortfall, load_share, mismatch_share];
             self.second_reading = true;
             self.take_start_load(k, input, c);
         }
@@ -145,20 +146,19 @@ impl SpeedLoop {
             (self.start_lag_angle - self.start_lag * w.ago_s) / w.span_s,
         ]
     }
+}
 
-    /// The mean over window `w` of the share of a load's steady deficit the shaft showed
-    /// (`load_lag`), at least a half: the reading is never more than doubled (the first
-    /// window read comes a pitch after the first edge, where the share of the heaviest rods,
-    /// tau 0.7 s, is about 0.55).
-    #[inline(always)]
-    fn load_shown_share(&self, w: WindowSample) -> f32 {
-        let share = self.shares(w)[0];
-        if share > 1.0 {
-            1.0
-        } else if share > 0.5 {
-            share
-        } else {
-            0.5
-        }
+/// A window's mean share of a load's steady deficit the shaft showed (`load_lag`, from
+/// [`SpeedLoop::shares`]) as the first reading divides by it: at most 1, at least a half, so
+/// the reading is never more than doubled (the first window read comes a pitch after the first
+/// edge, where the share of the heaviest rods, tau 0.7 s, is about 0.55).
+#[inline(always)]
+fn shown_share(share: f32) -> f32 {
+    if share > 1.0 {
+        1.0
+    } else if share > 0.5 {
+        share
+    } else {
+        0.5
     }
 }
