@@ -14,6 +14,9 @@
 //!   that window. `e` is then held (and filtered with the estimator's weight) until the next
 //!   window closes. Between edges, once the stall bound says the shaft is slower than its last
 //!   measurement, `e` is at least `r_p - bound`.
+//! - The reference's lead: a shaft slower than [`REFERENCE_TAU_S`] is fed, and modelled with,
+//!   a reference ahead of the ramp by `(tau / REFERENCE_TAU_S - 1) (r - r_p)` while its model
+//!   is behind, so it follows a model of that lag instead of its own (wpilib's `kA`).
 //! - The window's dead time is modelled (a Smith predictor): the duty the feedback applied is
 //!   run through the same model (`c`), a window reads the load `L = model mean + c mean -
 //!   measured mean`, and `e = L - c` now, so what the correction already does is not asked for
@@ -95,8 +98,8 @@ mod window;
 pub use constants::{LoopConstants, SCHEDULE_TOP_RAD_S, bandwidth_ceiling_rad_s};
 pub use state::SpeedLoop;
 pub use tuning::{
-    CRAWL_READ_MIN_S, PUSH_KEPT, PUSH_SPAN_DUTY, QUIET_PITCHES, SECOND_READING_MISMATCH_SHARE,
-    START_READ_MIN_S, STUCK_PITCHES,
+    CRAWL_READ_MIN_S, LEAD_MARGIN_DUTY, PUSH_KEPT, PUSH_SPAN_DUTY, QUIET_PITCHES, REFERENCE_TAU_S,
+    SECOND_READING_MISMATCH_SHARE, START_READ_MIN_S, STUCK_PITCHES,
 };
 
 /// Inputs of one loop step.
@@ -137,8 +140,21 @@ impl SpeedLoop {
             return 0.0;
         }
         let r_abs = r.abs();
+        // The reference's lead: a shaft slower than [`REFERENCE_TAU_S`] gets, while its model
+        // is behind the reference in the commanded direction, the feedforward of a reference
+        // ahead of it by `(tau / REFERENCE_TAU_S - 1) (r - r_p)`, so it follows a model of
+        // that lag instead of its own (below the duty limit; none on the way down, where the
+        // shaft coasts as its inertia lets it). The model is driven by the same led reference.
+        let mut lead = k.lead_gain * (r - self.model_rad_s);
+        let room = k.lead_room_rad_s - r_abs;
+        if lead * input.direction <= 0.0 || room <= 0.0 {
+            lead = 0.0;
+        } else if lead.abs() > room {
+            lead = room * input.direction;
+        }
+        let led = r + lead;
         // The plant model's speed and its angle over the estimator's current window.
-        self.model_rad_s += (r - self.model_rad_s) * k.model_alpha;
+        self.model_rad_s += (led - self.model_rad_s) * k.model_alpha;
         let rp = self.model_rad_s;
         self.model_angle_rad += rp * k.dt_s;
         // What the feedback's own correction has done to the shaft, by the same model: a
@@ -301,7 +317,7 @@ impl SpeedLoop {
         let kick_on = self.kick_rad_s < r_abs || input.torque_duty.is_some();
         if starting && input.feedback && self.push == 0.0 {
             if kick_on {
-                kick = k.kick_level(r_abs);
+                kick = k.kick_level(led.abs());
             }
             // Driven by the applied duty (the slew limit holds it back at first) above
             // friction: the true breakaway lies below the identified one (the search's duty
@@ -366,7 +382,7 @@ impl SpeedLoop {
 
         // r != 0 here, so its sign is the commanded direction.
         let ff = (k.friction_duty + self.push + kick) * input.direction
-            + r * k.duty_per_rad_s
+            + led * k.duty_per_rad_s
             + input.extra_duty;
         let e_int = if stale_too_fast { 0.0 } else { e };
         let candidate_i = self.integral + ki_dt * e_int;

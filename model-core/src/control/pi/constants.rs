@@ -2,7 +2,7 @@
 //! kick's and the push's rates, the runaway rule's arming speed), precomputed once from the
 //! configuration so that the tick only multiplies.
 
-use super::{PUSH_SPAN_DUTY, STUCK_PITCHES};
+use super::{LEAD_MARGIN_DUTY, PUSH_SPAN_DUTY, REFERENCE_TAU_S, STUCK_PITCHES};
 use crate::control::config::AxisConfig;
 use crate::control::supervisor::{
     PAIR_RUNAWAY_ARMED_SHARE, RUNAWAY_MARGIN_RAD_S, RUNAWAY_RATIO, WATCH_PITCHES,
@@ -27,6 +27,12 @@ pub struct LoopConstants {
     pub(super) stuck_angle_rad: f32,
     pub(super) duty_limit: f32,
     pub(super) slew_per_tick: f32,
+    /// The reference's lead per rad/s of the model's lag behind it (`lead` in
+    /// [`SpeedLoop::step`](super::SpeedLoop::step)): `tau / REFERENCE_TAU_S - 1`, at least 0.
+    pub(super) lead_gain: f32,
+    /// The speed whose feedforward reaches the duty limit less [`LEAD_MARGIN_DUTY`], rad/s:
+    /// the lead stays below it less the reference.
+    pub(super) lead_room_rad_s: f32,
 }
 
 /// The model speed above which a bridge stuck on may stay below the single-interval runaway
@@ -96,6 +102,14 @@ impl LoopConstants {
             stuck_angle_rad: STUCK_PITCHES / pulses_per_rad,
             duty_limit: axis.duty_limit,
             slew_per_tick: axis.duty_slew_per_s * dt_s,
+            lead_gain: if axis.model.time_constant_s > REFERENCE_TAU_S {
+                axis.model.time_constant_s / REFERENCE_TAU_S - 1.0
+            } else {
+                0.0
+            },
+            lead_room_rad_s: (axis.duty_limit - LEAD_MARGIN_DUTY - axis.model.friction_duty)
+                * supply_v
+                / axis.model.volts_per_rad_s,
         }
     }
 
