@@ -10,7 +10,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 log=target/test-logs/qemu-cases.log
 mkdir -p target/test-logs
 if [ "${1:-}" != "--no-qemu" ]; then
-  if ! cargo run --release -q -p qemu-tests --target thumbv7em-none-eabihf >"$log" 2>&1; then
+  if ! cargo run --profile firmware -q -p qemu-tests --target thumbv7em-none-eabihf >"$log" 2>&1; then
     tail -n 20 "$log" >&2
     echo "QEMU run failed (log: $log); rerun with --no-qemu to chart without fresh counts" >&2
     exit 1

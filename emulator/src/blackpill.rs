@@ -1,4 +1,4 @@
-//! The second emulator: the exact Black Pill image (`cargo build --release -p firmware`) on an
+//! The second emulator: the exact Black Pill image (`cargo fw`) on an
 //! emulated STM32F411, run by `tests/blackpill/run_board.py` (qiling with the project's
 //! peripheral models, the simulated plant through `tests/blackpill/plant-ffi`). USART2 is served
 //! on a pseudo-terminal. The emulator's Python environment, the thumb target and flip-link are
@@ -19,7 +19,7 @@ use crate::workspace;
 
 /// The Black Pill image: the release build of the firmware's board binary.
 pub fn image_path() -> PathBuf {
-    workspace::target_dir().join("thumbv7em-none-eabihf/release/firmware")
+    workspace::target_dir().join("thumbv7em-none-eabihf/firmware/firmware")
 }
 
 /// The emulator's Python interpreter (its virtual environment under the target directory).
@@ -79,7 +79,8 @@ pub fn build() -> Result<()> {
     for args in [
         &[
             "build",
-            "--release",
+            "--profile",
+            "firmware",
             "-p",
             "firmware",
             "--target",

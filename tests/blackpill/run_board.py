@@ -30,7 +30,7 @@ from pty_link import PtyLink  # noqa: E402
 
 def default_paths():
     return {
-        "elf": os.path.join(ROOT, "target/thumbv7em-none-eabihf/release/firmware"),
+        "elf": os.path.join(ROOT, "target/thumbv7em-none-eabihf/firmware/firmware"),
         "plant": os.path.join(ROOT, "target/debug/libplant_ffi.so"),
         "flash": os.path.join(ROOT, "target/blackpill/flash.bin"),
         "logs": os.path.join(ROOT, "target/test-logs"),

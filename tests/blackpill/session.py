@@ -19,7 +19,7 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 # the image, the plant library and `bowl` the same build left there.
 TARGET = os.environ.get("CARGO_TARGET_DIR") or os.path.join(ROOT, "target")
 # BLACKPILL_ELF runs another image (e.g. an older build, to see a test fail on it).
-ELF = os.environ.get("BLACKPILL_ELF") or os.path.join(TARGET, "thumbv7em-none-eabihf/release/firmware")
+ELF = os.environ.get("BLACKPILL_ELF") or os.path.join(TARGET, "thumbv7em-none-eabihf/firmware/firmware")
 PLANT_LIB = os.path.join(TARGET, "debug/libplant_ffi.so")
 BOWL = os.path.join(TARGET, "debug/bowl")
 LOGS = os.path.join(TARGET, "test-logs")

@@ -138,7 +138,7 @@ fn run_blackpill(args: &RunArgs) -> Result<ExitCode> {
     if args.elf.is_some() || args.image.is_some() {
         bail!(
             "the Black Pill emulator runs the board image it builds itself \
-             (target/thumbv7em-none-eabihf/release/firmware): drop the ELF / --image"
+             (target/thumbv7em-none-eabihf/firmware/firmware): drop the ELF / --image"
         );
     }
     let seconds = if args.timeout_s > 0 {

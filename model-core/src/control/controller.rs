@@ -288,6 +288,9 @@ impl Controller {
         let s = &self.axes[1];
         let duty = (s.duty - s.extra_duty) * s.direction;
         let by_duty = s.direction * s.obs.drive_rad_s(&s.ok, duty);
+        // The ramp's, not the led reference's (pi.rs `lead`): a led spin's model accelerates at
+        // `(led - r_p) / tau`, and fed that, the eleven families' shares within 2 % by 3 s from
+        // rest to 1 rad/s summed 1079.2 against 1080.9 (docs/control.md, "The reference's lead").
         let by_model = ramped[1] - s.speed_loop.model_rad_s();
         // With current sense a spin at rest whose current has not shown its breakaway is
         // held (by stiction, or material the model does not know): its motor's torque and
