@@ -49,6 +49,9 @@ pub struct Endpoint {
     pub kind: &'static str,
     /// Why the emulated board is not used, when it is not.
     pub qemu_note: Option<String>,
+    /// Device seconds per wall second: above 1 only for the host rig run fast (the emulated
+    /// boards run at or below real time).
+    pub device_per_wall: f64,
     running: Running,
 }
 
@@ -155,6 +158,7 @@ fn start_host(fast: bool, seed: u32, qemu_note: Option<String>) -> Result<Endpoi
         ),
         kind: "host",
         qemu_note,
+        device_per_wall: speed,
         running: Running::Host {
             stop,
             thread: Some(thread),
@@ -192,6 +196,8 @@ fn start_qemu(fast: bool, seconds: f64) -> Result<Endpoint> {
         port: board.port.clone(),
         kind: "qemu",
         qemu_note: None,
+        // Virtual time may run ahead of the wall clock: counted as the host rig's fast pace.
+        device_per_wall: if fast { FAST_FACTOR } else { 1.0 },
         running: Running::Qemu(board),
     })
 }
@@ -209,6 +215,7 @@ fn start_blackpill(seconds: f64) -> Result<Endpoint> {
         port: board.port.clone(),
         kind: "blackpill",
         qemu_note: None,
+        device_per_wall: 1.0,
         running: Running::Blackpill(board),
     })
 }

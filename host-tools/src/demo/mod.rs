@@ -76,7 +76,7 @@ pub fn run(args: &Args) -> Result<()> {
             return Err(e);
         }
     };
-    let timing = script::Timing::for_seconds(args.seconds);
+    let timing = script::Timing::for_seconds(args.seconds, rig.device_per_wall);
     let boot_limit = std::time::Duration::from_secs(if rig.kind == "host" { 10 } else { 60 });
     let mut rig = rig;
     let outcome = match session.wait_first_telemetry(boot_limit) {

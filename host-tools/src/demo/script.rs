@@ -2,7 +2,7 @@
 //! printed as it happens. Durations are device time, scaled to the session length.
 
 use anyhow::{Result, bail};
-use model_core::wire::{DeviceState, FaultCode, Frame, ParamValues, Telemetry};
+use model_core::wire::{DeviceState, FaultCode, Frame, ParamId, ParamValues, Telemetry};
 
 use super::session::Session;
 
@@ -62,18 +62,25 @@ pub struct Timing {
     pub faulted_ms: u32,
     /// Pause after CLEAR and at the end.
     pub pause_ms: u32,
+    /// Device seconds per wall second of the rig (above 1: faster than real time).
+    pub device_per_wall: f64,
 }
 
 impl Timing {
     /// Durations for a session of about `seconds` device seconds.
-    pub fn for_seconds(seconds: f64) -> Timing {
+    pub fn for_seconds(seconds: f64, device_per_wall: f64) -> Timing {
         let k = seconds / NOMINAL_SECONDS;
         let ms = |s: f64| (s * k * 1000.0).round() as u32;
         Timing {
             dwell_ms: ms(7.0),
-            wait_limit_ms: ms(6.0).max(2000),
+            // A limit, not a duration: the wait ends when the event comes. Scaled down with a
+            // short session it ended before the physics did (`--seconds 20`: 3 s, and a rig
+            // coasting from 2.4 rad/s neither came to rest after its fault nor reached Idle
+            // after STOP, so the demo's checks failed on a healthy rig).
+            wait_limit_ms: ms(6.0).max(6000),
             faulted_ms: ms(3.0),
             pause_ms: ms(1.0),
+            device_per_wall,
         }
     }
 }
@@ -105,6 +112,27 @@ fn mark(s: &Session, name: &str, kind: MarkKind, accepted: bool) -> Mark {
             .unwrap_or(0),
         accepted,
     }
+}
+
+/// A rig faster than real time gets its link watch (`LINK_TIMEOUT_MS`) scaled by its pace, so
+/// that the PC keeps the wall time it has at real time: at 10x the default 3 s of device time
+/// were 0.3 s of wall time, and a PC busy for that long (several fast demos in parallel on two
+/// cores) faulted the rig for link loss mid-session. A watch that is off (0) stays off.
+fn keep_link_watch_in_wall_time(s: &mut Session, values: &ParamValues, pace: f64) -> Result<()> {
+    let now = values[ParamId::LinkTimeoutMs.index()];
+    let (_, max) = ParamId::LinkTimeoutMs.range();
+    if pace <= 1.0 || now <= 0 {
+        return Ok(());
+    }
+    let scaled = (f64::from(now) * pace).min(f64::from(max)).round() as i32;
+    let what = format!(
+        "keep the link watch at {:.1} s of wall time (the rig runs {pace}x real time)",
+        f64::from(now) / 1000.0
+    );
+    if !s.command(&what, &["set", "LINK_TIMEOUT_MS", &scaled.to_string()])? {
+        s.event("the rig kept its link watch: a PC slower than it for that long faults it".into());
+    }
+    Ok(())
 }
 
 fn words(v: &[String]) -> Vec<&str> {
@@ -152,6 +180,7 @@ fn steps(
     let (_, params) = s.command_answer("read the parameters", &["params"])?;
     if let Frame::Params { values, .. } = params {
         out.params = Some(values);
+        keep_link_watch_in_wall_time(s, &values, d.device_per_wall)?;
     }
 
     // 1. Start towards the first speeds (set while idle, taken at START).
