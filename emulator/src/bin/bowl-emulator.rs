@@ -137,8 +137,9 @@ fn run_qemu(elf: &std::path::Path, args: &RunArgs) -> Result<ExitCode> {
 fn run_blackpill(args: &RunArgs) -> Result<ExitCode> {
     if args.elf.is_some() || args.image.is_some() {
         bail!(
-            "the Black Pill emulator runs the board image it builds itself \
-             (target/thumbv7em-none-eabihf/firmware/firmware): drop the ELF / --image"
+            "the Black Pill emulator runs the board image it builds itself ({}): drop the ELF / \
+             --image",
+            blackpill::image_path().display()
         );
     }
     let seconds = if args.timeout_s > 0 {

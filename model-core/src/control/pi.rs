@@ -140,19 +140,8 @@ impl SpeedLoop {
             return 0.0;
         }
         let r_abs = r.abs();
-        // The reference's lead: a shaft slower than [`REFERENCE_TAU_S`] gets, while its model
-        // is behind the reference in the commanded direction, the feedforward of a reference
-        // ahead of it by `(tau / REFERENCE_TAU_S - 1) (r - r_p)`, so it follows a model of
-        // that lag instead of its own (below the duty limit; none on the way down, where the
-        // shaft coasts as its inertia lets it). The model is driven by the same led reference.
-        let mut lead = k.lead_gain * (r - self.model_rad_s);
-        let room = k.lead_room_rad_s - r_abs;
-        if lead * input.direction <= 0.0 || room <= 0.0 {
-            lead = 0.0;
-        } else if lead.abs() > room {
-            lead = room * input.direction;
-        }
-        let led = r + lead;
+        // The reference the feedforward and the model take (the reference's lead, above).
+        let led = k.led_reference(r, r_abs, self.model_rad_s, input.direction);
         // The plant model's speed and its angle over the estimator's current window.
         self.model_rad_s += (led - self.model_rad_s) * k.model_alpha;
         let rp = self.model_rad_s;

@@ -121,6 +121,25 @@ impl LoopConstants {
         if level > 0.0 { level } else { 0.0 }
     }
 
+    /// The reference `r` (magnitude `r_abs`, sign `direction`) led for a model at `r_p`: a
+    /// shaft slower than [`REFERENCE_TAU_S`] gets, while its model is behind the reference in
+    /// the commanded direction, the feedforward of a reference ahead of it by
+    /// `(tau / REFERENCE_TAU_S - 1) (r - r_p)`, so it follows a model of that lag instead of
+    /// its own. Below the duty limit (less [`LEAD_MARGIN_DUTY`]); none on the way down, where
+    /// the shaft coasts as its inertia lets it.
+    #[inline(always)]
+    pub(super) fn led_reference(&self, r: f32, r_abs: f32, r_p: f32, direction: f32) -> f32 {
+        let lead = self.lead_gain * (r - r_p);
+        let room = self.lead_room_rad_s - r_abs;
+        if lead * direction <= 0.0 || room <= 0.0 {
+            r
+        } else if lead.abs() > room {
+            r + room * direction
+        } else {
+            r + lead
+        }
+    }
+
     /// Closed-loop bandwidth the schedule picks at reference speed `r_abs`, rad/s.
     #[inline]
     pub fn scheduled_bandwidth(&self, r_abs: f32) -> f32 {
