@@ -51,6 +51,22 @@ pub const START_READ_MIN_S: f32 = 0.4;
 /// reading"). At 0.15 and 0.25 the eleven families' shares summed 1074.1 and 1075.0, at 0.35
 /// 1076.7 (1069.9 without the second reading).
 pub const SECOND_READING_MISMATCH_SHARE: f32 = 0.35;
+/// The least mismatch share for the start's second reading where it changes the load read by
+/// more than [`SECOND_READING_CHANGE_SHARE`] of the reference: between this and
+/// [`SECOND_READING_MISMATCH_SHARE`] a first window that read a rod running ahead of its model
+/// (the kick's leap) as no load, or as a negative one, is read again, and a reading that moves
+/// by no more than a window's noise is left to the loop. With current sense a heavy rod's
+/// first window there read -0.077 rad/s where it needed +0.02 (seed 5 p48, `b1` 0.346), and
+/// the loop took a second per e-fold of it: 2 % settled at 3.43 s (docs/control.md, "The
+/// start's second reading where it moves the load"). From rest to 1 rad/s, summed shares
+/// within 2 % by 3 s on the eleven families: with current sense 1083.4 -> 1088.4 (98 % on 8 ->
+/// 10 of them), pulses only 1080.9 -> 1080.1; every second reading from 0.25 on, regardless
+/// of what it changes: 1085.0 and 1080.1, more axes moved both ways.
+pub const SECOND_READING_LESSER_MISMATCH_SHARE: f32 = 0.25;
+/// How far the start's second reading must move the load read from the first alone, as a share
+/// of the reference, where the mismatch share is below [`SECOND_READING_MISMATCH_SHARE`]: a few
+/// percent is what a window of a light shaft reads from its eccentric load and its teeth.
+pub const SECOND_READING_CHANGE_SHARE: f32 = 0.03;
 /// The time constant the loop's model follows the reference with where the identified shaft
 /// is slower (`lead` in [`SpeedLoop::step`](super::SpeedLoop::step)), s: the feedforward leads
 /// the reference by `(tau / REFERENCE_TAU_S - 1) (r - r_p)`, which drives a shaft of lag `tau`

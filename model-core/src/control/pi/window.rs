@@ -3,7 +3,9 @@
 //! hand the integral what the shaft needs (the crawl's, the start's).
 
 use super::{
-    LoopConstants, LoopInput, PUSH_KEPT, SECOND_READING_MISMATCH_SHARE, START_READ_MIN_S, SpeedLoop,
+    LoopConstants, LoopInput, PUSH_KEPT, SECOND_READING_CHANGE_SHARE,
+    SECOND_READING_LESSER_MISMATCH_SHARE, SECOND_READING_MISMATCH_SHARE, START_READ_MIN_S,
+    SpeedLoop,
 };
 use crate::control::estimator::WindowSample;
 
@@ -109,7 +111,9 @@ impl SpeedLoop {
     /// window read 0.025 of a load of about 0.095 rad/s, the filtered error reached 0.055 at the
     /// second, the two together 0.083. The integral takes `L` as at the first reading
     /// (`take_start_load`). Only where the mismatch made up at least
-    /// [`SECOND_READING_MISMATCH_SHARE`] of the first window (docs/control.md, "The start's
+    /// [`SECOND_READING_MISMATCH_SHARE`] of the first window, or at least
+    /// [`SECOND_READING_LESSER_MISMATCH_SHARE`] where `L` moves the first window's reading by more
+    /// than [`SECOND_READING_CHANGE_SHARE`] of the reference (docs/control.md, "The start's
     /// second reading"). Once per start, so out of the tick's common path.
     #[cold]
     #[inline(never)]
@@ -125,10 +129,16 @@ impl SpeedLoop {
         let [s1, a1, b1] = self.first_reading;
         let [a2, b2] = self.shares(w);
         let det = a1 * b2 - a2 * b1;
-        if !(b1 > SECOND_READING_MISMATCH_SHARE && det.abs() > 0.05 * a1 * b1.max(b2)) {
+        let load = (s1 * b2 - shortfall * b1) / det;
+        // Where the mismatch made up less of the first window, the reading is taken only if it
+        // moves the load the first window read by more than a window's noise.
+        let moves = (load - s1 / shown_share(a1)).abs()
+            > SECOND_READING_CHANGE_SHARE * input.reference_rad_s.abs();
+        let mismatched = b1 > SECOND_READING_MISMATCH_SHARE
+            || (b1 > SECOND_READING_LESSER_MISMATCH_SHARE && moves);
+        if !(mismatched && det.abs() > 0.05 * a1 * b1.max(b2)) {
             return;
         }
-        let load = (s1 * b2 - shortfall * b1) / det;
         if load.is_finite() {
             self.error = load;
             if input.feedback && w.span_s >= START_READ_MIN_S {
