@@ -25,11 +25,15 @@ pub fn incline_times_s<T: Real>(scene: &RollingScene<T>) -> Option<[T; 12]> {
 }
 
 pub(crate) fn mean_of<T: Real>(times: &[T; 12]) -> T {
+    sum_of(times) / T::from_f64(AZIMUTHS_DEG.len() as f64)
+}
+
+pub(crate) fn sum_of<T: Real>(times: &[T; 12]) -> T {
     let mut sum = T::ZERO;
     for &t in times {
         sum += t;
     }
-    sum / T::from_f64(AZIMUTHS_DEG.len() as f64)
+    sum
 }
 
 /// The friction rolling down the incline needs, as a fraction of the normal force:

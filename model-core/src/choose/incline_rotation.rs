@@ -273,8 +273,7 @@ pub fn mean_second_order_from<T: Real>(scene: &RollingScene<T>, times: &[T; 12])
     tilted_second_order(scene, th.sin(), th.cos(), times)
 }
 
-/// [`mean_second_order_from`] with the tilt's sine `s` and cosine `c` already computed (the
-/// chooser's).
+/// [`mean_second_order_from`] with the tilt's sine `s` and cosine `c` already computed.
 pub(crate) fn tilted_second_order<T: Real>(
     scene: &RollingScene<T>,
     s: T,
@@ -282,16 +281,46 @@ pub(crate) fn tilted_second_order<T: Real>(
     times: &[T; 12],
 ) -> Option<(T, T)> {
     let orders = Orders::new(scene, s, c)?;
-    // Branch-free: every time finite and positive, checked together.
+    let t0 = checked_sum(times)?;
+    let n = T::from_f64(AZIMUTHS_DEG.len() as f64);
+    let mean = t0 / n;
+    let rel = relative_second_order(&orders, times, t0)?;
+    mean.is_finite().then_some(rel).map(|rel| (mean, rel))
+}
+
+/// The sum of `times`, `None` unless every one is finite and positive (branch-free: checked
+/// together).
+pub(crate) fn checked_sum<T: Real>(times: &[T; 12]) -> Option<T> {
     let mut t0 = T::ZERO;
     let mut ok = true;
     for &t in times {
         ok &= t.is_finite() & (t > T::ZERO);
         t0 += t;
     }
-    if !ok {
-        return None;
-    }
+    ok.then_some(t0)
+}
+
+/// The chooser's second order: `mean T2 / mean T0` from the incline's own times (finite, and
+/// positive wherever the orders exist: a release inside the rim), their sum `t0`, and its mode
+/// (`slides`, as [`InclineMode::Slides`](super::rotation_bound::InclineMode) has it), all of
+/// which the chooser already holds; [`tilted_second_order`] checks and computes them again.
+pub(crate) fn incline_second_order<T: Real>(
+    scene: &RollingScene<T>,
+    (s, c): (T, T),
+    slides: bool,
+    times: &[T; 12],
+    t0: T,
+) -> Option<T> {
+    let orders = if slides {
+        Orders::sliding(scene, s, c)
+    } else {
+        Orders::rolling(scene, s, c)
+    }?;
+    relative_second_order(&orders, times, t0)
+}
+
+/// `mean T2 / mean T0` over the seven releases that stand for the twelve (`t0` the times' sum).
+fn relative_second_order<T: Real>(orders: &Orders<T>, times: &[T; 12], t0: T) -> Option<T> {
     // Azimuths 0 to 180 deg; 30 to 150 stand for their mirrors 330 to 210 too.
     const WEIGHT: [f64; 7] = [1.0, 2.0, 2.0, 2.0, 2.0, 2.0, 1.0];
     let mut t2 = T::ZERO;
@@ -299,9 +328,8 @@ pub(crate) fn tilted_second_order<T: Real>(
         let (_, c) = orders.terms(T::from_f64(cb), T::from_f64(sb), t);
         t2 += T::from_f64(w) * c;
     }
-    let n = T::from_f64(AZIMUTHS_DEG.len() as f64);
-    let (mean, rel) = (t0 / n, t2 / t0);
-    (mean.is_finite() && rel.is_finite()).then_some((mean, rel))
+    let rel = t2 / t0;
+    rel.is_finite().then_some(rel)
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@ use crate::Real;
 use crate::particle::rolling::RollingScene;
 
 use super::incline::{Tilt, needed_at, needed_in};
-use super::incline_rotation::tilted_second_order;
+use super::incline_rotation::{checked_sum, incline_second_order};
 
 /// The rotation's effect on the incline's mean `T`: at most
 /// `K (|Omega|^2 + 2 w1^2) T_incline^2 ri / (R - ri)` (relative, [`rotation_estimate`]), where
@@ -83,13 +83,29 @@ pub fn rotation_constant<T: Real>(scene: &RollingScene<T>) -> T {
 }
 
 /// [`rotation_estimate`] with the incline's mode already known.
-pub(crate) fn estimate_in<T: Real>(
+fn estimate_in<T: Real>(
     scene: &RollingScene<T>,
     tilt: Tilt<T>,
     incline_mean_s: T,
     mode: InclineMode,
 ) -> T {
-    let estimate = mode_constant::<T>(mode) * form_in(scene, tilt, incline_mean_s)
+    estimate_of(
+        scene,
+        form_in(scene, tilt, incline_mean_s),
+        incline_mean_s,
+        mode,
+    )
+}
+
+/// [`rotation_estimate`] from the rotation's form `f` ([`rotation_form`]) and the incline's
+/// mode (the chooser computes `f` once for the estimate and the second order's bound).
+pub(crate) fn estimate_of<T: Real>(
+    scene: &RollingScene<T>,
+    f: T,
+    incline_mean_s: T,
+    mode: InclineMode,
+) -> T {
+    let estimate = mode_constant::<T>(mode) * f
         + T::from_f64(ROTATION_K_ROD) * rod_form(scene, incline_mean_s);
     // A speed whose square overflows times a release at the centre (`inf * 0`) bounds nothing:
     // infinite, so the incline is not taken and no NaN is reported.
@@ -210,11 +226,26 @@ pub fn second_order_bound<T: Real>(
     bound_in(scene, Tilt::of(scene), times, incline_mean_s, mode)
 }
 
-pub(crate) fn bound_in<T: Real>(
+fn bound_in<T: Real>(
     scene: &RollingScene<T>,
     tilt: Tilt<T>,
     times: &[T; 12],
     incline_mean_s: T,
+    mode: InclineMode,
+) -> Option<SecondOrder<T>> {
+    let sum = checked_sum(times)?;
+    let f = form_in(scene, tilt, incline_mean_s);
+    bound_of(scene, tilt, (times, sum), f, mode)
+}
+
+/// [`second_order_bound`] from the incline's times (finite and positive, as the incline gives
+/// them) and their sum, and the rotation's form `f` ([`rotation_form`]): what the chooser
+/// already holds, not computed again.
+pub(crate) fn bound_of<T: Real>(
+    scene: &RollingScene<T>,
+    tilt: Tilt<T>,
+    (times, sum): (&[T; 12], T),
+    f: T,
     mode: InclineMode,
 ) -> Option<SecondOrder<T>> {
     let (k4, k4c) = match mode {
@@ -229,8 +260,8 @@ pub(crate) fn bound_in<T: Real>(
     if scene.rod_length_m != T::ZERO {
         return None;
     }
-    let (_, c2) = tilted_second_order(scene, tilt.sin, tilt.cos, times)?;
-    let f = form_in(scene, tilt, incline_mean_s);
+    let slides = mode == InclineMode::Slides;
+    let c2 = incline_second_order(scene, (tilt.sin, tilt.cos), slides, times, sum)?;
     let bound = c2.abs() + T::from_f64(k4) * f * f;
     let corrected_bound = T::from_f64(k4c) * f * f;
     (bound.is_finite() && corrected_bound.is_finite()).then_some(SecondOrder {
@@ -263,7 +294,7 @@ pub fn rotation_form<T: Real>(scene: &RollingScene<T>, incline_mean_s: T) -> T {
     form_in(scene, Tilt::of(scene), incline_mean_s)
 }
 
-fn form_in<T: Real>(scene: &RollingScene<T>, tilt: Tilt<T>, incline_mean_s: T) -> T {
+pub(crate) fn form_in<T: Real>(scene: &RollingScene<T>, tilt: Tilt<T>, incline_mean_s: T) -> T {
     let w_sq = tilt.combined_speed_sq(scene);
     let w1 = scene.precession_rad_s;
     let path = scene.rim_radius_m - scene.ri_m;

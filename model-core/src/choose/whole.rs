@@ -37,9 +37,9 @@
 
 use crate::Real;
 use crate::particle::bowl::BowlShape;
-use crate::particle::rolling::RollingScene;
+use crate::particle::rolling::{AZIMUTHS_DEG, RollingScene};
 
-use super::incline::{Tilt, mean_of, needed_at};
+use super::incline::{Tilt, needed_at, sum_of};
 pub use super::incline::{
     friction_needed_at_release, friction_needed_at_rim, incline_friction_needed, incline_mean_s,
     incline_release_s, incline_times_s,
@@ -50,7 +50,7 @@ pub use super::rotation_bound::{
     SECOND_ORDER_K4_NEAR_RIM, SECOND_ORDER_K4_SLIDING, SecondOrder, incline_mode, may_stick,
     rod_form, rotation_constant, rotation_estimate, rotation_form, second_order_bound,
 };
-use super::rotation_bound::{bound_in, estimate_in, mode_in};
+use super::rotation_bound::{bound_of, estimate_of, form_in, mode_in};
 
 /// A level of the hierarchy, cheapest first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -133,7 +133,7 @@ pub struct WholeChoice<T> {
     pub second_order: Option<SecondOrder<T>>,
     /// The friction rolling needs at release (worst azimuth), as a fraction of `N`.
     pub friction_needed: T,
-    /// The incline's mean `T` over [`AZIMUTHS_DEG`](crate::particle::rolling::AZIMUTHS_DEG), s, corrected by the rotation's second
+    /// The incline's mean `T` over [`AZIMUTHS_DEG`], s, corrected by the rotation's second
     /// order where the chooser took it so ([`SecondOrder::corrected`]); computed for the
     /// choice: when the incline is chosen, this is its answer, at no further cost.
     pub incline_mean_s: Option<T>,
@@ -178,19 +178,22 @@ pub fn choose_level<T: Real>(
     let slides = needed > scene.sliding_friction;
     // The incline: its own friction check is inside it; the rotation decides.
     let times = incline_times_s(scene);
-    let incline = times.as_ref().map(mean_of);
-    fails[0] = match (incline, times) {
-        (Some(_), _) if each_release => Some(Fails::EachRelease),
-        (Some(t), Some(times)) => {
+    let sum = times.as_ref().map(sum_of);
+    let incline = sum.map(|sum| sum / T::from_f64(AZIMUTHS_DEG.len() as f64));
+    fails[0] = match (incline, times, sum) {
+        (Some(_), _, _) if each_release => Some(Fails::EachRelease),
+        (Some(t), Some(times), Some(sum)) => {
             let mode = mode_in(scene, tilt);
-            rotation_estimate = estimate_in(scene, tilt, t, mode);
+            // The rotation's form, once for the estimate and the second order's bound.
+            let f = form_in(scene, tilt, t);
+            rotation_estimate = estimate_of(scene, f, t, mode);
             if rotation_estimate > tolerance {
                 // The a-priori estimate refuses it: the rotation's second order along the
                 // incline's path may still bound it within (docs/model.md §12, "The four
                 // rotation rows"); only here, so the rows taken by the estimate pay nothing.
                 // The plain incline where its bound holds; else its mean corrected by `c2`
                 // where the remainder's bound does.
-                second_order = bound_in(scene, tilt, &times, t, mode);
+                second_order = bound_of(scene, tilt, (&times, sum), f, mode);
                 match &mut second_order {
                     Some(b) if b.bound <= tolerance => None,
                     Some(b) if b.corrected_bound <= tolerance => {
