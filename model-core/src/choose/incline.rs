@@ -25,7 +25,12 @@ pub fn incline_times_s<T: Real>(scene: &RollingScene<T>) -> Option<[T; 12]> {
 }
 
 pub(crate) fn mean_of<T: Real>(times: &[T; 12]) -> T {
-    sum_of(times) / T::from_f64(AZIMUTHS_DEG.len() as f64)
+    mean_from_sum(sum_of(times))
+}
+
+/// The mean over [`AZIMUTHS_DEG`] of times whose sum is `sum`.
+pub(crate) fn mean_from_sum<T: Real>(sum: T) -> T {
+    sum / T::from_f64(AZIMUTHS_DEG.len() as f64)
 }
 
 pub(crate) fn sum_of<T: Real>(times: &[T; 12]) -> T {

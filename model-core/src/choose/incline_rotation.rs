@@ -28,7 +28,7 @@
 use crate::Real;
 use crate::particle::rolling::{AZIMUTHS_DEG, RollingScene};
 
-use super::incline::{incline_release_s, slides_in};
+use super::incline::{incline_release_s, mean_from_sum, slides_in};
 
 /// `(cos beta, sin beta)` of [`AZIMUTHS_DEG`] (every 30 deg), exact to the last bit of `f64`
 /// (`libm`'s `sin`/`cos` cost about 20 ns each: 24 of them would be most of the chooser's
@@ -282,8 +282,7 @@ pub(crate) fn tilted_second_order<T: Real>(
 ) -> Option<(T, T)> {
     let orders = Orders::new(scene, s, c)?;
     let t0 = checked_sum(times)?;
-    let n = T::from_f64(AZIMUTHS_DEG.len() as f64);
-    let mean = t0 / n;
+    let mean = mean_from_sum(t0);
     let rel = relative_second_order(&orders, times, t0)?;
     mean.is_finite().then_some(rel).map(|rel| (mean, rel))
 }

@@ -37,9 +37,9 @@
 
 use crate::Real;
 use crate::particle::bowl::BowlShape;
-use crate::particle::rolling::{AZIMUTHS_DEG, RollingScene};
+use crate::particle::rolling::RollingScene;
 
-use super::incline::{Tilt, needed_at, sum_of};
+use super::incline::{Tilt, mean_from_sum, needed_at, sum_of};
 pub use super::incline::{
     friction_needed_at_release, friction_needed_at_rim, incline_friction_needed, incline_mean_s,
     incline_release_s, incline_times_s,
@@ -133,7 +133,7 @@ pub struct WholeChoice<T> {
     pub second_order: Option<SecondOrder<T>>,
     /// The friction rolling needs at release (worst azimuth), as a fraction of `N`.
     pub friction_needed: T,
-    /// The incline's mean `T` over [`AZIMUTHS_DEG`], s, corrected by the rotation's second
+    /// The incline's mean `T` over [`AZIMUTHS_DEG`](crate::particle::rolling::AZIMUTHS_DEG), s, corrected by the rotation's second
     /// order where the chooser took it so ([`SecondOrder::corrected`]); computed for the
     /// choice: when the incline is chosen, this is its answer, at no further cost.
     pub incline_mean_s: Option<T>,
@@ -177,12 +177,15 @@ pub fn choose_level<T: Real>(
     }
     let slides = needed > scene.sliding_friction;
     // The incline: its own friction check is inside it; the rotation decides.
-    let times = incline_times_s(scene);
-    let sum = times.as_ref().map(sum_of);
-    let incline = sum.map(|sum| sum / T::from_f64(AZIMUTHS_DEG.len() as f64));
-    fails[0] = match (incline, times, sum) {
-        (Some(_), _, _) if each_release => Some(Fails::EachRelease),
-        (Some(t), Some(times), Some(sum)) => {
+    // Its times, their sum and their mean (the incline's answer), kept for the checks below.
+    let drive = incline_times_s(scene).map(|times| {
+        let sum = sum_of(&times);
+        (times, sum, mean_from_sum(sum))
+    });
+    let incline = drive.map(|(_, _, t)| t);
+    fails[0] = match drive {
+        Some(_) if each_release => Some(Fails::EachRelease),
+        Some((times, sum, t)) => {
             let mode = mode_in(scene, tilt);
             // The rotation's form, once for the estimate and the second order's bound.
             let f = form_in(scene, tilt, t);
@@ -208,7 +211,7 @@ pub fn choose_level<T: Real>(
                 None
             }
         }
-        _ => Some(Fails::NoDrive),
+        None => Some(Fails::NoDrive),
     };
     if fails[0].is_none() {
         let corrected = second_order.filter(|b| b.corrected);
