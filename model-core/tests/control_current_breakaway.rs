@@ -332,48 +332,6 @@ fn a_pushed_spin_whose_breakaway_the_current_saw_takes_the_starts_reading() {
     assert!(peak <= 0.55, "spin peaked at {peak} rad/s");
 }
 
-/// With current sense the spin starts once the current shows the rod's breakaway, before the
-/// rod's first edge (up to a pitch later at 0.5 rad/s, a second with 12 pulses a revolution): the
-/// rod turns under its own motor then, which is what the spin waits for. Without current sense it
-/// waits for that first edge.
-#[test]
-fn with_current_the_spin_starts_at_the_rods_breakaway() {
-    // (time the spin's duty came on, time of the rod's first edge), s, from rest to 0.5 rad/s
-    // after commissioning (which learns the current's offset and scale).
-    let start = |rig: PlantParams| {
-        let mut cl = ClosedLoop::new(
-            Plant::new(rig, 1),
-            Controller::new_or_faulted(ControllerConfig::nominal()),
-        );
-        assert_eq!(cl.commission(300.0), State::Idle);
-        let edges_before = cl.rig.edges_emitted(0);
-        assert!(cl.ctrl.set_motor_speeds(0.5, 0.5).is_ok() && cl.ctrl.start().is_ok());
-        let dt = cl.dt_s();
-        let (mut t, mut spin_s, mut edge_s) = (0.0f32, None, None);
-        cl.run(3.0, |c| {
-            t += dt;
-            if spin_s.is_none() && c.duties()[1] != 0.0 {
-                spin_s = Some(t);
-            }
-            if edge_s.is_none() && c.rig.edges_emitted(0) > edges_before {
-                edge_s = Some(t);
-            }
-        });
-        assert_eq!(cl.ctrl.fault(), None);
-        (spin_s.unwrap(), edge_s.unwrap())
-    };
-    let (spin, edge) = start(sensed(PlantParams::nominal()));
-    assert!(
-        spin < edge - 0.1,
-        "spin at {spin:.3} s, the rod's first edge at {edge:.3} s"
-    );
-    let (spin, edge) = start(PlantParams::nominal());
-    assert!(
-        spin >= edge,
-        "pulses only: spin at {spin:.3} s before the first edge {edge:.3} s"
-    );
-}
-
 /// The breakaway watch of a light shaft held by material the model does not know: its
 /// identified friction duty (0.017) is far below what holds it, so the start's fit below that
 /// duty takes two or three samples, and the supervisor's current per duty, learned while the

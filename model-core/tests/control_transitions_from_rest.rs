@@ -133,51 +133,66 @@ fn from_rest_to_the_lowest_speed_the_kept_kick_is_read_away() {
     }
 }
 
-/// From rest, the spin starts as soon as the rod has given its first edge under its own motor
-/// (the spin's reaction can then no longer drag it backwards unseen), not when the rod's first
-/// measurement comes a pitch later: at 1 rad/s with 12 pulses a revolution that wait held the
-/// spin 0.6-1.2 s and cost it its 3 s to settle. Both axes of a rig loaded with material the
-/// model does not know are then inside +/-2 % of 1 rad/s within 3 s.
+/// From rest, the spin starts with the rod (planner.rs): the rod's motor is kicked to its
+/// breakaway from its first tick, so the spin's reaction cannot drag it backwards, and waiting
+/// for the rod's first edge held the spin 0.05-0.8 s (docs/control.md, "The spin starts with
+/// the rod"). Pulses only and with current sense: the spin's duty comes on within two ticks of
+/// the rod's, the rod never turns backwards, and both axes of a rig loaded with material the
+/// model does not know are inside +/-2 % of 1 rad/s within 3 s.
 #[test]
-fn from_rest_the_spin_starts_at_the_rods_first_edge() {
+fn from_rest_the_spin_starts_with_the_rod() {
     use model_core::control::Controller;
+    use model_core::sim::CurrentSense;
     use model_core::sim::experiments::true_model_config;
     use model_core::sim::harness::{ClosedLoop, StepMetrics};
     use model_core::sim::plant::Plant;
 
-    let rig = rig_with_pulses(12);
-    let mut cl = ClosedLoop::new(
-        Plant::new(rig, 1),
-        Controller::new_or_faulted(true_model_config(&rig)),
-    );
-    for a in &mut cl.rig.params_mut().axes {
-        a.faults.load_step_from_s = 0.0;
-        a.faults.load_step_nm = 0.04;
-    }
-    assert!(cl.ctrl.set_motor_speeds(1.0, 1.0).is_ok() && cl.ctrl.start().is_ok());
-    let dt = cl.dt_s();
-    let (mut t, mut first_edge_s, mut spin_s) = (0.0f32, None, None);
-    let mut m = [StepMetrics::new(1.0, 4.0), StepMetrics::new(1.0, 4.0)];
-    cl.run(8.0, |c| {
-        t += dt;
-        if first_edge_s.is_none() && c.rig.edges_emitted(0) > 0 {
-            first_edge_s = Some(t);
+    for sense in [CurrentSense::NONE, CurrentSense::TYPICAL] {
+        let mut rig = rig_with_pulses(12);
+        for a in &mut rig.axes {
+            a.current_sense = sense;
         }
-        if spin_s.is_none() && c.duties()[1] != 0.0 {
-            spin_s = Some(t);
+        let mut cl = ClosedLoop::new(
+            Plant::new(rig, 1),
+            Controller::new_or_faulted(true_model_config(&rig)),
+        );
+        for a in &mut cl.rig.params_mut().axes {
+            a.faults.load_step_from_s = 0.0;
+            a.faults.load_step_nm = 0.04;
         }
-        m[0].add(t, c.rig.speed_rad_s(0));
-        m[1].add(t, c.rig.speed_rad_s(1));
-    });
-    assert_eq!(cl.ctrl.fault(), None);
-    let (edge, spin) = (first_edge_s.unwrap(), spin_s.unwrap());
-    assert!(
-        spin >= edge && spin <= edge + 0.05,
-        "the rod's first edge at {edge:.3} s, the spin started at {spin:.3} s"
-    );
-    for (axis, m) in m.iter().enumerate() {
-        let r = m.report();
-        assert!(r.settled && r.settling_time_s <= 3.0, "axis {axis}: {r:?}");
+        assert!(cl.ctrl.set_motor_speeds(1.0, 1.0).is_ok() && cl.ctrl.start().is_ok());
+        let dt = cl.dt_s();
+        let (mut t, mut rod_s, mut spin_s, mut slowest) = (0.0f32, None, None, 0.0f32);
+        let mut m = [StepMetrics::new(1.0, 4.0), StepMetrics::new(1.0, 4.0)];
+        cl.run(8.0, |c| {
+            t += dt;
+            if rod_s.is_none() && c.duties()[0] != 0.0 {
+                rod_s = Some(t);
+            }
+            if spin_s.is_none() && c.duties()[1] != 0.0 {
+                spin_s = Some(t);
+            }
+            slowest = slowest.min(c.rig.speed_rad_s(0));
+            m[0].add(t, c.rig.speed_rad_s(0));
+            m[1].add(t, c.rig.speed_rad_s(1));
+        });
+        assert_eq!(cl.ctrl.fault(), None);
+        let (rod, spin) = (rod_s.unwrap(), spin_s.unwrap());
+        assert!(
+            spin >= rod && spin <= rod + 2.5 * dt,
+            "{sense:?}: the rod started at {rod:.3} s, the spin at {spin:.3} s"
+        );
+        assert!(
+            slowest >= 0.0,
+            "{sense:?}: the rod turned backwards at {slowest} rad/s"
+        );
+        for (axis, m) in m.iter().enumerate() {
+            let r = m.report();
+            assert!(
+                r.settled && r.settling_time_s <= 3.0,
+                "{sense:?}, axis {axis}: {r:?}"
+            );
+        }
     }
 }
 

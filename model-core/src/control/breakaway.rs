@@ -234,7 +234,17 @@ impl Breakaway {
         }
         if watch && !self.released {
             let threshold = (BREAKAWAY_SHARE * r_abs).max(BREAKAWAY_FLOOR_RAD_S);
-            self.above = if self.speed_rad_s > threshold {
+            // Below the friction duty the shaft is held for sure, whatever the current says:
+            // there a back-EMF speed is the sense chain's offset and noise. The first sample
+            // of a start, at zero duty, read -0.006 duty of current, 0.056 rad/s, above the
+            // lowest speed's threshold (0.05): taken as a breakaway 3 ms into the start, it
+            // ended the kick of a heavy rod whose feedforward alone (0.22 duty) could not
+            // start it (0.33), the held ratio was never fitted, the band read the sense
+            // chain's error as the model speed, and the expected-edge watch faulted the
+            // healthy rod 7.5 s in (seed 31 p41 at 0.2 rad/s; docs/control.md, "A breakaway
+            // below the friction duty").
+            let may_turn = applied > FIT_BELOW_FRICTION * friction_duty;
+            self.above = if may_turn && self.speed_rad_s > threshold {
                 self.above.saturating_add(1)
             } else {
                 0

@@ -255,24 +255,7 @@ impl Controller {
         let [p, s] = &self.axes;
         let stopped = [p.est.is_stopped(), s.est.is_stopped()];
         let max_step = [p.max_step, s.max_step];
-        let r0 = self.planner.ramped()[0];
-        // Precession established: its loop has seen it turn under its own motor (an edge since
-        // the loop left rest, or with current sense the back-EMF of its breakaway: the spin's
-        // reaction can no longer drag it backwards unseen), or
-        // it is measured at half its reference or more, or (sparse pulses: N = 1 needs two
-        // pulse periods for a first measurement) its ramp has been done for a second. Waiting
-        // for a measurement held the spin 0.6-1.2 s at 1 rad/s (a 12-pulse rod's first window
-        // spans its second pitch) and cost the spin its 3 s: family-60 0 -> 1 rad/s within 2 %
-        // by 3 s on 52.5 % of axes, 72.5 % released at the first edge; with current sense,
-        // released at the breakaway, 0 -> 0.5 rad/s within 5 % by 8 s 90.8-95.0 % -> 96.7-100 %
-        // on seven families (docs/control.md, "The spin released at the precession's first
-        // edge").
-        let established = !self.planner.spin_released()
-            && r0 != 0.0
-            && (p.speed_loop.turning()
-                || (p.est.is_valid() && p.measured.abs() >= 0.5 * r0.abs())
-                || self.planner.steady_s()[0] > 1.0);
-        let ramped = self.planner.step(dt, max_step, stopped, established);
+        let ramped = self.planner.step(dt, max_step, stopped);
         // Spin first: its expected acceleration feeds the precession axis's decoupling.
         if self.axis_loop(1, ramped[1], 0.0, seen[1], dt) {
             return;

@@ -49,21 +49,22 @@ pub fn split_combined(
 ///
 /// Two rules beyond the ramps, both because the sensors cannot see direction:
 /// - A reversal ramps to zero and holds there until the axis's estimator reads zero.
-/// - The spin axis starts ramping only once the precession axis is established (its loop has
-///   seen it turn, or a valid measurement at least half its ramped reference, or its ramp
-///   finished for a second when the pulses are too sparse to measure that soon), if precession
-///   is asked to turn at all.
-///   The spin motor rides on the rod: its accelerating torque reacts on the precession axis.
-///   Started together, a lightly loaded precession axis can be dragged *backwards* before its
-///   own motor gets going, and a direction-blind loop would then read that as forward motion.
-///   Started first, the precession motor holds its direction against the reaction.
+/// - The spin axis starts ramping only once the precession axis has started (its reference
+///   is off zero: its kick, the identified breakaway duty, is on from that tick), if
+///   precession is asked to turn at all. The spin motor rides on the rod: its accelerating
+///   torque reacts on the precession axis, and a rod whose motor had not yet got going could
+///   be dragged *backwards*, which a direction-blind loop would read as forward motion. With
+///   the rod's motor kicked to its breakaway, that reaction would have to exceed the kick and
+///   the rod's stiction together; on 600 family starts it reached at most 0.62 of the stiction
+///   alone while the rod was held, no rod turned backwards, and the rod's decoupling feeds it
+///   forward (docs/control.md, "The spin starts with the rod"). Waiting for the rod's first
+///   edge held the spin 0.05-0.8 s from rest.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SetpointPlanner {
     target: [f32; 2],
     ramped: [f32; 2],
     steady_s: [f32; 2],
     reversing: [bool; 2],
-    spin_released: bool,
 }
 
 impl SetpointPlanner {
@@ -73,7 +74,6 @@ impl SetpointPlanner {
         ramped: [0.0; 2],
         steady_s: [0.0; 2],
         reversing: [false; 2],
-        spin_released: false,
     };
 
     /// Sets the targets (already validated), rad/s.
@@ -96,9 +96,10 @@ impl SetpointPlanner {
         self.steady_s
     }
 
-    /// True once the spin axis may ramp (see the type's docs).
+    /// True once the spin axis may ramp: the precession axis has started, or is not asked to
+    /// turn (see the type's docs).
     pub fn spin_released(&self) -> bool {
-        self.spin_released
+        self.ramped[0] != 0.0 || self.target[0] == 0.0
     }
 
     /// Drops everything to rest at once (fault, abort).
@@ -107,22 +108,9 @@ impl SetpointPlanner {
     }
 
     /// Advances the ramps by `dt_s`. `max_step` is the largest change per step of each axis,
-    /// `stopped` says whether each axis's estimator reads zero, `precession_established`
-    /// whether the precession axis turns under its own motor (see the type's docs).
+    /// `stopped` says whether each axis's estimator reads zero.
     #[inline(always)]
-    pub fn step(
-        &mut self,
-        dt_s: f32,
-        max_step: [f32; 2],
-        stopped: [bool; 2],
-        precession_established: bool,
-    ) -> [f32; 2] {
-        if self.ramped[0] == 0.0 {
-            self.spin_released = self.target[0] == 0.0;
-        }
-        if precession_established {
-            self.spin_released = true;
-        }
+    pub fn step(&mut self, dt_s: f32, max_step: [f32; 2], stopped: [bool; 2]) -> [f32; 2] {
         for i in 0..2 {
             let (t, r) = (self.target[i], self.ramped[i]);
             let d = t - r;
@@ -147,7 +135,8 @@ impl SetpointPlanner {
                         next = 0.0;
                     }
                 }
-                if i == 1 && !self.spin_released {
+                // The precession's ramp has stepped already this tick (`i` = 0 first).
+                if i == 1 && !self.spin_released() {
                     next = 0.0;
                 }
             }

@@ -18,8 +18,18 @@ pub fn from_rest_to_1_rad_s(
     rig: model_core::sim::PlantParams,
     seed: u32,
 ) -> [model_core::sim::StepReport; 2] {
+    from_rest_to(rig, seed, 1.0)
+}
+
+/// As [`from_rest_to_1_rad_s`], to `target_rad_s` on both axes.
+pub fn from_rest_to(
+    rig: model_core::sim::PlantParams,
+    seed: u32,
+    target_rad_s: f32,
+) -> [model_core::sim::StepReport; 2] {
     let load = [rig.axes[0].load_step_nm, rig.axes[1].load_step_nm];
-    let o = commissioned_transition(rig, ControllerConfig::nominal(), seed, 0.0, 1.0, true, load);
+    let config = ControllerConfig::nominal();
+    let o = commissioned_transition(rig, config, seed, 0.0, target_rad_s, true, load);
     assert!(o.commissioned && o.fault.is_none(), "{:?}", o.fault);
     o.reports
 }

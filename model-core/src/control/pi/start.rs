@@ -186,8 +186,28 @@ impl SpeedLoop {
                 k.dt_s,
             );
             self.integral = clamp(self.integral + step * input.direction, k.duty_limit);
+            if self.kept_kick > 0.0 {
+                self.drop_kept_kick_ahead(input.direction);
+            }
         }
         released
+    }
+
+    /// The kick kept at a first edge that came before the current confirmed the breakaway,
+    /// on a shaft then behind its model (`first_edge`): kept so that a loaded shaft does not
+    /// stick again. Once the back-EMF speed runs ahead of the model by more than the band
+    /// (it reads low if anything, by the viscous share), the shaft does not need it, and it
+    /// goes before the first measurement would take it. Held to that measurement, a heavy
+    /// rod (time constant 0.56 s) whose first tooth came 60 ms into the start ran on half a
+    /// kick of 0.09 duty to 35 % past 0.5 rad/s (seed 34 p03; docs/control.md, "The kept
+    /// kick the current shows is not needed").
+    #[cold]
+    #[inline(never)]
+    fn drop_kept_kick_ahead(&mut self, direction: f32) {
+        if self.breakaway.speed_rad_s() > (1.0 + FUSED_BAND_SHARE) * self.model_rad_s.abs() {
+            self.integral -= self.kept_kick * direction;
+            self.kept_kick = 0.0;
+        }
     }
 
     /// The back-EMF duty per rad/s the current sense learned at measured speeds
