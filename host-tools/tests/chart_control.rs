@@ -80,8 +80,11 @@ fn settling_chart_meets_the_targets_and_shows_the_pulse_rate_limit() {
         "the chart must contain points at >= 60 pulses/rev"
     );
     assert!(num(by_n(12), "worst_settling_s") <= 2.5);
-    // Where the pulse rate limits the loop: one pulse per revolution is far slower than 60.
-    assert!(num(by_n(1), "worst_settling_s") > 1.5 * num(by_n(60), "worst_settling_s"));
+    // The step from rest is the identified model's feedforward, the kick and the ramp: the
+    // spin starts with the rod (it waited for the rod's first edge, 2.11 s at one pulse a
+    // revolution against 0.85 s at 60), so even one pulse a revolution settles within 10 % of
+    // sixty (docs/control.md, "The spin starts with the rod").
+    assert!(num(by_n(1), "worst_settling_s") <= 1.1 * num(by_n(60), "worst_settling_s"));
 }
 
 #[test]

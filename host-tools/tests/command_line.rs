@@ -88,6 +88,24 @@ fn replay_of_what_is_not_a_capture_says_so_and_fails() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("empty.bin is empty"));
 }
 
+/// `--csv` naming the capture itself is refused before anything is written: the capture
+/// stays as it was (it used to be emptied, then reported empty).
+#[test]
+fn replay_never_writes_its_csv_over_the_capture() {
+    let dir = temp_dir("csv-over-capture");
+    let capture = dir.join("run.bin");
+    std::fs::write(&capture, "minutes of the lab meeting\n").unwrap();
+    let path = capture.to_str().unwrap();
+    let out = bowl(&["replay", path, "--csv", path]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("is the capture being read"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(&capture).unwrap(),
+        "minutes of the lab meeting\n"
+    );
+}
+
 /// A directory where a file is expected: the error names it (never a bare "Is a directory").
 #[test]
 fn every_file_error_names_its_file() {

@@ -30,9 +30,19 @@ fn bad_bowl_input_is_said_in_words() {
             "already touches the corner between bottom and wall",
         ),
         (
-            ["60", "0.02", "0"],
-            vec!["--particle-radius-m", "0.1"],
+            ["60", "0.08", "0"],
+            vec!["--particle-radius-m", "0.07"],
             "give a smaller --ri-m, --fillet-radius-m or --particle-radius-m",
+        ),
+        (
+            ["60", "0.02", "0"],
+            vec!["--particle-radius-m", "1"],
+            "--particle-radius-m 1 m is not smaller than the bowl's radius R = 0.075 m",
+        ),
+        (
+            ["90", "0.001", "0"],
+            vec![],
+            "--wall-height-m 0.001 m is lower than the granule's radius 0.003 m",
         ),
         (
             ["60", "0.02", "0"],

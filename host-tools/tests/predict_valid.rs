@@ -57,6 +57,45 @@ fn every_answer_says_whether_its_model_holds() {
     assert_eq!(v["releases_leaving"], 0);
 }
 
+/// The rolling model's hierarchy (`--hierarchy-tolerance`) judges its members against the
+/// rolling model, so where the granule slides its answer says so too (it named the cheapest
+/// member with no word of it); and the paper's level-bowl models refuse the tilted bowl's
+/// flags instead of answering for the default level scene.
+#[test]
+fn the_hierarchy_says_it_too_and_the_level_models_refuse_a_tilt() {
+    let w = rig_axis_speed();
+    let rig = tilted_rig("rolling", &w);
+    let v = json(&predict_args(
+        &rig,
+        &["--json", "--hierarchy-tolerance", "0.05"],
+    ));
+    assert_eq!(v["valid"], false, "{v}");
+    assert!(v["chosen"].is_string(), "{v}");
+    let out = bowl(&predict_args(&rig, &["--hierarchy-tolerance", "0.05"]));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.starts_with("NOT VALID HERE: "), "{text}");
+    for model in ["flat", "coriolis", "both"] {
+        let out = bowl(&[
+            "predict",
+            "--model",
+            model,
+            "--axes-angle-deg",
+            "60",
+            "--precession-rad-s",
+            "1.2",
+            "--spin-rad-s",
+            "1.2",
+        ]);
+        assert_eq!(out.status.code(), Some(1), "{model}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert!(
+            err.contains(&format!("--model {model} is the paper's level bowl"))
+                && err.contains("--axes-angle-deg"),
+            "{err}"
+        );
+    }
+}
+
 /// The paper's 1-D models roll the granule radially on a horizontal bowl: the contact must give
 /// `(1 - k2) m (R omega^2 - mu g)` to spin it up and `2 m omega r'` against the Coriolis force
 /// at the rim. Within `mu_s m g` (R 100 mm at 3.6 rad/s) the answer is valid; at R 300 mm it

@@ -39,10 +39,16 @@ fn settling_against_pulses_per_rev() {
             assert!(settle <= 2.5, "N {n}: {settle}");
         }
     }
-    // Where the pulse rate limits the loop: one pulse per revolution settles slowest.
+    // The step from rest is the identified model's feedforward, the kick and the ramp: since
+    // the spin starts with the rod (it waited for the rod's first edge, slowest at one pulse a
+    // revolution), even one pulse a revolution settles within 10 % of sixty
+    // (docs/control.md, "The spin starts with the rod").
     let one = data.iter().find(|d| d.0 == 1).unwrap().1;
     let sixty = data.iter().find(|d| d.0 == 60).unwrap().1;
-    assert!(one > 2.0 * sixty);
+    assert!(
+        one <= 1.1 * sixty,
+        "1 pulse/rev {one} s, 60 pulses/rev {sixty} s"
+    );
 }
 
 #[test]

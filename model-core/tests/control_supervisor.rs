@@ -177,6 +177,21 @@ fn invalid_configuration_is_refused_or_boots_faulted() {
     assert_eq!(c.state(), State::Idle);
 }
 
+/// SET of a parameter keeps the speeds asked for (the rig found it zeroed them: START then
+/// answered ok with both motors still), unless the new limits refuse them.
+#[test]
+fn set_parameters_keeps_the_speeds_asked_for() {
+    let mut c = Controller::new(ControllerConfig::nominal()).unwrap();
+    assert_eq!(c.set_motor_speeds(1.8, 2.1), Ok(()));
+    assert_eq!(c.set_parameters(ControllerConfig::nominal()), Ok(()));
+    let axes = c.status().axes;
+    assert_eq!([axes[0].target_rad_s, axes[1].target_rad_s], [1.8, 2.1]);
+    let mut slow = ControllerConfig::nominal();
+    slow.axes[1].max_speed_rad_s = 1.0;
+    assert_eq!(c.set_parameters(slow), Ok(()));
+    assert_eq!(c.status().axes[1].target_rad_s, 0.0);
+}
+
 #[test]
 fn rejected_commands_change_nothing() {
     let mut c = Controller::new(ControllerConfig::nominal()).unwrap();

@@ -213,6 +213,22 @@ pub fn run(args: &Inputs) -> Result<()> {
     if args.model == ModelChoice::Auto && whole::wanted(args) {
         return whole::run(args);
     }
+    if whole::wanted(args) {
+        // The paper's 1-D models know one combined speed on a level bowl: a tilt, the two
+        // motor speeds or a rig file would otherwise be ignored without a word (the default
+        // omega and R answered instead).
+        anyhow::bail!(
+            "--model {} is the paper's level bowl at one combined speed (--omega-rad-s, \
+             --rim-radius-m): it takes no --axes-angle-deg, --precession-rad-s, --spin-rad-s \
+             or --rig-file. Leave out --model (the chooser picks a tilted-bowl model), or \
+             give --model rolling or bowl for the tilted, precessing bowl",
+            match args.model {
+                ModelChoice::Flat => "flat",
+                ModelChoice::Coriolis => "coriolis",
+                _ => "both",
+            }
+        );
+    }
     if let (Some(input), Some(output)) = (&args.batch, &args.out) {
         return batch::run(input, output, args);
     }

@@ -98,6 +98,17 @@ pub fn run(args: &Args) -> Result<()> {
             args.file.display()
         );
     }
+    // Writing the CSV over the capture would empty it before it is read (a typo that lost
+    // the user's recording).
+    if let Some(path) = &args.csv
+        && same_file(path, &args.file)
+    {
+        bail!(
+            "--csv {} is the capture being read: it would be overwritten before it is decoded; \
+             give another file name for the CSV",
+            path.display()
+        );
+    }
     let mut csv = match &args.csv {
         Some(path) => {
             let mut w = BufWriter::new(
@@ -198,4 +209,12 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Whether `a` names the existing file `b` (the same path, or another path to it).
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
 }

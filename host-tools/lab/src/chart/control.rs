@@ -138,7 +138,7 @@ pub fn settling_chart(points: &[SettlingPoint]) -> (Figure, Table) {
     let n_min = points.iter().map(x).fold(n_max, f64::min);
     let mut series = vec![
         Series {
-            name: "spin (starts once precession runs)".into(),
+            name: "spin (starts with the precession)".into(),
             points: points.iter().map(|p| (x(p), p.settling_s[1])).collect(),
             mark: Mark::LinePoints,
             color: 0,
@@ -203,7 +203,7 @@ pub fn settling_chart(points: &[SettlingPoint]) -> (Figure, Table) {
             },
             VLine {
                 x: knee,
-                label: format!(" pulse rate no longer limits (N = {knee:.0})"),
+                label: format!(" loop bandwidth no longer pulse-limited (N = {knee:.0})"),
                 color: 2,
             },
         ],
@@ -213,14 +213,16 @@ pub fn settling_chart(points: &[SettlingPoint]) -> (Figure, Table) {
             "0.5 s); seed 1; the simulator's true speed.".into(),
             format!("Left of N = {knee:.0} the loop bandwidth is"),
             format!(
-                "{} x pulse rate at <= 2.1 rad/s (the schedule): the pulse",
+                "{} x pulse rate at <= 2.1 rad/s (the schedule);",
                 cfg.axes[1].per_pulse_bandwidth
             ),
             format!(
-                "rate limits the loop; right of it, the {} rad/s",
+                "right of it, the {} rad/s ceiling. On this step",
                 cfg.axes[1].bandwidth_rad_s
             ),
-            "ceiling, the ramp and the plant do.".into(),
+            "the identified model's feedforward, the kick".into(),
+            "and the ramp set the time: the loop corrects".into(),
+            "little, so the pulse rate barely shows.".into(),
             format!("A run lasts {STEP_RUN_S} s: a point there never settled."),
         ],
     };

@@ -5,7 +5,7 @@
 use anyhow::{Result, bail};
 use model_core::ode::system::SystemLimits;
 use model_core::particle::bowl::{self, BowlError, BowlOutcome, BowlReport, BowlShape};
-use model_core::particle::rolling::{AZIMUTHS_DEG, MAX_STEPS, RollingMethod, RollingScene};
+use model_core::particle::rolling::{MAX_STEPS, RollingMethod, RollingScene};
 use serde_json::{Value, json};
 
 use super::speed_range::{self, SpeedAxis, SpeedReport};
@@ -81,27 +81,6 @@ pub(crate) fn words(e: BowlError) -> String {
     }
 }
 
-/// `all`, one azimuth or a comma-separated list, degrees.
-pub(super) fn azimuths(text: &str) -> Result<Vec<f64>> {
-    if text.trim() == "all" {
-        return Ok(AZIMUTHS_DEG.to_vec());
-    }
-    text.split(',')
-        .map(|p| {
-            let v: f64 = p.trim().parse().map_err(|_| {
-                anyhow::anyhow!(
-                    "--release-azimuth-deg {text:?}: {p:?} is not a number of degrees (give \
-                     `all`, one number, or numbers separated by commas)"
-                )
-            })?;
-            if !v.is_finite() {
-                bail!("--release-azimuth-deg must be finite numbers of degrees, not {p:?}");
-            }
-            Ok(v)
-        })
-        .collect()
-}
-
 /// Each mode's share of the time a release spent in the bowl.
 fn regime(r: &BowlReport<f64>) -> Value {
     if r.outcome == BowlOutcome::Held {
@@ -149,7 +128,7 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
         horizon_s: b.max_time_s,
         max_steps: MAX_STEPS,
     };
-    let betas = azimuths(r.release_azimuth_deg())?;
+    let betas = rolling::azimuths(r.release_azimuth_deg())?;
     let mut rows = Vec::new();
     // A release the integrator gives up on (the step cap, e.g. a granule chattering at the
     // stick threshold in a corner, or a stall: steps that no longer advance the time, found
@@ -474,6 +453,7 @@ pub(super) fn scene_and_shape(
             bail!("{flag} must be a finite number, not {v}");
         }
     }
+    rolling::fits(&scene)?;
     let shape = BowlShape {
         wall_angle_rad: wall.angle_deg.to_radians(),
         wall_height_m: wall.height_m,
@@ -483,6 +463,19 @@ pub(super) fn scene_and_shape(
     shape
         .validate(&scene)
         .map_err(|e| anyhow::anyhow!(words(e)))?;
+    if wall.height_m > 0.0 && wall.height_m < scene.particle_radius_m {
+        // The model meets the granule on the wall's face and ends it over the lip's radius;
+        // a step lower than the granule's radius it would meet at the step's edge, which the
+        // model does not have: a 1 nm wall held every release where a bare rim let them go.
+        bail!(
+            "--wall-height-m {} m is lower than the granule's radius {} m \
+             (--particle-radius-m): the bowl model's wall meets the granule on its face, not \
+             at the lip's edge, so it does not hold for a step that low; give 0 (a bare rim) or \
+             a wall at least the granule's radius high",
+            wall.height_m,
+            scene.particle_radius_m
+        );
+    }
     Ok(BowlSetup {
         scene,
         th_deg,

@@ -88,8 +88,25 @@ impl RollingInputs {
             rim_radius_m: args.rim_radius_m,
         };
         scene.validate().map_err(|e| anyhow::anyhow!(words(e)))?;
+        fits(&scene)?;
         Ok((scene, th_deg))
     }
+}
+
+/// The granule fits the bowl: its radius below the bottom's (the model puts its centre on the
+/// bottom at the release radius; a 1 m granule in a 75 mm bowl was answered as valid, a 1e9 m
+/// one ran for minutes and gave up).
+pub fn fits(scene: &RollingScene<f64>) -> Result<()> {
+    if scene.particle_radius_m >= scene.rim_radius_m {
+        bail!(
+            "--particle-radius-m {} m is not smaller than the bowl's radius R = {} m \
+             (--rim-radius-m): a granule that size does not fit the bowl; give the granule's \
+             radius (0.003 m for a 6 mm sago pearl)",
+            scene.particle_radius_m,
+            scene.rim_radius_m
+        );
+    }
+    Ok(())
 }
 
 pub fn words(e: RollingError) -> String {
@@ -231,6 +248,7 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
         rim_radius_m: args.rim_radius_m,
     };
     scene.validate().map_err(|e| anyhow::anyhow!(words(e)))?;
+    fits(&scene)?;
     let head = format!(
         "rolling model: w1 {w1} rad/s, w2 {w2} rad/s, tilt {th_deg} deg (combined {:.4} rad/s), \
          mu_r {}, a {} m, L {} m, ri {} m, R {} m",
@@ -368,6 +386,17 @@ fn hierarchy(
         .map(|(&m, diff)| (m, mean_residence_s(m, scene, method), diff))
         .collect();
     let (chosen, diff) = cheapest_within(scene, tol, method, wanted);
+    // Every member is judged against the rolling model: where that does not hold (the granule
+    // slides or lifts off), neither does the member chosen, and the answer says so first.
+    let sum =
+        rolling::residence_over_azimuths(scene, method).map_err(|e| anyhow::anyhow!(words(e)))?;
+    let validity = validity::rolling(
+        sum.slid,
+        sum.lifted,
+        AZIMUTHS_DEG.len() as u32,
+        sum.max_friction_ratio,
+        scene.sliding_friction,
+    );
     if json_out {
         let members: Vec<_> = rows
             .iter()
@@ -375,15 +404,17 @@ fn hierarchy(
                 json!({"member": m.name(), "residence_time_mean_s": t, "difference_from_rolling": d})
             })
             .collect();
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&json!({
-                "model": "rolling", "tolerance": tol, "members": members,
-                "judged_on": if wanted == Wanted::EachRelease { "each release" } else { "azimuth mean" },
-                "chosen": chosen.name(), "chosen_difference": diff,
-            }))?
-        );
+        let mut v = json!({
+            "model": "rolling", "tolerance": tol, "members": members,
+            "judged_on": if wanted == Wanted::EachRelease { "each release" } else { "azimuth mean" },
+            "chosen": chosen.name(), "chosen_difference": diff,
+        });
+        validity.add_to(&mut v);
+        println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
+    }
+    if let Some(line) = validity.text_line() {
+        println!("{line}");
     }
     println!("{head}");
     println!(
@@ -405,4 +436,25 @@ fn hierarchy(
         ))
     );
     Ok(())
+}
+
+/// `all`, one azimuth or a comma-separated list, degrees.
+pub(super) fn azimuths(text: &str) -> Result<Vec<f64>> {
+    if text.trim() == "all" {
+        return Ok(AZIMUTHS_DEG.to_vec());
+    }
+    text.split(',')
+        .map(|p| {
+            let v: f64 = p.trim().parse().map_err(|_| {
+                anyhow::anyhow!(
+                    "--release-azimuth-deg {text:?}: {p:?} is not a number of degrees (give \
+                     `all`, one number, or numbers separated by commas)"
+                )
+            })?;
+            if !v.is_finite() {
+                bail!("--release-azimuth-deg must be finite numbers of degrees, not {p:?}");
+            }
+            Ok(v)
+        })
+        .collect()
 }

@@ -324,7 +324,7 @@ pub fn run(args: &Inputs) -> Result<()> {
     if !(tolerance.is_finite() && tolerance > 0.0) {
         anyhow::bail!("--tolerance must be a positive number (0.01 = 1 %), not {tolerance}");
     }
-    let betas = super::bowl::azimuths(args.rolling.release_azimuth_deg())?;
+    let betas = super::rolling::azimuths(args.rolling.release_azimuth_deg())?;
     // The incline's bounds hold for the mean over the twelve azimuths only: releases picked by
     // hand are single releases (the rotation turns each path; at 60 deg, 2 rad/s the incline
     // corrected for the mean gave a release at 30 deg its own second-order time, unbounded).

@@ -202,9 +202,16 @@ impl Controller {
             }
             cfg.validate().map_err(Rejection::InvalidConfig)?;
             let (state, fault) = (c.state, c.fault);
+            let targets = c.planner.targets();
             c.rebuild_keep_state(cfg);
             c.state = state;
             c.fault = fault;
+            // The speeds asked for (SPEED or RTIME) stay asked for, where the new limits allow
+            // them: rebuilt from scratch they were zeroed without a word, and the next START
+            // answered ok with both motors still.
+            if c.check_speed(0, targets[0]).is_ok() && c.check_speed(1, targets[1]).is_ok() {
+                c.planner.set_targets(targets);
+            }
             Ok(())
         })
     }
