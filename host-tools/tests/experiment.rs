@@ -121,3 +121,77 @@ fn an_experiment_over_a_port_times_granules_by_the_rigs_gate_events() {
     let text = common::stdout(&again);
     assert!(text.contains("still has its granule in the bowl"), "{text}");
 }
+
+/// `--suggest` refuses, with exit 1 and in words, the values that printed a NaN speed, a
+/// `D = NaN` or `inf`, or a plan `bowl experiment` itself refuses; nothing goes to stdout then.
+#[test]
+fn suggest_refuses_bad_values_in_words_with_a_failing_exit() {
+    let dir = temp_dir("experiment-suggest");
+    let rig = rig_with_particle(&dir, "");
+    let rig = rig.to_str().unwrap();
+    let cases: [(&str, &str, &str); 8] = [
+        (
+            "--mu-guess",
+            "nan",
+            "--mu-guess NaN: the guessed rolling resistance must be a number above 0 and at most 1",
+        ),
+        (
+            "--mu-guess",
+            "0",
+            "--mu-guess 0: the guessed rolling resistance must be",
+        ),
+        (
+            "--mu-guess",
+            "-1",
+            "--mu-guess -1: the guessed rolling resistance must be",
+        ),
+        (
+            "--mu-guess",
+            "1e9",
+            "--mu-guess 1000000000: the guessed rolling resistance must be",
+        ),
+        (
+            "--conditions",
+            "0",
+            "--conditions 0: a suggested plan holds 1 to 40 conditions",
+        ),
+        (
+            "--conditions",
+            "1000",
+            "--conditions 1000: a suggested plan holds 1 to 40 conditions",
+        ),
+        (
+            "--repeats",
+            "0",
+            "--repeats 0: releases per condition must lie in 1 to 10000",
+        ),
+        (
+            "--repeats",
+            "100000",
+            "--repeats 100000: releases per condition must lie in 1 to 10000",
+        ),
+    ];
+    for (flag, value, words) in cases {
+        let out = bowl(&["experiment", "--suggest", "--rig-file", rig, flag, value]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{flag} {value}: {err}");
+        assert!(err.contains(words), "{flag} {value}: {err}");
+        assert!(
+            out.stdout.is_empty(),
+            "{flag} {value}: {}",
+            common::stdout(&out)
+        );
+        assert!(!err.contains("panicked"), "{flag} {value}: {err}");
+    }
+    // The defaults still suggest a plan that `bowl experiment` reads.
+    let out = bowl(&["experiment", "--suggest", "--rig-file", rig]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = common::stdout(&out);
+    assert_eq!(text.matches("[[condition]]").count(), 4, "{text}");
+    assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

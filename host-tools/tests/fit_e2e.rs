@@ -187,3 +187,92 @@ fn impossible_times_are_refused_with_their_lines() {
     }
     let _ = std::fs::remove_dir_all(path.parent().unwrap());
 }
+
+/// `text` (a results or trace file as `bowl experiment` writes it) as a spreadsheet in a
+/// comma-decimal locale saves it: a `sep=;` first line, `;` between cells, decimal commas,
+/// headers uppercase and padded, cells with trailing spaces.
+fn as_semicolon_sheet(text: &str) -> String {
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(|h| format!(" {} ", h.to_uppercase()))
+        .collect();
+    let mut out = format!("sep=;\n{}\n", header.join(";"));
+    for line in lines {
+        let cells: Vec<String> = line
+            .split(',')
+            .map(|c| match c.parse::<f64>() {
+                Ok(_) => format!("{} ", c.replace('.', ",")),
+                Err(_) => format!("{c} "),
+            })
+            .collect();
+        out.push_str(&cells.join(";"));
+        out.push('\n');
+    }
+    out
+}
+
+/// The fitted Coriolis mu of a run of `bowl fit --json`.
+fn coriolis_mu(path: &Path) -> f64 {
+    let v = success_json(&fit(path, true), "bowl fit --json");
+    assert_eq!(v["runs"], 6, "{v}");
+    assert_eq!(v["excluded"], serde_json::json!([]), "{v}");
+    v["models"]["coriolis"]["mu"].as_f64().unwrap()
+}
+
+#[test]
+fn a_spreadsheets_files_fit_like_the_original() {
+    let path = results("fit-sheet", &[]);
+    let dir = path.parent().unwrap();
+    let original = std::fs::read_to_string(&path).unwrap();
+    let mu = coriolis_mu(&path);
+    // `;`-separated with decimal commas, its traces too, and an emptied row after the second.
+    let mut sheet = as_semicolon_sheet(&original);
+    let at = sheet.match_indices('\n').nth(3).unwrap().0 + 1;
+    sheet.insert_str(at, ";;;;;;;;;;;;;\n");
+    for run in 1..=RELEASES.len() {
+        let trace = dir.join(format!("results_traces/run_{run:04}.csv"));
+        let text = std::fs::read_to_string(&trace).unwrap();
+        std::fs::write(&trace, as_semicolon_sheet(&text)).unwrap();
+    }
+    let semicolon = dir.join("semicolon.csv");
+    std::fs::write(&semicolon, &sheet).unwrap();
+    assert_eq!(coriolis_mu(&semicolon), mu);
+    // Comma-separated, the header uppercase and padded, an emptied row, trailing spaces.
+    let mut lines: Vec<String> = original.lines().map(|l| format!("{l} ")).collect();
+    lines[0] = lines[0]
+        .split(',')
+        .map(|h| format!(" {} ", h.trim().to_uppercase()))
+        .collect::<Vec<_>>()
+        .join(",");
+    lines.insert(3, ",,,,,,,,,,,,,".into());
+    let comma = dir.join("comma.csv");
+    std::fs::write(&comma, lines.join("\n") + "\n").unwrap();
+    assert_eq!(coriolis_mu(&comma), mu);
+    // A decimal comma in a comma-separated file: refused with its one line and its column.
+    // Line 6 (header, two rows, the emptied row, a row): its time written as "1,07" would be.
+    let column = original.lines().next().unwrap().split(',');
+    let column = column.into_iter().position(|h| h == "residence_s").unwrap();
+    let mut cells: Vec<String> = lines[5].split(',').map(str::to_string).collect();
+    let decimal_comma = format!("{:.2}", cells[column].parse::<f64>().unwrap()).replace('.', ",");
+    cells[column] = format!("\"{decimal_comma}\"");
+    lines[5] = cells.join(",");
+    std::fs::write(&comma, lines.join("\n") + "\n").unwrap();
+    let out = fit(&comma, false);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(&format!(
+            "comma.csv, line 6, column residence_s: \"{decimal_comma}\" is not a number (use a \
+             decimal point, or a ;-separated file)"
+        )),
+        "{err}"
+    );
+    assert!(
+        !err.contains("deserialize") && !err.contains("record"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}

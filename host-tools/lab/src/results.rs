@@ -8,6 +8,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
+mod sheet;
+use sheet::Sheet;
+
 /// How a release ended.
 pub const STATUS_OK: &str = "ok";
 /// The granule was still in the bowl when the run gave up.
@@ -84,7 +87,7 @@ impl Writer {
     /// Writes the trace of run `run`, returns its path relative to the results file.
     pub fn write_trace(&self, run: usize, trace: &[(f64, f64)]) -> Result<String> {
         let rel = self.trace_dir.join(format!("run_{run:04}.csv"));
-        let mut text = String::from("t_s,bowl_rad_s\n");
+        let mut text = format!("{}\n", TRACE_COLUMNS.join(","));
         for (t, w) in trace {
             text.push_str(&format!("{t:.4},{w:.6}\n"));
         }
@@ -101,7 +104,26 @@ impl Writer {
     }
 }
 
-/// Reads a results file: the rows with their line numbers (header = line 1).
+/// The columns every results row has (`release_azimuth_deg` may be absent: older files).
+const COLUMNS: [&str; 14] = [
+    "run",
+    "condition",
+    "bowl_rad_s",
+    "precession_rad_s",
+    "spin_rad_s",
+    "release_radius_m",
+    "rim_radius_m",
+    "k2",
+    "status",
+    "residence_s",
+    "trace_mean_rad_s",
+    "trace_sd_rad_s",
+    "trace_path",
+    "release_azimuth_deg",
+];
+
+/// Reads a results file: the rows with their line numbers (as the file numbers its lines,
+/// header included). The file may have passed through a spreadsheet ([`sheet`]).
 pub fn read(path: &Path) -> Result<Vec<(usize, Row)>> {
     // A directory opens like a file on Unix and reads as empty: said, with its name.
     if path.is_dir() {
@@ -110,36 +132,55 @@ pub fn read(path: &Path) -> Result<Vec<(usize, Row)>> {
             path.display()
         );
     }
-    let mut reader = csv::Reader::from_path(path)
-        .with_context(|| format!("cannot read the results file {}", path.display()))?;
+    let what = "a results file of bowl experiment";
+    let table = Sheet::read(path, what)?;
+    table.require(&COLUMNS[..COLUMNS.len() - 1], what)?;
     let mut rows = Vec::new();
-    for (i, rec) in reader.deserialize::<Row>().enumerate() {
-        let line = i + 2;
-        let row = rec.with_context(|| {
-            format!(
-                "{} line {line}: not a results row of bowl experiment (columns run, condition, \
-                 bowl_rad_s, ..., trace_path)",
-                path.display()
-            )
-        })?;
-        rows.push((line, row));
+    for cells in table.rows() {
+        let c = cells?;
+        let row = Row {
+            run: c.whole("run")?,
+            condition: c.whole("condition")?,
+            bowl_rad_s: c.number("bowl_rad_s")?,
+            precession_rad_s: c.number("precession_rad_s")?,
+            spin_rad_s: c.number("spin_rad_s")?,
+            release_radius_m: c.number("release_radius_m")?,
+            rim_radius_m: c.number("rim_radius_m")?,
+            k2: c.number("k2")?,
+            status: c.needed("status")?.to_string(),
+            residence_s: c.number_or_empty("residence_s")?,
+            trace_mean_rad_s: c.number_or_empty("trace_mean_rad_s")?,
+            trace_sd_rad_s: c.number_or_empty("trace_sd_rad_s")?,
+            trace_path: c.text("trace_path").to_string(),
+            release_azimuth_deg: c.number_or_empty("release_azimuth_deg")?,
+        };
+        rows.push((c.line, row));
     }
     Ok(rows)
 }
 
-/// Reads a trace file (`t_s,bowl_rad_s`).
+/// Reads a trace file (columns `t_s` and `bowl_rad_s`, in any case and order), with
+/// the results file's reader.
 pub fn read_trace(path: &Path) -> Result<Vec<(f64, f64)>> {
-    let what = || format!("cannot read the speed trace {}", path.display());
     if path.is_dir() {
-        anyhow::bail!("{}: it is a directory", what());
+        anyhow::bail!(
+            "cannot read the speed trace {}: it is a directory",
+            path.display()
+        );
     }
-    let mut reader = csv::Reader::from_path(path).with_context(what)?;
+    let table = Sheet::read(path, "the speed trace")?;
+    let [t, w] = TRACE_COLUMNS;
+    table.require(&TRACE_COLUMNS, "a speed trace")?;
     let mut out = Vec::new();
-    for rec in reader.deserialize::<(f64, f64)>() {
-        out.push(rec.with_context(what)?);
+    for cells in table.rows() {
+        let c = cells?;
+        out.push((c.number(t)?, c.number(w)?));
     }
     Ok(out)
 }
+
+/// The columns of a speed trace, as [`Writer::write_trace`] names them.
+const TRACE_COLUMNS: [&str; 2] = ["t_s", "bowl_rad_s"];
 
 /// Mean and standard deviation of the speeds of a trace.
 pub fn mean_sd(trace: &[(f64, f64)]) -> Option<(f64, f64)> {

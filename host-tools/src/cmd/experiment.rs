@@ -34,13 +34,13 @@ pub struct Args {
     /// Print a suggested plan instead of running one.
     #[arg(long)]
     pub suggest: bool,
-    /// With --suggest: the guessed mu the plan is designed for.
+    /// With --suggest: the guessed mu the plan is designed for (above 0, at most 1).
     #[arg(long, default_value_t = 0.029)]
     pub mu_guess: f64,
-    /// With --suggest: number of conditions.
+    /// With --suggest: number of conditions (1 to 40).
     #[arg(long, default_value_t = 4)]
     pub conditions: usize,
-    /// With --suggest: releases per condition.
+    /// With --suggest: releases per condition (1 to 10000).
     #[arg(long, default_value_t = 10)]
     pub repeats: usize,
     /// Run the plan on this many simulated rigs (seeds 1..=N), fit each, and report the
@@ -113,7 +113,7 @@ pub fn run(args: &Args) -> Result<()> {
                 max_bowl,
                 args.conditions,
                 args.repeats
-            )
+            )?
         );
         return Ok(());
     }

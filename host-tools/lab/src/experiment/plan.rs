@@ -29,6 +29,10 @@ pub struct Plan {
     pub condition: Vec<Condition>,
 }
 
+/// Releases a condition may ask for: at least one, and a bound on a run that would take days
+/// (`bowl experiment --suggest` checks its `--repeats` against the same range).
+pub const REPEATS: std::ops::RangeInclusive<usize> = 1..=10_000;
+
 fn default_settle() -> f64 {
     3.0
 }
@@ -55,10 +59,12 @@ pub fn parse(text: &str, file: &str) -> Result<Plan> {
                  and spin_rad_s, finite"
             ),
         }
-        if !(1..=10_000).contains(&c.repeats) {
+        if !REPEATS.contains(&c.repeats) {
             bail!(
-                "{file}: condition {n} repeats = {} must lie in 1 ..= 10000",
-                c.repeats
+                "{file}: condition {n} repeats = {} must lie in {} ..= {}",
+                c.repeats,
+                REPEATS.start(),
+                REPEATS.end()
             );
         }
     }

@@ -188,7 +188,7 @@ fn suggested_plan_leaves_and_separates() {
         gate_jitter_s: 0.002,
         ..ParticleParams::default()
     };
-    let text = crate::experiment::suggest::plan_text(&p, 0.03, 6.5, 4, 10);
+    let text = crate::experiment::suggest::plan_text(&p, 0.03, 6.5, 4, 10).unwrap();
     let plan = plan::parse(&text, "suggested").unwrap();
     assert_eq!(plan.condition.len(), 4);
     let speeds: Vec<f64> = plan
@@ -205,4 +205,56 @@ fn suggested_plan_leaves_and_separates() {
     let d = crate::experiment::suggest::separation(&p, 0.03, &speeds, 10, 0.002);
     assert!(text.contains(&format!("D = {d:.1}")), "{text}");
     assert!(d > 6.0, "{d}");
+}
+
+/// `--suggest` refuses, in words naming the value and the range, every input that would print a
+/// plan `bowl experiment` refuses or a non-finite number (NaN speeds, `D = NaN` or `inf`).
+#[test]
+fn suggest_refuses_what_the_plan_reader_or_the_arithmetic_would() {
+    let p = ParticleParams {
+        mu: 0.03,
+        gate_jitter_s: 0.002,
+        ..ParticleParams::default()
+    };
+    let refusal = |mu: f64, conditions: usize, repeats: usize| {
+        crate::experiment::suggest::plan_text(&p, mu, 6.5, conditions, repeats)
+            .unwrap_err()
+            .to_string()
+    };
+    for mu in [f64::NAN, 0.0, -1.0, f64::INFINITY, 1e9] {
+        let e = refusal(mu, 4, 10);
+        assert!(e.contains(&format!("--mu-guess {mu}:")), "{e}");
+        assert!(e.contains("above 0 and at most 1"), "{e}");
+    }
+    // Within the rig file's range but too rough for the rig's motors to make the granule leave.
+    let e = refusal(0.9, 4, 10);
+    assert!(
+        e.contains("beyond the rig's fastest bowl speed (6.500 rad/s"),
+        "{e}"
+    );
+    assert!(e.contains("give a mu guess below"), "{e}");
+    for n in [0, 41, 1000] {
+        let e = refusal(0.03, n, 10);
+        assert!(
+            e.contains(&format!("--conditions {n}: a suggested plan holds 1 to 40")),
+            "{e}"
+        );
+    }
+    for n in [0, 10_001, 100_000] {
+        let e = refusal(0.03, 4, n);
+        assert!(
+            e.contains(&format!(
+                "--repeats {n}: releases per condition must lie in 1 to 10000"
+            )),
+            "{e}"
+        );
+    }
+    // The edges are accepted and read back by the plan reader.
+    for (conditions, repeats) in [(1, 1), (40, 10_000)] {
+        let text =
+            crate::experiment::suggest::plan_text(&p, 0.03, 6.5, conditions, repeats).unwrap();
+        let plan = plan::parse(&text, "suggested").unwrap();
+        assert_eq!(plan.condition.len(), conditions, "{text}");
+        assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
+    }
 }
