@@ -287,15 +287,7 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
         return hierarchy(&scene, method, tol, wanted, args.json, &head);
     }
     if r.release_azimuth_deg.trim() == "all" {
-        let sum = rolling::residence_over_azimuths(&scene, method)
-            .map_err(|e| anyhow::anyhow!(words(e)))?;
-        let validity = validity::rolling(
-            sum.slid,
-            sum.lifted,
-            AZIMUTHS_DEG.len() as u32,
-            sum.max_friction_ratio,
-            r.sliding_mu,
-        );
+        let (sum, validity) = over_azimuths(&scene, method)?;
         if args.json {
             let mut v = json!({
                 "model": "rolling", "release_azimuths_deg": AZIMUTHS_DEG,
@@ -363,6 +355,24 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
     Ok(())
 }
 
+/// The rolling model over the twelve release azimuths, and whether it holds there (the
+/// granule slides or lifts off on the way).
+fn over_azimuths(
+    scene: &RollingScene<f64>,
+    method: RollingMethod<f64>,
+) -> Result<(rolling::AzimuthSummary<f64>, validity::Validity)> {
+    let sum =
+        rolling::residence_over_azimuths(scene, method).map_err(|e| anyhow::anyhow!(words(e)))?;
+    let validity = validity::rolling(
+        sum.slid,
+        sum.lifted,
+        AZIMUTHS_DEG.len() as u32,
+        sum.max_friction_ratio,
+        scene.sliding_friction,
+    );
+    Ok((sum, validity))
+}
+
 /// `--hierarchy-tolerance`: each member's mean residence time and difference from the full
 /// model, and the cheapest member within the tolerance.
 fn hierarchy(
@@ -388,15 +398,7 @@ fn hierarchy(
     let (chosen, diff) = cheapest_within(scene, tol, method, wanted);
     // Every member is judged against the rolling model: where that does not hold (the granule
     // slides or lifts off), neither does the member chosen, and the answer says so first.
-    let sum =
-        rolling::residence_over_azimuths(scene, method).map_err(|e| anyhow::anyhow!(words(e)))?;
-    let validity = validity::rolling(
-        sum.slid,
-        sum.lifted,
-        AZIMUTHS_DEG.len() as u32,
-        sum.max_friction_ratio,
-        scene.sliding_friction,
-    );
+    let (_, validity) = over_azimuths(scene, method)?;
     if json_out {
         let members: Vec<_> = rows
             .iter()
