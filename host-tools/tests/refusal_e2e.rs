@@ -116,3 +116,47 @@ fn infeasible_residence_time_gives_the_range_the_rig_accepts() {
         assert_eq!(code, if accepted { 0 } else { 1 }, "{t} s: {text}");
     }
 }
+
+/// A SET inside the parameter's own range is taken unless it breaks a rule tying it to another
+/// parameter, and then the refusal names that rule with both values. The rig is the check:
+/// every controller parameter is taken at both ends of its documented range (a QA pass found
+/// SPEED_MAX 200, ACCEL 1..9 and DUTY_MAX 500 inside the range yet refused, with a text about
+/// the start radius), and a start radius at the rim is refused with the rim's value.
+#[test]
+fn set_inside_its_range_is_taken_or_refused_with_the_rule_it_breaks() {
+    let sim = Sim::start(&[]);
+    let defaults = default_params();
+    for id in [
+        ParamId::SpeedMax1MradS,
+        ParamId::SpeedMax2MradS,
+        ParamId::Accel1MradS2,
+        ParamId::Accel2MradS2,
+        ParamId::DutyMax1Bp,
+        ParamId::DutyMax2Bp,
+        ParamId::Bandwidth1MradS,
+        ParamId::PerPulse2Milli,
+        ParamId::Teeth1,
+    ] {
+        let (lo, hi) = id.range();
+        for value in [lo, hi, defaults[id.index()]] {
+            let (code, text) = send(&sim.path, &format!("set {} {value}", id.token()));
+            assert_eq!(code, 0, "{} {value}: {text}", id.token());
+        }
+    }
+    // The rig's own rim (the virtual rig's bowl, not the table's default).
+    let (_, params) = send(&sim.path, "params");
+    let rim: i32 = params
+        .split_whitespace()
+        .find_map(|kv| kv.strip_prefix("RIM_UM="))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no RIM_UM in {params}"));
+    let (code, text) = send(&sim.path, &format!("set START_UM {rim}"));
+    assert_eq!(code, 1, "{text}");
+    assert!(
+        text.contains(&format!(
+            "the granule's start radius START_UM = {rim} um must lie inside the rim RIM_UM = \
+             {rim} um"
+        )),
+        "{text}"
+    );
+}

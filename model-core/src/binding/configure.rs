@@ -146,16 +146,20 @@ pub fn scene_from_params<R: Real>(params: &ParamValues) -> Result<Scene<R>, Reas
 }
 
 fn apply_axis(a: &mut AxisConfig, setting: AxisSetting, value: i32) -> Result<(), Reason> {
+    // Divided, not multiplied by 1e-3: the quotient is the f32 nearest the decimal, the same
+    // as the controller's limit literals, so a range's end (10 mrad/s^2 = 0.01, 500 bp =
+    // 0.05) passes the controller's check instead of falling a rounding short of it.
     let x = value as f32;
+    let milli = x / 1000.0;
     match setting {
-        AxisSetting::Bandwidth => a.bandwidth_rad_s = x * 1e-3,
-        AxisSetting::PerPulseBandwidth => a.per_pulse_bandwidth = x * 1e-3,
+        AxisSetting::Bandwidth => a.bandwidth_rad_s = milli,
+        AxisSetting::PerPulseBandwidth => a.per_pulse_bandwidth = milli,
         AxisSetting::MaxSpeed => {
-            a.max_speed_rad_s = x * 1e-3;
+            a.max_speed_rad_s = milli;
             a.overspeed_rad_s = a.max_speed_rad_s * OVERSPEED_PER_MAX;
         }
-        AxisSetting::AccelLimit => a.accel_limit_rad_s2 = x * 1e-3,
-        AxisSetting::DutyLimit => a.duty_limit = x * 1e-4,
+        AxisSetting::AccelLimit => a.accel_limit_rad_s2 = milli,
+        AxisSetting::DutyLimit => a.duty_limit = x / 10_000.0,
         AxisSetting::PulsesPerRev => {
             a.pulses_per_rev = u16::try_from(value).map_err(|_| Reason::Range)?
         }
@@ -342,5 +346,37 @@ mod tests {
         p[ParamId::StartUm.index()] = 0;
         p[ParamId::K2Ppm.index()] = 0;
         assert_eq!(scene_from_params::<f32>(&p), Err(Reason::Range));
+    }
+
+    /// The wire range of every controller parameter is what the controller accepts: both ends
+    /// of each range pass (with the others at their defaults), and the speed limit's lower
+    /// end is tight (one step below it the controller refuses). A QA pass found SPEED_MAX 200,
+    /// ACCEL 1..9 and DUTY_MAX 500 inside their wire ranges yet refused, with no limit to show.
+    #[test]
+    fn every_controller_parameters_wire_range_is_what_the_controller_accepts() {
+        let cfg = ControllerConfig::nominal();
+        for id in ParamId::ALL {
+            if matches!(
+                ParamRole::of(id),
+                ParamRole::Scene | ParamRole::TelemetryRate | ParamRole::ResidenceTable
+            ) {
+                continue;
+            }
+            let (lo, hi) = id.range();
+            for value in [lo, hi] {
+                let mut p = default_params();
+                p[id.index()] = value;
+                assert!(
+                    config_from_params(&cfg, &p).is_ok(),
+                    "{} = {value} is inside its wire range but refused",
+                    id.token()
+                );
+            }
+        }
+        for id in [ParamId::SpeedMax1MradS, ParamId::SpeedMax2MradS] {
+            let mut p = default_params();
+            p[id.index()] = id.range().0 - 1;
+            assert_eq!(config_from_params(&cfg, &p), Err(Reason::Range));
+        }
     }
 }

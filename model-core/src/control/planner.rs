@@ -98,7 +98,7 @@ impl SetpointPlanner {
 
     /// True once the spin axis may ramp: the precession axis has started, or is not asked to
     /// turn (see the type's docs).
-    pub fn spin_released(&self) -> bool {
+    fn spin_released(&self) -> bool {
         self.ramped[0] != 0.0 || self.target[0] == 0.0
     }
 

@@ -166,10 +166,11 @@ const fn int(min: i64, max: i64) -> FieldKind {
     }
 }
 
-/// A speed field: 0 (stopped) up to the axis's `SPEED_MAX`, which is at most `i16::MAX`.
+/// A speed field: 0 (stopped) up to the axis's `SPEED_MAX`, which is at most `i16::MAX`
+/// (the limit's own range starts above the lowest speed; a speed of 0 is a stop).
 const fn speed(limit: ParamId) -> FieldKind {
     FieldKind::Int {
-        min: limit.range().0 as i64,
+        min: 0,
         max: limit.range().1 as i64,
         limit: Some(limit),
     }

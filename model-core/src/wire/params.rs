@@ -93,18 +93,20 @@ parameter_table! {
     PerPulse1Milli: "PER_PULSE1_MILLI", "1/1000", range (10, 10_000), default 500;
     /// Spin loop bandwidth per pulse rate.
     PerPulse2Milli: "PER_PULSE2_MILLI", "1/1000", range (10, 10_000), default 500;
-    /// Precession speed limit (setpoints above it are rejected).
-    SpeedMax1MradS: "SPEED_MAX1_MRAD_S", "mrad/s", range (0, i16::MAX as i32), default 4_000;
-    /// Spin speed limit.
-    SpeedMax2MradS: "SPEED_MAX2_MRAD_S", "mrad/s", range (0, i16::MAX as i32), default 4_000;
-    /// Precession setpoint ramp rate.
-    Accel1MradS2: "ACCEL1_MRAD_S2", "mrad/s^2", range (1, 1_000_000), default 6_000;
+    /// Precession speed limit (setpoints above it are rejected). It must lie above the
+    /// lowest speed the controller drives (0.2 rad/s, the nominal `min_speed_rad_s`): the
+    /// range says so, rather than a refusal that only the controller could explain.
+    SpeedMax1MradS: "SPEED_MAX1_MRAD_S", "mrad/s", range (201, i16::MAX as i32), default 4_000;
+    /// Spin speed limit (above 0.2 rad/s, as the precession's).
+    SpeedMax2MradS: "SPEED_MAX2_MRAD_S", "mrad/s", range (201, i16::MAX as i32), default 4_000;
+    /// Precession setpoint ramp rate (the controller's own limits: 0.01..=1000 rad/s^2).
+    Accel1MradS2: "ACCEL1_MRAD_S2", "mrad/s^2", range (10, 1_000_000), default 6_000;
     /// Spin setpoint ramp rate.
-    Accel2MradS2: "ACCEL2_MRAD_S2", "mrad/s^2", range (1, 1_000_000), default 6_000;
-    /// Precession PWM duty limit.
-    DutyMax1Bp: "DUTY_MAX1_BP", "bp", range (0, DUTY_MAX_BP as i32), default 9_500;
+    Accel2MradS2: "ACCEL2_MRAD_S2", "mrad/s^2", range (10, 1_000_000), default 6_000;
+    /// Precession PWM duty limit (the controller's own limits: 0.05..=1).
+    DutyMax1Bp: "DUTY_MAX1_BP", "bp", range (500, DUTY_MAX_BP as i32), default 9_500;
     /// Spin PWM duty limit.
-    DutyMax2Bp: "DUTY_MAX2_BP", "bp", range (0, DUTY_MAX_BP as i32), default 9_500;
+    DutyMax2Bp: "DUTY_MAX2_BP", "bp", range (500, DUTY_MAX_BP as i32), default 9_500;
     /// Target-wheel teeth (pulses per revolution) on the precession sensor.
     Teeth1: "TEETH1", "pulses/rev", range (1, 255), default 12;
     /// Target-wheel teeth on the spin sensor.

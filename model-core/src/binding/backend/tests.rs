@@ -71,7 +71,7 @@ fn rejected_parameter_changes_nothing() {
             reason: Reason::Range
         }
     );
-    // A duty limit the controller's validation refuses (inside the wire range).
+    // A duty limit below its wire range (the range is what the controller accepts).
     let f = command(&mut s, "C1,6,SET,DUTY_MAX1_BP,0");
     assert_eq!(
         f,
