@@ -101,6 +101,67 @@ fn every_intact_command_counts_as_host_presence() {
     assert_eq!(rig.heartbeats, 7, "a damaged line is not the host");
 }
 
+/// A line typed at a plain console (picocom, tio: words, spaces, Enter; no `$`, id or CRC) is
+/// answered with the frame a `$` command gets, id 0, and counts as the host being there. It is
+/// carried out each time it is typed (no ids, no copies), a typo is refused with the frame's
+/// reason, and what a damaged frame leaves (commas, `*`) gets no answer at all.
+#[test]
+fn a_line_typed_at_a_console_is_answered_like_a_frame() {
+    let (mut rig, mut d) = rig_and_device();
+    let got = answers(&mut d, &mut rig, b"status\r");
+    assert!(
+        matches!(got.as_slice(), [Frame::Status { id: 0, .. }]),
+        "{got:?}"
+    );
+    let got = answers(
+        &mut d,
+        &mut rig,
+        b"speed 1800 2100\r\nstart\r\nspeed 1000 1000\rspeed 1800 2100\r",
+    );
+    assert_eq!(got, vec![Frame::Ack { id: 0 }; 4]);
+    assert_eq!(
+        rig.calls,
+        [
+            "speeds 1800 2100",
+            "start",
+            "speeds 1000 1000",
+            "speeds 1800 2100"
+        ]
+    );
+    assert_eq!(rig.heartbeats, 5);
+    let got = answers(&mut d, &mut rig, b"speed 1800 9000\rstatsu\r");
+    assert_eq!(
+        got,
+        [
+            Frame::Reject {
+                id: 0,
+                reason: Reason::Range
+            },
+            Frame::Reject {
+                id: 0,
+                reason: Reason::UnknownCommand
+            }
+        ]
+    );
+    // A frame that lost its `$` gets no answer; typing cut by a frame is dropped, and what
+    // follows the frame is a line of its own (`rt`, not `start`).
+    let mut input = b"C1,9,START*00000000\r\nsta".to_vec();
+    input.extend(line("C1,10,PING"));
+    input.extend(b"rt\r");
+    let got = answers(&mut d, &mut rig, &input);
+    assert_eq!(
+        got,
+        [
+            Frame::Ack { id: 10 },
+            Frame::Reject {
+                id: 0,
+                reason: Reason::UnknownCommand
+            }
+        ]
+    );
+    assert_eq!(rig.calls.len(), 4, "{:?}", rig.calls);
+}
+
 fn answers(device: &mut Device, rig: &mut Recorder, input: &[u8]) -> Vec<Frame> {
     let mut out = Vec::new();
     device.receive(rig, input, |bytes| out.push(decode_frame(bytes).unwrap()));

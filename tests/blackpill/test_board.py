@@ -24,6 +24,7 @@ from checks import WORK, check, fill_parameter_region, fresh_flash, mean_speed, 
 from test_gates import *  # noqa: E402,F401,F403  (the gate tests join this run)
 from test_power_on import *  # noqa: E402,F401,F403  (the first-power-on tests join this run)
 from test_power_stage import *  # noqa: E402,F401,F403  (the break input and supply switch tests)
+from test_console import *  # noqa: E402,F401,F403  (a person typing at picocom)
 
 # The control task's tick counter in the image (`HEARTBEAT` static).
 HEARTBEAT = None

@@ -93,3 +93,12 @@ ensure_tmux() {
     apt_install tmux
   fi
 }
+
+# The plain serial consoles a person at the bench uses (host-tools/tests/plain_console.rs
+# types commands into them against the virtual rig).
+ensure_plain_consoles() {
+  if ! command -v picocom >/dev/null || ! command -v tio >/dev/null; then
+    echo "== installing picocom and tio"
+    apt_install picocom tio
+  fi
+}

@@ -5,6 +5,8 @@
 //! Each test file is its own crate and uses only some of these, hence the `dead_code` allowance.
 #![allow(dead_code)]
 
+pub mod tmux;
+
 use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};

@@ -204,6 +204,12 @@ fn command(f: &mut Fields<'_>) -> Result<Command, Reason> {
     Command::from_values(kind, &values).ok_or(Reason::Malformed)
 }
 
+/// A command's word and fields without the frame around them (`SPEED,1800,2100`): what a line
+/// typed at a console becomes ([`super::console`]), read by the frame's own parser.
+pub(crate) fn typed_command(fields: &[u8]) -> Result<Command, Reason> {
+    command(&mut Fields { rest: Some(fields) })
+}
+
 impl From<FieldError> for FrameError {
     fn from(_: FieldError) -> FrameError {
         FrameError::Malformed

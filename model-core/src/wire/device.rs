@@ -2,7 +2,9 @@
 //! hardware: the firmware and the virtual rig both drive a [`Device`] over their own [`Backend`]
 //! (what the protocol needs from the controller).
 
+use super::FRAME_START;
 use super::commands::Command;
+use super::console::ConsoleLine;
 use super::decode::FrameError;
 use super::encode::{EncodeError, encode};
 use super::frame::Frame;
@@ -86,6 +88,8 @@ pub trait Backend {
 /// the telemetry schedule.
 pub struct Device {
     decoder: Decoder,
+    /// A line typed at a plain console, between frames ([`super::console`]).
+    console: ConsoleLine,
     seq: u16,
     telemetry_hz: u8,
     /// Frames sent since `schedule_start_ms`; frame k is due at start + k * 1000 / hz.
@@ -178,6 +182,7 @@ impl Device {
     pub const fn new() -> Self {
         Self {
             decoder: Decoder::new(),
+            console: ConsoleLine::new(),
             seq: 0,
             telemetry_hz: DEFAULT_TELEMETRY_HZ,
             frames_scheduled: 0,
@@ -223,14 +228,30 @@ impl Device {
     ) {
         let mut out = [0u8; MAX_FRAME_LEN];
         for &b in bytes {
-            let answer = match self.decoder.push_command(b) {
-                Some(Ok(Frame::Command { id, command })) => {
+            // Bytes outside every frame may be a line typed at a console (answered as id 0);
+            // a `$` starts a frame and ends any typing.
+            let typed = if self.decoder.in_frame() || b == FRAME_START {
+                self.console.clear();
+                None
+            } else {
+                self.console.push(b)
+            };
+            let answer = match (self.decoder.push_command(b), typed) {
+                (Some(Ok(Frame::Command { id, command })), _) => {
                     backend.heartbeat();
                     self.answer(backend, id, command)
                 }
-                Some(Err(FrameError::BadCommand { id, reason })) => {
+                (Some(Err(FrameError::BadCommand { id, reason })), _) => {
                     backend.heartbeat();
                     Frame::Reject { id, reason }
+                }
+                // Typed by a person: carried out as typed (no copies to look for without ids).
+                (_, Some(typed)) => {
+                    backend.heartbeat();
+                    match typed {
+                        Ok(command) => self.execute(backend, 0, command),
+                        Err(reason) => Frame::Reject { id: 0, reason },
+                    }
                 }
                 // Not a command, or damaged beyond reading an id: the PC times out and retries.
                 _ => continue,

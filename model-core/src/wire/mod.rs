@@ -18,11 +18,13 @@
 //! - [`commands`]: the commands, one table (token, fields with units and ranges, answer, the
 //!   states that allow it);
 //! - [`typed`]: [`Command::from_words`] (the words a person types) and the refusal words;
+//! - [`console`]: a command typed at a plain serial console, without `$`, id or CRC;
 //! - [`frame`]: a frame in either direction;
 //! - [`encode()`] and [`decode`]: the codec and the streaming [`Decoder`];
 //! - [`device`]: the rig's side (command dispatch, telemetry pacing) over the [`device::Backend`] trait.
 
 pub mod commands;
+pub mod console;
 pub mod crc;
 pub mod decode;
 pub mod device;

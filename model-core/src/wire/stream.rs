@@ -106,6 +106,11 @@ impl Decoder {
         }
     }
 
+    /// Whether a frame has begun (its `$` came) and not yet ended.
+    pub fn in_frame(&self) -> bool {
+        self.in_frame
+    }
+
     /// The counters so far.
     pub fn stats(&self) -> &DecodeStats {
         &self.stats

@@ -1,0 +1,65 @@
+//! A tmux session as a person's terminal: start a command in it, type keys, read the screen.
+
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+/// A tmux session (its own server socket), killed when dropped.
+pub struct Tmux {
+    socket: String,
+}
+
+impl Tmux {
+    pub fn start(name: &str, command: &str) -> Tmux {
+        let socket = format!("bowl-test-{name}-{}", std::process::id());
+        let tmux = Tmux { socket };
+        let ok = tmux
+            .cmd(&["new-session", "-d", "-x", "120", "-y", "40", command])
+            .status()
+            .expect("tmux runs (tests/lib/ensure-tools.sh installs it)")
+            .success();
+        assert!(ok, "tmux new-session");
+        tmux
+    }
+
+    pub fn cmd(&self, args: &[&str]) -> Command {
+        let mut c = Command::new("tmux");
+        c.args(["-L", &self.socket]).args(args);
+        c
+    }
+
+    pub fn keys(&self, keys: &[&str]) {
+        let mut args = vec!["send-keys", "-t", "0"];
+        args.extend_from_slice(keys);
+        assert!(self.cmd(&args).status().unwrap().success());
+    }
+
+    pub fn screen(&self) -> String {
+        let out = self
+            .cmd(&["capture-pane", "-p", "-t", "0"])
+            .output()
+            .unwrap();
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    }
+
+    /// Waits until the screen shows every one of `texts`; fails with the screen otherwise.
+    pub fn wait_for(&self, texts: &[&str], what: &str) -> String {
+        let started = Instant::now();
+        loop {
+            let screen = self.screen();
+            if texts.iter().all(|t| screen.contains(t)) {
+                return screen;
+            }
+            assert!(
+                started.elapsed() < Duration::from_secs(10),
+                "{what}: expected {texts:?} on the screen:\n{screen}"
+            );
+            std::thread::sleep(Duration::from_millis(200));
+        }
+    }
+}
+
+impl Drop for Tmux {
+    fn drop(&mut self) {
+        let _ = self.cmd(&["kill-server"]).status();
+    }
+}
