@@ -52,10 +52,12 @@ const WIRE: &[(&str, &[&str])] = &[
     ),
     ("stream", &["decode", "frame", "wire"]),
     ("typed", &["commands", "params", "types"]),
+    // A line typed at a plain console, read by the frame's own parser.
+    ("console", &["commands", "decode", "types", "wire"]),
     (
         "device",
         &[
-            "commands", "decode", "encode", "frame", "params", "stream", "types", "wire",
+            "commands", "console", "decode", "encode", "frame", "params", "stream", "types", "wire",
         ],
     ),
 ];
