@@ -352,7 +352,7 @@ fn ask_status(link: &mut Link, id: u16, timeout: Duration) -> Option<Status> {
     }
 }
 
-fn ask_params(link: &mut Link, id: u16, timeout: Duration) -> Option<ParamValues> {
+pub(crate) fn ask_params(link: &mut Link, id: u16, timeout: Duration) -> Option<ParamValues> {
     match ask(link, id, "params", timeout)? {
         Frame::Params { values, .. } => Some(values),
         _ => None,
