@@ -181,3 +181,24 @@ fn replay_says_when_it_replaced_the_csv() {
         "replaced, not appended"
     );
 }
+
+/// The other rig-side commands' own checks: judged before any port is opened.
+#[test]
+fn monitor_commission_and_stability_flags_are_usage_errors() {
+    refused(
+        &["monitor", "/dev/null-never-opened", "--seconds", "inf"],
+        &["--seconds inf", "0 s or more"],
+    );
+    refused(
+        &["commission", "/dev/null-never-opened", "--timeout-s", "0"],
+        &["--timeout-s must be above 0 and at most 86400 s (got 0)"],
+    );
+    refused(
+        &["sim", "stability", "--speed-rad-s", "-1"],
+        &["--speed-rad-s -1 is outside the controller's speed range, above 0 and up to 4 rad/s"],
+    );
+    refused(
+        &["sim", "stability", "--tick-hz", "0"],
+        &["--tick-hz", "100..=10000"],
+    );
+}

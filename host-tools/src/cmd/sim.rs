@@ -199,8 +199,9 @@ pub struct StabilityArgs {
     /// Only this pulse count (default: 1, 4, 12 and 60).
     #[arg(long)]
     pulses_per_rev: Option<u16>,
-    /// Control tick rate, Hz (the loop rate axis of the map).
-    #[arg(long, default_value_t = 1000)]
+    /// Control tick rate, Hz (the loop rate axis of the map; the controller runs at 100 to
+    /// 10 000).
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(100..=10_000))]
     tick_hz: u32,
 }
 
@@ -330,7 +331,10 @@ pub fn run(what: &What) -> Result<()> {
             println!("{}", serde_json::to_string_pretty(&out)?);
         }
         What::Sweep(a) => sweep(a.seed),
-        What::Stability(a) => stability(a.common.seed, a.speed_rad_s, a.pulses_per_rev, a.tick_hz),
+        What::Stability(a) => {
+            flags::speed(a.speed_rad_s, "--speed-rad-s", &[])?;
+            stability(a.common.seed, a.speed_rad_s, a.pulses_per_rev, a.tick_hz)
+        }
         What::Trace(a) => {
             let rig = match &a.rig_file {
                 Some(path) => {

@@ -123,6 +123,14 @@ const STATUS_ID: u16 = u16::MAX - 1;
 const STATUS_AGAIN_EVERY: Duration = Duration::from_secs(2);
 
 pub fn run(args: &Args) -> Result<()> {
+    if let Some(s) = args.seconds
+        && !(s.is_finite() && s >= 0.0)
+    {
+        return Err(crate::exit_code::usage(format!(
+            "--seconds {s}: give how long to watch, 0 s or more (leave it out to watch until \
+             interrupted)"
+        )));
+    }
     // The UI needs a screen and a keyboard; without either it prints lines.
     let plain = args.plain || !std::io::stdout().is_terminal() || !std::io::stdin().is_terminal();
     // The port is checked before anything is drawn: a wrong path is an error, not a wait.

@@ -46,9 +46,17 @@ pub fn speed(x: f32, flag: &str, plants: &[Plant]) -> Result<()> {
         .flat_map(|p| p.cfg.axes.iter().map(lowest_speed_rad_s))
         .fold(0.0f32, f32::max);
     if !(x.is_finite() && x > 0.0 && x <= max) {
+        // No plants: a report that runs below the sensors' floor on purpose (`sim stability`).
+        let range = if plants.is_empty() {
+            format!("above 0 and up to {max} rad/s")
+        } else {
+            format!(
+                "{floor:.3} to {max} rad/s (the lower end is the lowest speed the sensors can \
+                 measure)"
+            )
+        };
         return Err(usage(format!(
-            "{flag} {x} is outside the controller's speed range, {floor:.3} to {max} rad/s (the \
-             lower end is the lowest speed the sensors can measure); give a speed in it"
+            "{flag} {x} is outside the controller's speed range, {range}; give a speed in it"
         )));
     }
     for p in plants {
