@@ -76,7 +76,9 @@ fn main() -> ExitCode {
         Err(e) if exit_code::is_closed_output(&e) => exit_code::OK,
         Err(e) => {
             eprintln!("error: {e:#}");
-            if e.chain().any(|c| c.is::<rig_client::serial::LinkError>()) {
+            if e.chain().any(|c| c.is::<exit_code::Usage>()) {
+                exit_code::USAGE
+            } else if e.chain().any(|c| c.is::<rig_client::serial::LinkError>()) {
                 exit_code::LINK
             } else {
                 exit_code::REFUSED

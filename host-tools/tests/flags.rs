@@ -90,7 +90,8 @@ fn a_drop_share_outside_0_to_50_pct_is_said_in_words() {
             "--drop-pulses-pct",
             bad,
         ]);
-        assert_eq!(code, Some(1), "{bad}: {err}");
+        // A value on the command line: a usage error (docs/console.md, exit codes).
+        assert_eq!(code, Some(2), "{bad}: {err}");
         assert!(
             err.contains("--drop-pulses-pct must be from 0 to 50") && err.contains(bad),
             "{bad}: {err}"

@@ -160,3 +160,41 @@ fn set_inside_its_range_is_taken_or_refused_with_the_rule_it_breaks() {
         "{text}"
     );
 }
+
+/// `start` while the motors run says so and what to do instead; a SET that waits for idle while
+/// the rig is already stopping says to wait, not to stop.
+#[test]
+fn start_while_running_and_set_while_stopping_say_what_to_do() {
+    let sim = Sim::start(&[]);
+    // Slow ramps, so the stop lasts seconds; no watchdog, so the test's pauses fault nothing.
+    for words in [
+        "set LINK_TIMEOUT_MS 0",
+        "set ACCEL1_MRAD_S2 500",
+        "set ACCEL2_MRAD_S2 500",
+        "speed 3000 3000",
+        "start",
+    ] {
+        let (code, text) = send(&sim.path, words);
+        assert_eq!(code, 0, "{words}: {text}");
+    }
+    let (code, text) = send(&sim.path, "start");
+    assert_eq!(code, 1, "{text}");
+    assert!(
+        text.contains(
+            "already running (state spinning-up); change speed with `speed`, or `stop` first"
+        ) || text.contains(
+            "already running (state running); change speed with `speed`, or `stop` first"
+        ),
+        "{text}"
+    );
+    std::thread::sleep(std::time::Duration::from_secs(2));
+    let (code, text) = send(&sim.path, "stop");
+    assert_eq!(code, 0, "{text}");
+    let (code, text) = send(&sim.path, "set CUR_SENSE 1");
+    assert_eq!(code, 1, "{text}");
+    assert!(text.contains("the rig is stopping"), "{text}");
+    assert!(
+        text.contains("wait until the rig is idle") && !text.contains("stop the motors first"),
+        "{text}"
+    );
+}

@@ -198,7 +198,8 @@ fn a_transition_from_an_impossible_speed_is_refused_in_words() {
     for (from, want) in [
         (
             "-1",
-            "--from-rad-s -1 is outside the controller's speed range, above 0 and up to 4 rad/s",
+            "--from-rad-s -1 is outside the controller's speed range, 0.200 to 4 rad/s (the \
+             lower end is the lowest speed the sensors can measure)",
         ),
         (
             "99",
@@ -207,7 +208,7 @@ fn a_transition_from_an_impossible_speed_is_refused_in_words() {
         ("3", "equals --target-rad-s"),
     ] {
         let out = small_family_run(from, "3", &[]);
-        assert!(!out.status.success(), "{from}");
+        assert_eq!(out.status.code(), Some(2), "a usage error: {from}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(want), "{from}: {err}");
     }

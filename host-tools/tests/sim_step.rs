@@ -29,6 +29,8 @@ fn nominal_step_meets_overshoot_settling_and_ripple_targets() {
     let v = json(&["sim", "step"]);
     assert_eq!(v["pulses_per_rev"], 12);
     assert_eq!(v["fault_code"], 0);
+    // The fault in the console's word, as `sim family` names it: none latched.
+    assert!(v["fault"].is_null(), "{v}");
     assert_eq!(v["commissioned"], true);
     for axis in v["axes"].as_array().unwrap() {
         assert!(f(axis, "overshoot_pct") <= 2.0, "{axis}");

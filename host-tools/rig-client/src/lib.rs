@@ -7,7 +7,8 @@
 //! typed rig: `Rig::speed`, `Rig::status`, ...), `lines` (command lines built from words and
 //! checked, answers described; the rig's states and faults in words are the types' own,
 //! `model_core::wire::words`), `command_words` and `refusal` (a refused command in
-//! particulars), `telemetry_csv` (the CSV log), `decode_stats` (the decoder's counters as JSON).
+//! particulars), `telemetry_csv` (the CSV log), `decode_stats` (the decoder's counters as JSON), `watchdog` (the note that a one-shot
+//! `start` will meet the rig's host-silence watchdog).
 
 pub mod command_words;
 pub mod decode_stats;
@@ -20,3 +21,4 @@ pub mod rig;
 pub mod serial;
 pub mod telemetry_csv;
 pub mod unreadable;
+pub mod watchdog;

@@ -89,14 +89,30 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
             D::Running | D::SpinningUp | D::Stopping | D::Commissioning
         )
     {
+        // A rig that is already stopping needs no `stop`: only time.
+        let todo = if s.state == D::Stopping {
+            "wait until the rig is idle (`bowl send PORT status`; stopping from 3 rad/s takes \
+             several seconds)"
+        } else {
+            "stop the motors first (`bowl send PORT stop`)"
+        };
         return format!(
             "the rig is {}: {} changes only while the rig is idle or faulted (it rebuilds the \
-             controller); stop the motors first (`bowl send PORT stop`), then set it",
+             controller); {todo}, then set it",
             s.state.words(),
             p.token()
         );
     }
     let todo = match s.state {
+        D::Running | D::SpinningUp if command == "start" => format!(
+            "already running (state {}); change speed with `speed`, or `stop` first",
+            s.state.token()
+        ),
+        D::Stopping if matches!(command, "start" | "commission") => {
+            "wait until the rig is idle (stopping from 3 rad/s takes several seconds), then \
+             send it again"
+                .to_string()
+        }
         D::Faulted => format!(
             "{}; clear it first (`bowl send PORT clear`)",
             s.fault.words()
@@ -323,7 +339,7 @@ fn ask_status(link: &mut Link, id: u16, timeout: Duration) -> Option<Status> {
     }
 }
 
-fn ask_params(link: &mut Link, id: u16, timeout: Duration) -> Option<ParamValues> {
+pub(crate) fn ask_params(link: &mut Link, id: u16, timeout: Duration) -> Option<ParamValues> {
     match ask(link, id, "params", timeout)? {
         Frame::Params { values, .. } => Some(values),
         _ => None,

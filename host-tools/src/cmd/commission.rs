@@ -216,7 +216,11 @@ fn print(report: &Report, json: bool) -> Result<()> {
 /// Runs `bowl commission`; returns the process exit status.
 pub fn run(args: &Args) -> Result<i32> {
     if !(args.timeout_s.is_finite() && args.timeout_s > 0.0 && args.timeout_s <= 86_400.0) {
-        bail!("--timeout-s must be between 0 and 86400");
+        return Err(crate::exit_code::usage(format!(
+            "--timeout-s must be above 0 and at most 86400 s (got {}): give how long to wait for \
+             commissioning to end",
+            args.timeout_s
+        )));
     }
     let mut rig = Rig::open(&args.port, args.baud, ANSWER_TIMEOUT)?;
     let mut report = Report {

@@ -13,6 +13,8 @@ use rig_client::decode_stats::stats_json;
 use rig_client::telemetry_csv;
 use serde_json::json;
 
+use crate::exit_code::usage;
+
 /// Flags of `bowl replay`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -90,6 +92,8 @@ const CHUNK_BYTES: usize = 1 << 16;
 
 /// Runs `bowl replay`: reads the capture in chunks into one decoder (constant memory).
 pub fn run(args: &Args) -> Result<()> {
+    // Checked before the open: a serial port never ends, so the decode would wait forever.
+    refuse_a_port(&args.file)?;
     let mut file =
         File::open(&args.file).with_context(|| format!("cannot read {}", args.file.display()))?;
     if args.file.is_dir() {
@@ -109,6 +113,12 @@ pub fn run(args: &Args) -> Result<()> {
             path.display()
         );
     }
+    // A replay writes the whole decode each time (appending would repeat its rows), unlike the
+    // monitor's live log, which appends: say so when a file was there.
+    let replaced = args
+        .csv
+        .as_ref()
+        .filter(|p| p.metadata().is_ok_and(|m| m.is_file() && m.len() > 0));
     let mut csv = match &args.csv {
         Some(path) => {
             let mut w = BufWriter::new(
@@ -170,6 +180,13 @@ pub fn run(args: &Args) -> Result<()> {
     if let Some(mut w) = csv {
         w.flush().context("writing the CSV")?;
     }
+    if let Some(path) = replaced {
+        eprintln!(
+            "note: {} existed and was replaced by this decode (`bowl monitor --log` appends; \
+             `bowl replay --csv` writes the whole file)",
+            path.display()
+        );
+    }
     let mut out = stats_json(&stats);
     out["telemetry_frames"] = json!(telemetry);
     out["decode_seconds"] = json!(seconds);
@@ -208,6 +225,27 @@ pub fn run(args: &Args) -> Result<()> {
             stats.bytes
         );
     }
+    Ok(())
+}
+
+/// Refuses a serial port or terminal (a character device) as the capture: its bytes never
+/// end, so a replay of it would print nothing, forever. Watching a port live is the monitor's job.
+fn refuse_a_port(path: &std::path::Path) -> Result<()> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if std::fs::metadata(path).is_ok_and(|m| m.file_type().is_char_device()) {
+            let p = path.display();
+            return Err(usage(format!(
+                "{p} is a serial port or terminal, not a capture file: `bowl replay` decodes a \
+                 recorded capture and would wait forever on a port; to watch the rig and log its \
+                 telemetry use `bowl monitor {p} --log run.csv` (then `bowl chart log --csv \
+                 run.csv`)"
+            )));
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = path;
     Ok(())
 }
 

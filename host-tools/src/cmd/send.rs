@@ -10,6 +10,7 @@ use rig_client::lines::{command_line, describe, explain};
 use rig_client::link::Link;
 use rig_client::refusal;
 use rig_client::request::transact;
+use rig_client::watchdog;
 
 use crate::exit_code;
 
@@ -26,7 +27,11 @@ pub struct Args {
     /// Baud rate.
     #[arg(long, default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(50..=12_000_000))]
     baud: u32,
-    /// Request id echoed by the rig (default: derived from the clock).
+    /// Request id echoed by the rig (default: a fresh one from the clock; leave it out unless
+    /// you resend). The same id with the same words within 60 s is a resend to the rig: it
+    /// answers again ("ok") but does not do it again, even with other commands in between, and
+    /// its answer is the same either way, so `bowl send` cannot tell you. Give each new
+    /// command a new id.
     #[arg(long)]
     id: Option<u16>,
     /// How long to wait for the answer, ms (1..=60000: the rig remembers a command for 60 s to
@@ -56,6 +61,12 @@ pub fn run(args: &Args) -> Result<i32> {
     match transact(&mut link, id, &line, timeout)? {
         Ok(frame) => {
             println!("{}", describe(&frame));
+            if !matches!(frame, Frame::Reject { .. })
+                && watchdog::starts_motors(&args.command)
+                && let Some(note) = watchdog::note(&mut link, &args.port, id, timeout)
+            {
+                println!("{note}");
+            }
             if let Frame::Reject { reason, .. } = frame
                 && let Some(why) =
                     refusal::particulars(Some(&mut link), id, &args.command, reason, timeout)

@@ -11,11 +11,14 @@ use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
-use rig_client::lines::command_line;
+use rig_client::command_words;
+use rig_client::lines::{command_line, explain};
 use virtual_rig::VirtualRig;
 #[cfg(unix)]
 use virtual_rig::serve::{Backlog, Pacing, Pty, serve_on_pty};
-use virtual_rig::serve::{LineNoise, Scheduled, capture};
+use virtual_rig::serve::{LineNoise, Scheduled, capture, check_seconds};
+
+use crate::exit_code::usage;
 
 /// Flags of `bowl serve`.
 #[derive(clap::Args)]
@@ -51,18 +54,57 @@ pub struct Args {
     line_noise_percent: f64,
 }
 
-fn parse_commands(specs: &[String]) -> Result<Vec<Scheduled>> {
+/// The `--command AT_MS:WORDS` flags, judged before the rig starts (usage errors in the words
+/// `bowl send` gives), in time order. `run_ms`: the run's length, when it has one; a command
+/// due at or after its end would never be sent.
+fn parse_commands(specs: &[String], run_ms: Option<f64>) -> Result<Vec<Scheduled>> {
     let mut out = Vec::new();
     for (i, spec) in specs.iter().enumerate() {
-        let (at, words) = spec
-            .split_once(':')
-            .with_context(|| format!("--command {spec}: expected AT_MS:WORDS"))?;
-        let at_ms: u32 = at
-            .parse()
-            .with_context(|| format!("--command {spec}: bad time"))?;
+        let (at, words) = spec.split_once(':').ok_or_else(|| {
+            usage(format!(
+                "--command {spec}: expected AT_MS:WORDS, the device time in ms, a colon, then the \
+                 command's words separated by commas (e.g. 0:speed,1800,2100)"
+            ))
+        })?;
+        let at_ms: u32 = at.parse().map_err(|_| {
+            usage(format!(
+                "--command {spec}: `{at}` is not a time: give whole milliseconds from the rig's \
+                 start, 0 to {} (e.g. 5000:start)",
+                u32::MAX
+            ))
+        })?;
+        let split: Vec<String> = words.split(',').map(str::to_string).collect();
         let id = u16::try_from(i + 1).unwrap_or(u16::MAX);
-        let line = command_line(id, &[words.to_string()])
-            .map_err(|r| anyhow::anyhow!("--command {spec}: rejected locally ({})", r.token()))?;
+        let line = command_line(id, &split).map_err(|reason| {
+            // Typed as for `bowl send` (spaces) instead of the flag's commas.
+            let hint = if words.contains(char::is_whitespace) {
+                let fields: Vec<&str> = words
+                    .split(|c: char| c == ',' || c.is_whitespace())
+                    .filter(|w| !w.is_empty())
+                    .collect();
+                format!(
+                    "; the fields are separated by commas, without spaces: `{at}:{}`",
+                    fields.join(",")
+                )
+            } else {
+                String::new()
+            };
+            usage(format!(
+                "--command {spec}: rejected locally: {} - {}: {}{hint}",
+                reason.token(),
+                explain(reason),
+                command_words::local_refusal(&split, reason)
+            ))
+        })?;
+        if let Some(run_ms) = run_ms
+            && f64::from(at_ms) >= run_ms
+        {
+            return Err(usage(format!(
+                "--command {spec}: due at {at_ms} ms, but the run ends at {run_ms} ms (--seconds \
+                 {}): it would never be sent; give a time before the end or a longer --seconds",
+                run_ms / 1000.0
+            )));
+        }
         out.push(Scheduled { at_ms, line });
     }
     out.sort_by_key(|s| s.at_ms);
@@ -71,8 +113,13 @@ fn parse_commands(specs: &[String]) -> Result<Vec<Scheduled>> {
 
 /// Runs `bowl serve`.
 pub fn run(args: &Args) -> Result<()> {
-    let commands = parse_commands(&args.commands)?;
-    let noise = LineNoise::new(args.line_noise_percent, args.seed)?;
+    // Every flag and the rig file are judged before anything starts (or a pty path is printed
+    // that a script would take for a running rig).
+    if let Some(seconds) = args.seconds {
+        check_seconds(seconds).map_err(usage)?;
+    }
+    let commands = parse_commands(&args.commands, args.seconds.map(|s| s * 1000.0))?;
+    let noise = LineNoise::new(args.line_noise_percent, args.seed).map_err(usage)?;
     let new_rig = || match &args.rig_file {
         None => VirtualRig::new(args.seed),
         Some(path) => {
@@ -89,9 +136,15 @@ pub fn run(args: &Args) -> Result<()> {
                 .with_context(|| format!("the rig in {}", path.display()))
         }
     };
+    if !args.pty && args.capture.is_none() {
+        return Err(usage(
+            "say --pty (serve on a pseudo-terminal) or --capture FILE --seconds S (write to a file)",
+        ));
+    }
+    let rig = new_rig()?;
     if let Some(path) = &args.capture {
         let seconds = args.seconds.unwrap_or(0.0);
-        return capture(path, seconds, commands, new_rig()?, noise);
+        return capture(path, seconds, commands, rig, noise);
     }
     #[cfg(not(unix))]
     if args.pty {
@@ -112,7 +165,7 @@ pub fn run(args: &Args) -> Result<()> {
         let never = AtomicBool::new(false);
         let served = serve_on_pty(
             pty,
-            new_rig()?,
+            rig,
             Pacing {
                 device_ms_per_wall_ms: 1.0,
                 stop: &never,
@@ -127,7 +180,7 @@ pub fn run(args: &Args) -> Result<()> {
         }
         return served.map(|_| ());
     }
-    bail!("say --pty (serve on a pseudo-terminal) or --capture FILE --seconds S (write to a file)")
+    Ok(())
 }
 
 #[cfg(test)]
@@ -137,12 +190,14 @@ mod tests {
     #[test]
     fn scheduled_commands_run_in_time_order_and_bad_ones_are_named() {
         let specs = ["5000:start".to_string(), "0:speed,1800,2100".to_string()];
-        let cmds = parse_commands(&specs).unwrap();
+        let cmds = parse_commands(&specs, None).unwrap();
         assert_eq!(cmds.iter().map(|c| c.at_ms).collect::<Vec<_>>(), [0, 5000]);
         let first = String::from_utf8(cmds[0].line.clone()).unwrap();
         assert!(first.contains("SPEED"), "{first}");
         for bad in ["start", "soon:start"] {
-            let err = parse_commands(&[bad.to_string()]).err().expect("refused");
+            let err = parse_commands(&[bad.to_string()], None)
+                .err()
+                .expect("refused");
             assert!(format!("{err:#}").contains(bad), "{err:#}");
         }
     }

@@ -15,6 +15,11 @@
 
 use anyhow::{Result, bail};
 use model_core::control::ControllerConfig;
+
+mod flags;
+use flags::Plant;
+
+use crate::exit_code::usage;
 use model_core::sim::experiments::rig_with_pulses;
 
 use lab::parallel::parallel;
@@ -116,11 +121,9 @@ pub struct StepSpeeds {
 }
 
 impl StepSpeeds {
-    /// `(from, target)`, each judged in words.
-    fn checked(&self) -> Result<(f32, f32)> {
-        check_speed(self.target_rad_s, "--target-rad-s")?;
-        check_from(self.from_rad_s, self.target_rad_s)?;
-        Ok((self.from_rad_s, self.target_rad_s))
+    /// `(from, target)`, each judged in words against the plants the step runs on.
+    fn checked(&self, plants: &[Plant]) -> Result<(f32, f32)> {
+        flags::step(self.from_rad_s, self.target_rad_s, plants)
     }
 }
 
@@ -196,8 +199,9 @@ pub struct StabilityArgs {
     /// Only this pulse count (default: 1, 4, 12 and 60).
     #[arg(long)]
     pulses_per_rev: Option<u16>,
-    /// Control tick rate, Hz (the loop rate axis of the map).
-    #[arg(long, default_value_t = 1000)]
+    /// Control tick rate, Hz (the loop rate axis of the map; the controller runs at 100 to
+    /// 10 000).
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(100..=10_000))]
     tick_hz: u32,
 }
 
@@ -205,7 +209,6 @@ pub struct StabilityArgs {
 pub fn run(what: &What) -> Result<()> {
     match what {
         What::Step(a) if a.rig_file.is_some() => {
-            let (from, target) = a.step.checked()?;
             let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
             let rigs = rig_file::load(path)?;
             if rigs.len() != 1 {
@@ -216,6 +219,7 @@ pub fn run(what: &What) -> Result<()> {
                 );
             }
             let rig = &rigs[0];
+            let (from, target) = a.step.checked(&[Plant::of_rig(rig)])?;
             let cfg = sim_reports::config_for(rig);
             let load = [
                 rig.params.axes[0].load_step_nm,
@@ -240,12 +244,8 @@ pub fn run(what: &What) -> Result<()> {
         }
         What::Family(a) if a.rig_file.is_some() => {
             let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
-            let (from, target) = a.step.checked()?;
             let rigs = sensed(rig_file::load(path)?, a.current_sense);
-            check_lowest(&rigs, target, "--target-rad-s")?;
-            if from > 0.0 {
-                check_lowest(&rigs, from, "--from-rad-s")?;
-            }
+            let (from, target) = a.step.checked(&plants_of(&rigs))?;
             let plants = parallel(&rigs, |r| sim_reports::family_plant(r, from, target));
             let summary = sim_reports::summary(&plants);
             let out = serde_json::json!({
@@ -257,15 +257,14 @@ pub fn run(what: &What) -> Result<()> {
             println!("{}", serde_json::to_string_pretty(&out)?);
         }
         What::Faults(a) => {
-            check_speed(a.speed_rad_s, "--speed-rad-s")?;
-            let rigs = sensed(rig_file::load(&a.rig_file)?, a.current_sense);
-            check_lowest(&rigs, a.speed_rad_s, "--speed-rad-s")?;
             if !(0.0..=50.0).contains(&a.drop_pulses_pct) {
-                bail!(
+                return Err(usage(format!(
                     "--drop-pulses-pct must be from 0 to 50 (% of pulses the sensors drop; got {}): above half the pulses the controller cannot tell a dropping sensor from a dead one",
                     a.drop_pulses_pct
-                );
+                )));
             }
+            let rigs = sensed(rig_file::load(&a.rig_file)?, a.current_sense);
+            flags::speed(a.speed_rad_s, "--speed-rad-s", &plants_of(&rigs))?;
             let plants = parallel(&rigs, |r| {
                 sim_reports::fault_plant(r, a.speed_rad_s, a.drop_pulses_pct)
             });
@@ -274,9 +273,14 @@ pub fn run(what: &What) -> Result<()> {
         }
         What::MakeFamily(a) => print!("{}", family_file::family_toml(a.seed, a.plants)),
         What::Step(a) => {
-            let (from, target) = a.step.checked()?;
+            let (from, target) = a.step.checked(&[Plant::nominal(a.pulses_per_rev)])?;
             let mut rig = rig_with_pulses(a.pulses_per_rev);
             if let Some(r) = a.ripple_nm {
+                if !(r.is_finite() && r >= 0.0) {
+                    return Err(usage(format!(
+                        "--ripple-nm {r}: the load ripple must be a torque of 0 N m or more"
+                    )));
+                }
                 for ax in &mut rig.axes {
                     ax.ripple_nm = r;
                 }
@@ -293,6 +297,15 @@ pub fn run(what: &What) -> Result<()> {
                     ax.accel_limit_rad_s2 = acc;
                 }
             }
+            // The controller's own check of its settings, in its own words.
+            cfg.validate().map_err(|e| {
+                usage(format!(
+                    "--per-pulse-bandwidth, --filter-weight or --accel-rad-s2: {} (per-pulse \
+                     bandwidth 0.01 to 10, filter weight above 0 and at most 1, acceleration \
+                     0.01 to 1000 rad/s^2)",
+                    virtual_rig::controller_words::config(e)
+                ))
+            })?;
             let feedback = !a.no_feedback;
             let outcome = step_run_with(rig, cfg, a.common.seed, from, target, feedback, [0.0; 2]);
             print_step(
@@ -305,10 +318,10 @@ pub fn run(what: &What) -> Result<()> {
         }
         What::Family(a) => {
             if a.plants < 50 && !a.allow_small {
-                bail!(
+                return Err(usage(format!(
                     "--plants must be at least 50, the family size the control targets are stated for (got {}); docs/control.md",
                     a.plants
-                );
+                )));
             }
             let out = family(a.common.seed, a.plants, !a.no_feedback);
             println!("{}", serde_json::to_string_pretty(&out)?);
@@ -318,24 +331,35 @@ pub fn run(what: &What) -> Result<()> {
             println!("{}", serde_json::to_string_pretty(&out)?);
         }
         What::Sweep(a) => sweep(a.seed),
-        What::Stability(a) => stability(a.common.seed, a.speed_rad_s, a.pulses_per_rev, a.tick_hz),
+        What::Stability(a) => {
+            flags::speed(a.speed_rad_s, "--speed-rad-s", &[])?;
+            stability(a.common.seed, a.speed_rad_s, a.pulses_per_rev, a.tick_hz)
+        }
         What::Trace(a) => {
             let rig = match &a.rig_file {
                 Some(path) => {
                     let rigs = rig_file::load(path)?;
+                    let names: Vec<String> = rigs.iter().map(|r| r.name.clone()).collect();
                     let found = match &a.name {
                         Some(n) => rigs.into_iter().find(|r| &r.name == n),
                         None => rigs.into_iter().next(),
                     };
-                    Some(
-                        found
-                            .ok_or_else(|| anyhow::anyhow!("no plant of that name in the file"))?,
-                    )
+                    Some(found.ok_or_else(|| {
+                        usage(format!(
+                            "--name {}: no plant of that name in {} (its plants: {})",
+                            a.name.as_deref().unwrap_or(""),
+                            path.display(),
+                            names.join(", ")
+                        ))
+                    })?)
                 }
                 None => None,
             };
-            check_speed(a.target_rad_s, "--target-rad-s")?;
-            check_from(a.from_rad_s, a.target_rad_s)?;
+            let plant = match &rig {
+                Some(r) => Plant::of_rig(r),
+                None => Plant::nominal(ControllerConfig::nominal().axes[0].pulses_per_rev),
+            };
+            flags::step(a.from_rad_s, a.target_rad_s, &[plant])?;
             trace(a.common.seed, a.plant, rig, (a.from_rad_s, a.target_rad_s));
         }
     }
@@ -383,55 +407,18 @@ fn check_step(o: &StepOutcome) -> Result<()> {
     }
     if o.fault_code != 0 {
         bail!(
-            "the run faulted (fault code {}, see docs/protocol.md): the figures above are not a step \
-             response",
+            "the run faulted ({}, fault code {}, see docs/protocol.md): the figures above are not \
+             a step response",
+            o.fault.unwrap_or("unknown fault"),
             o.fault_code
         );
     }
     Ok(())
 }
 
-/// `--from-rad-s`: 0 (from rest) or a speed in the controller's range, not the target itself.
-fn check_from(from: f32, target: f32) -> Result<()> {
-    if from == 0.0 {
-        return Ok(());
-    }
-    check_speed(from, "--from-rad-s")?;
-    if from == target {
-        bail!(
-            "--from-rad-s {from} equals --target-rad-s: there is no step; give a different speed or 0 (from rest)"
-        );
-    }
-    Ok(())
-}
-
-fn check_speed(x: f32, flag: &str) -> Result<()> {
-    let max = ControllerConfig::nominal().axes[0].max_speed_rad_s;
-    if !(x.is_finite() && x > 0.0 && x <= max) {
-        bail!(
-            "{flag} {x} is outside the controller's speed range, above 0 and up to {max} rad/s; \
-             give a speed in it"
-        );
-    }
-    Ok(())
-}
-
-/// Refuses a speed below the lowest one a plant's sensors can measure (one pulse per 4 s).
-fn check_lowest(rigs: &[rig_file::Rig], x: f32, flag: &str) -> Result<()> {
-    for r in rigs {
-        let cfg = sim_reports::config_for(r);
-        for (axis, name) in cfg.axes.iter().zip(["precession", "spin"]) {
-            let lowest = model_core::control::estimator::lowest_speed_rad_s(axis);
-            if x < lowest {
-                bail!(
-                    "{flag} {x} is below the lowest speed of plant {}'s {name} axis, {lowest:.3} rad/s ({} pulses per revolution); ask for at least that",
-                    r.name,
-                    axis.pulses_per_rev
-                );
-            }
-        }
-    }
-    Ok(())
+/// The controller's view of each plant, for judging speed flags.
+fn plants_of(rigs: &[rig_file::Rig]) -> Vec<Plant> {
+    rigs.iter().map(Plant::of_rig).collect()
 }
 
 #[cfg(test)]
@@ -452,6 +439,9 @@ mod tests {
             axes: [axis; 2],
             worst: axis,
             fault_code,
+            fault: model_core::wire::FaultCode::from_code(i64::from(fault_code))
+                .filter(|&f| f != model_core::wire::FaultCode::None)
+                .map(model_core::wire::FaultCode::token),
             commissioned,
         }
     }
@@ -461,7 +451,10 @@ mod tests {
     fn a_faulted_step_is_an_error() {
         assert!(check_step(&outcome(0, true)).is_ok());
         let e = check_step(&outcome(3, true)).unwrap_err().to_string();
-        assert!(e.contains("faulted (fault code 3"), "{e}");
+        assert!(
+            e.contains("faulted (overspeed-precession, fault code 3"),
+            "{e}"
+        );
         let e = check_step(&outcome(6, false)).unwrap_err().to_string();
         assert!(e.contains("commissioning did not finish"), "{e}");
     }

@@ -6,6 +6,7 @@
 //! `bowl send`, `bowl commission` and scripts reach the rig meanwhile. Commands can also be typed
 //! into the monitor itself (the UI's command line, or stdin lines in plain mode).
 
+mod backlog;
 mod commands;
 mod line_edit;
 mod tui;
@@ -122,6 +123,14 @@ const STATUS_ID: u16 = u16::MAX - 1;
 const STATUS_AGAIN_EVERY: Duration = Duration::from_secs(2);
 
 pub fn run(args: &Args) -> Result<()> {
+    if let Some(s) = args.seconds
+        && !(s.is_finite() && s >= 0.0)
+    {
+        return Err(crate::exit_code::usage(format!(
+            "--seconds {s}: give how long to watch, 0 s or more (leave it out to watch until \
+             interrupted)"
+        )));
+    }
     // The UI needs a screen and a keyboard; without either it prints lines.
     let plain = args.plain || !std::io::stdout().is_terminal() || !std::io::stdin().is_terminal();
     // The port is checked before anything is drawn: a wrong path is an error, not a wait.
@@ -145,6 +154,8 @@ pub fn run(args: &Args) -> Result<()> {
     let mut view = View::new();
     let mut commands = Commands::new();
     let mut port = Some(first);
+    let mut backlog = backlog::Backlog::default();
+    backlog.opened();
     view.set_connected(true);
     view.event(plain, format!("port {} open", args.port));
     let link_event = |log: &mut Option<BufWriter<File>>, boot: u64, what: &str| -> Result<()> {
@@ -183,6 +194,7 @@ pub fn run(args: &Args) -> Result<()> {
                 view.set_connected(true);
                 view.reconnects += 1;
                 view.event(plain, format!("port {} reopened", args.port));
+                backlog.opened();
                 status_due = Some(Instant::now());
                 link_event(&mut log, decoder.stats().restarts, "port reopened")?;
             }
@@ -228,17 +240,30 @@ pub fn run(args: &Args) -> Result<()> {
                         None => continue,
                     };
                     if decoder.stats().restarts > restarts {
+                        // The held rows are of the boot before: the new clock cannot date them.
+                        if let Some(w) = log.as_mut() {
+                            view.logged_rows += backlog.release(w, None)?;
+                        }
                         link_event(&mut log, decoder.stats().restarts, "device restart")?;
                     }
+                    let boot = decoder.stats().restarts;
                     if let (Frame::Event(e), Some(w)) = (&frame, log.as_mut()) {
-                        let boot = decoder.stats().restarts;
-                        telemetry_csv::write_gate_event(w, boot, Some(SystemTime::now()), e)?;
+                        if backlog.pending() {
+                            backlog.hold_gate(boot, *e);
+                        } else {
+                            telemetry_csv::write_gate_event(w, boot, Some(SystemTime::now()), e)?;
+                        }
                     }
                     if let Frame::Telemetry(t) = &frame {
                         if let Some(w) = log.as_mut() {
-                            let boot = decoder.stats().restarts;
-                            telemetry_csv::write_row(w, boot, t, Some(SystemTime::now()))?;
-                            view.logged_rows += 1;
+                            if backlog.holding() {
+                                backlog.hold_row(boot, *t);
+                            } else {
+                                let now = SystemTime::now();
+                                view.logged_rows += backlog.release(w, Some((boot, t, now)))?;
+                                telemetry_csv::write_row(w, boot, t, Some(now))?;
+                                view.logged_rows += 1;
+                            }
                         }
                         if let Some(ui) = tui.as_mut() {
                             ui.on_telemetry(t);
@@ -270,8 +295,11 @@ pub fn run(args: &Args) -> Result<()> {
                     }
                 }
             }
-            ReadOutcome::Timeout => {}
+            ReadOutcome::Timeout => backlog.quiet(),
             ReadOutcome::Gone => {
+                if let Some(w) = log.as_mut() {
+                    view.logged_rows += backlog.release(w, None)?;
+                }
                 port = None;
                 relay = None;
                 view.set_connected(false);
@@ -376,6 +404,9 @@ pub fn run(args: &Args) -> Result<()> {
     }
     // Leave the alternate screen first, so the summary stays on the terminal.
     drop(tui);
+    if let Some(w) = log.as_mut() {
+        view.logged_rows += backlog.release(w, None)?;
+    }
     link_event(&mut log, decoder.stats().restarts, "monitor end")?;
     if let Some(w) = log.as_mut() {
         w.flush().context("writing the log")?;

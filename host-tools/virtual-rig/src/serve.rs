@@ -100,6 +100,16 @@ fn script_heartbeat(scripted: bool, now_ms: u32) -> Option<Vec<u8>> {
         .flatten()
 }
 
+/// The run length `bowl serve --seconds` takes: a finite time from 0 to 4e6 s (46 days).
+pub fn check_seconds(seconds: f64) -> Result<()> {
+    if !(seconds.is_finite() && (0.0..=4_000_000.0).contains(&seconds)) {
+        bail!(
+            "--seconds must be between 0 and 4e6 (got {seconds}): give the run's length in seconds"
+        );
+    }
+    Ok(())
+}
+
 /// Runs `rig` for `seconds` of device time faster than real time and writes its output bytes
 /// (with `noise`) to `path`: `bowl serve --capture`.
 pub fn capture(
@@ -109,9 +119,7 @@ pub fn capture(
     mut rig: VirtualRig,
     mut noise: LineNoise,
 ) -> Result<()> {
-    if !(seconds.is_finite() && (0.0..=4_000_000.0).contains(&seconds)) {
-        bail!("--seconds must be between 0 and 4e6 (got {seconds})");
-    }
+    check_seconds(seconds)?;
     let mut file = BufWriter::new(
         File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
     );

@@ -45,8 +45,11 @@ pub struct StepOutcome {
     pub axes: [AxisFigures; 2],
     /// The worse axis of each figure.
     pub worst: AxisFigures,
-    /// Fault code latched during the run (0 = none).
+    /// Fault code latched during the run (0 = none); kept for the CSV reports and scripts.
     pub fault_code: u8,
+    /// The same fault in the console's word (`bowl send ... status`, `sim family`'s `fault`),
+    /// null when none latched.
+    pub fault: Option<&'static str>,
     /// Commissioning ended in Idle (not a fault).
     pub commissioned: bool,
 }
@@ -91,6 +94,7 @@ pub fn outcome_json(o: experiments::StepOutcome) -> StepOutcome {
         worst: worst_of(&axes),
         axes,
         fault_code: o.fault.map_or(0, Fault::code),
+        fault: o.fault.map(|f| FaultCode::from(Some(f)).token()),
         commissioned: o.commissioned,
     }
 }
