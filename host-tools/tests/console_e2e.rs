@@ -46,7 +46,7 @@ const ROUND: [(&str, i32, &str, &str); 10] = [
     ("clear", 1, "rejected", "STATE"),
     ("speed 1800 30000", 1, "rejected", "RANGE"),
     ("start", 0, "ok", ""),
-    ("status", 0, "status", "state=spinning-up|state=running"),
+    ("status", 0, "status", "state=changing-speed|state=running"),
     ("ping", 0, "ok", ""),
     ("stop", 0, "ok", ""),
     ("ping", 0, "ok", ""),

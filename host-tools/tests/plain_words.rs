@@ -15,7 +15,7 @@ fn faults() -> Vec<FaultCode> {
 #[test]
 fn plain_words_only() {
     // A Rust name: a word that starts with a capital and has a lower-upper run inside
-    // (`SpinningUp`); units such as `kHz` are not.
+    // (`ChangingSpeed`); units such as `kHz` are not.
     let camel = |s: &str| {
         s.split(|c: char| !c.is_ascii_alphanumeric()).any(|w| {
             w.starts_with(|c: char| c.is_ascii_uppercase())
@@ -24,7 +24,7 @@ fn plain_words_only() {
                     .any(|p| p[0].is_ascii_lowercase() && p[1].is_ascii_uppercase())
         })
     };
-    assert!(camel("state SpinningUp") && !camel("10 kHz"));
+    assert!(camel("state ChangingSpeed") && !camel("10 kHz"));
     for f in faults() {
         assert!(!camel(f.words()), "{f:?}");
     }
@@ -32,7 +32,7 @@ fn plain_words_only() {
     for s in [
         ControllerState::Idle,
         ControllerState::Commissioning,
-        ControllerState::SpinningUp,
+        ControllerState::ChangingSpeed,
         ControllerState::Running,
         ControllerState::Stopping,
         ControllerState::Fault,
@@ -46,7 +46,7 @@ fn plain_words_only() {
     let states: Vec<&str> = [
         DeviceState::Idle,
         DeviceState::Commissioning,
-        DeviceState::SpinningUp,
+        DeviceState::ChangingSpeed,
         DeviceState::Running,
         DeviceState::Stopping,
         DeviceState::Faulted,

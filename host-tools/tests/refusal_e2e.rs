@@ -181,7 +181,7 @@ fn start_while_running_and_set_while_stopping_say_what_to_do() {
     assert_eq!(code, 1, "{text}");
     assert!(
         text.contains(
-            "already running (state spinning-up); change speed with `speed`, or `stop` first"
+            "already running (state changing-speed); change speed with `speed`, or `stop` first"
         ) || text.contains(
             "already running (state running); change speed with `speed`, or `stop` first"
         ),

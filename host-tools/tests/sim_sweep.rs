@@ -94,7 +94,7 @@ fn trace_from_a_speed_starts_settled_there() {
     assert!(
         rows[1..]
             .iter()
-            .all(|r| r[9] == "running" || r[9] == "spinning-up"),
+            .all(|r| r[9] == "running" || r[9] == "changing-speed"),
         "{:?}",
         rows[1]
     );

@@ -89,7 +89,7 @@ fn send_and_monitor_against_the_virtual_rig() {
     assert_eq!(summary["frames_missing"], 0, "{summary}");
     let text = stdout(&mon);
     assert!(
-        text.contains("state=running") || text.contains("state=spinning up"),
+        text.contains("state=running") || text.contains("state=changing speed"),
         "{text}"
     );
     // The setpoints as sent, in rad/s.

@@ -253,11 +253,11 @@ fn states_follow_start_stop_and_refuse_out_of_order_commands() {
     cl.ctrl.start().unwrap();
     assert_eq!(
         cl.ctrl.start(),
-        Err(Rejection::WrongState(State::SpinningUp))
+        Err(Rejection::WrongState(State::ChangingSpeed))
     );
     assert_eq!(
         cl.ctrl.set_parameters(ControllerConfig::nominal()),
-        Err(Rejection::WrongState(State::SpinningUp))
+        Err(Rejection::WrongState(State::ChangingSpeed))
     );
     cl.run(3.0, |_| {});
     assert_eq!(cl.ctrl.state(), State::Running);

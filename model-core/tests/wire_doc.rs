@@ -135,7 +135,7 @@ fn command_table_markdown() -> String {
     let state = |s: DeviceState| match s {
         DeviceState::Idle => "idle",
         DeviceState::Commissioning => "commissioning",
-        DeviceState::SpinningUp => "spinning up",
+        DeviceState::ChangingSpeed => "changing speed",
         DeviceState::Running => "running",
         DeviceState::Stopping => "stopping",
         DeviceState::Faulted => "faulted",

@@ -77,7 +77,7 @@ def test_every_command_and_its_refusals():
         check(s.bowl("start").startswith("ok"), "START refused")
         s.wait_emulated(0.3)
         st = s.status()
-        check(st.get("state") in ("spinning-up", "running"), f"not driving after START: {st}")
+        check(st.get("state") in ("changing-speed", "running"), f"not driving after START: {st}")
         check(s.bowl("stop").startswith("ok"), "STOP refused")
         out = s.bowl("clear")
         check(out.startswith(("ok", "rejected")), f"CLEAR: {out}")

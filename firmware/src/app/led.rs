@@ -5,7 +5,7 @@
 //! | state                                  | pattern (1 s frame)                         |
 //! |----------------------------------------|---------------------------------------------|
 //! | idle                                   | one short flash (100 ms on, 900 ms off)     |
-//! | driving (commissioning, spinning up, running, stopping) | on, one short gap (900 ms on, 100 ms off) |
+//! | driving (commissioning, changing speed, running, stopping) | on, one short gap (900 ms on, 100 ms off) |
 //! | fault (any but link lost)              | fast blink, 5 flashes (100 ms on/off)       |
 //! | link lost (fault `link-lost`)          | two flashes (100 on, 100 off, 100 on, 700 off) |
 //!
@@ -20,7 +20,7 @@ use model_core::control::{Fault, State};
 pub enum LedMode {
     /// Motors off, waiting for a command.
     Idle,
-    /// A motor may be driven (commissioning, spinning up, running, stopping).
+    /// A motor may be driven (commissioning, changing speed, running, stopping).
     Driving,
     /// A fault stopped the motors (sensor, over-speed, configuration).
     Fault,
@@ -104,7 +104,7 @@ mod tests {
         assert_eq!(L::of(State::Idle, None), L::Idle);
         for s in [
             State::Commissioning,
-            State::SpinningUp,
+            State::ChangingSpeed,
             State::Running,
             State::Stopping,
         ] {

@@ -86,7 +86,7 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
         && !ParamRole::of(p).changes_while_running()
         && matches!(
             s.state,
-            D::Running | D::SpinningUp | D::Stopping | D::Commissioning
+            D::Running | D::ChangingSpeed | D::Stopping | D::Commissioning
         )
     {
         // A rig that is already stopping needs no `stop`: only time.
@@ -104,7 +104,7 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
         );
     }
     let todo = match s.state {
-        D::Running | D::SpinningUp if command == "start" => format!(
+        D::Running | D::ChangingSpeed if command == "start" => format!(
             "already running (state {}); change speed with `speed`, or `stop` first",
             s.state.token()
         ),
@@ -118,7 +118,7 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
             s.fault.words()
         ),
         D::Commissioning => "wait for commissioning to end".to_string(),
-        D::Running | D::SpinningUp if command == "commission" => {
+        D::Running | D::ChangingSpeed if command == "commission" => {
             "stop the motors first (`bowl send PORT stop`)".to_string()
         }
         D::Idle if command == "clear" => "there is no fault to clear".to_string(),

@@ -77,7 +77,7 @@ pub struct Expect {
     pub from_ms: u32,
     /// Span end, device ms (inclusive).
     pub to_ms: u32,
-    /// The states allowed (`idle`, `commissioning`, `spinning-up`, `running`, `stopping`,
+    /// The states allowed (`idle`, `commissioning`, `changing-speed`, `running`, `stopping`,
     /// `faulted`: the words `bowl send status` and the CSV use).
     #[serde(default)]
     pub state: Vec<String>,

@@ -121,7 +121,7 @@ mod tests {
         let states = [
             State::Idle,
             State::Commissioning,
-            State::SpinningUp,
+            State::ChangingSpeed,
             State::Running,
             State::Stopping,
             State::Fault,

@@ -96,7 +96,7 @@ impl From<State> for DeviceState {
         match s {
             State::Idle => DeviceState::Idle,
             State::Commissioning => DeviceState::Commissioning,
-            State::SpinningUp => DeviceState::SpinningUp,
+            State::ChangingSpeed => DeviceState::ChangingSpeed,
             State::Running => DeviceState::Running,
             State::Stopping => DeviceState::Stopping,
             State::Fault => DeviceState::Faulted,

@@ -221,7 +221,7 @@ impl Controller {
             }
         }
         match self.state {
-            State::SpinningUp | State::Running | State::Stopping => {
+            State::ChangingSpeed | State::Running | State::Stopping => {
                 self.closed_loop_step(dt, &seen)
             }
             _ => self.set_duties_zero(),
@@ -310,7 +310,7 @@ impl Controller {
                     self.reached = true;
                     State::Running
                 } else {
-                    State::SpinningUp
+                    State::ChangingSpeed
                 };
             }
         }

@@ -1,11 +1,11 @@
 //! Operating states and faults.
 //!
 //! ```text
-//!   Idle --start--> SpinningUp --(both references reached)--> Running
+//!   Idle --start--> ChangingSpeed --(both references reached)--> Running
 //!    ^  \                |  ^                                  |
 //!    |   \--commission-->|  '------(new setpoint: ramping)-----'
 //!    |                   v
-//!    '--(both at rest)-- Stopping <--stop-- (SpinningUp | Running)
+//!    '--(both at rest)-- Stopping <--stop-- (ChangingSpeed | Running)
 //!   any state --fault--> Fault --clear_fault--> Idle
 //! ```
 //! On a fault both duties go to zero in the same tick it is detected, and the bridge *coasts*
@@ -30,7 +30,7 @@ pub enum State {
     /// The identification routine drives one axis at a time open loop.
     Commissioning = 1,
     /// Closed loop, at least one reference still ramping or not yet reached.
-    SpinningUp = 2,
+    ChangingSpeed = 2,
     /// Closed loop, both references reached and steady.
     Running = 3,
     /// Closed loop, ramping both references down to zero after a stop command.

@@ -92,10 +92,10 @@ pub struct States(u8);
 impl States {
     /// Every state.
     pub const ANY: States = States(0b11_1111);
-    /// Where a setpoint may change: idle (taken at START), spinning up, running.
+    /// Where a setpoint may change: idle (taken at START), changing speed, running.
     pub const SETPOINT: States = States::of(&[
         DeviceState::Idle,
-        DeviceState::SpinningUp,
+        DeviceState::ChangingSpeed,
         DeviceState::Running,
     ]);
     /// Idle only.

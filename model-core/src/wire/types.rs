@@ -18,7 +18,7 @@ pub enum DeviceState {
     /// The identification routine drives one axis at a time, open loop.
     Commissioning = 1,
     /// Closed loop, ramping towards the setpoints.
-    SpinningUp = 2,
+    ChangingSpeed = 2,
     /// Closed loop, at the setpoints.
     Running = 3,
     /// Ramping down after STOP.
@@ -352,7 +352,7 @@ macro_rules! code_enum {
 code_enum!(DeviceState {
     Idle,
     Commissioning,
-    SpinningUp,
+    ChangingSpeed,
     Running,
     Stopping,
     Faulted,

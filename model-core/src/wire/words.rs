@@ -16,7 +16,7 @@ impl DeviceState {
         match self {
             DeviceState::Idle => "idle",
             DeviceState::Commissioning => "commissioning",
-            DeviceState::SpinningUp => "spinning-up",
+            DeviceState::ChangingSpeed => "changing-speed",
             DeviceState::Running => "running",
             DeviceState::Stopping => "stopping",
             DeviceState::Faulted => "faulted",
@@ -29,7 +29,7 @@ impl DeviceState {
         match self {
             DeviceState::Idle => "idle",
             DeviceState::Commissioning => "commissioning",
-            DeviceState::SpinningUp => "spinning up",
+            DeviceState::ChangingSpeed => "changing speed",
             DeviceState::Running => "running",
             DeviceState::Stopping => "stopping",
             DeviceState::Faulted => "faulted (motors off)",

@@ -180,7 +180,7 @@ fn state_and_fault_names_keep_the_controller_codes() {
     for state in [
         State::Idle,
         State::Commissioning,
-        State::SpinningUp,
+        State::ChangingSpeed,
         State::Running,
         State::Stopping,
         State::Fault,

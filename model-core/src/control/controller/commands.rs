@@ -87,7 +87,7 @@ impl Controller {
 
     /// Sets both motor speeds, rad/s (signed; sign = direction). Zero, or a magnitude within
     /// `[min_speed_rad_s, max_speed_rad_s]` of the axis. Allowed in Idle (taken at `start`),
-    /// SpinningUp and Running; the planner ramps to it.
+    /// ChangingSpeed and Running; the planner ramps to it.
     pub const fn set_motor_speeds(
         &mut self,
         precession_rad_s: f32,
@@ -136,7 +136,7 @@ impl Controller {
         })
     }
 
-    /// Starts the closed loop (Idle -> SpinningUp) toward the current targets.
+    /// Starts the closed loop (Idle -> ChangingSpeed) toward the current targets.
     pub const fn start(&mut self) -> Result<(), Rejection> {
         // What `command` does, in a `const fn` (see `set_motor_speeds`).
         self.host.heard();
@@ -145,7 +145,7 @@ impl Controller {
                 self.axes[0].rest_loop();
                 self.axes[1].rest_loop();
                 self.reached = false;
-                self.state = State::SpinningUp;
+                self.state = State::ChangingSpeed;
                 Ok(())
             }
             State::Fault => Err(Rejection::Faulted(self.latched())),
@@ -158,7 +158,7 @@ impl Controller {
     pub fn stop(&mut self) -> Result<(), Rejection> {
         self.command(|c| {
             match c.state {
-                State::SpinningUp | State::Running => {
+                State::ChangingSpeed | State::Running => {
                     c.planner.set_targets([0.0; 2]);
                     c.reached = false;
                     c.state = State::Stopping;
