@@ -78,6 +78,8 @@ fn main() -> ExitCode {
             eprintln!("error: {e:#}");
             if e.chain().any(|c| c.is::<rig_client::serial::LinkError>()) {
                 exit_code::LINK
+            } else if e.chain().any(|c| c.is::<lab::usage::Usage>()) {
+                exit_code::USAGE
             } else {
                 exit_code::REFUSED
             }

@@ -239,7 +239,8 @@ fn batch_rows_carry_the_results_condition_and_flags_of_single_predictions() {
             "never_leaves" => {
                 assert_eq!(
                     (&row[8], &row[9], &row[10], &row[11]),
-                    ("inf", "nan", "nan", "")
+                    ("", "", "", ""),
+                    "never leaves: empty cells, never inf or nan"
                 );
                 assert!(row[12].starts_with("never_leaves"), "{row:?}");
             }

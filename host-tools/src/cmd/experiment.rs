@@ -45,7 +45,8 @@ pub struct Args {
     pub repeats: usize,
     /// Run the plan on this many simulated rigs (seeds 1..=N), fit each, and report the
     /// statistics of the fits against the rig file's truth (results under --out's folder).
-    #[arg(long)]
+    /// At least 1 (0 seeds would give a mean of nothing).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub benchmark_seeds: Option<u32>,
     /// Seed of the simulated rig (overrides the rig file's `seed`).
     #[arg(long)]

@@ -88,15 +88,30 @@ impl RollingInputs {
             rim_radius_m: args.rim_radius_m,
         };
         scene.validate().map_err(|e| anyhow::anyhow!(words(e)))?;
+        super::refusals::gravity(scene.g_m_s2, "--g")?;
         fits(&scene)?;
         Ok((scene, th_deg))
     }
 }
 
+/// The largest rod offset L the models are checked for (the bowl model's property test runs
+/// rod offsets to 1 m, docs/model.md §10), the same bound as a rig file's largest bowl radius:
+/// L = 1e8 m answered "still inside after 10 s", marked valid.
+pub const ROD_OFFSET_MAX_M: f64 = 1.0;
+
 /// The granule fits the bowl: its radius below the bottom's (the model puts its centre on the
 /// bottom at the release radius; a 1 m granule in a 75 mm bowl was answered as valid, a 1e9 m
 /// one ran for minutes and gave up).
 pub fn fits(scene: &RollingScene<f64>) -> Result<()> {
+    if scene.rod_length_m > ROD_OFFSET_MAX_M {
+        bail!(
+            "--rod-offset-m {} m is beyond {ROD_OFFSET_MAX_M} m: the models are checked for rod \
+             offsets up to that (docs/model.md §10; a rig file bounds a bowl's radius to 1 m \
+             the same way), and far beyond it they answer wrongly without knowing; give the \
+             horizontal offset L = l sin(th) of your rod in metres",
+            scene.rod_length_m
+        );
+    }
     if scene.particle_radius_m >= scene.rim_radius_m {
         bail!(
             "--particle-radius-m {} m is not smaller than the bowl's radius R = {} m \
@@ -193,7 +208,9 @@ fn outcome(o: &RollingOutcome<f64>, sliding_mu: f64) -> (serde_json::Value, Stri
                     "max_friction_ratio": max_friction_ratio, "first_slip_s": first_slip_s,
                 }),
                 format!(
-                    "leaves after T = {residence_time_s:.6} s at {exit_speed_m_s:.4} m/s relative to the bowl{slip}"
+                    "leaves after T = {} s at {} m/s relative to the bowl{slip}",
+                    crate::number::fixed(residence_time_s, 6),
+                    crate::number::fixed(exit_speed_m_s, 4)
                 ),
             )
         }
@@ -306,9 +323,13 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
             println!("{head}");
             match (sum.mean_s, sum.min_s, sum.max_s) {
                 (Some(m), Some(lo), Some(hi)) => println!(
-                    "over 12 release azimuths: T mean {m:.6} s, min {lo:.6} s, max {hi:.6} s; \
+                    "over 12 release azimuths: T mean {} s, min {} s, max {} s; \
                      {} of 12 leave, {} of those slide on the way",
-                    sum.left, sum.slid
+                    crate::number::fixed(m, 6),
+                    crate::number::fixed(lo, 6),
+                    crate::number::fixed(hi, 6),
+                    sum.left,
+                    sum.slid
                 ),
                 _ => println!("none of the 12 releases leaves the bowl"),
             }

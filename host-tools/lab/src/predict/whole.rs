@@ -445,11 +445,20 @@ fn report(
     }
     match (mean, min, max) {
         (Some(m), Some(lo), Some(hi)) => println!(
-            "over {} releases: {} leave, T mean {m:.6} s, min {lo:.6} s, max {hi:.6} s",
-            a.times.len(),
-            left.len()
+            "over {}: {} leave, T mean {} s, min {} s, max {} s",
+            crate::number::count(a.times.len(), "release", "releases"),
+            left.len(),
+            crate::number::fixed(m, 6),
+            crate::number::fixed(lo, 6),
+            crate::number::fixed(hi, 6)
         ),
-        _ => println!("none of the {} releases leaves", a.times.len()),
+        _ => println!(
+            "{}",
+            match a.times.len() {
+                1 => "the release does not leave".to_string(),
+                n => format!("none of the {n} releases leaves"),
+            }
+        ),
     }
     Ok(())
 }
