@@ -260,3 +260,45 @@ fn batch_refusals_name_the_column_and_the_row() {
     assert!(!err.contains("--omega-rad-s"), "{err}");
     assert!(written.is_empty());
 }
+
+/// The QA scene where one release stalls at the default --tol 1e-9: the advice does not ask
+/// for a tighter --tol (it does not help) or dp54 (already run); the sentence names the
+/// azimuth and is said once, by the bowl model and by the chooser.
+#[test]
+fn the_gave_up_advice_is_true_and_said_once() {
+    let scene = [
+        "--axes-angle-deg",
+        "5",
+        "--sliding-mu",
+        "0.05",
+        "--precession-rad-s",
+        "1.2",
+        "--spin-rad-s",
+        "3.6",
+        "--rim-radius-m",
+        "0.075",
+        "--ri-m",
+        "0.0375",
+        "--wall-angle-deg",
+        "60",
+        "--wall-height-m",
+        "0.02",
+        "--max-time-s",
+        "3",
+        "--json",
+    ];
+    for model in [
+        &["predict", "--model", "bowl", "--speed-range", "false"][..],
+        &["predict"][..],
+    ] {
+        let mut args = model.to_vec();
+        args.extend(scene);
+        let v = json(&args);
+        let why = v["invalid_reason"].as_str().unwrap_or_default();
+        assert!(why.contains("gave up on 1 of 12 releases (at 90 deg"), "{why}");
+        assert!(why.contains("no setting gets those releases through"), "{why}");
+        assert!(!why.contains("may get through"), "{why}");
+        assert!(!why.contains("--method dp54"), "{why}");
+        assert_eq!(why.matches("gave up").count(), 1, "{why}");
+    }
+}

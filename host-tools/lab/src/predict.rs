@@ -12,6 +12,7 @@ mod bowl_setup;
 mod choice;
 mod ends;
 mod flags;
+mod gave_up;
 pub(crate) mod ode;
 mod paper_text;
 mod refusals;

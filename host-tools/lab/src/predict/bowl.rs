@@ -9,6 +9,7 @@ use model_core::particle::rolling::{MAX_STEPS, RollingMethod, RollingScene};
 use serde_json::{Value, json};
 
 pub(super) use super::bowl_setup::{BowlSetup, scene_and_shape};
+use super::gave_up;
 use super::speed_range::{self, SpeedAxis, SpeedReport};
 use super::validity::Validity;
 use super::{Inputs, rolling};
@@ -116,19 +117,13 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
     // by the stall watch in tens of steps instead of at the cap, docs/model.md §12) is
     // reported as such; the others still count.
     let mut gave_up = Vec::new();
-    let mut stalled = 0;
     for &deg in &betas {
         match bowl::residence_or_stall(&scene, &shape, deg.to_radians(), method, limits) {
             Ok(rep) => rows.push((deg, rep)),
             Err(
                 e @ BowlError::Scene(model_core::particle::rolling::RollingError::Integration(_)),
             ) => {
-                if e == BowlError::Scene(model_core::particle::rolling::RollingError::Integration(
-                    model_core::ode::system::SystemError::Stalled,
-                )) {
-                    stalled += 1;
-                }
-                gave_up.push((deg, words(e)));
+                gave_up.push((deg, e));
             }
             Err(e) => bail!("release at {deg} deg: {}", words(e)),
         }
@@ -158,19 +153,11 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
         ));
     }
     if !gave_up.is_empty() {
-        // A stall is the loose tolerance's own (a tighter one gets past it); the step cap
-        // is met by long runs, which a shorter horizon or a looser tolerance shortens.
-        let advice = if stalled == gave_up.len() {
-            "a tighter --tol (1e-7 or below) may get through"
-        } else {
-            "a shorter --max-time-s or a looser --tol may get through"
+        let settings = gave_up::Settings::Bowl {
+            method,
+            max_time_s: b.max_time_s,
         };
-        why.push(format!(
-            "the integration gave up on {} of {releases} releases ({}), so they have no \
-             residence time; {advice}",
-            gave_up.len(),
-            gave_up[0].1
-        ));
+        why.push(gave_up::sentence(&gave_up, releases, &settings));
     }
     let validity = if why.is_empty() {
         Validity::valid()
@@ -211,12 +198,12 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
                 )
             })
             .collect();
-        for (deg, why) in &gave_up {
+        for (deg, e) in &gave_up {
             per.push((
                 *deg,
                 json!({
                     "azimuth_deg": deg, "left": false, "residence_time_s": null,
-                    "regime": {}, "outcome": "gave_up", "error": why,
+                    "regime": {}, "outcome": "gave_up", "error": gave_up::what(e),
                 }),
             ));
         }
@@ -292,8 +279,8 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
             shares(&regime(rep))
         );
     }
-    for (deg, why) in &gave_up {
-        println!("release at {deg} deg: no answer: {why}");
+    for (deg, e) in &gave_up {
+        println!("release at {deg} deg: no answer: {}", gave_up::what(e));
     }
     if let Some(sp) = &speed {
         println!(

@@ -125,6 +125,7 @@ pub(crate) fn run_level(
 ) -> Result<std::result::Result<Answer, String>> {
     let mut times = Vec::new();
     let mut why = Vec::new();
+    let mut failed = Vec::new();
     match level {
         Level::Incline => {
             for &deg in betas {
@@ -268,15 +269,20 @@ pub(crate) fn run_level(
                         _ => times.push((deg, None)),
                     },
                     Err(e) => {
-                        why.push(format!(
-                            "release at {deg} deg: no answer: {}",
-                            bowl_cli::words(e)
-                        ));
+                        failed.push((deg, e));
                         times.push((deg, None));
                     }
                 }
             }
         }
+    }
+    if !failed.is_empty() {
+        // One sentence for all of them (it was one per release, eight times over).
+        why.push(super::gave_up::sentence(
+            &failed,
+            times.len(),
+            &super::gave_up::Settings::Chooser,
+        ));
     }
     why.dedup();
     Ok(Ok(Answer {
