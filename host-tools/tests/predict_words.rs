@@ -295,8 +295,14 @@ fn the_gave_up_advice_is_true_and_said_once() {
         args.extend(scene);
         let v = json(&args);
         let why = v["invalid_reason"].as_str().unwrap_or_default();
-        assert!(why.contains("gave up on 1 of 12 releases (at 90 deg"), "{why}");
-        assert!(why.contains("no setting gets those releases through"), "{why}");
+        assert!(
+            why.contains("gave up on 1 of 12 releases (at 90 deg"),
+            "{why}"
+        );
+        assert!(
+            why.contains("no setting gets those releases through"),
+            "{why}"
+        );
         assert!(!why.contains("may get through"), "{why}");
         assert!(!why.contains("--method dp54"), "{why}");
         assert_eq!(why.matches("gave up").count(), 1, "{why}");
