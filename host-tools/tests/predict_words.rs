@@ -308,3 +308,79 @@ fn the_gave_up_advice_is_true_and_said_once() {
         assert_eq!(why.matches("gave up").count(), 1, "{why}");
     }
 }
+
+/// One JSON shape for the tilted bowl's models: the bowl model's summary keys and per-release
+/// keys from `--model rolling` (a list of azimuths taken, as the bowl model takes it), `bowl`
+/// and `auto`, a release given up on included (its `regime` null, not missing).
+#[test]
+fn the_tilted_bowls_models_share_one_json_shape() {
+    let scene = [
+        "--axes-angle-deg",
+        "60",
+        "--precession-rad-s",
+        "2.08",
+        "--spin-rad-s",
+        "2.08",
+        "--ri-m",
+        "0.0375",
+        "--rim-radius-m",
+        "0.075",
+        "--release-azimuth-deg",
+        "0,90",
+        "--json",
+    ];
+    for model in ["rolling", "bowl", "auto"] {
+        let mut args = vec!["predict", "--model", model];
+        args.extend(scene);
+        let v = json(&args);
+        for key in [
+            "residence_time_mean_s",
+            "residence_time_min_s",
+            "residence_time_max_s",
+            "releases",
+            "releases_leaving",
+        ] {
+            assert!(v.get(key).is_some(), "{model}: no {key} in {v}");
+        }
+        assert_eq!(v["releases"], 2, "{model}: {v}");
+        let per = v["per_release"].as_array().unwrap();
+        assert_eq!(per.len(), 2, "{model}: {v}");
+        for (e, deg) in per.iter().zip([0.0, 90.0]) {
+            assert_eq!(e["azimuth_deg"], deg, "{model}: {e}");
+            for key in ["left", "residence_time_s", "regime"] {
+                assert!(e.get(key).is_some(), "{model}: no {key} in {e}");
+            }
+        }
+    }
+    let v = json(&[
+        "predict",
+        "--model",
+        "bowl",
+        "--axes-angle-deg",
+        "5",
+        "--sliding-mu",
+        "0.05",
+        "--precession-rad-s",
+        "1.2",
+        "--spin-rad-s",
+        "3.6",
+        "--rim-radius-m",
+        "0.075",
+        "--ri-m",
+        "0.0375",
+        "--wall-angle-deg",
+        "60",
+        "--wall-height-m",
+        "0.02",
+        "--max-time-s",
+        "3",
+        "--release-azimuth-deg",
+        "90",
+        "--speed-range",
+        "false",
+        "--json",
+    ]);
+    let e = &v["per_release"][0];
+    assert_eq!(e["outcome"], "gave_up", "{v}");
+    assert!(e.get("regime").is_some_and(|r| r.is_null()), "{e}");
+}

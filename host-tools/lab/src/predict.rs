@@ -16,6 +16,7 @@ mod gave_up;
 pub(crate) mod ode;
 mod paper_text;
 mod refusals;
+mod release_json;
 mod rolling;
 mod speed_range;
 mod spin_up;

@@ -9,10 +9,10 @@ use model_core::particle::rolling::{MAX_STEPS, RollingMethod, RollingScene};
 use serde_json::{Value, json};
 
 pub(super) use super::bowl_setup::{BowlSetup, scene_and_shape};
-use super::gave_up;
 use super::speed_range::{self, SpeedAxis, SpeedReport};
 use super::validity::Validity;
 use super::{Inputs, rolling};
+use super::{gave_up, release_json};
 use crate::number::{count, fixed, shares};
 
 /// The bowl model's own flags (the scene's are the rolling model's; `--mu` is the rolling
@@ -187,24 +187,30 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
                 };
                 (
                     *deg,
-                    json!({
-                        "azimuth_deg": deg, "left": t.is_some(), "residence_time_s": t,
-                        "regime": regime(rep), "outcome": outcome_name(&rep.outcome),
-                        "exit_speed_relative_m_s": v, "on_wall_s": rep.on_wall_s,
-                        "flight_s": rep.flight_s, "landings": rep.landings,
-                        "left_in_flight": t.is_some() && rep.left_in_flight,
-                        "switches": rep.switches, "rhs_evaluations": rep.evaluations,
-                    }),
+                    release_json::entry(
+                        *deg,
+                        t,
+                        regime(rep),
+                        json!({
+                            "outcome": outcome_name(&rep.outcome),
+                            "exit_speed_relative_m_s": v, "on_wall_s": rep.on_wall_s,
+                            "flight_s": rep.flight_s, "landings": rep.landings,
+                            "left_in_flight": t.is_some() && rep.left_in_flight,
+                            "switches": rep.switches, "rhs_evaluations": rep.evaluations,
+                        }),
+                    ),
                 )
             })
             .collect();
         for (deg, e) in &gave_up {
             per.push((
                 *deg,
-                json!({
-                    "azimuth_deg": deg, "left": false, "residence_time_s": null,
-                    "regime": {}, "outcome": "gave_up", "error": gave_up::what(e),
-                }),
+                release_json::entry(
+                    *deg,
+                    None,
+                    Value::Null,
+                    json!({"outcome": "gave_up", "error": gave_up::what(e)}),
+                ),
             ));
         }
         // In the order the azimuths were given.

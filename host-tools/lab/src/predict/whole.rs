@@ -423,7 +423,8 @@ fn report(
             "residence_time_mean_s": mean, "residence_time_min_s": min,
             "residence_time_max_s": max, "releases": a.times.len(),
             "releases_leaving": left.len(),
-            "per_release": a.times.iter().map(|(d, t)| json!({"azimuth_deg": d, "left": t.is_some(), "residence_time_s": t})).collect::<Vec<Value>>(),
+            // The chooser's levels give T alone: `regime` is null (the shape is the bowl model's).
+            "per_release": a.times.iter().map(|&(d, t)| super::release_json::entry(d, t, Value::Null, super::release_json::none())).collect::<Vec<Value>>(),
             "axes_angle_deg": th_deg,
         });
         a.validity.add_to(&mut v);
