@@ -77,6 +77,12 @@ fn non_finite_values_are_said_in_words_or_refused() {
     let (code, _, err) = run(&["predict", "--uncertainty", "mu=1e9"].map(String::from));
     assert_eq!(code, Some(1));
     assert!(err.contains("must be at most 1 (100 %)"), "{err}");
+    // A radius uncertainty that lets the granule stay: the spread is said to be unbounded.
+    let (code, out, _) = run(&["predict", "--uncertainty", "radius_m=1e9"].map(String::from));
+    assert_eq!(code, Some(0));
+    assert!(out.contains("spreads T without bound"), "{out}");
+    assert!(!out.contains("asked for"), "{out}");
+    no_inf_or_nan(&out);
 }
 
 /// A residence time of nanoseconds and a radius of 1e17 m keep their significant figures

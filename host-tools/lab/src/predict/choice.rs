@@ -173,6 +173,17 @@ pub fn describe(c: &Choice<f64>, need: &Need<f64>, runs_on: RunsOn) -> String {
             1e3 * k.radius_m,
             100.0 * k.omega_rel
         ),
+        // An uncertainty that lets the granule stay in the bowl spreads T without bound: said
+        // so, not "the inf % spread" (nor "asked for": nothing was asked).
+        (Need::Uncertainty(k), _) => format!(
+            "the tolerance {}, the chooser's largest: the parameters' uncertainty (mu +-{:.0} %, \
+             radii +-{} mm, omega +-{:.1} %) spreads T without bound (within it the granule may \
+             never leave)",
+            percent(c.tolerance_rel),
+            100.0 * k.mu_rel,
+            1e3 * k.radius_m,
+            100.0 * k.omega_rel
+        ),
         (Need::Tolerance(asked), _) if c.tolerance_rel > *asked * (1.0 + 1e-6) => format!(
             "the tolerance {} ({:.2e} asked for, raised to 64 rounding units of the precision \
              the plan runs in)",
