@@ -390,3 +390,39 @@ fn the_tilted_bowls_models_share_one_json_shape() {
     assert_eq!(e["outcome"], "gave_up", "{v}");
     assert!(e.get("regime").is_some_and(|r| r.is_null()), "{e}");
 }
+
+/// Where only some releases leave, the "what speed can do" paragraph says so (6 of 12 left
+/// and it offered the T range for RTIME TABLE without a word).
+#[test]
+fn the_speed_paragraph_says_when_not_every_release_leaves() {
+    let (code, out, err) = run(&[
+        "predict",
+        "--model",
+        "bowl",
+        "--axes-angle-deg",
+        "30",
+        "--precession-rad-s",
+        "2.08",
+        "--spin-rad-s",
+        "2.08",
+        "--rim-radius-m",
+        "0.075",
+        "--ri-m",
+        "0.0375",
+        "--wall-angle-deg",
+        "60",
+        "--wall-height-m",
+        "0.02",
+    ]
+    .map(String::from));
+    assert_eq!(code, Some(0), "{err}");
+    let para = out
+        .lines()
+        .find(|l| l.starts_with("what speed can do:"))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(
+        para.contains("but only 6 of 12 releases leave at the asked speed"),
+        "{para}"
+    );
+    assert!(out.contains("over 12 releases: 6 leave"), "{out}");
+}
