@@ -195,3 +195,64 @@ fn suggest_refuses_bad_values_in_words_with_a_failing_exit() {
     assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A plan beyond the motors' limits is refused before anything runs, naming the condition,
+/// the speed, the limit and the fastest bowl speed (it ran, every row a motor fault without
+/// the limit); a plan value of the wrong type is said in words with its key; no rig names
+/// both ways to give one, exit 2; one release is singular.
+#[test]
+fn a_plan_is_checked_against_the_rig_before_it_runs() {
+    let dir = temp_dir("experiment-limits");
+    let rig = rig_with_particle(&dir, "seed = 3");
+    let plan = dir.join("fast.toml");
+    std::fs::write(&plan, "[[condition]]\nbowl_rad_s = 50\nrepeats = 2\n").unwrap();
+    let out = dir.join("out").join("x.csv");
+    let args = |plan: &std::path::Path| {
+        vec![
+            "experiment".to_string(),
+            plan.display().to_string(),
+            "--rig-file".into(),
+            rig.display().to_string(),
+            "--out".into(),
+            out.display().to_string(),
+        ]
+    };
+    let run = |a: &[String]| bowl(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let o = run(&args(&plan));
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("condition 1: bowl_rad_s = 50, which needs a precession speed of")
+            && err.contains("above the rig's limit of")
+            && err.contains("the fastest bowl speed this rig can run is"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing written");
+    std::fs::write(&plan, "[[condition]]\nbowl_rad_s = 3\nrepeats = 1.5\n").unwrap();
+    let err = String::from_utf8_lossy(&run(&args(&plan)).stderr).into_owned();
+    assert!(
+        err.contains("line 3") && err.contains("repeats:") && err.contains("a whole number"),
+        "{err}"
+    );
+    assert!(!err.contains("usize"), "{err}");
+    std::fs::write(
+        &plan,
+        "settle_s = 0.5\n[[condition]]\nbowl_rad_s = 3\nrepeats = 1\n",
+    )
+    .unwrap();
+    let o = run(&args(&plan));
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("1 release written to"));
+    let o = bowl(&["experiment", plan.to_str().unwrap(), "--out", "x.csv"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("--rig-file FILE") && err.contains("--port PORT"),
+        "{err}"
+    );
+}

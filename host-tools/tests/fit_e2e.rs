@@ -276,3 +276,55 @@ fn a_spreadsheets_files_fit_like_the_original() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// A model that cannot reproduce the runs (a vertical wall holds a release: no finite error or
+/// AIC) shows "-" in the text table and an empty cell in the condition table, never inf.
+#[test]
+fn a_model_without_an_error_shows_no_inf() {
+    let dir = common::temp_dir("fit-unreproducible");
+    let plan = dir.join("plan.toml");
+    std::fs::write(
+        &plan,
+        "settle_s = 0.5\n[[condition]]\nbowl_rad_s = 2\nrepeats = 3\n\
+         [[condition]]\nbowl_rad_s = 4\nrepeats = 3\n",
+    )
+    .unwrap();
+    let results = dir.join("x.csv");
+    let rig = "../docs/rigs/bowl-60deg.toml";
+    let out = common::bowl(&[
+        "experiment",
+        plan.to_str().unwrap(),
+        "--rig-file",
+        rig,
+        "--out",
+        results.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = common::bowl(&["fit", results.to_str().unwrap(), "--rig-file", rig]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("not a candidate: some run never leaves under it"),
+        "{text}"
+    );
+    let words: Vec<&str> = text.split(|c: char| !c.is_alphanumeric()).collect();
+    assert!(
+        !words.iter().any(|w| ["inf", "NaN", "nan"].contains(w)),
+        "{text}"
+    );
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("bowl-wall-vertical-20mm "))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(line.trim_end().ends_with("-            -"), "{line}");
+}

@@ -239,7 +239,8 @@ fn batch_rows_carry_the_results_condition_and_flags_of_single_predictions() {
             "never_leaves" => {
                 assert_eq!(
                     (&row[8], &row[9], &row[10], &row[11]),
-                    ("inf", "nan", "nan", "")
+                    ("", "", "", ""),
+                    "never leaves: empty cells, never inf or nan"
                 );
                 assert!(row[12].starts_with("never_leaves"), "{row:?}");
             }
@@ -353,9 +354,16 @@ fn rolling_model_on_the_tilted_rig() {
     assert!((get("residence_time_mean_s") - 0.211).abs() < 5e-4, "{v}");
     assert!((get("residence_time_min_s") - 0.153).abs() < 5e-4, "{v}");
     assert!((get("residence_time_max_s") - 0.287).abs() < 5e-4, "{v}");
+    // One azimuth, or a list: the same shape as --model bowl (per_release, releases).
     let v = json(&at("0"));
-    let t = v["residence_time_s"].as_f64().unwrap();
+    let t = v["per_release"][0]["residence_time_s"].as_f64().unwrap();
     assert!(t > 0.15 && t < 0.29, "{v}");
+    assert_eq!(v["residence_time_mean_s"].as_f64(), Some(t));
+    assert_eq!(v["per_release"][0]["regime"]["roll"], 1.0, "{v}");
+    let v = json(&at("0,90"));
+    assert_eq!(v["releases"], 2, "{v}");
+    assert_eq!(v["per_release"][1]["azimuth_deg"], 90.0, "{v}");
+    assert_eq!(v["releases_leaving"], 2, "{v}");
     // A missing speed is said plainly, exit code 1.
     let out = bowl(&["predict", "--model", "rolling", "--axes-angle-deg", "30"]);
     assert_eq!(out.status.code(), Some(1));

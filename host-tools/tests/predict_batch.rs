@@ -34,7 +34,10 @@ fn line_numbers_are_right_for_lf_crlf_and_cr() {
             err.contains("line 4: `w_rad_s` = \"fast\""),
             "{name}: {err}"
         );
-        assert!(err.contains("line 5: --ri-m 0.2 m"), "{name}: {err}");
+        assert!(
+            err.contains("line 5: column ri_m = 0.2 m"),
+            "the column, not a flag: {name}: {err}"
+        );
         assert!(err.contains("--keep-going"), "{name}: {err}");
         assert!(
             written.is_empty(),

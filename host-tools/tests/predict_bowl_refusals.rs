@@ -57,7 +57,7 @@ fn bad_bowl_input_is_said_in_words() {
         (
             ["60", "0.02", "0"],
             vec!["--max-time-s", "0"],
-            "--max-time-s must be a positive",
+            "--max-time-s 0 s: each release is followed this long, so it must be above 0",
         ),
         (
             ["60", "0.02", "0"],

@@ -8,10 +8,15 @@ use model_core::particle::{self, Model, Outcome, Scene};
 
 mod batch;
 pub(crate) mod bowl;
+mod bowl_setup;
 mod choice;
 mod ends;
+mod flags;
+mod gave_up;
 pub(crate) mod ode;
+mod paper_text;
 mod refusals;
+mod release_json;
 mod rolling;
 mod speed_range;
 mod spin_up;
@@ -23,6 +28,7 @@ pub(crate) mod whole;
 
 pub use bowl::BowlInputs;
 pub use ends::{Ends, Leaves};
+pub use flags::Given;
 pub use refusals::ode as ode_words;
 pub use refusals::scene as scene_words;
 pub use rolling::RollingInputs;
@@ -122,6 +128,8 @@ pub struct Inputs {
     pub rolling: rolling::RollingInputs,
     /// The bowl model's own flags.
     pub bowl: bowl::BowlInputs,
+    /// Which of the flags with a default were typed.
+    pub given: flags::Given,
 }
 
 /// One computed result, whatever the method.
@@ -204,6 +212,7 @@ pub fn run(args: &Inputs) -> Result<()> {
              --model and --method (give --tolerance or --uncertainty instead)"
         );
     }
+    flags::refuse_unused(args)?;
     if args.model == ModelChoice::Rolling {
         return rolling::run(args, &args.rolling);
     }
@@ -330,7 +339,7 @@ pub fn run(args: &Inputs) -> Result<()> {
                 println!("{} model {line}", model_name(*m));
             }
         }
-        println!("{}", describe_scene(&scene));
+        println!("{}", paper_text::describe_scene(&scene));
         if let Some(c) = &chosen {
             println!(
                 "{}\n  (--model flat, coriolis or both to override)",
@@ -338,7 +347,7 @@ pub fn run(args: &Inputs) -> Result<()> {
             );
         }
         for (m, p) in &rows {
-            println!("{}", describe(&scene, *m, args.method, p));
+            println!("{}", paper_text::describe(&scene, *m, args.method, p));
         }
     }
     Ok(())
@@ -401,62 +410,6 @@ fn json_result(model: Model, method: MethodChoice, p: &Prediction) -> serde_json
         obj.extend(more);
     }
     v
-}
-
-fn describe_scene(s: &Scene<f64>) -> String {
-    format!(
-        "scene: omega {} rad/s, mu {}, g {} m/s^2, k2 {:.6}, ri {} m, R {} m; equilibrium radius a = mu g / omega^2 = {:.6} m",
-        s.omega_rad_s,
-        s.mu,
-        s.g_m_s2,
-        s.k2,
-        s.ri_m,
-        s.rim_radius_m,
-        s.equilibrium_radius_m()
-    )
-}
-
-fn describe(scene: &Scene<f64>, model: Model, method: MethodChoice, p: &Prediction) -> String {
-    let head = format!("{:<8} {:<13}", model_name(model), method_name(method));
-    let cost = if p.rhs_evaluations > 0 {
-        format!(
-            " [{} steps, {} rhs evaluations]",
-            p.steps, p.rhs_evaluations
-        )
-    } else {
-        String::new()
-    };
-    match Ends::from(p.outcome) {
-        Ends::Leaves(l) => format!(
-            "{head} leaves after T = {:.9} s; exit radial {:.6} m/s, total {:.6} m/s; condition {:.3}{}{cost}",
-            l.residence_time_s,
-            l.exit_radial_velocity_m_s,
-            l.exit_total_velocity_m_s,
-            l.condition_number,
-            if l.ill_conditioned {
-                " (ILL-CONDITIONED: start just above the threshold a)"
-            } else {
-                ""
-            }
-        ),
-        Ends::AtRim {
-            exit_total_velocity_m_s,
-        } => {
-            format!("{head} starts at the rim: T = 0, exit total {exit_total_velocity_m_s:.6} m/s")
-        }
-        Ends::Never {
-            equilibrium_radius_m,
-            near_threshold,
-        } => format!(
-            "{head} NEVER LEAVES: {}{}",
-            refusals::what_holds(scene, equilibrium_radius_m),
-            if near_threshold {
-                " (within rounding of the threshold)"
-            } else {
-                ""
-            }
-        ),
-    }
 }
 
 fn run_inverse(scene: &Scene<f64>, models: &[Model], target: f64, json: bool) -> Result<()> {

@@ -19,7 +19,8 @@ pub struct Args {
     pub plan: Option<PathBuf>,
     /// Run on a simulated rig described by this rig file (its [particle] table is the truth;
     /// with `model = "bowl"` the granules follow the bowl model in its [bowl] table).
-    #[arg(long, required_unless_present = "port", conflicts_with = "port")]
+    /// One of --rig-file and --port is needed (refused in words naming both when neither).
+    #[arg(long, conflicts_with = "port")]
     pub rig_file: Option<PathBuf>,
     /// Run on the rig on this serial port (or a `bowl serve --pty` pseudo-terminal): releases by
     /// RELEASE, residence times from the rig's gate events.
@@ -45,7 +46,8 @@ pub struct Args {
     pub repeats: usize,
     /// Run the plan on this many simulated rigs (seeds 1..=N), fit each, and report the
     /// statistics of the fits against the rig file's truth (results under --out's folder).
-    #[arg(long)]
+    /// At least 1 (0 seeds would give a mean of nothing).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub benchmark_seeds: Option<u32>,
     /// Seed of the simulated rig (overrides the rig file's `seed`).
     #[arg(long)]
@@ -91,14 +93,21 @@ pub fn run(args: &Args) -> Result<()> {
             .with_context(|| format!("cannot read the plan {}", plan_path.display()))?;
         let plan = plan::parse(&text, &plan_path.display().to_string())?;
         let mut rig = port::PortRig::open(port, args.baud)?;
+        lab::experiment::check_speeds(&rig, &plan)?;
         let mut writer = Writer::create(out)?;
         let progress = std::io::stderr().is_terminal();
         let run_no = run_plan(&mut rig, &plan, &mut writer, progress)?;
-        println!("{run_no} releases written to {}", out.display());
+        println!(
+            "{} written to {}",
+            lab::number::count(run_no, "release", "releases"),
+            out.display()
+        );
         return Ok(());
     }
     let Some(rig_file) = &args.rig_file else {
-        bail!("give --rig-file FILE (a simulated rig) or --port PORT (a rig on a serial line)");
+        return lab::usage::usage(
+            "give --rig-file FILE (a simulated rig) or --port PORT (a rig on a serial line)",
+        );
     };
     let (plant, particle, file_seed) = read_rig_file(rig_file)?;
     let seed = args.seed.unwrap_or(file_seed);
@@ -126,10 +135,16 @@ pub fn run(args: &Args) -> Result<()> {
     if let Some(seeds) = args.benchmark_seeds {
         return benchmark::run(&plan, &plant, &particle, seeds, out);
     }
+    // Before the results file is made: a plan beyond the motors' limits writes nothing.
+    lab::experiment::check_speeds(&rig, &plan)?;
     let mut writer = Writer::create(out)?;
     let progress = std::io::stderr().is_terminal();
     let run_no = run_plan(&mut rig, &plan, &mut writer, progress)?;
     rig.stop();
-    println!("{run_no} releases written to {}", out.display());
+    println!(
+        "{} written to {}",
+        lab::number::count(run_no, "release", "releases"),
+        out.display()
+    );
     Ok(())
 }

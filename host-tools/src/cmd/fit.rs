@@ -218,10 +218,24 @@ pub fn run(args: &Args) -> Result<()> {
         println!("  outlier line {}: {}", o.row, o.why);
     }
     println!("model      mu        95 % interval          rms error %   AIC");
+    // A model that cannot reproduce the runs has no finite error or AIC (and an interval
+    // may be unbounded): "-" in its cell, the reason on the line below, never "inf".
+    let cell = |x: f64, decimals: usize| {
+        if x.is_finite() {
+            format!("{x:.decimals$}")
+        } else {
+            "-".into()
+        }
+    };
     for m in &fit.models {
         println!(
-            "{:<10} {:.5}  [{:.5}, {:.5}]   {:>8.2}   {:>10.2}",
-            m.candidate.name, m.mu, m.mu_ci95.0, m.mu_ci95.1, m.rms_error_pct, m.aic
+            "{:<10} {}  [{}, {}]   {:>8}   {:>10}",
+            m.candidate.name,
+            cell(m.mu, 5),
+            cell(m.mu_ci95.0, 5),
+            cell(m.mu_ci95.1, 5),
+            cell(m.rms_error_pct, 2),
+            cell(m.aic, 2)
         );
         match &m.k2 {
             K2::Given => {}

@@ -4,7 +4,7 @@
 use anyhow::Result;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use lab::predict::{
-    self as lp, BowlInputs, Inputs, MethodChoice, ModelChoice, RollingInputs, RunsOn,
+    self as lp, BowlInputs, Given, Inputs, MethodChoice, ModelChoice, RollingInputs, RunsOn,
 };
 
 /// A choice among named values, each with its help line: the typed value of the lab's enum.
@@ -104,18 +104,21 @@ fn choice<T: Copy + Send + Sync + 'static>(table: Choices<T>) -> impl TypedValue
 /// Flags of `bowl predict`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Combined bowl speed omega (paper Eq. 2), rad/s.
-    #[arg(long, visible_alias = "w-rad-s", default_value_t = 3.0)]
-    omega_rad_s: f64,
+    /// Combined bowl speed omega (paper Eq. 2), rad/s, of the paper's level-bowl models
+    /// [default: 3]. The tilted bowl's models take --precession-rad-s and --spin-rad-s instead.
+    #[arg(long, visible_alias = "w-rad-s")]
+    omega_rad_s: Option<f64>,
     /// Effective rolling resistance coefficient mu (the paper's literal 0.4 makes nothing move).
     #[arg(long, default_value_t = 0.029)]
     mu: f64,
-    /// Start radius ri, m (the particle starts at rest).
-    #[arg(long, default_value_t = 0.05)]
-    ri_m: f64,
-    /// Rim radius R, m (0.1 m: a 200 mm bowl, reading the paper's sizes as diameters).
-    #[arg(long, visible_alias = "r-m", default_value_t = 0.1)]
-    rim_radius_m: f64,
+    /// Start radius ri, m (the particle starts at rest) [default: 0.05, or with --rig-file its
+    /// [particle] release_radius_m].
+    #[arg(long)]
+    ri_m: Option<f64>,
+    /// Rim radius R, m (0.1 m: a 200 mm bowl, reading the paper's sizes as diameters)
+    /// [default: 0.1]. A rig file sets it (its [bowl] rim_radius_m): not both.
+    #[arg(long, visible_alias = "r-m")]
+    rim_radius_m: Option<f64>,
     /// Gravity, m/s^2.
     #[arg(long, default_value_t = 9.81)]
     g: f64,
@@ -152,9 +155,9 @@ pub struct Args {
     /// With --spin-up-from-rad-s: the spin-up's time constant, s.
     #[arg(long, requires = "spin_up_from_rad_s")]
     time_constant_s: Option<f64>,
-    /// Method: closed form or one of the integrators.
-    #[arg(long, value_parser = choice(METHODS), default_value = "closed")]
-    method: MethodChoice,
+    /// Method: closed form or one of the integrators [default: closed; the bowl model: dp54].
+    #[arg(long, value_parser = choice(METHODS))]
+    method: Option<MethodChoice>,
     /// Fixed step of euler / semi-implicit / rk4, s (default: 0.01 / omega).
     #[arg(long, visible_alias = "step")]
     step_s: Option<f64>,
@@ -207,9 +210,10 @@ pub struct RollingArgs {
     /// Rolling model: angle between the bowl's axis and the vertical, degrees (paper Eq. 2).
     #[arg(long)]
     axes_angle_deg: Option<f64>,
-    /// Rolling model: granule radius a, m.
-    #[arg(long, default_value_t = 0.003)]
-    particle_radius_m: f64,
+    /// Rolling model: granule radius a, m [default: 0.003]. A rig file sets it (its [bowl]
+    /// particle_radius_m): not both.
+    #[arg(long)]
+    particle_radius_m: Option<f64>,
     /// Rolling model: the rod's horizontal offset L, the distance of the bowl's centre from the
     /// precession axis, m. Not the rod's length: a rod of length l at angle th from the
     /// vertical gives L = l sin(th) (l overstates L by 15 % at 60 deg). `--rod-length-m` is
@@ -283,10 +287,10 @@ impl Args {
         let r = &self.rolling;
         let b = &self.bowl;
         Inputs {
-            omega_rad_s: self.omega_rad_s,
+            omega_rad_s: self.omega_rad_s.unwrap_or(3.0),
             mu: self.mu,
-            ri_m: self.ri_m,
-            rim_radius_m: self.rim_radius_m,
+            ri_m: self.ri_m.unwrap_or(0.05),
+            rim_radius_m: self.rim_radius_m.unwrap_or(0.1),
             g: self.g,
             k2: self.k2,
             model: self.model,
@@ -296,7 +300,7 @@ impl Args {
             release_at_ms: self.release_at_ms,
             spin_up_from_rad_s: self.spin_up_from_rad_s,
             time_constant_s: self.time_constant_s,
-            method: self.method,
+            method: self.method.unwrap_or(MethodChoice::Closed),
             step_s: self.step_s,
             tol: self.tol,
             target_time_s: self.target_time_s,
@@ -310,13 +314,20 @@ impl Args {
                 precession_rad_s: r.precession_rad_s,
                 spin_rad_s: r.spin_rad_s,
                 axes_angle_deg: r.axes_angle_deg,
-                particle_radius_m: r.particle_radius_m,
+                particle_radius_m: r.particle_radius_m.unwrap_or(0.003),
                 rod_offset_m: r.rod_offset_m,
                 release_azimuth_deg: r.release_azimuth_deg.clone(),
                 sliding_mu: r.sliding_mu,
                 hierarchy_tolerance: r.hierarchy_tolerance,
                 hierarchy_uncertainty_mu: r.hierarchy_uncertainty_mu,
                 each_release: r.each_release,
+            },
+            given: Given {
+                omega_rad_s: self.omega_rad_s.is_some(),
+                ri_m: self.ri_m.is_some(),
+                rim_radius_m: self.rim_radius_m.is_some(),
+                particle_radius_m: r.particle_radius_m.is_some(),
+                method: self.method.is_some(),
             },
             bowl: BowlInputs {
                 wall_angle_deg: b.wall_angle_deg,

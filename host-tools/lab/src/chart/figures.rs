@@ -218,8 +218,17 @@ fn sweep(which: Sweep) -> anyhow::Result<(Figure, Table)> {
                     model_name(model).into(),
                     format!("{w}"),
                     kind.into(),
-                    format!("{t:.17e}"),
-                    format!("{v:.17e}"),
+                    // Never leaves: empty cells (the kind column says so), not inf and NaN.
+                    if t.is_finite() {
+                        format!("{t:.17e}")
+                    } else {
+                        String::new()
+                    },
+                    if v.is_finite() {
+                        format!("{v:.17e}")
+                    } else {
+                        String::new()
+                    },
                 ]);
                 // Never leaves: no point, so the line has a gap (NaN).
                 let y = match which {

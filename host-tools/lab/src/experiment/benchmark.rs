@@ -88,17 +88,27 @@ pub fn run(
         .sum::<f64>()
         / n;
     let count = |p: &str| outcomes.iter().filter(|o| o.preferred == p).count();
+    // One seed has no spread: the mean's standard error is not given (it would be NaN).
+    let of_mean = if outcomes.len() > 1 {
+        format!(
+            ", {:+.2} of the mean of {} ({:.5})",
+            (mean - particle.mu) / (sd / n.sqrt()),
+            outcomes.len(),
+            sd / n.sqrt()
+        )
+    } else {
+        " (one seed: no spread between seeds; give --benchmark-seeds 2 or more for the mean's \
+         standard error)"
+            .into()
+    };
     println!(
         "truth {truth} mu {}: interval covers the truth in {covered} of {}; mean estimate {mean:.5}, \
-         bias {:+.5} = {:+.2} standard errors of one fit ({se_fit:.5}), {:+.2} of the mean of {} \
-         ({:.5}); preferred flat {}, coriolis {}, undecided {}; runs excluded {}; slowest plan {slowest_s:.2} s",
+         bias {:+.5} = {:+.2} standard errors of one fit ({se_fit:.5}){of_mean}; preferred flat {}, \
+         coriolis {}, undecided {}; runs excluded {}; slowest plan {slowest_s:.2} s",
         particle.mu,
         outcomes.len(),
         mean - particle.mu,
         (mean - particle.mu) / se_fit,
-        (mean - particle.mu) / (sd / n.sqrt()),
-        outcomes.len(),
-        sd / n.sqrt(),
         count("flat"),
         count("coriolis"),
         count("undecided"),

@@ -38,6 +38,49 @@ pub trait ReleaseRig {
     fn release(&mut self) -> Release;
     /// Stops the motors.
     fn stop(&mut self);
+    /// The fastest each motor may turn (precession, spin), rad/s, when the rig says.
+    fn max_speeds_rad_s(&self) -> Option<[f64; 2]> {
+        None
+    }
+}
+
+/// Every condition's motor speeds within the rig's limits, checked before the first release:
+/// a plan beyond them ran to the end, every row a motor fault without the limit.
+pub fn check_speeds(rig: &impl ReleaseRig, plan: &plan::Plan) -> Result<()> {
+    let Some(max) = rig.max_speeds_rad_s() else {
+        return Ok(());
+    };
+    for (ci, c) in plan.condition.iter().enumerate() {
+        let (targets, asked) = match (c.bowl_rad_s, c.precession_rad_s, c.spin_rad_s) {
+            (Some(w), _, _) => (rig.split(w)?, format!("bowl_rad_s = {w}, which needs")),
+            (None, Some(p), Some(s)) => ([p, s], "it asks for".to_string()),
+            _ => continue,
+        };
+        for (i, motor) in ["precession", "spin"].into_iter().enumerate() {
+            if targets[i].abs() > max[i] {
+                let fastest = match rig.split(1.0) {
+                    Ok(per) => (0..2)
+                        .map(|k| max[k] / per[k].abs().max(1e-9))
+                        .fold(f64::INFINITY, f64::min),
+                    Err(_) => f64::NAN,
+                };
+                let hint = if fastest.is_finite() {
+                    format!("; the fastest bowl speed this rig can run is {fastest:.3} rad/s")
+                } else {
+                    String::new()
+                };
+                anyhow::bail!(
+                    "condition {}: {asked} a {motor} speed of {:.3} rad/s, above the rig's \
+                     limit of {:.3} rad/s for that motor{hint}: lower the condition's speed \
+                     (nothing was run)",
+                    ci + 1,
+                    targets[i].abs(),
+                    max[i]
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A fault a rig reports, in the words the results file writes (the monitor's and `bowl send
@@ -61,6 +104,7 @@ pub fn run_plan(
     writer: &mut Writer,
     progress: bool,
 ) -> Result<usize> {
+    check_speeds(rig, plan)?;
     let (release_radius_m, rim_radius_m, k2) = rig.geometry();
     let total = plan::releases(plan);
     let mut run_no = 0;

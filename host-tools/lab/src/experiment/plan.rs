@@ -1,7 +1,7 @@
 //! The experiment plan (TOML): a settle time and a list of conditions, each a combined bowl
 //! speed (split into motor speeds by the rig's rule) or the two motor speeds, repeated.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use serde::Deserialize;
 
 /// One condition as written.
@@ -39,7 +39,11 @@ fn default_settle() -> f64 {
 
 /// Reads and checks a plan.
 pub fn parse(text: &str, file: &str) -> Result<Plan> {
-    let plan: Plan = toml::from_str(text).with_context(|| format!("{file}: not a valid plan"))?;
+    let plan: Plan = toml::from_str(text).map_err(|e| {
+        let (line, words) = rig_file::toml_error_words(text, &e);
+        let line = line.map_or(String::new(), |n| format!(", line {n}"));
+        anyhow::anyhow!("{file}{line}: not a valid plan: {words}")
+    })?;
     if !(plan.settle_s.is_finite() && (0.0..=600.0).contains(&plan.settle_s)) {
         bail!(
             "{file}: settle_s = {} must lie in 0 ..= 600 s",
@@ -102,5 +106,14 @@ mod tests {
             .to_string();
         assert!(e.contains("repeats = 0"), "{e}");
         assert!(parse("settle_s = 1\n", "p.toml").is_err());
+        // serde's Rust type names are said in words, with the key and the line.
+        let e = parse("[[condition]]\nbowl_rad_s = 6.5\nrepeats = 1.5\n", "p.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("p.toml, line 3") && e.contains("repeats:"),
+            "{e}"
+        );
+        assert!(e.contains("a whole number") && !e.contains("usize"), "{e}");
     }
 }

@@ -269,6 +269,16 @@ impl ReleaseRig for PortRig {
         let _ = self.command(Rig::stop);
     }
 
+    /// The limits the rig's parameters configure (as the speed range reads them).
+    fn max_speeds_rad_s(&self) -> Option<[f64; 2]> {
+        let cfg = model_core::binding::config_from_params(
+            &model_core::control::ControllerConfig::default(),
+            &self.params,
+        )
+        .ok()?;
+        Some([0, 1].map(|i| f64::from(cfg.axes[i].max_speed_rad_s)))
+    }
+
     /// The rig's AXES_MDEG parameter.
     fn axes_angle_rad(&self) -> f64 {
         super::axes_angle_rad(param(&self.params, ParamId::AxesMdeg))

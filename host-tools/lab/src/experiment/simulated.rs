@@ -234,4 +234,9 @@ impl super::ReleaseRig for BackendRig {
     fn stop(&mut self) {
         let _ = self.backend.bound_mut().controller_mut().stop();
     }
+
+    fn max_speeds_rad_s(&self) -> Option<[f64; 2]> {
+        let cfg = self.backend.bound().controller().config();
+        Some([0, 1].map(|i| f64::from(cfg.axes[i].max_speed_rad_s)))
+    }
 }

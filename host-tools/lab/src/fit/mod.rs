@@ -425,10 +425,21 @@ pub fn condition_table(fit: &Fit) -> crate::chart::table::Table {
             idx.len().to_string(),
             format!("{:.4}", mean(&|i| fit.runs[i].mean_rad_s)),
             format!("{t_mean:.4}"),
-            format!("{t_se:.4}"),
+            // One run has no standard error, a model that cannot reproduce a run no error:
+            // empty cells, never NaN or inf.
+            if t_se.is_finite() {
+                format!("{t_se:.4}")
+            } else {
+                String::new()
+            },
         ];
         for m in &fit.models {
-            row.push(format!("{:+.2}", mean(&|i| m.errors_pct[i])));
+            let e = mean(&|i| m.errors_pct[i]);
+            row.push(if e.is_finite() {
+                format!("{e:+.2}")
+            } else {
+                String::new()
+            });
         }
         table.row(row);
     }

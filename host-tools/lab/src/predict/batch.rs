@@ -146,7 +146,7 @@ fn parse_row(row: &csv::StringRecord, cols: &Columns, width: usize) -> Result<(M
         ri_m: field(cols.ri, "ri_m")?,
         rim_radius_m: field(cols.rim, "R_m")?,
     };
-    refusals::check(&scene)?;
+    refusals::check_named(&scene, &refusals::COLUMNS)?;
     Ok((model, scene))
 }
 
@@ -174,10 +174,12 @@ fn result_fields(o: &Outcome<f64>) -> [String; 5] {
             String::new(),
             String::new(),
         ],
+        // No time and no exit velocity: empty cells (a spreadsheet reads "inf" or "nan" as
+        // text, or worse as a number), the flags column says never_leaves.
         Ends::Never { near_threshold, .. } => [
-            "inf".into(),
-            "nan".into(),
-            "nan".into(),
+            String::new(),
+            String::new(),
+            String::new(),
             String::new(),
             if near_threshold {
                 "never_leaves;near_threshold"

@@ -8,9 +8,12 @@ use model_core::particle::bowl::{self, BowlError, BowlOutcome, BowlReport, BowlS
 use model_core::particle::rolling::{MAX_STEPS, RollingMethod, RollingScene};
 use serde_json::{Value, json};
 
+pub(super) use super::bowl_setup::{BowlSetup, scene_and_shape};
 use super::speed_range::{self, SpeedAxis, SpeedReport};
 use super::validity::Validity;
-use super::{Inputs, MethodChoice, rolling};
+use super::{Inputs, rolling};
+use super::{gave_up, release_json};
+use crate::number::{count, fixed, shares};
 
 /// The bowl model's own flags (the scene's are the rolling model's; `--mu` is the rolling
 /// resistance, `--sliding-mu` the contact's sliding coefficient).
@@ -38,27 +41,6 @@ pub struct BowlInputs {
     pub speed_range: bool,
     /// Bowl model: store the residence-time table on the rig at this port.
     pub store_table: Option<String>,
-}
-
-/// The wall flags with the rig file's `[bowl]` table (or the defaults) under them.
-pub(super) struct Wall {
-    angle_deg: f64,
-    height_m: f64,
-    fillet_m: f64,
-    restitution: f64,
-}
-
-impl BowlInputs {
-    fn wall(&self, table: Option<&rig_file::BowlGeometry>) -> Wall {
-        let pick =
-            |flag: Option<f64>, from: Option<f64>, default: f64| flag.or(from).unwrap_or(default);
-        Wall {
-            angle_deg: pick(self.wall_angle_deg, table.map(|t| t.wall_angle_deg), 90.0),
-            height_m: pick(self.wall_height_m, table.map(|t| t.wall_height_m), 0.0),
-            fillet_m: pick(self.fillet_radius_m, table.map(|t| t.fillet_radius_m), 0.0),
-            restitution: pick(self.restitution, table.map(|t| t.restitution), 0.5),
-        }
-    }
 }
 
 pub(crate) fn words(e: BowlError) -> String {
@@ -135,19 +117,13 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
     // by the stall watch in tens of steps instead of at the cap, docs/model.md §12) is
     // reported as such; the others still count.
     let mut gave_up = Vec::new();
-    let mut stalled = 0;
     for &deg in &betas {
         match bowl::residence_or_stall(&scene, &shape, deg.to_radians(), method, limits) {
             Ok(rep) => rows.push((deg, rep)),
             Err(
                 e @ BowlError::Scene(model_core::particle::rolling::RollingError::Integration(_)),
             ) => {
-                if e == BowlError::Scene(model_core::particle::rolling::RollingError::Integration(
-                    model_core::ode::system::SystemError::Stalled,
-                )) {
-                    stalled += 1;
-                }
-                gave_up.push((deg, words(e)));
+                gave_up.push((deg, e));
             }
             Err(e) => bail!("release at {deg} deg: {}", words(e)),
         }
@@ -177,19 +153,11 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
         ));
     }
     if !gave_up.is_empty() {
-        // A stall is the loose tolerance's own (a tighter one gets past it); the step cap
-        // is met by long runs, which a shorter horizon or a looser tolerance shortens.
-        let advice = if stalled == gave_up.len() {
-            "a tighter --tol (1e-7 or below) may get through"
-        } else {
-            "a shorter --max-time-s or a looser --tol may get through"
+        let settings = gave_up::Settings::Bowl {
+            method,
+            max_time_s: b.max_time_s,
         };
-        why.push(format!(
-            "the integration gave up on {} of {releases} releases ({}), so they have no \
-             residence time; {advice}",
-            gave_up.len(),
-            gave_up[0].1
-        ));
+        why.push(gave_up::sentence(&gave_up, releases, &settings));
     }
     let validity = if why.is_empty() {
         Validity::valid()
@@ -219,24 +187,30 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
                 };
                 (
                     *deg,
-                    json!({
-                        "azimuth_deg": deg, "left": t.is_some(), "residence_time_s": t,
-                        "regime": regime(rep), "outcome": outcome_name(&rep.outcome),
-                        "exit_speed_relative_m_s": v, "on_wall_s": rep.on_wall_s,
-                        "flight_s": rep.flight_s, "landings": rep.landings,
-                        "left_in_flight": t.is_some() && rep.left_in_flight,
-                        "switches": rep.switches, "rhs_evaluations": rep.evaluations,
-                    }),
+                    release_json::entry(
+                        *deg,
+                        t,
+                        regime(rep),
+                        json!({
+                            "outcome": outcome_name(&rep.outcome),
+                            "exit_speed_relative_m_s": v, "on_wall_s": rep.on_wall_s,
+                            "flight_s": rep.flight_s, "landings": rep.landings,
+                            "left_in_flight": t.is_some() && rep.left_in_flight,
+                            "switches": rep.switches, "rhs_evaluations": rep.evaluations,
+                        }),
+                    ),
                 )
             })
             .collect();
-        for (deg, why) in &gave_up {
+        for (deg, e) in &gave_up {
             per.push((
                 *deg,
-                json!({
-                    "azimuth_deg": deg, "left": false, "residence_time_s": null,
-                    "regime": {}, "outcome": "gave_up", "error": why,
-                }),
+                release_json::entry(
+                    *deg,
+                    None,
+                    Value::Null,
+                    json!({"outcome": "gave_up", "error": gave_up::what(e)}),
+                ),
             ));
         }
         // In the order the azimuths were given.
@@ -293,37 +267,66 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
                 residence_time_s,
                 exit_speed_m_s,
             } => format!(
-                "leaves over the lip after T = {residence_time_s:.6} s at {exit_speed_m_s:.4} m/s"
+                "leaves over the lip after T = {} s at {} m/s",
+                fixed(residence_time_s, 6),
+                fixed(exit_speed_m_s, 4)
             ),
             BowlOutcome::Held => "held at rest where it was released".into(),
             BowlOutcome::LiftsOff { time_s } => {
-                format!("lifts off at t = {time_s:.4} s (no landing found)")
+                format!("lifts off at t = {} s (no landing found)", fixed(time_s, 4))
             }
             BowlOutcome::Inside { horizon_s } if rep.held_s > 0.0 => {
                 format!("held by the wall: still inside after {horizon_s} s")
             }
             BowlOutcome::Inside { horizon_s } => format!("still inside after {horizon_s} s"),
         };
-        println!("release at {deg} deg: {what}; regime {}", regime(rep));
+        println!(
+            "release at {deg} deg: {what}; regime {}",
+            shares(&regime(rep))
+        );
     }
-    for (deg, why) in &gave_up {
-        println!("release at {deg} deg: no answer: {why}");
+    for (deg, e) in &gave_up {
+        println!("release at {deg} deg: no answer: {}", gave_up::what(e));
     }
     if let Some(sp) = &speed {
-        println!("what speed can do: {}", sp.words(th_deg));
+        println!(
+            "what speed can do: {}{}",
+            sp.words(th_deg),
+            not_all_leave(times.len(), releases)
+        );
     }
     match (mean, min, max) {
         (Some(m), Some(lo), Some(hi)) => println!(
-            "over {releases} releases: {} leave, T mean {m:.6} s, min {lo:.6} s, max {hi:.6} s",
-            times.len()
+            "over {}: {} leave, T mean {} s, min {} s, max {} s",
+            count(releases, "release", "releases"),
+            times.len(),
+            fixed(m, 6),
+            fixed(lo, 6),
+            fixed(hi, 6)
         ),
         _ => println!(
-            "none of the {} releases leaves within {} s",
-            rows.len(),
+            "{} within {} s",
+            match rows.len() {
+                1 => "the release does not leave".to_string(),
+                n => format!("none of the {n} releases leaves"),
+            },
             b.max_time_s
         ),
     }
     Ok(())
+}
+
+/// The speed paragraph's caveat when some releases never leave: its T is the mean over those
+/// that do (6 of 12 leaving was offered as a T range for RTIME TABLE without a word).
+fn not_all_leave(leaving: usize, releases: usize) -> String {
+    if leaving == releases {
+        return String::new();
+    }
+    format!(
+        "; but only {leaving} of {releases} releases leave at the asked speed (the others stay \
+         in the bowl): these times are the mean over the releases that leave, and a granule \
+         released elsewhere may never come out"
+    )
 }
 
 /// The mean residence time over the releases that leave (`None`: none leaves or one fails).
@@ -389,98 +392,4 @@ fn speed_report(
             midpoint_error: None,
         },
     }))
-}
-
-/// The bowl model's scene, checked, as the flags and the rig file give it.
-pub(super) struct BowlSetup {
-    pub(super) scene: RollingScene<f64>,
-    /// The tilt, degrees.
-    pub(super) th_deg: f64,
-    pub(super) wall: Wall,
-    pub(super) shape: BowlShape<f64>,
-    pub(super) method: RollingMethod<f64>,
-}
-
-/// The bowl model's scene, tilt (degrees), wall, shape and method from the flags and the rig
-/// file's `[bowl]` table, checked (also the whole-hierarchy chooser's, `--model auto`).
-pub(super) fn scene_and_shape(
-    args: &Inputs,
-    r: &rolling::RollingInputs,
-    b: &BowlInputs,
-) -> Result<BowlSetup> {
-    let table = match &b.rig_file {
-        Some(path) => {
-            let rigs = rig_file::load(path)?;
-            let Some(t) = rigs.first().and_then(|rig| rig.bowl) else {
-                bail!(
-                    "the rig file {} has no [bowl] table (its keys: docs/rigs/nominal.toml)",
-                    path.display()
-                );
-            };
-            Some(t)
-        }
-        None => None,
-    };
-    let (mut scene, th_deg) = r.scene(args, "bowl", table.map(|t| t.axes_angle_deg))?;
-    if let Some(t) = &table {
-        scene.rim_radius_m = t.rim_radius_m;
-        scene.particle_radius_m = t.particle_radius_m;
-        scene.validate().map_err(|e| {
-            anyhow::anyhow!("with the rig file's [bowl] table: {}", rolling::words(e))
-        })?;
-    }
-    let wall = b.wall(table.as_ref());
-    let method = match args.method {
-        MethodChoice::Closed | MethodChoice::Dp54 => RollingMethod::Dp54 { rtol: args.tol },
-        MethodChoice::Rk4 => RollingMethod::Rk4 {
-            step_s: args.step_s.unwrap_or(1e-4),
-        },
-        other => {
-            bail!(
-                "--method {} is not offered for the bowl model: use dp54 (default) or rk4",
-                super::method_name(other)
-            )
-        }
-    };
-    for (v, flag) in [
-        (wall.angle_deg, "--wall-angle-deg"),
-        (wall.height_m, "--wall-height-m"),
-        (wall.fillet_m, "--fillet-radius-m"),
-        (wall.restitution, "--restitution"),
-        (b.max_time_s, "--max-time-s"),
-    ] {
-        if !v.is_finite() {
-            bail!("{flag} must be a finite number, not {v}");
-        }
-    }
-    rolling::fits(&scene)?;
-    let shape = BowlShape {
-        wall_angle_rad: wall.angle_deg.to_radians(),
-        wall_height_m: wall.height_m,
-        fillet_radius_m: wall.fillet_m,
-        restitution: wall.restitution,
-    };
-    shape
-        .validate(&scene)
-        .map_err(|e| anyhow::anyhow!(words(e)))?;
-    if wall.height_m > 0.0 && wall.height_m < scene.particle_radius_m {
-        // The model meets the granule on the wall's face and ends it over the lip's radius;
-        // a step lower than the granule's radius it would meet at the step's edge, which the
-        // model does not have: a 1 nm wall held every release where a bare rim let them go.
-        bail!(
-            "--wall-height-m {} m is lower than the granule's radius {} m \
-             (--particle-radius-m): the bowl model's wall meets the granule on its face, not \
-             at the lip's edge, so it does not hold for a step that low; give 0 (a bare rim) or \
-             a wall at least the granule's radius high",
-            wall.height_m,
-            scene.particle_radius_m
-        );
-    }
-    Ok(BowlSetup {
-        scene,
-        th_deg,
-        wall,
-        shape,
-        method,
-    })
 }

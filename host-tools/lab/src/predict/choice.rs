@@ -47,6 +47,14 @@ fn parse_uncertainty_keys(spec: &str) -> Result<(Knowledge<f64>, bool)> {
         if !(x.is_finite() && x >= 0.0) {
             bail!("--uncertainty: {key} = {x} must be zero or positive");
         }
+        // mu and omega are relative: beyond 1 (100 %) the low end is a negative resistance
+        // or speed, and the spread of T comes out infinite.
+        if matches!(key.trim(), "mu" | "omega") && x > 1.0 {
+            bail!(
+                "--uncertainty: {key} = {x} is a relative uncertainty and must be at most 1 \
+                 (100 %); e.g. mu=0.2 for +-20 %"
+            );
+        }
         match key.trim() {
             "mu" => k.mu_rel = x,
             "radius_m" => k.radius_m = x,
@@ -156,11 +164,22 @@ pub fn claimed_error(c: &Choice<f64>) -> (f64, f64, f64) {
 /// The choice and its reasons, for the text output.
 pub fn describe(c: &Choice<f64>, need: &Need<f64>, runs_on: RunsOn) -> String {
     let tolerance = match (need, c.spread_rel) {
-        (Need::Uncertainty(k), Some(spread)) => format!(
+        (Need::Uncertainty(k), Some(spread)) if spread.is_finite() => format!(
             "the tolerance {}, a tenth of the {} spread of T over the parameters' uncertainty \
              (mu +-{:.0} %, radii +-{} mm, omega +-{:.1} %)",
             percent(c.tolerance_rel),
             percent(spread),
+            100.0 * k.mu_rel,
+            1e3 * k.radius_m,
+            100.0 * k.omega_rel
+        ),
+        // An uncertainty that lets the granule stay in the bowl spreads T without bound: said
+        // so, not "the inf % spread" (nor "asked for": nothing was asked).
+        (Need::Uncertainty(k), _) => format!(
+            "the tolerance {}, the chooser's largest: the parameters' uncertainty (mu +-{:.0} %, \
+             radii +-{} mm, omega +-{:.1} %) spreads T without bound (within it the granule may \
+             never leave)",
+            percent(c.tolerance_rel),
             100.0 * k.mu_rel,
             1e3 * k.radius_m,
             100.0 * k.omega_rel

@@ -47,33 +47,73 @@ pub fn scene(e: SceneError) -> String {
     }
 }
 
-/// Why a scene was refused, with the value given.
-pub fn scene_with_values(e: SceneError, s: &Scene<f64>) -> String {
+/// What each input of the 1-D scene is called where it came from: a flag of `bowl predict`,
+/// or a column of a batch file (a row's refusal names the column the user wrote, not a flag
+/// they never typed).
+pub struct Names {
+    pub omega: &'static str,
+    pub mu: &'static str,
+    pub g: &'static str,
+    pub k2: &'static str,
+    pub ri: &'static str,
+    pub rim: &'static str,
+}
+
+/// The flags' names.
+pub const FLAGS: Names = Names {
+    omega: "--omega-rad-s",
+    mu: "--mu",
+    g: "--g",
+    k2: "--k2",
+    ri: "--ri-m",
+    rim: "--rim-radius-m",
+};
+
+/// The batch file's column names.
+pub const COLUMNS: Names = Names {
+    omega: "column w_rad_s =",
+    mu: "column mu =",
+    g: "column g =",
+    k2: "column k2 =",
+    ri: "column ri_m =",
+    rim: "column R_m =",
+};
+
+/// Why a scene was refused, with the value given, each input named as in `n`.
+pub fn scene_with_values(e: SceneError, s: &Scene<f64>, n: &Names) -> String {
     match e {
         SceneError::InvalidOmega => format!(
-            "--omega-rad-s {} rad/s: the paper's models take the bowl's speed as a rate of turning, \
+            "{} {} rad/s: the paper's models take the bowl's speed as a rate of turning, \
              0 or more (which way it turns is not one of their parameters): give 0 or a positive \
              speed",
-            s.omega_rad_s
+            n.omega, s.omega_rad_s
         ),
         SceneError::InvalidResistance => format!(
-            "--mu {}: the rolling resistance must be 0 or more (0.029 is the paper's)",
-            s.mu
+            "{} {}: the rolling resistance must be 0 or more (0.029 is the paper's)",
+            n.mu, s.mu
         ),
         SceneError::InvalidGravity => {
-            format!("--g {}: must be 0 or more (9.81 on Earth)", s.g_m_s2)
+            format!("{} {}: must be above 0 (9.81 on Earth)", n.g, s.g_m_s2)
         }
         SceneError::InvalidK2 => format!(
-            "--k2 {}: must lie in (0, 1] (5/7 for a solid sphere, 3/5 for a hollow one)",
-            s.k2
+            "{} {}: must lie in (0, 1] (5/7 for a solid sphere, 3/5 for a hollow one)",
+            n.k2, s.k2
         ),
         SceneError::InvalidStartRadius => {
-            format!("--ri-m {} m: the start radius must be 0 or more", s.ri_m)
+            format!("{} {} m: the start radius must be 0 or more", n.ri, s.ri_m)
         }
         SceneError::InvalidRimRadius => format!(
-            "--rim-radius-m {} m: the rim radius must be 0 or more",
-            s.rim_radius_m
+            "{} {} m: the rim radius must be 0 or more",
+            n.rim, s.rim_radius_m
         ),
+        SceneError::ExtremeMagnitude(input) => extreme_magnitude(match input {
+            Input::Omega => n.omega,
+            Input::Resistance => n.mu,
+            Input::Gravity => n.g,
+            Input::K2 => n.k2,
+            Input::StartRadius => n.ri,
+            Input::RimRadius => n.rim,
+        }),
         other => scene(other),
     }
 }
@@ -81,14 +121,34 @@ pub fn scene_with_values(e: SceneError, s: &Scene<f64>) -> String {
 /// The scene as the rig would take it: valid, and starting inside the rim (the rig refuses a
 /// start at or beyond the rim, so predicting T = 0 there would answer a question it never asks).
 pub fn check(s: &Scene<f64>) -> anyhow::Result<()> {
+    check_named(s, &FLAGS)
+}
+
+/// [`check`], each input named as in `n`.
+pub fn check_named(s: &Scene<f64>, n: &Names) -> anyhow::Result<()> {
     s.validate()
-        .map_err(|e| anyhow::anyhow!(scene_with_values(e, s)))?;
+        .map_err(|e| anyhow::anyhow!(scene_with_values(e, s, n)))?;
+    gravity(s.g_m_s2, n.g)?;
     if s.ri_m >= s.rim_radius_m {
         anyhow::bail!(
-            "--ri-m {} m is not inside the rim (--rim-radius-m {} m): the granule must start \
-             inside the bowl, as the rig requires",
+            "{} {} m is not inside the rim ({} {} m): the granule must start inside the bowl, \
+             as the rig requires",
+            n.ri,
             s.ri_m,
+            n.rim,
             s.rim_radius_m
+        );
+    }
+    Ok(())
+}
+
+/// Gravity above 0: the models weigh friction against the granule's weight, so g = 0 puts
+/// weight in a denominator (friction "of inf of the granule's weight", T without a meaning).
+pub fn gravity(g_m_s2: f64, name: &str) -> anyhow::Result<()> {
+    if g_m_s2 == 0.0 {
+        anyhow::bail!(
+            "{name} 0 m/s^2: the models weigh friction against the granule's weight, which needs \
+             gravity above 0; give g in m/s^2 (9.81 on Earth)"
         );
     }
     Ok(())
@@ -103,7 +163,10 @@ pub fn what_holds(scene: &Scene<f64>, equilibrium_radius_m: f64) -> String {
         (true, false) => "the bowl is not turning (omega 0): nothing pushes the granule \
                           outward, and friction keeps it where it was put"
             .into(),
-        _ => format!("ri <= a = {equilibrium_radius_m:.6} m, friction holds it"),
+        _ => format!(
+            "ri <= a = {} m, friction holds it",
+            crate::number::fixed(equilibrium_radius_m, 6)
+        ),
     }
 }
 

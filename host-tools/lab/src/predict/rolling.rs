@@ -88,15 +88,30 @@ impl RollingInputs {
             rim_radius_m: args.rim_radius_m,
         };
         scene.validate().map_err(|e| anyhow::anyhow!(words(e)))?;
+        super::refusals::gravity(scene.g_m_s2, "--g")?;
         fits(&scene)?;
         Ok((scene, th_deg))
     }
 }
 
+/// The largest rod offset L the models are checked for (the bowl model's property test runs
+/// rod offsets to 1 m, docs/model.md §10), the same bound as a rig file's largest bowl radius:
+/// L = 1e8 m answered "still inside after 10 s", marked valid.
+pub const ROD_OFFSET_MAX_M: f64 = 1.0;
+
 /// The granule fits the bowl: its radius below the bottom's (the model puts its centre on the
 /// bottom at the release radius; a 1 m granule in a 75 mm bowl was answered as valid, a 1e9 m
 /// one ran for minutes and gave up).
 pub fn fits(scene: &RollingScene<f64>) -> Result<()> {
+    if scene.rod_length_m > ROD_OFFSET_MAX_M {
+        bail!(
+            "--rod-offset-m {} m is beyond {ROD_OFFSET_MAX_M} m: the models are checked for rod \
+             offsets up to that (docs/model.md §10; a rig file bounds a bowl's radius to 1 m \
+             the same way), and far beyond it they answer wrongly without knowing; give the \
+             horizontal offset L = l sin(th) of your rod in metres",
+            scene.rod_length_m
+        );
+    }
     if scene.particle_radius_m >= scene.rim_radius_m {
         bail!(
             "--particle-radius-m {} m is not smaller than the bowl's radius R = {} m \
@@ -193,7 +208,9 @@ fn outcome(o: &RollingOutcome<f64>, sliding_mu: f64) -> (serde_json::Value, Stri
                     "max_friction_ratio": max_friction_ratio, "first_slip_s": first_slip_s,
                 }),
                 format!(
-                    "leaves after T = {residence_time_s:.6} s at {exit_speed_m_s:.4} m/s relative to the bowl{slip}"
+                    "leaves after T = {} s at {} m/s relative to the bowl{slip}",
+                    crate::number::fixed(residence_time_s, 6),
+                    crate::number::fixed(exit_speed_m_s, 4)
                 ),
             )
         }
@@ -234,21 +251,8 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
             super::method_name(other)
         ),
     };
-    let scene = RollingScene {
-        precession_rad_s: w1,
-        spin_rad_s: w2,
-        axes_angle_rad: th_deg.to_radians(),
-        rolling_resistance: args.mu,
-        sliding_friction: r.sliding_mu,
-        g_m_s2: args.g,
-        k2: args.k2,
-        particle_radius_m: r.particle_radius_m,
-        rod_length_m: r.rod_offset_m,
-        ri_m: args.ri_m,
-        rim_radius_m: args.rim_radius_m,
-    };
-    scene.validate().map_err(|e| anyhow::anyhow!(words(e)))?;
-    fits(&scene)?;
+    // The scene as the bowl model reads it (one check of every flag, g above 0 included).
+    let (scene, _) = r.scene(args, "rolling", None)?;
     let head = format!(
         "rolling model: w1 {w1} rad/s, w2 {w2} rad/s, tilt {th_deg} deg (combined {:.4} rad/s), \
          mu_r {}, a {} m, L {} m, ri {} m, R {} m",
@@ -286,71 +290,64 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
         }
         return hierarchy(&scene, method, tol, wanted, args.json, &head);
     }
-    if r.release_azimuth_deg.trim() == "all" {
-        let (sum, validity) = over_azimuths(&scene, method)?;
-        if args.json {
-            let mut v = json!({
-                "model": "rolling", "release_azimuths_deg": AZIMUTHS_DEG,
-                "residence_time_mean_s": sum.mean_s, "residence_time_min_s": sum.min_s,
-                "residence_time_max_s": sum.max_s, "releases_leaving": sum.left,
-                "releases_sliding": sum.slid, "releases_lifting_off": sum.lifted,
-                "max_friction_ratio": sum.max_friction_ratio,
-                "rhs_evaluations": sum.evaluations,
-            });
-            validity.add_to(&mut v);
-            println!("{}", serde_json::to_string_pretty(&v)?);
-        } else {
-            if let Some(line) = validity.text_line() {
-                println!("{line}");
-            }
-            println!("{head}");
-            match (sum.mean_s, sum.min_s, sum.max_s) {
-                (Some(m), Some(lo), Some(hi)) => println!(
-                    "over 12 release azimuths: T mean {m:.6} s, min {lo:.6} s, max {hi:.6} s; \
-                     {} of 12 leave, {} of those slide on the way",
-                    sum.left, sum.slid
-                ),
-                _ => println!("none of the 12 releases leaves the bowl"),
-            }
-        }
+    let betas = azimuths(r.release_azimuth_deg())?;
+    let (sum, validity, reports) = over_azimuths(&scene, method, &betas)?;
+    let n = betas.len();
+    if args.json {
+        let per: Vec<_> = betas
+            .iter()
+            .zip(&reports)
+            .map(|(&deg, rep)| {
+                let (more, _) = outcome(&rep.outcome, r.sliding_mu);
+                let (t, regime) = match rep.outcome {
+                    RollingOutcome::Leaves {
+                        residence_time_s, ..
+                    } => (Some(residence_time_s), json!({"roll": 1.0})),
+                    RollingOutcome::Held => (None, json!({"held": 1.0})),
+                    // The model rolls until it ends (lift-off, the horizon).
+                    _ => (None, json!({"roll": 1.0})),
+                };
+                super::release_json::entry(deg, t, regime, more)
+            })
+            .collect();
+        let mut v = json!({
+            "model": "rolling", "release_azimuths_deg": betas,
+            "residence_time_mean_s": sum.mean_s, "residence_time_min_s": sum.min_s,
+            "residence_time_max_s": sum.max_s, "releases": n, "releases_leaving": sum.left,
+            "releases_sliding": sum.slid, "releases_lifting_off": sum.lifted,
+            "max_friction_ratio": sum.max_friction_ratio,
+            "rhs_evaluations": sum.evaluations, "per_release": per,
+        });
+        validity.add_to(&mut v);
+        println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
-    let beta_deg: f64 = r.release_azimuth_deg.trim().parse().map_err(|_| {
-        anyhow::anyhow!(
-            "--release-azimuth-deg {:?} is neither a number of degrees nor `all`",
-            r.release_azimuth_deg
-        )
-    })?;
-    let report = rolling::residence(&scene, beta_deg.to_radians(), method)
-        .map_err(|e| anyhow::anyhow!(words(e)))?;
-    let validity = match report.outcome {
-        RollingOutcome::Leaves {
-            max_friction_ratio,
-            first_slip_s,
-            ..
-        } => validity::rolling(
-            u32::from(first_slip_s.is_some()),
-            0,
-            1,
-            max_friction_ratio,
-            r.sliding_mu,
-        ),
-        RollingOutcome::LiftsOff { .. } => validity::rolling(0, 1, 1, 0.0, r.sliding_mu),
-        _ => validity::Validity::valid(),
-    };
-    let (mut v, text) = outcome(&report.outcome, r.sliding_mu);
-    if args.json {
-        validity.add_to(&mut v);
-        v["model"] = json!("rolling");
-        v["release_azimuth_deg"] = json!(beta_deg);
-        v["rhs_evaluations"] = json!(report.evaluations);
-        println!("{}", serde_json::to_string_pretty(&v)?);
-    } else {
-        if let Some(line) = validity.text_line() {
-            println!("{line}");
+    if let Some(line) = validity.text_line() {
+        println!("{line}");
+    }
+    println!("{head}");
+    if r.release_azimuth_deg.trim() != "all" {
+        for (deg, rep) in betas.iter().zip(&reports) {
+            println!(
+                "release at {deg} deg: {}",
+                outcome(&rep.outcome, r.sliding_mu).1
+            );
         }
-        println!("{head}");
-        println!("release at {beta_deg} deg: {text}");
+    }
+    if n > 1 {
+        match (sum.mean_s, sum.min_s, sum.max_s) {
+            (Some(m), Some(lo), Some(hi)) => println!(
+                "over {}: T mean {} s, min {} s, max {} s; {} of {n} leave, {} of those slide \
+                 on the way",
+                crate::number::count(n, "release azimuth", "release azimuths"),
+                crate::number::fixed(m, 6),
+                crate::number::fixed(lo, 6),
+                crate::number::fixed(hi, 6),
+                sum.left,
+                sum.slid
+            ),
+            _ => println!("none of the {n} releases leaves the bowl"),
+        }
     }
     Ok(())
 }
@@ -360,17 +357,29 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
 fn over_azimuths(
     scene: &RollingScene<f64>,
     method: RollingMethod<f64>,
-) -> Result<(rolling::AzimuthSummary<f64>, validity::Validity)> {
-    let sum =
-        rolling::residence_over_azimuths(scene, method).map_err(|e| anyhow::anyhow!(words(e)))?;
+    betas: &[f64],
+) -> Result<(
+    rolling::AzimuthSummary<f64>,
+    validity::Validity,
+    Vec<rolling::RollingReport<f64>>,
+)> {
+    let mut tally = rolling::AzimuthTally::new();
+    let mut reports = Vec::with_capacity(betas.len());
+    for &deg in betas {
+        let rep = rolling::residence(scene, deg.to_radians(), method)
+            .map_err(|e| anyhow::anyhow!(words(e)))?;
+        tally.add(&rep);
+        reports.push(rep);
+    }
+    let sum = tally.summary();
     let validity = validity::rolling(
         sum.slid,
         sum.lifted,
-        AZIMUTHS_DEG.len() as u32,
+        betas.len() as u32,
         sum.max_friction_ratio,
         scene.sliding_friction,
     );
-    Ok((sum, validity))
+    Ok((sum, validity, reports))
 }
 
 /// `--hierarchy-tolerance`: each member's mean residence time and difference from the full
@@ -398,7 +407,7 @@ fn hierarchy(
     let (chosen, diff) = cheapest_within(scene, tol, method, wanted);
     // Every member is judged against the rolling model: where that does not hold (the granule
     // slides or lifts off), neither does the member chosen, and the answer says so first.
-    let (_, validity) = over_azimuths(scene, method)?;
+    let (_, validity, _) = over_azimuths(scene, method, &AZIMUTHS_DEG)?;
     if json_out {
         let members: Vec<_> = rows
             .iter()

@@ -58,18 +58,19 @@ impl Validity {
 /// and stays on the bottom (`N > 0`).
 pub fn rolling(slid: u32, lifted: u32, releases: u32, max_ratio: f64, sliding_mu: f64) -> Validity {
     let mut why = Vec::new();
+    let releases = crate::number::count(releases as usize, "release", "releases");
     if slid > 0 {
         why.push(format!(
             "rolling needs friction up to {max_ratio:.3} of the normal force, more than the \
              {sliding_mu} the contact gives (--sliding-mu): the granule slides in {slid} of \
-             {releases} releases, so this T is the rolling model's, not the rig's (--model bowl \
+             {releases}, so this T is the rolling model's, not the rig's (--model bowl \
              follows the sliding granule)"
         ));
     }
     if lifted > 0 {
         why.push(format!(
             "the granule lifts off the bottom (the normal force reaches zero) in {lifted} of \
-             {releases} releases; the model ends there and gives no T for them"
+             {releases}; the model ends there and gives no T for them"
         ));
     }
     if why.is_empty() {

@@ -125,6 +125,7 @@ pub(crate) fn run_level(
 ) -> Result<std::result::Result<Answer, String>> {
     let mut times = Vec::new();
     let mut why = Vec::new();
+    let mut failed = Vec::new();
     match level {
         Level::Incline => {
             for &deg in betas {
@@ -268,15 +269,20 @@ pub(crate) fn run_level(
                         _ => times.push((deg, None)),
                     },
                     Err(e) => {
-                        why.push(format!(
-                            "release at {deg} deg: no answer: {}",
-                            bowl_cli::words(e)
-                        ));
+                        failed.push((deg, e));
                         times.push((deg, None));
                     }
                 }
             }
         }
+    }
+    if !failed.is_empty() {
+        // One sentence for all of them (it was one per release, eight times over).
+        why.push(super::gave_up::sentence(
+            &failed,
+            times.len(),
+            &super::gave_up::Settings::Chooser,
+        ));
     }
     why.dedup();
     Ok(Ok(Answer {
@@ -417,7 +423,8 @@ fn report(
             "residence_time_mean_s": mean, "residence_time_min_s": min,
             "residence_time_max_s": max, "releases": a.times.len(),
             "releases_leaving": left.len(),
-            "per_release": a.times.iter().map(|(d, t)| json!({"azimuth_deg": d, "left": t.is_some(), "residence_time_s": t})).collect::<Vec<Value>>(),
+            // The chooser's levels give T alone: `regime` is null (the shape is the bowl model's).
+            "per_release": a.times.iter().map(|&(d, t)| super::release_json::entry(d, t, Value::Null, super::release_json::none())).collect::<Vec<Value>>(),
             "axes_angle_deg": th_deg,
         });
         a.validity.add_to(&mut v);
@@ -445,11 +452,20 @@ fn report(
     }
     match (mean, min, max) {
         (Some(m), Some(lo), Some(hi)) => println!(
-            "over {} releases: {} leave, T mean {m:.6} s, min {lo:.6} s, max {hi:.6} s",
-            a.times.len(),
-            left.len()
+            "over {}: {} leave, T mean {} s, min {} s, max {} s",
+            crate::number::count(a.times.len(), "release", "releases"),
+            left.len(),
+            crate::number::fixed(m, 6),
+            crate::number::fixed(lo, 6),
+            crate::number::fixed(hi, 6)
         ),
-        _ => println!("none of the {} releases leaves", a.times.len()),
+        _ => println!(
+            "{}",
+            match a.times.len() {
+                1 => "the release does not leave".to_string(),
+                n => format!("none of the {n} releases leaves"),
+            }
+        ),
     }
     Ok(())
 }

@@ -167,15 +167,53 @@ pub fn over_azimuths_within<T: Real>(
     method: RollingMethod<T>,
     limits: SystemLimits<T>,
 ) -> Result<AzimuthSummary<T>, RollingError> {
-    let mut sum = T::ZERO;
-    let (mut min_s, mut max_s): (Option<T>, Option<T>) = (None, None);
-    let (mut left, mut slid, mut lifted, mut evaluations) = (0u32, 0u32, 0u32, 0u32);
-    let mut max_ratio = T::ZERO;
+    let mut tally = AzimuthTally::new();
     for deg in AZIMUTHS_DEG {
         let beta = T::from_f64(deg.to_radians());
-        let report = residence_within(scene, beta, method, limits)?;
-        evaluations = evaluations.saturating_add(report.evaluations);
-        lifted += u32::from(matches!(report.outcome, RollingOutcome::LiftsOff { .. }));
+        tally.add(&residence_within(scene, beta, method, limits)?);
+    }
+    Ok(tally.summary())
+}
+
+/// The summary of releases taken one report at a time: [`over_azimuths_within`]'s over the
+/// twelve azimuths, and the PC's over any list of them (one summary, whichever releases).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AzimuthTally<T> {
+    sum: T,
+    min_s: Option<T>,
+    max_s: Option<T>,
+    left: u32,
+    slid: u32,
+    lifted: u32,
+    max_ratio: T,
+    evaluations: u32,
+}
+
+impl<T: Real> Default for AzimuthTally<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<T: Real> AzimuthTally<T> {
+    /// No releases yet.
+    pub fn new() -> Self {
+        Self {
+            sum: T::ZERO,
+            min_s: None,
+            max_s: None,
+            left: 0,
+            slid: 0,
+            lifted: 0,
+            max_ratio: T::ZERO,
+            evaluations: 0,
+        }
+    }
+
+    /// One more release.
+    pub fn add(&mut self, report: &RollingReport<T>) {
+        self.evaluations = self.evaluations.saturating_add(report.evaluations);
+        self.lifted += u32::from(matches!(report.outcome, RollingOutcome::LiftsOff { .. }));
         if let RollingOutcome::Leaves {
             residence_time_s: t,
             first_slip_s,
@@ -183,22 +221,26 @@ pub fn over_azimuths_within<T: Real>(
             ..
         } = report.outcome
         {
-            max_ratio = max_ratio.max(max_friction_ratio);
-            sum += t;
-            left += 1;
-            slid += u32::from(first_slip_s.is_some());
-            min_s = Some(min_s.map_or(t, |m| m.min(t)));
-            max_s = Some(max_s.map_or(t, |m| m.max(t)));
+            self.max_ratio = self.max_ratio.max(max_friction_ratio);
+            self.sum += t;
+            self.left += 1;
+            self.slid += u32::from(first_slip_s.is_some());
+            self.min_s = Some(self.min_s.map_or(t, |m| m.min(t)));
+            self.max_s = Some(self.max_s.map_or(t, |m| m.max(t)));
         }
     }
-    Ok(AzimuthSummary {
-        mean_s: (left > 0).then(|| sum / T::from_f64(f64::from(left))),
-        min_s,
-        max_s,
-        left,
-        slid,
-        lifted,
-        max_friction_ratio: max_ratio,
-        evaluations,
-    })
+
+    /// The summary of the releases added.
+    pub fn summary(&self) -> AzimuthSummary<T> {
+        AzimuthSummary {
+            mean_s: (self.left > 0).then(|| self.sum / T::from_f64(f64::from(self.left))),
+            min_s: self.min_s,
+            max_s: self.max_s,
+            left: self.left,
+            slid: self.slid,
+            lifted: self.lifted,
+            max_friction_ratio: self.max_ratio,
+            evaluations: self.evaluations,
+        }
+    }
 }

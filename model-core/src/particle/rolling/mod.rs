@@ -19,8 +19,8 @@ pub mod slide;
 
 mod integrate;
 pub use integrate::{
-    AZIMUTHS_DEG, AzimuthSummary, over_azimuths_within, residence, residence_over_azimuths,
-    residence_within,
+    AZIMUTHS_DEG, AzimuthSummary, AzimuthTally, over_azimuths_within, residence,
+    residence_over_azimuths, residence_within,
 };
 
 use crate::Real;

@@ -1,0 +1,169 @@
+//! The bowl model's scene from the flags and a rig file's `[bowl]` table, checked: the bowl
+//! model's and the whole hierarchy's (`--model auto`) one reading of them.
+
+use anyhow::{Result, bail};
+use model_core::particle::bowl::BowlShape;
+use model_core::particle::rolling::{RollingMethod, RollingScene};
+
+use super::bowl::{BowlInputs, words};
+use super::{Inputs, MethodChoice, rolling};
+
+/// The wall flags with the rig file's `[bowl]` table (or the defaults) under them.
+pub(super) struct Wall {
+    pub(super) angle_deg: f64,
+    pub(super) height_m: f64,
+    pub(super) fillet_m: f64,
+    pub(super) restitution: f64,
+}
+
+impl BowlInputs {
+    pub(super) fn wall(&self, table: Option<&rig_file::BowlGeometry>) -> Wall {
+        let pick =
+            |flag: Option<f64>, from: Option<f64>, default: f64| flag.or(from).unwrap_or(default);
+        Wall {
+            angle_deg: pick(self.wall_angle_deg, table.map(|t| t.wall_angle_deg), 90.0),
+            height_m: pick(self.wall_height_m, table.map(|t| t.wall_height_m), 0.0),
+            fillet_m: pick(self.fillet_radius_m, table.map(|t| t.fillet_radius_m), 0.0),
+            restitution: pick(self.restitution, table.map(|t| t.restitution), 0.5),
+        }
+    }
+}
+
+/// The flags a rig file's `[bowl]` table sets, refused when given too (exit 2): the rig's
+/// value was used while a later error blamed the flag's.
+fn rig_conflicts(args: &Inputs, path: &std::path::Path, t: &rig_file::BowlGeometry) -> Result<()> {
+    for (given, flag, what, value) in [
+        (
+            args.given.rim_radius_m,
+            "--rim-radius-m",
+            "the bowl's radius",
+            t.rim_radius_m,
+        ),
+        (
+            args.given.particle_radius_m,
+            "--particle-radius-m",
+            "the granule's radius",
+            t.particle_radius_m,
+        ),
+    ] {
+        if given {
+            return crate::usage::usage(format!(
+                "{flag} conflicts with --rig-file {}, which sets {what} ({value} m): drop one",
+                path.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
+pub(super) struct BowlSetup {
+    pub(super) scene: RollingScene<f64>,
+    /// The tilt, degrees.
+    pub(super) th_deg: f64,
+    pub(super) wall: Wall,
+    pub(super) shape: BowlShape<f64>,
+    pub(super) method: RollingMethod<f64>,
+}
+
+/// The bowl model's scene, tilt (degrees), wall, shape and method from the flags and the rig
+/// file's `[bowl]` table, checked (also the whole-hierarchy chooser's, `--model auto`).
+pub(super) fn scene_and_shape(
+    args: &Inputs,
+    r: &rolling::RollingInputs,
+    b: &BowlInputs,
+) -> Result<BowlSetup> {
+    let (table, release_m) = match &b.rig_file {
+        Some(path) => {
+            let rigs = rig_file::load(path)?;
+            let Some(t) = rigs.first().and_then(|rig| rig.bowl) else {
+                bail!(
+                    "the rig file {} has no [bowl] table (its keys: docs/rigs/nominal.toml)",
+                    path.display()
+                );
+            };
+            rig_conflicts(args, path, &t)?;
+            let release = rigs
+                .first()
+                .and_then(|rig| rig.particle)
+                .map(|p| p.release_radius_m);
+            (Some(t), release)
+        }
+        None => (None, None),
+    };
+    let (mut scene, th_deg) = r.scene(args, "bowl", table.map(|t| t.axes_angle_deg))?;
+    if let Some(t) = &table {
+        scene.rim_radius_m = t.rim_radius_m;
+        scene.particle_radius_m = t.particle_radius_m;
+        // The rig's own release radius unless --ri-m is given (the release is the
+        // experiment's choice; --store-table used the default 0.05 m on a 0.0375 m rig).
+        if let (false, Some(ri)) = (args.given.ri_m, release_m) {
+            scene.ri_m = ri;
+        }
+        scene.validate().map_err(|e| {
+            anyhow::anyhow!("with the rig file's [bowl] table: {}", rolling::words(e))
+        })?;
+    }
+    let wall = b.wall(table.as_ref());
+    let method = match args.method {
+        MethodChoice::Closed | MethodChoice::Dp54 => RollingMethod::Dp54 { rtol: args.tol },
+        MethodChoice::Rk4 => RollingMethod::Rk4 {
+            step_s: args.step_s.unwrap_or(1e-4),
+        },
+        other => {
+            bail!(
+                "--method {} is not offered for the bowl model: use dp54 (default) or rk4",
+                super::method_name(other)
+            )
+        }
+    };
+    for (v, flag) in [
+        (wall.angle_deg, "--wall-angle-deg"),
+        (wall.height_m, "--wall-height-m"),
+        (wall.fillet_m, "--fillet-radius-m"),
+        (wall.restitution, "--restitution"),
+        (b.max_time_s, "--max-time-s"),
+    ] {
+        if !v.is_finite() {
+            bail!("{flag} must be a finite number, not {v}");
+        }
+    }
+    // Checked here, once: the model checks it per release, and its refusal came prefixed with
+    // the first release's azimuth although the flag is the whole run's.
+    if b.max_time_s <= 0.0 {
+        bail!(
+            "--max-time-s {} s: each release is followed this long, so it must be above 0 \
+             (default 10 s)",
+            b.max_time_s
+        );
+    }
+    rolling::fits(&scene)?;
+    let shape = BowlShape {
+        wall_angle_rad: wall.angle_deg.to_radians(),
+        wall_height_m: wall.height_m,
+        fillet_radius_m: wall.fillet_m,
+        restitution: wall.restitution,
+    };
+    shape
+        .validate(&scene)
+        .map_err(|e| anyhow::anyhow!(words(e)))?;
+    if wall.height_m > 0.0 && wall.height_m < scene.particle_radius_m {
+        // The model meets the granule on the wall's face and ends it over the lip's radius;
+        // a step lower than the granule's radius it would meet at the step's edge, which the
+        // model does not have: a 1 nm wall held every release where a bare rim let them go.
+        bail!(
+            "--wall-height-m {} m is lower than the granule's radius {} m \
+             (--particle-radius-m): the bowl model's wall meets the granule on its face, not \
+             at the lip's edge, so it does not hold for a step that low; give 0 (a bare rim) or \
+             a wall at least the granule's radius high",
+            wall.height_m,
+            scene.particle_radius_m
+        );
+    }
+    Ok(BowlSetup {
+        scene,
+        th_deg,
+        wall,
+        shape,
+        method,
+    })
+}

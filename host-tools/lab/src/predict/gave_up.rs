@@ -1,0 +1,132 @@
+//! Releases the integrator gave up on, said once for the run: what happened, at which
+//! azimuths, and only advice that works at the current settings (the advice said "a tighter
+//! --tol (1e-7 or below)" with the default 1e-9 already in force, and "try --method dp54" to
+//! the bowl model, which runs dp54; the chooser repeated one sentence per release).
+
+use model_core::ode::system::SystemError;
+use model_core::particle::bowl::BowlError;
+use model_core::particle::rolling::{MAX_STEPS, RollingError, RollingMethod};
+
+/// The tolerance at and below which a stall at a roll/slide switch is the scene's own, not the
+/// tolerance's: the stall watch's loose-tolerance stalls go away by 1e-7; tighter ones
+/// (1e-10, 1e-12) still fail the same release and 1e-14 more of them.
+const STALL_TOL: f64 = 1e-7;
+
+/// How the run was set: what the user can still change.
+pub enum Settings {
+    /// `--model bowl`: its method and `--max-time-s`.
+    Bowl {
+        method: RollingMethod<f64>,
+        max_time_s: f64,
+    },
+    /// `--model auto`: the chooser sets the tolerance and tightens it for such releases itself.
+    Chooser,
+}
+
+/// What happened to one release, without advice.
+pub fn what(e: &BowlError) -> String {
+    match e {
+        BowlError::Scene(RollingError::Integration(SystemError::Stalled)) => {
+            "the steps stopped advancing the time at a roll/slide switch (a granule chattering \
+             at the stick threshold)"
+                .into()
+        }
+        BowlError::Scene(RollingError::Integration(SystemError::StepLimit)) => {
+            format!("the step cap ({MAX_STEPS} steps) was reached")
+        }
+        BowlError::Scene(RollingError::Integration(SystemError::NotFinite)) => {
+            "a state became infinite".into()
+        }
+        other => super::bowl::words(*other),
+    }
+}
+
+/// The one sentence for the releases in `failed` (azimuth in degrees and why) of `releases`.
+pub fn sentence(failed: &[(f64, BowlError)], releases: usize, settings: &Settings) -> String {
+    let mut kinds: Vec<String> = Vec::new();
+    for (_, e) in failed {
+        let w = what(e);
+        if !kinds.contains(&w) {
+            kinds.push(w);
+        }
+    }
+    let at: Vec<String> = failed.iter().map(|(d, _)| format!("{d}")).collect();
+    format!(
+        "the integration gave up on {} of {releases} releases (at {} deg: {}), so they have no \
+         residence time and the times given are over the others; {}",
+        failed.len(),
+        at.join(", "),
+        kinds.join("; "),
+        advice(failed, settings)
+    )
+}
+
+fn advice(failed: &[(f64, BowlError)], settings: &Settings) -> String {
+    let is = |k: SystemError| {
+        failed
+            .iter()
+            .all(|(_, e)| *e == BowlError::Scene(RollingError::Integration(k)))
+    };
+    let nothing = "no setting gets those releases through";
+    match settings {
+        Settings::Chooser => {
+            format!("the chooser already tightens its tolerance for such releases, so {nothing}")
+        }
+        Settings::Bowl {
+            method: RollingMethod::Dp54 { rtol },
+            max_time_s,
+        } => {
+            if is(SystemError::Stalled) {
+                if *rtol > STALL_TOL {
+                    format!(
+                        "a tighter --tol ({STALL_TOL:e} or below; now {rtol:e}) may get through"
+                    )
+                } else {
+                    format!(
+                        "--tol is {rtol:e} already, and a tighter one stalls the same way (at \
+                         {STALL_TOL:e} and below the stall is the scene's): {nothing}"
+                    )
+                }
+            } else if is(SystemError::NotFinite) {
+                format!("the adaptive dp54 already controls its step: {nothing}")
+            } else {
+                // The step cap is met by long runs: a shorter horizon shortens them.
+                format!("a shorter --max-time-s (now {max_time_s} s) may get through")
+            }
+        }
+        Settings::Bowl {
+            method: RollingMethod::Rk4 { step_s },
+            ..
+        } => format!(
+            "a smaller --step-s (now {step_s} s) or --method dp54 (the default) may get through"
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const STALL: BowlError = BowlError::Scene(RollingError::Integration(SystemError::Stalled));
+
+    /// At the default tolerance a stall gets no "tighter --tol" advice; looser, it does; the
+    /// azimuths are listed once, the sentence said once.
+    #[test]
+    fn the_advice_holds_at_the_settings_given() {
+        let bowl = |rtol| Settings::Bowl {
+            method: RollingMethod::Dp54 { rtol },
+            max_time_s: 3.0,
+        };
+        let s = sentence(&[(150.0, STALL), (180.0, STALL)], 12, &bowl(1e-9));
+        assert!(s.contains("2 of 12 releases (at 150, 180 deg"), "{s}");
+        assert!(s.contains("no setting gets those releases through"), "{s}");
+        assert!(!s.contains("may get through"), "{s}");
+        assert_eq!(s.matches("roll/slide switch").count(), 1, "{s}");
+        let s = sentence(&[(150.0, STALL)], 12, &bowl(1e-5));
+        assert!(
+            s.contains("a tighter --tol (1e-7 or below; now 1e-5)"),
+            "{s}"
+        );
+        assert!(!s.contains("--method dp54"), "{s}");
+    }
+}

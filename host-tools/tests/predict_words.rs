@@ -1,0 +1,428 @@
+//! `bowl predict` says what it computed in words a person can read (the QA pass of the model
+//! side): no inf or NaN on screen, significant figures kept at the ends of the range, flags the
+//! model would ignore refused, and one message per thing said once.
+
+mod common;
+
+use common::{bowl, json};
+
+/// The `BOWL` scene of the QA pass: the rig's 60 deg tilt, w1 1.2, w2 -2.7 rad/s.
+const BOWL: [&str; 15] = [
+    "predict",
+    "--model",
+    "bowl",
+    "--axes-angle-deg",
+    "60",
+    "--precession-rad-s",
+    "1.2",
+    "--spin-rad-s",
+    "-2.7",
+    "--rim-radius-m",
+    "0.075",
+    "--ri-m",
+    "0.0375",
+    "--speed-range",
+    "false",
+];
+
+/// `BOWL` with the flags in `extra` replacing its own (the flag and its value).
+fn bowl_with(extra: &[&str]) -> Vec<String> {
+    let mut v: Vec<String> = vec![BOWL[0].into()];
+    for pair in BOWL[1..].chunks(2) {
+        if !extra.contains(&pair[0]) {
+            v.extend(pair.iter().map(|s| s.to_string()));
+        }
+    }
+    v.extend(extra.iter().map(|s| s.to_string()));
+    v
+}
+
+fn run(args: &[String]) -> (Option<i32>, String, String) {
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = bowl(&args);
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn no_inf_or_nan(text: &str) {
+    for word in ["inf", "NaN", "nan"] {
+        assert!(
+            !text
+                .split(|c: char| !c.is_alphanumeric())
+                .any(|w| w == word),
+            "{word} in {text:?}"
+        );
+    }
+}
+
+/// omega 0 has no equilibrium radius: said in words, not "= inf m"; g = 0 and a relative
+/// uncertainty beyond 100 % (which gave "needs friction of inf" and "the inf % spread") are
+/// refused with the value, the limit and what to give.
+#[test]
+fn non_finite_values_are_said_in_words_or_refused() {
+    let (code, out, _) =
+        run(&["predict", "--model", "flat", "--omega-rad-s", "0"].map(String::from));
+    assert_eq!(code, Some(0));
+    assert!(out.contains("no equilibrium radius: omega is 0"), "{out}");
+    no_inf_or_nan(&out);
+    let (code, _, err) = run(&["predict", "--model", "flat", "--g", "0"].map(String::from));
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains("--g 0 m/s^2") && err.contains("above 0"),
+        "{err}"
+    );
+    let (code, _, err) = run(&["predict", "--uncertainty", "mu=1e9"].map(String::from));
+    assert_eq!(code, Some(1));
+    assert!(err.contains("must be at most 1 (100 %)"), "{err}");
+    // A radius uncertainty that lets the granule stay: the spread is said to be unbounded.
+    let (code, out, _) = run(&["predict", "--uncertainty", "radius_m=1e9"].map(String::from));
+    assert_eq!(code, Some(0));
+    assert!(out.contains("spreads T without bound"), "{out}");
+    assert!(!out.contains("asked for"), "{out}");
+    no_inf_or_nan(&out);
+}
+
+/// A residence time of nanoseconds and a radius of 1e17 m keep their significant figures
+/// (they printed as "T = 0.000000 s" and "284489999999999968.000000 m").
+#[test]
+fn tiny_and_huge_values_keep_their_significant_figures() {
+    let (code, out, _) = run(&bowl_with(&[
+        "--precession-rad-s",
+        "1e9",
+        "--release-azimuth-deg",
+        "0",
+        "--max-time-s",
+        "1",
+    ]));
+    assert_eq!(code, Some(0));
+    assert!(!out.contains("0.000000 s"), "{out}");
+    assert!(out.contains("T = 2.8") && out.contains("e-9 s"), "{out}");
+    let (_, out, _) =
+        run(&["predict", "--model", "flat", "--omega-rad-s", "1e-9"].map(String::from));
+    assert!(out.contains("= 2.845e17 m"), "{out}");
+    assert!(!out.contains("284489999999999968"), "{out}");
+}
+
+/// Flags the chosen model would ignore, and flags a rig file sets, are refused (exit 2) naming
+/// the flag and what to do; the rig's value is quoted, not blamed on the user's.
+#[test]
+fn flags_the_model_ignores_are_refused() {
+    for (extra, want) in [
+        (
+            vec!["--omega-rad-s", "3"],
+            "--omega-rad-s 3 is the paper's level bowl's one combined speed",
+        ),
+        (
+            vec!["--method", "closed"],
+            "--method closed: the bowl model has no closed form",
+        ),
+        (
+            vec![
+                "--rig-file",
+                "../docs/rigs/bowl-60deg.toml",
+                "--rim-radius-m",
+                "0.2",
+                "--ri-m",
+                "0.1",
+            ],
+            "--rim-radius-m conflicts with --rig-file ../docs/rigs/bowl-60deg.toml, which sets \
+             the bowl's radius (0.075 m): drop one",
+        ),
+    ] {
+        let (code, out, err) = run(&bowl_with(&extra));
+        assert_eq!(code, Some(2), "{extra:?}: {err}");
+        assert!(err.contains(want), "{extra:?}: {err}");
+        assert!(out.is_empty(), "{out}");
+    }
+    let (code, _, err) = run(&[
+        "predict",
+        "--model",
+        "bowl",
+        "--rig-file",
+        "../docs/rigs/bowl-60deg.toml",
+        "--precession-rad-s",
+        "1.2",
+        "--spin-rad-s",
+        "1.2",
+        "--particle-radius-m",
+        "0.002",
+    ]
+    .map(String::from));
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("--particle-radius-m conflicts with --rig-file") && err.contains("(0.003 m)"),
+        "{err}"
+    );
+    let (code, _, err) = run(&[
+        "predict",
+        "--model",
+        "auto",
+        "--precession-rad-s",
+        "1.2",
+        "--spin-rad-s",
+        "1.2",
+        "--axes-angle-deg",
+        "60",
+        "--omega-rad-s",
+        "3",
+    ]
+    .map(String::from));
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("drop --omega-rad-s"), "{err}");
+}
+
+/// The rig file's release radius is the bowl model's start unless --ri-m is given.
+#[test]
+fn the_rig_files_release_radius_is_used() {
+    let rig = [
+        "predict",
+        "--model",
+        "bowl",
+        "--rig-file",
+        "../docs/rigs/bowl-60deg.toml",
+        "--precession-rad-s",
+        "1.2",
+        "--spin-rad-s",
+        "1.2",
+        "--speed-range",
+        "false",
+        "--release-azimuth-deg",
+        "0",
+    ];
+    let (code, out, err) = run(&rig.map(String::from));
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains("ri 0.0375 m"), "{out}");
+    let mut given: Vec<String> = rig.map(String::from).to_vec();
+    given.extend(["--ri-m".into(), "0.03".into()]);
+    let (_, out, _) = run(&given);
+    assert!(out.contains("ri 0.03 m"), "{out}");
+}
+
+/// A rod offset beyond the models' checked range is refused with the limit (L = 1e8 m was
+/// answered "still inside after 10 s", valid); --max-time-s 0 is the run's, not a release's.
+#[test]
+fn out_of_range_run_settings_are_refused_once() {
+    let (code, _, err) = run(&bowl_with(&["--rod-offset-m", "1e8"]));
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains("--rod-offset-m 100000000 m is beyond 1 m"),
+        "{err}"
+    );
+    let v = json(
+        &bowl_with(&[
+            "--rod-offset-m",
+            "0.3",
+            "--release-azimuth-deg",
+            "0",
+            "--json",
+        ])
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>(),
+    );
+    assert!(v["per_release"][0]["left"].is_boolean(), "{v}");
+    let (code, _, err) = run(&bowl_with(&["--max-time-s", "0"]));
+    assert_eq!(code, Some(1));
+    assert!(err.starts_with("error: --max-time-s 0 s:"), "{err}");
+    assert!(!err.contains("release at"), "{err}");
+}
+
+/// One release is singular, and a regime reads as percentages, not raw JSON.
+#[test]
+fn counts_and_regimes_read_as_words() {
+    let (code, out, _) = run(&bowl_with(&["--release-azimuth-deg", "0"]));
+    assert_eq!(code, Some(0));
+    assert!(out.contains("over 1 release: 1 leave"), "{out}");
+    assert!(out.contains("regime slide 100 %"), "{out}");
+    assert!(!out.contains('{'), "{out}");
+}
+
+/// `--benchmark-seeds 0` is a usage error (it printed "mean estimate NaN", exit 0).
+#[test]
+fn zero_benchmark_seeds_are_refused() {
+    let (code, out, err) = run(&["experiment", "--benchmark-seeds", "0"].map(String::from));
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("--benchmark-seeds") && err.contains("1.."),
+        "{err}"
+    );
+    assert!(out.is_empty());
+}
+
+/// A refused batch row names its column and line, not a flag the user never typed.
+#[test]
+fn batch_refusals_name_the_column_and_the_row() {
+    let (out, written) = common::run_batch(
+        "words-columns",
+        "model,w_rad_s,mu,ri_m,R_m\nflat,3.6,0.01,0.03,0.1\nflat,-1,0.01,0.03,0.1\n",
+        &[],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("line 3: column w_rad_s = -1 rad/s"), "{err}");
+    assert!(!err.contains("--omega-rad-s"), "{err}");
+    assert!(written.is_empty());
+}
+
+/// The QA scene where one release stalls at the default --tol 1e-9: the advice does not ask
+/// for a tighter --tol (it does not help) or dp54 (already run); the sentence names the
+/// azimuth and is said once, by the bowl model and by the chooser.
+#[test]
+fn the_gave_up_advice_is_true_and_said_once() {
+    let scene = [
+        "--axes-angle-deg",
+        "5",
+        "--sliding-mu",
+        "0.05",
+        "--precession-rad-s",
+        "1.2",
+        "--spin-rad-s",
+        "3.6",
+        "--rim-radius-m",
+        "0.075",
+        "--ri-m",
+        "0.0375",
+        "--wall-angle-deg",
+        "60",
+        "--wall-height-m",
+        "0.02",
+        "--max-time-s",
+        "3",
+        "--json",
+    ];
+    for model in [
+        &["predict", "--model", "bowl", "--speed-range", "false"][..],
+        &["predict"][..],
+    ] {
+        let mut args = model.to_vec();
+        args.extend(scene);
+        let v = json(&args);
+        let why = v["invalid_reason"].as_str().unwrap_or_default();
+        assert!(
+            why.contains("gave up on 1 of 12 releases (at 90 deg"),
+            "{why}"
+        );
+        assert!(
+            why.contains("no setting gets those releases through"),
+            "{why}"
+        );
+        assert!(!why.contains("may get through"), "{why}");
+        assert!(!why.contains("--method dp54"), "{why}");
+        assert_eq!(why.matches("gave up").count(), 1, "{why}");
+    }
+}
+
+/// One JSON shape for the tilted bowl's models: the bowl model's summary keys and per-release
+/// keys from `--model rolling` (a list of azimuths taken, as the bowl model takes it), `bowl`
+/// and `auto`, a release given up on included (its `regime` null, not missing).
+#[test]
+fn the_tilted_bowls_models_share_one_json_shape() {
+    let scene = [
+        "--axes-angle-deg",
+        "60",
+        "--precession-rad-s",
+        "2.08",
+        "--spin-rad-s",
+        "2.08",
+        "--ri-m",
+        "0.0375",
+        "--rim-radius-m",
+        "0.075",
+        "--release-azimuth-deg",
+        "0,90",
+        "--json",
+    ];
+    for model in ["rolling", "bowl", "auto"] {
+        let mut args = vec!["predict", "--model", model];
+        args.extend(scene);
+        let v = json(&args);
+        for key in [
+            "residence_time_mean_s",
+            "residence_time_min_s",
+            "residence_time_max_s",
+            "releases",
+            "releases_leaving",
+        ] {
+            assert!(v.get(key).is_some(), "{model}: no {key} in {v}");
+        }
+        assert_eq!(v["releases"], 2, "{model}: {v}");
+        let per = v["per_release"].as_array().unwrap();
+        assert_eq!(per.len(), 2, "{model}: {v}");
+        for (e, deg) in per.iter().zip([0.0, 90.0]) {
+            assert_eq!(e["azimuth_deg"], deg, "{model}: {e}");
+            for key in ["left", "residence_time_s", "regime"] {
+                assert!(e.get(key).is_some(), "{model}: no {key} in {e}");
+            }
+        }
+    }
+    let v = json(&[
+        "predict",
+        "--model",
+        "bowl",
+        "--axes-angle-deg",
+        "5",
+        "--sliding-mu",
+        "0.05",
+        "--precession-rad-s",
+        "1.2",
+        "--spin-rad-s",
+        "3.6",
+        "--rim-radius-m",
+        "0.075",
+        "--ri-m",
+        "0.0375",
+        "--wall-angle-deg",
+        "60",
+        "--wall-height-m",
+        "0.02",
+        "--max-time-s",
+        "3",
+        "--release-azimuth-deg",
+        "90",
+        "--speed-range",
+        "false",
+        "--json",
+    ]);
+    let e = &v["per_release"][0];
+    assert_eq!(e["outcome"], "gave_up", "{v}");
+    assert!(e.get("regime").is_some_and(|r| r.is_null()), "{e}");
+}
+
+/// Where only some releases leave, the "what speed can do" paragraph says so (6 of 12 left
+/// and it offered the T range for RTIME TABLE without a word).
+#[test]
+fn the_speed_paragraph_says_when_not_every_release_leaves() {
+    let (code, out, err) = run(&[
+        "predict",
+        "--model",
+        "bowl",
+        "--axes-angle-deg",
+        "30",
+        "--precession-rad-s",
+        "2.08",
+        "--spin-rad-s",
+        "2.08",
+        "--rim-radius-m",
+        "0.075",
+        "--ri-m",
+        "0.0375",
+        "--wall-angle-deg",
+        "60",
+        "--wall-height-m",
+        "0.02",
+    ]
+    .map(String::from));
+    assert_eq!(code, Some(0), "{err}");
+    let para = out
+        .lines()
+        .find(|l| l.starts_with("what speed can do:"))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(
+        para.contains("but only 6 of 12 releases leave at the asked speed"),
+        "{para}"
+    );
+    assert!(out.contains("over 12 releases: 6 leave"), "{out}");
+}
