@@ -23,17 +23,9 @@ pub fn is_closed_output(e: &anyhow::Error) -> bool {
 
 /// A flag or value on the command line is wrong: its words say which value, the limit and
 /// what to do. `main` ends with [`USAGE`] when an error carries one, so a script can tell a
-/// typo from a rig's refusal or a failed run (both 1).
-#[derive(Debug)]
-pub struct Usage(String);
-
-impl std::fmt::Display for Usage {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for Usage {}
+/// typo from a rig's refusal or a failed run (both 1). One type for the binary and the lab's
+/// library (`predict`, `experiment`), which raises it too.
+pub use lab::usage::Usage;
 
 /// A usage error with these words (a check's message, or a library's error about a flag's value).
 pub fn usage(words: impl std::fmt::Display) -> anyhow::Error {

@@ -80,8 +80,6 @@ fn main() -> ExitCode {
                 exit_code::USAGE
             } else if e.chain().any(|c| c.is::<rig_client::serial::LinkError>()) {
                 exit_code::LINK
-            } else if e.chain().any(|c| c.is::<lab::usage::Usage>()) {
-                exit_code::USAGE
             } else {
                 exit_code::REFUSED
             }

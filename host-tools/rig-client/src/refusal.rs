@@ -256,6 +256,24 @@ fn time_span(t0: f64, t1: f64) -> String {
     format!("{t0:.places$}-{t1:.places$} s")
 }
 
+/// `t0`-`t1` s with its ends rounded inwards (the first decimals where they still differ):
+/// every time quoted is one the table takes (0.16773-0.16883 s is `0.1678-0.1688 s`, not
+/// `0.168-0.169 s`, whose 0.1689 it refuses).
+fn inner_time_span(t0: f64, t1: f64) -> String {
+    let rounded = |p: usize| {
+        let scale = 10f64.powi(p as i32);
+        ((t0 * scale).ceil() / scale, (t1 * scale).floor() / scale)
+    };
+    let places = (3..=6)
+        .find(|&p| {
+            let (a, b) = rounded(p);
+            a < b
+        })
+        .unwrap_or(6);
+    let (a, b) = rounded(places);
+    format!("{a:.places$}-{b:.places$} s")
+}
+
 /// What speed can do with a residence-time table, in words: `at 60 deg tilt T is
 /// 0.143-0.144 s at every speed from 0.5 to 3.6 rad/s: speed cannot set it; the tilt or the
 /// wall can` when the table is flat ([`SpeedTable::is_flat`]), else the range of T and the
@@ -278,7 +296,7 @@ pub fn speed_range_words(tilt_deg: f64, table: &SpeedTable) -> String {
         format!(
             "at {tilt_deg} deg tilt T is {} over the speeds from {speeds} ({slow:.4} s at the \
              slowest, {fast:.4} s at the fastest)",
-            time_span(t_lo, t_hi)
+            inner_time_span(t_lo, t_hi)
         )
     }
 }
@@ -293,7 +311,22 @@ fn table_refusal(words: &[String], params: &ParamValues) -> String {
         .unwrap_or_default();
     match table_from_params(params) {
         Ok(Some(table)) if table.is_flat() => {
-            format!("{asked}{}", speed_range_words(tilt_deg, &table))
+            // A time the rig gives at every speed is not refused for being out of reach: RTIME
+            // TABLE chooses a speed, and none is better than another (QA: "168 ms refused
+            // inside the range it quotes").
+            let (t_lo, t_hi) = table.residence_range_s();
+            let given = words
+                .get(2)
+                .and_then(|w| w.parse::<f64>().ok())
+                .filter(|ms| {
+                    (f64::from(t_lo) * 1e3 - 0.5..=f64::from(t_hi) * 1e3 + 0.5).contains(ms)
+                })
+                .map(|_| {
+                    "; that is the time the rig gives at any of these speeds: choose the speeds \
+                     with `speed` (RTIME TABLE sets a speed only where the speed sets T)"
+                })
+                .unwrap_or_default();
+            format!("{asked}{}{given}", speed_range_words(tilt_deg, &table))
         }
         Ok(Some(table)) => format!(
             "{asked}{}; ask for a time in that range, or change the tilt or the wall",
@@ -396,6 +429,43 @@ mod tests {
         assert!(
             text.starts_with("0.143 s asked; at 60 deg tilt T is 0.143-0.144 s"),
             "{text}"
+        );
+    }
+
+    /// A table whose speed sets T quotes only times it takes (rounded inwards, checked against
+    /// the table's own `omega_for_s`); a flat one says that a time inside its range is what
+    /// every speed gives, and one outside it is not reachable.
+    #[test]
+    fn the_quoted_times_are_the_ones_the_table_takes() {
+        let t: [f32; 8] = core::array::from_fn(|k| 0.16773 + 0.011 * k as f32 / 7.0);
+        let table = SpeedTable::new(0.5, 3.6, t).unwrap();
+        assert!(!table.is_flat());
+        let words = speed_range_words(60.0, &table);
+        assert!(words.contains("T is 0.168-0.178 s"), "{words}");
+        for ms in [168.0f32, 178.0] {
+            assert!(table.omega_for_s(ms * 1e-3).is_ok(), "{ms} ms");
+        }
+        // Rounded to the nearest, the ends would be 0.168-0.179: 179 ms is refused.
+        assert!(table.omega_for_s(0.179).is_err());
+        let flat: [f32; 8] = core::array::from_fn(|k| 0.16773 + 0.0011 * k as f32 / 7.0);
+        let flat = SpeedTable::new(0.5, 3.6, flat).unwrap();
+        assert!(flat.is_flat());
+        let mut p = default_params();
+        for (id, v) in model_core::binding::TABLE_PARAMS
+            .into_iter()
+            .zip(model_core::binding::table_to_params(&flat).unwrap())
+        {
+            p[id.index()] = v;
+        }
+        let inside = table_refusal(&w("rtime table 168"), &p);
+        assert!(
+            inside.contains("that is the time the rig gives at any of these speeds"),
+            "{inside}"
+        );
+        let outside = table_refusal(&w("rtime table 150"), &p);
+        assert!(
+            outside.contains("speed cannot set it") && !outside.contains("any of these speeds"),
+            "{outside}"
         );
     }
 
