@@ -5,14 +5,7 @@
 
 mod common;
 
-use common::{Sim, bowl, stdout};
-
-fn send(port: &str, words: &str) -> (i32, String) {
-    let mut args = vec!["send", port, "--timeout-ms", "3000"];
-    args.extend(words.split_whitespace());
-    let out = bowl(&args);
-    (out.status.code().unwrap_or(-1), stdout(&out))
-}
+use common::{Sim, send};
 
 #[test]
 fn start_without_a_monitor_warns_of_the_watchdog_and_the_rig_does_fault() {

@@ -267,38 +267,41 @@ fn batch_refusals_name_the_column_and_the_row() {
     assert!(written.is_empty());
 }
 
+/// A scene where one release stalls at the default --tol 1e-9 (found by the QA pass): a low
+/// tilt, little sliding friction, a fast spin against a flared wall.
+const STALLING_SCENE: [&str; 18] = [
+    "--axes-angle-deg",
+    "5",
+    "--sliding-mu",
+    "0.05",
+    "--precession-rad-s",
+    "1.2",
+    "--spin-rad-s",
+    "3.6",
+    "--rim-radius-m",
+    "0.075",
+    "--ri-m",
+    "0.0375",
+    "--wall-angle-deg",
+    "60",
+    "--wall-height-m",
+    "0.02",
+    "--max-time-s",
+    "3",
+];
+
 /// The QA scene where one release stalls at the default --tol 1e-9: the advice does not ask
 /// for a tighter --tol (it does not help) or dp54 (already run); the sentence names the
 /// azimuth and is said once, by the bowl model and by the chooser.
 #[test]
 fn the_gave_up_advice_is_true_and_said_once() {
-    let scene = [
-        "--axes-angle-deg",
-        "5",
-        "--sliding-mu",
-        "0.05",
-        "--precession-rad-s",
-        "1.2",
-        "--spin-rad-s",
-        "3.6",
-        "--rim-radius-m",
-        "0.075",
-        "--ri-m",
-        "0.0375",
-        "--wall-angle-deg",
-        "60",
-        "--wall-height-m",
-        "0.02",
-        "--max-time-s",
-        "3",
-        "--json",
-    ];
+    let scene: Vec<&str> = STALLING_SCENE.iter().copied().chain(["--json"]).collect();
     for model in [
         &["predict", "--model", "bowl", "--speed-range", "false"][..],
         &["predict"][..],
     ] {
         let mut args = model.to_vec();
-        args.extend(scene);
+        args.extend(&scene);
         let v = json(&args);
         let why = v["invalid_reason"].as_str().unwrap_or_default();
         assert!(
@@ -358,34 +361,16 @@ fn the_tilted_bowls_models_share_one_json_shape() {
             }
         }
     }
-    let v = json(&[
-        "predict",
-        "--model",
-        "bowl",
-        "--axes-angle-deg",
-        "5",
-        "--sliding-mu",
-        "0.05",
-        "--precession-rad-s",
-        "1.2",
-        "--spin-rad-s",
-        "3.6",
-        "--rim-radius-m",
-        "0.075",
-        "--ri-m",
-        "0.0375",
-        "--wall-angle-deg",
-        "60",
-        "--wall-height-m",
-        "0.02",
-        "--max-time-s",
-        "3",
+    let mut args = vec!["predict", "--model", "bowl"];
+    args.extend(STALLING_SCENE);
+    args.extend([
         "--release-azimuth-deg",
         "90",
         "--speed-range",
         "false",
         "--json",
     ]);
+    let v = json(&args);
     let e = &v["per_release"][0];
     assert_eq!(e["outcome"], "gave_up", "{v}");
     assert!(e.get("regime").is_some_and(|r| r.is_null()), "{e}");

@@ -5,16 +5,9 @@
 
 mod common;
 
-use common::{Sim, bowl, sim_timed, stdout};
+use common::{Sim, bowl, send, sim_timed, stdout};
 use model_core::binding::default_params;
 use model_core::wire::ParamId;
-
-fn send(port: &str, words: &str) -> (i32, String) {
-    let mut args = vec!["send", port, "--timeout-ms", "3000"];
-    args.extend(words.split_whitespace());
-    let out = bowl(&args);
-    (out.status.code().unwrap_or(-1), stdout(&out))
-}
 
 #[test]
 fn state_refusal_says_the_state_and_what_to_do() {

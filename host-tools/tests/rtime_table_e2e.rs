@@ -6,14 +6,7 @@
 
 mod common;
 
-use common::{Sim, bowl, stdout, success_json};
-
-fn send(port: &str, words: &str) -> (i32, String) {
-    let mut args = vec!["send", port, "--timeout-ms", "3000"];
-    args.extend(words.split_whitespace());
-    let out = bowl(&args);
-    (out.status.code().unwrap_or(-1), stdout(&out))
-}
+use common::{Sim, bowl, send, success_json};
 
 /// The bowl model's scene: a bare rim, tilt `tilt`, both motors at `w` rad/s.
 fn scene(tilt: &str, w: &str) -> Vec<String> {

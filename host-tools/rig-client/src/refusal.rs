@@ -417,19 +417,25 @@ mod tests {
             "at 60 deg tilt T is 0.143-0.144 s at every speed from 0.50 to 3.60 rad/s: speed \
              cannot set it; the tilt or the wall can"
         );
-        let mut p = default_params();
+        let p = default_params();
         assert!(table_refusal(&w("rtime table 143"), &p).contains("no residence-time table"));
-        for (id, v) in model_core::binding::TABLE_PARAMS
-            .into_iter()
-            .zip(model_core::binding::table_to_params(&table).unwrap())
-        {
-            p[id.index()] = v;
-        }
+        let p = with_table(p, &table);
         let text = table_refusal(&w("rtime table 143"), &p);
         assert!(
             text.starts_with("0.143 s asked; at 60 deg tilt T is 0.143-0.144 s"),
             "{text}"
         );
+    }
+
+    /// `p` with `table` stored in its residence-time parameters.
+    fn with_table(mut p: ParamValues, table: &SpeedTable) -> ParamValues {
+        for (id, v) in model_core::binding::TABLE_PARAMS
+            .into_iter()
+            .zip(model_core::binding::table_to_params(table).unwrap())
+        {
+            p[id.index()] = v;
+        }
+        p
     }
 
     /// A table whose speed sets T quotes only times it takes (rounded inwards, checked against
@@ -450,13 +456,7 @@ mod tests {
         let flat: [f32; 8] = core::array::from_fn(|k| 0.16773 + 0.0011 * k as f32 / 7.0);
         let flat = SpeedTable::new(0.5, 3.6, flat).unwrap();
         assert!(flat.is_flat());
-        let mut p = default_params();
-        for (id, v) in model_core::binding::TABLE_PARAMS
-            .into_iter()
-            .zip(model_core::binding::table_to_params(&flat).unwrap())
-        {
-            p[id.index()] = v;
-        }
+        let p = with_table(default_params(), &flat);
         let inside = table_refusal(&w("rtime table 168"), &p);
         assert!(
             inside.contains("that is the time the rig gives at any of these speeds"),

@@ -147,6 +147,14 @@ impl Drop for Sim {
     }
 }
 
+/// `bowl send PORT WORDS...` with a 3 s timeout: its exit code and standard output.
+pub fn send(port: &str, words: &str) -> (i32, String) {
+    let mut args = vec!["send", port, "--timeout-ms", "3000"];
+    args.extend(words.split_whitespace());
+    let out = bowl(&args);
+    (out.status.code().unwrap_or(-1), stdout(&out))
+}
+
 /// `bowl serve`'s flags for a run of `seconds` with the timed commands `AT_MS:WORDS,...`.
 pub fn timed(seconds: &str, commands: &[&str]) -> Vec<String> {
     let mut args = vec!["--seconds".to_string(), seconds.to_string()];
