@@ -26,6 +26,19 @@ const BOWL: [&str; 15] = [
 ];
 
 /// `BOWL` with the flags in `extra` replacing its own (the flag and its value).
+/// The bowl model on the 60 deg rig file at 1.2 rad/s on both motors.
+const RIG_BOWL: [&str; 9] = [
+    "predict",
+    "--model",
+    "bowl",
+    "--rig-file",
+    "../docs/rigs/bowl-60deg.toml",
+    "--precession-rad-s",
+    "1.2",
+    "--spin-rad-s",
+    "1.2",
+];
+
 fn bowl_with(extra: &[&str]) -> Vec<String> {
     let mut v: Vec<String> = vec![BOWL[0].into()];
     for pair in BOWL[1..].chunks(2) {
@@ -137,20 +150,9 @@ fn flags_the_model_ignores_are_refused() {
         assert!(err.contains(want), "{extra:?}: {err}");
         assert!(out.is_empty(), "{out}");
     }
-    let (code, _, err) = run(&[
-        "predict",
-        "--model",
-        "bowl",
-        "--rig-file",
-        "../docs/rigs/bowl-60deg.toml",
-        "--precession-rad-s",
-        "1.2",
-        "--spin-rad-s",
-        "1.2",
-        "--particle-radius-m",
-        "0.002",
-    ]
-    .map(String::from));
+    let mut args: Vec<String> = RIG_BOWL.map(String::from).to_vec();
+    args.extend(["--particle-radius-m".into(), "0.002".into()]);
+    let (code, _, err) = run(&args);
     assert_eq!(code, Some(2), "{err}");
     assert!(
         err.contains("--particle-radius-m conflicts with --rig-file") && err.contains("(0.003 m)"),
@@ -177,25 +179,12 @@ fn flags_the_model_ignores_are_refused() {
 /// The rig file's release radius is the bowl model's start unless --ri-m is given.
 #[test]
 fn the_rig_files_release_radius_is_used() {
-    let rig = [
-        "predict",
-        "--model",
-        "bowl",
-        "--rig-file",
-        "../docs/rigs/bowl-60deg.toml",
-        "--precession-rad-s",
-        "1.2",
-        "--spin-rad-s",
-        "1.2",
-        "--speed-range",
-        "false",
-        "--release-azimuth-deg",
-        "0",
-    ];
-    let (code, out, err) = run(&rig.map(String::from));
+    let mut rig: Vec<String> = RIG_BOWL.map(String::from).to_vec();
+    rig.extend(["--speed-range", "false", "--release-azimuth-deg", "0"].map(String::from));
+    let (code, out, err) = run(&rig);
     assert_eq!(code, Some(0), "{err}");
     assert!(out.contains("ri 0.0375 m"), "{out}");
-    let mut given: Vec<String> = rig.map(String::from).to_vec();
+    let mut given = rig;
     given.extend(["--ri-m".into(), "0.03".into()]);
     let (_, out, _) = run(&given);
     assert!(out.contains("ri 0.03 m"), "{out}");

@@ -5,7 +5,7 @@
 
 use std::time::Duration;
 
-use model_core::wire::ParamId;
+use model_core::wire::{CommandKind, ParamId};
 
 use crate::link::Link;
 use crate::refusal::ask_params;
@@ -14,9 +14,11 @@ use crate::refusal::ask_params;
 /// both motors for several seconds). A speed or residence target while running only moves the
 /// setpoints; the note came with the `start`.
 pub fn starts_motors(words: &[String]) -> bool {
-    words
-        .first()
-        .is_some_and(|w| w.eq_ignore_ascii_case("start") || w.eq_ignore_ascii_case("commission"))
+    // Read by the command table, as `send` reads the word.
+    matches!(
+        words.first().and_then(|w| CommandKind::from_word(w)),
+        Some(CommandKind::Start | CommandKind::Commission)
+    )
 }
 
 /// The note for a command that `starts_motors`, done over `link`, on `port`: `None` when a

@@ -1,6 +1,6 @@
 //! `SET NAME VALUE` refused: the parameter's own range, or the rule that ties it to the others.
 
-use model_core::binding::{ParamRole, TABLE_PARAMS, table_from_params};
+use model_core::binding::{ParamRole, TABLE_PARAMS, scene_from_params, table_from_params};
 use model_core::wire::{Command, ParamId, ParamValues};
 
 /// `set NAME VALUE` refused: not an integer, or outside the parameter's own range (the
@@ -33,7 +33,8 @@ fn conflict(id: ParamId, value: i32, params: &ParamValues) -> Option<String> {
     next[id.index()] = value;
     let p = |id: ParamId| next[id.index()];
     let (start, rim) = (p(ParamId::StartUm), p(ParamId::RimUm));
-    if matches!(id, ParamId::StartUm | ParamId::RimUm) && start >= rim {
+    // The rig's own scene check (the start inside the rim is its one rule between the two).
+    if matches!(id, ParamId::StartUm | ParamId::RimUm) && scene_from_params::<f64>(&next).is_err() {
         return Some(format!(
             "the granule's start radius {} = {start} um must lie inside the rim {} = {rim} um; \
              set {} below {rim} um, or widen {} first",
