@@ -11,6 +11,9 @@ pub const USAGE: i32 = 2;
 pub const LINK: i32 = 3;
 /// No answer came in time.
 pub const TIMEOUT: i32 = 4;
+/// Ended by Ctrl-C or SIGTERM after putting the rig in a safe state (`commission` stops the
+/// motors); 128 + SIGINT, as a shell reports a command Ctrl-C ended.
+pub const INTERRUPTED: i32 = 130;
 
 /// Whether the error is only that our standard output was closed (`bowl ... | head`): the
 /// reader has what it wanted, so that is not a failure to report.

@@ -9,6 +9,7 @@ mod cmd;
 #[cfg(unix)]
 mod demo;
 mod exit_code;
+mod interrupt;
 mod monitor;
 
 /// The PC side of the bowl granulation rig.

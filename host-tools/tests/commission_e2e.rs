@@ -101,6 +101,9 @@ fn refusal_and_fault_both_exit_1_told_apart_by_their_result() {
         rig_client::lines::explain(model_core::wire::Reason::State)
     );
     assert!(text.contains(&want), "{text}");
+    // And what to do, as `bowl send PORT commission` says it (the rig's state, asked: still
+    // changing speed or running by now).
+    assert!(text.contains(": stop the motors first"), "{text}");
 
     send(&["stop"]);
     std::thread::sleep(std::time::Duration::from_secs(3));

@@ -100,6 +100,27 @@ impl Rig {
         }
     }
 
+    /// The device restarts seen on this link so far (a Hello frame, or the device clock
+    /// starting again: the decoder's count), so a caller can tell that the rig reset meanwhile.
+    pub fn restarts(&self) -> u64 {
+        self.reader.decoder.stats().restarts
+    }
+
+    /// The particulars of the rig's refusal of `words` (the command as `bowl send` takes it),
+    /// asking the rig what they need ([`crate::refusal::particulars`]); `None` when the
+    /// reason's own words say it all.
+    pub fn refusal_particulars(&mut self, words: &[&str], reason: Reason) -> Option<String> {
+        self.next_id = next_id(self.next_id);
+        let words: Vec<String> = words.iter().map(|w| (*w).to_string()).collect();
+        crate::refusal::particulars(
+            Some(&mut self.link),
+            self.next_id,
+            &words,
+            reason,
+            self.timeout,
+        )
+    }
+
     /// Reads for `wait`; what arrives goes to [`Rig::arrived`].
     pub fn listen(&mut self, wait: Duration) -> anyhow::Result<()> {
         let mut buf = [0u8; 4096];

@@ -4,10 +4,12 @@
 //! the state leaves "commissioning", then asks MODELS and PARAMS and prints the identified motor
 //! models and the speed-loop gains that follow from them, as text or `--json`.
 //!
-//! Exit status (`exit_code`): 0 done, 1 the rig refused COMMISSION (the reason is printed) or
-//! commissioning ended in a fault (the rig's fault code is printed; the motors are off), 3 the
-//! link failed, 4 no answer or commissioning did not end within `--timeout-s`.
+//! Exit status (`exit_code`): 0 done, 1 the rig refused COMMISSION (the reason and its
+//! particulars are printed), commissioning ended in a fault (the rig's fault code is printed;
+//! the motors are off) or the rig reset meanwhile, 3 the link failed, 4 no answer or
+//! commissioning did not end within `--timeout-s`, 130 Ctrl-C or SIGTERM (STOP sent first).
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
@@ -62,7 +64,8 @@ struct AxisReport {
 /// The whole outcome, as `--json` prints it.
 #[derive(Serialize)]
 struct Report {
-    /// `ok`, `rejected`, `timeout` or `fault`.
+    /// `ok`, `rejected`, `timeout`, `fault`, `interrupted` (Ctrl-C or SIGTERM: STOP sent) or
+    /// `restarted` (the rig reset meanwhile).
     result: &'static str,
     /// Seconds from the rig's acknowledgement to the end of commissioning.
     seconds: f64,
@@ -70,6 +73,9 @@ struct Report {
     fault: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     reason: Option<&'static str>,
+    /// A refusal's particulars (the rig's state, what to do), as `bowl send` gives them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    why: Option<String>,
     axes: Vec<AxisReport>,
 }
 
@@ -91,18 +97,27 @@ enum End {
     Fault(FaultCode),
     OtherState(DeviceState),
     Timeout,
+    /// Ctrl-C or SIGTERM on this command.
+    Interrupted,
+    /// The rig reset meanwhile (a Hello, or its clock started again): its idle state after
+    /// the reset says nothing of the identification, which the reset ended.
+    Restarted,
 }
 
 /// Follows the rig until it leaves the commissioning state (its telemetry, or STATUS when it
 /// sends none), through the rig client's typed [`Rig`].
-fn follow(rig: &mut Rig, timeout: Duration, quiet: bool) -> Result<End> {
+fn follow(rig: &mut Rig, timeout: Duration, quiet: bool, interrupted: &AtomicBool) -> Result<End> {
     let start = Instant::now();
     let mut last_seen = Instant::now();
     let mut last_report = Instant::now();
     let mut last_ping = Instant::now();
+    let restarts = rig.restarts();
     loop {
         if start.elapsed() > timeout {
             return Ok(End::Timeout);
+        }
+        if interrupted.load(Ordering::SeqCst) {
+            return Ok(End::Interrupted);
         }
         // Telemetry out is not presence: the rig's link-loss timeout needs bytes from us.
         if last_ping.elapsed() >= PING_EVERY {
@@ -111,6 +126,10 @@ fn follow(rig: &mut Rig, timeout: Duration, quiet: bool) -> Result<End> {
         }
         let mut state = None;
         rig.listen(Duration::from_millis(50))?;
+        // A Hello, or the device clock starting again (the decoder's one rule).
+        if rig.restarts() > restarts {
+            return Ok(End::Restarted);
+        }
         // Telemetry (and what came while a command waited for its answer).
         while let Some(frame) = rig.arrived.pop_front() {
             if let Frame::Telemetry(t) = frame {
@@ -180,13 +199,35 @@ fn print(report: &Report, json: bool) -> Result<()> {
             report.seconds,
             report.fault.as_deref().unwrap_or("?")
         ),
-        "rejected" => println!(
-            "COMMISSION rejected: {} - {}",
-            report.reason.unwrap_or("?"),
-            report
-                .reason
-                .and_then(|t| Reason::from_token(t.as_bytes()))
-                .map_or("", explain)
+        "rejected" => {
+            println!(
+                "COMMISSION rejected: {} - {}",
+                report.reason.unwrap_or("?"),
+                report
+                    .reason
+                    .and_then(|t| Reason::from_token(t.as_bytes()))
+                    .map_or("", explain)
+            );
+            if let Some(why) = &report.why {
+                println!("  {why}");
+            }
+        }
+        "interrupted" => println!(
+            "commissioning interrupted after {:.1} s: STOP sent{}; the motor models in force are \
+             the ones from before (`bowl send PORT models`)",
+            report.seconds,
+            if report.why.is_some() {
+                ", but the rig did not acknowledge it: check that the motors are off"
+            } else {
+                ", the motors are off"
+            }
+        ),
+        "restarted" => println!(
+            "commissioning did NOT finish: the rig reset after {:.1} s (it sent a Hello, or its \
+             clock started again), which ended the identification; the motor models in force \
+             are the ones it booted with. Look at why it reset (`bowl send PORT status`: \
+             reset_cause), then run `bowl commission` again",
+            report.seconds
         ),
         other => println!("commissioning: {other} after {:.1} s", report.seconds),
     }
@@ -222,12 +263,16 @@ pub fn run(args: &Args) -> Result<i32> {
             args.timeout_s
         )));
     }
+    // Ctrl-C or a `kill` while the motors turn: stop them before ending (below), rather than
+    // leave the identification running unattended.
+    let interrupted = crate::interrupt::flag();
     let mut rig = Rig::open(&args.port, args.baud, ANSWER_TIMEOUT)?;
     let mut report = Report {
         result: "ok",
         seconds: 0.0,
         fault: None,
         reason: None,
+        why: None,
         axes: Vec::new(),
     };
     match answered(rig.commission())? {
@@ -236,6 +281,7 @@ pub fn run(args: &Args) -> Result<i32> {
         Some(Reply::Refused(reason)) => {
             report.result = "rejected";
             report.reason = Some(reason.token());
+            report.why = rig.refusal_particulars(&["commission"], reason);
             print(&report, args.json)?;
             return Ok(exit_code::REFUSED);
         }
@@ -252,7 +298,12 @@ pub fn run(args: &Args) -> Result<i32> {
         );
     }
     let started = Instant::now();
-    let end = follow(&mut rig, Duration::from_secs_f64(args.timeout_s), args.json)?;
+    let end = follow(
+        &mut rig,
+        Duration::from_secs_f64(args.timeout_s),
+        args.json,
+        &interrupted,
+    )?;
     report.seconds = started.elapsed().as_secs_f64();
     let code = match end {
         End::Idle => exit_code::OK,
@@ -272,6 +323,17 @@ pub fn run(args: &Args) -> Result<i32> {
             // Leave the motors off rather than half-way through a duty step.
             let _ = rig.stop();
             exit_code::TIMEOUT
+        }
+        End::Interrupted => {
+            report.result = "interrupted";
+            if !matches!(answered(rig.stop()), Ok(Some(Reply::Done(())))) {
+                report.why = Some("STOP not acknowledged".into());
+            }
+            exit_code::INTERRUPTED
+        }
+        End::Restarted => {
+            report.result = "restarted";
+            exit_code::REFUSED
         }
     };
     if code == exit_code::OK {

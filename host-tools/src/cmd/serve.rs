@@ -6,8 +6,6 @@
 use std::io::Write;
 use std::path::PathBuf;
 #[cfg(unix)]
-use std::sync::atomic::AtomicBool;
-#[cfg(unix)]
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
@@ -162,13 +160,15 @@ pub fn run(args: &Args) -> Result<()> {
         }
         println!("{}", pty.path);
         std::io::stdout().flush()?;
-        let never = AtomicBool::new(false);
+        // Ctrl-C or a `kill` ends the serving loop, so the `--link` below is removed rather
+        // than left pointing at a pseudo-terminal that is gone (or soon another program's).
+        let interrupted = crate::interrupt::flag();
         let served = serve_on_pty(
             pty,
             rig,
             Pacing {
                 device_ms_per_wall_ms: 1.0,
-                stop: &never,
+                stop: &interrupted,
                 stop_after: args.seconds.map(Duration::from_secs_f64),
                 backlog: Backlog::DropWhenUnread,
             },

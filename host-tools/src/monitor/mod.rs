@@ -18,8 +18,7 @@ pub(crate) use view::View;
 use std::fs::{File, OpenOptions};
 use std::io::{BufRead, BufWriter, IsTerminal, Write};
 use std::path::PathBuf;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::mpsc;
 use std::time::{Duration, Instant, SystemTime};
 
@@ -138,12 +137,9 @@ pub fn run(args: &Args) -> Result<()> {
     // Served only while the port is held: a lost port's name may soon be another device's.
     let mut relay = Some(Relay::serve(&args.port)?);
     let mut log = args.log.as_ref().map(open_log).transpose()?;
-    let interrupted = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupted.clone();
-        // In the UI, Ctrl-C arrives as a key; this catches it in plain mode.
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-    }
+    // In the UI, Ctrl-C arrives as a key; this catches it in plain mode, and SIGTERM or SIGHUP
+    // in both: the loop ends, so the terminal is given back and the log gets `monitor end`.
+    let interrupted = crate::interrupt::flag();
     let started = Instant::now();
     let deadline = args
         .seconds
