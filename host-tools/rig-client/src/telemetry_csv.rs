@@ -87,6 +87,17 @@ pub fn write_row(
     Ok(())
 }
 
+/// An event's words as one CSV cell (RFC 4180): quoted, with its quotes doubled, when it holds
+/// a comma, a quote or a line end (a warning in words has commas), so a spreadsheet and
+/// [`LogReader`] read it as the one `event` cell, not as extra columns.
+fn event_cell(event: &str) -> std::borrow::Cow<'_, str> {
+    if event.contains([',', '"', '\r', '\n']) {
+        format!("\"{}\"", event.replace('"', "\"\"")).into()
+    } else {
+        event.into()
+    }
+}
+
 /// Writes an event's row (a link event, a gate event): `boot`, empty telemetry columns, the
 /// PC's time if known and the event.
 pub fn write_event(
@@ -97,9 +108,10 @@ pub fn write_event(
 ) -> Result<()> {
     writeln!(
         out,
-        "{boot},{}{},{event}",
+        "{boot},{}{},{}",
         ",".repeat(TELEMETRY_COLUMNS),
-        host.map(utc).unwrap_or_default()
+        host.map(utc).unwrap_or_default(),
+        event_cell(event)
     )?;
     Ok(())
 }
@@ -114,8 +126,9 @@ pub fn write_device_event(
 ) -> Result<()> {
     writeln!(
         out,
-        "{boot},{device_time_ms}{},{event}",
-        ",".repeat(TELEMETRY_COLUMNS)
+        "{boot},{device_time_ms}{},{}",
+        ",".repeat(TELEMETRY_COLUMNS),
+        event_cell(event)
     )?;
     Ok(())
 }
@@ -233,5 +246,26 @@ mod tests {
             "{line}"
         );
         assert!(line.starts_with("2,") && line.trim_end().ends_with(",link lost"));
+    }
+
+    /// An event in words with commas and quotes (the monitor's warning about another program
+    /// on the port) stays one cell: a CSV reader gets the header's column count and the words
+    /// back whole.
+    #[test]
+    fn an_event_with_commas_is_one_cell() {
+        let words = "warning: /dev/pts/3 is also open in picocom (pid 42), which does not lock \
+                     it: it takes some of the rig's bytes, so frames go \"missing\"";
+        let mut out = Vec::new();
+        write_event(&mut out, 0, Some(SystemTime::UNIX_EPOCH), words).unwrap();
+        write_device_event(&mut out, 0, 5000, words).unwrap();
+        let text = format!("{HEADER}\n{}", String::from_utf8(out).unwrap());
+        let mut reader = csv::Reader::from_reader(text.as_bytes());
+        let columns = reader.headers().unwrap().len();
+        let rows: Vec<csv::StringRecord> = reader.records().map(|r| r.unwrap()).collect();
+        assert_eq!(rows.len(), 2);
+        for row in rows {
+            assert_eq!(row.len(), columns, "{row:?}");
+            assert_eq!(&row[columns - 1], words);
+        }
     }
 }

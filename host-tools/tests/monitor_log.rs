@@ -1,0 +1,60 @@
+//! End to end: `bowl monitor --log FILE` onto a file that exists. Its own earlier log is
+//! appended to (one header, every row whole, even after a row cut off by a power loss); any
+//! other CSV is refused before anything is written to it.
+
+mod common;
+
+use common::{Sim, monitor_logged, temp_dir};
+
+/// The columns of a log row, counted as a CSV reader counts them.
+fn fields(line: &str) -> usize {
+    csv::ReaderBuilder::new()
+        .has_headers(false)
+        .from_reader(line.as_bytes())
+        .records()
+        .next()
+        .map_or(0, |r| r.unwrap().len())
+}
+
+#[test]
+fn a_log_is_appended_to_and_another_csv_is_left_alone() {
+    let sim = Sim::start(&["--seconds", "30"]);
+    let dir = temp_dir("monitor-log");
+
+    // A results file given by mistake: refused as a usage error (2), not one byte added.
+    let results = dir.join("results.csv");
+    let kept = "model,w_rad_s,mu,ri_m,R_m\ncoriolis,3.0,0.02,0.02,0.15\n";
+    std::fs::write(&results, kept).unwrap();
+    let out = monitor_logged(&sim.path, "1", &results);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("results.csv") && err.contains("not a telemetry log"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&results).unwrap(), kept);
+
+    // The monitor's own log, its last row cut off mid-line (the PC lost power), appended to.
+    let log = dir.join("run.csv");
+    assert!(monitor_logged(&sim.path, "1", &log).status.success());
+    let whole = std::fs::read_to_string(&log).unwrap();
+    let columns = fields(whole.lines().next().unwrap());
+    let cut = whole.trim_end().len() - 40;
+    std::fs::write(&log, &whole[..cut]).unwrap();
+    let out = monitor_logged(&sim.path, "1", &log);
+    assert!(out.status.success(), "{out:?}");
+    let text = std::fs::read_to_string(&log).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(
+        lines.iter().filter(|l| l.starts_with("boot,")).count(),
+        1,
+        "one header"
+    );
+    // The stub stays short; every other row, the second run's `port open` first, is whole.
+    let short: Vec<&&str> = lines.iter().filter(|l| fields(l) != columns).collect();
+    assert_eq!(short.len(), 1, "{short:?}");
+    assert!(
+        lines.iter().filter(|l| l.ends_with(",port open")).count() == 2,
+        "{text}"
+    );
+}
