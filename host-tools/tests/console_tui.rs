@@ -154,3 +154,91 @@ fn telemetry_that_stops_is_said_and_marked_in_the_log() {
         "the gap is marked in the log: {events:?}"
     );
 }
+
+/// A small terminal (40 x 12, a split pane): the charts give way, never the banner (link and
+/// state), the fault line, the values (as sentences, wrapped, not cut at the edge) or the
+/// command line; a time label is never shown with its first digits cut off.
+#[test]
+fn a_small_terminal_keeps_the_state_values_and_command_line() {
+    let sim = Sim::start(&[]);
+    let tmux = Tmux::start(
+        "tui-small",
+        &format!("{BOWL} monitor {} ; sleep 30", sim.path),
+    );
+    assert!(
+        tmux.cmd(&["resize-window", "-t", "0", "-x", "40", "-y", "12"])
+            .status()
+            .unwrap()
+            .success()
+    );
+    let screen = tmux.wait_for(
+        &[
+            "LINK OK",
+            "state idle",
+            "no fault",
+            "precession w1: set 0.000 measured",
+            "spin w2: set 0.000 measured",
+            ": command",
+        ],
+        "the state, values and command line in 40 x 12",
+    );
+    assert!(
+        screen.lines().all(|l| l.chars().count() <= 40),
+        "fits 40 columns:\n{screen}"
+    );
+    // Taller, still 40 wide: the charts come back, their time axis whole (`NNN s`, the
+    // numbers the device time gives).
+    assert!(
+        tmux.cmd(&["resize-window", "-t", "0", "-x", "40", "-y", "30"])
+            .status()
+            .unwrap()
+            .success()
+    );
+    let screen = tmux.wait_for(&["precession w1 rad", " s│"], "charts at 40 x 30");
+    let device_s: f64 = screen
+        .split("device time ")
+        .nth(1)
+        .and_then(|r| r.split(" s").next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("device time on:\n{screen}"));
+    let axis = screen.lines().find(|l| l.ends_with(" s│")).unwrap();
+    let last: f64 = axis
+        .trim_end_matches(" s│")
+        .rsplit(' ')
+        .next()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("a time label: {axis}"));
+    assert!(
+        (last - device_s).abs() <= 20.0,
+        "the axis ends at {last} s, the device time is {device_s} s:\n{screen}"
+    );
+}
+
+/// Closing the terminal (SIGHUP: tmux killed, an ssh session dropped) ends the monitor: it
+/// must not stay behind holding the port.
+#[test]
+fn closing_the_terminal_ends_the_monitor() {
+    let sim = Sim::start(&[]);
+    let tmux = Tmux::start("tui-hangup", &format!("{BOWL} monitor {}", sim.path));
+    tmux.wait_for(&["LINK OK"], "the dashboard");
+    // The monitor itself, not the shell tmux may start it through.
+    let out = std::process::Command::new("pgrep")
+        .args(["-f", &format!("^{BOWL} monitor {}$", sim.path)])
+        .output()
+        .unwrap();
+    let monitor: u32 = String::from_utf8_lossy(&out.stdout)
+        .trim()
+        .parse()
+        .expect("one monitor pid");
+    drop(tmux);
+    let started = std::time::Instant::now();
+    while std::path::Path::new(&format!("/proc/{monitor}")).exists() {
+        if started.elapsed() > std::time::Duration::from_secs(5) {
+            let _ = std::process::Command::new("kill")
+                .args(["-9", &monitor.to_string()])
+                .status();
+            panic!("the monitor {monitor} still ran 5 s after its terminal closed");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+}

@@ -302,7 +302,7 @@ pub fn run(args: &Args) -> Result<i32> {
         &mut rig,
         Duration::from_secs_f64(args.timeout_s),
         args.json,
-        &interrupted,
+        interrupted,
     )?;
     report.seconds = started.elapsed().as_secs_f64();
     let code = match end {

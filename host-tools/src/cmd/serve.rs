@@ -152,6 +152,10 @@ pub fn run(args: &Args) -> Result<()> {
     }
     #[cfg(unix)]
     if args.pty {
+        // Ctrl-C or a `kill` ends the serving loop, so the `--link` below is removed rather
+        // than left pointing at a pseudo-terminal that is gone (or soon another program's).
+        // Installed before the path is printed: a script may signal as soon as it reads it.
+        let interrupted = crate::interrupt::flag();
         let pty = Pty::open()?;
         if let Some(link) = &args.link {
             let _ = std::fs::remove_file(link);
@@ -160,15 +164,12 @@ pub fn run(args: &Args) -> Result<()> {
         }
         println!("{}", pty.path);
         std::io::stdout().flush()?;
-        // Ctrl-C or a `kill` ends the serving loop, so the `--link` below is removed rather
-        // than left pointing at a pseudo-terminal that is gone (or soon another program's).
-        let interrupted = crate::interrupt::flag();
         let served = serve_on_pty(
             pty,
             rig,
             Pacing {
                 device_ms_per_wall_ms: 1.0,
-                stop: &interrupted,
+                stop: interrupted,
                 stop_after: args.seconds.map(Duration::from_secs_f64),
                 backlog: Backlog::DropWhenUnread,
             },

@@ -8,6 +8,7 @@
 
 mod backlog;
 mod commands;
+mod fit;
 mod line_edit;
 mod tui;
 mod view;
@@ -163,14 +164,14 @@ pub fn run(args: &Args) -> Result<()> {
     }
     // The UI needs a screen and a keyboard; without either it prints lines.
     let plain = args.plain || !std::io::stdout().is_terminal() || !std::io::stdin().is_terminal();
+    // In the UI, Ctrl-C arrives as a key; this catches it in plain mode, and SIGTERM in both:
+    // the loop ends, so the terminal is given back and the log gets `monitor end`.
+    let interrupted = crate::interrupt::flag();
     // The port is checked before anything is drawn: a wrong path is an error, not a wait.
     let first = Port::open(&args.port, args.baud)?;
     // Served only while the port is held: a lost port's name may soon be another device's.
     let mut relay = Some(Relay::serve(&args.port)?);
     let mut log = args.log.as_ref().map(open_log).transpose()?;
-    // In the UI, Ctrl-C arrives as a key; this catches it in plain mode, and SIGTERM or SIGHUP
-    // in both: the loop ends, so the terminal is given back and the log gets `monitor end`.
-    let interrupted = crate::interrupt::flag();
     let started = Instant::now();
     let deadline = args
         .seconds

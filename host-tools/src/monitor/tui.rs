@@ -168,22 +168,27 @@ impl Tui {
                 event_rows.extend(lines);
             }
             let banner_rows = banner(port, view, silence, paused, tools, width);
-            let rows = Layout::vertical([
-                Constraint::Length(banner_rows.len() as u16),
-                Constraint::Length(fault_rows.len() as u16),
-                Constraint::Min(8),
-                Constraint::Length(5),
-                Constraint::Length(1),
-                Constraint::Length(event_space as u16 + 1),
-                Constraint::Length(1),
-            ])
-            .split(f.area());
+            let live = view.connected && silence.is_none() && view.latest.is_some();
+            let (value_lines, value_style) = values(view, live, width);
+            let counters: Vec<Line> = wrap(&view.counters(decoder), width)
+                .into_iter()
+                .map(Line::from)
+                .collect();
+            // In a small terminal the charts give way first, never the banner or the fault.
+            let heights = super::fit::rows(
+                f.area().height,
+                banner_rows.len(),
+                fault_rows.len(),
+                value_lines.len(),
+                counters.len(),
+                event_space + 1,
+            );
+            let rows = Layout::vertical(heights.map(Constraint::Length)).split(f.area());
             f.render_widget(Paragraph::new(banner_rows), rows[0]);
             let fault_lines: Vec<Line> = fault_rows.into_iter().map(Line::from).collect();
             f.render_widget(Paragraph::new(fault_lines).style(fault_style), rows[1]);
             let charts = Layout::horizontal([Constraint::Ratio(1, 2), Constraint::Ratio(1, 2)])
                 .split(rows[2]);
-            let live = view.connected && silence.is_none() && view.latest.is_some();
             for (i, (name, area)) in ["precession w1", "spin w2"]
                 .iter()
                 .zip(charts.iter())
@@ -191,9 +196,9 @@ impl Tui {
             {
                 speed_chart(f, *area, name, &history.axes[i], live);
             }
-            f.render_widget(values(view, live), rows[3]);
+            f.render_widget(Paragraph::new(value_lines).style(value_style), rows[3]);
             f.render_widget(
-                Paragraph::new(view.counters(decoder)).style(Style::default().fg(Color::Cyan)),
+                Paragraph::new(counters).style(Style::default().fg(Color::Cyan)),
                 rows[4],
             );
             let events: Vec<Line> = event_rows.into_iter().map(Line::from).collect();
@@ -362,7 +367,10 @@ fn speed_chart(
             .style(Style::default().fg(dim(Color::Cyan)))
             .data(&measured),
     ];
-    let label = |v: f64| Span::raw(format!("{v:.2}"));
+    let y_labels = [y0, (y0 + y1) / 2.0, y1].map(|v| format!("{v:.2}"));
+    // The plot's columns: the frame's two, the y labels' and the axis line's are not in it.
+    let y_label_width = y_labels.iter().map(String::len).max().unwrap_or(0) as u16;
+    let plot_width = area.width.saturating_sub(2 + y_label_width + 1);
     // What the lines are and the units go in the frame's title: a legend or an axis title
     // inside the plot would be drawn over the newest samples at the right edge.
     let title = Line::from(vec![
@@ -375,25 +383,25 @@ fn speed_chart(
     let chart = Chart::new(datasets)
         .block(Block::default().borders(Borders::ALL).title(title))
         .legend_position(None)
-        .x_axis(Axis::default().bounds([t_start, t_end]).labels([
-            Span::raw(format!("{t_start:.0}")),
-            Span::raw(format!("{:.0}", (t_start + t_end) / 2.0)),
-            // The unit on the last label, below the axis (device time, s).
-            Span::raw(format!("{t_end:.0} s")),
-        ]))
-        .y_axis(Axis::default().bounds([y0, y1]).labels([
-            label(y0),
-            label((y0 + y1) / 2.0),
-            label(y1),
-        ]));
+        // The unit on the last label, below the axis (device time, s).
+        .x_axis(
+            Axis::default()
+                .bounds([t_start, t_end])
+                .labels(super::fit::time_labels(t_start, t_end, plot_width)),
+        )
+        .y_axis(Axis::default().bounds([y0, y1]).labels(y_labels));
     f.render_widget(chart, area);
 }
 
-/// The latest values; grey when they are not current (`live` false: the link is lost or no
-/// telemetry came for a while: they are then the last known).
-fn values(view: &View, live: bool) -> Paragraph<'static> {
+/// The widest line of the values' table: narrower screens get them as sentences, wrapped.
+const VALUES_TABLE_WIDTH: usize = 82;
+
+/// The latest values in lines no wider than `width`, and their style: grey when they are not
+/// current (`live` false: the link is lost or no telemetry came for a while: they are then the
+/// last known).
+fn values(view: &View, live: bool, width: usize) -> (Vec<Line<'static>>, Style) {
     let Some(t) = view.latest else {
-        return Paragraph::new("no telemetry yet");
+        return (vec![Line::from("no telemetry yet")], Style::default());
     };
     let style = if live {
         Style::default()
@@ -402,34 +410,55 @@ fn values(view: &View, live: bool) -> Paragraph<'static> {
             .fg(Color::DarkGray)
             .add_modifier(Modifier::CROSSED_OUT)
     };
-    let mut lines = vec![Line::from(format!(
-        "device time {:.3} s  seq {}   {:>13} {:>15} {:>8} {:>7}",
-        f64::from(t.time_ms) / 1000.0,
-        t.seq,
-        "set rad/s",
-        "measured rad/s",
-        "duty %",
-        "pulses"
-    ))];
-    for (name, m) in [("precession w1", t.precession), ("spin w2      ", t.spin)] {
-        lines.push(Line::from(format!(
-            "{name}                  {:>13.3} {:>15.3} {:>8.2} {:>7}",
-            f64::from(m.set_mrad_s) / 1000.0,
-            f64::from(m.measured_mrad_s) / 1000.0,
-            f64::from(m.duty_bp) / 100.0,
-            m.pulses
-        )));
+    let mut lines = Vec::new();
+    let axes = [("precession w1", t.precession), ("spin w2      ", t.spin)];
+    if width >= VALUES_TABLE_WIDTH {
+        lines.push(format!(
+            "device time {:.3} s  seq {}   {:>13} {:>15} {:>8} {:>7}",
+            f64::from(t.time_ms) / 1000.0,
+            t.seq,
+            "set rad/s",
+            "measured rad/s",
+            "duty %",
+            "pulses"
+        ));
+        for (name, m) in axes {
+            lines.push(format!(
+                "{name}                  {:>13.3} {:>15.3} {:>8.2} {:>7}",
+                f64::from(m.set_mrad_s) / 1000.0,
+                f64::from(m.measured_mrad_s) / 1000.0,
+                f64::from(m.duty_bp) / 100.0,
+                m.pulses
+            ));
+        }
+    } else {
+        lines.push(format!(
+            "device time {:.3} s  seq {}",
+            f64::from(t.time_ms) / 1000.0,
+            t.seq
+        ));
+        for (name, m) in axes {
+            lines.push(format!(
+                "{}: set {:.3} measured {:.3} rad/s, duty {:.2} %, pulses {}",
+                name.trim_end(),
+                f64::from(m.set_mrad_s) / 1000.0,
+                f64::from(m.measured_mrad_s) / 1000.0,
+                f64::from(m.duty_bp) / 100.0,
+                m.pulses
+            ));
+        }
     }
-    lines.push(Line::from(format!(
+    lines.push(format!(
         "bowl speed (Eq. 2) {:.3} rad/s   residence flat {}   Coriolis {}",
         f64::from(t.bowl_mrad_s) / 1000.0,
         residence_text(t.residence_flat),
         residence_text(t.residence_coriolis)
-    )));
+    ));
     if !view.connected {
-        lines.push(Line::from("(last values before the link was lost)"));
+        lines.push("(last values before the link was lost)".into());
     } else if !live {
-        lines.push(Line::from("(last values before the telemetry stopped)"));
+        lines.push("(last values before the telemetry stopped)".into());
     }
-    Paragraph::new(lines).style(style)
+    let rows = lines.iter().flat_map(|l| wrap(l, width)).map(Line::from);
+    (rows.collect(), style)
 }
