@@ -242,3 +242,48 @@ fn closing_the_terminal_ends_the_monitor() {
         std::thread::sleep(std::time::Duration::from_millis(100));
     }
 }
+
+/// The colour parameters of the SGR sequences in `screen` (tmux `capture-pane -e`).
+fn colour_codes(screen: &str) -> Vec<String> {
+    screen
+        .split("\x1b[")
+        .skip(1)
+        .filter_map(|s| s.split_once('m').map(|(params, _)| params))
+        .filter(|p| p.chars().all(|c| c.is_ascii_digit() || c == ';'))
+        .flat_map(|p| p.split(';').map(str::to_string).collect::<Vec<_>>())
+        .filter(|p| {
+            p.parse::<u32>()
+                .is_ok_and(|n| matches!(n, 30..=37 | 38 | 40..=47 | 48 | 90..=97 | 100..=107))
+        })
+        .collect()
+}
+
+/// NO_COLOR (no-color.org): no colour on the screen, the banner's marks in reverse video; and
+/// TERM=dumb (an editor's shell buffer): the plain lines, not a screen of escape sequences.
+#[test]
+fn no_color_and_a_dumb_terminal_are_respected() {
+    let sim = Sim::start(&[]);
+    let tmux = Tmux::start(
+        "tui-nocolor",
+        &format!("env NO_COLOR=1 {BOWL} monitor {} ; sleep 30", sim.path),
+    );
+    tmux.wait_for(&["LINK OK", "state idle"], "the dashboard");
+    let out = tmux
+        .cmd(&["capture-pane", "-e", "-p", "-t", "0"])
+        .output()
+        .unwrap();
+    let screen = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(colour_codes(&screen), Vec::<String>::new(), "{screen}");
+    assert!(
+        screen.contains("\x1b[7m") || screen.contains(";7m"),
+        "reverse: {screen}"
+    );
+    drop(tmux);
+
+    let tmux = Tmux::start(
+        "tui-dumb",
+        &format!("env TERM=dumb {BOWL} monitor {} ; sleep 30", sim.path),
+    );
+    let screen = tmux.wait_for(&["state=idle", "corrupt 0"], "the plain lines");
+    assert!(!screen.contains("LINK OK"), "no screen UI:\n{screen}");
+}

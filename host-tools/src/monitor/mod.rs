@@ -162,8 +162,11 @@ pub fn run(args: &Args) -> Result<()> {
              interrupted)"
         )));
     }
-    // The UI needs a screen and a keyboard; without either it prints lines.
-    let plain = args.plain || !std::io::stdout().is_terminal() || !std::io::stdin().is_terminal();
+    // The UI needs a screen and a keyboard; without either it prints lines, and so it does on
+    // a terminal that says it cannot move the cursor (TERM=dumb: an editor's shell buffer).
+    let dumb = std::env::var_os("TERM").is_some_and(|t| t == "dumb");
+    let plain =
+        args.plain || dumb || !std::io::stdout().is_terminal() || !std::io::stdin().is_terminal();
     // In the UI, Ctrl-C arrives as a key; this catches it in plain mode, and SIGTERM in both:
     // the loop ends, so the terminal is given back and the log gets `monitor end`.
     let interrupted = crate::interrupt::flag();

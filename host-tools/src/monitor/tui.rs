@@ -72,6 +72,9 @@ pub struct Tui {
     typing: bool,
     /// The command line's text and history.
     line: LineEdit,
+    /// `NO_COLOR` is set (no-color.org): no colours; what a coloured background marked (the
+    /// alarms, LINK OK, PAUSED) is drawn in reverse video instead, so it still stands out.
+    no_color: bool,
 }
 
 impl Tui {
@@ -87,6 +90,7 @@ impl Tui {
             paused: false,
             typing: false,
             line: LineEdit::default(),
+            no_color: std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty()),
         })
     }
 
@@ -149,6 +153,7 @@ impl Tui {
         let (history, paused) = (&self.history, self.paused);
         let input = self.typing.then_some(&self.line);
         let silence = view.silence(Instant::now());
+        let no_color = self.no_color;
         self.terminal.draw(|f| {
             let width = usize::from(f.area().width).max(20);
             // The fault line and the events are wrapped to the width, never cut: the end of a
@@ -228,6 +233,14 @@ impl Tui {
                 )),
             };
             f.render_widget(Paragraph::new(prompt), rows[6]);
+            if no_color {
+                for cell in &mut f.buffer_mut().content {
+                    if cell.bg != Color::Reset {
+                        cell.modifier |= Modifier::REVERSED;
+                    }
+                    (cell.fg, cell.bg) = (Color::Reset, Color::Reset);
+                }
+            }
         })?;
         Ok(())
     }
