@@ -333,9 +333,39 @@ fn a_second_monitor_is_told_the_port_is_held() {
     let out = bowl(&["monitor", &sim.path, "--plain", "--seconds", "1"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{err}");
-    assert!(err.contains("is in use by another program"), "{err}");
+    // That the holder is a monitor, and so what to do: go through it.
+    assert!(
+        err.contains("another `bowl monitor` already holds"),
+        "{err}"
+    );
     let _ = first.kill();
     let _ = first.wait();
+}
+
+/// `bowl send` while `bowl commission` holds the port (no monitor): the busy port's holder is
+/// named (on Linux), not guessed at.
+#[test]
+fn a_busy_port_names_its_holder() {
+    let sim = Sim::start(&["--seconds", "60"]);
+    let mut commission = std::process::Command::new(common::BOWL)
+        .args(["commission", &sim.path, "--json"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let out = bowl(&["send", &sim.path, "status"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    let _ = commission.kill();
+    let _ = commission.wait();
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains(&format!(
+            "in use by another program: bowl (pid {})",
+            commission.id()
+        )),
+        "{err}"
+    );
 }
 
 /// A program that opened the port before us without locking it (here: this test, holding the

@@ -76,10 +76,15 @@ fn explain_open_error(path: &str, e: &serialport::Error) -> String {
             format!("permission denied opening {path}: check the device's owner and group ({text})")
         }
     } else if lower.contains("exclusive lock") || lower.contains("busy") {
-        format!(
-            "{path} is in use by another program (a second `bowl monitor`, tio, screen?); \
-             close it, or send through the running monitor"
-        )
+        // Named where the system lets us see (`bowl` is a `commission` or `experiment` that
+        // holds it until it ends; a monitor would have let the command through).
+        let who: Vec<String> = other_holders(path).iter().map(Holder::to_string).collect();
+        let who = if who.is_empty() {
+            "another program (a second `bowl monitor`, tio, screen?)".to_string()
+        } else {
+            format!("another program: {}", who.join(", "))
+        };
+        format!("{path} is in use by {who}; close it, or send through a running `bowl monitor`")
     } else if lower.contains("not a typewriter") || lower.contains("inappropriate ioctl") {
         format!("{path} is not a serial port or terminal")
     } else if lower.contains("no such file") || lower.contains("cannot find") {

@@ -170,10 +170,11 @@ pub fn run(args: &Args) -> Result<()> {
     // In the UI, Ctrl-C arrives as a key; this catches it in plain mode, and SIGTERM in both:
     // the loop ends, so the terminal is given back and the log gets `monitor end`.
     let interrupted = crate::interrupt::flag();
+    // Served only while the port is held: a lost port's name may soon be another device's.
+    // Asked first, so a second monitor is told that one runs (not only that the port is busy).
+    let mut relay = Some(Relay::serve(&args.port)?);
     // The port is checked before anything is drawn: a wrong path is an error, not a wait.
     let first = Port::open(&args.port, args.baud)?;
-    // Served only while the port is held: a lost port's name may soon be another device's.
-    let mut relay = Some(Relay::serve(&args.port)?);
     let mut log = args.log.as_ref().map(open_log).transpose()?;
     let started = Instant::now();
     let deadline = args
