@@ -326,3 +326,33 @@ fn captured_csv(name: &str, seconds: &str, commands: &[&str]) -> std::path::Path
     assert!(replay.status.success(), "{}", stdout(&replay));
     csv
 }
+
+/// A granule released 4300.5 s after the rig's reset, past the gates' microsecond wrap
+/// (4294.967 s): `replay --csv` puts its row at 4300500 ms among the telemetry, where a chart
+/// draws it, not at the 5532.704 ms its own count reads.
+#[test]
+fn a_gate_after_the_microsecond_wrap_is_placed_on_the_telemetry_clock() {
+    let dir = temp_dir("gate-wrap");
+    let frame = |payload: String| format!("${payload}*{:08X}\r\n", crc32(payload.as_bytes()));
+    let mut bytes = String::new();
+    for (seq, ms) in (4_300_000u32..=4_301_000).step_by(20).enumerate() {
+        bytes += &frame(format!(
+            "T1,{ms},{seq},3,0,1800,1800,4000,10,2100,2100,5000,10,3381,2345,2410"
+        ));
+        if ms == 4_300_500 {
+            let us = (4_300_500_000u64 - (1u64 << 32)) as u32;
+            bytes += &frame(format!("E1,0,{us},0"));
+        }
+    }
+    let capture = dir.join("wrap.bin");
+    std::fs::write(&capture, bytes).unwrap();
+    let csv = dir.join("wrap.csv");
+    let out = replay_to_csv(&capture, &csv);
+    assert!(out.status.success(), "{out:?}");
+    let rows = csv_rows(&csv);
+    let gate = rows
+        .iter()
+        .find(|r| r["event"].starts_with("release gate"))
+        .expect("the gate's row");
+    assert_eq!(gate["device_time_ms"], "4300500.000", "{gate:?}");
+}

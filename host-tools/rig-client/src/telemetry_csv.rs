@@ -191,18 +191,36 @@ impl LogReader {
     }
 }
 
-/// Writes a gate event's row: as [`write_event`], with the event's device time (ms, from its
-/// microseconds) in `device_time_ms`, so a chart places it on the telemetry's time axis.
+/// A gate event's device time in ms on the telemetry's clock. The gates count microseconds,
+/// which wrap every 71.6 minutes, the telemetry milliseconds, which wrap after 49.7 days: after
+/// a boot's first 71.6 minutes a gate's own count no longer says where it sits among the rows.
+/// It is placed from `telemetry_ms`, a telemetry frame of the same boot near it (the latest
+/// before it; within 35 minutes either way, half the microseconds' wrap); without one, from its
+/// own count (right within a boot's first 71.6 minutes).
+pub fn gate_device_ms(time_us: u32, telemetry_ms: Option<u32>) -> f64 {
+    let Some(t) = telemetry_ms else {
+        return f64::from(time_us) / 1000.0;
+    };
+    let t_us = (u64::from(t) * 1000) as u32;
+    // The signed distance from that frame to the gate, in the wrapping microsecond count.
+    let ahead_us = time_us.wrapping_sub(t_us) as i32;
+    f64::from(t) + f64::from(ahead_us) / 1000.0
+}
+
+/// Writes a gate event's row: as [`write_event`], with the event's device time in ms
+/// ([`gate_device_ms`] from `telemetry_ms`, the latest telemetry of the same boot) in
+/// `device_time_ms`, so a chart places it on the telemetry's time axis.
 pub fn write_gate_event(
     out: &mut impl Write,
     boot: u64,
     host: Option<SystemTime>,
     e: &model_core::wire::GateEvent,
+    telemetry_ms: Option<u32>,
 ) -> Result<()> {
     writeln!(
         out,
         "{boot},{:.3}{}{},{}",
-        f64::from(e.time_us) / 1000.0,
+        gate_device_ms(e.time_us, telemetry_ms),
         ",".repeat(TELEMETRY_COLUMNS),
         host.map(utc).unwrap_or_default(),
         gate_event_text(e)
@@ -246,6 +264,21 @@ mod tests {
             "{line}"
         );
         assert!(line.starts_with("2,") && line.trim_end().ends_with(",link lost"));
+    }
+
+    /// A gate 4300.5 s after boot (past the microseconds' wrap at 4294.967 s) sits at 4300.5 s
+    /// among the telemetry, not at the 5.5 s its own count reads; before the wrap, and without
+    /// telemetry, its own count is it.
+    #[test]
+    fn a_gate_after_the_microsecond_wrap_sits_among_its_telemetry() {
+        let wrap_us = 1u64 << 32;
+        let time_us = (4_300_500_000u64 - wrap_us) as u32;
+        assert_eq!(time_us, 5_532_704);
+        assert_eq!(gate_device_ms(time_us, Some(4_300_000)), 4_300_500.0);
+        // The latest frame may be just after the gate (a late row): a negative distance.
+        assert_eq!(gate_device_ms(time_us, Some(4_300_520)), 4_300_500.0);
+        assert_eq!(gate_device_ms(5_000_123, Some(4_990)), 5_000.123);
+        assert_eq!(gate_device_ms(5_000_123, None), 5_000.123);
     }
 
     /// An event in words with commas and quotes (the monitor's warning about another program

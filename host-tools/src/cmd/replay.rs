@@ -130,6 +130,8 @@ pub fn run(args: &Args) -> Result<()> {
         None => None,
     };
     let mut telemetry = 0u64;
+    // The latest telemetry's (boot, device ms): where a gate event sits on the device clock.
+    let mut latest: Option<(u64, u32)> = None;
     let mut gaps = Gaps::default();
     let mut csv_error = None;
     let started = Instant::now();
@@ -149,6 +151,7 @@ pub fn run(args: &Args) -> Result<()> {
             let written = match (r, csv.as_mut()) {
                 (Ok(Frame::Telemetry(t)), w) => {
                     telemetry += 1;
+                    latest = Some((stats.restarts, t.time_ms));
                     let gap = gaps.on_frame(stats.restarts, t.time_ms, t.seq);
                     w.map(|w| {
                         for (at_ms, what) in gap.iter().flatten() {
@@ -159,7 +162,14 @@ pub fn run(args: &Args) -> Result<()> {
                 }
                 // Gate events are logged too: nothing the rig sends is dropped.
                 (Ok(Frame::Event(e)), Some(w)) => {
-                    Some(telemetry_csv::write_gate_event(w, stats.restarts, None, &e))
+                    let near = latest.filter(|(boot, _)| *boot == stats.restarts);
+                    Some(telemetry_csv::write_gate_event(
+                        w,
+                        stats.restarts,
+                        None,
+                        &e,
+                        near.map(|(_, ms)| ms),
+                    ))
                 }
                 _ => None,
             };

@@ -69,6 +69,8 @@ impl Backlog {
         live: Option<(u64, &Telemetry, SystemTime)>,
     ) -> Result<u64> {
         let mut rows = 0;
+        // The latest held row's (boot, device ms): where a held gate sits on the device clock.
+        let mut latest: Option<(u64, u32)> = None;
         for held in self.held.drain(..) {
             // The device milliseconds (or microseconds, the gates' time base) from this row to
             // the live frame; only within one boot, where the device clock is one clock.
@@ -79,6 +81,7 @@ impl Backlog {
             };
             match held {
                 Held::Row(boot, t) => {
+                    latest = Some((boot, t.time_ms));
                     let ago = live.and_then(|(_, l, _)| {
                         let ms = l.time_ms.checked_sub(t.time_ms)?;
                         Some(Duration::from_millis(u64::from(ms)))
@@ -92,7 +95,11 @@ impl Backlog {
                         let live_us = (u64::from(l.time_ms) * 1000) as u32;
                         Duration::from_micros(u64::from(live_us.wrapping_sub(e.time_us)))
                     });
-                    telemetry_csv::write_gate_event(w, boot, back(boot, ago), &e)?;
+                    let near = latest
+                        .or(live.map(|(b, l, _)| (b, l.time_ms)))
+                        .filter(|(b, _)| *b == boot)
+                        .map(|(_, ms)| ms);
+                    telemetry_csv::write_gate_event(w, boot, back(boot, ago), &e, near)?;
                 }
             }
         }

@@ -210,6 +210,8 @@ pub fn run(args: &Args) -> Result<()> {
     // When to ask the rig's STATUS next (None: answered).
     let mut status_due = Some(Instant::now());
     let mut next_holder_check = Instant::now();
+    // The latest telemetry's (boot, device ms): where a gate event sits on the device clock.
+    let mut latest: Option<(u64, u32)> = None;
 
     while deadline.is_none_or(|d| Instant::now() < d) && !interrupted.load(Ordering::SeqCst) {
         if port.is_none() && last_open_try.elapsed() >= REOPEN_EVERY {
@@ -283,10 +285,18 @@ pub fn run(args: &Args) -> Result<()> {
                         if backlog.pending() {
                             backlog.hold_gate(boot, *e);
                         } else {
-                            telemetry_csv::write_gate_event(w, boot, Some(SystemTime::now()), e)?;
+                            let near = latest.filter(|(b, _)| *b == boot).map(|(_, ms)| ms);
+                            telemetry_csv::write_gate_event(
+                                w,
+                                boot,
+                                Some(SystemTime::now()),
+                                e,
+                                near,
+                            )?;
                         }
                     }
                     if let Frame::Telemetry(t) = &frame {
+                        latest = Some((boot, t.time_ms));
                         if let Some(w) = log.as_mut() {
                             if backlog.holding() {
                                 backlog.hold_row(boot, *t);
