@@ -39,12 +39,7 @@ fn a_person_sees_the_rig_commands_it_and_quits() {
     tmux.wait_for(&["1.500"], "the set speed");
 
     // A smaller window: the screen is drawn again to fit, axes and values still there.
-    assert!(
-        tmux.cmd(&["resize-window", "-t", "0", "-x", "90", "-y", "30"])
-            .status()
-            .unwrap()
-            .success()
-    );
+    tmux.resize(90, 30);
     let small = tmux.wait_for(
         &["precession w1 rad/s: set, measured", "measured rad/s"],
         "after a resize",
@@ -165,12 +160,7 @@ fn a_small_terminal_keeps_the_state_values_and_command_line() {
         "tui-small",
         &format!("{BOWL} monitor {} ; sleep 30", sim.path),
     );
-    assert!(
-        tmux.cmd(&["resize-window", "-t", "0", "-x", "40", "-y", "12"])
-            .status()
-            .unwrap()
-            .success()
-    );
+    tmux.resize(40, 12);
     let screen = tmux.wait_for(
         &[
             "LINK OK",
@@ -188,12 +178,7 @@ fn a_small_terminal_keeps_the_state_values_and_command_line() {
     );
     // Taller, still 40 wide: the charts come back, their time axis whole (`NNN s`, the
     // numbers the device time gives).
-    assert!(
-        tmux.cmd(&["resize-window", "-t", "0", "-x", "40", "-y", "30"])
-            .status()
-            .unwrap()
-            .success()
-    );
+    tmux.resize(40, 30);
     let screen = tmux.wait_for(&["precession w1 rad", " s│"], "charts at 40 x 30");
     let device_s: f64 = screen
         .split("device time ")

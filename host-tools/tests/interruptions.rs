@@ -23,6 +23,18 @@ fn signal(child: &Child, sig: Signal) {
     kill(Pid::from_raw(child.id() as i32), sig).expect("signal sent");
 }
 
+/// Reads `from` up to a line that holds `text` (the command is under way); fails at its end.
+fn read_until(from: &mut impl BufRead, text: &str) {
+    let mut line = String::new();
+    while from.read_line(&mut line).unwrap() > 0 {
+        if line.contains(text) {
+            return;
+        }
+        line.clear();
+    }
+    panic!("no line with {text:?}");
+}
+
 /// Ctrl-C on `commission` while the rig identifies its motors: STOP goes out before it ends, so
 /// the rig is idle at once (not left commissioning, nor faulted by the link watchdog 3 s later),
 /// and the exit code says it was interrupted (130, as a shell reports Ctrl-C).
@@ -36,12 +48,10 @@ fn commission_interrupted_stops_the_motors_first() {
         .spawn()
         .unwrap();
     // The first progress line: the motors turn.
-    let mut err = BufReader::new(child.stderr.take().unwrap());
-    let mut line = String::new();
-    while err.read_line(&mut line).unwrap() > 0 && !line.contains(" s  precession") {
-        line.clear();
-    }
-    assert!(line.contains(" s  precession"), "progress: {line}");
+    read_until(
+        &mut BufReader::new(child.stderr.take().unwrap()),
+        " s  precession",
+    );
     signal(&child, Signal::SIGINT);
     let status = wait_within(
         &mut child,
@@ -81,11 +91,8 @@ fn monitor_on_sigterm_closes_its_log() {
         .spawn()
         .unwrap();
     let mut out = BufReader::new(child.stdout.take().unwrap());
-    let mut line = String::new();
     // One status line: telemetry is flowing and being logged.
-    while out.read_line(&mut line).unwrap() > 0 && !line.contains("frames ok") {
-        line.clear();
-    }
+    read_until(&mut out, "frames ok");
     signal(&child, Signal::SIGTERM);
     let status = wait_within(&mut child, Duration::from_secs(5), "monitor after SIGTERM");
     let mut rest = String::new();

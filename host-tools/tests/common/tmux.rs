@@ -33,6 +33,21 @@ impl Tmux {
         assert!(self.cmd(&args).status().unwrap().success());
     }
 
+    /// Resizes the window, as a person dragging the terminal's corner.
+    pub fn resize(&self, columns: u16, rows: u16) {
+        let (x, y) = (columns.to_string(), rows.to_string());
+        let args = [
+            "resize-window",
+            "-t",
+            "0",
+            "-x",
+            x.as_str(),
+            "-y",
+            y.as_str(),
+        ];
+        assert!(self.cmd(&args).status().unwrap().success(), "tmux resize");
+    }
+
     pub fn screen(&self) -> String {
         let out = self
             .cmd(&["capture-pane", "-p", "-t", "0"])
