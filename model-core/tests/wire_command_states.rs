@@ -49,10 +49,10 @@ fn rigs() -> Vec<Rig> {
     commission_on_plant(&mut idle, &mut plant).unwrap();
     let mut commissioning = idle.clone();
     commissioning.commission().unwrap();
-    let mut spinning_up = idle.clone();
-    spinning_up.set_speeds(1800, 2100).unwrap();
-    spinning_up.start().unwrap();
-    let mut running = spinning_up.clone();
+    let mut changing_speed = idle.clone();
+    changing_speed.set_speeds(1800, 2100).unwrap();
+    changing_speed.start().unwrap();
+    let mut running = changing_speed.clone();
     run(&mut running, &mut plant, 20.0, true, |r| {
         state(r) == DeviceState::Running
     });
@@ -63,7 +63,7 @@ fn rigs() -> Vec<Rig> {
     run(&mut faulted, &mut plant, 10.0, false, |r| {
         state(r) == DeviceState::Faulted
     });
-    let rigs = vec![idle, commissioning, spinning_up, running, stopping, faulted];
+    let rigs = vec![idle, commissioning, changing_speed, running, stopping, faulted];
     let states: Vec<DeviceState> = rigs.iter().map(state).collect();
     assert_eq!(
         states,
