@@ -63,7 +63,14 @@ fn rigs() -> Vec<Rig> {
     run(&mut faulted, &mut plant, 10.0, false, |r| {
         state(r) == DeviceState::Faulted
     });
-    let rigs = vec![idle, commissioning, changing_speed, running, stopping, faulted];
+    let rigs = vec![
+        idle,
+        commissioning,
+        changing_speed,
+        running,
+        stopping,
+        faulted,
+    ];
     let states: Vec<DeviceState> = rigs.iter().map(state).collect();
     assert_eq!(
         states,

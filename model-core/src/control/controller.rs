@@ -252,6 +252,10 @@ impl Controller {
 
     #[inline(never)]
     fn closed_loop_step(&mut self, dt: f32, seen: &[bool; 2]) {
+        let off = self.planner.ramped();
+        for (a, off) in self.axes.iter_mut().zip(off) {
+            a.settle_coasted(off == 0.0);
+        }
         let [p, s] = &self.axes;
         let stopped = [p.est.is_stopped(), s.est.is_stopped()];
         let max_step = [p.max_step, s.max_step];

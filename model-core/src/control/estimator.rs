@@ -381,6 +381,25 @@ impl PulseSpeedEstimator {
     /// `pitches`: how many pitches the shaft may have turned since the last edge (2 at steady
     /// speed, where one missing pulse must not halve the reading; 1 otherwise; see
     /// `bound_pitches`).
+    /// Stopped (or slower than the minimum speed): forget the old reference edge so the next
+    /// edge starts a fresh measurement instead of a bogus long period.
+    fn forget_edges(&mut self) {
+        self.has_edge = false;
+        self.valid = false;
+        self.speed_filt = 0.0;
+        self.raw_period_ticks = 0.0;
+        self.lockout_now = self.lockout_ticks;
+        self.missing_from = u32::MAX;
+    }
+
+    /// The shaft is at rest, as the controller knows from its drive (off, and the plant model
+    /// coasted to rest: `AxisState::settle_coasted`) before two pitches at the lowest speed
+    /// have passed without an edge: the estimate reads zero from now on, as after that bound.
+    pub fn settle_at_rest(&mut self) {
+        self.forget_edges();
+        self.speed = 0.0;
+    }
+
     fn bounded_speed(&mut self, pitches: u32) -> f32 {
         self.bound_active = false;
         if !self.has_edge {
@@ -388,14 +407,7 @@ impl PulseSpeedEstimator {
         }
         let since = self.clock.wrapping_sub(self.last_edge);
         if since > self.stall_ticks {
-            // Stopped (or slower than the minimum speed): forget the old reference edge so the
-            // next edge starts a fresh measurement instead of a bogus long period.
-            self.has_edge = false;
-            self.valid = false;
-            self.speed_filt = 0.0;
-            self.raw_period_ticks = 0.0;
-            self.lockout_now = self.lockout_ticks;
-            self.missing_from = u32::MAX;
+            self.forget_edges();
             return 0.0;
         }
         if !self.valid {

@@ -47,7 +47,20 @@ pub(super) struct AxisState {
     /// What the last duty held beyond the identified model (the spin's reaction on the
     /// precession axis, the once-per-revolution load): not what drives the observer's plant.
     pub(super) extra_duty: f32,
+    /// Seconds from the last edge to when the observer's plant coasted to rest with the drive
+    /// off (negative: it has not, or the drive is on); see [`AxisState::settle_coasted`].
+    pub(super) coasted_after_s: f32,
 }
+
+/// The observer's speed, rad/s, below which a shaft coasting with the drive off has no edge
+/// to come: a pitch of a 12-tooth wheel would take 52 s.
+pub const COASTED_RAD_S: f32 = 0.01;
+/// A coasting shaft reads at rest once the time since its last edge is this many times what
+/// its plant model took from that edge to rest (the time scales with the inertia, and the
+/// material poured in since commissioning adds inertia the model does not know), ...
+pub const COAST_MARGIN: f32 = 3.0;
+/// ... plus this, s (a shaft the model stops at its last edge still gets a fifth of a second).
+pub const COAST_MIN_S: f32 = 0.2;
 
 impl AxisState {
     /// At rest, for axis configuration `a` of `cfg`, ticking every `dt_s`.
@@ -69,7 +82,38 @@ impl AxisState {
             obs: AngleObserver::REST,
             ok: ObserverConstants::new(a, dt_s, cfg.supply_v),
             extra_duty: 0.0,
+            coasted_after_s: -1.0,
         }
+    }
+
+    /// With the drive off (`drive_off`: the reference ramped to zero; and the duty zero), reads
+    /// the shaft at rest once the observer's plant, driven by that zero duty, has coasted to
+    /// rest and [`COAST_MARGIN`] times as long has passed since the last edge (plus
+    /// [`COAST_MIN_S`]). The estimator alone waits for two pitches at the lowest speed without
+    /// an edge (5.2 s at 12 teeth and 0.2 rad/s): a stopped rig read `stopping`, and its
+    /// speed the bound `pitch / time since the last edge`, for 5 s after its shafts stood still
+    /// (STOP from 2.4 rad/s; reversals wait for it too). True when it read the shaft at rest.
+    pub(super) fn settle_coasted(&mut self, drive_off: bool) -> bool {
+        if !drive_off
+            || self.duty != 0.0
+            || self.est.is_stopped()
+            || self.obs.speed_rad_s() > COASTED_RAD_S
+        {
+            self.coasted_after_s = -1.0;
+            return false;
+        }
+        let since = self.est.since_edge_s();
+        // An edge since the mark (the shaft was still turning): measure from that edge.
+        if self.coasted_after_s < 0.0 || since < self.coasted_after_s {
+            self.coasted_after_s = since;
+        }
+        if since < COAST_MARGIN * self.coasted_after_s + COAST_MIN_S {
+            return false;
+        }
+        self.est.settle_at_rest();
+        self.measured = 0.0;
+        self.coasted_after_s = -1.0;
+        true
     }
 
     /// Loop and sensor watch back to rest (a fresh start).
