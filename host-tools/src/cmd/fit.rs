@@ -11,6 +11,7 @@ use lab::fit::stats::AIC_DECISIVE;
 use lab::fit::{
     DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit_candidates, load, to_json,
 };
+use lab::number::count;
 
 /// Arguments of `bowl fit`.
 #[derive(clap::Args)]
@@ -204,12 +205,12 @@ pub fn run(args: &Args) -> Result<()> {
         .filter(|r| r.method == Method::Integrated)
         .count();
     println!(
-        "{} runs ({} by the closed form at the mean speed, {} integrated over the speed trace), {} excluded, {} outliers left out",
-        fit.runs.len(),
+        "{} ({} by the closed form at the mean speed, {} integrated over the speed trace), {} excluded, {} left out",
+        count(fit.runs.len(), "run", "runs"),
         fit.runs.len() - integrated,
         integrated,
         fit.excluded.len(),
-        fit.outliers.len()
+        count(fit.outliers.len(), "outlier", "outliers")
     );
     for e in &fit.excluded {
         println!("  excluded line {}: {}", e.row, e.reason);
