@@ -67,13 +67,11 @@ fn speed_range(fit: &Fit) -> (f64, f64) {
     (0.95 * lo, 1.05 * hi)
 }
 
-fn model_curves(
+/// The fitted paper models with their place in the fit (which sets their colour and dash): the
+/// only ones with these curves.
+fn paper_models(
     fit: &Fit,
-    value: &dyn Fn(&Scene<f64>, model_core::particle::Model) -> f64,
-) -> Vec<Series> {
-    let (lo, hi) = speed_range(fit);
-    // The paper's radial models have these curves; the rolling model's residence time is in the
-    // fit's tables (its paths are two-dimensional).
+) -> impl Iterator<Item = (usize, &ModelFit, model_core::particle::Model)> {
     fit.models
         .iter()
         .enumerate()
@@ -81,6 +79,16 @@ fn model_curves(
             Equation::Paper(model) => Some((i, m, model)),
             Equation::Rolling | Equation::Bowl(_) => None,
         })
+}
+
+fn model_curves(
+    fit: &Fit,
+    value: &dyn Fn(&Scene<f64>, model_core::particle::Model) -> f64,
+) -> Vec<Series> {
+    let (lo, hi) = speed_range(fit);
+    // The paper's radial models have these curves; the rolling model's residence time is in the
+    // fit's tables (its paths are two-dimensional).
+    paper_models(fit)
         .map(|(i, m, model)| Series {
             name: format!("{} model, fitted mu {:.4}", m.candidate.name, m.mu),
             points: (0..=CURVE_POINTS)
@@ -98,13 +106,7 @@ fn model_curves(
 /// Paper Fig. 5 of each fitted paper model at `w5` rad/s: `r(t)` from the release to the
 /// model's own exit on the rim (drawn over `1.5 t5`, `t5` the measured mean time there).
 fn radial_curves(fit: &Fit, w5: f64, t5: f64) -> Vec<Series> {
-    fit.models
-        .iter()
-        .enumerate()
-        .filter_map(|(i, m)| match m.candidate.equation {
-            Equation::Paper(model) => Some((i, m, model)),
-            Equation::Rolling | Equation::Bowl(_) => None,
-        })
+    paper_models(fit)
         .map(|(i, m, model)| {
             let s = scene(fit, m, w5);
             let t_end = 1.5 * t5;
