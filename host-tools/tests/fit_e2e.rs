@@ -359,3 +359,22 @@ fn a_hand_edited_results_file_is_read_as_the_person_meant() {
     );
     let _ = std::fs::remove_dir_all(path.parent().unwrap());
 }
+
+#[test]
+fn runs_at_one_speed_say_why_no_model_is_preferred() {
+    // The first condition's two releases, three times over: six runs at 2.9 rad/s.
+    let path = results("fit-one-speed", &[]);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let rows = [lines[1], lines[2]].repeat(3).join("\n");
+    std::fs::write(&path, format!("{}\n{rows}\n", lines[0])).unwrap();
+    let out = fit(&path, false);
+    assert_eq!(out.status.code(), Some(0), "{}", stdout(&out));
+    let text = stdout(&out);
+    assert!(text.contains("preferred: undecided"), "{text}");
+    assert!(
+        text.contains("undecided because every run is at one condition (2.900 rad/s)"),
+        "{text}"
+    );
+    let _ = std::fs::remove_dir_all(path.parent().unwrap());
+}

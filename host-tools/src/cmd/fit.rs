@@ -10,6 +10,7 @@ use lab::fit::models::{BowlBase, CANDIDATES, Equation, Method, Run, Wall, bowl_c
 use lab::fit::stats::AIC_DECISIVE;
 use lab::fit::{
     DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit_candidates, load, to_json,
+    undecided_why,
 };
 use lab::number::count;
 
@@ -251,6 +252,9 @@ pub fn run(args: &Args) -> Result<()> {
         "preferred: {} (a model is preferred when its AIC is lower by more than {AIC_DECISIVE})",
         fit.preferred
     );
+    if let Some(why) = undecided_why(&fit) {
+        println!("  undecided because {why}");
+    }
     // MU_PPM is the paper's and the rolling model's resistance: a bowl wall's mu_s is not it.
     if let Some(m) = fit.models.iter().find(|m| {
         m.candidate.name == fit.preferred && !matches!(m.candidate.equation, Equation::Bowl(_))

@@ -356,6 +356,28 @@ pub fn fit_candidates(
     })
 }
 
+/// Why the AIC cannot prefer a model, when the runs themselves say it: all in one condition,
+/// where each one-parameter model refits `mu` to the same mean time (the models are told apart
+/// by how `T` changes with speed, docs/experiment.md "Design"). `None` when the runs span
+/// conditions, or with the bowl walls (a recorded azimuth separates them at one speed).
+pub fn undecided_why(fit: &Fit) -> Option<String> {
+    let first = fit.runs.first()?;
+    let one_condition = fit.runs.iter().all(|r| r.condition == first.condition);
+    let bowl = fit
+        .models
+        .iter()
+        .any(|m| matches!(m.candidate.equation, Equation::Bowl(_)));
+    if fit.preferred != "undecided" || !one_condition || bowl {
+        return None;
+    }
+    let mean = fit.runs.iter().map(|r| r.mean_rad_s).sum::<f64>() / fit.runs.len() as f64;
+    Some(format!(
+        "every run is at one condition ({mean:.3} rad/s): refitting mu makes the models agree \
+         at one speed, and only how T changes with speed tells them apart; add conditions at \
+         other speeds (bowl experiment --suggest chooses them)"
+    ))
+}
+
 /// The JSON of the fit (the shape docs/experiment.md gives).
 pub fn to_json(fit: &Fit) -> serde_json::Value {
     let mut models = serde_json::Map::new();
