@@ -137,7 +137,7 @@ fn an_outlier_is_named_in_words_and_in_the_json_and_left_out() {
     assert_eq!(out.status.code(), Some(0));
     let text = stdout(&out);
     assert!(
-        text.contains("5 runs") && text.contains("1 outliers left out"),
+        text.contains("5 runs") && text.contains("1 outlier left out"),
         "{text}"
     );
     let said = format!("outlier line 5: residence time {slow:.4} s where the other runs say");
@@ -327,4 +327,54 @@ fn a_model_without_an_error_shows_no_inf() {
         .find(|l| l.starts_with("bowl-wall-vertical-20mm "))
         .unwrap_or_else(|| panic!("{text}"));
     assert!(line.trim_end().ends_with("-            -"), "{line}");
+}
+
+#[test]
+fn a_hand_edited_results_file_is_read_as_the_person_meant() {
+    // Two measurements pasted one under the other (the second header kept), a status typed
+    // "OK", and a run marked "excluded" by hand.
+    let path = results("fit-edited", &[]);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    lines[2] = lines[2].replace(",ok,", ",OK,");
+    lines[3] = lines[3].replace(",ok,", ",excluded,");
+    let header = lines[0].to_uppercase();
+    let pasted = format!(
+        "{}\n{header}\n{}\n",
+        lines.join("\n"),
+        lines[1..].join("\n")
+    );
+    std::fs::write(&path, pasted).unwrap();
+    let out = fit(&path, false);
+    assert_eq!(out.status.code(), Some(0), "{}", stdout(&out));
+    let text = stdout(&out);
+    // 12 rows: the second copy's line 11 is "excluded" too; the "OK" rows are fitted.
+    assert!(text.contains("10 runs (10 by the closed form"), "{text}");
+    assert!(text.contains("2 excluded, 0 outliers left out"), "{text}");
+    let said = "excluded line 4: status \"excluded\" (only rows whose status is ok are fitted)";
+    assert!(text.contains(said), "{text}");
+    assert!(
+        text.contains("excluded line 11: status \"excluded\""),
+        "{text}"
+    );
+    let _ = std::fs::remove_dir_all(path.parent().unwrap());
+}
+
+#[test]
+fn runs_at_one_speed_say_why_no_model_is_preferred() {
+    // The first condition's two releases, three times over: six runs at 2.9 rad/s.
+    let path = results("fit-one-speed", &[]);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let rows = [lines[1], lines[2]].repeat(3).join("\n");
+    std::fs::write(&path, format!("{}\n{rows}\n", lines[0])).unwrap();
+    let out = fit(&path, false);
+    assert_eq!(out.status.code(), Some(0), "{}", stdout(&out));
+    let text = stdout(&out);
+    assert!(text.contains("preferred: undecided"), "{text}");
+    assert!(
+        text.contains("undecided because every run is at one condition (2.900 rad/s)"),
+        "{text}"
+    );
+    let _ = std::fs::remove_dir_all(path.parent().unwrap());
 }

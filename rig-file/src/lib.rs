@@ -160,10 +160,27 @@ pub fn parse(text: &str, file: &str, default_name: &str) -> Result<Vec<Rig>> {
         let line = line.map_or(String::new(), |n| format!(", line {n}"));
         anyhow!("rig file {file}{line}: {words}")
     };
-    let is_family = text
-        .parse::<toml::Table>()
-        .map_err(syntax)?
-        .contains_key("plant");
+    let top = text.parse::<toml::Table>().map_err(syntax)?;
+    let is_family = top.contains_key("plant");
+    // A rig wrapped in [[plant]] whose tables kept their rig-file names ([precession]) puts
+    // them at the top level, beside the plants: serde's "unknown field `precession`, expected
+    // `plant`" did not say where they go.
+    let stray: Vec<String> = top
+        .iter()
+        .filter(|(k, _)| is_family && k.as_str() != "plant")
+        .map(|(k, v)| match v {
+            toml::Value::Table(_) => format!("[{k}] (write it [plant.{k}])"),
+            _ => format!("{k} (write it after the plant's [[plant]] line)"),
+        })
+        .collect();
+    if !stray.is_empty() {
+        return Err(anyhow!(
+            "rig file {file}: a family file holds [[plant]] tables only, and {} is outside \
+             them: each plant's keys follow its [[plant]] line, its tables are [plant.precession], \
+             [plant.spin], [plant.particle] and [plant.bowl] (one rig needs no [[plant]] at all)",
+            stray.join(", ")
+        ));
+    }
     let tables = if is_family {
         toml::from_str::<FamilyToml>(text).map_err(syntax)?.plant
     } else {

@@ -180,6 +180,24 @@ fn a_family_needs_names() {
     assert_eq!(r[1].params.supply_v, 11.0);
 }
 
+/// A rig wrapped in [[plant]] with its tables left as [precession] (and a key before the
+/// first plant): refused with where each goes, not serde's "expected `plant`".
+#[test]
+fn a_family_says_where_stray_tables_go() {
+    let text = "seed = 2\n[[plant]]\nname = \"a\"\n[precession]\nsupply_v = 11\n";
+    let e = parse(text, "f.toml", "x").unwrap_err().to_string();
+    assert!(
+        e.contains("[precession] (write it [plant.precession])"),
+        "{e}"
+    );
+    assert!(
+        e.contains("seed (write it after the plant's [[plant]] line)"),
+        "{e}"
+    );
+    let text = "[[plant]]\nname = \"a\"\n[plant.precession]\ncoulomb_nm = 0.2\n";
+    assert_eq!(parse(text, "f.toml", "x").unwrap().len(), 1);
+}
+
 /// A granule that starts touching the corner is refused in the rig file's own keys, the
 /// granule's radius among them (it widens the fillet the centre cannot enter).
 #[test]

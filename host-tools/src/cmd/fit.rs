@@ -10,7 +10,9 @@ use lab::fit::models::{BowlBase, CANDIDATES, Equation, Method, Run, Wall, bowl_c
 use lab::fit::stats::AIC_DECISIVE;
 use lab::fit::{
     DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit_candidates, load, to_json,
+    undecided_why,
 };
+use lab::number::count;
 
 /// Arguments of `bowl fit`.
 #[derive(clap::Args)]
@@ -204,12 +206,12 @@ pub fn run(args: &Args) -> Result<()> {
         .filter(|r| r.method == Method::Integrated)
         .count();
     println!(
-        "{} runs ({} by the closed form at the mean speed, {} integrated over the speed trace), {} excluded, {} outliers left out",
-        fit.runs.len(),
+        "{} ({} by the closed form at the mean speed, {} integrated over the speed trace), {} excluded, {} left out",
+        count(fit.runs.len(), "run", "runs"),
         fit.runs.len() - integrated,
         integrated,
         fit.excluded.len(),
-        fit.outliers.len()
+        count(fit.outliers.len(), "outlier", "outliers")
     );
     for e in &fit.excluded {
         println!("  excluded line {}: {}", e.row, e.reason);
@@ -250,6 +252,9 @@ pub fn run(args: &Args) -> Result<()> {
         "preferred: {} (a model is preferred when its AIC is lower by more than {AIC_DECISIVE})",
         fit.preferred
     );
+    if let Some(why) = undecided_why(&fit) {
+        println!("  undecided because {why}");
+    }
     // MU_PPM is the paper's and the rolling model's resistance: a bowl wall's mu_s is not it.
     if let Some(m) = fit.models.iter().find(|m| {
         m.candidate.name == fit.preferred && !matches!(m.candidate.equation, Equation::Bowl(_))

@@ -4,6 +4,7 @@
 
 use super::plot::{Figure, Mark, Scale, Series, VLine};
 use super::table::Table;
+use crate::number::count;
 use crate::sim_reports::{self, PlantStep};
 use rig_file::Rig;
 
@@ -144,8 +145,10 @@ pub fn chart(rigs: &[Rig], from: f32, target: f32, file: &str) -> (Figure, Table
         },
         notes: vec![
             format!(
-                "{} plants, {} commissioned, {} false faults",
-                s.plants, s.commissioned, s.false_faults
+                "{}, {} commissioned, {}",
+                count(s.plants, "plant", "plants"),
+                s.commissioned,
+                count(s.false_faults, "false fault", "false faults")
             ),
             format!(
                 "overshoot <= 5 %: {:.1} % of axes, worst {:.2} %",
@@ -162,4 +165,17 @@ pub fn chart(rigs: &[Rig], from: f32, target: f32, file: &str) -> (Figure, Table
         ],
     };
     (fig, table)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One rig: its counts in the singular ("1 plant", not "1 plants").
+    #[test]
+    fn one_rig_is_counted_in_the_singular() {
+        let rigs = rig_file::parse("", "one.toml", "one").unwrap();
+        let (fig, _) = chart(&rigs, 0.0, 3.0, "one.toml");
+        assert_eq!(fig.notes[0], "1 plant, 1 commissioned, 0 false faults");
+    }
 }

@@ -25,7 +25,9 @@ pub struct Plan {
     /// Wait after the speeds have settled, before each release, s.
     #[serde(default = "default_settle")]
     pub settle_s: f64,
-    /// The conditions, run in order.
+    /// The conditions, run in order (none: refused below in words, not as serde's "missing
+    /// field" blamed on the first line's key).
+    #[serde(default)]
     pub condition: Vec<Condition>,
 }
 
@@ -42,7 +44,14 @@ pub fn parse(text: &str, file: &str) -> Result<Plan> {
     let plan: Plan = toml::from_str(text).map_err(|e| {
         let (line, words) = rig_file::toml_error_words(text, &e);
         let line = line.map_or(String::new(), |n| format!(", line {n}"));
-        anyhow::anyhow!("{file}{line}: not a valid plan: {words}")
+        // Below a [[condition]] line every key is the condition's: the plan's own key there
+        // reads as an unknown condition key, so say where it goes.
+        let hint = if words.contains("unknown field `settle_s`") {
+            " (settle_s is the whole plan's: write it above the first [[condition]])"
+        } else {
+            ""
+        };
+        anyhow::anyhow!("{file}{line}: not a valid plan: {words}{hint}")
     })?;
     if !(plan.settle_s.is_finite() && (0.0..=600.0).contains(&plan.settle_s)) {
         bail!(
@@ -105,7 +114,18 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("repeats = 0"), "{e}");
-        assert!(parse("settle_s = 1\n", "p.toml").is_err());
+        let e = parse("settle_s = 1\n", "p.toml").unwrap_err().to_string();
+        assert_eq!(e, "p.toml: the plan has no [[condition]]");
+        let e = parse(
+            "[[condition]]\nbowl_rad_s = 3\nrepeats = 1\nsettle_s = 1\n",
+            "p.toml",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("line 4") && e.contains("write it above the first [[condition]]"),
+            "{e}"
+        );
         // serde's Rust type names are said in words, with the key and the line.
         let e = parse("[[condition]]\nbowl_rad_s = 6.5\nrepeats = 1.5\n", "p.toml")
             .unwrap_err()

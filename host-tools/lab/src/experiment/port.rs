@@ -218,7 +218,7 @@ impl PortRig {
                 match (e.kind, released) {
                     (GateKind::Release, _) => released = Some(e),
                     (GateKind::Exit, Some(r)) if r.boot == e.boot => {
-                        let residence_s = f64::from(e.time_us.wrapping_sub(r.time_us)) * 1e-6;
+                        let residence_s = f64::from(e.time_us.wrapping_sub(r.time_us)) / 1e6;
                         return Ok(Release::Left(residence_s, trace(&samples, &r)));
                     }
                     // An exit without a release before it in this boot: not this granule.

@@ -171,7 +171,9 @@ impl BackendRig {
                 match (e.kind, released_us) {
                     (GateKind::Release, _) => released_us = Some(e.time_us),
                     (GateKind::Exit, Some(at)) => {
-                        return Release::Left(f64::from(e.time_us.wrapping_sub(at)) * 1e-6, trace);
+                        // Divided, not multiplied by 1e-6: 1066302 us is written 1.066302 s,
+                        // not 1.0663019999999999.
+                        return Release::Left(f64::from(e.time_us.wrapping_sub(at)) / 1e6, trace);
                     }
                     (GateKind::Exit, None) => {}
                 }

@@ -37,6 +37,21 @@ fn small_plan_on_the_simulated_rig() {
     let mut rig = BackendRig::new(model_core::sim::PlantParams::nominal(), particle, 5).unwrap();
     let mut writer = Writer::create(&out).unwrap();
     assert_eq!(run_plan(&mut rig, &plan, &mut writer, false).unwrap(), 7);
+    // A time counted in microseconds is written as one: at most six decimals, never the
+    // binary noise of 1066302 * 1e-6 (1.0663019999999999).
+    let text = std::fs::read_to_string(&out).unwrap();
+    let times: Vec<&str> = text
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').nth(9))
+        .collect();
+    assert!(
+        times
+            .iter()
+            .filter(|t| !t.is_empty())
+            .all(|t| t.split_once('.').is_none_or(|(_, f)| f.len() <= 6)),
+        "{times:?}"
+    );
     std::fs::remove_file(dir.join("results_traces/run_0002.csv")).unwrap();
     let (runs, excluded) = load(&out).unwrap();
     assert_eq!(runs.len(), 5);

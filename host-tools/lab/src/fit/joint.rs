@@ -51,8 +51,9 @@ impl JointError {
     pub fn words(&self) -> String {
         match self {
             Self::TooFewRuns(n) => format!(
-                "{n} usable runs: fitting k2 as well needs at least 4 (mu, k2, the timing noise \
-                 and one degree of freedom)"
+                "{}: fitting k2 as well needs at least 4 (mu, k2, the timing noise \
+                 and one degree of freedom)",
+                crate::number::count(*n, "usable run", "usable runs")
             ),
             Self::NoStart => "some run would never leave at the one-parameter fit's mu".into(),
             Self::NotIdentifiable => {

@@ -94,7 +94,8 @@ pub fn load(path: &Path) -> Result<(Vec<Run>, Vec<Excluded>)> {
     let mut excluded = Vec::new();
     for (line, row) in results::read(path)? {
         let mut exclude = |reason: String| excluded.push(Excluded { row: line, reason });
-        if row.status != STATUS_OK {
+        // A status typed by hand ("OK", "Ok") means ok: header names match whatever their case too.
+        if !row.status.eq_ignore_ascii_case(STATUS_OK) {
             exclude(match row.status.split_once(':') {
                 Some((kind, detail)) => format!("{}: {}", words(kind), detail.trim()),
                 None => words(&row.status).to_string(),
@@ -177,12 +178,17 @@ pub fn load(path: &Path) -> Result<(Vec<Run>, Vec<Excluded>)> {
     Ok((runs, excluded))
 }
 
-fn words(status: &str) -> &str {
+fn words(status: &str) -> String {
     match status {
-        results::STATUS_NEVER_LEFT => "the granule never left the bowl",
-        results::STATUS_NOT_SETTLED => "the speeds never settled (stalled or weak motor)",
-        results::STATUS_MOTOR_FAULT => "the controller stopped the motors on a fault",
-        other => other,
+        results::STATUS_NEVER_LEFT => "the granule never left the bowl".into(),
+        results::STATUS_NOT_SETTLED => "the speeds never settled (stalled or weak motor)".into(),
+        results::STATUS_MOTOR_FAULT => "the controller stopped the motors on a fault".into(),
+        // A word a person typed (e.g. "excluded" to drop a run): quoted, with the rule, so the
+        // line says both that it was meant and why it left the fit.
+        other => format!(
+            "status \"{}\" (only rows whose status is ok are fitted)",
+            other.trim()
+        ),
     }
 }
 
@@ -323,11 +329,11 @@ pub fn fit_candidates(
     let (runs, outliers) = robust::screen(runs);
     if runs.len() < 3 {
         bail!(
-            "{} usable runs ({} excluded, {} outliers): the fit needs at least 3 (two parameters, mu and the \
+            "{} ({} excluded, {}): the fit needs at least 3 (two parameters, mu and the \
              timing noise, and one degree of freedom for the interval)",
-            runs.len(),
+            crate::number::count(runs.len(), "usable run", "usable runs"),
             excluded.len(),
-            outliers.len()
+            crate::number::count(outliers.len(), "outlier", "outliers")
         );
     }
     let mut models: Vec<ModelFit> = candidates
@@ -348,6 +354,28 @@ pub fn fit_candidates(
         preferred,
         walls,
     })
+}
+
+/// Why the AIC cannot prefer a model, when the runs themselves say it: all in one condition,
+/// where each one-parameter model refits `mu` to the same mean time (the models are told apart
+/// by how `T` changes with speed, docs/experiment.md "Design"). `None` when the runs span
+/// conditions, or with the bowl walls (a recorded azimuth separates them at one speed).
+pub fn undecided_why(fit: &Fit) -> Option<String> {
+    let first = fit.runs.first()?;
+    let one_condition = fit.runs.iter().all(|r| r.condition == first.condition);
+    let bowl = fit
+        .models
+        .iter()
+        .any(|m| matches!(m.candidate.equation, Equation::Bowl(_)));
+    if fit.preferred != "undecided" || !one_condition || bowl {
+        return None;
+    }
+    let mean = fit.runs.iter().map(|r| r.mean_rad_s).sum::<f64>() / fit.runs.len() as f64;
+    Some(format!(
+        "every run is at one condition ({mean:.3} rad/s): refitting mu makes the models agree \
+         at one speed, and only how T changes with speed tells them apart; add conditions at \
+         other speeds (bowl experiment --suggest chooses them)"
+    ))
 }
 
 /// The JSON of the fit (the shape docs/experiment.md gives).

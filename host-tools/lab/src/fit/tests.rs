@@ -134,6 +134,27 @@ fn preference_follows_the_truth() {
 }
 
 /// Too few runs is a plain error, not a panic.
+/// Runs at one speed cannot tell the models apart, and the fit says why; at several speeds it
+/// has nothing to explain.
+#[test]
+fn one_speed_says_why_it_is_undecided() {
+    let truth = Truth {
+        model: Model::Coriolis,
+        mu: 0.03,
+        k2: 5.0 / 7.0,
+    };
+    let one = fit_paper(
+        synthetic_runs(truth, truth.k2, &[3.0], 8, 0.002, 3),
+        Vec::new(),
+    )
+    .unwrap();
+    assert_eq!(one.preferred, "undecided");
+    let why = super::undecided_why(&one).unwrap();
+    assert!(why.contains("one condition (3.000 rad/s)"), "{why}");
+    let many = fit_paper(synthetic(Model::Coriolis, 0.03, 0.002, 4, 3), Vec::new()).unwrap();
+    assert_eq!(super::undecided_why(&many), None);
+}
+
 #[test]
 fn too_few_runs_is_an_error() {
     let runs = synthetic(Model::Flat, 0.03, 0.01, 1, 1)[..2].to_vec();

@@ -1,7 +1,8 @@
 //! The one reader of the results file and its speed traces, tolerant of what a spreadsheet does
 //! to a CSV file: in a comma-decimal locale it saves `;`-separated cells with decimal commas
 //! (`1,07`), sometimes after a first line `sep=;`; headers may come back uppercase or padded
-//! with spaces, cells with trailing spaces, and an emptied row as `,,,,,,`. Every error names
+//! with spaces, cells with trailing spaces, and an emptied row as `,,,,,,`; two files pasted
+//! one under the other repeat the header line (skipped). Every error names
 //! one line (the file's own numbering, header line included) and the column, in words.
 
 use std::path::Path;
@@ -101,9 +102,17 @@ impl Sheet {
                 );
             }
         }
-        // A row emptied in a spreadsheet comes back as separators only: not a row.
+        // A row emptied in a spreadsheet comes back as separators only: not a row. Two files
+        // pasted one under the other repeat the header: a name row, not a row of values.
+        let repeats_header = |cells: &[String]| {
+            cells.len() >= columns.len()
+                && cells
+                    .iter()
+                    .zip(&columns)
+                    .all(|(c, name)| c.eq_ignore_ascii_case(name))
+        };
         let rows = records
-            .filter(|(_, cells)| cells.iter().any(|c| !c.is_empty()))
+            .filter(|(_, cells)| cells.iter().any(|c| !c.is_empty()) && !repeats_header(cells))
             .collect();
         Ok(Self {
             file,
@@ -272,6 +281,11 @@ mod tests {
         assert_eq!(rows[1].number_or_empty("note").unwrap(), None);
         let s = sheet("a,b\n1,2\n,,,,\n");
         assert_eq!(s.rows().count(), 1);
+        // Two files pasted together: the second header (any case) is skipped, the lines keep
+        // the file's numbering.
+        let s = sheet("run,t\n1,2\nRun,T\n3,4\n");
+        let lines: Vec<usize> = s.rows().map(|r| r.unwrap().line).collect();
+        assert_eq!(lines, [2, 4]);
     }
 
     #[test]

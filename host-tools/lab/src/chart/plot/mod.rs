@@ -18,6 +18,7 @@ use std::sync::Once;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 mod axis;
 
@@ -337,15 +338,24 @@ impl Figure {
 
         // The lines' labels over the data, staggered downwards from one step below the top
         // (a series along the top edge, such as a target, would cross the first one).
+        // A label that would run past the plot's right edge (into the legend) ends at its line
+        // instead of starting there.
+        let right_px = chart.plotting_area().get_pixel_range().0.end;
         for (i, v) in self.vlines.iter().enumerate() {
             if let Some(x) = to_axis(self.x_scale, v.x) {
                 let label_y = ya.hi - (ya.hi - ya.lo) * 0.035 * (1 + i % 8) as f64;
+                let font = (FONT, 13).into_font().color(&colour(v.color));
+                let width_px = plot_area
+                    .estimate_text_size(&v.label, &font)
+                    .map_or(0, |(w, _)| w as i32);
+                let (label, font) = if chart.backend_coord(&(x, label_y)).0 + width_px > right_px {
+                    let anchor = Pos::new(HPos::Right, VPos::Top);
+                    (format!("{} ", v.label.trim()), font.pos(anchor))
+                } else {
+                    (v.label.clone(), font)
+                };
                 chart
-                    .draw_series(std::iter::once(Text::new(
-                        v.label.clone(),
-                        (x, label_y),
-                        (FONT, 13).into_font().color(&colour(v.color)),
-                    )))
+                    .draw_series(std::iter::once(Text::new(label, (x, label_y), font)))
                     .map_err(be)?;
             }
         }

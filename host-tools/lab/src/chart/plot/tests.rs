@@ -86,6 +86,39 @@ fn png_and_svg_are_written_with_text() {
     assert!(text.contains("\n1e-2\n"), "log tick labels");
 }
 
+/// A line's label that would run past the plot's right edge into the legend ends at its line
+/// (anchored right); one with room starts at its line.
+#[test]
+fn a_label_near_the_right_edge_ends_at_its_line() {
+    let dir = std::env::temp_dir().join(format!("bowl-plot-label-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("s.svg");
+    let mut f = sample();
+    let long = "fault: spin motor: no sensor pulses (sensor lost or motor stalled)";
+    f.vlines.push(VLine {
+        x: 45.0,
+        label: long.into(),
+        color: 6,
+    });
+    f.write_svg(&svg).unwrap();
+    let text = std::fs::read_to_string(&svg).unwrap();
+    let tag_of = |label: &str| {
+        let at = text.find(&format!("\n{label}")).unwrap();
+        text[text[..at].rfind("<text").unwrap()..at].to_string()
+    };
+    assert!(
+        tag_of(long).contains("text-anchor=\"end\""),
+        "{}",
+        tag_of(long)
+    );
+    assert!(
+        !tag_of("bound").contains("text-anchor=\"end\""),
+        "{}",
+        tag_of("bound")
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// The topmost pixel row holding `rgb` in a PNG's plot area (left of the legend), if any.
 fn top_row_of(path: &Path, rgb: RGBColor) -> Option<usize> {
     let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
