@@ -190,6 +190,63 @@ fn the_rig_files_release_radius_is_used() {
     assert!(out.contains("ri 0.03 m"), "{out}");
 }
 
+/// The rig file's granule (`[particle]` mu, sliding_mu, k2) is the bowl model's unless a flag
+/// is given: predict answered with the flags' defaults (mu_r 0.029, mu_s 0.4, k2 5/7) beside a
+/// rig whose granule `bowl experiment` runs with other values.
+#[test]
+fn the_rig_files_granule_is_used() {
+    let text = std::fs::read_to_string("../docs/rigs/bowl-60deg.toml").unwrap();
+    let edited: String = text
+        .lines()
+        .map(|l| match l.split(" = ").next() {
+            Some("mu") => "mu = 0.05".to_string(),
+            Some("sliding_mu") => "sliding_mu = 0.2".to_string(),
+            Some("k2") => "k2 = 0.6".to_string(),
+            _ => l.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let path = common::temp("granule.toml");
+    std::fs::write(&path, edited).unwrap();
+    let with = |file: &str, extra: &[&str]| {
+        let mut a: Vec<String> = RIG_BOWL.map(String::from).to_vec();
+        a[4] = file.into();
+        a.extend(
+            [
+                "--speed-range",
+                "false",
+                "--release-azimuth-deg",
+                "0",
+                "--json",
+            ]
+            .map(String::from),
+        );
+        a.extend(extra.iter().map(|s| s.to_string()));
+        json(&a.iter().map(String::as_str).collect::<Vec<_>>())["residence_time_mean_s"]
+            .as_f64()
+            .unwrap()
+    };
+    let file = path.to_str().unwrap();
+    let from_file = with(file, &[]);
+    // The same granule through the flags on the unedited file: the same answer.
+    let by_flags = with(
+        RIG_BOWL[4],
+        &["--mu", "0.05", "--sliding-mu", "0.2", "--k2", "0.6"],
+    );
+    assert_eq!(from_file, by_flags);
+    // The defaults through the flags on the edited file: the unedited file's answer.
+    let defaults = with(
+        file,
+        &["--mu", "0.029", "--sliding-mu", "0.4", "--k2", "0.7142857"],
+    );
+    assert_eq!(defaults, with(RIG_BOWL[4], &[]));
+    assert!(
+        (from_file / defaults - 1.0).abs() > 0.01,
+        "{from_file} against {defaults}: the granule made no difference"
+    );
+    let _ = std::fs::remove_file(&path);
+}
+
 /// A rod offset beyond the models' checked range is refused with the limit (L = 1e8 m was
 /// answered "still inside after 10 s", valid); --max-time-s 0 is the run's, not a release's.
 #[test]

@@ -108,9 +108,10 @@ pub struct Args {
     /// [default: 3]. The tilted bowl's models take --precession-rad-s and --spin-rad-s instead.
     #[arg(long, visible_alias = "w-rad-s")]
     omega_rad_s: Option<f64>,
-    /// Effective rolling resistance coefficient mu (the paper's literal 0.4 makes nothing move).
-    #[arg(long, default_value_t = 0.029)]
-    mu: f64,
+    /// Effective rolling resistance coefficient mu (the paper's literal 0.4 makes nothing move)
+    /// [default: 0.029, or with --rig-file its [particle] mu].
+    #[arg(long)]
+    mu: Option<f64>,
     /// Start radius ri, m (the particle starts at rest) [default: 0.05, or with --rig-file its
     /// [particle] release_radius_m].
     #[arg(long)]
@@ -122,9 +123,10 @@ pub struct Args {
     /// Gravity, m/s^2.
     #[arg(long, default_value_t = 9.81)]
     g: f64,
-    /// k2 = m rp^2 / (I + m rp^2): 5/7 solid sphere, 3/5 hollow.
-    #[arg(long, default_value_t = 5.0 / 7.0)]
-    k2: f64,
+    /// k2 = m rp^2 / (I + m rp^2): 5/7 solid sphere, 3/5 hollow [default: 5/7, or with
+    /// --rig-file its [particle] k2].
+    #[arg(long)]
+    k2: Option<f64>,
     /// Model: auto (the chooser), flat, coriolis, both or rolling.
     #[arg(long, value_parser = choice(MODELS), default_value = "auto")]
     model: ModelChoice,
@@ -224,9 +226,10 @@ pub struct RollingArgs {
     /// and max over 0, 30, ..., 330).
     #[arg(long, default_value = "all")]
     release_azimuth_deg: String,
-    /// Rolling model: the friction coefficient the contact can give (slip beyond it is reported).
-    #[arg(long, default_value_t = 0.4)]
-    sliding_mu: f64,
+    /// Rolling model: the friction coefficient the contact can give (slip beyond it is reported)
+    /// [default: 0.4, or with --rig-file its [particle] sliding_mu].
+    #[arg(long)]
+    sliding_mu: Option<f64>,
     /// Rolling model: every member of the model hierarchy on this scene, its mean residence
     /// time and its difference from the full model, and the cheapest member within this
     /// relative tolerance (e.g. 0.05).
@@ -288,11 +291,11 @@ impl Args {
         let b = &self.bowl;
         Inputs {
             omega_rad_s: self.omega_rad_s.unwrap_or(3.0),
-            mu: self.mu,
+            mu: self.mu.unwrap_or(0.029),
             ri_m: self.ri_m.unwrap_or(0.05),
             rim_radius_m: self.rim_radius_m.unwrap_or(0.1),
             g: self.g,
-            k2: self.k2,
+            k2: self.k2.unwrap_or(5.0 / 7.0),
             model: self.model,
             tolerance: self.tolerance,
             uncertainty: self.uncertainty.clone(),
@@ -317,7 +320,7 @@ impl Args {
                 particle_radius_m: r.particle_radius_m.unwrap_or(0.003),
                 rod_offset_m: r.rod_offset_m,
                 release_azimuth_deg: r.release_azimuth_deg.clone(),
-                sliding_mu: r.sliding_mu,
+                sliding_mu: r.sliding_mu.unwrap_or(0.4),
                 hierarchy_tolerance: r.hierarchy_tolerance,
                 hierarchy_uncertainty_mu: r.hierarchy_uncertainty_mu,
                 each_release: r.each_release,
@@ -328,6 +331,9 @@ impl Args {
                 rim_radius_m: self.rim_radius_m.is_some(),
                 particle_radius_m: r.particle_radius_m.is_some(),
                 method: self.method.is_some(),
+                mu: self.mu.is_some(),
+                k2: self.k2.is_some(),
+                sliding_mu: r.sliding_mu.is_some(),
             },
             bowl: BowlInputs {
                 wall_angle_deg: b.wall_angle_deg,

@@ -257,7 +257,9 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
     );
     if let Some(p) = &b.rig_file {
         println!(
-            "  (bowl, tilt and granule radius from {}'s [bowl] table; flags given override its wall)",
+            "  (the bowl, tilt and granule radius from {}'s [bowl] table; mu_r, mu_s, k2 and the \
+             release radius from its [particle] table; a flag given overrides any of these but \
+             the rim and the granule's radius)",
             p.display()
         );
     }

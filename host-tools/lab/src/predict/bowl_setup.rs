@@ -72,7 +72,7 @@ pub(super) fn scene_and_shape(
     r: &rolling::RollingInputs,
     b: &BowlInputs,
 ) -> Result<BowlSetup> {
-    let (table, release_m) = match &b.rig_file {
+    let (table, particle) = match &b.rig_file {
         Some(path) => {
             let rigs = rig_file::load(path)?;
             let Some(t) = rigs.first().and_then(|rig| rig.bowl) else {
@@ -82,11 +82,7 @@ pub(super) fn scene_and_shape(
                 );
             };
             rig_conflicts(args, path, &t)?;
-            let release = rigs
-                .first()
-                .and_then(|rig| rig.particle)
-                .map(|p| p.release_radius_m);
-            (Some(t), release)
+            (Some(t), rigs.first().and_then(|rig| rig.particle))
         }
         None => (None, None),
     };
@@ -96,8 +92,22 @@ pub(super) fn scene_and_shape(
         scene.particle_radius_m = t.particle_radius_m;
         // The rig's own release radius unless --ri-m is given (the release is the
         // experiment's choice; --store-table used the default 0.05 m on a 0.0375 m rig).
-        if let (false, Some(ri)) = (args.given.ri_m, release_m) {
-            scene.ri_m = ri;
+        // The same for the granule's own values: `bowl experiment` runs the rig file's granule,
+        // and predict answered with the flags' defaults (mu_r 0.029, mu_s 0.4, k2 5/7) beside it.
+        if let Some(p) = &particle {
+            let g = &args.given;
+            for (given, to, from) in [
+                (g.ri_m, &mut scene.ri_m, p.release_radius_m),
+                (g.mu, &mut scene.rolling_resistance, p.mu),
+                (g.k2, &mut scene.k2, p.k2),
+            ] {
+                if !given {
+                    *to = from;
+                }
+            }
+            if let (false, Some(truth)) = (g.sliding_mu, &p.bowl) {
+                scene.sliding_friction = truth.sliding_mu;
+            }
         }
         scene.validate().map_err(|e| {
             anyhow::anyhow!("with the rig file's [bowl] table: {}", rolling::words(e))

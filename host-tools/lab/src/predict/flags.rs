@@ -15,6 +15,9 @@ pub struct Given {
     pub rim_radius_m: bool,
     pub particle_radius_m: bool,
     pub method: bool,
+    pub mu: bool,
+    pub k2: bool,
+    pub sliding_mu: bool,
 }
 
 /// Flags the chosen model would ignore, refused (exit 2) instead of answered without them.
