@@ -91,8 +91,8 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
     {
         // A rig that is already stopping needs no `stop`: only time.
         let todo = if s.state == D::Stopping {
-            "wait until the rig is idle (`bowl send PORT status`; stopping from 3 rad/s takes \
-             several seconds)"
+            "wait until the rig is idle (`bowl send PORT status`; stopping takes the ramp down, \
+             then up to about two seconds until both shafts read at rest)"
         } else {
             "stop the motors first (`bowl send PORT stop`)"
         };
@@ -108,9 +108,10 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
             "already running (state {}); change speed with `speed`, or `stop` first",
             s.state.token()
         ),
-        D::Stopping if matches!(command, "start" | "commission") => {
-            "wait until the rig is idle (stopping from 3 rad/s takes several seconds), then \
-             send it again"
+        // A new speed while stopping: STOP is final, and a speed is taken again from idle.
+        D::Stopping if matches!(command, "start" | "commission" | "speed" | "rtime") => {
+            "wait until the rig is idle (stopping takes the ramp down, then up to about two \
+             seconds until both shafts read at rest), then send it again"
                 .to_string()
         }
         D::Faulted => format!(
@@ -380,108 +381,4 @@ pub(crate) fn ask_params(link: &mut Link, id: u16, timeout: Duration) -> Option<
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use model_core::binding::default_params;
-
-    fn w(s: &str) -> Vec<String> {
-        s.split_whitespace().map(str::to_string).collect()
-    }
-
-    #[test]
-    fn speed_above_the_limit_names_the_axis_and_limit() {
-        let p = default_params();
-        let max2 = p[ParamId::SpeedMax2MradS.index()];
-        let text = speed_limits(&w(&format!("speed 1000 {}", max2 + 1)), &p).unwrap();
-        assert!(text.contains("spin speed"), "{text}");
-        assert!(text.contains(ParamId::SpeedMax2MradS.token()), "{text}");
-        assert!(!text.contains("precession"), "{text}");
-    }
-
-    #[test]
-    fn speed_below_the_sensor_names_the_lowest() {
-        let p = default_params();
-        let text = speed_limits(&w("speed 10 0"), &p).unwrap();
-        assert!(
-            text.contains("precession speed 0.010 rad/s is below"),
-            "{text}"
-        );
-    }
-
-    #[test]
-    fn a_flat_table_is_said_in_the_issues_words() {
-        let t: [f32; 8] = core::array::from_fn(|k| 0.1432 + 0.0009 * k as f32 / 7.0);
-        let table = SpeedTable::new(0.5, 3.6, t).unwrap();
-        assert_eq!(
-            speed_range_words(60.0, &table),
-            "at 60 deg tilt T is 0.143-0.144 s at every speed from 0.50 to 3.60 rad/s: speed \
-             cannot set it; the tilt or the wall can"
-        );
-        let p = default_params();
-        assert!(table_refusal(&w("rtime table 143"), &p).contains("no residence-time table"));
-        let p = with_table(p, &table);
-        let text = table_refusal(&w("rtime table 143"), &p);
-        assert!(
-            text.starts_with("0.143 s asked; at 60 deg tilt T is 0.143-0.144 s"),
-            "{text}"
-        );
-    }
-
-    /// `p` with `table` stored in its residence-time parameters.
-    fn with_table(mut p: ParamValues, table: &SpeedTable) -> ParamValues {
-        for (id, v) in model_core::binding::TABLE_PARAMS
-            .into_iter()
-            .zip(model_core::binding::table_to_params(table).unwrap())
-        {
-            p[id.index()] = v;
-        }
-        p
-    }
-
-    /// A table whose speed sets T quotes only times it takes (rounded inwards, checked against
-    /// the table's own `omega_for_s`); a flat one says that a time inside its range is what
-    /// every speed gives, and one outside it is not reachable.
-    #[test]
-    fn the_quoted_times_are_the_ones_the_table_takes() {
-        let t: [f32; 8] = core::array::from_fn(|k| 0.16773 + 0.011 * k as f32 / 7.0);
-        let table = SpeedTable::new(0.5, 3.6, t).unwrap();
-        assert!(!table.is_flat());
-        let words = speed_range_words(60.0, &table);
-        assert!(words.contains("T is 0.168-0.178 s"), "{words}");
-        for ms in [168.0f32, 178.0] {
-            assert!(table.omega_for_s(ms * 1e-3).is_ok(), "{ms} ms");
-        }
-        // Rounded to the nearest, the ends would be 0.168-0.179: 179 ms is refused.
-        assert!(table.omega_for_s(0.179).is_err());
-        let flat: [f32; 8] = core::array::from_fn(|k| 0.16773 + 0.0011 * k as f32 / 7.0);
-        let flat = SpeedTable::new(0.5, 3.6, flat).unwrap();
-        assert!(flat.is_flat());
-        let p = with_table(default_params(), &flat);
-        let inside = table_refusal(&w("rtime table 168"), &p);
-        assert!(
-            inside.contains("that is the time the rig gives at any of these speeds"),
-            "{inside}"
-        );
-        let outside = table_refusal(&w("rtime table 150"), &p);
-        assert!(
-            outside.contains("speed cannot set it") && !outside.contains("any of these speeds"),
-            "{outside}"
-        );
-    }
-
-    /// A finite, positive range is printed for the nominal rig (its ends are checked against
-    /// the rig itself in tests/refusal_e2e.rs).
-    #[test]
-    fn residence_range_is_printed_for_the_nominal_rig() {
-        let p = default_params();
-        let text = residence_range(&w("rtime cori 1"), &p).unwrap();
-        assert!(text.contains("this rig can give"), "{text}");
-        let shortest: f64 = text
-            .split("this rig can give ")
-            .nth(1)
-            .and_then(|t| t.split(' ').next())
-            .and_then(|t| t.parse().ok())
-            .unwrap();
-        assert!(shortest > 0.0 && shortest.is_finite(), "{text}");
-    }
-}
+mod tests;
