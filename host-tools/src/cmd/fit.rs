@@ -252,6 +252,13 @@ pub fn run(args: &Args) -> Result<()> {
         "preferred: {} (a model is preferred when its AIC is lower by more than {AIC_DECISIVE})",
         fit.preferred
     );
+    if fit.preferred == "none" {
+        println!(
+            "  none because no model reproduces these runs (each says why above): check the \
+             times' unit and the rig's geometry, or fit one with more of the rig in it \
+             (`--models rolling`, `--bowl-walls`)"
+        );
+    }
     if let Some(why) = undecided_why(&fit) {
         println!("  undecided because {why}");
     }

@@ -81,7 +81,7 @@ pub struct Fit {
     pub outliers: Vec<robust::Outlier>,
     /// One per candidate, in [`CANDIDATES`] order.
     pub models: Vec<ModelFit>,
-    /// The preferred candidate's name, or `undecided`.
+    /// The preferred candidate's name, `undecided`, or `none` (no model reproduces the runs).
     pub preferred: &'static str,
     /// Which bowl wall the times prefer, in words (`None`: no bowl wall fitted).
     pub walls: Option<walls::WallVerdict>,
@@ -298,6 +298,9 @@ fn fit_mu(runs: &[Run], candidate: Candidate) -> ModelFit {
 /// The model whose AIC is lower than every other's by more than [`AIC_DECISIVE`], else
 /// "undecided". A model that cannot reproduce the runs takes no part.
 fn preferred_by_aic(models: &[ModelFit]) -> &'static str {
+    if !models.is_empty() && models.iter().all(|m| m.cannot_reproduce.is_some()) {
+        return "none";
+    }
     let mut by_aic: Vec<&ModelFit> = models
         .iter()
         .filter(|m| m.aic.is_finite() && m.cannot_reproduce.is_none())
@@ -340,7 +343,7 @@ pub fn fit_candidates(
         .iter()
         .map(|&c| fit_model(&runs, c, fit_k2))
         .collect();
-    let marks = robust::cannot_reproduce(&models);
+    let marks = robust::cannot_reproduce(&models, &runs);
     for (m, why) in models.iter_mut().zip(marks) {
         m.cannot_reproduce = why;
     }

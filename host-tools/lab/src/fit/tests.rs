@@ -155,6 +155,32 @@ fn one_speed_says_why_it_is_undecided() {
     assert_eq!(super::undecided_why(&many), None);
 }
 
+/// Times no mu of either paper model can give (every one typed as 5.5 s, against 0.6-1.1 s):
+/// no model is preferred, each says its lack of fit against the runs' own scatter, and no
+/// condition is left out whole as "outliers" (10 of 40 were, and the fit then reported a mu).
+#[test]
+fn times_no_model_gives_are_said_so() {
+    let mut runs = synthetic(Model::Coriolis, 0.03, 0.002, 6, 5);
+    for r in &mut runs {
+        r.residence_s = 5.5;
+    }
+    let f = fit_paper(runs, Vec::new()).unwrap();
+    assert_eq!(f.preferred, "none");
+    assert!(f.outliers.is_empty(), "{:?}", f.outliers);
+    for m in &f.models {
+        let why = m.cannot_reproduce.as_deref().unwrap_or_default();
+        assert!(
+            why.contains("no mu of it gives these times"),
+            "{}: {why}",
+            m.candidate.name
+        );
+    }
+    // The same truth timed as measured: one model preferred, none marked.
+    let good = fit_paper(synthetic(Model::Coriolis, 0.03, 0.002, 6, 5), Vec::new()).unwrap();
+    assert_eq!(good.preferred, "coriolis");
+    assert!(good.models.iter().all(|m| m.cannot_reproduce.is_none()));
+}
+
 #[test]
 fn too_few_runs_is_an_error() {
     let runs = synthetic(Model::Flat, 0.03, 0.01, 1, 1)[..2].to_vec();
