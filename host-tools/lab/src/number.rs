@@ -19,6 +19,30 @@ pub fn fixed(x: f64, decimals: usize) -> String {
     }
 }
 
+/// `x`, an `f32` (what the MCU and the controller compute in), as the `f64` of its shortest
+/// decimal: widened with `f64::from` it was written with its binary's noise (a split speed of
+/// 1.7153077 rad/s as 1.7153077125549316 in a results file).
+pub fn from_f32(x: f32) -> f64 {
+    x.to_string().parse().unwrap_or(f64::from(x))
+}
+
+/// serde's `serialize_with` for an `f64` computed from `f32` data (the simulated rig's speeds
+/// and ticks): written as that `f32`'s shortest decimal, not with the widening's digits (a
+/// settling time of 1.543 s as 1.5430000732885674).
+pub fn f32_digits<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    // As the f64 of the f32's decimal, not `serialize_f32`: a report built as a
+    // `serde_json::Value` first widens an f32 again.
+    s.serialize_f64(from_f32(*x as f32))
+}
+
+/// [`f32_digits`] for an optional value.
+pub fn f32_digits_opt<S: serde::Serializer>(x: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    match x {
+        Some(v) => s.serialize_some(&from_f32(*v as f32)),
+        None => s.serialize_none(),
+    }
+}
+
 /// `n` and the noun, singular for one ("1 release", "12 releases").
 pub fn count(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
@@ -44,7 +68,32 @@ pub fn shares(v: &serde_json::Value) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{count, fixed, shares};
+    use super::{count, f32_digits, f32_digits_opt, fixed, from_f32, shares};
+
+    /// An f32's value is written with its own digits, not the widening's.
+    #[test]
+    fn f32_values_keep_their_own_digits() {
+        assert_eq!(from_f32(1.715_307_7).to_string(), "1.7153077");
+        assert_eq!(f64::from(1.715_307_7f32).to_string(), "1.7153077125549316");
+        #[derive(serde::Serialize)]
+        struct Figures {
+            #[serde(serialize_with = "f32_digits")]
+            pct: f64,
+            #[serde(serialize_with = "f32_digits_opt")]
+            s: Option<f64>,
+            #[serde(serialize_with = "f32_digits_opt")]
+            never: Option<f64>,
+        }
+        let f = Figures {
+            pct: f64::from(1.048_243f32),
+            s: Some(1543.0 * from_f32(0.001)),
+            never: None,
+        };
+        assert_eq!(
+            serde_json::to_string(&f).unwrap(),
+            r#"{"pct":1.048243,"s":1.543,"never":null}"#
+        );
+    }
 
     /// One release is singular; a regime reads as percentages.
     #[test]

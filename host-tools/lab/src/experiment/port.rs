@@ -252,7 +252,7 @@ impl ReleaseRig for PortRig {
             ratio as f32,
         )
         .ok_or_else(|| anyhow!("bowl speed {bowl_rad_s} rad/s cannot be split"))?;
-        Ok([f64::from(s[0]), f64::from(s[1])])
+        Ok(s.map(crate::number::from_f32))
     }
 
     fn settle(&mut self, targets: [f64; 2], settle_s: f64) -> Result<(), Release> {

@@ -74,7 +74,7 @@ impl BackendRig {
             cfg.spin_per_precession,
         )
         .ok_or_else(|| anyhow!("bowl speed {bowl_rad_s} rad/s cannot be split"))?;
-        Ok([f64::from(s[0]), f64::from(s[1])])
+        Ok(s.map(crate::number::from_f32))
     }
 
     /// The fastest combined bowl speed whose split keeps both motors within their limits.

@@ -52,6 +52,19 @@ fn small_plan_on_the_simulated_rig() {
             .all(|t| t.split_once('.').is_none_or(|(_, f)| f.len() <= 6)),
         "{times:?}"
     );
+    // The split speeds are the controller's f32s, written as their shortest decimals (at most
+    // eight digits), not widened (1.7153077125549316).
+    let speeds: Vec<&str> = text
+        .lines()
+        .skip(1)
+        .flat_map(|l| l.split(',').skip(3).take(2))
+        .collect();
+    assert!(
+        speeds
+            .iter()
+            .all(|w| w.chars().filter(char::is_ascii_digit).count() <= 8),
+        "{speeds:?}"
+    );
     std::fs::remove_file(dir.join("results_traces/run_0002.csv")).unwrap();
     let (runs, excluded) = load(&out).unwrap();
     assert_eq!(runs.len(), 5);

@@ -15,15 +15,20 @@ use super::{commissioned, config_for, pour_material};
 pub struct AxisStep {
     /// Largest excursion of the true speed past the target in the step's direction (above it
     /// on a step up, below it on a step down), % of the target.
+    #[serde(serialize_with = "crate::number::f32_digits")]
     pub overshoot_pct: f64,
     /// Time after which the revolution-averaged true speed stays in the report's band
     /// ([`band_for`]: 2 %, 5 % below 1 rad/s), s; None = never.
+    #[serde(serialize_with = "crate::number::f32_digits_opt")]
     pub settling_s: Option<f64>,
     /// The same in a +/-2 % band, s; None = never.
+    #[serde(serialize_with = "crate::number::f32_digits_opt")]
     pub settling_2pct_s: Option<f64>,
     /// The same in a +/-5 % band, s; None = never.
+    #[serde(serialize_with = "crate::number::f32_digits_opt")]
     pub settling_5pct_s: Option<f64>,
     /// RMS of the true speed about its mean over whole revolutions at steady state, %.
+    #[serde(serialize_with = "crate::number::f32_digits")]
     pub ripple_pct: f64,
     /// Full duty held the axis short of the target at the end of the run: the plant cannot
     /// reach it (see `saturated` in this module).
@@ -52,6 +57,7 @@ pub struct PlantStep {
     pub fault: Option<&'static str>,
     /// When it latched, s after the command to the target (null while still settling at
     /// `from_rad_s`, or no fault).
+    #[serde(serialize_with = "crate::number::f32_digits_opt")]
     pub fault_after_step_s: Option<f64>,
     /// None when commissioning refused.
     pub axes: Option<Axes<AxisStep>>,
@@ -247,7 +253,8 @@ fn step(mut cl: ClosedLoop, from: f32, target: f32) -> StepRun {
     }
     let limits = cl.ctrl.config().axes.map(|a| a.duty_limit);
     let mut rec = Record {
-        dt_s: cl.dt_s() as f64,
+        // The tick as its decimal (0.001 s): widened, 1543 ticks read 1.5430000732885674 s.
+        dt_s: crate::number::from_f32(cl.dt_s()),
         speed: Vec::new(),
         angle: Vec::new(),
         duty: Vec::new(),
