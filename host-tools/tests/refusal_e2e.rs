@@ -32,11 +32,13 @@ fn set_while_running_names_the_parameter_and_what_to_do() {
     std::thread::sleep(std::time::Duration::from_millis(300));
     let (code, text) = send(&sim.path, "set CUR_SENSE 1");
     assert_eq!(code, 1, "{text}");
+    // The suggestion names the port given, so it can be pasted as it stands.
     assert!(
-        text.contains(
+        text.contains(&format!(
             "CUR_SENSE changes only while the rig is idle or faulted (it rebuilds the \
-             controller); stop the motors first (`bowl send PORT stop`), then set it"
-        ),
+             controller); stop the motors first (`bowl send {} stop`), then set it",
+            sim.path
+        )),
         "{text}"
     );
     let bw = default_params()[ParamId::Bandwidth1MradS.index()];

@@ -372,3 +372,31 @@ proptest! {
         }
     }
 }
+
+/// The coast on zero duty the STOP rule judges with (`AngleObserver::coast_s`) against the
+/// identified plant's closed form `tau ln(1 + w / w_f)` (`tau dw/dt = -w_f - w`): never shorter,
+/// at most 26 % longer for speeds up to ten times the friction's, and unbounded without friction.
+#[test]
+fn the_coast_to_rest_bounds_the_plants_closed_form() {
+    let cfg = ControllerConfig::nominal();
+    let axis = cfg.axes[0];
+    let k = ObserverConstants::new(&axis, 1.0 / cfg.tick_hz as f32, cfg.supply_v);
+    let tau = axis.model.time_constant_s;
+    let w_f = axis.model.friction_duty * cfg.supply_v / axis.model.volts_per_rad_s;
+    for w in [0.0f32, 0.1, 0.5, 1.0, 3.0, 10.0 * w_f] {
+        let exact = tau * (1.0 + w / w_f).ln();
+        let got = AngleObserver::REST.coast_s(&k, w);
+        assert!(
+            got >= exact * (1.0 - 1e-4),
+            "{w} rad/s: {got} s < {exact} s"
+        );
+        assert!(
+            got <= 1.26 * exact + 1e-6,
+            "{w} rad/s: {got} s against {exact} s"
+        );
+    }
+    let mut frictionless = axis;
+    frictionless.model.friction_duty = 0.0;
+    let k0 = ObserverConstants::new(&frictionless, 1.0 / cfg.tick_hz as f32, cfg.supply_v);
+    assert_eq!(AngleObserver::REST.coast_s(&k0, 1.0), f32::INFINITY);
+}

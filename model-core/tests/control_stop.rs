@@ -88,3 +88,55 @@ fn after_stop_the_rig_is_idle_soon_after_its_shafts_stand_still() {
         }
     }
 }
+
+/// After a fault (the board's break input, both duties zero at once) at 3 rad/s, the shafts
+/// read at rest within 2.5 s of standing still (the demo's spin-sensor fault: "stopped after
+/// 6.180 s" by the estimator's bound), and stay read at rest.
+#[test]
+fn after_a_fault_the_shafts_read_at_rest_soon_after_they_stand_still() {
+    for index in 0..6 {
+        let (rig, load) = family_plant(43, index);
+        let mut cfg = ControllerConfig::nominal();
+        for i in 0..2 {
+            cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
+        }
+        let mut cl = ClosedLoop::new(Plant::new(rig, index), Controller::new_or_faulted(cfg));
+        assert_eq!(cl.commission(300.0), State::Idle, "plant {index}");
+        let now = cl.rig.time_s() as f32;
+        for (a, load) in cl.rig.params_mut().axes.iter_mut().zip(load) {
+            a.faults.load_step_from_s = now;
+            a.faults.load_step_nm = load;
+        }
+        cl.ctrl.set_motor_speeds(3.0, 3.0).unwrap();
+        cl.ctrl.start().unwrap();
+        cl.run(8.0, |_| {});
+        cl.ctrl.hardware_stop();
+        let dt = cl.dt_s();
+        let (mut t, mut still_from, mut read_at_rest) = (0.0f32, None, None);
+        for _ in 0..(10.0 / dt) as u32 {
+            cl.tick();
+            t += dt;
+            let still = (0..2).all(|i| cl.rig.speed_rad_s(i) == 0.0);
+            if still && still_from.is_none() {
+                still_from = Some(t);
+            }
+            let zero = cl
+                .ctrl
+                .status()
+                .axes
+                .iter()
+                .all(|a| a.measured_rad_s == 0.0);
+            match (zero, read_at_rest) {
+                (true, None) => read_at_rest = Some(t),
+                (false, Some(at)) => panic!("plant {index}: read at rest at {at} s, not at {t} s"),
+                _ => {}
+            }
+        }
+        let still_from = still_from.expect("the shafts still turn 10 s after the fault");
+        let late = read_at_rest.expect("never read at rest") - still_from;
+        assert!(
+            late <= 2.5,
+            "plant {index}: read at rest {late:.2} s after the shafts stood still"
+        );
+    }
+}

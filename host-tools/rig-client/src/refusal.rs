@@ -22,6 +22,12 @@ use crate::request::transact;
 mod set;
 pub(crate) use set::set_range;
 
+/// `text` (particulars, a note) with its `bowl send PORT ...` suggestions naming `port`, the
+/// port the command was given, so a suggestion can be pasted as it stands.
+pub fn on_port(text: &str, port: &str) -> String {
+    text.replace("bowl send PORT", &format!("bowl send {port}"))
+}
+
 /// The particulars of a refusal of `words` (the command as typed), asking the rig what it
 /// needs through `link`; `None` when there is nothing to add to the reason's own words.
 pub fn particulars(

@@ -281,7 +281,9 @@ pub fn run(args: &Args) -> Result<i32> {
         Some(Reply::Refused(reason)) => {
             report.result = "rejected";
             report.reason = Some(reason.token());
-            report.why = rig.refusal_particulars(&["commission"], reason);
+            report.why = rig
+                .refusal_particulars(&["commission"], reason)
+                .map(|why| rig_client::refusal::on_port(&why, &args.port));
             print(&report, args.json)?;
             return Ok(exit_code::REFUSED);
         }

@@ -71,7 +71,7 @@ pub fn run(args: &Args) -> Result<i32> {
                 && let Some(why) =
                     refusal::particulars(Some(&mut link), id, &args.command, reason, timeout)
             {
-                println!("  {why}");
+                println!("  {}", refusal::on_port(&why, &args.port));
             }
             Ok(if matches!(frame, Frame::Reject { .. }) {
                 exit_code::REFUSED

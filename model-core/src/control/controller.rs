@@ -224,7 +224,14 @@ impl Controller {
             State::ChangingSpeed | State::Running | State::Stopping => {
                 self.closed_loop_step(dt, &seen)
             }
-            _ => self.set_duties_zero(),
+            _ => {
+                self.set_duties_zero();
+                // The drive is off: a shaft still coasting after a fault reads at rest as
+                // after a STOP (`settle_coasted`), not 5 s later by the estimator's bound.
+                for a in &mut self.axes {
+                    a.settle_coasted(true);
+                }
+            }
         }
         self.after_tick(dt)
     }
@@ -243,11 +250,14 @@ impl Controller {
         [self.axes[0].duty, self.axes[1].duty]
     }
 
-    /// Both duties 0 (coast).
+    /// Both duties 0 (coast), and nothing held beyond the model: the observer's plant coasts on
+    /// zero duty (a stale decoupling or load duty drove it on after a fault).
     #[inline(always)]
     fn set_duties_zero(&mut self) {
-        self.axes[0].duty = 0.0;
-        self.axes[1].duty = 0.0;
+        for a in &mut self.axes {
+            a.duty = 0.0;
+            a.extra_duty = 0.0;
+        }
     }
 
     #[inline(never)]

@@ -47,16 +47,15 @@ pub(super) struct AxisState {
     /// What the last duty held beyond the identified model (the spin's reaction on the
     /// precession axis, the once-per-revolution load): not what drives the observer's plant.
     pub(super) extra_duty: f32,
-    /// Seconds from the last edge to when the observer's plant coasted to rest with the drive
-    /// off (negative: it has not, or the drive is on); see [`AxisState::settle_coasted`].
-    pub(super) coasted_after_s: f32,
+    /// With the drive off: the time since the last edge when this was judged (negative: not
+    /// judged, or the drive is on), and when the plant model puts the shaft at rest, both
+    /// counted from the last edge, s; see [`AxisState::settle_coasted`].
+    pub(super) coast_from_s: f32,
+    pub(super) coast_rest_s: f32,
 }
 
-/// The observer's speed, rad/s, below which a shaft coasting with the drive off has no edge
-/// to come: a pitch of a 12-tooth wheel would take 52 s.
-pub const COASTED_RAD_S: f32 = 0.01;
 /// A coasting shaft reads at rest once the time since its last edge is this many times what
-/// its plant model took from that edge to rest (the time scales with the inertia, and the
+/// its plant model takes from that edge to rest (the time scales with the inertia, and the
 /// material poured in since commissioning adds inertia the model does not know), ...
 pub const COAST_MARGIN: f32 = 3.0;
 /// ... plus this, s (a shaft the model stops at its last edge still gets a fifth of a second).
@@ -82,37 +81,38 @@ impl AxisState {
             obs: AngleObserver::REST,
             ok: ObserverConstants::new(a, dt_s, cfg.supply_v),
             extra_duty: 0.0,
-            coasted_after_s: -1.0,
+            coast_from_s: -1.0,
+            coast_rest_s: 0.0,
         }
     }
 
-    /// With the drive off (`drive_off`: the reference ramped to zero; and the duty zero), reads
-    /// the shaft at rest once the observer's plant, driven by that zero duty, has coasted to
-    /// rest and [`COAST_MARGIN`] times as long has passed since the last edge (plus
-    /// [`COAST_MIN_S`]). The estimator alone waits for two pitches at the lowest speed without
-    /// an edge (5.2 s at 12 teeth and 0.2 rad/s): a stopped rig read `stopping`, and its
-    /// speed the bound `pitch / time since the last edge`, for 5 s after its shafts stood still
-    /// (STOP from 2.4 rad/s; reversals wait for it too). True when it read the shaft at rest.
+    /// With the drive off (`drive_off`: the reference ramped to zero, or a fault; and the duty
+    /// zero), reads the shaft at rest once [`COAST_MARGIN`] times the time its plant model
+    /// takes from the last edge to rest has passed since that edge (plus [`COAST_MIN_S`]). The
+    /// model's coast is judged once, from the faster of the measured and the observer's speed
+    /// (`AngleObserver::coast_s`), and again after any later edge. The estimator alone waits
+    /// for two pitches at the lowest speed without an edge (5.2 s at 12 teeth and 0.2 rad/s):
+    /// a stopped rig read `stopping`, and its speed the bound `pitch / time since the last
+    /// edge`, for 5 s after its shafts stood still (STOP from 2.4 rad/s; a fault's coast, and
+    /// reversals, waited for it too). True when it read the shaft at rest.
     pub(super) fn settle_coasted(&mut self, drive_off: bool) -> bool {
-        if !drive_off
-            || self.duty != 0.0
-            || self.est.is_stopped()
-            || self.obs.speed_rad_s() > COASTED_RAD_S
-        {
-            self.coasted_after_s = -1.0;
+        if !drive_off || self.duty != 0.0 || self.est.is_stopped() {
+            self.coast_from_s = -1.0;
             return false;
         }
         let since = self.est.since_edge_s();
-        // An edge since the mark (the shaft was still turning): measure from that edge.
-        if self.coasted_after_s < 0.0 || since < self.coasted_after_s {
-            self.coasted_after_s = since;
+        // Not judged yet, or an edge since (the shaft still turned): judge from here.
+        if self.coast_from_s < 0.0 || since < self.coast_from_s {
+            let w = self.measured.abs().max(self.obs.speed_rad_s());
+            self.coast_from_s = since;
+            self.coast_rest_s = since + self.obs.coast_s(&self.ok, w);
         }
-        if since < COAST_MARGIN * self.coasted_after_s + COAST_MIN_S {
+        if since < COAST_MARGIN * self.coast_rest_s + COAST_MIN_S {
             return false;
         }
         self.est.settle_at_rest();
         self.measured = 0.0;
-        self.coasted_after_s = -1.0;
+        self.coast_from_s = -1.0;
         true
     }
 
