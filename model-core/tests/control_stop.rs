@@ -9,19 +9,15 @@ use model_core::control::{Controller, ControllerConfig, State};
 use model_core::sim::experiments::family_plant;
 use model_core::sim::{ClosedLoop, Plant};
 
-/// Family plant `index` of `seed`, commissioned, its material poured in, held at `speed` for
-/// 8 s, then stopped: (seconds from the moment both shafts stood still to Idle, edges either
-/// shaft gave after Idle).
-fn stop_from(seed: u32, index: u32, speed: f32) -> (f32, u32) {
+/// Family plant `index` of `seed` (its noise seeded by `noise`), commissioned, its material
+/// poured in, held at `speed` for 8 s: running.
+fn running(seed: u32, index: u32, noise: u32, speed: f32) -> ClosedLoop {
     let (rig, load) = family_plant(seed, index);
     let mut cfg = ControllerConfig::nominal();
     for i in 0..2 {
         cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
     }
-    let mut cl = ClosedLoop::new(
-        Plant::new(rig, seed ^ index),
-        Controller::new_or_faulted(cfg),
-    );
+    let mut cl = ClosedLoop::new(Plant::new(rig, noise), Controller::new_or_faulted(cfg));
     assert_eq!(
         cl.commission(300.0),
         State::Idle,
@@ -40,6 +36,13 @@ fn stop_from(seed: u32, index: u32, speed: f32) -> (f32, u32) {
         State::Running,
         "plant {index} at {speed} rad/s"
     );
+    cl
+}
+
+/// [`running`] at `speed`, then stopped: (seconds from the moment both shafts stood still to
+/// Idle, edges either shaft gave after Idle).
+fn stop_from(seed: u32, index: u32, speed: f32) -> (f32, u32) {
+    let mut cl = running(seed, index, seed ^ index, speed);
     cl.ctrl.stop().unwrap();
     let dt = cl.dt_s();
     let (mut t, mut still_from, mut idle_at) = (0.0f32, None, None);
@@ -95,21 +98,7 @@ fn after_stop_the_rig_is_idle_soon_after_its_shafts_stand_still() {
 #[test]
 fn after_a_fault_the_shafts_read_at_rest_soon_after_they_stand_still() {
     for index in 0..6 {
-        let (rig, load) = family_plant(43, index);
-        let mut cfg = ControllerConfig::nominal();
-        for i in 0..2 {
-            cfg.axes[i].pulses_per_rev = rig.axes[i].sensor.pulses_per_rev;
-        }
-        let mut cl = ClosedLoop::new(Plant::new(rig, index), Controller::new_or_faulted(cfg));
-        assert_eq!(cl.commission(300.0), State::Idle, "plant {index}");
-        let now = cl.rig.time_s() as f32;
-        for (a, load) in cl.rig.params_mut().axes.iter_mut().zip(load) {
-            a.faults.load_step_from_s = now;
-            a.faults.load_step_nm = load;
-        }
-        cl.ctrl.set_motor_speeds(3.0, 3.0).unwrap();
-        cl.ctrl.start().unwrap();
-        cl.run(8.0, |_| {});
+        let mut cl = running(43, index, index, 3.0);
         cl.ctrl.hardware_stop();
         let dt = cl.dt_s();
         let (mut t, mut still_from, mut read_at_rest) = (0.0f32, None, None);
