@@ -71,3 +71,28 @@ fn from_rest_a_heavy_rod_the_kick_ran_ahead_reads_its_load_from_two_windows() {
     );
     assert_settled_within_2_pct_by(rod_from_rest_to_1_rad_s(p19, 4019), 3.0, "the rod");
 }
+
+/// Seed 33 p11 (`bowl sim make-family --seed 33`): a spin carrying 0.076 N m of material that
+/// crawled at 0.6 rad/s between its first two edges while the push rose. The crawl's reading
+/// moved the push into the integral (0.161 duty, what 1 rad/s needs), but the correction's
+/// model started that duty from nothing where the shaft had followed the push for 0.3 s: the
+/// next window read the shaft ahead of the model as a smaller load, the integral dropped to
+/// 0.151 and the loop closed the rest at its bandwidth, 2 % at 5.15 s. The push's speed goes
+/// to the correction with it (pi/start.rs `take_crawl_load`).
+#[test]
+fn from_rest_a_crawling_spins_push_goes_to_the_correction_with_its_speed() {
+    let p11 = plant_rows::rig_from_table(
+        13.570,
+        0.598,
+        [
+            [
+                1.8794, 0.07657, 0.01667, 0.1667, 0.2223, 0.0424, 0.000164, 0.0020, 0.0335,
+            ],
+            [
+                1.1234, 0.04594, 0.00625, 0.0625, 0.0875, 0.0459, 0.000506, 0.0036, 0.0759,
+            ],
+        ],
+    );
+    let [_, spin] = from_rest::from_rest_to_1_rad_s(p11, 33011);
+    assert_settled_within_2_pct_by(spin, 3.0, "the spin");
+}

@@ -65,6 +65,7 @@ impl SpeedLoop {
         }
         self.push = 0.0;
         self.push_sum = 0.0;
+        self.push_rad_s = 0.0;
         // The start's reading (`take_start_load`) is left out after a push: its first
         // window carries the leap of stiction the push overcame. Not when the current saw
         // the breakaway: the push ended there and the back-EMF band held the shaft near the
@@ -94,8 +95,15 @@ impl SpeedLoop {
         let mean_push = self.push_sum * k.dt_s / span_s;
         self.integral += reading * (mean_push * direction + sample * k.duty_per_rad_s)
             + (1.0 - reading) * PUSH_KEPT * self.push * direction;
+        // The push becomes the integral's, so the speed it has given the shaft becomes the
+        // correction's: started from nothing, the correction's model ran behind a shaft that
+        // had followed the push, and the next window read that lead as a smaller load (seed
+        // 33 p11's spin: the integral fell from 0.044 to 0.035 duty, 2 % at 5.15 s, now
+        // 2.60 s; docs/control.md, "The crawl's push in the correction").
+        self.correction_rad_s += reading * self.push_rad_s * direction;
         self.push_sum = 0.0;
         self.push = 0.0;
+        self.push_rad_s = 0.0;
     }
 
     /// The first measurement of a start, over a window of at least [`START_READ_MIN_S`](super::START_READ_MIN_S): the
@@ -178,6 +186,7 @@ impl SpeedLoop {
             // The push has done its work.
             self.push = 0.0;
             self.push_sum = 0.0;
+            self.push_rad_s = 0.0;
         }
         if released && input.feedback && !input.measurement_valid && !self.slowing {
             let step = self.breakaway.fused_integral_step(

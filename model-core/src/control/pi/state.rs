@@ -18,6 +18,10 @@ pub struct SpeedLoop {
     pub(super) moved: bool,
     pub(super) kick_rad_s: f32,
     pub(super) push_sum: f32,
+    /// The speed the push has given the plant model (the push through the identified lag),
+    /// rad/s, magnitude: a crawling shaft follows it, and the crawl's reading hands it to
+    /// the correction with the push.
+    pub(super) push_rad_s: f32,
     /// The kick's share the integral kept at the first edge, until the first measurement
     /// (duty, magnitude; see `kept_kick` in [`SpeedLoop::step`]).
     pub(super) kept_kick: f32,
@@ -85,6 +89,7 @@ impl SpeedLoop {
         moved: false,
         kick_rad_s: 0.0,
         push_sum: 0.0,
+        push_rad_s: 0.0,
         kept_kick: 0.0,
         slowing: false,
         model_down_quiet_s: 0.0,
