@@ -336,8 +336,8 @@ impl SpeedLoop {
             }
             self.push += k.push_per_rad_tick * r_abs;
             self.pushed = true;
-            self.push_sum += self.push;
             self.push_rad_s += self.push * k.kick_gain_per_tick - self.push_rad_s * k.model_alpha;
+            self.push_angle_rad += self.push_rad_s * k.dt_s;
         }
         // The stall bound is only active with a valid measurement, and counts only from an
         // edge the loop has seen (see `rest`).

@@ -64,8 +64,8 @@ impl SpeedLoop {
             }
         }
         self.push = 0.0;
-        self.push_sum = 0.0;
         self.push_rad_s = 0.0;
+        self.push_angle_rad = 0.0;
         // The start's reading (`take_start_load`) is left out after a push: its first
         // window carries the leap of stiction the push overcame. Not when the current saw
         // the breakaway: the push ended there and the back-EMF band held the shaft near the
@@ -77,7 +77,12 @@ impl SpeedLoop {
     }
 
     /// The integral takes the load read from a crawl window of `span_s` seconds whose model
-    /// mean exceeded the measured mean by `sample` rad/s; the push ends. A window shorter than
+    /// mean exceeded the measured mean by `sample` rad/s; the push ends. The push counts as
+    /// the speed it gave the shaft through the identified lag over the window, not as its mean
+    /// duty: the push rises fastest where the shaft has had least time to follow it, and read
+    /// as a steady duty it stood for more speed than the window measured, a load read high
+    /// (seed 4 p01's spin held 0.179 duty where 0.170 holds 1 rad/s, 3.3 % fast, 2 % at 3.16 s;
+    /// now 2.39 s; docs/control.md, "The crawl's push in the correction"). A window shorter than
     /// [`CRAWL_READ_MIN_S`] was no crawl: half the push stays, as after the first edge. Rare
     /// (once per start of a loaded shaft), so kept out of the tick's common path; the choice
     /// is a product, not a branch (a branch here cost the common path two instructions, over
@@ -92,7 +97,7 @@ impl SpeedLoop {
         direction: f32,
     ) {
         let reading = if span_s >= CRAWL_READ_MIN_S { 1.0 } else { 0.0 };
-        let mean_push = self.push_sum * k.dt_s / span_s;
+        let mean_push = self.push_angle_rad / span_s * k.duty_per_rad_s;
         self.integral += reading * (mean_push * direction + sample * k.duty_per_rad_s)
             + (1.0 - reading) * PUSH_KEPT * self.push * direction;
         // The push becomes the integral's, so the speed it has given the shaft becomes the
@@ -101,9 +106,9 @@ impl SpeedLoop {
         // 33 p11's spin: the integral fell from 0.044 to 0.035 duty, 2 % at 5.15 s, now
         // 2.60 s; docs/control.md, "The crawl's push in the correction").
         self.correction_rad_s += reading * self.push_rad_s * direction;
-        self.push_sum = 0.0;
         self.push = 0.0;
         self.push_rad_s = 0.0;
+        self.push_angle_rad = 0.0;
     }
 
     /// The first measurement of a start, over a window of at least [`START_READ_MIN_S`](super::START_READ_MIN_S): the
@@ -185,8 +190,8 @@ impl SpeedLoop {
         if released {
             // The push has done its work.
             self.push = 0.0;
-            self.push_sum = 0.0;
             self.push_rad_s = 0.0;
+            self.push_angle_rad = 0.0;
         }
         if released && input.feedback && !input.measurement_valid && !self.slowing {
             let step = self.breakaway.fused_integral_step(

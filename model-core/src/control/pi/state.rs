@@ -17,11 +17,11 @@ pub struct SpeedLoop {
     pub(super) push: f32,
     pub(super) moved: bool,
     pub(super) kick_rad_s: f32,
-    pub(super) push_sum: f32,
     /// The speed the push has given the plant model (the push through the identified lag),
-    /// rad/s, magnitude: a crawling shaft follows it, and the crawl's reading hands it to
-    /// the correction with the push.
+    /// rad/s, magnitude, and the angle it has turned it since the push began, rad: a crawling
+    /// shaft follows them, and the crawl's reading takes both (`take_crawl_load`).
     pub(super) push_rad_s: f32,
+    pub(super) push_angle_rad: f32,
     /// The kick's share the integral kept at the first edge, until the first measurement
     /// (duty, magnitude; see `kept_kick` in [`SpeedLoop::step`]).
     pub(super) kept_kick: f32,
@@ -88,8 +88,8 @@ impl SpeedLoop {
         push: 0.0,
         moved: false,
         kick_rad_s: 0.0,
-        push_sum: 0.0,
         push_rad_s: 0.0,
+        push_angle_rad: 0.0,
         kept_kick: 0.0,
         slowing: false,
         model_down_quiet_s: 0.0,

@@ -35,8 +35,8 @@ impl SpeedLoop {
             if self.push != 0.0 {
                 self.integral += PUSH_KEPT * self.push * input.direction;
                 self.push = 0.0;
-                self.push_sum = 0.0;
                 self.push_rad_s = 0.0;
+                self.push_angle_rad = 0.0;
             }
             // The load the model does not know, as the speed it costs: the window's
             // shortfall against the model *with* the correction applied through it.
