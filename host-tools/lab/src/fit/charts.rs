@@ -142,6 +142,7 @@ fn figure(title: &str, x: &str, y: &str, series: Vec<Series>, notes: Vec<String>
         x_scale: Scale::Linear,
         y_scale: Scale::Linear,
         series,
+        hlines: Vec::new(),
         vlines: Vec::new(),
         notes,
     }
