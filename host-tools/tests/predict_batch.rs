@@ -116,3 +116,27 @@ fn an_unknown_column_is_refused_by_name() {
         "{written}"
     );
 }
+
+/// A spreadsheet's `;`-separated file (comma-decimal locale, BOM, CRLF) is told as such, with
+/// what to save instead; it was "column 1 `model;w_rad_s;mu;ri_m;R_m` is not a column of the
+/// batch".
+#[test]
+fn a_semicolon_file_is_told_what_to_save() {
+    for (name, sep, said) in [("semicolons", ";", "`;`"), ("tabs", "\t", "tabs")] {
+        let text = format!(
+            "\u{feff}model{sep}w_rad_s{sep}mu{sep}ri_m{sep}R_m\r\nflat{sep}3,6{sep}0,01{sep}0,03{sep}0,1\r\n"
+        );
+        let (out, written, err) = batch(name, &text, &[]);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains(&format!("line 1: the cells are separated by {said}")),
+            "{err}"
+        );
+        assert!(
+            err.contains("field delimiter , and the decimal separator ."),
+            "{err}"
+        );
+        assert!(!err.contains("is not a column of the batch"), "{err}");
+        assert!(written.is_empty());
+    }
+}

@@ -140,3 +140,20 @@ fn the_papers_models_say_where_the_granule_would_slide() {
         assert!(v["residence_time_s"].as_f64().is_some());
     }
 }
+
+/// A huge speed's friction is written in scientific notation (`{:.3}` wrote 1e30 rad/s's need
+/// as a 59-digit number).
+#[test]
+fn a_huge_speeds_friction_is_written_short() {
+    let out = bowl(&["predict", "--omega-rad-s", "1e30", "--model", "coriolis"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("needs friction of 1.495e58 of the granule's weight"),
+        "{text}"
+    );
+    let longest_digits = text
+        .split(|c: char| !c.is_ascii_digit())
+        .map(str::len)
+        .max();
+    assert!(longest_digits < Some(32), "{text}");
+}

@@ -6,6 +6,7 @@
 //! Built on model-core, the rig client (a rig on a serial line) and the virtual rig.
 
 pub mod chart;
+pub mod csv_lines;
 pub mod experiment;
 pub mod family_file;
 pub mod fit;

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
-mod sheet;
+pub(crate) mod sheet;
 use sheet::Sheet;
 
 /// How a release ended.

@@ -96,6 +96,7 @@ fn residence_figure(tel: &[Telemetry], marks: &[Mark]) -> Figure {
                 color: 1,
             },
         ],
+        hlines: Vec::new(),
         vlines: markers(marks, tel),
         notes: vec![
             "Gaps: the particle never leaves (bowl".into(),

@@ -293,6 +293,7 @@ pub fn chart() -> Result<(Figure, Figure, Table)> {
         x_scale: Scale::Linear,
         y_scale: Scale::Linear,
         series,
+        hlines: Vec::new(),
         vlines: Vec::new(),
         notes: vec![
             format!("{n} scenes: worst ratio {worst:.2}, tolerance missed {misses} times"),
@@ -314,6 +315,7 @@ pub fn chart() -> Result<(Figure, Figure, Table)> {
         x_scale: Scale::Linear,
         y_scale: Scale::Log,
         series: cost_series,
+        hlines: Vec::new(),
         vlines: Vec::new(),
         notes: vec![
             "saved: DP5(4) at a tenth of the tolerance".into(),

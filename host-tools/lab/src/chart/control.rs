@@ -15,7 +15,7 @@
 use model_core::control::{ControllerConfig, Fault};
 use model_core::sim::experiments::{self, STEP_RUN_S, rig_with_pulses};
 
-use super::plot::{Figure, Mark, Scale, Series, VLine};
+use super::plot::{Figure, HLine, Mark, Scale, Series, VLine};
 use super::table::Table;
 
 /// Step target of the settling chart, rad/s (as `bowl sim step`).
@@ -135,7 +135,6 @@ pub fn settling_chart(points: &[SettlingPoint]) -> (Figure, Table) {
     }
     let x = |p: &SettlingPoint| f64::from(p.pulses_per_rev);
     let n_max = points.iter().map(x).fold(1.0, f64::max);
-    let n_min = points.iter().map(x).fold(n_max, f64::min);
     let mut series = vec![
         Series {
             name: "spin (starts with the precession)".into(),
@@ -148,15 +147,6 @@ pub fn settling_chart(points: &[SettlingPoint]) -> (Figure, Table) {
             points: points.iter().map(|p| (x(p), p.settling_s[0])).collect(),
             mark: Mark::LinePoints,
             color: 1,
-        },
-        Series {
-            name: format!("target {NOMINAL_SETTLING_TARGET_S} s (nominal, 12 pulses/rev)"),
-            points: vec![
-                (n_min, NOMINAL_SETTLING_TARGET_S),
-                (n_max, NOMINAL_SETTLING_TARGET_S),
-            ],
-            mark: Mark::Dashed,
-            color: 7,
         },
         Series {
             name: format!("target {FINE_SETTLING_TARGET_S} s at >= {FINE_FROM_PULSES} pulses/rev"),
@@ -193,11 +183,17 @@ pub fn settling_chart(points: &[SettlingPoint]) -> (Figure, Table) {
         x_scale: Scale::Log,
         y_scale: Scale::Linear,
         series,
+        // Across the plot, clear of the frame (as a series, the axis ended on it).
+        hlines: vec![HLine {
+            y: NOMINAL_SETTLING_TARGET_S,
+            label: format!("target {NOMINAL_SETTLING_TARGET_S} s (nominal, 12 pulses/rev)"),
+            color: 7,
+        }],
         vlines: vec![
             VLine {
                 x: 12.0,
-                // Unlabelled (the 2.5 s target's legend names it): its label would sit on the
-                // target line; this also puts the next label one row lower.
+                // Unlabelled (the 2.5 s target's label names the nominal rig): this also puts
+                // the next label one row lower.
                 label: String::new(),
                 color: 7,
             },
@@ -428,6 +424,7 @@ pub fn stability_chart(points: &[HoldPoint]) -> (Figure, Table) {
         x_scale: Scale::Log,
         y_scale: Scale::Log,
         series,
+        hlines: Vec::new(),
         vlines: vec![VLine {
             x: nominal,
             label: format!(" nominal gain {nominal}"),

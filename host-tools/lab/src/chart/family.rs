@@ -2,7 +2,7 @@
 //! rig or family file), each commissioned and stepped from rest or from a running speed, with the
 //! targets marked.
 
-use super::plot::{Figure, Mark, Scale, Series, VLine};
+use super::plot::{Figure, HLine, Mark, Scale, Series, VLine};
 use super::table::Table;
 use crate::number::count;
 use crate::sim_reports::{self, PlantStep};
@@ -61,12 +61,6 @@ pub fn chart(rigs: &[Rig], from: f32, target: f32, file: &str) -> (Figure, Table
         }
     }
     let s = sim_reports::summary(&plants);
-    let x_max = pts
-        .iter()
-        .flatten()
-        .chain(&never)
-        .map(|p| p.0)
-        .fold(11.0, f64::max);
     // Issue 27's settling targets: 3 s to 2 % at 1 rad/s and above; 10 s to 5 % below, 8 s
     // where every axis has current sense.
     let current_sense = rigs
@@ -99,12 +93,6 @@ pub fn chart(rigs: &[Rig], from: f32, target: f32, file: &str) -> (Figure, Table
             mark: Mark::Points,
             color: 0,
         },
-        Series {
-            name: format!("settling target {settle_target} s"),
-            points: vec![(0.0, settle_target), (x_max, settle_target)],
-            mark: Mark::Dashed,
-            color: 7,
-        },
     ];
     if !never.is_empty() {
         series.push(Series {
@@ -127,6 +115,13 @@ pub fn chart(rigs: &[Rig], from: f32, target: f32, file: &str) -> (Figure, Table
         y_scale: Scale::Linear,
         series,
         // The overshoot targets belong to the 3 rad/s step; the low-speed one has none.
+        // Across the whole plot, clear of the frame (it was a series ending at the largest
+        // overshoot, and the y axis ended on it, on the frame).
+        hlines: vec![HLine {
+            y: settle_target,
+            label: format!("settling target {settle_target} s"),
+            color: 7,
+        }],
         vlines: if target < 1.0 {
             Vec::new()
         } else {
@@ -177,5 +172,28 @@ mod tests {
         let rigs = rig_file::parse("", "one.toml", "one").unwrap();
         let (fig, _) = chart(&rigs, 0.0, 3.0, "one.toml");
         assert_eq!(fig.notes[0], "1 plant, 1 commissioned, 0 false faults");
+    }
+
+    /// The settling target is a labelled line across the plot, inside it: it was a series, the
+    /// y axis ended on it (settling up to 1.8 s, the axis 0.5-3 s) and it lay on the frame.
+    #[test]
+    fn the_settling_target_is_inside_the_plot_with_its_label() {
+        let rigs = rig_file::parse("", "one.toml", "one").unwrap();
+        for (target, line) in [(3.0, 3.0), (0.5, 10.0)] {
+            let (fig, _) = chart(&rigs, 0.0, target, "one.toml");
+            let h = &fig.hlines[..];
+            assert_eq!(h.len(), 1, "{h:?}");
+            assert_eq!(
+                (h[0].y, &*h[0].label),
+                (line, &*format!("settling target {line} s"))
+            );
+            let (_, y) = fig.axes().unwrap();
+            let span = y.hi - y.lo;
+            assert!(
+                y.lo < line && y.hi - line >= 0.03 * span,
+                "{line} s on {y:?}"
+            );
+            assert!(fig.series.iter().all(|s| !s.name.contains("target")));
+        }
     }
 }

@@ -225,6 +225,7 @@ pub fn work_precision() -> Result<(Figure, Table)> {
         x_scale: Scale::Log,
         y_scale: Scale::Log,
         series,
+        hlines: Vec::new(),
         vlines: vec![],
         notes: vec![
             "75 mm bottom, ri = R/2, mu_r 0.029, w1 = w2".into(),

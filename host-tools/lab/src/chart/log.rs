@@ -215,6 +215,7 @@ pub fn speed_figure(
                 color: MEASURED_COLOUR,
             },
         ],
+        hlines: Vec::new(),
         vlines: Vec::new(),
         notes,
     }

@@ -98,6 +98,7 @@ pub fn residence(tilt_deg: f64) -> Result<(Figure, Table)> {
         x_scale: Scale::Linear,
         y_scale: Scale::Log,
         series,
+        hlines: Vec::new(),
         vlines: vec![],
         notes: vec![
             "rolling resistance 0.029, granule 3 mm, release at R/2".into(),
@@ -187,6 +188,7 @@ pub fn trajectories() -> Result<(Figure, Table)> {
         x_scale: Scale::Linear,
         y_scale: Scale::Linear,
         series,
+        hlines: Vec::new(),
         vlines: vec![],
         notes: vec!["released at rest at R/2; rolling resistance 0.029".into()],
     };
@@ -240,6 +242,7 @@ pub fn hierarchy_map(mu: f64) -> Result<(Figure, Table)> {
         x_scale: Scale::Linear,
         y_scale: Scale::Log,
         series,
+        hlines: Vec::new(),
         vlines: vec![],
         notes: vec![
             "solid 0 deg, dashed 30 deg, dashed with points 60 deg".into(),
@@ -351,6 +354,7 @@ pub(super) fn work_precision_figure(
         x_scale: Scale::Log,
         y_scale: Scale::Log,
         series,
+        hlines: Vec::new(),
         vlines: vec![],
         notes,
     }

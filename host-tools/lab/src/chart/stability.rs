@@ -211,6 +211,7 @@ pub fn chart() -> anyhow::Result<(Figure, Table)> {
     }
     Ok((
         Figure {
+            hlines: Vec::new(),
             vlines,
             ..Figure::error_in_t(
                 "Stability: error in T against step h*omega (fixed-step methods)".into(),

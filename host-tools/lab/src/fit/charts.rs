@@ -14,6 +14,7 @@ use super::models::Equation;
 use super::stats::t_quantile_975;
 use super::{Fit, K2, ModelFit, condition_table};
 use crate::chart::plot::{Figure, Mark, Scale, Series};
+use crate::number::count;
 
 /// Points along each model curve.
 const CURVE_POINTS: usize = 120;
@@ -134,6 +135,71 @@ fn radial_curves(fit: &Fit, w5: f64, t5: f64) -> Vec<Series> {
         .collect()
 }
 
+/// Paper Fig. 7 from the fit: the fitted paper models' T against speed, the measured mean per
+/// condition with its 95 % interval, and the runs the outlier screen left out.
+fn fig7(fit: &Fit, points: &[(f64, f64, f64)]) -> Figure {
+    let mut bars = Vec::new();
+    for &(w, t, half) in points {
+        bars.extend([(w, t - half), (w, t + half), (f64::NAN, f64::NAN)]);
+    }
+    let mut series = model_curves(fit, &|s, m| {
+        residence(s, m).map_or(f64::NAN, |o| o.residence_time_s())
+    });
+    series.push(Series {
+        name: "measured, mean per condition".into(),
+        points: points.iter().map(|p| (p.0, p.1)).collect(),
+        mark: Mark::Points,
+        color: 0,
+    });
+    series.push(Series {
+        name: "95 % interval of the mean".into(),
+        points: bars,
+        mark: Mark::Line,
+        color: 0,
+    });
+    let mut notes = vec![format!(
+        "{} fitted, {} left out; preferred by AIC: {}",
+        count(fit.runs.len(), "run", "runs"),
+        count(fit.outliers.len(), "outlier", "outliers"),
+        fit.preferred
+    )];
+    // An outlier is drawn where it lies when that keeps the fit readable: within the span of
+    // what is drawn (curves, means, intervals) beyond either end. One further off (a time typed
+    // x10) would squash the curves to a line, so it is named in the notes instead.
+    let ys = series.iter().flat_map(|s| &s.points).map(|p| p.1);
+    let (lo, hi) = ys
+        .filter(|y| y.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), y| {
+            (l.min(y), h.max(y))
+        });
+    let span = (hi - lo).max(0.05 * hi.abs());
+    let (near, far): (Vec<_>, Vec<_>) = fit
+        .outliers
+        .iter()
+        .partition(|o| (lo - span..=hi + span).contains(&o.value));
+    if !near.is_empty() {
+        series.push(Series {
+            name: "left out (outlier)".into(),
+            points: near.iter().map(|o| (o.mean_rad_s, o.value)).collect(),
+            mark: Mark::Crosses,
+            color: 8,
+        });
+    }
+    for o in far {
+        notes.push(format!(
+            "off the chart: line {}, {:.4} s at {:.3} rad/s",
+            o.row, o.value, o.mean_rad_s
+        ));
+    }
+    figure(
+        "Residence time against bowl speed (paper Fig. 7), measured and fitted",
+        "combined bowl speed, rad/s",
+        "residence time, s",
+        series,
+        notes,
+    )
+}
+
 fn figure(title: &str, x: &str, y: &str, series: Vec<Series>, notes: Vec<String>) -> Figure {
     Figure {
         title: title.into(),
@@ -142,6 +208,7 @@ fn figure(title: &str, x: &str, y: &str, series: Vec<Series>, notes: Vec<String>
         x_scale: Scale::Linear,
         y_scale: Scale::Linear,
         series,
+        hlines: Vec::new(),
         vlines: Vec::new(),
         notes,
     }
@@ -152,30 +219,6 @@ fn figure(title: &str, x: &str, y: &str, series: Vec<Series>, notes: Vec<String>
 pub fn write(fit: &Fit, dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let points = measured_points(fit);
-    let mut bars = Vec::new();
-    for &(w, t, half) in &points {
-        bars.extend([(w, t - half), (w, t + half), (f64::NAN, f64::NAN)]);
-    }
-    let mut fig7 = model_curves(fit, &|s, m| {
-        residence(s, m).map_or(f64::NAN, |o| o.residence_time_s())
-    });
-    fig7.push(Series {
-        name: "measured, mean per condition".into(),
-        points: points.iter().map(|p| (p.0, p.1)).collect(),
-        mark: Mark::Points,
-        color: 0,
-    });
-    fig7.push(Series {
-        name: "95 % interval of the mean".into(),
-        points: bars,
-        mark: Mark::Line,
-        color: 0,
-    });
-    let notes = vec![format!(
-        "{} runs; preferred by AIC: {}",
-        fit.runs.len(),
-        fit.preferred
-    )];
     let draw = |f: Figure, name: &str| -> Result<()> {
         let path = dir.join(name);
         f.write_svg(&path)
@@ -184,16 +227,7 @@ pub fn write(fit: &Fit, dir: &Path) -> Result<()> {
         f.write_png(&png)
             .map_err(|e| anyhow::anyhow!("cannot draw {}: {e:?}", png.display()))
     };
-    draw(
-        figure(
-            "Residence time against bowl speed (paper Fig. 7), measured and fitted",
-            "combined bowl speed, rad/s",
-            "residence time, s",
-            fig7,
-            notes.clone(),
-        ),
-        "fig7_residence_fit.svg",
-    )?;
+    draw(fig7(fit, &points), "fig7_residence_fit.svg")?;
     let fig6 = model_curves(fit, &|s, m| {
         residence(s, m)
             .ok()
@@ -261,5 +295,45 @@ mod tests {
             let last = *curve.points.last().unwrap();
             assert_eq!(last, (t, s.rim_radius_m), "{}", m.candidate.name);
         }
+    }
+
+    /// Fig. 7 draws the runs the outlier screen left out, crossed, under "left out (outlier)"
+    /// (it drew none: a reader could not see what was dropped); one too far off to draw beside
+    /// the fit (a time x10) is named in the notes with its line, time and speed.
+    #[test]
+    fn fig7_draws_the_runs_left_out() {
+        let mut runs = synthetic(model_core::particle::Model::Coriolis, 0.03, 0.002, 6, 3);
+        for (i, r) in runs.iter_mut().enumerate() {
+            r.row = i + 2;
+        }
+        runs[2].residence_s *= 1.3;
+        runs[9].residence_s *= 10.0;
+        let (near, far) = (runs[2].clone(), runs[9].clone());
+        let fit = fit_paper(runs, Vec::new()).unwrap();
+        assert_eq!(fit.outliers.len(), 2, "{:?}", fit.outliers);
+        let fig = fig7(&fit, &measured_points(&fit));
+        let left_out: Vec<_> = fig
+            .series
+            .iter()
+            .filter(|s| s.name == "left out (outlier)")
+            .collect();
+        assert_eq!(left_out.len(), 1, "{:?}", fig.series);
+        assert_eq!(left_out[0].mark, Mark::Crosses);
+        assert_eq!(
+            left_out[0].points,
+            vec![(near.mean_rad_s, near.residence_s)]
+        );
+        let far_note = format!(
+            "off the chart: line {}, {:.4} s at {:.3} rad/s",
+            far.row, far.residence_s, far.mean_rad_s
+        );
+        assert!(fig.notes.contains(&far_note), "{:?}", fig.notes);
+        assert!(fig.notes[0].starts_with(&format!(
+            "{} runs fitted, 2 outliers left out",
+            fit.runs.len()
+        )));
+        // The crossed run is inside the drawn axis.
+        let (_, y) = fig.axes().unwrap();
+        assert!(y.lo < near.residence_s && near.residence_s < y.hi, "{y:?}");
     }
 }

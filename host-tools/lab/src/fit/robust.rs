@@ -50,6 +50,8 @@ pub struct Outlier {
     pub row: usize,
     /// Its residence time, s.
     pub value: f64,
+    /// Its mean measured combined speed, rad/s (where Fig. 7 draws it).
+    pub mean_rad_s: f64,
     /// Plain words.
     pub why: String,
 }
@@ -164,6 +166,7 @@ pub fn screen(runs: Vec<Run>) -> (Vec<Run>, Vec<Outlier>) {
             outliers.push(Outlier {
                 row: run.row,
                 value: run.residence_s,
+                mean_rad_s: run.mean_rad_s,
                 why: format!(
                     "residence time {:.4} s where the other runs say {:.4} s ({} model, mu \
                      {mu:.4}, fitted robustly): {:.0} robust standard deviations off, the cut is \

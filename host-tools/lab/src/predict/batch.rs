@@ -29,6 +29,7 @@ use anyhow::{Context, Result, anyhow, bail};
 use model_core::particle::{Model, Outcome, Scene};
 
 use super::{Ends, Inputs, predict, refusals};
+use crate::csv_lines::Lines;
 
 /// Formats an f64 for the batch output: shortest round-trip digits, `inf`, `nan`.
 pub fn format_f64(x: f64) -> String {
@@ -205,44 +206,10 @@ impl Drop for Partial {
     }
 }
 
-/// Start offsets of the lines of `bytes`: LF, CRLF and lone CR each end one line.
-fn line_starts(bytes: &[u8]) -> Vec<u64> {
-    let mut starts = vec![0];
-    let mut i = 0;
-    while i < bytes.len() {
-        match bytes[i] {
-            b'\r' if bytes.get(i + 1) == Some(&b'\n') => {
-                i += 1;
-                starts.push(i as u64 + 1);
-            }
-            b'\r' | b'\n' => starts.push(i as u64 + 1),
-            _ => {}
-        }
-        i += 1;
-    }
-    starts
-}
-
-/// Where a record read from `offset` begins: the csv reader's position can sit on the line
-/// end before it (the LF of a CRLF) or on blank lines it skips.
-fn record_start(bytes: &[u8], offset: u64) -> u64 {
-    let skipped = bytes
-        .iter()
-        .skip(offset as usize)
-        .take_while(|b| matches!(b, b'\r' | b'\n'))
-        .count();
-    offset + skipped as u64
-}
-
-/// The line (from 1) holding byte `offset`.
-fn line_of(starts: &[u64], offset: u64) -> usize {
-    starts.partition_point(|&s| s <= offset)
-}
-
 /// Runs `bowl predict --batch INPUT --out OUTPUT`.
 pub fn run(input: &Path, output: &Path, args: &Inputs) -> Result<()> {
     let bytes = std::fs::read(input).with_context(|| format!("cannot open {}", input.display()))?;
-    let starts = line_starts(&bytes);
+    let lines = Lines::of(&bytes);
     let mut reader = csv::ReaderBuilder::new()
         .flexible(true)
         .from_reader(bytes.as_slice());
@@ -250,6 +217,23 @@ pub fn run(input: &Path, output: &Path, args: &Inputs) -> Result<()> {
         .headers()
         .with_context(|| format!("{}: cannot read the header row", input.display()))?
         .clone();
+    // A spreadsheet in a comma-decimal locale saves `;` between cells (and decimal commas):
+    // the whole header then reads as one column, which the column check would only call
+    // unknown.
+    let sep = crate::results::sheet::detect(&header.iter().collect::<Vec<_>>().join(","));
+    if sep != b',' {
+        bail!(
+            "{}: line 1: the cells are separated by {} (a spreadsheet's CSV in a comma-decimal \
+             locale), but a batch file is comma-separated with decimal points (3.6, not 3,6): \
+             save it as CSV with the field delimiter , and the decimal separator .",
+            input.display(),
+            if sep == b'\t' {
+                "tabs".into()
+            } else {
+                format!("`{}`", sep as char)
+            }
+        );
+    }
     let cols = Columns::find(&header).with_context(|| format!("{}: line 1", input.display()))?;
     let name = output
         .file_name()
@@ -282,10 +266,7 @@ pub fn run(input: &Path, output: &Path, args: &Inputs) -> Result<()> {
             Ok(true) => (Ok(record.clone()), record.position().map(|p| p.byte())),
             Err(e) => (Err(anyhow!("{e}")), e.position().map(|p| p.byte())),
         };
-        let line = line_of(
-            &starts,
-            record_start(&bytes, byte.unwrap_or(reader.position().byte())),
-        );
+        let line = lines.record_line(&bytes, byte.unwrap_or(reader.position().byte()));
         rows += 1;
         let result = row.and_then(|row| {
             let (model, scene) = parse_row(&row, &cols, header.len())?;
@@ -361,22 +342,4 @@ pub fn run(input: &Path, output: &Path, args: &Inputs) -> Result<()> {
         println!("{}", super::throughput::measure(&scenes));
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn lines_end_at_lf_crlf_and_cr() {
-        for text in ["a\nb\nc\n", "a\r\nb\r\nc\r\n", "a\rb\rc\r"] {
-            let starts = line_starts(text.as_bytes());
-            let c = text.find('c').unwrap() as u64;
-            assert_eq!(line_of(&starts, 0), 1, "{text:?}");
-            assert_eq!(line_of(&starts, c), 3, "{text:?}");
-            // From just after b's first line end (a CRLF's LF, or a blank line) to c.
-            let after_b = text.find('b').unwrap() as u64 + 2;
-            assert_eq!(line_of(&starts, record_start(text.as_bytes(), after_b)), 3);
-        }
-    }
 }

@@ -99,11 +99,12 @@ pub fn paper(scene: &Scene<f64>, outcome: &Outcome<f64>, sliding_mu: f64) -> Val
     let give = sliding_mu * scene.g_m_s2;
     if need > give {
         Validity(Some(format!(
-            "rolling out to the rim needs friction of {:.3} of the granule's weight (spin-up \
+            "rolling out to the rim needs friction of {} of the granule's weight (spin-up \
              and the Coriolis force), more than the {sliding_mu} the contact gives \
              (--sliding-mu): the granule slides there, so this T is the paper's rolling \
              model's",
-            need / scene.g_m_s2
+            // Through `fixed`: at 1e30 rad/s `{:.3}` wrote a 59-digit number.
+            crate::number::fixed(need / scene.g_m_s2, 3)
         )))
     } else {
         Validity::valid()

@@ -2,12 +2,15 @@
 //! to a CSV file: in a comma-decimal locale it saves `;`-separated cells with decimal commas
 //! (`1,07`), sometimes after a first line `sep=;`; headers may come back uppercase or padded
 //! with spaces, cells with trailing spaces, and an emptied row as `,,,,,,`; two files pasted
-//! one under the other repeat the header line (skipped). Every error names
+//! one under the other repeat the header line (skipped), and a units row under the header is
+//! skipped too. Every error names
 //! one line (the file's own numbering, header line included) and the column, in words.
 
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+
+use crate::csv_lines::Lines;
 
 /// A table read from a file: its header and its non-blank rows.
 pub struct Sheet {
@@ -37,9 +40,26 @@ fn sep_line(line: &str) -> Option<u8> {
     (sep.len() == 1).then(|| sep[0])
 }
 
+/// Text with no digit but in a power (`rad/s`, `m/s^2`, `%`): a unit, not a value.
+fn unit_like(cell: &str) -> bool {
+    let mut power = false;
+    cell.chars().all(|ch| match ch {
+        '^' => {
+            power = true;
+            true
+        }
+        '0'..='9' => power,
+        '-' => true,
+        _ => {
+            power = false;
+            true
+        }
+    })
+}
+
 /// The separator of a header line: the most frequent of `,`, `;` and tab (the header's names
 /// hold none of them), `,` when none occurs.
-fn detect(header: &str) -> u8 {
+pub(crate) fn detect(header: &str) -> u8 {
     [b',', b';', b'\t']
         .into_iter()
         .max_by_key(|&c| (header.bytes().filter(|&b| b == c).count(), c == b','))
@@ -64,13 +84,22 @@ impl Sheet {
         // A spreadsheet's UTF-8 export may start with a byte-order mark.
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let first = text.lines().next().unwrap_or("");
-        // With `sep=X` the table starts on line 2: the csv reader's lines are offset by one.
-        let (sep, body, offset) = match sep_line(first) {
-            Some(sep) => (sep, text.split_once('\n').map_or("", |x| x.1), 1),
+        // With `sep=X` the table starts on line 2.
+        let (sep, body) = match sep_line(first) {
+            Some(sep) => (sep, text.split_once('\n').map_or("", |x| x.1)),
             None => {
                 let header = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
-                (detect(header), text, 0)
+                (detect(header), text)
             }
+        };
+        // Lines counted on the whole text, records placed by their byte offset (the reader's
+        // own line count is one short after a CRLF file's first row).
+        let lines = Lines::of(text.as_bytes());
+        let skipped = (text.len() - body.len()) as u64;
+        let line_at = |p: Option<&csv::Position>| {
+            p.map_or(0, |p| {
+                lines.record_line(text.as_bytes(), skipped + p.byte())
+            })
         };
         let mut reader = csv::ReaderBuilder::new()
             .delimiter(sep)
@@ -80,10 +109,10 @@ impl Sheet {
         let mut records = Vec::new();
         for rec in reader.records() {
             let rec = rec.map_err(|e| {
-                let line = e.position().map_or(0, |p| p.line() as usize + offset);
+                let line = line_at(e.position());
                 anyhow::anyhow!("{file}, line {line}: not readable as CSV ({e})")
             })?;
-            let line = rec.position().map_or(0, |p| p.line() as usize + offset);
+            let line = line_at(rec.position());
             let cells: Vec<String> = rec.iter().map(|c| c.trim().to_string()).collect();
             records.push((line, cells));
         }
@@ -111,6 +140,15 @@ impl Sheet {
                     .zip(&columns)
                     .all(|(c, name)| c.eq_ignore_ascii_case(name))
         };
+        // A spreadsheet's second header line, the units (`rad/s`, `m`, `s`) under the names:
+        // the row right below the header with two or more cells and no digit but in a power
+        // (`m/s^2`). A row of values always has digits (its run number).
+        let units = |cells: &[String]| {
+            cells.iter().filter(|c| !c.is_empty()).count() >= 2
+                && cells.iter().all(|c| unit_like(c))
+        };
+        let mut records = records.peekable();
+        records.next_if(|(_, cells)| units(cells));
         let rows = records
             .filter(|(_, cells)| cells.iter().any(|c| !c.is_empty()) && !repeats_header(cells))
             .collect();
@@ -286,6 +324,31 @@ mod tests {
         let s = sheet("run,t\n1,2\nRun,T\n3,4\n");
         let lines: Vec<usize> = s.rows().map(|r| r.unwrap().line).collect();
         assert_eq!(lines, [2, 4]);
+    }
+
+    /// A spreadsheet's file as Excel on Windows saves it: CRLF line ends, a units row under the
+    /// header, spare empty columns. The units row is skipped, and each row keeps its own line
+    /// (with CRLF the rows after the first were named one line too early: line 2 for line 3).
+    #[test]
+    fn a_crlf_file_with_a_units_row_keeps_its_lines() {
+        let text = "run;residence_s;g;status;;\r\n;s;m/s^2;;;\r\n1;1,07;9,8;ok;;\r\n2;;9,8;ok;;\r\n3;0,9;9,8;ok;;\r\n";
+        let s = sheet(text);
+        let rows: Vec<Cells> = s.rows().map(Result::unwrap).collect();
+        let lines: Vec<usize> = rows.iter().map(|r| r.line).collect();
+        assert_eq!(lines, [3, 4, 5]);
+        assert_eq!(rows[0].number("residence_s").unwrap(), 1.07);
+        let e = rows[1].number("residence_s").unwrap_err().to_string();
+        assert!(
+            e.starts_with("r.csv, line 4, column residence_s: empty"),
+            "{e}"
+        );
+        // Without the units row, CRLF alone, and with a sep= line.
+        let s = sheet("sep=;\r\nrun;t\r\n1;2\r\n\r\n3;4\r\n");
+        let lines: Vec<usize> = s.rows().map(|r| r.unwrap().line).collect();
+        assert_eq!(lines, [3, 5]);
+        // A first row of values is never taken for units, even with its numbers missing.
+        let s = sheet("run,status,t\n,ok,\n");
+        assert_eq!(s.rows().count(), 1);
     }
 
     #[test]

@@ -127,6 +127,36 @@ pub fn axis_for(scale: Scale, values: &[f64]) -> Option<Axis> {
     }
 }
 
+/// Share of the axis within which a marker line counts as on the frame.
+const FRAME_SHARE: f64 = 0.03;
+
+/// Chooses a range and ticks covering `values` and the marker `lines` (both in plotted
+/// coordinates), with every line clear of the frame: the round range of the data alone often
+/// ends exactly on a target (settling times up to 1.8 s and a 3 s target gave an axis ending at
+/// 3), and a line drawn on the frame cannot be seen, nor can its label.
+pub fn axis_clear_of(scale: Scale, values: &[f64], lines: &[f64]) -> Option<Axis> {
+    let mut all: Vec<f64> = values.iter().chain(lines).copied().collect();
+    let first = axis_for(scale, &all)?;
+    let span = first.hi - first.lo;
+    let room = 2.0 * FRAME_SHARE * span;
+    let mut moved = false;
+    for &l in lines {
+        if first.hi - l < FRAME_SHARE * span {
+            all.push(l + room);
+            moved = true;
+        }
+        if l - first.lo < FRAME_SHARE * span {
+            all.push(l - room);
+            moved = true;
+        }
+    }
+    if moved {
+        axis_for(scale, &all)
+    } else {
+        Some(first)
+    }
+}
+
 /// Formats a tick label for a plotted coordinate.
 pub fn tick_label(scale: Scale, v: f64) -> String {
     match scale {
@@ -172,6 +202,28 @@ mod tests {
         assert!(a.lo <= 0.013 && a.hi >= 0.74);
         let step = a.ticks[1] - a.ticks[0];
         assert!((step - 0.1).abs() < 1e-12, "step {step}");
+    }
+
+    /// A line on the data's round range's end moves the end out: settling times 0.97-1.8 s and
+    /// a 3 s target gave an axis 0.5-3, the target on the frame.
+    #[test]
+    fn a_line_on_the_frame_moves_the_frame() {
+        let data = [0.97, 1.2, 1.8];
+        assert_eq!(axis_for(Scale::Linear, &[0.97, 1.8, 3.0]).unwrap().hi, 3.0);
+        let a = axis_clear_of(Scale::Linear, &data, &[3.0]).unwrap();
+        let span = a.hi - a.lo;
+        assert!(a.hi - 3.0 >= FRAME_SHARE * span, "{a:?}");
+        assert!(a.lo <= 0.97, "{a:?}");
+        // At the bottom too, and on a log axis.
+        let a = axis_clear_of(Scale::Linear, &data, &[0.0]).unwrap();
+        assert!(0.0 - a.lo >= FRAME_SHARE * (a.hi - a.lo), "{a:?}");
+        let a = axis_clear_of(Scale::Log, &[-1.5, -0.3], &[0.0]).unwrap();
+        assert!(a.hi - 0.0 >= FRAME_SHARE * (a.hi - a.lo), "{a:?}");
+        // A line well inside leaves the data's axis as it was.
+        assert_eq!(
+            axis_clear_of(Scale::Linear, &data, &[1.5]),
+            axis_for(Scale::Linear, &data)
+        );
     }
 
     #[test]

@@ -18,11 +18,11 @@ use std::sync::Once;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 mod axis;
+mod lines;
 
-pub use axis::{Axis, axis_for, tick_label, to_axis};
+pub use axis::{Axis, axis_clear_of, axis_for, tick_label, to_axis};
 
 /// How an axis maps data to the page.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -74,6 +74,18 @@ pub struct VLine {
     pub color: usize,
 }
 
+/// A horizontal line at a given y across the whole plot, labelled on the line (for example a
+/// target). The y axis keeps it clear of the frame.
+#[derive(Clone, Debug)]
+pub struct HLine {
+    /// Position on the y axis, in data units.
+    pub y: f64,
+    /// Label drawn on the line, at its right end.
+    pub label: String,
+    /// Palette index.
+    pub color: usize,
+}
+
 /// A whole chart.
 #[derive(Clone, Debug)]
 pub struct Figure {
@@ -91,6 +103,8 @@ pub struct Figure {
     pub series: Vec<Series>,
     /// Vertical marker lines.
     pub vlines: Vec<VLine>,
+    /// Horizontal reference lines.
+    pub hlines: Vec<HLine>,
     /// Free text lines printed under the legend (how to read the chart).
     pub notes: Vec<String>,
 }
@@ -111,6 +125,7 @@ impl Figure {
             x_scale: Scale::Linear,
             y_scale: Scale::Linear,
             series,
+            hlines: vec![],
             vlines: vec![],
             notes: notes.iter().map(|n| (*n).to_string()).collect(),
         }
@@ -131,6 +146,7 @@ impl Figure {
             x_scale: Scale::Log,
             y_scale: Scale::Log,
             series,
+            hlines: vec![],
             vlines: vec![],
             notes,
         }
@@ -235,25 +251,37 @@ impl Figure {
         out
     }
 
+    /// The axes (x, y; plotted coordinates) covering the drawable points and the marker lines,
+    /// each line clear of the frame.
+    pub fn axes(&self) -> Result<(Axis, Axis), PlotError> {
+        let segs: Vec<_> = self.series.iter().map(|s| self.segments(s)).collect();
+        let points = || segs.iter().flatten().flatten();
+        let xs: Vec<f64> = points().map(|p| p.0).collect();
+        let ys: Vec<f64> = points().map(|p| p.1).collect();
+        if xs.is_empty() {
+            return Err(PlotError::NoData);
+        }
+        let vx: Vec<f64> = self
+            .vlines
+            .iter()
+            .filter_map(|v| to_axis(self.x_scale, v.x))
+            .collect();
+        let hy: Vec<f64> = self
+            .hlines
+            .iter()
+            .filter_map(|h| to_axis(self.y_scale, h.y))
+            .collect();
+        let xa = axis_clear_of(self.x_scale, &xs, &vx).ok_or(PlotError::NoData)?;
+        let ya = axis_clear_of(self.y_scale, &ys, &hy).ok_or(PlotError::NoData)?;
+        Ok((xa, ya))
+    }
+
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         let be = |e: DrawingAreaErrorKind<DB::ErrorType>| PlotError::Backend(e.to_string());
         root.fill(&WHITE).map_err(be)?;
         let segs: Vec<Vec<Vec<(f64, f64)>>> =
             self.series.iter().map(|s| self.segments(s)).collect();
-        let xs: Vec<f64> = segs
-            .iter()
-            .flatten()
-            .flatten()
-            .map(|p| p.0)
-            .chain(
-                self.vlines
-                    .iter()
-                    .filter_map(|v| to_axis(self.x_scale, v.x)),
-            )
-            .collect();
-        let ys: Vec<f64> = segs.iter().flatten().flatten().map(|p| p.1).collect();
-        let xa = axis_for(self.x_scale, &xs).ok_or(PlotError::NoData)?;
-        let ya = axis_for(self.y_scale, &ys).ok_or(PlotError::NoData)?;
+        let (xa, ya) = self.axes()?;
 
         let (plot_area, legend_area) = root.split_horizontally(WIDTH - LEGEND_WIDTH);
         let xs_scale = self.x_scale;
@@ -280,18 +308,7 @@ impl Figure {
             .draw()
             .map_err(be)?;
 
-        for v in &self.vlines {
-            if let Some(x) = to_axis(self.x_scale, v.x) {
-                chart
-                    .draw_series(DashedLineSeries::new(
-                        vec![(x, ya.lo), (x, ya.hi)],
-                        6,
-                        4,
-                        colour(v.color).stroke_width(1),
-                    ))
-                    .map_err(be)?;
-            }
-        }
+        lines::draw_lines(self, &mut chart, &xa, &ya).map_err(be)?;
 
         for (s, parts) in self.series.iter().zip(&segs) {
             let c = colour(s.color);
@@ -336,29 +353,7 @@ impl Figure {
             }
         }
 
-        // The lines' labels over the data, staggered downwards from one step below the top
-        // (a series along the top edge, such as a target, would cross the first one).
-        // A label that would run past the plot's right edge (into the legend) ends at its line
-        // instead of starting there.
-        let right_px = chart.plotting_area().get_pixel_range().0.end;
-        for (i, v) in self.vlines.iter().enumerate() {
-            if let Some(x) = to_axis(self.x_scale, v.x) {
-                let label_y = ya.hi - (ya.hi - ya.lo) * 0.035 * (1 + i % 8) as f64;
-                let font = (FONT, 13).into_font().color(&colour(v.color));
-                let width_px = plot_area
-                    .estimate_text_size(&v.label, &font)
-                    .map_or(0, |(w, _)| w as i32);
-                let (label, font) = if chart.backend_coord(&(x, label_y)).0 + width_px > right_px {
-                    let anchor = Pos::new(HPos::Right, VPos::Top);
-                    (format!("{} ", v.label.trim()), font.pos(anchor))
-                } else {
-                    (v.label.clone(), font)
-                };
-                chart
-                    .draw_series(std::iter::once(Text::new(label, (x, label_y), font)))
-                    .map_err(be)?;
-            }
-        }
+        lines::draw_labels(self, &mut chart, &plot_area, &xa, &ya).map_err(be)?;
 
         self.draw_legend(&legend_area).map_err(be)
     }

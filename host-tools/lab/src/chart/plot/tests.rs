@@ -12,6 +12,7 @@ fn gaps_split_lines() {
         x_scale: Scale::Linear,
         y_scale: Scale::Log,
         series: vec![],
+        hlines: Vec::new(),
         vlines: vec![],
         notes: vec![],
     };
@@ -61,6 +62,7 @@ fn sample() -> Figure {
                 color: 2,
             },
         ],
+        hlines: Vec::new(),
         vlines: vec![VLine {
             x: 10.0,
             label: "bound".into(),
@@ -168,6 +170,7 @@ fn png_lines_stay_within_the_data() {
                 color: 1,
             },
         ],
+        hlines: Vec::new(),
         vlines: vec![],
         notes: vec![],
     };
@@ -248,4 +251,40 @@ fn a_line_that_turns_back_is_drawn_as_strokes_without_repeated_pixels() {
     // A right angle is no reversal: one stroke.
     let corner = [(0.0, 0.0), (5.0, 0.0), (5.0, 5.0)];
     assert_eq!(super::strokes(&corner, px).len(), 1);
+}
+
+/// A horizontal line is drawn across the plot with its label on it, right-anchored at the plot's
+/// right end, and the axis keeps it off the frame.
+#[test]
+fn a_horizontal_line_is_drawn_inside_with_its_label() {
+    let dir = std::env::temp_dir().join(format!("bowl-plot-hline-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("s.svg");
+    let mut f = Figure::linear(
+        "h".into(),
+        "x",
+        "y",
+        vec![Series {
+            name: "data".into(),
+            points: vec![(0.0, 0.97), (1.0, 1.8)],
+            mark: Mark::Points,
+            color: 0,
+        }],
+        &[],
+    );
+    f.hlines.push(HLine {
+        y: 3.0,
+        label: "settling target 3 s".into(),
+        color: 7,
+    });
+    let (_, y) = f.axes().unwrap();
+    assert!(y.hi - 3.0 >= 0.03 * (y.hi - y.lo), "{y:?}");
+    f.write_svg(&svg).unwrap();
+    let text = std::fs::read_to_string(&svg).unwrap();
+    let at = text
+        .find("\nsettling target 3 s")
+        .expect("the label is drawn");
+    let tag = &text[text[..at].rfind("<text").unwrap()..at];
+    assert!(tag.contains("text-anchor=\"end\""), "{tag}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }
