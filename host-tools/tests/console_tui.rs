@@ -272,3 +272,41 @@ fn no_color_and_a_dumb_terminal_are_respected() {
     let screen = tmux.wait_for(&["state=idle", "corrupt 0"], "the plain lines");
     assert!(!screen.contains("LINK OK"), "no screen UI:\n{screen}");
 }
+
+/// A terminal whose locale has no UTF-8 (`LC_ALL=C`, as on a serial console or a bare ssh
+/// session) shows braille and box-drawing as garbage: the dashboard is drawn in ASCII there,
+/// frames, axes and both speed lines included, and still reads.
+#[test]
+fn a_terminal_without_utf8_gets_ascii() {
+    let sim = Sim::start(&[]);
+    let tmux = Tmux::start(
+        "tui-ascii",
+        &format!("env LC_ALL=C {BOWL} monitor {} ; sleep 30", sim.path),
+    );
+    tmux.wait_for(&["LINK OK", "state idle"], "the dashboard");
+    tmux.keys(&[":", "speed 1500 1500", "Enter"]);
+    tmux.wait_for(&["speed 1500 1500 -> ok (id"], "the answer to speed");
+    tmux.keys(&[":", "start", "Enter"]);
+    let screen = tmux.wait_for(
+        &[
+            "state running",
+            "precession w1 rad/s: set (.), measured (*)",
+            "+-",
+            "s|",
+        ],
+        "the dashboard in ASCII",
+    );
+    let odd: Vec<char> = screen.chars().filter(|c| !c.is_ascii()).collect();
+    assert!(odd.is_empty(), "not ASCII: {odd:?} on\n{screen}");
+    // Both lines are drawn: the set speed's dots and the measured speed's stars, in the left
+    // chart's plot (`|1.65|  ....****  ||`: right of its speed axis).
+    let plot: String = screen
+        .lines()
+        .filter(|l| l.starts_with('|'))
+        .filter_map(|l| l.split('|').nth(2))
+        .collect();
+    assert!(
+        plot.contains('.') && plot.contains('*'),
+        "both speed lines:\n{screen}"
+    );
+}

@@ -9,6 +9,7 @@
 mod backlog;
 mod commands;
 mod fit;
+mod glyphs;
 mod line_edit;
 mod tui;
 mod view;

@@ -75,6 +75,8 @@ pub struct Tui {
     /// `NO_COLOR` is set (no-color.org): no colours; what a coloured background marked (the
     /// alarms, LINK OK, PAUSED) is drawn in reverse video instead, so it still stands out.
     no_color: bool,
+    /// The locale has no UTF-8: the screen is drawn in ASCII ([`super::glyphs`]).
+    ascii: bool,
 }
 
 impl Tui {
@@ -91,6 +93,7 @@ impl Tui {
             typing: false,
             line: LineEdit::default(),
             no_color: std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty()),
+            ascii: !super::glyphs::utf8_locale(),
         })
     }
 
@@ -153,7 +156,7 @@ impl Tui {
         let (history, paused) = (&self.history, self.paused);
         let input = self.typing.then_some(&self.line);
         let silence = view.silence(Instant::now());
-        let no_color = self.no_color;
+        let (no_color, ascii) = (self.no_color, self.ascii);
         self.terminal.draw(|f| {
             let width = usize::from(f.area().width).max(20);
             // The fault line and the events are wrapped to the width, never cut: the end of a
@@ -199,7 +202,7 @@ impl Tui {
                 .zip(charts.iter())
                 .enumerate()
             {
-                speed_chart(f, *area, name, &history.axes[i], live);
+                speed_chart(f, *area, name, &history.axes[i], live, ascii);
             }
             f.render_widget(Paragraph::new(value_lines).style(value_style), rows[3]);
             f.render_widget(
@@ -240,6 +243,9 @@ impl Tui {
                     }
                     (cell.fg, cell.bg) = (Color::Reset, Color::Reset);
                 }
+            }
+            if ascii {
+                super::glyphs::to_ascii(f.buffer_mut());
             }
         })?;
         Ok(())
@@ -353,6 +359,7 @@ fn speed_chart(
     name: &str,
     points: &VecDeque<(f64, f64, f64)>,
     live: bool,
+    ascii: bool,
 ) {
     let set: Vec<(f64, f64)> = points.iter().map(|&(t, s, _)| (t, s)).collect();
     let measured: Vec<(f64, f64)> = points.iter().map(|&(t, _, m)| (t, m)).collect();
@@ -366,16 +373,23 @@ fn speed_chart(
     let span = (hi - lo).max(MIN_SPAN_RAD_S) * 1.1;
     let (y0, y1) = (lo.min(0.0), lo.min(0.0) + span);
     let dim = |c: Color| if live { c } else { Color::DarkGray };
+    // In ASCII (see `glyphs`) one mark per cell, and a mark of its own for each line, so set
+    // and measured differ without colour: dots (`.`) and blocks (`*`).
+    let (set_marker, measured_marker, set_mark, measured_mark) = if ascii {
+        (Marker::Dot, Marker::Block, " (.)", " (*)")
+    } else {
+        (Marker::Braille, Marker::Braille, "", "")
+    };
     let datasets = vec![
         Dataset::default()
             .name("set")
-            .marker(Marker::Braille)
+            .marker(set_marker)
             .graph_type(GraphType::Line)
             .style(Style::default().fg(dim(Color::Yellow)))
             .data(&set),
         Dataset::default()
             .name("measured")
-            .marker(Marker::Braille)
+            .marker(measured_marker)
             .graph_type(GraphType::Line)
             .style(Style::default().fg(dim(Color::Cyan)))
             .data(&measured),
@@ -388,9 +402,15 @@ fn speed_chart(
     // inside the plot would be drawn over the newest samples at the right edge.
     let title = Line::from(vec![
         Span::raw(format!(" {name} rad/s: ")),
-        Span::styled("set", Style::default().fg(dim(Color::Yellow))),
+        Span::styled(
+            format!("set{set_mark}"),
+            Style::default().fg(dim(Color::Yellow)),
+        ),
         Span::raw(", "),
-        Span::styled("measured", Style::default().fg(dim(Color::Cyan))),
+        Span::styled(
+            format!("measured{measured_mark}"),
+            Style::default().fg(dim(Color::Cyan)),
+        ),
         Span::raw(" "),
     ]);
     let chart = Chart::new(datasets)
