@@ -306,12 +306,23 @@ fn commands_typed_into_the_plain_monitor_are_answered() {
     writeln!(stdin, "speed 1500 1500").unwrap();
     writeln!(stdin, "status").unwrap();
     writeln!(stdin, "speed 1500").unwrap();
+    // Inside its own range but outside the rim (RIM_UM 100000): refused with a suggestion,
+    // which names the port the monitor holds, to be pasted as it stands.
+    writeln!(stdin, "set START_UM 200000").unwrap();
     let out = child.wait_with_output().unwrap();
     let text = stdout(&out);
     assert!(out.status.success(), "{text}");
     assert!(text.contains("speed 1500 1500 -> ok (id"), "{text}");
     assert!(text.contains("status -> status (id"), "{text}");
     assert!(text.contains("`speed 1500` not sent: MALFORMED"), "{text}");
+    assert!(
+        text.contains("set START_UM 200000 -> rejected (id"),
+        "{text}"
+    );
+    assert!(
+        text.contains(&format!("`bowl send {} params`", sim.path)),
+        "{text}"
+    );
 }
 
 #[test]

@@ -70,6 +70,11 @@ fn commission_interrupted_stops_the_motors_first() {
         text.contains("commissioning interrupted") && text.contains("the motors are off"),
         "{text}"
     );
+    // Its suggestion names the port, to be pasted as it stands.
+    assert!(
+        text.contains(&format!("(`bowl send {} models`)", sim.path)),
+        "{text}"
+    );
     // Asked right away: well inside the rig's 3 s link timeout, so idle is STOP's doing.
     let (code, now) = send(&sim.path, "status");
     assert_eq!(code, 0, "{now}");

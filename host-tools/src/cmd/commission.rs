@@ -187,20 +187,22 @@ fn axis_report(
     }
 }
 
-fn print(report: &Report, json: bool) -> Result<()> {
+/// Prints the report; the suggestions in its words (`bowl send PORT clear`) name `port`, so
+/// they can be pasted as they stand.
+fn print(report: &Report, json: bool, port: &str) -> Result<()> {
     if json {
         println!("{}", serde_json::to_string(report)?);
         return Ok(());
     }
-    match report.result {
-        "ok" => println!("commissioning done in {:.1} s", report.seconds),
-        "fault" => println!(
+    let head = match report.result {
+        "ok" => format!("commissioning done in {:.1} s", report.seconds),
+        "fault" => format!(
             "commissioning FAILED after {:.1} s: fault {} (motors off; `bowl send PORT clear` clears it)",
             report.seconds,
             report.fault.as_deref().unwrap_or("?")
         ),
         "rejected" => {
-            println!(
+            let mut text = format!(
                 "COMMISSION rejected: {} - {}",
                 report.reason.unwrap_or("?"),
                 report
@@ -209,10 +211,11 @@ fn print(report: &Report, json: bool) -> Result<()> {
                     .map_or("", explain)
             );
             if let Some(why) = &report.why {
-                println!("  {why}");
+                text.push_str(&format!("\n  {why}"));
             }
+            text
         }
-        "interrupted" => println!(
+        "interrupted" => format!(
             "commissioning interrupted after {:.1} s: STOP sent{}; the motor models in force are \
              the ones from before (`bowl send PORT models`)",
             report.seconds,
@@ -222,15 +225,16 @@ fn print(report: &Report, json: bool) -> Result<()> {
                 ", the motors are off"
             }
         ),
-        "restarted" => println!(
+        "restarted" => format!(
             "commissioning did NOT finish: the rig reset after {:.1} s (it sent a Hello, or its \
              clock started again), which ended the identification; the motor models in force \
              are the ones it booted with. Look at why it reset (`bowl send PORT status`: \
              reset_cause), then run `bowl commission` again",
             report.seconds
         ),
-        other => println!("commissioning: {other} after {:.1} s", report.seconds),
-    }
+        other => format!("commissioning: {other} after {:.1} s", report.seconds),
+    };
+    println!("{}", rig_client::refusal::on_port(&head, port));
     for a in &report.axes {
         println!(
             "{:10} {}  Ke {:.4} V/(rad/s)  friction {:.4} duty  tau {:.4} s  |  bandwidth {}  Kp {:.4} duty/(rad/s)  Ki {:.4} duty/rad",
@@ -284,12 +288,12 @@ pub fn run(args: &Args) -> Result<i32> {
             report.why = rig
                 .refusal_particulars(&["commission"], reason)
                 .map(|why| rig_client::refusal::on_port(&why, &args.port));
-            print(&report, args.json)?;
+            print(&report, args.json, &args.port)?;
             return Ok(exit_code::REFUSED);
         }
         None => {
             report.result = "timeout";
-            print(&report, args.json)?;
+            print(&report, args.json, &args.port)?;
             return Ok(exit_code::TIMEOUT);
         }
     }
@@ -368,6 +372,6 @@ pub fn run(args: &Args) -> Result<i32> {
             None => eprintln!("no answer to MODELS"),
         }
     }
-    print(&report, args.json)?;
+    print(&report, args.json, &args.port)?;
     Ok(code)
 }

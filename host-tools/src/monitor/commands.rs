@@ -7,7 +7,7 @@ use model_core::wire::Frame;
 
 use rig_client::command_words::local_refusal;
 use rig_client::lines::{command_line, describe, explain};
-use rig_client::refusal::particulars;
+use rig_client::refusal::{on_port, particulars};
 use rig_client::request::{Request, fresh_id, next_id};
 use rig_client::unreadable::UnreadableAnswer;
 
@@ -24,15 +24,18 @@ struct Pending {
 pub struct Commands {
     next_id: u16,
     pending: Vec<Pending>,
+    /// The port the monitor holds, named in the suggestions (`bowl send PORT params`).
+    port: String,
 }
 
 impl Commands {
-    pub fn new() -> Self {
+    pub fn new(port: &str) -> Self {
         // Ids from the clock, so no tool before this one used them within the rig's memory of
         // recent commands (a late copy of theirs must not look like ours, nor ours like theirs).
         Self {
             next_id: fresh_id(),
             pending: Vec::new(),
+            port: port.to_owned(),
         }
     }
 
@@ -79,7 +82,7 @@ impl Commands {
         if let Frame::Reject { reason, .. } = frame {
             let words: Vec<String> = p.words.split_whitespace().map(str::to_owned).collect();
             if let Some(more) = particulars(None, id, &words, *reason, Duration::ZERO) {
-                text.push_str(&format!(" ({more})"));
+                text.push_str(&format!(" ({})", on_port(&more, &self.port)));
             }
         }
         Some(text)

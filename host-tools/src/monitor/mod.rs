@@ -185,7 +185,7 @@ pub fn run(args: &Args) -> Result<()> {
     let mut tap = LineTap::default();
     let mut other_version_said = false;
     let mut view = View::new();
-    let mut commands = Commands::new();
+    let mut commands = Commands::new(&args.port);
     let mut port = Some(first);
     let mut backlog = backlog::Backlog::default();
     backlog.opened();
