@@ -199,16 +199,15 @@ fn a_small_terminal_keeps_the_state_values_and_command_line() {
     );
 }
 
-/// Closing the terminal (SIGHUP: tmux killed, an ssh session dropped) ends the monitor: it
-/// must not stay behind holding the port.
-#[test]
-fn closing_the_terminal_ends_the_monitor() {
-    let sim = Sim::start(&[]);
-    let tmux = Tmux::start("tui-hangup", &format!("{BOWL} monitor {}", sim.path));
+/// Starts `bowl monitor ARGS` in a terminal, closes the terminal once the dashboard shows
+/// (SIGHUP: tmux killed, an ssh session dropped), and waits for the monitor to end: it must
+/// not stay behind holding the port.
+fn close_the_terminal_under(name: &str, args: &str) {
+    let tmux = Tmux::start(name, &format!("{BOWL} monitor {args}"));
     tmux.wait_for(&["LINK OK"], "the dashboard");
     // The monitor itself, not the shell tmux may start it through.
     let out = std::process::Command::new("pgrep")
-        .args(["-f", &format!("^{BOWL} monitor {}$", sim.path)])
+        .args(["-f", &format!("^{BOWL} monitor {args}$")])
         .output()
         .unwrap();
     let monitor: u32 = String::from_utf8_lossy(&out.stdout)
@@ -226,6 +225,32 @@ fn closing_the_terminal_ends_the_monitor() {
         }
         std::thread::sleep(std::time::Duration::from_millis(100));
     }
+}
+
+#[test]
+fn closing_the_terminal_ends_the_monitor() {
+    let sim = Sim::start(&[]);
+    close_the_terminal_under("tui-hangup", &sim.path);
+}
+
+/// The terminal closed under a logging monitor: its log is closed as on Ctrl-C, the last row
+/// `monitor end` (before, the process died where it stood and the log just stopped).
+#[test]
+fn closing_the_terminal_closes_the_log() {
+    let sim = Sim::start(&[]);
+    let dir = common::temp_dir("tui-hangup-log");
+    let log = dir.join("run.csv");
+    close_the_terminal_under(
+        "tui-hangup-log",
+        &format!("{} --log {}", sim.path, log.display()),
+    );
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert!(text.lines().count() > 3, "telemetry was logged:\n{text}");
+    assert!(
+        text.trim_end().ends_with(",monitor end"),
+        "last row: {:?}",
+        text.lines().last()
+    );
 }
 
 /// The colour parameters of the SGR sequences in `screen` (tmux `capture-pane -e`).

@@ -6,6 +6,8 @@
 
 use std::collections::VecDeque;
 use std::io::Stdout;
+use std::mem::ManuallyDrop;
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
@@ -65,7 +67,9 @@ impl History {
 
 /// The terminal in raw mode on the alternate screen, and what the UI alone keeps.
 pub struct Tui {
-    terminal: Terminal<CrosstermBackend<Stdout>>,
+    /// Never dropped: ratatui's drop, finding the cursor hidden, shows it and on failure (the
+    /// terminal closed) prints to standard error, which then panics. [`Tui`]'s drop shows it.
+    terminal: ManuallyDrop<Terminal<CrosstermBackend<Stdout>>>,
     history: History,
     paused: bool,
     /// Whether the command line is open.
@@ -77,6 +81,19 @@ pub struct Tui {
     no_color: bool,
     /// The locale has no UTF-8: the screen is drawn in ASCII ([`super::glyphs`]).
     ascii: bool,
+    /// The terminal's events, read on a thread of their own ([`read_events`]).
+    events: mpsc::Receiver<Event>,
+}
+
+/// Reads the terminal's events into `tx` until the UI is gone. On its own thread because a
+/// terminal that closes (SIGHUP) makes crossterm's reader spin on the end of input without
+/// returning: the monitor's loop must stay free to see the hangup and close its log.
+fn read_events(tx: mpsc::Sender<Event>) {
+    while let Ok(ev) = event::read() {
+        if tx.send(ev).is_err() {
+            break;
+        }
+    }
 }
 
 impl Tui {
@@ -84,8 +101,10 @@ impl Tui {
         enable_raw_mode()?;
         crossterm::execute!(std::io::stdout(), EnterAlternateScreen)?;
         let terminal = Terminal::new(CrosstermBackend::new(std::io::stdout()))?;
+        let (tx, events) = mpsc::channel();
+        std::thread::spawn(move || read_events(tx));
         Ok(Tui {
-            terminal,
+            terminal: ManuallyDrop::new(terminal),
             history: History {
                 axes: [VecDeque::new(), VecDeque::new()],
             },
@@ -94,6 +113,7 @@ impl Tui {
             line: LineEdit::default(),
             no_color: std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty()),
             ascii: !super::glyphs::utf8_locale(),
+            events,
         })
     }
 
@@ -105,8 +125,8 @@ impl Tui {
 
     /// Handles the keys pressed since the last call (resizes are picked up by the next draw).
     pub fn keys(&mut self) -> Result<Action> {
-        while event::poll(Duration::ZERO)? {
-            if let Event::Key(key) = event::read()?
+        while let Ok(ev) = self.events.try_recv() {
+            if let Event::Key(key) = ev
                 && key.kind != KeyEventKind::Release
             {
                 let action = self.key(key);

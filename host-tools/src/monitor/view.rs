@@ -5,6 +5,7 @@
 #![cfg_attr(not(unix), allow(dead_code, unused_imports))]
 
 use std::collections::VecDeque;
+use std::io::Write;
 use std::time::{Duration, Instant};
 
 use model_core::wire::{Decoder, Frame, Hello, Residence, Telemetry};
@@ -189,7 +190,9 @@ impl View {
 
     pub(crate) fn event(&mut self, plain: bool, text: String) {
         if plain {
-            println!("{text}");
+            // Not a panic when the terminal is gone (SIGHUP): the monitor's next status line
+            // fails instead, and ends it with its log closed.
+            let _ = writeln!(std::io::stdout(), "{text}");
         }
         if self.events.len() == 5 {
             self.events.pop_front();
