@@ -56,3 +56,16 @@ pub fn flag_with_hangup() -> &'static AtomicBool {
 pub fn hung_up() -> bool {
     HUNG_UP.load(Ordering::SeqCst)
 }
+
+/// A reader that goes away (`bowl monitor PORT --log day.csv | head`) ends this process through
+/// its own way out, as Ctrl-C does, instead of SIGPIPE's default killing it where it stands
+/// (`main` sets that for the commands that have nothing to close): a write to the closed pipe
+/// fails with an error, which the command meets once it has closed its files.
+pub fn closed_pipe_as_error() {
+    #[cfg(unix)]
+    {
+        use nix::sys::signal::{SigHandler, Signal, signal};
+        // SAFETY: SIG_IGN installs no handler of ours.
+        let _ = unsafe { signal(Signal::SIGPIPE, SigHandler::SigIgn) };
+    }
+}

@@ -172,6 +172,7 @@ pub fn run(args: &Args) -> Result<()> {
     // (the terminal closed) in both: the loop ends, so the terminal is given back and the log
     // gets `monitor end`.
     let interrupted = crate::interrupt::flag_with_hangup();
+    crate::interrupt::closed_pipe_as_error();
     // Served only while the port is held: a lost port's name may soon be another device's.
     // Asked first, so a second monitor is told that one runs (not only that the port is busy).
     let mut relay = Some(Relay::serve(&args.port)?);
@@ -478,6 +479,6 @@ pub fn run(args: &Args) -> Result<()> {
     let mut summary = stats_json(decoder.stats());
     summary["reconnects"] = json!(view.reconnects);
     summary["logged_rows"] = json!(view.logged_rows);
-    println!("{summary}");
+    writeln!(std::io::stdout(), "{summary}")?;
     Ok(())
 }
