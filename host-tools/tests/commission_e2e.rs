@@ -3,7 +3,10 @@
 
 mod common;
 
-use common::{Sim, bowl, last_json};
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+
+use common::{BOWL, Sim, bowl, last_json};
 
 /// Commissioning over the wire identifies the simulated motors (against the simulator's true
 /// models, which `bowl sim commission` reports, with that test's tolerances), and the gains it
@@ -119,4 +122,60 @@ fn refusal_and_fault_both_exit_1_told_apart_by_their_result() {
             .contains("precession motor: no sensor pulses"),
         "{got}"
     );
+}
+
+/// A STOP from another console (`bowl send PORT stop` through the monitor, or typed into it)
+/// ends commissioning at once and the rig goes back to idle with the models it had: that is not
+/// "commissioning done" with those old models reported as identified (exit 0, as it was), but
+/// `stopped`, exit 1, no axes, and in words what happened.
+#[test]
+fn a_stop_from_another_console_is_not_commissioning_done() {
+    let sim = Sim::start(&["--seconds", "60"]);
+    // The monitor holds the port, so `send` and `commission` both go through it.
+    let mut monitor = Command::new(BOWL)
+        .args(["monitor", &sim.path, "--plain", "--seconds", "50"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(monitor.stdout.take().unwrap()).lines();
+    assert!(
+        lines.any(|l| l.unwrap().contains("frames ok")),
+        "the monitor runs"
+    );
+    for json in [true, false] {
+        let mut args = vec!["commission", sim.path.as_str()];
+        if json {
+            args.push("--json");
+        }
+        let mut commission = Command::new(BOWL)
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(1500));
+        let stop = bowl(&["send", &sim.path, "stop"]);
+        assert!(stop.status.success(), "{stop:?}");
+        let out = commission.wait_with_output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{out:?}");
+        if json {
+            let got = last_json(&out);
+            assert_eq!(got["result"], "stopped", "{got}");
+            assert_eq!(got["axes"], serde_json::json!([]), "{got}");
+        } else {
+            let text = common::stdout(&out);
+            assert!(
+                text.contains("commissioning did NOT finish")
+                    && text.contains("with the very motor models it had before")
+                    && text.contains(&format!("`bowl send {} stop`", sim.path)),
+                "{text}"
+            );
+            assert!(!text.contains("identified  Ke"), "{text}");
+        }
+    }
+    // SIGTERM: the monitor ends its own way, its socket removed.
+    let pid = nix::unistd::Pid::from_raw(monitor.id() as i32);
+    nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM).unwrap();
+    monitor.wait().unwrap();
 }

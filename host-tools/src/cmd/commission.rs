@@ -6,7 +6,8 @@
 //!
 //! Exit status (`exit_code`): 0 done, 1 the rig refused COMMISSION (the reason and its
 //! particulars are printed), commissioning ended in a fault (the rig's fault code is printed;
-//! the motors are off) or the rig reset meanwhile, 3 the link failed, 4 no answer or
+//! the motors are off), the rig reset meanwhile or it went idle with the very models it had
+//! before (a STOP from another console: nothing was identified), 3 the link failed, 4 no answer or
 //! commissioning did not end within `--timeout-s`, 130 Ctrl-C or SIGTERM (STOP sent first).
 
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -64,8 +65,9 @@ struct AxisReport {
 /// The whole outcome, as `--json` prints it.
 #[derive(Serialize)]
 struct Report {
-    /// `ok`, `rejected`, `timeout`, `fault`, `interrupted` (Ctrl-C or SIGTERM: STOP sent) or
-    /// `restarted` (the rig reset meanwhile).
+    /// `ok`, `rejected`, `timeout`, `fault`, `interrupted` (Ctrl-C or SIGTERM: STOP sent),
+    /// `restarted` (the rig reset meanwhile) or `stopped` (idle again with the models from
+    /// before: a STOP from another console ended it before it identified anything).
     result: &'static str,
     /// Seconds from the rig's acknowledgement to the end of commissioning.
     seconds: f64,
@@ -232,6 +234,13 @@ fn print(report: &Report, json: bool, port: &str) -> Result<()> {
              reset_cause), then run `bowl commission` again",
             report.seconds
         ),
+        "stopped" => format!(
+            "commissioning did NOT finish: the rig went back to idle after {:.1} s with the very \
+             motor models it had before, so nothing was identified (a STOP from another console, \
+             the monitor's command line or `bowl send PORT stop`, ends commissioning at once); \
+             run `bowl commission` again",
+            report.seconds
+        ),
         other => format!("commissioning: {other} after {:.1} s", report.seconds),
     };
     println!("{}", rig_client::refusal::on_port(&head, port));
@@ -271,6 +280,14 @@ pub fn run(args: &Args) -> Result<i32> {
     // leave the identification running unattended.
     let interrupted = crate::interrupt::flag();
     let mut rig = Rig::open(&args.port, args.baud, ANSWER_TIMEOUT)?;
+    // The models before: a rig that goes back to idle with these very numbers identified
+    // nothing (a STOP from another console, through the monitor, ends commissioning at once,
+    // and its idle looks like the end of a run). Real identifications never repeat each of
+    // their numbers to the last digit: they are measured.
+    let before = match answered(rig.models())? {
+        Some(Reply::Done(axes)) => Some(axes),
+        _ => None,
+    };
     let mut report = Report {
         result: "ok",
         seconds: 0.0,
@@ -311,7 +328,7 @@ pub fn run(args: &Args) -> Result<i32> {
         interrupted,
     )?;
     report.seconds = started.elapsed().as_secs_f64();
-    let code = match end {
+    let mut code = match end {
         End::Idle => exit_code::OK,
         End::Fault(fault) => {
             report.result = "fault";
@@ -352,6 +369,10 @@ pub fn run(args: &Args) -> Result<i32> {
             }
         }
         match answered(rig.models())? {
+            Some(Reply::Done(axes)) if Some(axes) == before => {
+                report.result = "stopped";
+                code = exit_code::REFUSED;
+            }
             Some(Reply::Done(axes)) => {
                 report.axes = vec![
                     axis_report(
