@@ -7,6 +7,7 @@
 //! into the monitor itself (the UI's command line, or stdin lines in plain mode).
 
 mod backlog;
+mod charts;
 mod commands;
 mod fit;
 mod glyphs;
