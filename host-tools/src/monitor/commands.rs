@@ -39,11 +39,19 @@ impl Commands {
         }
     }
 
-    /// Takes a typed line; returns the bytes to send, or the reason it was refused here.
-    pub fn submit(&mut self, text: &str) -> Result<Vec<u8>, String> {
+    /// Takes a typed line; returns the bytes to send, or the reason it was refused here. With
+    /// the port lost (`link` false) nothing is taken: a command kept to send once the port is
+    /// back would reach whatever rig is then on it, seconds after it was said not sent.
+    pub fn submit(&mut self, text: &str, link: bool) -> Result<Vec<u8>, String> {
         let words: Vec<String> = text.split_whitespace().map(str::to_owned).collect();
         if words.is_empty() {
             return Err("type a command, e.g. `status`, `speed 1800 2100`, `start`".into());
+        }
+        if !link {
+            return Err(format!(
+                "`{}` not sent: the link is lost; type it again once the port is reopened",
+                text.trim()
+            ));
         }
         let id = self.next_id;
         self.next_id = next_id(self.next_id);
@@ -101,6 +109,23 @@ impl Commands {
         }
     }
 
+    /// The port went away: the commands waiting for an answer are given up (sent again on the
+    /// reopened port they could reach another rig, or this one after a reset); the texts to
+    /// show, one each.
+    pub fn link_lost(&mut self) -> Vec<String> {
+        self.pending
+            .drain(..)
+            .map(|p| {
+                format!(
+                    "{} -> no answer before the link was lost (id {}): it may or may not have \
+                     reached the rig; its state shows once the port is reopened",
+                    p.words,
+                    p.request.id()
+                )
+            })
+            .collect()
+    }
+
     /// Lines to send again (same id) and texts for commands that got no answer at all.
     pub fn due(&mut self) -> (Vec<Vec<u8>>, Vec<String>) {
         let mut resend = Vec::new();
@@ -123,5 +148,32 @@ impl Commands {
             true
         });
         (resend, gave_up)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A command typed while the port is lost is refused at once and never sent later; one
+    /// waiting for its answer when the port goes is given up, not sent again on the new port.
+    #[test]
+    fn nothing_waits_through_a_lost_link() {
+        let mut commands = Commands::new("/dev/ttyUSB0");
+        let refused = commands.submit("start", false).unwrap_err();
+        assert!(
+            refused.contains("`start` not sent: the link is lost"),
+            "{refused}"
+        );
+        assert!(commands.submit("stop", true).is_ok());
+        let lost = commands.link_lost();
+        assert_eq!(lost.len(), 1, "{lost:?}");
+        assert!(
+            lost[0].starts_with("stop -> no answer before the link was lost"),
+            "{lost:?}"
+        );
+        std::thread::sleep(Duration::from_millis(1100));
+        let (resend, gave_up) = commands.due();
+        assert!(resend.is_empty() && gave_up.is_empty(), "{gave_up:?}");
     }
 }

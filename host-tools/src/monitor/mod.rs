@@ -355,6 +355,9 @@ pub fn run(args: &Args) -> Result<()> {
                     view.set_connected(false);
                     decoder.finish();
                     view.event(plain, format!("port {} lost; reopening", args.port));
+                    for text in commands.link_lost() {
+                        view.event(plain, text);
+                    }
                     link_event(&mut log, decoder.stats().restarts, "link lost")?;
                 }
             }
@@ -403,7 +406,7 @@ pub fn run(args: &Args) -> Result<()> {
                 }
             }
             for text in typed_now {
-                match commands.submit(&text) {
+                match commands.submit(&text, port.is_some()) {
                     Ok(line) => outgoing.push(line),
                     Err(why) => view.event(plain, why),
                 }
