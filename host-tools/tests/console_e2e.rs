@@ -311,9 +311,19 @@ fn commands_typed_into_the_plain_monitor_are_answered() {
     writeln!(stdin, "speed 1500 1500").unwrap();
     writeln!(stdin, "status").unwrap();
     writeln!(stdin, "speed 1500").unwrap();
-    // Inside its own range but outside the rim (RIM_UM 100000): refused with a suggestion,
-    // which names the port the monitor holds, to be pasted as it stands.
+    // Refusals whose particulars need the rig's parameters or state: asked of it, as `bowl
+    // send` does (before, the monitor gave the reason alone: RANGE, with no word of the limit).
+    // Inside its own range but outside the rim (RIM_UM):
     writeln!(stdin, "set START_UM 200000").unwrap();
+    writeln!(stdin, "speed 5000 5000").unwrap();
+    writeln!(stdin, "clear").unwrap();
+    // (The particulars tell the state when asked, just after the refusal: answered before the
+    // motors start.)
+    std::thread::sleep(Duration::from_millis(500));
+    // Refused while the motors turn, with a suggestion that names the port the monitor holds,
+    // to be pasted as it stands.
+    writeln!(stdin, "start").unwrap();
+    writeln!(stdin, "commission").unwrap();
     let out = child.wait_with_output().unwrap();
     let text = stdout(&out);
     assert!(out.status.success(), "{text}");
@@ -321,11 +331,28 @@ fn commands_typed_into_the_plain_monitor_are_answered() {
     assert!(text.contains("status -> status (id"), "{text}");
     assert!(text.contains("`speed 1500` not sent: MALFORMED"), "{text}");
     assert!(
-        text.contains("set START_UM 200000 -> rejected (id"),
+        text.contains("set START_UM 200000 -> rejected (id")
+            && text.contains("the granule's start radius START_UM = 200000 um must lie inside"),
         "{text}"
     );
     assert!(
-        text.contains(&format!("`bowl send {} params`", sim.path)),
+        text.contains("commission -> rejected (id")
+            && text.contains(&format!(
+                "stop the motors first (`bowl send {} stop`)",
+                sim.path
+            )),
+        "{text}"
+    );
+    assert!(
+        text.contains("speed 5000 5000 -> rejected (id")
+            && text.contains(
+                "(the precession speed 5.000 rad/s is above SPEED_MAX1_MRAD_S = 4.000 rad/s"
+            ),
+        "{text}"
+    );
+    assert!(
+        text.contains("clear -> rejected (id")
+            && text.contains("(the rig is idle: there is no fault to clear"),
         "{text}"
     );
 }
