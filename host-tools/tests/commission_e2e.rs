@@ -148,7 +148,7 @@ fn a_stop_from_another_console_is_not_commissioning_done() {
         if json {
             args.push("--json");
         }
-        let mut commission = Command::new(BOWL)
+        let commission = Command::new(BOWL)
             .args(&args)
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
