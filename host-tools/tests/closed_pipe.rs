@@ -71,13 +71,7 @@ fn monitor_into_a_closed_pipe() {
     let log = dir.join("run.csv");
     let log_arg = log.to_str().unwrap();
     ends_quietly_when_the_reader_goes(&["monitor", &sim.path, "--plain", "--log", log_arg], 2);
-    let text = std::fs::read_to_string(&log).unwrap();
-    assert!(text.lines().count() > 3, "telemetry was logged:\n{text}");
-    assert!(
-        text.trim_end().ends_with(",monitor end"),
-        "last row: {:?}",
-        text.lines().last()
-    );
+    common::assert_log_closed(&log);
 }
 
 #[test]

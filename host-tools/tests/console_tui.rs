@@ -244,13 +244,7 @@ fn closing_the_terminal_closes_the_log() {
         "tui-hangup-log",
         &format!("{} --log {}", sim.path, log.display()),
     );
-    let text = std::fs::read_to_string(&log).unwrap();
-    assert!(text.lines().count() > 3, "telemetry was logged:\n{text}");
-    assert!(
-        text.trim_end().ends_with(",monitor end"),
-        "last row: {:?}",
-        text.lines().last()
-    );
+    common::assert_log_closed(&log);
 }
 
 /// The colour parameters of the SGR sequences in `screen` (tmux `capture-pane -e`).
@@ -268,16 +262,23 @@ fn colour_codes(screen: &str) -> Vec<String> {
         .collect()
 }
 
+/// A virtual rig and the monitor's dashboard on it in a terminal, the monitor run with the
+/// environment `env` (`NAME=VALUE`), once it shows the rig idle.
+fn dashboard_with(name: &str, env: &str) -> (Sim, Tmux) {
+    let sim = Sim::start(&[]);
+    let tmux = Tmux::start(
+        name,
+        &format!("env {env} {BOWL} monitor {} ; sleep 30", sim.path),
+    );
+    tmux.wait_for(&["LINK OK", "state idle"], "the dashboard");
+    (sim, tmux)
+}
+
 /// NO_COLOR (no-color.org): no colour on the screen, the banner's marks in reverse video; and
 /// TERM=dumb (an editor's shell buffer): the plain lines, not a screen of escape sequences.
 #[test]
 fn no_color_and_a_dumb_terminal_are_respected() {
-    let sim = Sim::start(&[]);
-    let tmux = Tmux::start(
-        "tui-nocolor",
-        &format!("env NO_COLOR=1 {BOWL} monitor {} ; sleep 30", sim.path),
-    );
-    tmux.wait_for(&["LINK OK", "state idle"], "the dashboard");
+    let (sim, tmux) = dashboard_with("tui-nocolor", "NO_COLOR=1");
     let out = tmux
         .cmd(&["capture-pane", "-e", "-p", "-t", "0"])
         .output()
@@ -303,12 +304,7 @@ fn no_color_and_a_dumb_terminal_are_respected() {
 /// frames, axes and both speed lines included, and still reads.
 #[test]
 fn a_terminal_without_utf8_gets_ascii() {
-    let sim = Sim::start(&[]);
-    let tmux = Tmux::start(
-        "tui-ascii",
-        &format!("env LC_ALL=C {BOWL} monitor {} ; sleep 30", sim.path),
-    );
-    tmux.wait_for(&["LINK OK", "state idle"], "the dashboard");
+    let (_sim, tmux) = dashboard_with("tui-ascii", "LC_ALL=C");
     tmux.keys(&[":", "speed 1500 1500", "Enter"]);
     tmux.wait_for(&["speed 1500 1500 -> ok (id"], "the answer to speed");
     tmux.keys(&[":", "start", "Enter"]);

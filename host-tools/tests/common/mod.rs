@@ -253,6 +253,18 @@ pub fn temp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("bowl-predict-{}-{name}", std::process::id()))
 }
 
+/// A monitor's `--log` closed its own way: telemetry rows, then `monitor end` last (not a log
+/// that just stops where the process died).
+pub fn assert_log_closed(log: &Path) {
+    let text = std::fs::read_to_string(log).unwrap();
+    assert!(text.lines().count() > 3, "telemetry was logged:\n{text}");
+    assert!(
+        text.trim_end().ends_with(",monitor end"),
+        "last row: {:?}",
+        text.lines().last()
+    );
+}
+
 /// An empty scratch directory named after the test and this process.
 pub fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("bowl-test-{name}-{}", std::process::id()));
