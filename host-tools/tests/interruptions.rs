@@ -144,6 +144,50 @@ fn serve_on_sigterm_removes_its_link() {
     );
 }
 
+/// `serve --pty --link L` run again with the same `L` (a second bench, a restart in another
+/// terminal) takes the link over; the first one, ended, leaves it to the rig it points at now
+/// (before, it removed the link from under the running rig, and a monitor on `L` lost it).
+#[test]
+fn a_link_taken_over_stays_with_its_new_rig() {
+    let dir = temp_dir("serve-link-taken");
+    let link = dir.join("rig");
+    let link_text = link.to_str().unwrap();
+    let first = Sim::start(&["--link", link_text]);
+    let second = Sim::start(&["--link", link_text]);
+    assert_eq!(
+        std::fs::read_link(&link).unwrap(),
+        std::path::Path::new(&second.path)
+    );
+    let mut first = first;
+    first.terminate();
+    assert_eq!(
+        std::fs::read_link(&link).ok().as_deref(),
+        Some(std::path::Path::new(&second.path)),
+        "the link of the rig still served"
+    );
+}
+
+/// `--link` onto a path that is not a link (a file of the user's) is refused, the file left
+/// as it was (before, it was deleted to make the link).
+#[test]
+fn a_link_onto_a_file_is_refused() {
+    let dir = temp_dir("serve-link-file");
+    let notes = dir.join("notes.txt");
+    std::fs::write(&notes, "bench notes\n").unwrap();
+    let out = bowl(&[
+        "serve",
+        "--pty",
+        "--seconds",
+        "1",
+        "--link",
+        notes.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("exists and is not a symlink"), "{err}");
+    assert_eq!(std::fs::read_to_string(&notes).unwrap(), "bench notes\n");
+}
+
 /// A rig that resets while it commissions (a watchdog, a brown-out: a Hello, then idle with its
 /// clock from zero) has not identified anything; `commission` says so and fails instead of
 /// reporting the idle state after the reset as "commissioning done". A scripted rig on a pty:

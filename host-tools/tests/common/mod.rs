@@ -140,6 +140,20 @@ impl Sim {
     }
 }
 
+impl Sim {
+    /// Ends the rig its own way (SIGTERM, as `kill` sends) and waits until it has.
+    pub fn terminate(&mut self) {
+        use nix::sys::signal::{Signal, kill};
+        let pid = nix::unistd::Pid::from_raw(self.child.id() as i32);
+        kill(pid, Signal::SIGTERM).expect("SIGTERM sent");
+        wait_within(
+            &mut self.child,
+            Duration::from_secs(5),
+            "bowl serve after SIGTERM",
+        );
+    }
+}
+
 impl Drop for Sim {
     fn drop(&mut self) {
         let _ = self.child.kill();
