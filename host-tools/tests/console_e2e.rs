@@ -324,6 +324,8 @@ fn commands_typed_into_the_plain_monitor_are_answered() {
     // to be pasted as it stands.
     writeln!(stdin, "start").unwrap();
     writeln!(stdin, "commission").unwrap();
+    // The granule's gate event: a line of its own, not called an answer.
+    writeln!(stdin, "release").unwrap();
     let out = child.wait_with_output().unwrap();
     let text = stdout(&out);
     assert!(out.status.success(), "{text}");
@@ -333,6 +335,11 @@ fn commands_typed_into_the_plain_monitor_are_answered() {
     assert!(
         text.contains("set START_UM 200000 -> rejected (id")
             && text.contains("the granule's start radius START_UM = 200000 um must lie inside"),
+        "{text}"
+    );
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("gate event: release gate at")),
         "{text}"
     );
     assert!(

@@ -176,7 +176,8 @@ impl View {
                     ),
                 );
             }
-            other => self.event(plain, format!("answer: {}", describe(other))),
+            // Gate events and the like: what the rig says of itself, no answer to anything.
+            other => self.event(plain, describe(other)),
         }
     }
 
