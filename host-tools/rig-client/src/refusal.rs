@@ -166,11 +166,12 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
             "{}; clear it first (`bowl send PORT clear`)",
             s.fault.words()
         ),
+        // Whatever else the rig is doing, CLEAR is refused for want of a fault.
+        _ if command == "clear" => "there is no fault to clear".to_string(),
         D::Commissioning => "wait for commissioning to end".to_string(),
         D::Running | D::ChangingSpeed if command == "commission" => {
             "stop the motors first (`bowl send PORT stop`)".to_string()
         }
-        D::Idle if command == "clear" => "there is no fault to clear".to_string(),
         _ => "see docs/protocol.md for what each state allows".to_string(),
     };
     // The states the command table allows it in.

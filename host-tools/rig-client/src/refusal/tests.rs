@@ -31,6 +31,35 @@ fn while_stopping_every_refused_command_is_told_to_wait_for_idle() {
     }
 }
 
+/// CLEAR refused in any state but faulted is told there is no fault (a running rig got "see
+/// docs/protocol.md for what each state allows").
+#[test]
+fn clear_without_a_fault_says_so_in_every_state() {
+    use model_core::wire::{DeviceState, FaultCode, ResetCause};
+    for state in [
+        DeviceState::Idle,
+        DeviceState::ChangingSpeed,
+        DeviceState::Running,
+        DeviceState::Stopping,
+        DeviceState::Commissioning,
+    ] {
+        let s = Status {
+            state,
+            fault: FaultCode::None,
+            reset_cause: ResetCause::PowerOn,
+            reset_count: 0,
+            uptime_ms: 0,
+            telemetry_hz: 10,
+            flags: 0,
+        };
+        let text = state_words(&s, "clear", &w("clear"));
+        assert!(
+            text.contains("there is no fault to clear"),
+            "{state:?}: {text}"
+        );
+    }
+}
+
 #[test]
 fn speed_above_the_limit_names_the_axis_and_limit() {
     let p = default_params();
