@@ -179,3 +179,31 @@ fn a_stop_from_another_console_is_not_commissioning_done() {
     nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM).unwrap();
     monitor.wait().unwrap();
 }
+
+/// The two timeouts told apart, each with what to do: a rig that never answers COMMISSION
+/// (before: "commissioning: timeout after 0.0 s") and commissioning that does not end within
+/// `--timeout-s` (before: "commissioning: timeout after 1.0 s", no word of the motors).
+#[test]
+fn each_timeout_says_which_and_what_to_do() {
+    let (_master, path) = common::open_pty();
+    let out = bowl(&["commission", &path, "--timeout-s", "1"]);
+    let text = common::stdout(&out);
+    assert_eq!(out.status.code(), Some(4), "{text}");
+    assert!(
+        text.contains("commissioning not started: no answer to COMMISSION ("),
+        "{text}"
+    );
+    let sim = Sim::start(&["--seconds", "30"]);
+    let out = bowl(&["commission", &sim.path, "--timeout-s", "1"]);
+    let text = common::stdout(&out);
+    assert_eq!(out.status.code(), Some(4), "{text}");
+    assert!(
+        text.contains("commissioning did NOT end within --timeout-s 1.0 s")
+            && text.contains("STOP sent, the motors are off")
+            && text.contains("give a longer --timeout-s"),
+        "{text}"
+    );
+    let (code, now) = common::send(&sim.path, "status");
+    assert_eq!(code, 0, "{now}");
+    assert!(now.contains("state=idle"), "{now}");
+}

@@ -79,6 +79,16 @@ struct Report {
     #[serde(skip_serializing_if = "Option::is_none")]
     why: Option<String>,
     axes: Vec<AxisReport>,
+    /// Whether the rig took COMMISSION (a `timeout` is then commissioning's, not its answer's).
+    #[serde(skip)]
+    started: bool,
+}
+
+/// Sends STOP; the report says when the rig did not acknowledge it.
+fn stop_motors(rig: &mut Rig, report: &mut Report) {
+    if !matches!(answered(rig.stop()), Ok(Some(Reply::Done(())))) {
+        report.why = Some("STOP not acknowledged".into());
+    }
 }
 
 /// Heartbeat period (well inside the rig's default link-loss timeout).
@@ -189,6 +199,15 @@ fn axis_report(
     }
 }
 
+/// Whether the STOP sent at the end was acknowledged, in words.
+fn stop_words(report: &Report) -> &'static str {
+    if report.why.is_some() {
+        ", but the rig did not acknowledge it: check that the motors are off"
+    } else {
+        ", the motors are off"
+    }
+}
+
 /// Prints the report; the suggestions in its words (`bowl send PORT clear`) name `port`, so
 /// they can be pasted as they stand.
 fn print(report: &Report, json: bool, port: &str) -> Result<()> {
@@ -221,11 +240,18 @@ fn print(report: &Report, json: bool, port: &str) -> Result<()> {
             "commissioning interrupted after {:.1} s: STOP sent{}; the motor models in force are \
              the ones from before (`bowl send PORT models`)",
             report.seconds,
-            if report.why.is_some() {
-                ", but the rig did not acknowledge it: check that the motors are off"
-            } else {
-                ", the motors are off"
-            }
+            stop_words(report)
+        ),
+        "timeout" if report.started => format!(
+            "commissioning did NOT end within --timeout-s {:.1} s (it takes about 45 s; the rig \
+             gives up itself after 120 s): STOP sent{}; the motor models in force are the ones \
+             from before (`bowl send PORT models`); give a longer --timeout-s",
+            report.seconds,
+            stop_words(report)
+        ),
+        "timeout" => format!(
+            "commissioning not started: {}",
+            report.why.as_deref().unwrap_or("no answer to COMMISSION")
         ),
         "restarted" => format!(
             "commissioning did NOT finish: the rig reset after {:.1} s (it sent a Hello, or its \
@@ -295,10 +321,25 @@ pub fn run(args: &Args) -> Result<i32> {
         reason: None,
         why: None,
         axes: Vec::new(),
+        started: false,
     };
-    match answered(rig.commission())? {
+    let ack = match rig.commission() {
+        Ok(reply) => Some(reply),
+        Err(e) => match e.downcast_ref::<NoAnswer>() {
+            // Said with what came instead and what to check, as `bowl send` says it.
+            Some(no) => {
+                report.why = Some(no.to_string());
+                None
+            }
+            None => return Err(e),
+        },
+    };
+    match ack {
         // What came before the acknowledgement tells of the rig before commissioning.
-        Some(Reply::Done(())) => rig.arrived.clear(),
+        Some(Reply::Done(())) => {
+            rig.arrived.clear();
+            report.started = true;
+        }
         Some(Reply::Refused(reason)) => {
             report.result = "rejected";
             report.reason = Some(reason.token());
@@ -344,14 +385,12 @@ pub fn run(args: &Args) -> Result<i32> {
         End::Timeout => {
             report.result = "timeout";
             // Leave the motors off rather than half-way through a duty step.
-            let _ = rig.stop();
+            stop_motors(&mut rig, &mut report);
             exit_code::TIMEOUT
         }
         End::Interrupted => {
             report.result = "interrupted";
-            if !matches!(answered(rig.stop()), Ok(Some(Reply::Done(())))) {
-                report.why = Some("STOP not acknowledged".into());
-            }
+            stop_motors(&mut rig, &mut report);
             exit_code::INTERRUPTED
         }
         End::Restarted => {
