@@ -69,6 +69,16 @@ fn open_log(path: &PathBuf) -> Result<BufWriter<File>> {
         .read(true)
         .open(path)
         .with_context(|| format!("cannot open the log {}", path.display()))?;
+    // Held while the monitor runs: a second monitor's rows (another rig's) would be mixed into
+    // this one's, a row cut in two where their buffers met. A file system without locks
+    // does without.
+    if let Err(std::fs::TryLockError::WouldBlock) = file.try_lock() {
+        return Err(crate::exit_code::usage(format!(
+            "--log {}: another `bowl monitor` is writing to this log, and the rows of two \
+             monitors would be mixed in it; give each monitor a log of its own",
+            path.display()
+        )));
+    }
     let len = file.metadata().map(|m| m.len()).unwrap_or(0);
     // The header line and the last byte are all that is read: a day's log is hundreds of MB.
     let mut head = Vec::new();
