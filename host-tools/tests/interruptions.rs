@@ -81,6 +81,45 @@ fn commission_interrupted_stops_the_motors_first() {
     assert!(now.contains("state=idle fault=none"), "{now}");
 }
 
+/// Ctrl-C on `commission` before the rig took COMMISSION (here a rig slow to answer the
+/// question asked first): nothing is started, not motors started and stopped at once.
+#[test]
+fn commission_interrupted_before_it_starts_sends_nothing() {
+    let (master, path) = common::open_pty();
+    let child = Command::new(BOWL)
+        .args(["commission", &path])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    signal(&child, Signal::SIGINT);
+    let out = child.wait_with_output().unwrap();
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(130), "{text}");
+    assert!(
+        text.contains("interrupted before it started: COMMISSION was not sent"),
+        "{text}"
+    );
+    nix::fcntl::fcntl(
+        &master,
+        nix::fcntl::FcntlArg::F_SETFL(nix::fcntl::OFlag::O_NONBLOCK),
+    )
+    .unwrap();
+    let mut sent = Vec::new();
+    let mut buf = [0u8; 4096];
+    let mut master = master;
+    while let Ok(n) = master.read(&mut buf) {
+        if n == 0 {
+            break;
+        }
+        sent.extend_from_slice(&buf[..n]);
+    }
+    let sent = String::from_utf8_lossy(&sent);
+    assert!(sent.contains("MODELS"), "what the rig got: {sent}");
+    assert!(!sent.contains("COMMISSION"), "what the rig got: {sent}");
+}
+
 /// SIGTERM on a logging monitor: the loop ends as on Ctrl-C, so the log's last row is
 /// `monitor end` and the counters are printed (before, the process died where it stood).
 #[test]

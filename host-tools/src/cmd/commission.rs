@@ -236,6 +236,9 @@ fn print(report: &Report, json: bool, port: &str) -> Result<()> {
             }
             text
         }
+        "interrupted" if !report.started => {
+            "commissioning interrupted before it started: COMMISSION was not sent".to_string()
+        }
         "interrupted" => format!(
             "commissioning interrupted after {:.1} s: STOP sent{}; the motor models in force are \
              the ones from before (`bowl send PORT models`)",
@@ -323,6 +326,12 @@ pub fn run(args: &Args) -> Result<i32> {
         axes: Vec::new(),
         started: false,
     };
+    // Ctrl-C while the models were asked: nothing is started.
+    if interrupted.load(Ordering::SeqCst) {
+        report.result = "interrupted";
+        print(&report, args.json, &args.port)?;
+        return Ok(exit_code::INTERRUPTED);
+    }
     let ack = match rig.commission() {
         Ok(reply) => Some(reply),
         Err(e) => match e.downcast_ref::<NoAnswer>() {
