@@ -46,7 +46,13 @@ pub fn flag_with_hangup() -> &'static AtomicBool {
         }
         // SAFETY: the handler only stores to atomics; nothing else in the process handles
         // SIGHUP.
-        let _ = unsafe { signal(Signal::SIGHUP, SigHandler::Handler(on_sighup)) };
+        let before = unsafe { signal(Signal::SIGHUP, SigHandler::Handler(on_sighup)) };
+        // Started to outlive its terminal (`nohup bowl monitor ... &`: SIGHUP ignored, and
+        // so inherited): it goes on logging.
+        if let Ok(SigHandler::SigIgn) = before {
+            // SAFETY: SIG_IGN installs no handler.
+            let _ = unsafe { signal(Signal::SIGHUP, SigHandler::SigIgn) };
+        }
     }
     raised
 }

@@ -157,6 +157,41 @@ fn monitor_on_sigterm_closes_its_log() {
     assert_eq!(rows, logged, "{summary}");
 }
 
+/// A monitor started to outlive its terminal (`nohup bowl monitor ... &`, SIGHUP ignored) goes
+/// on logging when the terminal closes: only a monitor whose terminal is its console ends then.
+#[test]
+fn a_monitor_under_nohup_outlives_its_terminal() {
+    let sim = Sim::start(&["--seconds", "30"]);
+    let dir = temp_dir("monitor-nohup");
+    let log = dir.join("night.csv");
+    let mut child = Command::new("nohup")
+        .args([
+            BOWL,
+            "monitor",
+            &sim.path,
+            "--plain",
+            "--seconds",
+            "3",
+            "--log",
+        ])
+        .arg(&log)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    read_until(&mut out, "frames ok");
+    signal(&child, Signal::SIGHUP);
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the monitor ended on SIGHUP under nohup"
+    );
+    let status = wait_within(&mut child, Duration::from_secs(10), "monitor under nohup");
+    assert!(status.success(), "{status:?}");
+    common::assert_log_closed(&log);
+}
+
 /// SIGTERM on `serve --pty --link L`: the link goes with the rig, as at the end of `--seconds`.
 #[test]
 fn serve_on_sigterm_removes_its_link() {
