@@ -120,6 +120,27 @@ fn commission_interrupted_before_it_starts_sends_nothing() {
     assert!(!sent.contains("COMMISSION"), "what the rig got: {sent}");
 }
 
+/// `bowl monitor PORT --plain --log LOG EXTRA...` run by `command` (`bowl`, or `nohup bowl`),
+/// once it has printed a status line (telemetry flows and is logged); its standard output.
+fn logging_monitor(
+    mut command: Command,
+    port: &str,
+    log: &std::path::Path,
+    extra: &[&str],
+) -> (Child, BufReader<std::process::ChildStdout>) {
+    let mut child = command
+        .args(["monitor", port, "--plain", "--log"])
+        .arg(log)
+        .args(extra)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    read_until(&mut out, "frames ok");
+    (child, out)
+}
+
 /// SIGTERM on a logging monitor: the loop ends as on Ctrl-C, so the log's last row is
 /// `monitor end` and the counters are printed (before, the process died where it stood).
 #[test]
@@ -127,16 +148,7 @@ fn monitor_on_sigterm_closes_its_log() {
     let sim = Sim::start(&["--seconds", "30"]);
     let dir = temp_dir("monitor-sigterm");
     let log = dir.join("run.csv");
-    let mut child = Command::new(BOWL)
-        .args(["monitor", &sim.path, "--plain", "--log"])
-        .arg(&log)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    // One status line: telemetry is flowing and being logged.
-    read_until(&mut out, "frames ok");
+    let (mut child, mut out) = logging_monitor(Command::new(BOWL), &sim.path, &log, &[]);
     signal(&child, Signal::SIGTERM);
     let status = wait_within(&mut child, Duration::from_secs(5), "monitor after SIGTERM");
     let mut rest = String::new();
@@ -164,23 +176,9 @@ fn a_monitor_under_nohup_outlives_its_terminal() {
     let sim = Sim::start(&["--seconds", "30"]);
     let dir = temp_dir("monitor-nohup");
     let log = dir.join("night.csv");
-    let mut child = Command::new("nohup")
-        .args([
-            BOWL,
-            "monitor",
-            &sim.path,
-            "--plain",
-            "--seconds",
-            "3",
-            "--log",
-        ])
-        .arg(&log)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    read_until(&mut out, "frames ok");
+    let mut nohup = Command::new("nohup");
+    nohup.arg(BOWL);
+    let (mut child, _out) = logging_monitor(nohup, &sim.path, &log, &["--seconds", "3"]);
     signal(&child, Signal::SIGHUP);
     std::thread::sleep(Duration::from_millis(500));
     assert!(
