@@ -331,3 +331,15 @@ fn a_terminal_without_utf8_gets_ascii() {
         "both speed lines:\n{screen}"
     );
 }
+
+/// Control chords in the command line: a newline (Ctrl-J, as a pasted line ends) sends the
+/// command as Enter does, and other chords are not typed as their letter (before, Ctrl-U and
+/// Ctrl-J made `statusuj`, and Ctrl-Q quit as `q` did).
+#[test]
+fn control_chords_are_not_typed_as_letters() {
+    let (_sim, tmux) = dashboard_with("tui-chords", "BOWL_TEST=chords");
+    tmux.keys(&["C-q", ":", "status", "C-u", "M-b"]);
+    tmux.wait_for(&["command> status_"], "the line as typed");
+    tmux.keys(&["C-j"]);
+    tmux.wait_for(&["status -> status (id"], "sent by the newline");
+}

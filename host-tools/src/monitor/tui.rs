@@ -112,8 +112,19 @@ impl Tui {
         if key.modifiers.contains(KeyModifiers::CONTROL) && key.code == KeyCode::Char('c') {
             return Action::Quit;
         }
+        let chord = key
+            .modifiers
+            .intersects(KeyModifiers::CONTROL | KeyModifiers::ALT);
+        let code = match key.code {
+            // A newline (the end of a pasted line; Enter on some terminals) is Enter.
+            KeyCode::Char('j') if key.modifiers.contains(KeyModifiers::CONTROL) => KeyCode::Enter,
+            // Other chords with a letter (Ctrl-U, Alt-B from habit) are no letter to type, nor
+            // a key of the screen's (Ctrl-Q is not `q`). Symbols stay: AltGr sends Ctrl-Alt.
+            KeyCode::Char(c) if chord && c.is_ascii_alphabetic() => return Action::None,
+            code => code,
+        };
         let line = &mut self.line;
-        match (self.typing, key.code) {
+        match (self.typing, code) {
             (true, KeyCode::Enter) => {
                 self.typing = false;
                 return Action::Send(line.take());
