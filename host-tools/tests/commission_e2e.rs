@@ -207,3 +207,29 @@ fn each_timeout_says_which_and_what_to_do() {
     assert_eq!(code, 0, "{now}");
     assert!(now.contains("state=idle"), "{now}");
 }
+
+/// The monitor that `commission` went through ends meanwhile (`q` typed in it): said as that,
+/// not as "the rig's port went away", which sent one to the cable.
+#[test]
+fn the_monitor_it_went_through_ending_is_said_so() {
+    let sim = Sim::start(&["--seconds", "30"]);
+    let mut monitor = Command::new(BOWL)
+        .args(["monitor", &sim.path, "--plain", "--seconds", "2"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(monitor.stdout.take().unwrap()).lines();
+    assert!(
+        lines.any(|l| l.unwrap().contains("frames ok")),
+        "the monitor runs"
+    );
+    let out = bowl(&["commission", &sim.path]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains("the `bowl monitor` this went through ended"),
+        "{err}"
+    );
+    monitor.wait().unwrap();
+}
