@@ -124,16 +124,18 @@ fn refusal_and_fault_both_exit_1_told_apart_by_their_result() {
     );
 }
 
-/// A STOP from another console (`bowl send PORT stop` through the monitor, or typed into it)
-/// ends commissioning at once and the rig goes back to idle with the models it had: that is not
-/// "commissioning done" with those old models reported as identified (exit 0, as it was), but
-/// `stopped`, exit 1, no axes, and in words what happened.
-#[test]
-fn a_stop_from_another_console_is_not_commissioning_done() {
-    let sim = Sim::start(&["--seconds", "60"]);
-    // The monitor holds the port, so `send` and `commission` both go through it.
+/// A `bowl monitor PORT --plain --seconds SECONDS`, once it has printed a status line (it holds
+/// the port: `send` and `commission` go through it), and its output, to be kept open: a monitor
+/// whose reader goes ends.
+fn plain_monitor(
+    port: &str,
+    seconds: &str,
+) -> (
+    std::process::Child,
+    std::io::Lines<BufReader<std::process::ChildStdout>>,
+) {
     let mut monitor = Command::new(BOWL)
-        .args(["monitor", &sim.path, "--plain", "--seconds", "50"])
+        .args(["monitor", port, "--plain", "--seconds", seconds])
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .spawn()
@@ -143,6 +145,18 @@ fn a_stop_from_another_console_is_not_commissioning_done() {
         lines.any(|l| l.unwrap().contains("frames ok")),
         "the monitor runs"
     );
+    (monitor, lines)
+}
+
+/// A STOP from another console (`bowl send PORT stop` through the monitor, or typed into it)
+/// ends commissioning at once and the rig goes back to idle with the models it had: that is not
+/// "commissioning done" with those old models reported as identified (exit 0, as it was), but
+/// `stopped`, exit 1, no axes, and in words what happened.
+#[test]
+fn a_stop_from_another_console_is_not_commissioning_done() {
+    let sim = Sim::start(&["--seconds", "60"]);
+    // The monitor holds the port, so `send` and `commission` both go through it.
+    let (mut monitor, _output) = plain_monitor(&sim.path, "50");
     for json in [true, false] {
         let mut args = vec!["commission", sim.path.as_str()];
         if json {
@@ -213,17 +227,7 @@ fn each_timeout_says_which_and_what_to_do() {
 #[test]
 fn the_monitor_it_went_through_ending_is_said_so() {
     let sim = Sim::start(&["--seconds", "30"]);
-    let mut monitor = Command::new(BOWL)
-        .args(["monitor", &sim.path, "--plain", "--seconds", "2"])
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut lines = BufReader::new(monitor.stdout.take().unwrap()).lines();
-    assert!(
-        lines.any(|l| l.unwrap().contains("frames ok")),
-        "the monitor runs"
-    );
+    let (mut monitor, _output) = plain_monitor(&sim.path, "2");
     let out = bowl(&["commission", &sim.path]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{err}");
