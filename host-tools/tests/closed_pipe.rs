@@ -62,10 +62,16 @@ fn sim_sweep_into_a_closed_pipe() {
     ends_quietly_when_the_reader_goes(&["sim", "sweep"], 1);
 }
 
+/// The monitor's log is closed as on Ctrl-C when its reader goes (`... --log day.csv | head`):
+/// before, SIGPIPE killed it and the log just stopped, without `monitor end`.
 #[test]
 fn monitor_into_a_closed_pipe() {
     let sim = Sim::start(&["--seconds", "30"]);
-    ends_quietly_when_the_reader_goes(&["monitor", &sim.path, "--plain"], 2);
+    let dir = common::temp_dir("closed-pipe-monitor");
+    let log = dir.join("run.csv");
+    let log_arg = log.to_str().unwrap();
+    ends_quietly_when_the_reader_goes(&["monitor", &sim.path, "--plain", "--log", log_arg], 2);
+    common::assert_log_closed(&log);
 }
 
 #[test]

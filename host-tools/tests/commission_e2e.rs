@@ -3,7 +3,10 @@
 
 mod common;
 
-use common::{Sim, bowl, last_json};
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+
+use common::{BOWL, Sim, bowl, last_json};
 
 /// Commissioning over the wire identifies the simulated motors (against the simulator's true
 /// models, which `bowl sim commission` reports, with that test's tolerances), and the gains it
@@ -119,4 +122,118 @@ fn refusal_and_fault_both_exit_1_told_apart_by_their_result() {
             .contains("precession motor: no sensor pulses"),
         "{got}"
     );
+}
+
+/// A `bowl monitor PORT --plain --seconds SECONDS`, once it has printed a status line (it holds
+/// the port: `send` and `commission` go through it), and its output, to be kept open: a monitor
+/// whose reader goes ends.
+fn plain_monitor(
+    port: &str,
+    seconds: &str,
+) -> (
+    std::process::Child,
+    std::io::Lines<BufReader<std::process::ChildStdout>>,
+) {
+    let mut monitor = Command::new(BOWL)
+        .args(["monitor", port, "--plain", "--seconds", seconds])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(monitor.stdout.take().unwrap()).lines();
+    assert!(
+        lines.any(|l| l.unwrap().contains("frames ok")),
+        "the monitor runs"
+    );
+    (monitor, lines)
+}
+
+/// A STOP from another console (`bowl send PORT stop` through the monitor, or typed into it)
+/// ends commissioning at once and the rig goes back to idle with the models it had: that is not
+/// "commissioning done" with those old models reported as identified (exit 0, as it was), but
+/// `stopped`, exit 1, no axes, and in words what happened.
+#[test]
+fn a_stop_from_another_console_is_not_commissioning_done() {
+    let sim = Sim::start(&["--seconds", "60"]);
+    // The monitor holds the port, so `send` and `commission` both go through it.
+    let (mut monitor, _output) = plain_monitor(&sim.path, "50");
+    for json in [true, false] {
+        let mut args = vec!["commission", sim.path.as_str()];
+        if json {
+            args.push("--json");
+        }
+        let commission = Command::new(BOWL)
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(1500));
+        let stop = bowl(&["send", &sim.path, "stop"]);
+        assert!(stop.status.success(), "{stop:?}");
+        let out = commission.wait_with_output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{out:?}");
+        if json {
+            let got = last_json(&out);
+            assert_eq!(got["result"], "stopped", "{got}");
+            assert_eq!(got["axes"], serde_json::json!([]), "{got}");
+        } else {
+            let text = common::stdout(&out);
+            assert!(
+                text.contains("commissioning did NOT finish")
+                    && text.contains("with the very motor models it had before")
+                    && text.contains(&format!("`bowl send {} stop`", sim.path)),
+                "{text}"
+            );
+            assert!(!text.contains("identified  Ke"), "{text}");
+        }
+    }
+    // SIGTERM: the monitor ends its own way, its socket removed.
+    let pid = nix::unistd::Pid::from_raw(monitor.id() as i32);
+    nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM).unwrap();
+    monitor.wait().unwrap();
+}
+
+/// The two timeouts told apart, each with what to do: a rig that never answers COMMISSION
+/// (before: "commissioning: timeout after 0.0 s") and commissioning that does not end within
+/// `--timeout-s` (before: "commissioning: timeout after 1.0 s", no word of the motors).
+#[test]
+fn each_timeout_says_which_and_what_to_do() {
+    let (_master, path) = common::open_pty();
+    let out = bowl(&["commission", &path, "--timeout-s", "1"]);
+    let text = common::stdout(&out);
+    assert_eq!(out.status.code(), Some(4), "{text}");
+    assert!(
+        text.contains("commissioning not started: no answer to COMMISSION ("),
+        "{text}"
+    );
+    let sim = Sim::start(&["--seconds", "30"]);
+    let out = bowl(&["commission", &sim.path, "--timeout-s", "1"]);
+    let text = common::stdout(&out);
+    assert_eq!(out.status.code(), Some(4), "{text}");
+    assert!(
+        text.contains("commissioning did NOT end within --timeout-s 1.0 s")
+            && text.contains("STOP sent, the motors are off")
+            && text.contains("give a longer --timeout-s"),
+        "{text}"
+    );
+    let (code, now) = common::send(&sim.path, "status");
+    assert_eq!(code, 0, "{now}");
+    assert!(now.contains("state=idle"), "{now}");
+}
+
+/// The monitor that `commission` went through ends meanwhile (`q` typed in it): said as that,
+/// not as "the rig's port went away", which sent one to the cable.
+#[test]
+fn the_monitor_it_went_through_ending_is_said_so() {
+    let sim = Sim::start(&["--seconds", "30"]);
+    let (mut monitor, _output) = plain_monitor(&sim.path, "2");
+    let out = bowl(&["commission", &sim.path]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains("the `bowl monitor` this went through ended"),
+        "{err}"
+    );
+    monitor.wait().unwrap();
 }

@@ -12,12 +12,17 @@ use std::time::Duration;
 
 use common::{BOWL, Sim, bowl, stdout, wait_within};
 
-/// A `bowl monitor --plain` on `port`; its stdout lines arrive on the receiver.
-fn start_monitor(port: &str, log: &std::path::Path) -> (Child, mpsc::Receiver<String>) {
+/// A `bowl monitor --plain` on `port`, its standard input `stdin`; its stdout lines arrive on
+/// the receiver.
+fn start_monitor(
+    port: &str,
+    log: &std::path::Path,
+    stdin: Stdio,
+) -> (Child, mpsc::Receiver<String>) {
     let mut child = Command::new(BOWL)
         .args(["monitor", port, "--plain", "--log"])
         .arg(log)
-        .stdin(Stdio::null())
+        .stdin(stdin)
         .stdout(Stdio::piped())
         .spawn()
         .expect("bowl monitor starts");
@@ -93,7 +98,7 @@ fn wait_until_idle(port: &str, round: u16) {
 fn forty_commands(port: &str, clean: bool) {
     let dir = common::temp_dir(&format!("console-{}", port.replace('/', "_")));
     let log = dir.join("log.csv");
-    let (mut monitor, lines) = start_monitor(port, &log);
+    let (mut monitor, lines) = start_monitor(port, &log, Stdio::null());
     for round in 0..4u16 {
         for (k, (words, code, starts, says)) in ROUND.iter().enumerate() {
             let id = 1000 + round * 10 + k as u16;
@@ -306,12 +311,57 @@ fn commands_typed_into_the_plain_monitor_are_answered() {
     writeln!(stdin, "speed 1500 1500").unwrap();
     writeln!(stdin, "status").unwrap();
     writeln!(stdin, "speed 1500").unwrap();
+    // Refusals whose particulars need the rig's parameters or state: asked of it, as `bowl
+    // send` does (before, the monitor gave the reason alone: RANGE, with no word of the limit).
+    // Inside its own range but outside the rim (RIM_UM):
+    writeln!(stdin, "set START_UM 200000").unwrap();
+    writeln!(stdin, "speed 5000 5000").unwrap();
+    writeln!(stdin, "clear").unwrap();
+    // (The particulars tell the state when asked, just after the refusal: answered before the
+    // motors start.)
+    std::thread::sleep(Duration::from_millis(500));
+    // Refused while the motors turn, with a suggestion that names the port the monitor holds,
+    // to be pasted as it stands.
+    writeln!(stdin, "start").unwrap();
+    writeln!(stdin, "commission").unwrap();
+    // The granule's gate event: a line of its own, not called an answer.
+    writeln!(stdin, "release").unwrap();
     let out = child.wait_with_output().unwrap();
     let text = stdout(&out);
     assert!(out.status.success(), "{text}");
     assert!(text.contains("speed 1500 1500 -> ok (id"), "{text}");
     assert!(text.contains("status -> status (id"), "{text}");
     assert!(text.contains("`speed 1500` not sent: MALFORMED"), "{text}");
+    assert!(
+        text.contains("set START_UM 200000 -> rejected (id")
+            && text.contains("the granule's start radius START_UM = 200000 um must lie inside"),
+        "{text}"
+    );
+    assert!(
+        text.lines()
+            .any(|l| l.starts_with("gate event: release gate at")),
+        "{text}"
+    );
+    assert!(
+        text.contains("commission -> rejected (id")
+            && text.contains(&format!(
+                "stop the motors first (`bowl send {} stop`)",
+                sim.path
+            )),
+        "{text}"
+    );
+    assert!(
+        text.contains("speed 5000 5000 -> rejected (id")
+            && text.contains(
+                "(the precession speed 5.000 rad/s is above SPEED_MAX1_MRAD_S = 4.000 rad/s"
+            ),
+        "{text}"
+    );
+    assert!(
+        text.contains("clear -> rejected (id")
+            && text.contains("(the rig is idle: there is no fault to clear"),
+        "{text}"
+    );
 }
 
 #[test]
@@ -329,7 +379,7 @@ fn ports_are_listed_or_their_absence_said() {
 fn a_second_monitor_is_told_the_port_is_held() {
     let sim = Sim::start(&[]);
     let dir = common::temp_dir("second-monitor");
-    let (mut first, _lines) = start_monitor(&sim.path, &dir.join("log.csv"));
+    let (mut first, _lines) = start_monitor(&sim.path, &dir.join("log.csv"), Stdio::null());
     let out = bowl(&["monitor", &sim.path, "--plain", "--seconds", "1"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{err}");
@@ -396,5 +446,61 @@ fn a_reader_that_does_not_lock_the_port_is_named() {
     assert!(
         err.contains("also open in") && err.contains(&me),
         "send names the other reader ({me}): {err}"
+    );
+}
+
+/// The line on `lines` that contains `text`, within 10 s.
+fn wait_line(lines: &mpsc::Receiver<String>, text: &str) -> String {
+    let end = std::time::Instant::now() + Duration::from_secs(10);
+    while let Some(left) = end.checked_duration_since(std::time::Instant::now()) {
+        match lines.recv_timeout(left) {
+            Ok(line) if line.contains(text) => return line,
+            Ok(_) => {}
+            Err(_) => break,
+        }
+    }
+    panic!("no line with {text:?} from the monitor within 10 s");
+}
+
+/// The port lost under the monitor: a command typed meanwhile is said not sent, and is not
+/// sent later either, when the port comes back with a rig on it (here another rig: a USB
+/// adapter moved to the next bench, a link re-pointed). Before, it was sent again every second
+/// and the other rig started its motors after "not sent: the link is lost".
+#[test]
+fn a_command_typed_while_the_link_is_lost_is_never_sent() {
+    use std::io::Write;
+    let dir = common::temp_dir("lost-link-command");
+    let link = dir.join("rig");
+    let link_text = link.to_str().unwrap();
+    let first = Sim::start(&["--link", link_text]);
+    let second = Sim::start(&[]);
+    let (mut monitor, lines) = start_monitor(link_text, &dir.join("log.csv"), Stdio::piped());
+    let mut stdin = monitor.stdin.take().unwrap();
+    wait_line(&lines, "frames ok");
+    drop(first);
+    wait_line(&lines, "lost; reopening");
+    writeln!(stdin, "start").unwrap();
+    let said = wait_line(&lines, "not sent");
+    std::fs::remove_file(&link).unwrap();
+    std::os::unix::fs::symlink(&second.path, &link).unwrap();
+    wait_line(&lines, "reopened");
+    // Past the monitor's resend period (1 s) on the reopened port.
+    std::thread::sleep(Duration::from_millis(2500));
+    let (code, status) = common::send(&second.path, "status");
+    assert_eq!(code, 0, "{status}");
+    assert!(status.contains("state=idle"), "{status}");
+    assert!(
+        said.contains("`start` not sent: the link is lost"),
+        "{said}"
+    );
+    let sent = Command::new("kill")
+        .args(["-TERM", &monitor.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    wait_within(
+        &mut monitor,
+        Duration::from_secs(5),
+        "monitor after SIGTERM",
     );
 }

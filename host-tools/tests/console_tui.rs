@@ -199,16 +199,15 @@ fn a_small_terminal_keeps_the_state_values_and_command_line() {
     );
 }
 
-/// Closing the terminal (SIGHUP: tmux killed, an ssh session dropped) ends the monitor: it
-/// must not stay behind holding the port.
-#[test]
-fn closing_the_terminal_ends_the_monitor() {
-    let sim = Sim::start(&[]);
-    let tmux = Tmux::start("tui-hangup", &format!("{BOWL} monitor {}", sim.path));
+/// Starts `bowl monitor ARGS` in a terminal, closes the terminal once the dashboard shows
+/// (SIGHUP: tmux killed, an ssh session dropped), and waits for the monitor to end: it must
+/// not stay behind holding the port.
+fn close_the_terminal_under(name: &str, args: &str) {
+    let tmux = Tmux::start(name, &format!("{BOWL} monitor {args}"));
     tmux.wait_for(&["LINK OK"], "the dashboard");
     // The monitor itself, not the shell tmux may start it through.
     let out = std::process::Command::new("pgrep")
-        .args(["-f", &format!("^{BOWL} monitor {}$", sim.path)])
+        .args(["-f", &format!("^{BOWL} monitor {args}$")])
         .output()
         .unwrap();
     let monitor: u32 = String::from_utf8_lossy(&out.stdout)
@@ -228,6 +227,26 @@ fn closing_the_terminal_ends_the_monitor() {
     }
 }
 
+#[test]
+fn closing_the_terminal_ends_the_monitor() {
+    let sim = Sim::start(&[]);
+    close_the_terminal_under("tui-hangup", &sim.path);
+}
+
+/// The terminal closed under a logging monitor: its log is closed as on Ctrl-C, the last row
+/// `monitor end` (before, the process died where it stood and the log just stopped).
+#[test]
+fn closing_the_terminal_closes_the_log() {
+    let sim = Sim::start(&[]);
+    let dir = common::temp_dir("tui-hangup-log");
+    let log = dir.join("run.csv");
+    close_the_terminal_under(
+        "tui-hangup-log",
+        &format!("{} --log {}", sim.path, log.display()),
+    );
+    common::assert_log_closed(&log);
+}
+
 /// The colour parameters of the SGR sequences in `screen` (tmux `capture-pane -e`).
 fn colour_codes(screen: &str) -> Vec<String> {
     screen
@@ -243,16 +262,23 @@ fn colour_codes(screen: &str) -> Vec<String> {
         .collect()
 }
 
+/// A virtual rig and the monitor's dashboard on it in a terminal, the monitor run with the
+/// environment `env` (`NAME=VALUE`), once it shows the rig idle.
+fn dashboard_with(name: &str, env: &str) -> (Sim, Tmux) {
+    let sim = Sim::start(&[]);
+    let tmux = Tmux::start(
+        name,
+        &format!("env {env} {BOWL} monitor {} ; sleep 30", sim.path),
+    );
+    tmux.wait_for(&["LINK OK", "state idle"], "the dashboard");
+    (sim, tmux)
+}
+
 /// NO_COLOR (no-color.org): no colour on the screen, the banner's marks in reverse video; and
 /// TERM=dumb (an editor's shell buffer): the plain lines, not a screen of escape sequences.
 #[test]
 fn no_color_and_a_dumb_terminal_are_respected() {
-    let sim = Sim::start(&[]);
-    let tmux = Tmux::start(
-        "tui-nocolor",
-        &format!("env NO_COLOR=1 {BOWL} monitor {} ; sleep 30", sim.path),
-    );
-    tmux.wait_for(&["LINK OK", "state idle"], "the dashboard");
+    let (sim, tmux) = dashboard_with("tui-nocolor", "NO_COLOR=1");
     let out = tmux
         .cmd(&["capture-pane", "-e", "-p", "-t", "0"])
         .output()
@@ -271,4 +297,49 @@ fn no_color_and_a_dumb_terminal_are_respected() {
     );
     let screen = tmux.wait_for(&["state=idle", "corrupt 0"], "the plain lines");
     assert!(!screen.contains("LINK OK"), "no screen UI:\n{screen}");
+}
+
+/// A terminal whose locale has no UTF-8 (`LC_ALL=C`, as on a serial console or a bare ssh
+/// session) shows braille and box-drawing as garbage: the dashboard is drawn in ASCII there,
+/// frames, axes and both speed lines included, and still reads.
+#[test]
+fn a_terminal_without_utf8_gets_ascii() {
+    let (_sim, tmux) = dashboard_with("tui-ascii", "LC_ALL=C");
+    tmux.keys(&[":", "speed 1500 1500", "Enter"]);
+    tmux.wait_for(&["speed 1500 1500 -> ok (id"], "the answer to speed");
+    tmux.keys(&[":", "start", "Enter"]);
+    let screen = tmux.wait_for(
+        &[
+            "state running",
+            "precession w1 rad/s: set (.), measured (*)",
+            "+-",
+            "s|",
+        ],
+        "the dashboard in ASCII",
+    );
+    let odd: Vec<char> = screen.chars().filter(|c| !c.is_ascii()).collect();
+    assert!(odd.is_empty(), "not ASCII: {odd:?} on\n{screen}");
+    // Both lines are drawn: the set speed's dots and the measured speed's stars, in the left
+    // chart's plot (`|1.65|  ....****  ||`: right of its speed axis).
+    let plot: String = screen
+        .lines()
+        .filter(|l| l.starts_with('|'))
+        .filter_map(|l| l.split('|').nth(2))
+        .collect();
+    assert!(
+        plot.contains('.') && plot.contains('*'),
+        "both speed lines:\n{screen}"
+    );
+}
+
+/// Control chords in the command line: a newline (Ctrl-J, as a pasted line ends) sends the
+/// command as Enter does, and other chords are not typed as their letter (before, Ctrl-U and
+/// Ctrl-J made `statusuj`, and Ctrl-Q quit as `q` did).
+#[test]
+fn control_chords_are_not_typed_as_letters() {
+    let (_sim, tmux) = dashboard_with("tui-chords", "BOWL_TEST=chords");
+    tmux.keys(&["C-q", ":", "status", "C-u", "M-b"]);
+    tmux.wait_for(&["command> status_"], "the line as typed");
+    tmux.keys(&["C-j"]);
+    tmux.wait_for(&["status -> status (id"], "sent by the newline");
 }

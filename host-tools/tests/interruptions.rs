@@ -70,10 +70,75 @@ fn commission_interrupted_stops_the_motors_first() {
         text.contains("commissioning interrupted") && text.contains("the motors are off"),
         "{text}"
     );
+    // Its suggestion names the port, to be pasted as it stands.
+    assert!(
+        text.contains(&format!("(`bowl send {} models`)", sim.path)),
+        "{text}"
+    );
     // Asked right away: well inside the rig's 3 s link timeout, so idle is STOP's doing.
     let (code, now) = send(&sim.path, "status");
     assert_eq!(code, 0, "{now}");
     assert!(now.contains("state=idle fault=none"), "{now}");
+}
+
+/// Ctrl-C on `commission` before the rig took COMMISSION (here a rig slow to answer the
+/// question asked first): nothing is started, not motors started and stopped at once.
+#[test]
+fn commission_interrupted_before_it_starts_sends_nothing() {
+    let (master, path) = common::open_pty();
+    let child = Command::new(BOWL)
+        .args(["commission", &path])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    signal(&child, Signal::SIGINT);
+    let out = child.wait_with_output().unwrap();
+    let text = stdout(&out);
+    assert_eq!(out.status.code(), Some(130), "{text}");
+    assert!(
+        text.contains("interrupted before it started: COMMISSION was not sent"),
+        "{text}"
+    );
+    nix::fcntl::fcntl(
+        &master,
+        nix::fcntl::FcntlArg::F_SETFL(nix::fcntl::OFlag::O_NONBLOCK),
+    )
+    .unwrap();
+    let mut sent = Vec::new();
+    let mut buf = [0u8; 4096];
+    let mut master = master;
+    while let Ok(n) = master.read(&mut buf) {
+        if n == 0 {
+            break;
+        }
+        sent.extend_from_slice(&buf[..n]);
+    }
+    let sent = String::from_utf8_lossy(&sent);
+    assert!(sent.contains("MODELS"), "what the rig got: {sent}");
+    assert!(!sent.contains("COMMISSION"), "what the rig got: {sent}");
+}
+
+/// `bowl monitor PORT --plain --log LOG EXTRA...` run by `command` (`bowl`, or `nohup bowl`),
+/// once it has printed a status line (telemetry flows and is logged); its standard output.
+fn logging_monitor(
+    mut command: Command,
+    port: &str,
+    log: &std::path::Path,
+    extra: &[&str],
+) -> (Child, BufReader<std::process::ChildStdout>) {
+    let mut child = command
+        .args(["monitor", port, "--plain", "--log"])
+        .arg(log)
+        .args(extra)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    read_until(&mut out, "frames ok");
+    (child, out)
 }
 
 /// SIGTERM on a logging monitor: the loop ends as on Ctrl-C, so the log's last row is
@@ -83,16 +148,7 @@ fn monitor_on_sigterm_closes_its_log() {
     let sim = Sim::start(&["--seconds", "30"]);
     let dir = temp_dir("monitor-sigterm");
     let log = dir.join("run.csv");
-    let mut child = Command::new(BOWL)
-        .args(["monitor", &sim.path, "--plain", "--log"])
-        .arg(&log)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    // One status line: telemetry is flowing and being logged.
-    read_until(&mut out, "frames ok");
+    let (mut child, mut out) = logging_monitor(Command::new(BOWL), &sim.path, &log, &[]);
     signal(&child, Signal::SIGTERM);
     let status = wait_within(&mut child, Duration::from_secs(5), "monitor after SIGTERM");
     let mut rest = String::new();
@@ -111,6 +167,27 @@ fn monitor_on_sigterm_closes_its_log() {
     // Every telemetry row counted was written (the buffer was flushed, not lost).
     let rows = text.lines().filter(|l| l.ends_with(',')).count() as u64;
     assert_eq!(rows, logged, "{summary}");
+}
+
+/// A monitor started to outlive its terminal (`nohup bowl monitor ... &`, SIGHUP ignored) goes
+/// on logging when the terminal closes: only a monitor whose terminal is its console ends then.
+#[test]
+fn a_monitor_under_nohup_outlives_its_terminal() {
+    let sim = Sim::start(&["--seconds", "30"]);
+    let dir = temp_dir("monitor-nohup");
+    let log = dir.join("night.csv");
+    let mut nohup = Command::new("nohup");
+    nohup.arg(BOWL);
+    let (mut child, _out) = logging_monitor(nohup, &sim.path, &log, &["--seconds", "3"]);
+    signal(&child, Signal::SIGHUP);
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the monitor ended on SIGHUP under nohup"
+    );
+    let status = wait_within(&mut child, Duration::from_secs(10), "monitor under nohup");
+    assert!(status.success(), "{status:?}");
+    common::assert_log_closed(&log);
 }
 
 /// SIGTERM on `serve --pty --link L`: the link goes with the rig, as at the end of `--seconds`.
@@ -137,6 +214,50 @@ fn serve_on_sigterm_removes_its_link() {
         link.display(),
         path.trim()
     );
+}
+
+/// `serve --pty --link L` run again with the same `L` (a second bench, a restart in another
+/// terminal) takes the link over; the first one, ended, leaves it to the rig it points at now
+/// (before, it removed the link from under the running rig, and a monitor on `L` lost it).
+#[test]
+fn a_link_taken_over_stays_with_its_new_rig() {
+    let dir = temp_dir("serve-link-taken");
+    let link = dir.join("rig");
+    let link_text = link.to_str().unwrap();
+    let first = Sim::start(&["--link", link_text]);
+    let second = Sim::start(&["--link", link_text]);
+    assert_eq!(
+        std::fs::read_link(&link).unwrap(),
+        std::path::Path::new(&second.path)
+    );
+    let mut first = first;
+    first.terminate();
+    assert_eq!(
+        std::fs::read_link(&link).ok().as_deref(),
+        Some(std::path::Path::new(&second.path)),
+        "the link of the rig still served"
+    );
+}
+
+/// `--link` onto a path that is not a link (a file of the user's) is refused, the file left
+/// as it was (before, it was deleted to make the link).
+#[test]
+fn a_link_onto_a_file_is_refused() {
+    let dir = temp_dir("serve-link-file");
+    let notes = dir.join("notes.txt");
+    std::fs::write(&notes, "bench notes\n").unwrap();
+    let out = bowl(&[
+        "serve",
+        "--pty",
+        "--seconds",
+        "1",
+        "--link",
+        notes.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("exists and is not a symlink"), "{err}");
+    assert_eq!(std::fs::read_to_string(&notes).unwrap(), "bench notes\n");
 }
 
 /// A rig that resets while it commissions (a watchdog, a brown-out: a Hello, then idle with its

@@ -58,3 +58,46 @@ fn a_log_is_appended_to_and_another_csv_is_left_alone() {
         "{text}"
     );
 }
+
+/// Two monitors given the same log (two benches, one command line copied): the second is
+/// refused (2) before it writes, and the log holds the first one's rows alone (before, both
+/// wrote, their rows mixed and cut where their buffers met).
+#[test]
+fn one_log_takes_one_monitor() {
+    let first = Sim::start(&["--seconds", "30"]);
+    let second = Sim::start(&["--seconds", "30"]);
+    let dir = temp_dir("monitor-log-shared");
+    let log = dir.join("bench.csv");
+    let mut writing = std::process::Command::new(common::BOWL)
+        .args(["monitor", &first.path, "--plain", "--seconds", "3", "--log"])
+        .arg(&log)
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // The first monitor has its log open once its first row is there.
+    let started = std::time::Instant::now();
+    while !std::fs::read_to_string(&log).is_ok_and(|t| t.contains("port open")) {
+        assert!(
+            started.elapsed().as_secs() < 5,
+            "no first row in {}",
+            log.display()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let out = monitor_logged(&second.path, "1", &log);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("another `bowl monitor` is writing to this log"),
+        "{err}"
+    );
+    assert!(writing.wait().unwrap().success());
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert_eq!(text.matches(",port open").count(), 1, "{text}");
+    assert!(
+        text.lines()
+            .skip(1)
+            .all(|l| fields(l) == fields(text.lines().next().unwrap())),
+        "{text}"
+    );
+}

@@ -89,6 +89,20 @@ impl Link {
         }
     }
 
+    /// The link ended (a read saw [`ReadOutcome::Gone`]), in words that say which end went:
+    /// through a monitor, it is the monitor that ended, not the rig's cable.
+    pub fn gone(&self) -> LinkError {
+        LinkError(match self {
+            Link::Port(_) => "the rig's port went away (unplugged? `bowl ports` lists the \
+                              ports there are)"
+                .into(),
+            Link::Monitor(_) => "the `bowl monitor` this went through ended (it held the \
+                                 port, and this link with it); run this again once it runs, \
+                                 or without it"
+                .into(),
+        })
+    }
+
     /// Writes a whole command line.
     pub fn write_all(&mut self, bytes: &[u8]) -> Result<(), LinkError> {
         match self {

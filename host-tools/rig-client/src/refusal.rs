@@ -28,6 +28,39 @@ pub fn on_port(text: &str, port: &str) -> String {
     text.replace("bowl send PORT", &format!("bowl send {port}"))
 }
 
+/// What the particulars of a refusal need to know of the rig, beyond the command itself.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Question {
+    /// Its parameters (limits, the residence-time table).
+    Params,
+    /// Its state and fault.
+    Status,
+}
+
+impl Question {
+    /// The command that asks it.
+    pub fn word(self) -> &'static str {
+        match self {
+            Question::Params => "params",
+            Question::Status => "status",
+        }
+    }
+}
+
+/// What the rig must be asked for the particulars of a refusal of `words` (the command as
+/// typed) for `reason`; `None` when they need nothing from it, or there are none.
+pub fn question(words: &[String], reason: Reason) -> Option<Question> {
+    let word = words.first()?.to_ascii_lowercase();
+    match (reason, word.as_str()) {
+        (Reason::State | Reason::Unsupported, "release") => None,
+        (Reason::State, _) => Some(Question::Status),
+        (Reason::Range, "set" | "speed") | (Reason::Range | Reason::Infeasible, "rtime") => {
+            Some(Question::Params)
+        }
+        _ => None,
+    }
+}
+
 /// The particulars of a refusal of `words` (the command as typed), asking the rig what it
 /// needs through `link`; `None` when there is nothing to add to the reason's own words.
 pub fn particulars(
@@ -37,12 +70,28 @@ pub fn particulars(
     reason: Reason,
     timeout: Duration,
 ) -> Option<String> {
+    let answer = match (question(words, reason), link) {
+        (Some(q), Some(link)) => ask(link, id, q.word(), timeout),
+        _ => None,
+    };
+    particulars_given(words, reason, answer.as_ref())
+}
+
+/// The particulars of a refusal of `words` for `reason`, given the rig's `answer` to its
+/// [`question`] (a PARAMS or STATUS frame; `None`: not asked, or not answered): for a console
+/// that asks in its own time, as the monitor does.
+pub fn particulars_given(
+    words: &[String],
+    reason: Reason,
+    answer: Option<&Frame>,
+) -> Option<String> {
     let word = words.first()?.to_ascii_lowercase();
+    let params = match answer {
+        Some(Frame::Params { values, .. }) => Some(values),
+        _ => None,
+    };
     match (reason, word.as_str()) {
-        (Reason::Range, "set") => {
-            let params = link.and_then(|l| ask_params(l, id, timeout));
-            set_range(words, params.as_ref())
-        }
+        (Reason::Range, "set") => set_range(words, params),
         (Reason::State, "release") => Some(
             "the last release is not over: a simulated rig still has its granule in the bowl \
              (wait for its exit gate event), the Black Pill's solenoid is still energised \
@@ -54,26 +103,19 @@ pub fn particulars(
              times it once wired)"
                 .into(),
         ),
-        (Reason::State, _) => {
-            let status = ask_status(link?, id, timeout)?;
-            Some(state_words(&status, &word, words))
-        }
-        (Reason::Range, "speed") => {
-            let params = ask_params(link?, id, timeout)?;
-            speed_limits(words, &params)
-        }
+        (Reason::State, _) => match answer? {
+            Frame::Status { status, .. } => Some(state_words(status, &word, words)),
+            _ => None,
+        },
+        (Reason::Range, "speed") => speed_limits(words, params?),
         (Reason::Infeasible, "rtime")
             if words
                 .get(1)
                 .is_some_and(|m| m.eq_ignore_ascii_case("table")) =>
         {
-            let params = ask_params(link?, id, timeout)?;
-            Some(table_refusal(words, &params))
+            Some(table_refusal(words, params?))
         }
-        (Reason::Range | Reason::Infeasible, "rtime") => {
-            let params = ask_params(link?, id, timeout)?;
-            residence_range(words, &params)
-        }
+        (Reason::Range | Reason::Infeasible, "rtime") => residence_range(words, params?),
         _ => None,
     }
 }
@@ -124,11 +166,12 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
             "{}; clear it first (`bowl send PORT clear`)",
             s.fault.words()
         ),
+        // Whatever else the rig is doing, CLEAR is refused for want of a fault.
+        _ if command == "clear" => "there is no fault to clear".to_string(),
         D::Commissioning => "wait for commissioning to end".to_string(),
         D::Running | D::ChangingSpeed if command == "commission" => {
             "stop the motors first (`bowl send PORT stop`)".to_string()
         }
-        D::Idle if command == "clear" => "there is no fault to clear".to_string(),
         _ => "see docs/protocol.md for what each state allows".to_string(),
     };
     // The states the command table allows it in.
@@ -370,13 +413,6 @@ fn ask(link: &mut Link, id: u16, word: &str, timeout: Duration) -> Option<Frame>
     let query_id = id ^ 0x8000;
     let line = command_line(query_id, &[word.to_string()]).ok()?;
     transact(link, query_id, &line, timeout).ok()?.ok()
-}
-
-fn ask_status(link: &mut Link, id: u16, timeout: Duration) -> Option<Status> {
-    match ask(link, id, "status", timeout)? {
-        Frame::Status { status, .. } => Some(status),
-        _ => None,
-    }
 }
 
 pub(crate) fn ask_params(link: &mut Link, id: u16, timeout: Duration) -> Option<ParamValues> {

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use model_core::wire::{Command, Decoder, Frame, MAX_FRAME_LEN, Reason, decode_frame, encode};
 
 use crate::link::Link;
-use crate::serial::{LinkError, ReadOutcome};
+use crate::serial::ReadOutcome;
 use crate::unreadable::{LineTap, UnreadableAnswer};
 
 /// Whether `frame` is the kind of answer `command` gets, as the command table says (`S` to
@@ -281,11 +281,7 @@ pub fn request(
                 }
             }
             ReadOutcome::Timeout => {}
-            ReadOutcome::Gone => {
-                return Err(
-                    LinkError("the link went away while waiting for the answer".into()).into(),
-                );
-            }
+            ReadOutcome::Gone => return Err(link.gone().into()),
         }
     }
 }

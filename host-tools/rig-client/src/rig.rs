@@ -134,7 +134,7 @@ impl Rig {
                 Ok(())
             }
             ReadOutcome::Timeout => Ok(()),
-            ReadOutcome::Gone => Err(LinkError("the rig's port went away".into()).into()),
+            ReadOutcome::Gone => Err(self.link.gone().into()),
         }
     }
 

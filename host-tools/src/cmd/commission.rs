@@ -6,7 +6,8 @@
 //!
 //! Exit status (`exit_code`): 0 done, 1 the rig refused COMMISSION (the reason and its
 //! particulars are printed), commissioning ended in a fault (the rig's fault code is printed;
-//! the motors are off) or the rig reset meanwhile, 3 the link failed, 4 no answer or
+//! the motors are off), the rig reset meanwhile or it went idle with the very models it had
+//! before (a STOP from another console: nothing was identified), 3 the link failed, 4 no answer or
 //! commissioning did not end within `--timeout-s`, 130 Ctrl-C or SIGTERM (STOP sent first).
 
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -64,8 +65,9 @@ struct AxisReport {
 /// The whole outcome, as `--json` prints it.
 #[derive(Serialize)]
 struct Report {
-    /// `ok`, `rejected`, `timeout`, `fault`, `interrupted` (Ctrl-C or SIGTERM: STOP sent) or
-    /// `restarted` (the rig reset meanwhile).
+    /// `ok`, `rejected`, `timeout`, `fault`, `interrupted` (Ctrl-C or SIGTERM: STOP sent),
+    /// `restarted` (the rig reset meanwhile) or `stopped` (idle again with the models from
+    /// before: a STOP from another console ended it before it identified anything).
     result: &'static str,
     /// Seconds from the rig's acknowledgement to the end of commissioning.
     seconds: f64,
@@ -77,6 +79,16 @@ struct Report {
     #[serde(skip_serializing_if = "Option::is_none")]
     why: Option<String>,
     axes: Vec<AxisReport>,
+    /// Whether the rig took COMMISSION (a `timeout` is then commissioning's, not its answer's).
+    #[serde(skip)]
+    started: bool,
+}
+
+/// Sends STOP; the report says when the rig did not acknowledge it.
+fn stop_motors(rig: &mut Rig, report: &mut Report) {
+    if !matches!(answered(rig.stop()), Ok(Some(Reply::Done(())))) {
+        report.why = Some("STOP not acknowledged".into());
+    }
 }
 
 /// Heartbeat period (well inside the rig's default link-loss timeout).
@@ -187,20 +199,31 @@ fn axis_report(
     }
 }
 
-fn print(report: &Report, json: bool) -> Result<()> {
+/// Whether the STOP sent at the end was acknowledged, in words.
+fn stop_words(report: &Report) -> &'static str {
+    if report.why.is_some() {
+        ", but the rig did not acknowledge it: check that the motors are off"
+    } else {
+        ", the motors are off"
+    }
+}
+
+/// Prints the report; the suggestions in its words (`bowl send PORT clear`) name `port`, so
+/// they can be pasted as they stand.
+fn print(report: &Report, json: bool, port: &str) -> Result<()> {
     if json {
         println!("{}", serde_json::to_string(report)?);
         return Ok(());
     }
-    match report.result {
-        "ok" => println!("commissioning done in {:.1} s", report.seconds),
-        "fault" => println!(
+    let head = match report.result {
+        "ok" => format!("commissioning done in {:.1} s", report.seconds),
+        "fault" => format!(
             "commissioning FAILED after {:.1} s: fault {} (motors off; `bowl send PORT clear` clears it)",
             report.seconds,
             report.fault.as_deref().unwrap_or("?")
         ),
         "rejected" => {
-            println!(
+            let mut text = format!(
                 "COMMISSION rejected: {} - {}",
                 report.reason.unwrap_or("?"),
                 report
@@ -209,28 +232,47 @@ fn print(report: &Report, json: bool) -> Result<()> {
                     .map_or("", explain)
             );
             if let Some(why) = &report.why {
-                println!("  {why}");
+                text.push_str(&format!("\n  {why}"));
             }
+            text
         }
-        "interrupted" => println!(
+        "interrupted" if !report.started => {
+            "commissioning interrupted before it started: COMMISSION was not sent".to_string()
+        }
+        "interrupted" => format!(
             "commissioning interrupted after {:.1} s: STOP sent{}; the motor models in force are \
              the ones from before (`bowl send PORT models`)",
             report.seconds,
-            if report.why.is_some() {
-                ", but the rig did not acknowledge it: check that the motors are off"
-            } else {
-                ", the motors are off"
-            }
+            stop_words(report)
         ),
-        "restarted" => println!(
+        "timeout" if report.started => format!(
+            "commissioning did NOT end within --timeout-s {:.1} s (it takes about 45 s; the rig \
+             gives up itself after 120 s): STOP sent{}; the motor models in force are the ones \
+             from before (`bowl send PORT models`); give a longer --timeout-s",
+            report.seconds,
+            stop_words(report)
+        ),
+        "timeout" => format!(
+            "commissioning not started: {}",
+            report.why.as_deref().unwrap_or("no answer to COMMISSION")
+        ),
+        "restarted" => format!(
             "commissioning did NOT finish: the rig reset after {:.1} s (it sent a Hello, or its \
              clock started again), which ended the identification; the motor models in force \
              are the ones it booted with. Look at why it reset (`bowl send PORT status`: \
              reset_cause), then run `bowl commission` again",
             report.seconds
         ),
-        other => println!("commissioning: {other} after {:.1} s", report.seconds),
-    }
+        "stopped" => format!(
+            "commissioning did NOT finish: the rig went back to idle after {:.1} s with the very \
+             motor models it had before, so nothing was identified (a STOP from another console, \
+             the monitor's command line or `bowl send PORT stop`, ends commissioning at once); \
+             run `bowl commission` again",
+            report.seconds
+        ),
+        other => format!("commissioning: {other} after {:.1} s", report.seconds),
+    };
+    println!("{}", rig_client::refusal::on_port(&head, port));
     for a in &report.axes {
         println!(
             "{:10} {}  Ke {:.4} V/(rad/s)  friction {:.4} duty  tau {:.4} s  |  bandwidth {}  Kp {:.4} duty/(rad/s)  Ki {:.4} duty/rad",
@@ -267,6 +309,14 @@ pub fn run(args: &Args) -> Result<i32> {
     // leave the identification running unattended.
     let interrupted = crate::interrupt::flag();
     let mut rig = Rig::open(&args.port, args.baud, ANSWER_TIMEOUT)?;
+    // The models before: a rig that goes back to idle with these very numbers identified
+    // nothing (a STOP from another console, through the monitor, ends commissioning at once,
+    // and its idle looks like the end of a run). Real identifications never repeat each of
+    // their numbers to the last digit: they are measured.
+    let before = match answered(rig.models())? {
+        Some(Reply::Done(axes)) => Some(axes),
+        _ => None,
+    };
     let mut report = Report {
         result: "ok",
         seconds: 0.0,
@@ -274,22 +324,43 @@ pub fn run(args: &Args) -> Result<i32> {
         reason: None,
         why: None,
         axes: Vec::new(),
+        started: false,
     };
-    match answered(rig.commission())? {
+    // Ctrl-C while the models were asked: nothing is started.
+    if interrupted.load(Ordering::SeqCst) {
+        report.result = "interrupted";
+        print(&report, args.json, &args.port)?;
+        return Ok(exit_code::INTERRUPTED);
+    }
+    let ack = match rig.commission() {
+        Ok(reply) => Some(reply),
+        Err(e) => match e.downcast_ref::<NoAnswer>() {
+            // Said with what came instead and what to check, as `bowl send` says it.
+            Some(no) => {
+                report.why = Some(no.to_string());
+                None
+            }
+            None => return Err(e),
+        },
+    };
+    match ack {
         // What came before the acknowledgement tells of the rig before commissioning.
-        Some(Reply::Done(())) => rig.arrived.clear(),
+        Some(Reply::Done(())) => {
+            rig.arrived.clear();
+            report.started = true;
+        }
         Some(Reply::Refused(reason)) => {
             report.result = "rejected";
             report.reason = Some(reason.token());
             report.why = rig
                 .refusal_particulars(&["commission"], reason)
                 .map(|why| rig_client::refusal::on_port(&why, &args.port));
-            print(&report, args.json)?;
+            print(&report, args.json, &args.port)?;
             return Ok(exit_code::REFUSED);
         }
         None => {
             report.result = "timeout";
-            print(&report, args.json)?;
+            print(&report, args.json, &args.port)?;
             return Ok(exit_code::TIMEOUT);
         }
     }
@@ -307,7 +378,7 @@ pub fn run(args: &Args) -> Result<i32> {
         interrupted,
     )?;
     report.seconds = started.elapsed().as_secs_f64();
-    let code = match end {
+    let mut code = match end {
         End::Idle => exit_code::OK,
         End::Fault(fault) => {
             report.result = "fault";
@@ -323,14 +394,12 @@ pub fn run(args: &Args) -> Result<i32> {
         End::Timeout => {
             report.result = "timeout";
             // Leave the motors off rather than half-way through a duty step.
-            let _ = rig.stop();
+            stop_motors(&mut rig, &mut report);
             exit_code::TIMEOUT
         }
         End::Interrupted => {
             report.result = "interrupted";
-            if !matches!(answered(rig.stop()), Ok(Some(Reply::Done(())))) {
-                report.why = Some("STOP not acknowledged".into());
-            }
+            stop_motors(&mut rig, &mut report);
             exit_code::INTERRUPTED
         }
         End::Restarted => {
@@ -348,6 +417,10 @@ pub fn run(args: &Args) -> Result<i32> {
             }
         }
         match answered(rig.models())? {
+            Some(Reply::Done(axes)) if Some(axes) == before => {
+                report.result = "stopped";
+                code = exit_code::REFUSED;
+            }
             Some(Reply::Done(axes)) => {
                 report.axes = vec![
                     axis_report(
@@ -368,6 +441,6 @@ pub fn run(args: &Args) -> Result<i32> {
             None => eprintln!("no answer to MODELS"),
         }
     }
-    print(&report, args.json)?;
+    print(&report, args.json, &args.port)?;
     Ok(code)
 }

@@ -24,7 +24,8 @@ pub struct Args {
     /// Serve the virtual rig on a new pseudo-terminal; its path is printed on the first line.
     #[arg(long, conflicts_with = "capture")]
     pty: bool,
-    /// Also make this symlink point at the pseudo-terminal (replaced if it exists).
+    /// Also make this symlink point at the pseudo-terminal (a link already there is replaced;
+    /// removed at the end unless another `serve --link` took it over meanwhile).
     #[arg(long, requires = "pty")]
     link: Option<PathBuf>,
     /// Run faster than real time and write the rig's output bytes to this file.
@@ -157,10 +158,9 @@ pub fn run(args: &Args) -> Result<()> {
         // Installed before the path is printed: a script may signal as soon as it reads it.
         let interrupted = crate::interrupt::flag();
         let pty = Pty::open()?;
+        let pty_path = pty.path.clone();
         if let Some(link) = &args.link {
-            let _ = std::fs::remove_file(link);
-            std::os::unix::fs::symlink(&pty.path, link)
-                .with_context(|| format!("cannot link {} to {}", link.display(), pty.path))?;
+            make_link(link, &pty_path)?;
         }
         println!("{}", pty.path);
         std::io::stdout().flush()?;
@@ -177,11 +177,39 @@ pub fn run(args: &Args) -> Result<()> {
             noise,
         );
         if let Some(link) = &args.link {
-            let _ = std::fs::remove_file(link);
+            remove_link(link, &pty_path);
         }
         return served.map(|_| ());
     }
     Ok(())
+}
+
+/// Points `link` at `pty`. A link already there is replaced (a rig served before, gone or
+/// not); anything else is refused untouched: `--link notes.txt` must not delete a file.
+#[cfg(unix)]
+fn make_link(link: &std::path::Path, pty: &str) -> Result<()> {
+    if let Ok(meta) = std::fs::symlink_metadata(link) {
+        if !meta.file_type().is_symlink() {
+            return Err(crate::exit_code::usage(format!(
+                "--link {}: the path exists and is not a symlink, so it was left as it is; give \
+                 a new path for the link (e.g. /tmp/rig)",
+                link.display()
+            )));
+        }
+        std::fs::remove_file(link)
+            .with_context(|| format!("cannot replace the link {}", link.display()))?;
+    }
+    std::os::unix::fs::symlink(pty, link)
+        .with_context(|| format!("cannot link {} to {pty}", link.display()))
+}
+
+/// Removes `link` at the end if it still points at `pty`: another `serve --link` of the same
+/// path took it over meanwhile, and its rig is still there.
+#[cfg(unix)]
+fn remove_link(link: &std::path::Path, pty: &str) {
+    if std::fs::read_link(link).is_ok_and(|to| to == std::path::Path::new(pty)) {
+        let _ = std::fs::remove_file(link);
+    }
 }
 
 #[cfg(test)]

@@ -7,8 +7,10 @@
 //! into the monitor itself (the UI's command line, or stdin lines in plain mode).
 
 mod backlog;
+mod charts;
 mod commands;
 mod fit;
+mod glyphs;
 mod line_edit;
 mod tui;
 mod view;
@@ -67,6 +69,16 @@ fn open_log(path: &PathBuf) -> Result<BufWriter<File>> {
         .read(true)
         .open(path)
         .with_context(|| format!("cannot open the log {}", path.display()))?;
+    // Held while the monitor runs: a second monitor's rows (another rig's) would be mixed into
+    // this one's, a row cut in two where their buffers met. A file system without locks
+    // does without.
+    if let Err(std::fs::TryLockError::WouldBlock) = file.try_lock() {
+        return Err(crate::exit_code::usage(format!(
+            "--log {}: another `bowl monitor` is writing to this log, and the rows of two \
+             monitors would be mixed in it; give each monitor a log of its own",
+            path.display()
+        )));
+    }
     let len = file.metadata().map(|m| m.len()).unwrap_or(0);
     // The header line and the last byte are all that is read: a day's log is hundreds of MB.
     let mut head = Vec::new();
@@ -167,9 +179,11 @@ pub fn run(args: &Args) -> Result<()> {
     let dumb = std::env::var_os("TERM").is_some_and(|t| t == "dumb");
     let plain =
         args.plain || dumb || !std::io::stdout().is_terminal() || !std::io::stdin().is_terminal();
-    // In the UI, Ctrl-C arrives as a key; this catches it in plain mode, and SIGTERM in both:
-    // the loop ends, so the terminal is given back and the log gets `monitor end`.
-    let interrupted = crate::interrupt::flag();
+    // In the UI, Ctrl-C arrives as a key; this catches it in plain mode, and SIGTERM and SIGHUP
+    // (the terminal closed) in both: the loop ends, so the terminal is given back and the log
+    // gets `monitor end`.
+    let interrupted = crate::interrupt::flag_with_hangup();
+    crate::interrupt::closed_pipe_as_error();
     // Served only while the port is held: a lost port's name may soon be another device's.
     // Asked first, so a second monitor is told that one runs (not only that the port is busy).
     let mut relay = Some(Relay::serve(&args.port)?);
@@ -184,7 +198,7 @@ pub fn run(args: &Args) -> Result<()> {
     let mut tap = LineTap::default();
     let mut other_version_said = false;
     let mut view = View::new();
-    let mut commands = Commands::new();
+    let mut commands = Commands::new(&args.port);
     let mut port = Some(first);
     let mut backlog = backlog::Backlog::default();
     backlog.opened();
@@ -213,249 +227,272 @@ pub fn run(args: &Args) -> Result<()> {
     // The latest telemetry's (boot, device ms): where a gate event sits on the device clock.
     let mut latest: Option<(u64, u32)> = None;
 
-    while deadline.is_none_or(|d| Instant::now() < d) && !interrupted.load(Ordering::SeqCst) {
-        if port.is_none() && last_open_try.elapsed() >= REOPEN_EVERY {
-            last_open_try = Instant::now();
-            if let Ok(p) = Port::open(&args.port, args.baud) {
-                port = Some(p);
-                relay = match Relay::serve(&args.port) {
-                    Ok(r) => Some(r),
-                    Err(e) => {
-                        view.event(plain, format!("other tools cannot reach the rig: {e:#}"));
-                        None
-                    }
-                };
-                view.set_connected(true);
-                view.reconnects += 1;
-                view.event(plain, format!("port {} reopened", args.port));
-                backlog.opened();
-                status_due = Some(Instant::now());
-                link_event(&mut log, decoder.stats().restarts, "port reopened")?;
-            }
-        }
-        let outcome = match port.as_mut() {
-            Some(p) => p.read(&mut buf, Duration::from_millis(10))?,
-            None => {
-                std::thread::sleep(Duration::from_millis(10));
-                ReadOutcome::Timeout
-            }
-        };
-        match outcome {
-            ReadOutcome::Data(n) => {
-                if let Some(r) = relay.as_mut() {
-                    r.broadcast(&buf[..n]);
-                }
-                for &b in &buf[..n] {
-                    // Damaged frames are counted by the decoder (corrupt, oversize, truncated).
-                    let restarts = decoder.stats().restarts;
-                    tap.push(b);
-                    let frame = match decoder.push(b) {
-                        Some(Ok(frame)) => frame,
-                        Some(Err(e)) => {
-                            // Intact but unreadable here (another version, an unknown word):
-                            // shown as it came, never taken for silence.
-                            if let Some(u) = tap.unreadable_answer(e) {
-                                view.event(plain, commands.on_unreadable(&u));
-                            } else if e == FrameError::UnsupportedVersion && !other_version_said {
-                                // Telemetry in another protocol version: every frame would
-                                // count as malformed with no word why. Said once.
-                                other_version_said = true;
-                                view.event(
-                                    plain,
-                                    format!(
-                                        "the rig sends another protocol version than this \
-                                         bowl reads (1): `{}`; update whichever is older",
-                                        tap.text()
-                                    ),
-                                );
-                            }
-                            continue;
+    // The loop in a closure, so that every way out of it (an error too: a terminal that is
+    // gone fails the next draw) passes through the end below and the log gets `monitor end`.
+    let watched = (|| -> Result<()> {
+        while deadline.is_none_or(|d| Instant::now() < d) && !interrupted.load(Ordering::SeqCst) {
+            if port.is_none() && last_open_try.elapsed() >= REOPEN_EVERY {
+                last_open_try = Instant::now();
+                if let Ok(p) = Port::open(&args.port, args.baud) {
+                    port = Some(p);
+                    relay = match Relay::serve(&args.port) {
+                        Ok(r) => Some(r),
+                        Err(e) => {
+                            view.event(plain, format!("other tools cannot reach the rig: {e:#}"));
+                            None
                         }
-                        None => continue,
                     };
-                    if decoder.stats().restarts > restarts {
-                        // The held rows are of the boot before: the new clock cannot date them.
-                        if let Some(w) = log.as_mut() {
-                            view.logged_rows += backlog.release(w, None)?;
-                        }
-                        link_event(&mut log, decoder.stats().restarts, "device restart")?;
+                    view.set_connected(true);
+                    view.reconnects += 1;
+                    view.event(plain, format!("port {} reopened", args.port));
+                    backlog.opened();
+                    status_due = Some(Instant::now());
+                    link_event(&mut log, decoder.stats().restarts, "port reopened")?;
+                }
+            }
+            let outcome = match port.as_mut() {
+                Some(p) => p.read(&mut buf, Duration::from_millis(10))?,
+                None => {
+                    std::thread::sleep(Duration::from_millis(10));
+                    ReadOutcome::Timeout
+                }
+            };
+            match outcome {
+                ReadOutcome::Data(n) => {
+                    if let Some(r) = relay.as_mut() {
+                        r.broadcast(&buf[..n]);
                     }
-                    let boot = decoder.stats().restarts;
-                    if let (Frame::Event(e), Some(w)) = (&frame, log.as_mut()) {
-                        if backlog.pending() {
-                            backlog.hold_gate(boot, *e);
-                        } else {
-                            let near = latest.filter(|(b, _)| *b == boot).map(|(_, ms)| ms);
-                            telemetry_csv::write_gate_event(
-                                w,
-                                boot,
-                                Some(SystemTime::now()),
-                                e,
-                                near,
-                            )?;
+                    for &b in &buf[..n] {
+                        // Damaged frames are counted by the decoder (corrupt, oversize, truncated).
+                        let restarts = decoder.stats().restarts;
+                        tap.push(b);
+                        let frame = match decoder.push(b) {
+                            Some(Ok(frame)) => frame,
+                            Some(Err(e)) => {
+                                // Intact but unreadable here (another version, an unknown word):
+                                // shown as it came, never taken for silence.
+                                if let Some(u) = tap.unreadable_answer(e) {
+                                    view.event(plain, commands.on_unreadable(&u));
+                                } else if e == FrameError::UnsupportedVersion && !other_version_said
+                                {
+                                    // Telemetry in another protocol version: every frame would
+                                    // count as malformed with no word why. Said once.
+                                    other_version_said = true;
+                                    view.event(
+                                        plain,
+                                        format!(
+                                            "the rig sends another protocol version than this \
+                                             bowl reads (1): `{}`; update whichever is older",
+                                            tap.text()
+                                        ),
+                                    );
+                                }
+                                continue;
+                            }
+                            None => continue,
+                        };
+                        if decoder.stats().restarts > restarts {
+                            // The held rows are of the boot before: the new clock cannot date them.
+                            if let Some(w) = log.as_mut() {
+                                view.logged_rows += backlog.release(w, None)?;
+                            }
+                            link_event(&mut log, decoder.stats().restarts, "device restart")?;
                         }
-                    }
-                    if let Frame::Telemetry(t) = &frame {
-                        latest = Some((boot, t.time_ms));
-                        if let Some(w) = log.as_mut() {
-                            if backlog.holding() {
-                                backlog.hold_row(boot, *t);
+                        let boot = decoder.stats().restarts;
+                        if let (Frame::Event(e), Some(w)) = (&frame, log.as_mut()) {
+                            if backlog.pending() {
+                                backlog.hold_gate(boot, *e);
                             } else {
-                                let now = SystemTime::now();
-                                view.logged_rows += backlog.release(w, Some((boot, t, now)))?;
-                                telemetry_csv::write_row(w, boot, t, Some(now))?;
-                                view.logged_rows += 1;
+                                let near = latest.filter(|(b, _)| *b == boot).map(|(_, ms)| ms);
+                                telemetry_csv::write_gate_event(
+                                    w,
+                                    boot,
+                                    Some(SystemTime::now()),
+                                    e,
+                                    near,
+                                )?;
                             }
                         }
-                        if let Some(ui) = tui.as_mut() {
-                            ui.on_telemetry(t);
-                        }
-                    }
-                    match &frame {
-                        Frame::Hello(_) => status_due = Some(Instant::now()),
-                        Frame::Status { id, status } if *id == STATUS_ID => {
-                            status_due = None;
-                            if view.board_flags != Some(status.flags) {
-                                view.board_flags = Some(status.flags);
-                                if let Some(words) =
-                                    rig_client::lines::status_flag_words(status.flags)
-                                {
-                                    let text = format!("the rig reports: {words}");
-                                    view.event(plain, text.clone());
-                                    link_event(&mut log, decoder.stats().restarts, &text)?;
+                        if let Frame::Telemetry(t) = &frame {
+                            latest = Some((boot, t.time_ms));
+                            if let Some(w) = log.as_mut() {
+                                if backlog.holding() {
+                                    backlog.hold_row(boot, *t);
+                                } else {
+                                    let now = SystemTime::now();
+                                    view.logged_rows += backlog.release(w, Some((boot, t, now)))?;
+                                    telemetry_csv::write_row(w, boot, t, Some(now))?;
+                                    view.logged_rows += 1;
                                 }
                             }
-                            continue;
+                            if let Some(ui) = tui.as_mut() {
+                                ui.on_telemetry(t);
+                            }
                         }
-                        _ => {}
-                    }
-                    match commands.on_frame(&frame) {
-                        Some(text) => view.event(plain, text),
-                        // Answers to other tools' commands are theirs to report.
-                        None if frame.answer_id().is_some() => {}
-                        None => view.on_frame(plain, &frame),
+                        match &frame {
+                            Frame::Hello(_) => status_due = Some(Instant::now()),
+                            Frame::Status { id, status } if *id == STATUS_ID => {
+                                status_due = None;
+                                if view.board_flags != Some(status.flags) {
+                                    view.board_flags = Some(status.flags);
+                                    if let Some(words) =
+                                        rig_client::lines::status_flag_words(status.flags)
+                                    {
+                                        let text = format!("the rig reports: {words}");
+                                        view.event(plain, text.clone());
+                                        link_event(&mut log, decoder.stats().restarts, &text)?;
+                                    }
+                                }
+                                continue;
+                            }
+                            _ => {}
+                        }
+                        match commands.on_frame(&frame) {
+                            Some(text) => view.event(plain, text),
+                            // Answers to other tools' commands are theirs to report.
+                            None if frame.answer_id().is_some() => {}
+                            None => view.on_frame(plain, &frame),
+                        }
                     }
                 }
-            }
-            ReadOutcome::Timeout => backlog.quiet(),
-            ReadOutcome::Gone => {
-                if let Some(w) = log.as_mut() {
-                    view.logged_rows += backlog.release(w, None)?;
+                ReadOutcome::Timeout => backlog.quiet(),
+                ReadOutcome::Gone => {
+                    if let Some(w) = log.as_mut() {
+                        view.logged_rows += backlog.release(w, None)?;
+                    }
+                    port = None;
+                    relay = None;
+                    view.set_connected(false);
+                    decoder.finish();
+                    view.event(plain, format!("port {} lost; reopening", args.port));
+                    for text in commands.link_lost() {
+                        view.event(plain, text);
+                    }
+                    link_event(&mut log, decoder.stats().restarts, "link lost")?;
                 }
-                port = None;
-                relay = None;
-                view.set_connected(false);
-                decoder.finish();
-                view.event(plain, format!("port {} lost; reopening", args.port));
-                link_event(&mut log, decoder.stats().restarts, "link lost")?;
             }
-        }
-        // Telemetry overdue, and back: said on the screen and marked in the log (so a chart of
-        // the log breaks its lines across the gap).
-        match gap {
-            None => {
-                if let Some(quiet) = view.silence(Instant::now()) {
-                    gap = Some((Instant::now() - quiet, view.telemetry_frames));
-                    view.event(
-                        plain,
-                        format!(
-                            "no telemetry for {:.1} s: the port is open but the rig sends no \
-                             frames (TELEM_HZ 0? a reset? a loose cable?); the values shown are old",
-                            quiet.as_secs_f64()
-                        ),
+            // Telemetry overdue, and back: said on the screen and marked in the log (so a chart of
+            // the log breaks its lines across the gap).
+            match gap {
+                None => {
+                    if let Some(quiet) = view.silence(Instant::now()) {
+                        gap = Some((Instant::now() - quiet, view.telemetry_frames));
+                        view.event(
+                            plain,
+                            format!(
+                                "no telemetry for {:.1} s: the port is open but the rig sends no \
+                                 frames (TELEM_HZ 0? a reset? a loose cable?); the values shown are old",
+                                quiet.as_secs_f64()
+                            ),
+                        );
+                        link_event(&mut log, decoder.stats().restarts, "no telemetry")?;
+                    }
+                }
+                Some((from, frames)) if view.telemetry_frames > frames => {
+                    gap = None;
+                    let text = format!(
+                        "telemetry again after {:.1} s",
+                        from.elapsed().as_secs_f64()
                     );
-                    link_event(&mut log, decoder.stats().restarts, "no telemetry")?;
+                    view.event(plain, text.clone());
+                    link_event(&mut log, decoder.stats().restarts, &text)?;
+                }
+                Some(_) => {}
+            }
+            if port.is_some() && Instant::now() >= next_holder_check {
+                next_holder_check = Instant::now() + HOLDER_CHECK_EVERY;
+                if let Some(text) = holders.check(&args.port) {
+                    view.event(plain, text.clone());
+                    link_event(&mut log, decoder.stats().restarts, &text)?;
                 }
             }
-            Some((from, frames)) if view.telemetry_frames > frames => {
-                gap = None;
-                let text = format!(
-                    "telemetry again after {:.1} s",
-                    from.elapsed().as_secs_f64()
-                );
-                view.event(plain, text.clone());
-                link_event(&mut log, decoder.stats().restarts, &text)?;
-            }
-            Some(_) => {}
-        }
-        if port.is_some() && Instant::now() >= next_holder_check {
-            next_holder_check = Instant::now() + HOLDER_CHECK_EVERY;
-            if let Some(text) = holders.check(&args.port) {
-                view.event(plain, text.clone());
-                link_event(&mut log, decoder.stats().restarts, &text)?;
-            }
-        }
-        let mut outgoing = relay.as_mut().map(Relay::poll).unwrap_or_default();
-        let mut typed_now: Vec<String> = typed.iter().flat_map(|rx| rx.try_iter()).collect();
-        if let Some(ui) = tui.as_mut() {
-            match ui.keys()? {
-                Action::Quit => break,
-                Action::Send(text) => typed_now.push(text),
-                Action::None => {}
-            }
-        }
-        for text in typed_now {
-            match commands.submit(&text) {
-                Ok(line) => outgoing.push(line),
-                Err(why) => view.event(plain, why),
-            }
-        }
-        let (resend, gave_up) = commands.due();
-        outgoing.extend(resend);
-        // The rig's link-loss watchdog (LINK_TIMEOUT_MS) needs bytes from the PC: the monitor,
-        // the one program holding the port, keeps the link alive while it watches.
-        if port.is_some() && last_heartbeat.elapsed() >= HEARTBEAT_EVERY {
-            last_heartbeat = Instant::now();
-            if let Ok(line) = rig_client::lines::command_line(HEARTBEAT_ID, &["PING".to_string()]) {
-                outgoing.push(line);
-            }
-        }
-        if port.is_some() && status_due.is_some_and(|due| Instant::now() >= due) {
-            status_due = Some(Instant::now() + STATUS_AGAIN_EVERY);
-            if let Ok(line) = rig_client::lines::command_line(STATUS_ID, &["STATUS".to_string()]) {
-                outgoing.push(line);
-            }
-        }
-        for text in gave_up {
-            view.event(plain, text);
-        }
-        if let Some(p) = port.as_mut() {
-            for line in &outgoing {
-                if let Err(e) = p.write_all(line) {
-                    view.event(plain, format!("{e}"));
-                }
-            }
-        } else if !outgoing.is_empty() {
-            view.event(plain, "not sent: the link is lost".into());
-        }
-        let now = Instant::now();
-        if now >= next_redraw {
-            next_redraw = now + REDRAW;
-            if let Some(w) = log.as_mut() {
-                w.flush().context("writing the log")?;
-            }
+            let mut outgoing = relay.as_mut().map(Relay::poll).unwrap_or_default();
+            let mut typed_now: Vec<String> = typed.iter().flat_map(|rx| rx.try_iter()).collect();
             if let Some(ui) = tui.as_mut() {
-                let tools = relay.as_ref().map_or(0, Relay::client_count);
-                ui.draw(&args.port, &view, &decoder, tools)?;
+                match ui.keys()? {
+                    Action::Quit => break,
+                    Action::Send(text) => typed_now.push(text),
+                    Action::None => {}
+                }
+            }
+            for text in typed_now {
+                match commands.submit(&text, port.is_some()) {
+                    Ok(line) => outgoing.push(line),
+                    Err(why) => view.event(plain, why),
+                }
+            }
+            let (resend, gave_up) = commands.due();
+            outgoing.extend(resend);
+            // The rig's link-loss watchdog (LINK_TIMEOUT_MS) needs bytes from the PC: the monitor,
+            // the one program holding the port, keeps the link alive while it watches.
+            if port.is_some() && last_heartbeat.elapsed() >= HEARTBEAT_EVERY {
+                last_heartbeat = Instant::now();
+                if let Ok(line) =
+                    rig_client::lines::command_line(HEARTBEAT_ID, &["PING".to_string()])
+                {
+                    outgoing.push(line);
+                }
+            }
+            if port.is_some() && status_due.is_some_and(|due| Instant::now() >= due) {
+                status_due = Some(Instant::now() + STATUS_AGAIN_EVERY);
+                if let Ok(line) =
+                    rig_client::lines::command_line(STATUS_ID, &["STATUS".to_string()])
+                {
+                    outgoing.push(line);
+                }
+            }
+            for text in gave_up {
+                view.event(plain, text);
+            }
+            if let Some(p) = port.as_mut() {
+                for line in &outgoing {
+                    if let Err(e) = p.write_all(line) {
+                        view.event(plain, format!("{e}"));
+                    }
+                }
+            } else if !outgoing.is_empty() {
+                view.event(plain, "not sent: the link is lost".into());
+            }
+            let now = Instant::now();
+            if now >= next_redraw {
+                next_redraw = now + REDRAW;
+                if let Some(w) = log.as_mut() {
+                    w.flush().context("writing the log")?;
+                }
+                if let Some(ui) = tui.as_mut() {
+                    let tools = relay.as_ref().map_or(0, Relay::client_count);
+                    ui.draw(&args.port, &view, &decoder, tools)?;
+                }
+            }
+            if plain && now >= next_plain {
+                next_plain = now + Duration::from_secs(1);
+                // An error, not a panic, when the terminal is gone: the log is still closed.
+                writeln!(std::io::stdout(), "{}", view.plain_line(&decoder))?;
             }
         }
-        if plain && now >= next_plain {
-            next_plain = now + Duration::from_secs(1);
-            println!("{}", view.plain_line(&decoder));
-        }
-    }
+        Ok(())
+    })();
     // Leave the alternate screen first, so the summary stays on the terminal.
     drop(tui);
-    if let Some(w) = log.as_mut() {
-        view.logged_rows += backlog.release(w, None)?;
+    let ended = (|| -> Result<()> {
+        if let Some(w) = log.as_mut() {
+            view.logged_rows += backlog.release(w, None)?;
+        }
+        link_event(&mut log, decoder.stats().restarts, "monitor end")?;
+        if let Some(w) = log.as_mut() {
+            w.flush().context("writing the log")?;
+        }
+        Ok(())
+    })();
+    if crate::interrupt::hung_up() {
+        // The terminal closed: nobody reads the summary, and its errors were its going.
+        return ended;
     }
-    link_event(&mut log, decoder.stats().restarts, "monitor end")?;
-    if let Some(w) = log.as_mut() {
-        w.flush().context("writing the log")?;
-    }
+    // The loop's error first: it is why the monitor ended.
+    watched.and(ended)?;
     let mut summary = stats_json(decoder.stats());
     summary["reconnects"] = json!(view.reconnects);
     summary["logged_rows"] = json!(view.logged_rows);
-    println!("{summary}");
+    writeln!(std::io::stdout(), "{summary}")?;
     Ok(())
 }

@@ -6,6 +6,8 @@
 
 use std::collections::VecDeque;
 use std::io::Stdout;
+use std::mem::ManuallyDrop;
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use anyhow::Result;
@@ -16,20 +18,15 @@ use crossterm::terminal::{
 use model_core::wire::{Decoder, FaultCode, Telemetry};
 use ratatui::Terminal;
 use ratatui::backend::CrosstermBackend;
-use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::layout::{Constraint, Layout};
 use ratatui::style::{Color, Modifier, Style};
-use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{Axis, Block, Borders, Chart, Dataset, GraphType, Paragraph};
+use ratatui::widgets::{Block, Borders, Paragraph};
 
+use super::charts::{History, speed_chart};
 use super::line_edit::LineEdit;
 use super::view::{View, residence_text};
 use super::wrap::{pack, wrap};
-
-/// Seconds of device time the charts show.
-const WINDOW_S: f64 = 20.0;
-/// The smallest speed span of a chart, rad/s: noise of a few mrad/s must not fill the height.
-const MIN_SPAN_RAD_S: f64 = 1.0;
 
 /// What a key asked for.
 pub enum Action {
@@ -38,34 +35,11 @@ pub enum Action {
     Send(String),
 }
 
-/// Speed history for the charts: (device time s, set, measured) per axis, rad/s.
-struct History {
-    axes: [VecDeque<(f64, f64, f64)>; 2],
-}
-
-impl History {
-    fn push(&mut self, t: &Telemetry) {
-        let now = f64::from(t.time_ms) / 1000.0;
-        for (axis, m) in self.axes.iter_mut().zip([t.precession, t.spin]) {
-            // A device restart starts the time axis again.
-            if axis.back().is_some_and(|&(last, _, _)| now < last) {
-                axis.clear();
-            }
-            axis.push_back((
-                now,
-                f64::from(m.set_mrad_s) / 1000.0,
-                f64::from(m.measured_mrad_s) / 1000.0,
-            ));
-            while axis.front().is_some_and(|&(t0, _, _)| now - t0 > WINDOW_S) {
-                axis.pop_front();
-            }
-        }
-    }
-}
-
 /// The terminal in raw mode on the alternate screen, and what the UI alone keeps.
 pub struct Tui {
-    terminal: Terminal<CrosstermBackend<Stdout>>,
+    /// Never dropped: ratatui's drop, finding the cursor hidden, shows it and on failure (the
+    /// terminal closed) prints to standard error, which then panics. [`Tui`]'s drop shows it.
+    terminal: ManuallyDrop<Terminal<CrosstermBackend<Stdout>>>,
     history: History,
     paused: bool,
     /// Whether the command line is open.
@@ -75,6 +49,21 @@ pub struct Tui {
     /// `NO_COLOR` is set (no-color.org): no colours; what a coloured background marked (the
     /// alarms, LINK OK, PAUSED) is drawn in reverse video instead, so it still stands out.
     no_color: bool,
+    /// The locale has no UTF-8: the screen is drawn in ASCII ([`super::glyphs`]).
+    ascii: bool,
+    /// The terminal's events, read on a thread of their own ([`read_events`]).
+    events: mpsc::Receiver<Event>,
+}
+
+/// Reads the terminal's events into `tx` until the UI is gone. On its own thread because a
+/// terminal that closes (SIGHUP) makes crossterm's reader spin on the end of input without
+/// returning: the monitor's loop must stay free to see the hangup and close its log.
+fn read_events(tx: mpsc::Sender<Event>) {
+    while let Ok(ev) = event::read() {
+        if tx.send(ev).is_err() {
+            break;
+        }
+    }
 }
 
 impl Tui {
@@ -82,8 +71,10 @@ impl Tui {
         enable_raw_mode()?;
         crossterm::execute!(std::io::stdout(), EnterAlternateScreen)?;
         let terminal = Terminal::new(CrosstermBackend::new(std::io::stdout()))?;
+        let (tx, events) = mpsc::channel();
+        std::thread::spawn(move || read_events(tx));
         Ok(Tui {
-            terminal,
+            terminal: ManuallyDrop::new(terminal),
             history: History {
                 axes: [VecDeque::new(), VecDeque::new()],
             },
@@ -91,6 +82,8 @@ impl Tui {
             typing: false,
             line: LineEdit::default(),
             no_color: std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty()),
+            ascii: !super::glyphs::utf8_locale(),
+            events,
         })
     }
 
@@ -102,8 +95,8 @@ impl Tui {
 
     /// Handles the keys pressed since the last call (resizes are picked up by the next draw).
     pub fn keys(&mut self) -> Result<Action> {
-        while event::poll(Duration::ZERO)? {
-            if let Event::Key(key) = event::read()?
+        while let Ok(ev) = self.events.try_recv() {
+            if let Event::Key(key) = ev
                 && key.kind != KeyEventKind::Release
             {
                 let action = self.key(key);
@@ -119,8 +112,19 @@ impl Tui {
         if key.modifiers.contains(KeyModifiers::CONTROL) && key.code == KeyCode::Char('c') {
             return Action::Quit;
         }
+        let chord = key
+            .modifiers
+            .intersects(KeyModifiers::CONTROL | KeyModifiers::ALT);
+        let code = match key.code {
+            // A newline (the end of a pasted line; Enter on some terminals) is Enter.
+            KeyCode::Char('j') if key.modifiers.contains(KeyModifiers::CONTROL) => KeyCode::Enter,
+            // Other chords with a letter (Ctrl-U, Alt-B from habit) are no letter to type, nor
+            // a key of the screen's (Ctrl-Q is not `q`). Symbols stay: AltGr sends Ctrl-Alt.
+            KeyCode::Char(c) if chord && c.is_ascii_alphabetic() => return Action::None,
+            code => code,
+        };
         let line = &mut self.line;
-        match (self.typing, key.code) {
+        match (self.typing, code) {
             (true, KeyCode::Enter) => {
                 self.typing = false;
                 return Action::Send(line.take());
@@ -153,7 +157,7 @@ impl Tui {
         let (history, paused) = (&self.history, self.paused);
         let input = self.typing.then_some(&self.line);
         let silence = view.silence(Instant::now());
-        let no_color = self.no_color;
+        let (no_color, ascii) = (self.no_color, self.ascii);
         self.terminal.draw(|f| {
             let width = usize::from(f.area().width).max(20);
             // The fault line and the events are wrapped to the width, never cut: the end of a
@@ -199,7 +203,7 @@ impl Tui {
                 .zip(charts.iter())
                 .enumerate()
             {
-                speed_chart(f, *area, name, &history.axes[i], live);
+                speed_chart(f, *area, name, &history.axes[i], live, ascii);
             }
             f.render_widget(Paragraph::new(value_lines).style(value_style), rows[3]);
             f.render_widget(
@@ -240,6 +244,9 @@ impl Tui {
                     }
                     (cell.fg, cell.bg) = (Color::Reset, Color::Reset);
                 }
+            }
+            if ascii {
+                super::glyphs::to_ascii(f.buffer_mut());
             }
         })?;
         Ok(())
@@ -344,66 +351,6 @@ fn fault_line(view: &View, stale: bool) -> (String, Style) {
             Style::default().fg(Color::DarkGray),
         ),
     }
-}
-
-/// One axis: set (yellow) and measured (cyan) speed against device time, numbered axes.
-fn speed_chart(
-    f: &mut ratatui::Frame,
-    area: Rect,
-    name: &str,
-    points: &VecDeque<(f64, f64, f64)>,
-    live: bool,
-) {
-    let set: Vec<(f64, f64)> = points.iter().map(|&(t, s, _)| (t, s)).collect();
-    let measured: Vec<(f64, f64)> = points.iter().map(|&(t, _, m)| (t, m)).collect();
-    let t_end = points.back().map_or(WINDOW_S, |p| p.0.max(WINDOW_S));
-    let t_start = t_end - WINDOW_S;
-    let (lo, hi) = points
-        .iter()
-        .fold((0.0f64, 0.0f64), |(lo, hi), &(_, s, m)| {
-            (lo.min(s).min(m), hi.max(s).max(m))
-        });
-    let span = (hi - lo).max(MIN_SPAN_RAD_S) * 1.1;
-    let (y0, y1) = (lo.min(0.0), lo.min(0.0) + span);
-    let dim = |c: Color| if live { c } else { Color::DarkGray };
-    let datasets = vec![
-        Dataset::default()
-            .name("set")
-            .marker(Marker::Braille)
-            .graph_type(GraphType::Line)
-            .style(Style::default().fg(dim(Color::Yellow)))
-            .data(&set),
-        Dataset::default()
-            .name("measured")
-            .marker(Marker::Braille)
-            .graph_type(GraphType::Line)
-            .style(Style::default().fg(dim(Color::Cyan)))
-            .data(&measured),
-    ];
-    let y_labels = [y0, (y0 + y1) / 2.0, y1].map(|v| format!("{v:.2}"));
-    // The plot's columns: the frame's two, the y labels' and the axis line's are not in it.
-    let y_label_width = y_labels.iter().map(String::len).max().unwrap_or(0) as u16;
-    let plot_width = area.width.saturating_sub(2 + y_label_width + 1);
-    // What the lines are and the units go in the frame's title: a legend or an axis title
-    // inside the plot would be drawn over the newest samples at the right edge.
-    let title = Line::from(vec![
-        Span::raw(format!(" {name} rad/s: ")),
-        Span::styled("set", Style::default().fg(dim(Color::Yellow))),
-        Span::raw(", "),
-        Span::styled("measured", Style::default().fg(dim(Color::Cyan))),
-        Span::raw(" "),
-    ]);
-    let chart = Chart::new(datasets)
-        .block(Block::default().borders(Borders::ALL).title(title))
-        .legend_position(None)
-        // The unit on the last label, below the axis (device time, s).
-        .x_axis(
-            Axis::default()
-                .bounds([t_start, t_end])
-                .labels(super::fit::time_labels(t_start, t_end, plot_width)),
-        )
-        .y_axis(Axis::default().bounds([y0, y1]).labels(y_labels));
-    f.render_widget(chart, area);
 }
 
 /// The widest line of the values' table: narrower screens get them as sentences, wrapped.

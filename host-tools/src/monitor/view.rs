@@ -5,6 +5,7 @@
 #![cfg_attr(not(unix), allow(dead_code, unused_imports))]
 
 use std::collections::VecDeque;
+use std::io::Write;
 use std::time::{Duration, Instant};
 
 use model_core::wire::{Decoder, Frame, Hello, Residence, Telemetry};
@@ -36,9 +37,12 @@ impl Trend {
 
     /// A sparkline of the points and the range it spans, `[lo .. hi]`. The range is the
     /// points' own, widened to at least `MIN_SPAN` (1 unit) about its middle, so a few thousandths
-    /// of noise stay a flat line instead of filling the height.
-    fn sparkline(&self) -> String {
+    /// of noise stay a flat line instead of filling the height. In `ascii` (a locale without
+    /// UTF-8, see `glyphs`) the bars are characters that sit ever higher in the line.
+    fn sparkline(&self, ascii: bool) -> String {
         const BARS: [char; 8] = ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'];
+        const ASCII_BARS: [char; 8] = ['_', '.', ',', '-', '=', '~', '^', '\''];
+        let bars = if ascii { ASCII_BARS } else { BARS };
         const MIN_SPAN: f64 = 1.0;
         let finite = self.points.iter().copied().filter(|v| v.is_finite());
         let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
@@ -58,7 +62,7 @@ impl Trend {
             .iter()
             .map(|&v| {
                 if v.is_finite() {
-                    BARS[(((v - lo) / (hi - lo)) * 7.0).round().clamp(0.0, 7.0) as usize]
+                    bars[(((v - lo) / (hi - lo)) * 7.0).round().clamp(0.0, 7.0) as usize]
                 } else {
                     ' '
                 }
@@ -172,7 +176,8 @@ impl View {
                     ),
                 );
             }
-            other => self.event(plain, format!("answer: {}", describe(other))),
+            // Gate events and the like: what the rig says of itself, no answer to anything.
+            other => self.event(plain, describe(other)),
         }
     }
 
@@ -186,7 +191,9 @@ impl View {
 
     pub(crate) fn event(&mut self, plain: bool, text: String) {
         if plain {
-            println!("{text}");
+            // Not a panic when the terminal is gone (SIGHUP): the monitor's next status line
+            // fails instead, and ends it with its log closed.
+            let _ = writeln!(std::io::stdout(), "{text}");
         }
         if self.events.len() == 5 {
             self.events.pop_front();
@@ -285,8 +292,9 @@ impl View {
             }
             None => s += "no telemetry yet\n\n",
         }
+        let ascii = !super::glyphs::utf8_locale();
         for trend in &self.trends {
-            s += &format!("{:<16} {}\n", trend.name, trend.sparkline());
+            s += &format!("{:<16} {}\n", trend.name, trend.sparkline(ascii));
         }
         if let Some(h) = self.hello {
             s += &format!(
@@ -320,14 +328,18 @@ mod tests {
     #[test]
     fn sparklines_say_their_range_and_do_not_magnify_noise() {
         let noisy = trend((0..40).map(|i| 1.8 + if i % 2 == 0 { 0.005 } else { -0.005 }));
-        let line = noisy.sparkline();
+        let line = noisy.sparkline(false);
         let bars: std::collections::BTreeSet<char> =
             line.chars().take_while(|c| *c != ' ').collect();
         assert!(bars.len() <= 2, "{line}");
         assert!(line.ends_with("[1.30 .. 2.30]"), "{line}");
         let ramp = trend((0..=30).map(|i| f64::from(i) * 0.1));
-        let line = ramp.sparkline();
+        let line = ramp.sparkline(false);
         assert!(line.starts_with('▁') && line.contains('█'), "{line}");
         assert!(line.ends_with("[0.00 .. 3.00]"), "{line}");
+        // The same ramp without UTF-8: ASCII from the bottom of the line to its top.
+        let line = ramp.sparkline(true);
+        assert!(line.is_ascii(), "{line}");
+        assert!(line.starts_with("__") && line.contains("^''' ["), "{line}");
     }
 }

@@ -140,6 +140,20 @@ impl Sim {
     }
 }
 
+impl Sim {
+    /// Ends the rig its own way (SIGTERM, as `kill` sends) and waits until it has.
+    pub fn terminate(&mut self) {
+        use nix::sys::signal::{Signal, kill};
+        let pid = nix::unistd::Pid::from_raw(self.child.id() as i32);
+        kill(pid, Signal::SIGTERM).expect("SIGTERM sent");
+        wait_within(
+            &mut self.child,
+            Duration::from_secs(5),
+            "bowl serve after SIGTERM",
+        );
+    }
+}
+
 impl Drop for Sim {
     fn drop(&mut self) {
         let _ = self.child.kill();
@@ -251,6 +265,18 @@ pub fn last_json(o: &Output) -> serde_json::Value {
 /// `bowl predict` tests' scratch files).
 pub fn temp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("bowl-predict-{}-{name}", std::process::id()))
+}
+
+/// A monitor's `--log` closed its own way: telemetry rows, then `monitor end` last (not a log
+/// that just stops where the process died).
+pub fn assert_log_closed(log: &Path) {
+    let text = std::fs::read_to_string(log).unwrap();
+    assert!(text.lines().count() > 3, "telemetry was logged:\n{text}");
+    assert!(
+        text.trim_end().ends_with(",monitor end"),
+        "last row: {:?}",
+        text.lines().last()
+    );
 }
 
 /// An empty scratch directory named after the test and this process.

@@ -9,11 +9,24 @@ pub struct Tmux {
 }
 
 impl Tmux {
+    /// Runs `command` in a new 120 x 40 terminal whose locale is UTF-8 (as most desktops' are,
+    /// whatever the environment the tests run in; a test that wants another sets its own).
     pub fn start(name: &str, command: &str) -> Tmux {
         let socket = format!("bowl-test-{name}-{}", std::process::id());
         let tmux = Tmux { socket };
+        let args = [
+            "new-session",
+            "-d",
+            "-x",
+            "120",
+            "-y",
+            "40",
+            "-e",
+            "LC_ALL=C.UTF-8",
+            command,
+        ];
         let ok = tmux
-            .cmd(&["new-session", "-d", "-x", "120", "-y", "40", command])
+            .cmd(&args)
             .status()
             .expect("tmux runs (tests/lib/ensure-tools.sh installs it)")
             .success();

@@ -7,26 +7,51 @@ fn w(s: &str) -> Vec<String> {
     s.split_whitespace().map(str::to_string).collect()
 }
 
-/// A speed, a residence time, START or COMMISSION while stopping is told to wait for idle
-/// (a speed got "see docs/protocol.md" where START got the wait).
-#[test]
-fn while_stopping_every_refused_command_is_told_to_wait_for_idle() {
-    use model_core::wire::{DeviceState, FaultCode, ResetCause};
-    let s = Status {
-        state: DeviceState::Stopping,
+/// A rig's STATUS in `state`, with no fault.
+fn status_in(state: model_core::wire::DeviceState) -> Status {
+    use model_core::wire::{FaultCode, ResetCause};
+    Status {
+        state,
         fault: FaultCode::None,
         reset_cause: ResetCause::PowerOn,
         reset_count: 0,
         uptime_ms: 0,
         telemetry_hz: 10,
         flags: 0,
-    };
+    }
+}
+
+/// A speed, a residence time, START or COMMISSION while stopping is told to wait for idle
+/// (a speed got "see docs/protocol.md" where START got the wait).
+#[test]
+fn while_stopping_every_refused_command_is_told_to_wait_for_idle() {
+    let s = status_in(model_core::wire::DeviceState::Stopping);
     for typed in ["speed 1000 1000", "rtime cori 800", "start", "commission"] {
         let words = w(typed);
         let text = state_words(&s, &words[0], &words);
         assert!(
             text.contains("wait until the rig is idle"),
             "{typed}: {text}"
+        );
+    }
+}
+
+/// CLEAR refused in any state but faulted is told there is no fault (a running rig got "see
+/// docs/protocol.md for what each state allows").
+#[test]
+fn clear_without_a_fault_says_so_in_every_state() {
+    use model_core::wire::DeviceState;
+    for state in [
+        DeviceState::Idle,
+        DeviceState::ChangingSpeed,
+        DeviceState::Running,
+        DeviceState::Stopping,
+        DeviceState::Commissioning,
+    ] {
+        let text = state_words(&status_in(state), "clear", &w("clear"));
+        assert!(
+            text.contains("there is no fault to clear"),
+            "{state:?}: {text}"
         );
     }
 }
