@@ -120,7 +120,7 @@ fn batch_with_a_bad_row_names_every_bad_line_and_writes_nothing() {
     assert_eq!(out.status.code(), Some(1), "a failed row fails the run");
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("line 3: 9 fields where the header has 8"),
+        err.contains("line 3: 9 cells, but the header names 8 columns"),
         "{err}"
     );
     assert!(err.contains("line 5") && err.contains("\"fast\""), "{err}");

@@ -20,6 +20,10 @@ pub struct Sheet {
     sep: u8,
     /// The header's names, trimmed and lowercased (matched case-insensitively).
     columns: Vec<String>,
+    /// The same names as the file spells them (written back out as they came in).
+    names: Vec<String>,
+    /// The header's line (after a `sep=` line or blank lines, not the first).
+    header_line: usize,
     /// Each row's line number and its trimmed cells.
     rows: Vec<(usize, Vec<String>)>,
 }
@@ -59,7 +63,7 @@ fn unit_like(cell: &str) -> bool {
 
 /// The separator of a header line: the most frequent of `,`, `;` and tab (the header's names
 /// hold none of them), `,` when none occurs.
-pub(crate) fn detect(header: &str) -> u8 {
+fn detect(header: &str) -> u8 {
     [b',', b';', b'\t']
         .into_iter()
         .max_by_key(|&c| (header.bytes().filter(|&b| b == c).count(), c == b','))
@@ -83,12 +87,22 @@ impl Sheet {
     pub fn parse(text: &str, file: String) -> Result<Self> {
         // A spreadsheet's UTF-8 export may start with a byte-order mark.
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let first = text.lines().next().unwrap_or("");
+        // Lines end at LF, CRLF or a lone CR (an old Mac's files): `str::lines` would take a
+        // whole CR file for its first line, and count the separators of every row.
+        let mut lines = text.split(['\r', '\n']);
+        let first = lines.next().unwrap_or("");
         // With `sep=X` the table starts on line 2.
         let (sep, body) = match sep_line(first) {
-            Some(sep) => (sep, text.split_once('\n').map_or("", |x| x.1)),
+            Some(sep) => {
+                let rest = &text[first.len()..];
+                let rest = rest.strip_prefix("\r").unwrap_or(rest);
+                (sep, rest.strip_prefix('\n').unwrap_or(rest))
+            }
             None => {
-                let header = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+                let header = std::iter::once(first)
+                    .chain(lines)
+                    .find(|l| !l.trim().is_empty())
+                    .unwrap_or("");
                 (detect(header), text)
             }
         };
@@ -121,6 +135,7 @@ impl Sheet {
             bail!("{file}: the file is empty (no header line)");
         };
         let columns: Vec<String> = header.iter().map(|h| h.to_lowercase()).collect();
+        let names = header;
         for (i, c) in columns.iter().enumerate() {
             if let Some(j) = columns[..i].iter().position(|d| !c.is_empty() && d == c) {
                 bail!(
@@ -156,6 +171,8 @@ impl Sheet {
             file,
             sep,
             columns,
+            names,
+            header_line,
             rows,
         })
     }
@@ -183,37 +200,66 @@ impl Sheet {
         self.columns.iter().position(|c| c == name)
     }
 
+    /// The separator found (`,`, `;` or a tab).
+    pub fn sep(&self) -> u8 {
+        self.sep
+    }
+
+    /// The line the header is on.
+    pub fn header_line(&self) -> usize {
+        self.header_line
+    }
+
+    /// The header's names as the file spells them (trimmed).
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+
     /// The rows, each checked to have no more cells than the header names (spare empty cells,
     /// which spreadsheets add, are let through).
     pub fn rows(&self) -> impl Iterator<Item = Result<Cells<'_>>> {
-        self.rows.iter().map(move |(line, cells)| {
-            if cells[self.columns.len().min(cells.len())..]
-                .iter()
-                .any(|c| !c.is_empty())
-            {
-                let hint = if self.sep == b',' {
-                    " (a decimal comma in a ,-separated file splits a number in two: use a \
-                     decimal point, or a ;-separated file)"
-                } else {
-                    ""
-                };
-                bail!(
-                    "{}, line {line}: {} cells, but the header names {} columns{hint}",
-                    self.file,
-                    cells.len(),
-                    self.columns.len()
-                );
-            }
-            Ok(Cells {
-                sheet: self,
-                line: *line,
-                cells,
-            })
+        self.each_row().map(move |c| match c.too_wide() {
+            Some(why) => bail!("{}, line {}: {why}", self.file, c.line),
+            None => Ok(c),
+        })
+    }
+
+    /// The rows unchecked, for a reader that reports each bad row and goes on.
+    pub fn each_row(&self) -> impl Iterator<Item = Cells<'_>> {
+        self.rows.iter().map(move |(line, cells)| Cells {
+            sheet: self,
+            line: *line,
+            cells,
         })
     }
 }
 
 impl Cells<'_> {
+    /// Why the row has more cells than the header has names (spare empty cells, which
+    /// spreadsheets add, are not counted), in words; `None` when it has not.
+    pub fn too_wide(&self) -> Option<String> {
+        let (cells, width) = (self.cells, self.sheet.columns.len());
+        if cells[width.min(cells.len())..].iter().all(String::is_empty) {
+            return None;
+        }
+        let hint = if self.sheet.sep == b',' {
+            " (a decimal comma in a ,-separated file splits a number in two: use a decimal \
+             point, or a ;-separated file)"
+        } else {
+            ""
+        };
+        Some(format!(
+            "{} cells, but the header names {width} columns{hint}",
+            cells.len()
+        ))
+    }
+
+    /// The row's trimmed cells, in the header's order (fewer than the header's names when the
+    /// row ends early).
+    pub fn cells(&self) -> &[String] {
+        self.cells
+    }
+
     /// The trimmed cell of column `name` (empty where the column or the cell is absent).
     pub fn text(&self, name: &str) -> &str {
         self.sheet
@@ -242,6 +288,13 @@ impl Cells<'_> {
     /// A number, or `None` for an empty cell. In a file separated by `;` or tabs a decimal
     /// comma is a decimal point (the separator cannot be a comma there).
     pub fn number_or_empty(&self, name: &str) -> Result<Option<f64>> {
+        self.read_number(name)
+            .map_err(|why| self.refuse(name, &why))
+    }
+
+    /// As [`Self::number_or_empty`], the error being only why the cell is not a number (for a
+    /// reader that names the file and line its own way).
+    pub fn read_number(&self, name: &str) -> std::result::Result<Option<f64>, String> {
         let cell = self.text(name);
         if cell.is_empty() {
             return Ok(None);
@@ -259,7 +312,7 @@ impl Cells<'_> {
                 "a number such as 1.07 (or 1,07 in a ;-separated file), without thousands \
                  separators or units"
             };
-            self.refuse(name, &format!("\"{cell}\" is not a number ({hint})"))
+            format!("\"{cell}\" is not a number ({hint})")
         })
     }
 
@@ -349,6 +402,21 @@ mod tests {
         // A first row of values is never taken for units, even with its numbers missing.
         let s = sheet("run,status,t\n,ok,\n");
         assert_eq!(s.rows().count(), 1);
+    }
+
+    /// Lone CR line ends (an old Mac's files): the separator is found from the header line
+    /// alone; it was counted over the whole file, where the decimal commas outnumber the `;`.
+    #[test]
+    fn a_cr_file_finds_its_separator_on_the_header_line() {
+        let s = sheet("a;b\r1,5;2,5\r3,5;4,5\r");
+        assert_eq!(s.sep, b';');
+        let rows: Vec<Cells> = s.rows().map(Result::unwrap).collect();
+        assert_eq!(rows[1].number("b").unwrap(), 4.5);
+        assert_eq!(rows[1].line, 3);
+        let s = sheet("sep=;\rA;b\r1,5;2\r");
+        assert_eq!((s.sep, s.header_line()), (b';', 2));
+        assert_eq!(s.names(), ["A", "b"]);
+        assert_eq!(s.rows().next().unwrap().unwrap().line, 3);
     }
 
     #[test]
