@@ -129,12 +129,23 @@ fn suggest_refuses_bad_values_in_words_with_a_failing_exit() {
     let dir = temp_dir("experiment-suggest");
     let rig = rig_with_particle(&dir, "");
     let rig = rig.to_str().unwrap();
-    let cases: [(&str, &str, &str); 8] = [
-        (
-            "--mu-guess",
-            "nan",
-            "--mu-guess NaN: the guessed rolling resistance must be a number above 0 and at most 1",
-        ),
+    // Not a number at all: refused as the command line is, with every number flag (exit 2).
+    let out = bowl(&[
+        "experiment",
+        "--suggest",
+        "--rig-file",
+        rig,
+        "--mu-guess",
+        "nan",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("`nan` is not a number: give a decimal number"),
+        "{err}"
+    );
+    assert!(out.stdout.is_empty());
+    let cases: [(&str, &str, &str); 7] = [
         (
             "--mu-guess",
             "0",

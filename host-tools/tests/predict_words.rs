@@ -119,6 +119,54 @@ fn tiny_and_huge_values_keep_their_significant_figures() {
     assert!(!out.contains("284489999999999968"), "{out}");
 }
 
+/// A speed of 1e30 was echoed in the scene line as 31 digits, and -1e-30 in its refusal as
+/// thirty zeros; 1e400 (beyond f64) was read as infinity and refused as "inf rad/s" with the
+/// advice to give a positive speed, and 1e-400 was taken as 0. Now each keeps its own short
+/// form, and a number out of range is said to be so (a usage error, exit 2), for every flag.
+#[test]
+fn huge_speeds_are_echoed_short_and_out_of_range_ones_refused() {
+    let (code, out, err) =
+        run(&["predict", "--model", "flat", "--omega-rad-s", "1e30"].map(String::from));
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains("scene: omega 1e30 rad/s, mu 0.029,"), "{out}");
+    let (code, _, err) =
+        run(&["predict", "--model", "flat", "--omega-rad-s=-1e-30"].map(String::from));
+    assert_eq!(code, Some(1));
+    assert!(err.contains("--omega-rad-s -1e-30 rad/s:"), "{err}");
+    for (flag, value, said) in [
+        (
+            "--omega-rad-s",
+            "1e400",
+            "1e400 is out of range: a number here is finite",
+        ),
+        ("--mu=-1e999", "", "-1e999 is out of range"),
+        (
+            "--rim-radius-m",
+            "1e-400",
+            "1e-400 is out of range: too small to tell from 0",
+        ),
+        ("--ri-m", "inf", "inf is out of range"),
+        ("--spin-rad-s", "nan", "`nan` is not a number"),
+        (
+            "--k2",
+            "0.7 kg",
+            "`0.7 kg` is not a number: give a decimal number",
+        ),
+    ] {
+        // `--mu=-1e999`: clap takes a dash and an exponent for a flag unless joined by `=`.
+        let args: Vec<String> = ["predict", flag, value]
+            .into_iter()
+            .filter(|a| !a.is_empty())
+            .map(String::from)
+            .collect();
+        let (code, out, err) = run(&args);
+        assert_eq!(code, Some(2), "{flag} {value}: {err}");
+        assert!(err.contains(said), "{flag} {value}: {err}");
+        assert!(out.is_empty(), "{flag} {value}: {out}");
+        no_inf_or_nan(&err.replace(value, "").replace("-1e999", ""));
+    }
+}
+
 /// Flags the chosen model would ignore, and flags a rig file sets, are refused (exit 2) naming
 /// the flag and what to do; the rig's value is quoted, not blamed on the user's.
 #[test]

@@ -19,6 +19,18 @@ pub fn fixed(x: f64, decimals: usize) -> String {
     }
 }
 
+/// A value the user gave, echoed with all its digits (shortest round-trip, so 3.6 reads 3.6) but
+/// in scientific notation beyond 1e-4 to 1e9: Rust's `{}` never is, and echoed `1e30` as 31
+/// digits and `1e-20` as twenty zeros.
+pub fn echo(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || !x.is_finite() || (1e-4..1e9).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// `x`, an `f32` (what the MCU and the controller compute in), as the `f64` of its shortest
 /// decimal: widened with `f64::from` it was written with its binary's noise (a split speed of
 /// 1.7153077 rad/s as 1.7153077125549316 in a results file).
@@ -68,7 +80,19 @@ pub fn shares(v: &serde_json::Value) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{count, f32_digits, f32_digits_opt, fixed, from_f32, shares};
+    use super::{count, echo, f32_digits, f32_digits_opt, fixed, from_f32, shares};
+
+    /// A given value keeps its digits, in scientific notation at the ends of the range.
+    #[test]
+    fn echoes_keep_digits_and_stay_short() {
+        assert_eq!(echo(3.6), "3.6");
+        assert_eq!(echo(0.029), "0.029");
+        assert_eq!(echo(-12345678.5), "-12345678.5");
+        assert_eq!(echo(0.0), "0");
+        assert_eq!(echo(1e30), "1e30");
+        assert_eq!(echo(-1.5e-20), "-1.5e-20");
+        assert_eq!(echo(2.5e9), "2.5e9");
+    }
 
     /// An f32's value is written with its own digits, not the widening's.
     #[test]

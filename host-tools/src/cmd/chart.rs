@@ -114,7 +114,7 @@ struct RollingResidenceArgs {
     #[command(flatten)]
     out: Out,
     /// Tilt of the bowl's axis from the vertical, degrees.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, value_parser = crate::cmd::number, default_value_t = 60.0)]
     axes_angle_deg: f64,
 }
 
@@ -124,7 +124,7 @@ struct RollingHierarchyArgs {
     #[command(flatten)]
     out: Out,
     /// Rolling resistance.
-    #[arg(long, default_value_t = 0.029)]
+    #[arg(long, value_parser = crate::cmd::number, default_value_t = 0.029)]
     mu: f64,
 }
 

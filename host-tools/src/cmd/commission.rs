@@ -36,7 +36,7 @@ pub struct Args {
     baud: u32,
     /// Give up when commissioning has not ended after this many seconds (the rig's own routine
     /// faults after 120 s).
-    #[arg(long, default_value_t = 180.0)]
+    #[arg(long, value_parser = crate::cmd::number, default_value_t = 180.0)]
     timeout_s: f64,
     /// Print one JSON object instead of text.
     #[arg(long)]

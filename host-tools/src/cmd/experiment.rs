@@ -36,7 +36,7 @@ pub struct Args {
     #[arg(long)]
     pub suggest: bool,
     /// With --suggest: the guessed mu the plan is designed for (above 0, at most 1).
-    #[arg(long, default_value_t = 0.029)]
+    #[arg(long, value_parser = crate::cmd::number, default_value_t = 0.029)]
     pub mu_guess: f64,
     /// With --suggest: number of conditions (1 to 40).
     #[arg(long, default_value_t = 4)]

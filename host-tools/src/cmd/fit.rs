@@ -31,7 +31,7 @@ pub struct Args {
     /// Angle between the bowl's axis and the vertical during the runs, degrees (the rolling
     /// and bowl models' tilt; the results file does not record it). Default: the rig file's
     /// `[bowl] axes_angle_deg` with --rig-file, else 60.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number)]
     pub axes_angle_deg: Option<f64>,
     /// Fit the granule's k2 as well as mu (needs conditions spread over the speed range; the
     /// results file's k2 is the starting point).

@@ -7,19 +7,19 @@ use model_core::bowl::{BowlError, BowlGeometry, MotorSpeeds};
 #[derive(clap::Args)]
 pub struct Args {
     /// Precession speed omega1 (rod about the vertical), rad/s.
-    #[arg(long, default_value_t = 1.8)]
+    #[arg(long, value_parser = crate::cmd::number, default_value_t = 1.8)]
     precession_rad_s: f64,
     /// Spin speed omega2 (bowl about its own axis), rad/s.
-    #[arg(long, default_value_t = 1.8)]
+    #[arg(long, value_parser = crate::cmd::number, default_value_t = 1.8)]
     spin_rad_s: f64,
     /// Angle between the spin and precession axes, degrees (see the docs: not the rod's tilt).
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, value_parser = crate::cmd::number, default_value_t = 60.0)]
     axes_angle_deg: f64,
     /// Instead: split this combined bowl speed (rad/s) into motor speeds.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number)]
     split_rad_s: Option<f64>,
     /// Spin/precession ratio used by --split-rad-s.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, value_parser = crate::cmd::number, default_value_t = 1.0)]
     ratio: f64,
     /// Print JSON instead of text.
     #[arg(long)]

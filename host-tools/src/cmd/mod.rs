@@ -11,3 +11,58 @@ pub mod replay;
 pub mod send;
 pub mod serve;
 pub mod sim;
+
+/// The parser of every number flag: clap's own read `1e400` as infinity and `1e-400` as 0,
+/// which the checks after it then echoed as "inf rad/s" (refused as if negative) or took as a
+/// real 0; and it said "invalid float literal" for a value typed with its unit.
+pub fn number(text: &str) -> Result<f64, String> {
+    let t = text.trim();
+    let example = "a decimal number such as 0.05, 3.6 or 2.5e-3 (a decimal point, no unit)";
+    let x: f64 = t
+        .parse()
+        .map_err(|_| format!("`{t}` is not a number: give {example}"))?;
+    if x.is_nan() {
+        return Err(format!("`{t}` is not a number: give {example}"));
+    }
+    if x.is_infinite() {
+        return Err(format!(
+            "{t} is out of range: a number here is finite, less than about 1.8e308 in size"
+        ));
+    }
+    let mantissa = t.split(['e', 'E']).next().unwrap_or(t);
+    if x == 0.0 && mantissa.bytes().any(|b| (b'1'..=b'9').contains(&b)) {
+        return Err(format!(
+            "{t} is out of range: too small to tell from 0 (the smallest size is about \
+             5e-324): give 0 if 0 is meant"
+        ));
+    }
+    Ok(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::number;
+
+    #[test]
+    fn numbers_out_of_range_are_refused_in_words() {
+        assert_eq!(number("3.6"), Ok(3.6));
+        assert_eq!(number("-0.5e-3"), Ok(-0.0005));
+        assert_eq!(number("0e-999"), Ok(0.0));
+        assert_eq!(number("1e30"), Ok(1e30));
+        let e = number("1e400").unwrap_err();
+        assert!(
+            e.starts_with("1e400 is out of range: a number here is finite"),
+            "{e}"
+        );
+        assert!(number("-inf").unwrap_err().contains("out of range"));
+        let e = number("1e-400").unwrap_err();
+        assert!(e.contains("too small to tell from 0"), "{e}");
+        let e = number("NaN").unwrap_err();
+        assert!(e.starts_with("`NaN` is not a number"), "{e}");
+        let e = number("0.02 kg").unwrap_err();
+        assert!(
+            e.starts_with("`0.02 kg` is not a number") && e.contains("no unit"),
+            "{e}"
+        );
+    }
+}

@@ -106,32 +106,32 @@ fn choice<T: Copy + Send + Sync + 'static>(table: Choices<T>) -> impl TypedValue
 pub struct Args {
     /// Combined bowl speed omega (paper Eq. 2), rad/s, of the paper's level-bowl models
     /// [default: 3]. The tilted bowl's models take --precession-rad-s and --spin-rad-s instead.
-    #[arg(long, visible_alias = "w-rad-s")]
+    #[arg(long, value_parser = crate::cmd::number, visible_alias = "w-rad-s")]
     omega_rad_s: Option<f64>,
     /// Effective rolling resistance coefficient mu (the paper's literal 0.4 makes nothing move)
     /// [default: 0.029, or with --rig-file its [particle] mu].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number)]
     mu: Option<f64>,
     /// Start radius ri, m (the particle starts at rest) [default: 0.05, or with --rig-file its
     /// [particle] release_radius_m].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number)]
     ri_m: Option<f64>,
     /// Rim radius R, m (0.1 m: a 200 mm bowl, reading the paper's sizes as diameters)
     /// [default: 0.1]. A rig file sets it (its [bowl] rim_radius_m): not both.
-    #[arg(long, visible_alias = "r-m")]
+    #[arg(long, value_parser = crate::cmd::number, visible_alias = "r-m")]
     rim_radius_m: Option<f64>,
     /// Gravity, m/s^2.
-    #[arg(long, default_value_t = 9.81)]
+    #[arg(long, value_parser = crate::cmd::number, default_value_t = 9.81)]
     g: f64,
     /// k2 = m rp^2 / (I + m rp^2): 5/7 solid sphere, 3/5 hollow [default: 5/7, or with
     /// --rig-file its [particle] k2].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number)]
     k2: Option<f64>,
     /// Model: auto (the chooser), flat, coriolis, both or rolling.
     #[arg(long, value_parser = choice(MODELS), default_value = "auto")]
     model: ModelChoice,
     /// The chooser: relative tolerance on T (0.01 = 1 %).
-    #[arg(long, conflicts_with = "uncertainty")]
+    #[arg(long, value_parser = crate::cmd::number, conflicts_with = "uncertainty")]
     tolerance: Option<f64>,
     /// The chooser: the parameters' uncertainty, `mu=REL,radius_m=M,omega=REL` (default
     /// mu=0.2,radius_m=0.001,omega=0.01); the tolerance is a tenth of the spread it causes in T.
@@ -142,7 +142,7 @@ pub struct Args {
     #[arg(long, value_name = "RUN.csv")]
     omega_trace: Option<std::path::PathBuf>,
     /// With --omega-trace: the device time of the release, ms (default: the log's first row).
-    #[arg(long, requires = "omega_trace")]
+    #[arg(long, value_parser = crate::cmd::number, requires = "omega_trace")]
     release_at_ms: Option<f64>,
     /// A spin-up, as a tuned speed loop drives it: the bowl starts at this speed, rad/s, and
     /// approaches --omega-rad-s with --time-constant-s; the particle is released at t = 0.
@@ -150,24 +150,25 @@ pub struct Args {
     /// --tolerance is given).
     #[arg(
         long,
+        value_parser = crate::cmd::number,
         requires = "time_constant_s",
         conflicts_with_all = ["omega_trace", "batch", "target_time_s"]
     )]
     spin_up_from_rad_s: Option<f64>,
     /// With --spin-up-from-rad-s: the spin-up's time constant, s.
-    #[arg(long, requires = "spin_up_from_rad_s")]
+    #[arg(long, value_parser = crate::cmd::number, requires = "spin_up_from_rad_s")]
     time_constant_s: Option<f64>,
     /// Method: closed form or one of the integrators [default: closed; the bowl model: dp54].
     #[arg(long, value_parser = choice(METHODS))]
     method: Option<MethodChoice>,
     /// Fixed step of euler / semi-implicit / rk4, s (default: 0.01 / omega).
-    #[arg(long, visible_alias = "step")]
+    #[arg(long, value_parser = crate::cmd::number, visible_alias = "step")]
     step_s: Option<f64>,
     /// Relative tolerance of dp54.
-    #[arg(long, default_value_t = 1e-9)]
+    #[arg(long, value_parser = crate::cmd::number, default_value_t = 1e-9)]
     tol: f64,
     /// Instead of the residence time: the bowl speed that gives this residence time, s.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number)]
     target_time_s: Option<f64>,
     /// The chooser: where the chosen plan runs: host (f64, priced in ns) or mcu (the
     /// Cortex-M4F: f32, priced in instructions).
@@ -203,24 +204,24 @@ pub struct Args {
 #[derive(clap::Args, Debug, Clone)]
 pub struct RollingArgs {
     /// Rolling model: precession speed w1 of the bowl's axis about the vertical, rad/s.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, value_parser = crate::cmd::number, allow_negative_numbers = true)]
     precession_rad_s: Option<f64>,
     /// Rolling model: spin speed w2 of the bowl about its own axis, rad/s (negative: the
     /// other way, e.g. --spin-rad-s -2.7).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, value_parser = crate::cmd::number, allow_negative_numbers = true)]
     spin_rad_s: Option<f64>,
     /// Rolling model: angle between the bowl's axis and the vertical, degrees (paper Eq. 2).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number)]
     axes_angle_deg: Option<f64>,
     /// Rolling model: granule radius a, m [default: 0.003]. A rig file sets it (its [bowl]
     /// particle_radius_m): not both.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number)]
     particle_radius_m: Option<f64>,
     /// Rolling model: the rod's horizontal offset L, the distance of the bowl's centre from the
     /// precession axis, m. Not the rod's length: a rod of length l at angle th from the
     /// vertical gives L = l sin(th) (l overstates L by 15 % at 60 deg). `--rod-length-m` is
     /// this flag's old name, kept as an alias.
-    #[arg(long, visible_alias = "rod-length-m", default_value_t = 0.0)]
+    #[arg(long, value_parser = crate::cmd::number, visible_alias = "rod-length-m", default_value_t = 0.0)]
     rod_offset_m: f64,
     /// Rolling model: release azimuth from the downhill direction, degrees, or `all` (mean, min
     /// and max over 0, 30, ..., 330).
@@ -228,16 +229,16 @@ pub struct RollingArgs {
     release_azimuth_deg: String,
     /// Rolling model: the friction coefficient the contact can give (slip beyond it is reported)
     /// [default: 0.4, or with --rig-file its [particle] sliding_mu].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number)]
     sliding_mu: Option<f64>,
     /// Rolling model: every member of the model hierarchy on this scene, its mean residence
     /// time and its difference from the full model, and the cheapest member within this
     /// relative tolerance (e.g. 0.05).
-    #[arg(long, conflicts_with = "hierarchy_uncertainty_mu")]
+    #[arg(long, value_parser = crate::cmd::number, conflicts_with = "hierarchy_uncertainty_mu")]
     hierarchy_tolerance: Option<f64>,
     /// Rolling model: as --hierarchy-tolerance, the tolerance set by this uncertainty in the
     /// rolling resistance (the change of the full model's mean T when mu moves by it).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number)]
     hierarchy_uncertainty_mu: Option<f64>,
     /// Rolling model: with the hierarchy, judge each single release (the worst azimuth), not
     /// the mean over the releases.
@@ -251,22 +252,22 @@ pub struct RollingArgs {
 pub struct BowlArgs {
     /// Bowl model: the wall's angle from the bottom plane, degrees (90 = vertical; default 90
     /// or the rig file's).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, value_parser = crate::cmd::number, allow_negative_numbers = true)]
     wall_angle_deg: Option<f64>,
     /// Bowl model: the wall's height above the bottom, m (0 = a bare rim at --rim-radius-m;
     /// default 0 or the rig file's).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, value_parser = crate::cmd::number, allow_negative_numbers = true)]
     wall_height_m: Option<f64>,
     /// Bowl model: the fillet's radius between bottom and wall, m (0 = a sharp corner; default
     /// 0 or the rig file's).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, value_parser = crate::cmd::number, allow_negative_numbers = true)]
     fillet_radius_m: Option<f64>,
     /// Bowl model: coefficient of restitution of the impact with a sharp corner's wall
     /// (default 0.5 or the rig file's).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, value_parser = crate::cmd::number, allow_negative_numbers = true)]
     restitution: Option<f64>,
     /// Bowl model: follow each release this long, s; still inside then, it has not left.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 10.0)]
+    #[arg(long, value_parser = crate::cmd::number, allow_negative_numbers = true, default_value_t = 10.0)]
     max_time_s: f64,
     /// Bowl model: the bowl from a rig file's [bowl] table (docs/rigs/nominal.toml): its wall
     /// keys unless given as flags, its tilt unless --axes-angle-deg is given, and its bottom

@@ -32,7 +32,7 @@ pub struct Args {
     #[arg(long, requires = "seconds")]
     capture: Option<PathBuf>,
     /// Simulated seconds to run (with --pty: stop after this many real seconds).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number)]
     seconds: Option<f64>,
     /// Commands fed to the rig as if from the PC, `AT_MS:WORDS`, e.g. `0:speed,1800,2100`
     /// `0:start` `5000:inject,sensor2` (repeatable; the answers appear in the output).
@@ -49,7 +49,7 @@ pub struct Args {
     rig_file: Option<PathBuf>,
     /// A noisy line: this percentage of the bytes sent is replaced by a different random byte
     /// (what the PC receives, to try the decoder and the counters; default 0).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, value_parser = crate::cmd::number, default_value_t = 0.0)]
     line_noise_percent: f64,
 }
 

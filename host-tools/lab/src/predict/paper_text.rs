@@ -3,7 +3,7 @@
 use model_core::particle::{Model, Scene};
 
 use super::{Ends, MethodChoice, Prediction, method_name, model_name, refusals};
-use crate::number::fixed;
+use crate::number::{echo, fixed};
 
 pub(super) fn describe_scene(s: &Scene<f64>) -> String {
     let a = s.equilibrium_radius_m();
@@ -15,7 +15,12 @@ pub(super) fn describe_scene(s: &Scene<f64>) -> String {
     };
     format!(
         "scene: omega {} rad/s, mu {}, g {} m/s^2, k2 {:.6}, ri {} m, R {} m; {equilibrium}",
-        s.omega_rad_s, s.mu, s.g_m_s2, s.k2, s.ri_m, s.rim_radius_m,
+        echo(s.omega_rad_s),
+        echo(s.mu),
+        echo(s.g_m_s2),
+        s.k2,
+        echo(s.ri_m),
+        echo(s.rim_radius_m),
     )
 }
 

@@ -4,6 +4,8 @@
 use model_core::particle::OdeError;
 use model_core::particle::{Input, InverseError, Scene, SceneError, magnitude_limits};
 
+use crate::number::echo;
+
 /// A `flag` whose value is outside [`magnitude_limits`], in words (the 1-D scene's and the
 /// tilted bowl's refusal alike).
 pub fn extreme_magnitude(flag: &str) -> String {
@@ -86,25 +88,37 @@ pub fn scene_with_values(e: SceneError, s: &Scene<f64>, n: &Names) -> String {
             "{} {} rad/s: the paper's models take the bowl's speed as a rate of turning, \
              0 or more (which way it turns is not one of their parameters): give 0 or a positive \
              speed",
-            n.omega, s.omega_rad_s
+            n.omega,
+            echo(s.omega_rad_s)
         ),
         SceneError::InvalidResistance => format!(
             "{} {}: the rolling resistance must be 0 or more (0.029 is the paper's)",
-            n.mu, s.mu
+            n.mu,
+            echo(s.mu)
         ),
         SceneError::InvalidGravity => {
-            format!("{} {}: must be above 0 (9.81 on Earth)", n.g, s.g_m_s2)
+            format!(
+                "{} {}: must be above 0 (9.81 on Earth)",
+                n.g,
+                echo(s.g_m_s2)
+            )
         }
         SceneError::InvalidK2 => format!(
             "{} {}: must lie in (0, 1] (5/7 for a solid sphere, 3/5 for a hollow one)",
-            n.k2, s.k2
+            n.k2,
+            echo(s.k2)
         ),
         SceneError::InvalidStartRadius => {
-            format!("{} {} m: the start radius must be 0 or more", n.ri, s.ri_m)
+            format!(
+                "{} {} m: the start radius must be 0 or more",
+                n.ri,
+                echo(s.ri_m)
+            )
         }
         SceneError::InvalidRimRadius => format!(
             "{} {} m: the rim radius must be 0 or more",
-            n.rim, s.rim_radius_m
+            n.rim,
+            echo(s.rim_radius_m)
         ),
         SceneError::ExtremeMagnitude(input) => extreme_magnitude(match input {
             Input::Omega => n.omega,
@@ -134,9 +148,9 @@ pub fn check_named(s: &Scene<f64>, n: &Names) -> anyhow::Result<()> {
             "{} {} m is not inside the rim ({} {} m): the granule must start inside the bowl, \
              as the rig requires",
             n.ri,
-            s.ri_m,
+            echo(s.ri_m),
             n.rim,
-            s.rim_radius_m
+            echo(s.rim_radius_m)
         );
     }
     Ok(())
