@@ -16,8 +16,10 @@ use toml::Spanned;
 
 mod bowl;
 mod check;
+mod words;
 pub use bowl::BowlGeometry;
 use check::Checker;
+pub use words::toml_error_words;
 
 /// One rig from a file: its name, the plant and the seed of its tooth offsets and jitter.
 #[derive(Debug, Clone)]
@@ -117,41 +119,6 @@ pub fn load(path: &Path) -> Result<Vec<Rig>> {
     parse(&text, &path.display().to_string(), &stem)
 }
 
-/// A TOML reading error in plain words: its line (1-based) and its message with the key on
-/// that line named and serde's Rust type names said in words ("expected usize" read as a
-/// defect to a person; it is "a whole number"). The plan's reader uses it too.
-pub fn toml_error_words(text: &str, e: &toml::de::Error) -> (Option<usize>, String) {
-    let mut words = e.message().trim().to_string();
-    for (rust, plain) in [
-        ("usize", "a whole number"),
-        ("u64", "a whole number"),
-        ("u32", "a whole number"),
-        ("u16", "a whole number"),
-        ("u8", "a whole number"),
-        ("i64", "a whole number"),
-        ("i32", "a whole number"),
-        ("f64", "a number"),
-        ("f32", "a number"),
-        ("a boolean", "true or false"),
-    ] {
-        words = words.replace(&format!("expected {rust}"), &format!("expected {plain}"));
-    }
-    let Some(span) = e.span() else {
-        return (None, words);
-    };
-    let start = span.start.min(text.len());
-    let line_no = 1 + text[..start].matches('\n').count();
-    let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
-    let line = text[line_start..].lines().next().unwrap_or("");
-    if let Some((key, _)) = line.split_once('=') {
-        let key = key.trim();
-        if !key.is_empty() && !key.starts_with('[') {
-            words = format!("{key}: {words}");
-        }
-    }
-    (Some(line_no), words)
-}
-
 /// Parses rig-file text; `file` names it in errors, `default_name` names a single rig.
 pub fn parse(text: &str, file: &str, default_name: &str) -> Result<Vec<Rig>> {
     let at = |offset: usize| 1 + text[..offset.min(text.len())].matches('\n').count();
@@ -206,7 +173,7 @@ pub fn parse(text: &str, file: &str, default_name: &str) -> Result<Vec<Rig>> {
         };
         rigs.push(Rig {
             params: check.rig(t)?,
-            seed: check.get(&t.seed, "seed", 0.0, u32::MAX as f64, 1.0)? as u32,
+            seed: check.integer(&t.seed, "seed", 0.0, u32::MAX as f64, 1.0)? as u32,
             particle: t
                 .particle
                 .as_ref()

@@ -218,3 +218,60 @@ fn a_start_in_the_corner_names_every_key_that_moves_it() {
         "{e}"
     );
 }
+
+/// A rig file edited by hand: a misspelt key or table is named with the name it may have meant
+/// (the table as a table, not a "field"); a value typed with its unit, which TOML told to
+/// quote ("string values must be quoted") and then refused as a string, is said to be a number
+/// with a unit; a decimal comma ("unexpected key or value, expected newline") is said to be
+/// one; a fractional seed, taken as its whole part without a word, is refused.
+#[test]
+fn hand_edits_are_said_in_words() {
+    let err = |text: &str| parse(text, "r.toml", "r").err().unwrap().to_string();
+    let e = err("[bowl]\nwall_angel_deg = 60.0\n");
+    assert!(
+        e.starts_with("rig file r.toml, line 2: wall_angel_deg: unknown field `wall_angel_deg`"),
+        "{e}"
+    );
+    assert!(e.ends_with("(did you mean `wall_angle_deg`?)"), "{e}");
+    let e = err("seed = 3\r\n\r\n[bowll] # the bowl\r\naxes_angle_deg = 60.0\r\n");
+    assert!(
+        e.starts_with("rig file r.toml, line 3: unknown table `bowll`"),
+        "{e}"
+    );
+    assert!(e.ends_with("(did you mean `bowl`?)"), "{e}");
+    // Nothing near: no guess.
+    let e = err("[particle]\nvelocity = 1.0\n");
+    assert!(!e.contains("did you mean"), "{e}");
+    for (line, value) in [
+        ("mu = 0.029 kg   # rolling resistance", "0.029 kg"),
+        ("mu = \"0.029 kg\"", "0.029 kg"),
+        ("mu = 0.029kg", "0.029kg"),
+    ] {
+        let e = err(&format!("[particle]\r\n{line}\r\n"));
+        assert_eq!(
+            e,
+            format!(
+                "rig file r.toml, line 2: mu: `{value}` is a number with a unit: write the \
+                 number alone (mu = 0.029), in the unit the key's name says (SI: m, kg, s, \
+                 rad/s, V, ohm, ...)"
+            ),
+            "{line}"
+        );
+    }
+    let e = err("[bowl]\naxes_angle_deg = 60,5\n");
+    assert!(
+        e.contains(
+            "line 2: axes_angle_deg: `60,5` has a decimal comma: TOML takes a decimal \
+                    point (axes_angle_deg = 60.5)"
+        ),
+        "{e}"
+    );
+    // A string key whose value starts with digits is no unit mistake.
+    let e = err("[particle]\nmodel = \"2 flat\"\n");
+    assert!(!e.contains("with a unit"), "{e}");
+    let e = err("seed = 3.5\n");
+    assert!(
+        e.contains("line 1: seed = 3.5 must be a whole number"),
+        "{e}"
+    );
+}
