@@ -28,7 +28,8 @@ fn every_answer_says_whether_its_model_holds() {
     let out = bowl(&predict_args(&rig, &[]));
     assert_eq!(out.status.code(), Some(0));
     let text = String::from_utf8(out.stdout).unwrap();
-    assert!(text.starts_with("NOT VALID HERE: "), "{text}");
+    // Which model does not hold, named (it was a bare "NOT VALID HERE").
+    assert!(text.starts_with("rolling model NOT VALID HERE: "), "{text}");
     let v = json(&predict_args(&rig, &["--json", "--sliding-mu", "0.8"]));
     assert_eq!(v["valid"], true, "{v}");
     assert!(v["invalid_reason"].is_null());
@@ -73,7 +74,26 @@ fn the_hierarchy_says_it_too_and_the_level_models_refuse_a_tilt() {
     assert!(v["chosen"].is_string(), "{v}");
     let out = bowl(&predict_args(&rig, &["--hierarchy-tolerance", "0.05"]));
     let text = String::from_utf8(out.stdout).unwrap();
-    assert!(text.starts_with("NOT VALID HERE: "), "{text}");
+    let chosen = v["chosen"].as_str().unwrap();
+    assert!(
+        text.starts_with(&format!("{chosen} model NOT VALID HERE: ")),
+        "{text}"
+    );
+    // A spin-up too names the model it judged.
+    let out = bowl(&[
+        "predict",
+        "--spin-up-from-rad-s",
+        "0",
+        "--time-constant-s",
+        "0.5",
+        "--omega-rad-s",
+        "30",
+    ]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.starts_with("coriolis model NOT VALID HERE: rolling out to the rim"),
+        "{text}"
+    );
     for model in ["flat", "coriolis", "both"] {
         let out = bowl(&[
             "predict",

@@ -335,8 +335,8 @@ pub fn run(args: &Inputs) -> Result<()> {
         println!("{v}");
     } else {
         for ((m, _), v) in rows.iter().zip(&validity) {
-            if let Some(line) = v.text_line() {
-                println!("{} model {line}", model_name(*m));
+            if let Some(line) = v.text_line(model_name(*m)) {
+                println!("{line}");
             }
         }
         println!("{}", paper_text::describe_scene(&scene));

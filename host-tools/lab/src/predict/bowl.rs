@@ -237,7 +237,7 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
-    if let Some(line) = validity.text_line() {
+    if let Some(line) = validity.text_line("bowl") {
         println!("{line}");
     }
     println!(

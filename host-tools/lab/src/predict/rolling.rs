@@ -322,7 +322,7 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
-    if let Some(line) = validity.text_line() {
+    if let Some(line) = validity.text_line("rolling") {
         println!("{line}");
     }
     println!("{head}");
@@ -424,7 +424,7 @@ fn hierarchy(
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
-    if let Some(line) = validity.text_line() {
+    if let Some(line) = validity.text_line(chosen.name()) {
         println!("{line}");
     }
     println!("{head}");

@@ -23,18 +23,30 @@ impl Validity {
         }
     }
 
-    /// The line the text output starts with when the model does not hold, else nothing.
-    pub fn text_line(&self) -> Option<String> {
-        self.0.as_ref().map(|r| format!("NOT VALID HERE: {r}"))
+    /// The line the text output starts with when the model does not hold, else nothing. It
+    /// names the model (`rolling model NOT VALID HERE: ...`), as the paper's models' lines
+    /// always did: after `--model auto` a bare "NOT VALID HERE" left the reader to guess which.
+    pub fn text_line(&self, model: &str) -> Option<String> {
+        self.0
+            .as_ref()
+            .map(|r| format!("{model} model NOT VALID HERE: {r}"))
     }
 
-    /// The start of an answer at a varying speed (a spin-up, a logged trace): with `json`, `v`
+    /// The start of an answer at a varying speed (a spin-up, a logged trace) of `model`: with
+    /// `json`, `v`
     /// with the chooser's `choice` (the JSON of `super::choice::json`), the residence time
     /// (null when the granule never leaves) and this validity, printed, and `false`; in text,
     /// this validity's line first, and `true`: the caller's text follows.
-    pub fn start_answer(&self, json: bool, mut v: Value, choice: Value, time_s: f64) -> bool {
+    pub fn start_answer(
+        &self,
+        json: bool,
+        model: &str,
+        mut v: Value,
+        choice: Value,
+        time_s: f64,
+    ) -> bool {
         if !json {
-            if let Some(line) = self.text_line() {
+            if let Some(line) = self.text_line(model) {
                 println!("{line}");
             }
             return true;

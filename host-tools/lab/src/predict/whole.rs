@@ -431,7 +431,7 @@ fn report(
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
-    if let Some(line) = a.validity.text_line() {
+    if let Some(line) = a.validity.text_line(a.level.name()) {
         println!("{line}");
     }
     println!(
