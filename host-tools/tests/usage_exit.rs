@@ -26,8 +26,19 @@ fn refused(args: &[&str], words: &[&str]) {
 #[test]
 fn sim_step_speed_flags_are_usage_errors_with_the_range_and_the_floor() {
     let range = "outside the controller's speed range, 0.200 to 4 rad/s";
-    for value in ["-1", "NaN", "inf", "100", "0"] {
+    for value in ["-1", "100", "0"] {
         refused(&["sim", "step", "--target-rad-s", value], &[range]);
+    }
+    // Not a number, or none f32 holds: said so by the one number parser of every flag.
+    refused(
+        &["sim", "step", "--target-rad-s", "NaN"],
+        &["--target-rad-s", "`NaN` is not a number"],
+    );
+    for value in ["inf", "1e400", "1e39"] {
+        refused(
+            &["sim", "step", "--target-rad-s", value],
+            &[&format!("{value} is out of range")],
+        );
     }
     // Below the sensor floor: the motor never moves, the figures would read as a perfect step.
     for value in ["0.1", "0.19"] {
@@ -52,7 +63,10 @@ fn sim_step_speed_flags_are_usage_errors_with_the_range_and_the_floor() {
         &["sim", "step", "--accel-rad-s2", "-1"],
         &["--accel-rad-s2", "0.01 to 1000"],
     );
-    refused(&["sim", "step", "--ripple-nm", "NaN"], &["--ripple-nm NaN"]);
+    refused(
+        &["sim", "step", "--ripple-nm", "NaN"],
+        &["--ripple-nm", "`NaN` is not a number"],
+    );
     refused(
         &["sim", "family", "--plants", "3"],
         &["--plants must be at least 50"],

@@ -39,9 +39,29 @@ pub fn number(text: &str) -> Result<f64, String> {
     Ok(x)
 }
 
+/// [`number`] for a flag kept in `f32` (the controller's and the simulated plant's precision):
+/// beyond `f32` it would turn to infinity or 0 just the same.
+pub fn number32(text: &str) -> Result<f32, String> {
+    let x = number(text)?;
+    let t = text.trim();
+    let narrow = x as f32;
+    if narrow.is_infinite() {
+        return Err(format!(
+            "{t} is out of range: a number here is less than about 3.4e38 in size"
+        ));
+    }
+    if narrow == 0.0 && x != 0.0 {
+        return Err(format!(
+            "{t} is out of range: too small to tell from 0 here (the smallest size is about \
+             1e-45): give 0 if 0 is meant"
+        ));
+    }
+    Ok(narrow)
+}
+
 #[cfg(test)]
 mod tests {
-    use super::number;
+    use super::{number, number32};
 
     #[test]
     fn numbers_out_of_range_are_refused_in_words() {
@@ -63,6 +83,18 @@ mod tests {
         assert!(
             e.starts_with("`0.02 kg` is not a number") && e.contains("no unit"),
             "{e}"
+        );
+        assert_eq!(number32("3.5"), Ok(3.5));
+        assert!(
+            number32("1e39")
+                .unwrap_err()
+                .starts_with("1e39 is out of range")
+        );
+        assert!(number32("1e-50").unwrap_err().contains("too small"));
+        assert!(
+            number32("1e400")
+                .unwrap_err()
+                .starts_with("1e400 is out of range")
         );
     }
 }

@@ -54,7 +54,7 @@ pub struct FaultsArgs {
     #[arg(long)]
     rig_file: std::path::PathBuf,
     /// Speed both axes run at when each fault is injected, rad/s.
-    #[arg(long, default_value_t = 3.0)]
+    #[arg(long, value_parser = crate::cmd::number32, default_value_t = 3.0)]
     speed_rad_s: f32,
     /// Give every plant the typical current sense (`current_sense = true`) where its file
     /// gave none.
@@ -63,7 +63,7 @@ pub struct FaultsArgs {
     /// Each sensor drops this share of its pulses at random (a worn target, a marginal gap),
     /// %, from after commissioning on; the plants are then held at speed 30 s more before the
     /// faults are injected, and the JSON says per axis what was dropped and inferred.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, value_parser = crate::cmd::number32, default_value_t = 0.0, allow_negative_numbers = true)]
     drop_pulses_pct: f32,
     /// JSON output (the only format; accepted for symmetry with the other reports).
     #[arg(long)]
@@ -94,11 +94,11 @@ pub struct TraceArgs {
     #[arg(long)]
     name: Option<String>,
     /// Step target, rad/s.
-    #[arg(long, default_value_t = 3.0)]
+    #[arg(long, value_parser = crate::cmd::number32, default_value_t = 3.0)]
     target_rad_s: f32,
     /// Both axes first settle at this speed, then step to --target-rad-s (0 = from rest),
     /// rad/s; the trace starts at the step's command.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, value_parser = crate::cmd::number32, default_value_t = 0.0)]
     from_rad_s: f32,
 }
 
@@ -113,10 +113,10 @@ pub struct CommonArgs {
 #[derive(clap::Args)]
 pub struct StepSpeeds {
     /// Step target, rad/s.
-    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+    #[arg(long, value_parser = crate::cmd::number32, default_value_t = 3.0, allow_negative_numbers = true)]
     target_rad_s: f32,
     /// Both axes first settle at this speed, then step to --target-rad-s (0 = from rest), rad/s.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, value_parser = crate::cmd::number32, default_value_t = 0.0, allow_negative_numbers = true)]
     from_rad_s: f32,
 }
 
@@ -144,16 +144,16 @@ pub struct StepArgs {
     #[arg(long)]
     no_feedback: bool,
     /// Override the once-per-revolution load ripple of both axes, N m.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number32)]
     ripple_nm: Option<f32>,
     /// Override the loop's per-pulse bandwidth.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number32)]
     per_pulse_bandwidth: Option<f32>,
     /// Override the estimator's filter weight.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number32)]
     filter_weight: Option<f32>,
     /// Override the setpoint ramp, rad/s^2.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::number32)]
     accel_rad_s2: Option<f32>,
     /// A rig file (one rig) instead of the nominal rig; its pulses per revolution and load
     /// step apply (`--pulses-per-rev` and `--ripple-nm` are then ignored).
@@ -194,7 +194,7 @@ pub struct StabilityArgs {
     #[command(flatten)]
     common: CommonArgs,
     /// Speed of the test, rad/s.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, value_parser = crate::cmd::number32, default_value_t = 0.5)]
     speed_rad_s: f32,
     /// Only this pulse count (default: 1, 4, 12 and 60).
     #[arg(long)]
