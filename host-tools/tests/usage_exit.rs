@@ -71,6 +71,11 @@ fn sim_step_speed_flags_are_usage_errors_with_the_range_and_the_floor() {
         &["sim", "family", "--plants", "3"],
         &["--plants must be at least 50"],
     );
+    // A family of no plants was written, and then refused by every reader of it.
+    refused(
+        &["sim", "make-family", "--plants", "0"],
+        &["--plants", "0 is not in 1.."],
+    );
 }
 
 #[test]

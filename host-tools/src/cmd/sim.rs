@@ -75,8 +75,8 @@ pub struct MakeFamilyArgs {
     /// Seed of the spread.
     #[arg(long, default_value_t = 1)]
     seed: u32,
-    /// Number of plants.
-    #[arg(long, default_value_t = 60)]
+    /// Number of plants (1 or more: a family file with none is refused by every reader).
+    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..))]
     plants: u32,
 }
 
