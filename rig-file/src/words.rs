@@ -91,9 +91,7 @@ fn nearest_field(words: &str) -> Option<&str> {
 /// A value's text: after the `=`, without a trailing comment, spaces or quotes.
 fn value_text(value: &str) -> &str {
     let v = match value.find('#') {
-        Some(i) if !value[..i].contains('"') || value[..i].matches('"').count() % 2 == 0 => {
-            &value[..i]
-        }
+        Some(i) if value[..i].matches('"').count().is_multiple_of(2) => &value[..i],
         _ => value,
     };
     v.trim().trim_matches('"').trim()

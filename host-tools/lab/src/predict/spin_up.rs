@@ -63,13 +63,7 @@ pub fn run(
         },
     });
     let choice_json = super::choice::json(&choice, runs_on);
-    if validity.start_answer(
-        json,
-        super::model_name(choice.model),
-        head,
-        choice_json,
-        time_s,
-    ) {
+    if validity.start_answer(json, choice.model, head, choice_json, time_s) {
         println!(
             "spin-up: from {start_rad_s} to {} rad/s with time constant {time_constant_s} s, \
              the particle released at t = 0; mu {}, ri {} m, R {} m",

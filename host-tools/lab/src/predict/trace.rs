@@ -199,13 +199,7 @@ pub fn run(
         "residence_time_from_choosing": answered.is_some(),
     });
     let choice_json = super::choice::json(&choice, runs_on);
-    if validity.start_answer(
-        json,
-        super::model_name(choice.model),
-        head,
-        choice_json,
-        time_s,
-    ) {
+    if validity.start_answer(json, choice.model, head, choice_json, time_s) {
         println!(
             "trace: {}, {} samples from device time {} ms over {covered_s:.3} s, bowl speed \
              {lo:.3} to {hi:.3} rad/s (held at the last sample after that)",

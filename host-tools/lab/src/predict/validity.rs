@@ -40,13 +40,13 @@ impl Validity {
     pub fn start_answer(
         &self,
         json: bool,
-        model: &str,
+        model: model_core::particle::Model,
         mut v: Value,
         choice: Value,
         time_s: f64,
     ) -> bool {
         if !json {
-            if let Some(line) = self.text_line(model) {
+            if let Some(line) = self.text_line(super::model_name(model)) {
                 println!("{line}");
             }
             return true;
