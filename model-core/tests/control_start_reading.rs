@@ -33,7 +33,11 @@ fn from_rest_a_heavy_rod_takes_the_load_with_the_kick_still_in_it() {
 /// Seed 4 p00: a heavy rod (tau 0.52 s) carrying 0.045 N m of material from the start. Its first
 /// window (0.55-1.27 s) showed 0.8 of the load's steady deficit through the rod's lag and read
 /// 0.198 rad/s where its loop settled at 0.26: 2 % at 4.78 s. Read through the lag, 3.86 s; with
-/// the correction set to it as well, 3.12 s.
+/// the correction set to it as well, 3.12 s (3.45 s since the crawl's reading counts the push
+/// as the speed it gave). Since the rod is fed the reaction of its spin catching up on its
+/// start reading (1.4 s in), its own first window sees the rod a little faster and reads
+/// 0.0005 duty less load, which the loop then closes at its bandwidth: 4.00 s. The bound
+/// stays below the 4.78 s of a load read without the lag.
 #[test]
 fn from_rest_a_heavy_rods_load_is_read_through_its_lag() {
     let p00 = plant_rows::rig_from_table(
@@ -48,7 +52,7 @@ fn from_rest_a_heavy_rods_load_is_read_through_its_lag() {
             ],
         ],
     );
-    assert_settled_within_2_pct_by(rod_from_rest_to_1_rad_s(p00, 4000), 3.5, "the rod");
+    assert_settled_within_2_pct_by(rod_from_rest_to_1_rad_s(p00, 4000), 4.2, "the rod");
 }
 
 /// Seed 4 p19: a heavy rod (tau 0.40 s) the kick ran ahead of its model until its first edge
@@ -118,4 +122,26 @@ fn from_rest_a_crawls_push_counts_as_the_speed_it_gave() {
     );
     let [_, spin] = from_rest::from_rest_to_1_rad_s(p01, 4001);
     assert_settled_within_2_pct_by(spin, 3.0, "the spin");
+}
+
+/// Seed 10 p06: a heavy, stiff rod (0.47 N m of friction) whose loaded spin took its start
+/// reading 1.2 s in and caught up from 0.71 rad/s. Its reference's model had long reached
+/// 1 rad/s, so the rod's decoupling fed none of that reaction: the rod dipped 3 %, read the dip
+/// as load, ran 3 % past 1 rad/s and settled within 2 % at 3.90 s. The spin's model now
+/// accelerates by what its correction is still to give (controller.rs, `to_come`).
+#[test]
+fn from_rest_the_rod_is_fed_the_reaction_of_a_spin_catching_up_on_its_reading() {
+    let p06 = plant_rows::rig_from_table(
+        10.969,
+        0.556,
+        [
+            [
+                1.4209, 0.07196, 0.04689, 0.4689, 0.6252, 0.0068, 0.000273, 0.0020, 0.0125,
+            ],
+            [
+                1.4168, 0.05557, 0.00604, 0.0604, 0.0846, 0.0023, 0.000660, 0.0086, 0.0733,
+            ],
+        ],
+    );
+    assert_settled_within_2_pct_by(rod_from_rest_to_1_rad_s(p06, 10006), 3.0, "the rod");
 }

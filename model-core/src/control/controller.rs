@@ -288,7 +288,22 @@ impl Controller {
         // The ramp's, not the led reference's (pi.rs `lead`): a led spin's model accelerates at
         // `(led - r_p) / tau`, and fed that, the eleven families' shares within 2 % by 3 s from
         // rest to 1 rad/s summed 1079.2 against 1080.9 (docs/control.md, "The reference's lead").
-        let by_model = ramped[1] - s.speed_loop.model_rad_s();
+        // Once the spin is measured, its model accelerates by what its correction is still to
+        // give too: a loaded spin's start reading raises its integral to the load it read, and
+        // the spin then catches up through its lag as the reference's model no longer does.
+        // Left out, the rod got none of that reaction, dipped 3 % and read the dip as load
+        // (seed 10 p06's rod: 3 % past 1 rad/s, 2 % at 3.90 s; now 0.8 %, 1.73 s; docs/control.md,
+        // "The crawl's push in the correction"). Only speeding up: a correction coming down
+        // after a reading that ran ahead of the load is no deceleration the shaft makes (the
+        // correction's model leaves out the load it then reads), and fed as one it starved
+        // rods at the lowest speed (family-60 p50, 0 -> 0.2 rad/s: 4 -> 30 % past).
+        let to_come = s.speed_loop.correction_to_come_rad_s(&s.k);
+        let correction = if s.est.is_valid() && to_come * s.direction > 0.0 {
+            to_come
+        } else {
+            0.0
+        };
+        let by_model = ramped[1] - s.speed_loop.model_rad_s() + correction;
         // With current sense a spin at rest whose current has not shown its breakaway is
         // held (by stiction, or material the model does not know): its motor's torque and
         // what holds it cancel on the rod, so there is no reaction to decouple. Fed, a fast

@@ -2,6 +2,7 @@
 //! [`SpeedLoop::step`], is [`super`]'s.
 
 use super::Breakaway;
+use super::LoopConstants;
 
 /// State of one axis's loop.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -125,6 +126,14 @@ impl SpeedLoop {
     /// deceleration, not a load.
     pub fn slowing(&self) -> bool {
         self.slowing
+    }
+
+    /// What the correction (the feedback's duty and the kick's beyond the feedforward) is
+    /// still to add to the plant model's speed through the identified lag, rad/s: its steady
+    /// speed less the speed it has given so far, that is the model's expected acceleration
+    /// from it times `tau`.
+    pub fn correction_to_come_rad_s(&self, k: &LoopConstants) -> f32 {
+        self.correction_duty * k.kick_gain_per_tick / k.model_alpha - self.correction_rad_s
     }
 
     /// The plant model's speed (the reference through the identified lag), rad/s.
