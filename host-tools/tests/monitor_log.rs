@@ -101,3 +101,61 @@ fn one_log_takes_one_monitor() {
         "{text}"
     );
 }
+
+/// `bowl replay cap.bin --csv day.csv` with the day's monitor log named by mistake: before, the
+/// log was emptied and filled with the capture's rows while the monitor went on appending to
+/// it (the day's rows gone, two runs mixed). Now it is refused (exit 2) and left whole, while a
+/// monitor writes it and after; a replay's own CSV is still replaced. The log itself given as
+/// the capture is told to be a log, with what draws it.
+#[test]
+fn a_replay_does_not_replace_a_monitor_log() {
+    let sim = Sim::start(&["--seconds", "30"]);
+    let dir = temp_dir("monitor-log-replay");
+    let capture = common::capture_timed(&dir, "1", &[]);
+    let log = dir.join("day.csv");
+    let mut writing = std::process::Command::new(common::BOWL)
+        .args(["monitor", &sim.path, "--plain", "--seconds", "3", "--log"])
+        .arg(&log)
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while !std::fs::read_to_string(&log).is_ok_and(|t| t.contains("port open")) {
+        assert!(started.elapsed().as_secs() < 5, "no first row");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let out = common::replay_to_csv(&capture, &log);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--csv") && err.contains("a `bowl monitor` is writing it now"),
+        "{err}"
+    );
+    assert!(writing.wait().unwrap().success());
+    let whole = std::fs::read_to_string(&log).unwrap();
+    assert_eq!(whole.matches(",port open").count(), 1, "{whole}");
+    assert!(whole.trim_end().ends_with(",monitor end"), "{whole}");
+
+    // The monitor gone, the log is still one of a day's PC times: refused again, untouched.
+    let out = common::replay_to_csv(&capture, &log);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("it was logged live"), "{err}");
+    assert_eq!(std::fs::read_to_string(&log).unwrap(), whole);
+
+    // The log as the capture: said to be a log, and what reads it.
+    let out = common::bowl(&["replay", log.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("is a telemetry log") && err.contains("bowl chart log --csv"),
+        "{err}"
+    );
+
+    // A replay's CSV is made again from its capture: replaced, as before.
+    let decoded = dir.join("replay.csv");
+    assert!(common::replay_to_csv(&capture, &decoded).status.success());
+    let again = common::replay_to_csv(&capture, &decoded);
+    assert!(again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("existed and was replaced"));
+}

@@ -228,6 +228,47 @@ pub fn write_gate_event(
     Ok(())
 }
 
+/// What an existing file is, as far as a telemetry log goes: read from its first 64 KiB (a day's
+/// log is hundreds of MB).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LogKind {
+    /// Not a telemetry log (no such header), or not readable.
+    Other,
+    /// A telemetry log decoded from a capture (`bowl replay --csv`): no PC times, so a replay
+    /// of its capture makes it again.
+    Decoded,
+    /// A log written live (`bowl monitor --log`, the demo's telemetry.csv): its rows carry the
+    /// PC's clock, which nothing can make again.
+    Live,
+}
+
+/// What the file at `path` is ([`LogKind`]).
+pub fn log_kind(path: &std::path::Path) -> LogKind {
+    use std::io::Read as _;
+    let mut head = Vec::new();
+    let read = std::fs::File::open(path).and_then(|f| f.take(1 << 16).read_to_end(&mut head));
+    if read.is_err() {
+        return LogKind::Other;
+    }
+    let mut reader = csv::ReaderBuilder::new()
+        .flexible(true)
+        .from_reader(head.as_slice());
+    let host = match reader.headers() {
+        Ok(h) if h.iter().eq(HEADER.split(',')) => TELEMETRY_COLUMNS + 1,
+        _ => return LogKind::Other,
+    };
+    // The last record read may be cut at 64 KiB: its host time, if any, is still a host time.
+    let live = reader
+        .records()
+        .map_while(Result::ok)
+        .any(|r| r.get(host).is_some_and(|t| !t.is_empty()));
+    if live {
+        LogKind::Live
+    } else {
+        LogKind::Decoded
+    }
+}
+
 /// A gate event in words, for the log's event column and the console: `release gate at
 /// 5000123 us (boot 0)`.
 pub fn gate_event_text(e: &model_core::wire::GateEvent) -> String {
@@ -279,6 +320,28 @@ mod tests {
         assert_eq!(gate_device_ms(time_us, Some(4_300_520)), 4_300_500.0);
         assert_eq!(gate_device_ms(5_000_123, Some(4_990)), 5_000.123);
         assert_eq!(gate_device_ms(5_000_123, None), 5_000.123);
+    }
+
+    /// A replay's CSV (no PC times) and a live log (a `port open` row with the PC's time) are
+    /// told apart; a results file and a missing file are neither.
+    #[test]
+    fn live_logs_are_told_from_decoded_ones() {
+        let dir = std::env::temp_dir().join(format!("bowl-log-kind-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (mut decoded, mut live) = (format!("{HEADER}\n").into_bytes(), Vec::new());
+        live.extend_from_slice(&decoded);
+        write_device_event(&mut decoded, 1, 5000, "no telemetry").unwrap();
+        write_event(&mut live, 0, Some(SystemTime::UNIX_EPOCH), "port open").unwrap();
+        for (name, text, kind) in [
+            ("decoded.csv", decoded, LogKind::Decoded),
+            ("live.csv", live, LogKind::Live),
+            ("results.csv", b"run,t_s\n1,2.5\n".to_vec(), LogKind::Other),
+        ] {
+            std::fs::write(dir.join(name), text).unwrap();
+            assert_eq!(log_kind(&dir.join(name)), kind, "{name}");
+        }
+        assert_eq!(log_kind(&dir.join("missing.csv")), LogKind::Other);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     /// An event in words with commas and quotes (the monitor's warning about another program

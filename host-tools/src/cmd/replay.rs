@@ -113,6 +113,9 @@ pub fn run(args: &Args) -> Result<()> {
             path.display()
         );
     }
+    if let Some(path) = &args.csv {
+        refuse_a_live_log(path)?;
+    }
     // A replay writes the whole decode each time (appending would repeat its rows), unlike the
     // monitor's live log, which appends: say so when a file was there.
     let replaced = args
@@ -220,6 +223,14 @@ pub fn run(args: &Args) -> Result<()> {
         if stats.bytes == 0 {
             bail!("{file} is empty: a capture holds the bytes the rig sent");
         }
+        // A telemetry log given for its capture: the decode is done already; say what reads it.
+        if telemetry_csv::log_kind(&args.file) != telemetry_csv::LogKind::Other {
+            return Err(usage(format!(
+                "{file} is a telemetry log (the CSV `bowl monitor --log` or `bowl replay --csv` \
+                 writes), decoded already, not a capture of the rig's raw bytes: draw it with \
+                 `bowl chart log --csv {file} --out run.svg`"
+            )));
+        }
         let damaged = if stats.frames_corrupt > 0 {
             format!(
                 "; {} frame candidates, every one damaged (a wrong baud rate or a broken line?)",
@@ -257,6 +268,27 @@ fn refuse_a_port(path: &std::path::Path) -> Result<()> {
     #[cfg(not(unix))]
     let _ = path;
     Ok(())
+}
+
+/// Refuses to replace a log written live (`bowl monitor --log`, the demo's telemetry.csv): its
+/// PC times are made once, and a monitor still writing it would append its rows after the
+/// decode's. A replay's own CSV is made again from its capture, so that one is replaced.
+fn refuse_a_live_log(path: &std::path::Path) -> Result<()> {
+    let p = path.display();
+    let held = File::open(path)
+        .is_ok_and(|f| matches!(f.try_lock_shared(), Err(std::fs::TryLockError::WouldBlock)));
+    let why = if held {
+        "a `bowl monitor` is writing it now (its `--log`)"
+    } else if telemetry_csv::log_kind(path) == telemetry_csv::LogKind::Live {
+        "it was logged live (`bowl monitor --log`, or a demo's telemetry.csv): its rows carry the \
+         PC's clock, which no capture holds"
+    } else {
+        return Ok(());
+    };
+    Err(usage(format!(
+        "--csv {p}: {why}, so replacing it with this decode would lose those rows; it was left \
+         as it is. Give a new file name for the decode (e.g. --csv replay.csv)"
+    )))
 }
 
 /// Whether `a` names the existing file `b` (the same path, or another path to it).
