@@ -504,3 +504,32 @@ fn a_command_typed_while_the_link_is_lost_is_never_sent() {
         "monitor after SIGTERM",
     );
 }
+
+/// A fault that comes and goes between two of the plain monitor's once-a-second lines (cleared
+/// at once from another console, as a script does): before, the monitor never said it, and the
+/// engineer found the motors stopped with no word why (only the log's fault column had it). Now
+/// each change is an event line of its own: the fault with its code and words, then its clearing.
+#[test]
+fn a_fault_and_its_clearing_are_said_as_they_come() {
+    let sim = Sim::start(&[]);
+    let dir = common::temp_dir("console-fault-events");
+    let (mut child, lines) = start_monitor(&sim.path, &dir.join("run.csv"), Stdio::piped());
+    for words in ["speed 1800 2100", "start", "inject sensor1"] {
+        assert_eq!(common::send(&sim.path, words).0, 0, "{words}");
+    }
+    let fault = wait_line(&lines, "FAULT 1:");
+    assert!(
+        fault.contains("precession motor: no sensor pulses")
+            && fault.contains("the rig stopped the motors; `clear`"),
+        "{fault}"
+    );
+    assert_eq!(common::send(&sim.path, "clear").0, 0);
+    let cleared = wait_line(&lines, "fault cleared");
+    assert!(
+        cleared.contains("it was: precession motor: no sensor pulses")
+            && cleared.contains("the motors stay off until `start`"),
+        "{cleared}"
+    );
+    let _ = child.kill();
+    let _ = child.wait();
+}

@@ -8,7 +8,7 @@ use std::collections::VecDeque;
 use std::io::Write;
 use std::time::{Duration, Instant};
 
-use model_core::wire::{Decoder, Frame, Hello, Residence, Telemetry};
+use model_core::wire::{Decoder, FaultCode, Frame, Hello, Residence, Telemetry};
 
 use rig_client::lines::describe;
 
@@ -104,6 +104,8 @@ pub(crate) struct View {
     pub(crate) telemetry_frames: u64,
     /// The board conditions the rig's STATUS reported (`wire::status_flags` bits), once asked.
     pub(crate) board_flags: Option<u8>,
+    /// The fault the telemetry reported last (each change is said once, as an event).
+    fault: FaultCode,
 }
 
 /// Telemetry is overdue after this many frame periods without a frame ...
@@ -133,6 +135,7 @@ impl View {
             period_ms: 0,
             telemetry_frames: 0,
             board_flags: None,
+            fault: FaultCode::None,
         }
     }
 
@@ -161,12 +164,34 @@ impl View {
                         self.period_ms = dt;
                     }
                 }
+                // A fault said as it comes and goes: one cleared within a second (`clear` from
+                // another console, a script) never reached a plain line or stayed on the screen,
+                // and the motors were found stopped with no word why.
+                let before = self.fault;
+                self.fault = t.fault;
+                if t.fault != before {
+                    let text = match t.fault {
+                        FaultCode::None => format!(
+                            "fault cleared (it was: {}); the motors stay off until `start`",
+                            before.words()
+                        ),
+                        now => format!(
+                            "FAULT {}: {}: the rig stopped the motors; `clear` once the cause \
+                             is fixed",
+                            now.code(),
+                            now.words()
+                        ),
+                    };
+                    self.event(plain, text);
+                }
                 self.latest = Some(*t);
                 self.heard_at = Instant::now();
                 self.telemetry_frames += 1;
             }
             Frame::Hello(h) => {
                 self.hello = Some(*h);
+                // A reset ends a fault without a `clear`: the boot is said, not a clearing.
+                self.fault = FaultCode::None;
                 self.event(
                     plain,
                     format!(
