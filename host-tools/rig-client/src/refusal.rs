@@ -151,6 +151,18 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
             p.token()
         );
     }
+    // The loop tuning, refused only while commissioning (which runs a loop of its own): the
+    // command's states (every one, commissioning too) would contradict the refusal.
+    if let Some(p) = param
+        && s.state == D::Commissioning
+    {
+        return format!(
+            "the rig is commissioning: {} changes in any state but commissioning (it identifies \
+             the motors with a loop of its own); wait until it is idle again (about 45 s; \
+             `bowl send PORT status`), then set it",
+            p.token()
+        );
+    }
     let todo = match s.state {
         D::Running | D::ChangingSpeed if command == "start" => format!(
             "already running (state {}); change speed with `speed`, or `stop` first",

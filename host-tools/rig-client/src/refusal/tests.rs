@@ -56,6 +56,24 @@ fn clear_without_a_fault_says_so_in_every_state() {
     }
 }
 
+/// A loop bandwidth SET while commissioning is told it waits for the end of commissioning;
+/// before, the refusal listed commissioning among the states `set` is taken in.
+#[test]
+fn a_loop_setting_refused_while_commissioning_says_why() {
+    let s = status_in(model_core::wire::DeviceState::Commissioning);
+    for typed in ["set BW1_MRAD_S 8000", "set per_pulse2_milli 400"] {
+        let words = w(typed);
+        let text = state_words(&s, "set", &words);
+        let name = words[1].to_ascii_uppercase();
+        assert!(
+            text.contains(&format!("{name} changes in any state but commissioning"))
+                && text.contains("wait until it is idle again")
+                && !text.contains("is taken while"),
+            "{typed}: {text}"
+        );
+    }
+}
+
 #[test]
 fn speed_above_the_limit_names_the_axis_and_limit() {
     let p = default_params();
