@@ -275,6 +275,29 @@ mod tests {
     use super::*;
     use crate::wire::device::DEFAULT_TELEMETRY_HZ;
 
+    /// SET's meaning (the command table, rendered into docs/protocol.md and the refusals'
+    /// reader) names every parameter a running rig takes, by name or as its group (`BWn_MRAD_S`,
+    /// `RT_*`): it left the residence-time table out, so it read as idle-only.
+    #[test]
+    fn set_names_every_parameter_it_takes_while_running() {
+        use std::string::String;
+        let meaning = crate::wire::CommandKind::SetParam.meaning();
+        for id in ParamId::ALL {
+            if !ParamRole::of(id).changes_while_running() {
+                continue;
+            }
+            let token = id.token();
+            let group: String = token
+                .chars()
+                .map(|c| if c.is_ascii_digit() { 'n' } else { c })
+                .collect();
+            let named = meaning.contains(token)
+                || meaning.contains(&group)
+                || (token.starts_with("RT_") && meaning.contains("`RT_*`"));
+            assert!(named, "{token} not named in SET's meaning: {meaning}");
+        }
+    }
+
     /// The table's defaults are the controller's nominal configuration and the particle
     /// model's default scene in wire units (computed here from those, independently).
     #[test]

@@ -368,8 +368,8 @@ command_table! {
     SetParam: "SET", answer Ack, refusable true, states ANY, changes true,
         example "set MU_PPM 29000",
         meaning "set one parameter (table below), each when its part of the rig allows: the \
-                 particle scene (`RIM_UM`, `START_UM`, `MU_PPM`, `K2_PPM`) and `TELEM_HZ` in any \
-                 state, the loop bandwidths (`BWn_MRAD_S`, `PER_PULSEn_MILLI`) in any but \
+                 particle scene (`RIM_UM`, `START_UM`, `MU_PPM`, `K2_PPM`), the residence-time table \
+                 (`RT_*`) and `TELEM_HZ` in any state, the loop bandwidths (`BWn_MRAD_S`, `PER_PULSEn_MILLI`) in any but \
                  commissioning, the rest while idle or faulted (`STATE` otherwise)"
     {
         /// Which parameter.
