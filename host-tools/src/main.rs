@@ -129,7 +129,7 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Commission(args) => cmd::commission::run(&args),
         Command::Replay(args) => done(cmd::replay::run(&args)),
         #[cfg(unix)]
-        Command::Demo(args) => done(demo::run(&args)),
+        Command::Demo(args) => demo::run(&args),
         Command::Serve(args) => done(cmd::serve::run(&args)),
         Command::Sim(report) => done(cmd::sim::run(&report)),
         Command::Experiment(args) => done(cmd::experiment::run(&args)),

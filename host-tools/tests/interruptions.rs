@@ -320,3 +320,52 @@ fn a_rig_reset_during_commissioning_is_not_success() {
     assert_eq!(got["result"], "restarted", "{got}");
     assert!(got["axes"].as_array().is_none_or(|a| a.is_empty()), "{got}");
 }
+
+/// Ctrl-C on `bowl demo` mid-session: before, it died where it stood (killed by the signal, no
+/// exit code), its telemetry.csv cut mid-row beside an earlier run's summary and charts, a chart
+/// being written left at 0 bytes. Now it sends STOP, waits for the motors to be off, says so,
+/// summarises and charts the run up to there, and exits 130.
+#[test]
+fn demo_interrupted_stops_the_motors_and_says_so() {
+    let dir = temp_dir("demo-interrupted");
+    let mut child = Command::new(BOWL)
+        .args(["demo", "--fast", "--rig", "host", "--plain", "--out"])
+        .arg(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    // The motors turn once START is answered.
+    read_until(&mut out, "start: start -> ok");
+    signal(&child, Signal::SIGINT);
+    let mut rest = String::new();
+    out.read_to_string(&mut rest).unwrap();
+    let status = wait_within(&mut child, Duration::from_secs(30), "demo after SIGINT");
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    assert_eq!(status.code(), Some(130), "{err}\n{rest}");
+    assert!(
+        err.contains("interrupted (Ctrl-C): STOP sent, the motors are off"),
+        "{err}"
+    );
+    assert!(rest.contains("stop (interrupted): stop -> ok"), "{rest}");
+    // The log ends with both motors off, idle, each row whole.
+    let rows = common::csv_rows(&dir.join("telemetry.csv"));
+    let last = rows.last().expect("telemetry rows");
+    assert_eq!(last["state"], "idle", "{last:?}");
+    assert_eq!((&*last["prec_duty_bp"], &*last["spin_duty_bp"]), ("0", "0"));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let aborted = summary.to_string();
+    assert!(aborted.contains("interrupted (Ctrl-C)"), "{summary}");
+    for chart in ["speeds_precession.png", "speeds_spin.png"] {
+        let len = std::fs::metadata(dir.join(chart)).map_or(0, |m| m.len());
+        assert!(len > 0, "{chart}: {len} bytes");
+    }
+}

@@ -45,8 +45,8 @@ pub struct Args {
     seed: u32,
 }
 
-/// Runs `bowl demo`.
-pub fn run(args: &Args) -> Result<()> {
+/// Runs `bowl demo`: its exit code (0, or 130 when Ctrl-C ended it with the motors stopped).
+pub fn run(args: &Args) -> Result<i32> {
     if !(args.seconds.is_finite() && (10.0..=3600.0).contains(&args.seconds)) {
         bail!("--seconds must be between 10 and 3600 (the steps need time to settle)");
     }
@@ -54,8 +54,18 @@ pub fn run(args: &Args) -> Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let started = Instant::now();
+    // Ctrl-C (or SIGTERM) ends the session with the motors stopped, and the run so far is
+    // still summarised and charted (before, the process died where it stood: a telemetry.csv
+    // cut mid-row beside an earlier run's summary and charts, a chart cut at 0 bytes).
+    let interrupt = crate::interrupt::flag();
 
     let rig = Endpoint::start(args.rig, args.fast, args.seed, args.seconds)?;
+    // Ctrl-C while the rig started (the emulated board boots for seconds): nothing was sent.
+    if interrupt.load(std::sync::atomic::Ordering::SeqCst) {
+        let _ = rig.shutdown();
+        eprintln!("bowl demo: interrupted (Ctrl-C) before the session began: nothing was sent");
+        return Ok(crate::exit_code::INTERRUPTED);
+    }
     println!("bowl demo: {}", rig.description);
     if let Some(why) = &rig.qemu_note {
         println!("bowl demo: not on the emulated board: {why}; using the host rig");
@@ -68,7 +78,7 @@ pub fn run(args: &Args) -> Result<()> {
 
     let csv_path = args.out.join("telemetry.csv");
     let label = format!("demo [{} rig]  {}", rig.kind, rig.port);
-    let session = session::Session::open(&rig.port, label, plain, &csv_path);
+    let session = session::Session::open(&rig.port, label, plain, &csv_path, interrupt);
     let mut session = match session {
         Ok(s) => s,
         Err(e) => {
@@ -146,6 +156,14 @@ pub fn run(args: &Args) -> Result<()> {
     for f in &files {
         println!("  {}", f.display());
     }
+    if interrupt.load(std::sync::atomic::Ordering::SeqCst) {
+        let why = outcome
+            .aborted
+            .as_deref()
+            .unwrap_or("interrupted (Ctrl-C) while the summary and charts were written");
+        eprintln!("bowl demo: {why}; the summary and charts above are of the run up to there");
+        return Ok(crate::exit_code::INTERRUPTED);
+    }
     if let Some(why) = &outcome.aborted {
         bail!("the session ended early: {why}");
     }
@@ -164,5 +182,5 @@ pub fn run(args: &Args) -> Result<()> {
     if !failed.is_empty() {
         bail!("the demo's checks failed: {}", failed.join(", "));
     }
-    Ok(())
+    Ok(crate::exit_code::OK)
 }

@@ -147,6 +147,33 @@ fn motors_off(t: &Telemetry) -> bool {
     t.state == DeviceState::Faulted && t.precession.duty_bp == 0 && t.spin.duty_bp == 0
 }
 
+/// Ctrl-C mid-session: the motors are stopped before the demo ends (a rig on another process,
+/// the emulated board, would otherwise go on at its last speeds until its link watch), and
+/// the words say whether they are.
+fn stop_when_interrupted(s: &mut Session) -> String {
+    let at_rest = |t: &Telemetry| {
+        matches!(t.state, DeviceState::Idle | DeviceState::Faulted)
+            && t.precession.duty_bp == 0
+            && t.spin.duty_bp == 0
+    };
+    let stopped = s.command("stop (interrupted)", &["stop"]).and_then(|ok| {
+        let off = s.wait_for(STOP_WAIT_MS, at_rest)?;
+        Ok(ok && off.is_some())
+    });
+    match stopped {
+        Ok(true) => "interrupted (Ctrl-C): STOP sent, the motors are off".into(),
+        Ok(false) => format!(
+            "interrupted (Ctrl-C): STOP sent, but the motors were not seen off within {} s",
+            STOP_WAIT_MS / 1000
+        ),
+        Err(e) => format!("interrupted (Ctrl-C): STOP not confirmed: {e:#}"),
+    }
+}
+
+/// How long (device time) an interrupted demo waits for the motors to stop: the ramp down from
+/// the script's speeds and the shafts read at rest (about two seconds).
+const STOP_WAIT_MS: u32 = 6000;
+
 /// Injects a fault into the rig's simulated world (`sensor2`, `none`, ...) when the rig's
 /// firmware does not take `INJECT` over the wire (real firmware on an emulated board).
 pub type Injector<'a> = &'a mut dyn FnMut(&str) -> Result<()>;
@@ -161,7 +188,11 @@ pub fn run(s: &mut Session, timing: Timing, injector: Option<Injector>) -> Outco
     };
     if let Err(e) = steps(s, timing, &mut out, injector) {
         s.event(format!("session aborted: {e:#}"));
-        out.aborted = Some(format!("{e:#}"));
+        out.aborted = Some(if s.interrupted() {
+            stop_when_interrupted(s)
+        } else {
+            format!("{e:#}")
+        });
     }
     let end = s.now_ms().unwrap_or(0);
     out.marks.push(Mark {

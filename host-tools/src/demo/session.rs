@@ -6,6 +6,7 @@
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
@@ -70,6 +71,10 @@ pub struct Session {
     next_plain_ms: u32,
     plain_every_ms: u32,
     last_frame_at: Instant,
+    /// Raised by Ctrl-C or SIGTERM ([`crate::interrupt::flag`]).
+    interrupt: &'static AtomicBool,
+    /// The interruption ended the script (once: the STOP after it still goes through).
+    interrupted: bool,
 }
 
 /// How long the rig may stay silent (wall time) before the session gives up.
@@ -86,6 +91,7 @@ impl Session {
         label: String,
         plain: bool,
         csv_path: &std::path::Path,
+        interrupt: &'static AtomicBool,
     ) -> Result<Self> {
         let port_handle = Port::open(port, model_core::wire::DEFAULT_BAUD)?;
         let mut csv = BufWriter::new(
@@ -110,6 +116,8 @@ impl Session {
             next_plain_ms: 0,
             plain_every_ms: 2000,
             last_frame_at: Instant::now(),
+            interrupt,
+            interrupted: false,
         })
     }
 
@@ -140,8 +148,18 @@ impl Session {
         self.view.event(self.plain, line);
     }
 
-    /// Reads what is there (waiting at most `wait`), handles every frame, redraws.
+    /// Whether Ctrl-C (or SIGTERM) ended the script.
+    pub fn interrupted(&self) -> bool {
+        self.interrupted
+    }
+
+    /// Reads what is there (waiting at most `wait`), handles every frame, redraws. Ctrl-C ends
+    /// the step under way with an error, once: the script then stops the motors through here.
     fn pump(&mut self, wait: Duration) -> Result<Vec<Answer>> {
+        if !self.interrupted && self.interrupt.load(Ordering::SeqCst) {
+            self.interrupted = true;
+            bail!("interrupted (Ctrl-C)");
+        }
         let mut answers = Vec::new();
         let mut buf = [0u8; 4096];
         match self.port.read(&mut buf, wait)? {
