@@ -10,7 +10,7 @@ use std::os::unix::process::ExitStatusExt;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use common::{BOWL, Sim, bowl, wait_within};
+use common::{BOWL, Sim, bowl, stderr_of, wait_within};
 
 /// Runs `bowl ARGS`, reads `lines` lines of its output, closes the pipe; the run must then end
 /// by SIGPIPE or with status 0, and say nothing of a panic.
@@ -42,19 +42,6 @@ fn ends_quietly_when_the_reader_goes(args: &[&str], lines: usize) {
         "{args:?}: {status:?}: {err}"
     );
     assert!(!err.contains("panicked"), "{args:?}: {err}");
-}
-
-/// All `child` wrote to its standard error.
-fn stderr_of(child: &mut std::process::Child) -> String {
-    use std::io::Read;
-    let mut err = String::new();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
-    err
 }
 
 #[test]

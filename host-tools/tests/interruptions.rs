@@ -342,13 +342,7 @@ fn demo_interrupted_stops_the_motors_and_says_so() {
     let mut rest = String::new();
     out.read_to_string(&mut rest).unwrap();
     let status = wait_within(&mut child, Duration::from_secs(30), "demo after SIGINT");
-    let mut err = String::new();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
+    let err = common::stderr_of(&mut child);
     assert_eq!(status.code(), Some(130), "{err}\n{rest}");
     assert!(
         err.contains("interrupted (Ctrl-C): STOP sent, the motors are off"),

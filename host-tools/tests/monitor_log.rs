@@ -16,6 +16,27 @@ fn fields(line: &str) -> usize {
         .map_or(0, |r| r.unwrap().len())
 }
 
+/// A `bowl monitor --plain --seconds 3 --log LOG` on `port`, once its log is open (its first
+/// row is there).
+fn monitor_writing(port: &str, log: &std::path::Path) -> std::process::Child {
+    let child = std::process::Command::new(common::BOWL)
+        .args(["monitor", port, "--plain", "--seconds", "3", "--log"])
+        .arg(log)
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while !std::fs::read_to_string(log).is_ok_and(|t| t.contains("port open")) {
+        assert!(
+            started.elapsed().as_secs() < 5,
+            "no first row in {}",
+            log.display()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    child
+}
+
 #[test]
 fn a_log_is_appended_to_and_another_csv_is_left_alone() {
     let sim = Sim::start(&["--seconds", "30"]);
@@ -68,22 +89,7 @@ fn one_log_takes_one_monitor() {
     let second = Sim::start(&["--seconds", "30"]);
     let dir = temp_dir("monitor-log-shared");
     let log = dir.join("bench.csv");
-    let mut writing = std::process::Command::new(common::BOWL)
-        .args(["monitor", &first.path, "--plain", "--seconds", "3", "--log"])
-        .arg(&log)
-        .stdout(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    // The first monitor has its log open once its first row is there.
-    let started = std::time::Instant::now();
-    while !std::fs::read_to_string(&log).is_ok_and(|t| t.contains("port open")) {
-        assert!(
-            started.elapsed().as_secs() < 5,
-            "no first row in {}",
-            log.display()
-        );
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    }
+    let mut writing = monitor_writing(&first.path, &log);
     let out = monitor_logged(&second.path, "1", &log);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
@@ -113,17 +119,7 @@ fn a_replay_does_not_replace_a_monitor_log() {
     let dir = temp_dir("monitor-log-replay");
     let capture = common::capture_timed(&dir, "1", &[]);
     let log = dir.join("day.csv");
-    let mut writing = std::process::Command::new(common::BOWL)
-        .args(["monitor", &sim.path, "--plain", "--seconds", "3", "--log"])
-        .arg(&log)
-        .stdout(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let started = std::time::Instant::now();
-    while !std::fs::read_to_string(&log).is_ok_and(|t| t.contains("port open")) {
-        assert!(started.elapsed().as_secs() < 5, "no first row");
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    }
+    let mut writing = monitor_writing(&sim.path, &log);
     let out = common::replay_to_csv(&capture, &log);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");

@@ -223,6 +223,18 @@ pub fn monitor_logged(port: &str, seconds: &str, log: &Path) -> Output {
     ])
 }
 
+/// All `child` wrote to its standard error.
+pub fn stderr_of(child: &mut Child) -> String {
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    err
+}
+
 /// Runs `bowl ARGS` to its end and returns what it printed.
 pub fn bowl(args: &[&str]) -> Output {
     Command::new(BOWL)
