@@ -63,9 +63,7 @@ impl SpeedLoop {
                 self.breakaway.confirm();
             }
         }
-        self.push = 0.0;
-        self.push_rad_s = 0.0;
-        self.push_angle_rad = 0.0;
+        self.end_push();
         // The start's reading (`take_start_load`) is left out after a push: its first
         // window carries the leap of stiction the push overcame. Not when the current saw
         // the breakaway: the push ended there and the back-EMF band held the shaft near the
@@ -79,8 +77,9 @@ impl SpeedLoop {
     /// The integral takes the load read from a crawl window of `span_s` seconds whose model
     /// mean exceeded the measured mean by `sample` rad/s; the push ends. The push counts as
     /// the speed it gave the shaft through the identified lag over the window, not as its mean
-    /// duty: the push rises fastest where the shaft has had least time to follow it, and read
-    /// as a steady duty it stood for more speed than the window measured, a load read high
+    /// duty: the push comes late in the window, where the shaft has had least time to follow
+    /// it, and read as a steady duty it stood for more speed than the window measured, a load
+    /// read high
     /// (seed 4 p01's spin held 0.179 duty where 0.170 holds 1 rad/s, 3.3 % fast, 2 % at 3.16 s;
     /// now 2.39 s; docs/control.md, "The crawl's push in the correction"). A window shorter than
     /// [`CRAWL_READ_MIN_S`] was no crawl: half the push stays, as after the first edge. Rare
@@ -106,9 +105,7 @@ impl SpeedLoop {
         // 33 p11's spin: the integral fell from 0.044 to 0.035 duty, 2 % at 5.15 s, now
         // 2.60 s; docs/control.md, "The crawl's push in the correction").
         self.correction_rad_s += reading * self.push_rad_s * direction;
-        self.push = 0.0;
-        self.push_rad_s = 0.0;
-        self.push_angle_rad = 0.0;
+        self.end_push();
     }
 
     /// The first measurement of a start, over a window of at least [`START_READ_MIN_S`](super::START_READ_MIN_S): the
@@ -189,9 +186,7 @@ impl SpeedLoop {
         }
         if released {
             // The push has done its work.
-            self.push = 0.0;
-            self.push_rad_s = 0.0;
-            self.push_angle_rad = 0.0;
+            self.end_push();
         }
         if released && input.feedback && !input.measurement_valid && !self.slowing {
             let step = self.breakaway.fused_integral_step(

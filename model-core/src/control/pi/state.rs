@@ -133,7 +133,16 @@ impl SpeedLoop {
     /// speed less the speed it has given so far, that is the model's expected acceleration
     /// from it times `tau`.
     pub fn correction_to_come_rad_s(&self, k: &LoopConstants) -> f32 {
-        self.correction_duty * k.kick_gain_per_tick / k.model_alpha - self.correction_rad_s
+        self.correction_duty / k.duty_per_rad_s - self.correction_rad_s
+    }
+
+    /// The push has done its work (or is given up): it and the speed and angle it gave the
+    /// plant model go.
+    #[inline(always)]
+    pub(super) fn end_push(&mut self) {
+        self.push = 0.0;
+        self.push_rad_s = 0.0;
+        self.push_angle_rad = 0.0;
     }
 
     /// The plant model's speed (the reference through the identified lag), rad/s.

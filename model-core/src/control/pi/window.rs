@@ -34,9 +34,7 @@ impl SpeedLoop {
             // after a first edge from rest; the loop corrects the rest.
             if self.push != 0.0 {
                 self.integral += PUSH_KEPT * self.push * input.direction;
-                self.push = 0.0;
-                self.push_rad_s = 0.0;
-                self.push_angle_rad = 0.0;
+                self.end_push();
             }
             // The load the model does not know, as the speed it costs: the window's
             // shortfall against the model *with* the correction applied through it.
