@@ -11,26 +11,36 @@ use ratatui::buffer::Buffer;
 
 /// Whether the locale the environment gives (the first set and non-empty of `LC_ALL`,
 /// `LC_CTYPE`, `LANG`, as the C library takes them) encodes characters in UTF-8. None set is
-/// the C locale: ASCII.
+/// the C locale (ASCII) on Unix; on Windows these are rarely set, and the console is written
+/// in UTF-16 whatever the code page, so none set there keeps Unicode.
 pub fn utf8_locale() -> bool {
     let var = |name| std::env::var_os(name);
     utf8(
         var("LC_ALL").as_deref(),
         var("LC_CTYPE").as_deref(),
         var("LANG").as_deref(),
+        cfg!(windows),
     )
 }
 
-fn utf8(lc_all: Option<&OsStr>, lc_ctype: Option<&OsStr>, lang: Option<&OsStr>) -> bool {
-    [lc_all, lc_ctype, lang]
+fn utf8(
+    lc_all: Option<&OsStr>,
+    lc_ctype: Option<&OsStr>,
+    lang: Option<&OsStr>,
+    windows: bool,
+) -> bool {
+    match [lc_all, lc_ctype, lang]
         .into_iter()
         .flatten()
         .find(|v| !v.is_empty())
-        .is_some_and(|v| {
-            // `en_US.UTF-8`, `C.utf8`, `de_DE.UTF-8@euro`: the codeset after the dot.
+    {
+        // `en_US.UTF-8`, `C.utf8`, `de_DE.UTF-8@euro`: the codeset after the dot.
+        Some(v) => {
             let v = v.to_string_lossy().to_ascii_lowercase();
             v.contains("utf-8") || v.contains("utf8")
-        })
+        }
+        None => windows,
+    }
 }
 
 /// Replaces every cell that is not ASCII with its nearest ASCII character.
@@ -85,15 +95,26 @@ mod tests {
 
     #[test]
     fn the_effective_locale_decides() {
-        assert!(utf8(None, None, os("en_US.UTF-8")));
-        assert!(utf8(None, None, os("C.utf8")));
-        assert!(!utf8(None, None, os("C")));
-        assert!(!utf8(None, None, None), "nothing set is the C locale");
+        assert!(utf8(None, None, os("en_US.UTF-8"), false));
+        assert!(utf8(None, None, os("C.utf8"), false));
+        assert!(!utf8(None, None, os("C"), false));
+        assert!(
+            !utf8(None, None, None, false),
+            "nothing set is the C locale"
+        );
+        assert!(
+            utf8(None, None, None, true),
+            "nothing set on Windows keeps Unicode"
+        );
+        assert!(
+            !utf8(None, None, os("C"), true),
+            "a locale set on Windows is taken"
+        );
         // LC_ALL overrides LC_CTYPE, which overrides LANG; an empty one counts as unset.
-        assert!(!utf8(os("C"), None, os("en_US.UTF-8")));
-        assert!(!utf8(None, os("POSIX"), os("en_US.UTF-8")));
-        assert!(utf8(os(""), os("de_DE.UTF-8@euro"), os("C")));
-        assert!(!utf8(None, None, os("en_US.ISO-8859-1")));
+        assert!(!utf8(os("C"), None, os("en_US.UTF-8"), false));
+        assert!(!utf8(None, os("POSIX"), os("en_US.UTF-8"), false));
+        assert!(utf8(os(""), os("de_DE.UTF-8@euro"), os("C"), false));
+        assert!(!utf8(None, None, os("en_US.ISO-8859-1"), false));
     }
 
     #[test]
