@@ -4,8 +4,8 @@
 use std::time::Duration;
 
 use anyhow::Result;
-use model_core::wire::Frame;
-use rig_client::command_words;
+use model_core::wire::{Frame, split_words};
+use rig_client::command_words::local_refusal;
 use rig_client::lines::{command_line, describe, explain};
 use rig_client::link::Link;
 use rig_client::refusal;
@@ -43,7 +43,10 @@ pub struct Args {
 /// Runs `bowl send`; returns the process exit status.
 pub fn run(args: &Args) -> Result<i32> {
     let id = args.id.unwrap_or_else(rig_client::request::fresh_id);
-    let line = match command_line(id, &args.command) {
+    // The words as the rig's console reads them (one reader: the refusal's particulars pick
+    // the values by position).
+    let words: Vec<String> = split_words(&args.command).map(str::to_owned).collect();
+    let line = match command_line(id, &words) {
         Ok(line) => line,
         Err(reason) => {
             // A command line that cannot be right on any rig: a usage error, said in words.
@@ -52,7 +55,7 @@ pub fn run(args: &Args) -> Result<i32> {
                 reason.token(),
                 explain(reason)
             );
-            println!("  {}", command_words::local_refusal(&args.command, reason));
+            println!("  {}", local_refusal(&words, reason));
             return Ok(exit_code::USAGE);
         }
     };
@@ -62,14 +65,14 @@ pub fn run(args: &Args) -> Result<i32> {
         Ok(frame) => {
             println!("{}", describe(&frame));
             if !matches!(frame, Frame::Reject { .. })
-                && watchdog::starts_motors(&args.command)
+                && watchdog::starts_motors(&words)
                 && let Some(note) = watchdog::note(&mut link, &args.port, id, timeout)
             {
                 println!("{note}");
             }
             if let Frame::Reject { reason, .. } = frame
                 && let Some(why) =
-                    refusal::particulars(Some(&mut link), id, &args.command, reason, timeout)
+                    refusal::particulars(Some(&mut link), id, &words, reason, timeout)
             {
                 println!("  {}", refusal::on_port(&why, &args.port));
             }

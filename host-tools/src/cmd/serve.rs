@@ -62,7 +62,7 @@ fn parse_commands(specs: &[String], run_ms: Option<f64>) -> Result<Vec<Scheduled
         let (at, words) = spec.split_once(':').ok_or_else(|| {
             usage(format!(
                 "--command {spec}: expected AT_MS:WORDS, the device time in ms, a colon, then the \
-                 command's words separated by commas (e.g. 0:speed,1800,2100)"
+                 command's words separated by commas or spaces (e.g. 0:speed,1800,2100)"
             ))
         })?;
         let at_ms: u32 = at.parse().map_err(|_| {
@@ -72,24 +72,14 @@ fn parse_commands(specs: &[String], run_ms: Option<f64>) -> Result<Vec<Scheduled
                 u32::MAX
             ))
         })?;
-        let split: Vec<String> = words.split(',').map(str::to_string).collect();
+        // The words as `bowl send` and the rig's console read them: commas or spaces.
+        let split: Vec<String> = model_core::wire::split_words(&[words])
+            .map(str::to_owned)
+            .collect();
         let id = u16::try_from(i + 1).unwrap_or(u16::MAX);
         let line = command_line(id, &split).map_err(|reason| {
-            // Typed as for `bowl send` (spaces) instead of the flag's commas.
-            let hint = if words.contains(char::is_whitespace) {
-                let fields: Vec<&str> = words
-                    .split(|c: char| c == ',' || c.is_whitespace())
-                    .filter(|w| !w.is_empty())
-                    .collect();
-                format!(
-                    "; the fields are separated by commas, without spaces: `{at}:{}`",
-                    fields.join(",")
-                )
-            } else {
-                String::new()
-            };
             usage(format!(
-                "--command {spec}: rejected locally: {} - {}: {}{hint}",
+                "--command {spec}: rejected locally: {} - {}: {}",
                 reason.token(),
                 explain(reason),
                 command_words::local_refusal(&split, reason)

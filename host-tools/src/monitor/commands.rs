@@ -6,7 +6,7 @@
 
 use std::time::Instant;
 
-use model_core::wire::{Frame, Reason};
+use model_core::wire::{Frame, Reason, split_words};
 
 use rig_client::command_words::local_refusal;
 use rig_client::lines::{command_line, describe, explain};
@@ -49,7 +49,7 @@ impl Commands {
     /// the port lost (`link` false) nothing is taken: a command kept to send once the port is
     /// back would reach whatever rig is then on it, seconds after it was said not sent.
     pub fn submit(&mut self, text: &str, link: bool) -> Result<Vec<u8>, String> {
-        let words: Vec<String> = text.split_whitespace().map(str::to_owned).collect();
+        let words: Vec<String> = split_words(&[text]).map(str::to_owned).collect();
         if words.is_empty() {
             return Err("type a command, e.g. `status`, `speed 1800 2100`, `start`".into());
         }
@@ -93,7 +93,7 @@ impl Commands {
             .iter()
             .position(|p| p.request.answered_by(frame))?;
         let p = self.pending.remove(i);
-        let words: Vec<String> = p.words.split_whitespace().map(str::to_owned).collect();
+        let words: Vec<String> = split_words(&[&p.words]).map(str::to_owned).collect();
         let (text, reason, answer) = match p.refusal {
             // The answer to the question about a refusal.
             Some((text, reason)) => (text, reason, Some(frame)),
@@ -244,6 +244,33 @@ mod tests {
         assert!(
             lost[0].starts_with(&format!("speed 5000 5000 -> rejected (id {id}): RANGE")),
             "{lost:?}"
+        );
+    }
+
+    /// A command typed with commas (`speed,5000,5000`, the frame's own separator, which the
+    /// rig's console and `bowl send` take) gets its refusal's particulars: before, it was sent
+    /// and refused RANGE with no word of the limit (the particulars read its words by
+    /// position, and the whole line was one word).
+    #[test]
+    fn a_command_typed_with_commas_gets_its_particulars() {
+        let mut commands = Commands::new("/dev/ttyUSB0");
+        let (id, _) = id_of(&commands.submit("speed,5000,5000\r", true).unwrap());
+        let refused = Frame::Reject {
+            id,
+            reason: Reason::Range,
+        };
+        assert_eq!(commands.on_frame(&refused), None, "asks its particulars");
+        let (ask, _) = commands.due();
+        let (qid, q) = id_of(&ask[0]);
+        assert_eq!(q, Command::GetParams);
+        let params = Frame::Params {
+            id: qid,
+            values: model_core::binding::default_params(),
+        };
+        let text = commands.on_frame(&params).expect("the refusal is shown");
+        assert!(
+            text.contains("the precession speed 5.000 rad/s is above SPEED_MAX1_MRAD_S"),
+            "{text}"
         );
     }
 

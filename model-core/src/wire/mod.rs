@@ -44,7 +44,7 @@ pub use encode::{EncodeError, encode};
 pub use frame::Frame;
 pub use params::*;
 pub use stream::{DecodeStats, Decoder, REORDER_FRAMES};
-pub use typed::Refusal;
+pub use typed::{Refusal, split_words};
 pub use types::*;
 
 /// The protocol version in every frame header (`$T1`): one decimal digit.

@@ -20,10 +20,7 @@ impl Command {
     /// negative number is a value like any other, refused when its range starts at 0). What is
     /// wrong is said by the [`Refusal`], in words (`Display`).
     pub fn from_words<S: AsRef<str>>(words: &[S]) -> Result<Command, Refusal<'_>> {
-        let mut words = words
-            .iter()
-            .flat_map(|w| w.as_ref().split(','))
-            .filter(|w| !w.is_empty());
+        let mut words = split_words(words);
         let word = words.next().ok_or(Refusal::NoCommand)?;
         let kind = CommandKind::from_word(word).ok_or(Refusal::UnknownCommand { word })?;
         // Field by field, as the rig's decoder reads them, so both refuse a line for the same
@@ -50,6 +47,21 @@ impl Command {
         // Every value passed its field, so it fits its type.
         Command::from_values(kind, &values).ok_or(Refusal::FieldCount { kind, given })
     }
+}
+
+/// The words of a command line as the rig's console reads a typed line: split at commas and
+/// at any ASCII white space (`speed,1800,2100`; `"speed  1800 2100"` given as one argument; a
+/// script saved with CRLF line ends passes `status\r`, and the CR, invisible, made `status` an
+/// unknown command). Every reader of a command's words takes them from here, so the words the
+/// refusal quotes by position are the words the command was judged by.
+pub fn split_words<S: AsRef<str>>(words: &[S]) -> impl Iterator<Item = &str> + Clone {
+    words
+        .iter()
+        .flat_map(|w| {
+            w.as_ref()
+                .split(|c: char| c == ',' || c.is_ascii_whitespace())
+        })
+        .filter(|w| !w.is_empty())
 }
 
 /// Why a command line typed by a person is refused before it is sent: `Display` says it in
