@@ -163,6 +163,21 @@ fn state_words(s: &Status, command: &str, typed: &[String]) -> String {
             p.token()
         );
     }
+    // The rig takes the command in the state it answered: it refused it in one it has since
+    // left (the monitor's question answered after a `stop` typed next had ended the run).
+    // Said as such: the words for the state now contradicted the refusal ("the rig is idle:
+    // ... `set` is taken while idle, ...").
+    if CommandKind::from_word(command).is_some_and(|kind| kind.states().contains(s.state)) {
+        let what = param.map_or_else(
+            || command.to_string(),
+            |p| format!("{command} {}", p.token()),
+        );
+        return format!(
+            "the rig is {} now, where `{what}` is taken: it refused it in a state it has since \
+             left; send it again",
+            s.state.words()
+        );
+    }
     let todo = match s.state {
         D::Running | D::ChangingSpeed if command == "start" => format!(
             "already running (state {}); change speed with `speed`, or `stop` first",

@@ -74,6 +74,37 @@ fn a_loop_setting_refused_while_commissioning_says_why() {
     }
 }
 
+/// A STATE refusal whose STATUS came back in a state that takes the command (the monitor asks
+/// after the refusal, and a `stop` typed next had ended the run meanwhile) says the state has
+/// changed and to send it again. Before: "the rig is idle: see docs/protocol.md for what each
+/// state allows (`set` is taken while idle, ...)", naming the state as the reason.
+#[test]
+fn a_state_the_rig_has_since_left_is_said_so() {
+    use model_core::wire::DeviceState as D;
+    for (typed, state, what) in [
+        ("set TEETH1 5", D::Idle, "`set TEETH1`"),
+        ("set teeth1 5", D::Faulted, "`set TEETH1`"),
+        ("set BW1_MRAD_S 8000", D::Running, "`set BW1_MRAD_S`"),
+        ("speed 1000 1000", D::Running, "`speed`"),
+        ("start", D::Idle, "`start`"),
+        ("commission", D::Idle, "`commission`"),
+        ("clear", D::Faulted, "`clear`"),
+    ] {
+        let words = w(typed);
+        let text = state_words(&status_in(state), &words[0], &words);
+        assert!(
+            text.contains(&format!("now, where {what} is taken"))
+                && text.contains("send it again")
+                && !text.contains("see docs/protocol.md"),
+            "{typed} in {state:?}: {text}"
+        );
+    }
+    // Still refused in the state answered: the reason, as before.
+    let words = w("set TEETH1 5");
+    let text = state_words(&status_in(D::Running), "set", &words);
+    assert!(text.contains("stop the motors first"), "{text}");
+}
+
 #[test]
 fn speed_above_the_limit_names_the_axis_and_limit() {
     let p = default_params();
