@@ -77,6 +77,17 @@ fn a_steep_wall_holds_the_granule_and_says_so() {
         text.contains("held by the wall: still inside after 3 s"),
         "{text}"
     );
+    // The speed paragraph with none leaving: no mean to caveat ("only 0 of 12 releases leave
+    // ...: these times are the mean over the releases that leave" before).
+    let out = bowl(&bowl_args("1.2", "1.2", "60", ["90", "0.01", "0"], &[]));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains(
+            "and at the asked speed none of the 12 releases leaves (each stays in the bowl)"
+        ),
+        "{text}"
+    );
+    assert!(!text.contains("only 0 of"), "{text}");
 }
 
 /// A release that stalled at a loose tolerance (a 60 deg wall at 45 deg tilt, 1.8 rad/s, mu_s

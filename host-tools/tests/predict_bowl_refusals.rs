@@ -12,12 +12,12 @@ fn bad_bowl_input_is_said_in_words() {
         (
             ["0", "0.02", "0"],
             vec![],
-            "--wall-angle-deg must be above 0 and at most 90",
+            "--wall-angle-deg 0: the wall's angle from the bottom must be above 0 and at most 90",
         ),
         (
-            ["95", "0.02", "0"],
+            ["179.9", "0.02", "0"],
             vec![],
-            "--wall-angle-deg must be above 0 and at most 90",
+            "--wall-angle-deg 179.9: the wall's angle from the bottom must be above 0 and at most 90",
         ),
         (
             ["60", "-0.01", "0"],
@@ -25,9 +25,23 @@ fn bad_bowl_input_is_said_in_words() {
             "--wall-height-m must be 0 or more",
         ),
         (
-            ["60", "0.02", "0.07"],
+            ["90", "0.08", "0.07"],
             vec![],
             "already touches the corner between bottom and wall",
+        ),
+        // A fillet above its wall, or with no wall: the granule climbed the arc past the lip
+        // and the time was a taller bowl's, without a word.
+        (
+            ["60", "0.01", "0.05"],
+            vec![],
+            "--fillet-radius-m 0.05 m rises 0.0250 m up a wall at 60 deg before it meets it, \
+             above the wall's height (--wall-height-m 0.01 m): a fillet ends on its wall; give a \
+             fillet of at most 0.02 m, or a taller wall",
+        ),
+        (
+            ["90", "0", "0.005"],
+            vec![],
+            "--fillet-radius-m 0.005 m with no wall (--wall-height-m 0, a bare rim)",
         ),
         (
             ["60", "0.08", "0"],

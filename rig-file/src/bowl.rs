@@ -78,7 +78,7 @@ impl Checker<'_> {
         {
             *slot = self.get(g, &format!("[bowl] {key}"), lo, hi, default)?;
         }
-        Ok(BowlGeometry {
+        let g = BowlGeometry {
             axes_angle_deg: v[0],
             rim_radius_m: v[1],
             wall_angle_deg: v[2],
@@ -86,7 +86,44 @@ impl Checker<'_> {
             fillet_radius_m: v[4],
             restitution: v[5],
             particle_radius_m: v[6],
-        })
+        };
+        // Every [bowl] table (`bowl predict --model bowl --rig-file` and `bowl fit --rig-file`
+        // read it without a granule in the bowl): its fillet must end on its wall.
+        let shape = BowlShape {
+            wall_angle_rad: g.wall_angle_deg.to_radians(),
+            wall_height_m: g.wall_height_m,
+            fillet_radius_m: g.fillet_radius_m,
+            restitution: g.restitution,
+        };
+        if shape.check_fillet().is_err() {
+            let line = (self.at)(
+                t.fillet_radius_m
+                    .as_ref()
+                    .or(t.wall_height_m.as_ref())
+                    .map_or(0, |v| v.span().start),
+            );
+            let why = if g.wall_height_m <= 0.0 {
+                format!(
+                    "[bowl] fillet_radius_m = {} m with no wall (wall_height_m = 0, a bare rim): \
+                     a fillet rounds the corner between the bottom and a wall, and a bare rim \
+                     has none; give fillet_radius_m = 0, or the wall",
+                    g.fillet_radius_m
+                )
+            } else {
+                format!(
+                    "[bowl] fillet_radius_m = {} m rises {:.4} m up the wall at wall_angle_deg = \
+                     {} before it meets it, above wall_height_m = {} m: a fillet ends on its \
+                     wall; measure the fillet again (the width of the rounded band seen from \
+                     above divided by tan(wall_angle / 2)), or the wall's height",
+                    g.fillet_radius_m,
+                    shape.fillet_rise_m(),
+                    g.wall_angle_deg,
+                    g.wall_height_m
+                )
+            };
+            return Err(anyhow!("rig file {}, line {line}: {why}", self.file));
+        }
+        Ok(g)
     }
 }
 
@@ -284,8 +321,25 @@ mod tests {
             "{e}"
         );
         let e = err("[particle]\nmodel = \"bowl\"\nrelease_radius_m = 0.06\n\
-             [bowl]\nwall_height_m = 0.01\nfillet_radius_m = 0.02\n");
+             [bowl]\nwall_height_m = 0.03\nfillet_radius_m = 0.02\n");
         assert!(e.contains("line 2") && e.contains("flat bottom"), "{e}");
+        // A fillet above its wall, and one with no wall, are no bowl (the granule climbed the
+        // arc past the lip).
+        let e = err(
+            "[particle]\nmodel = \"bowl\"\n[bowl]\nwall_angle_deg = 60\n\
+             wall_height_m = 0.01\nfillet_radius_m = 0.05\n",
+        );
+        assert!(
+            e.contains("line 6: [bowl] fillet_radius_m = 0.05 m rises 0.0250 m up the wall")
+                && e.contains("above wall_height_m = 0.01 m"),
+            "{e}"
+        );
+        // Any [bowl] table, a granule in it or not (predict and fit read it alone).
+        let e = err("[bowl]\nfillet_radius_m = 0.005\n");
+        assert!(
+            e.contains("line 2: [bowl] fillet_radius_m = 0.005 m with no wall"),
+            "{e}"
+        );
         let e = err("[particle]\nmodel = \"bowl\"\nrelease_radius_m = 0.08\n[bowl]\n");
         assert!(e.contains("must lie inside the rim"), "{e}");
     }

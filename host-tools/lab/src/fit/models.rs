@@ -46,6 +46,17 @@ pub struct Wall {
     pub height_m: f64,
 }
 
+impl Wall {
+    /// The rig's fillet as this candidate wall holds it: a fillet ends on its wall, so one
+    /// rising above a lower candidate wall is the largest that wall holds, and a bare rim has
+    /// none (the bowl model refuses a fillet above its wall; the candidate stays a wall of its
+    /// height and angle).
+    pub fn fillet_held_m(&self, fillet_m: f64) -> f64 {
+        let rise_per_m = 1.0 - self.angle_deg.to_radians().cos();
+        fillet_m.min(self.height_m / rise_per_m)
+    }
+}
+
 /// The bowl model's rolling resistance in the fit (the rig's, docs/model.md section 10): the
 /// fit's parameter is `mu_s`, which decides whether and where it slides.
 pub const BOWL_ROLLING_RESISTANCE: f64 = 0.029;
@@ -347,7 +358,7 @@ pub fn bowl_release(run: &Run, wall: Wall, mu_s: f64, k2: f64, azimuth_rad: f64)
     let shape = BowlShape {
         wall_angle_rad: wall.angle_deg.to_radians(),
         wall_height_m: wall.height_m,
-        fillet_radius_m: base.fillet_radius_m,
+        fillet_radius_m: wall.fillet_held_m(base.fillet_radius_m),
         restitution: base.restitution,
     };
     let limits = SystemLimits {

@@ -323,6 +323,49 @@ fn the_bowl_fit_finds_the_wall_and_mu_s() {
     );
 }
 
+/// A rig file's fillet is shared by every candidate wall: the bare rim has none to round into
+/// and a wall lower than the fillet's rise holds the largest fillet it can. The bowl model
+/// refuses a fillet above its wall, so without that each such candidate read as a wall that
+/// holds every release (an infinite time), and the bare rim lost to any wall.
+#[test]
+fn a_rigs_fillet_too_tall_for_a_candidate_wall_is_the_largest_it_holds() {
+    use super::models::{BOWL_CANDIDATES, BowlBase, Equation, predict};
+    let run = |fillet_m: f64| Run {
+        row: 2,
+        condition: 1,
+        residence_s: 0.2,
+        mean_rad_s: 2.0,
+        release_radius_m: 0.0375,
+        rim_radius_m: 0.075,
+        k2: 5.0 / 7.0,
+        trace: vec![(0.0, 2.0)],
+        method: Method::ClosedForm,
+        axes_angle_rad: 60f64.to_radians(),
+        bowl: models::BowlRun {
+            azimuth_rad: Some(0.0),
+            base: BowlBase {
+                fillet_radius_m: fillet_m,
+                ..BowlBase::DEFAULT
+            },
+            ..models::BowlRun::default()
+        },
+    };
+    let [bare, wall10, ..] = BOWL_CANDIDATES;
+    let t = |fillet_m: f64, c: super::models::Candidate| predict(&run(fillet_m), c.equation, 0.4);
+    // The bare rim with the rig's 15 mm fillet is the bare rim.
+    assert!(t(0.015, bare).is_finite(), "{}", t(0.015, bare));
+    assert_eq!(t(0.015, bare), t(0.0, bare));
+    // A 30 mm fillet rises 15 mm up a 60 deg wall: the 10 mm wall holds a 20 mm one.
+    let Equation::Bowl(w) = wall10.equation else {
+        panic!("not a wall")
+    };
+    let held = w.fillet_held_m(0.03);
+    assert!((held - 0.02).abs() < 1e-9, "{held}");
+    assert!(t(0.03, wall10).is_finite(), "{}", t(0.03, wall10));
+    assert_eq!(t(0.03, wall10), t(held, wall10));
+    assert_ne!(t(0.03, wall10), t(0.0, wall10));
+}
+
 /// `shortest_residence_s` is a lower bound for every candidate without friction (the fastest
 /// each can be), against the models themselves: the paper's closed forms at mu 0 and k2 1, and
 /// the rolling model (rolling resistance 0) at each release azimuth, over speeds from 0.3 to 30

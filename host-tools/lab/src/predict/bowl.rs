@@ -58,6 +58,10 @@ pub(crate) fn words(e: BowlError) -> String {
              granule's radius, --particle-radius-m): give a smaller --ri-m, --fillet-radius-m or \
              --particle-radius-m (the granule starts on the flat bottom)"
             .into(),
+        BowlError::FilletAboveWall => "the fillet (--fillet-radius-m) rises higher than the \
+             wall it rounds into (--wall-height-m, --wall-angle-deg): give a smaller fillet or a \
+             taller wall"
+            .into(),
         BowlError::InvalidRestitution => "--restitution must lie between 0 and 1".into(),
         BowlError::InvalidHorizon => "--max-time-s must be a positive number of seconds".into(),
     }
@@ -323,6 +327,14 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
 fn not_all_leave(leaving: usize, releases: usize) -> String {
     if leaving == releases {
         return String::new();
+    }
+    // None leaving: there is no mean to caveat (it read "only 0 of 12 releases leave ...: these
+    // times are the mean over the releases that leave").
+    if leaving == 0 {
+        return format!(
+            "; and at the asked speed none of the {releases} releases leaves (each stays in the \
+             bowl)"
+        );
     }
     format!(
         "; but only {leaving} of {releases} releases leave at the asked speed (the others stay \

@@ -2,7 +2,7 @@
 //! model's and the whole hierarchy's (`--model auto`) one reading of them.
 
 use anyhow::{Result, bail};
-use model_core::particle::bowl::BowlShape;
+use model_core::particle::bowl::{BowlError, BowlShape};
 use model_core::particle::rolling::{RollingMethod, RollingScene};
 
 use super::bowl::{BowlInputs, words};
@@ -153,9 +153,17 @@ pub(super) fn scene_and_shape(
         fillet_radius_m: wall.fillet_m,
         restitution: wall.restitution,
     };
-    shape
-        .validate(&scene)
-        .map_err(|e| anyhow::anyhow!(words(e)))?;
+    shape.validate(&scene).map_err(|e| match e {
+        BowlError::FilletAboveWall => fillet_above_wall(&wall, shape.fillet_rise_m()),
+        // The value given with the range (179.9 was refused without a word of which value).
+        BowlError::InvalidWallAngle => anyhow::anyhow!(
+            "--wall-angle-deg {}: the wall's angle from the bottom must be above 0 and at most \
+             90 degrees (90 = a vertical wall, below 90 flared outwards; a wall leaning in over \
+             the bottom is not modelled)",
+            crate::number::echo(wall.angle_deg)
+        ),
+        e => anyhow::anyhow!(words(e)),
+    })?;
     if wall.height_m > 0.0 && wall.height_m < scene.particle_radius_m {
         // The model meets the granule on the wall's face and ends it over the lip's radius;
         // a step lower than the granule's radius it would meet at the step's edge, which the
@@ -176,4 +184,31 @@ pub(super) fn scene_and_shape(
         shape,
         method,
     })
+}
+
+/// Why a fillet above its wall has no bowl, with the values: a bare rim has no corner to round,
+/// and a fillet of radius `F` meets a wall at `A` deg `F (1 - cos A)` up it.
+fn fillet_above_wall(wall: &Wall, rise_m: f64) -> anyhow::Error {
+    use crate::number::echo;
+    let f = echo(wall.fillet_m);
+    if wall.height_m <= 0.0 {
+        return anyhow::anyhow!(
+            "--fillet-radius-m {f} m with no wall (--wall-height-m 0, a bare rim): a fillet \
+             rounds the corner between the bottom and a wall, and a bare rim has none; give \
+             --fillet-radius-m 0, or the wall's height and angle"
+        );
+    }
+    // The largest fillet the wall holds, to four figures rounded down (so it is taken as given).
+    let highest = wall.height_m / (1.0 - wall.angle_deg.to_radians().cos());
+    let scale = 10f64.powf(3.0 - highest.log10().floor());
+    let highest = (highest * scale).floor() / scale;
+    anyhow::anyhow!(
+        "--fillet-radius-m {f} m rises {} m up a wall at {} deg before it meets it, above the \
+         wall's height (--wall-height-m {} m): a fillet ends on its wall; give a fillet of at \
+         most {} m, or a taller wall",
+        crate::number::fixed(rise_m, 4),
+        echo(wall.angle_deg),
+        echo(wall.height_m),
+        echo(highest)
+    )
 }

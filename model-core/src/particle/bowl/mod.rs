@@ -55,6 +55,9 @@ pub enum BowlError {
     InvalidFillet,
     /// The fillet (with the granule's radius) reaches in to the release radius.
     FilletReachesRelease,
+    /// The fillet rises higher than the wall it rounds into (or there is no wall): the bowl it
+    /// describes does not exist ([`BowlShape::fillet_rise_m`]).
+    FilletAboveWall,
     /// The restitution was not in [0, 1].
     InvalidRestitution,
     /// The horizon was not a positive finite time.

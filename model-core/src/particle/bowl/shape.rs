@@ -40,7 +40,8 @@ impl<T: Real> BowlShape<T> {
         let rho_b = rim - fillet * half_tan;
         let lip = rim + self.wall_height_m * ca / sa;
         // The centre when the contact is at the edge, and how far along the cone that is from
-        // the fillet's end (0 if the fillet rises above the wall: then the pivot starts there).
+        // the fillet's end (0 where the stand-in fillet of a sharp corner rises above a wall
+        // lower than it: then the pivot starts there; a real fillet that does is refused).
         let top = [lip - a * sa, self.wall_height_m + a * ca];
         let arc_end = [rho_b + rc * sa, a + rc * (T::ONE - ca)];
         let along = ((top[0] - arc_end[0]) * ca + (top[1] - arc_end[1]) * sa).max(T::ZERO);
@@ -53,6 +54,25 @@ impl<T: Real> BowlShape<T> {
             top_s: rc * alpha + along,
             pivot_m: a.max(rim * T::from_f64(1e-6)),
         })
+    }
+
+    /// How high the fillet's arc rises up the wall before it meets it, m: `F (1 - cos alpha)`.
+    pub fn fillet_rise_m(&self) -> T {
+        self.fillet_radius_m * (T::ONE - self.wall_angle_rad.cos())
+    }
+
+    /// Refuses a fillet that rises above its wall, or one with no wall (a bare rim): a fillet
+    /// rounds the corner into the wall and ends on it, so neither is a bowl. The wall's model
+    /// took the arc whole, so the granule climbed it past the lip (a 50 mm fillet on a 10 mm
+    /// wall at 60 deg: 25 mm up) and the time came out for a taller bowl than the one given.
+    pub fn check_fillet(&self) -> Result<(), BowlError> {
+        // A millionth over is rounding: a fillet of `h / (1 - cos alpha)` exactly is held.
+        if self.fillet_radius_m > T::ZERO
+            && self.fillet_rise_m() > self.wall_height_m * T::from_f64(1.0 + 1e-6)
+        {
+            return Err(BowlError::FilletAboveWall);
+        }
+        Ok(())
     }
 
     /// Whether the corner is sharper than the granule: then reaching it is an impact.
@@ -82,6 +102,7 @@ impl<T: Real> BowlShape<T> {
         {
             return Err(BowlError::InvalidRestitution);
         }
+        self.check_fillet()?;
         if let Some(m) = self.meridian(sc)
             && (m.rho_b_m <= sc.ri_m || m.rho_b_m.is_nan())
         {
