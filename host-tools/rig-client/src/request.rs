@@ -12,38 +12,15 @@ use crate::link::Link;
 use crate::serial::ReadOutcome;
 use crate::unreadable::{LineTap, UnreadableAnswer};
 
+mod ids;
+pub use ids::{fresh_id, next_id};
+
 /// Whether `frame` is the kind of answer `command` gets, as the command table says (`S` to
 /// STATUS, `P` to PARAMS, `M` to MODELS, `W` to RTIME, `A` to the rest), or `R` (anything can
 /// be refused).
 pub fn answers_kind(command: &Command, frame: &Frame) -> bool {
     matches!(frame, Frame::Reject { .. })
         || model_core::wire::encode::kind_letter(frame) == command.kind().answer().letter()
-}
-
-/// A request id for the first command of a process: the wall clock in milliseconds, mod 2^16
-/// (one turn in 65.5 s). The rig takes a command with the id and words of one of its recent
-/// commands, up to 60 s old, for a copy and does not carry it out again (docs/protocol.md), so
-/// ids must not come back within 60 s: from the clock, each process starts past the ids of
-/// the ones before it and counts up from there (a process sends far fewer than one command a
-/// millisecond). `u16::MAX` and `u16::MAX - 1` are left to the monitor (its heartbeat and its
-/// own STATUS).
-pub fn fresh_id() -> u16 {
-    let ms = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_millis())
-        .unwrap_or(0);
-    match (ms % 65_536) as u16 {
-        0xFFFE..=u16::MAX => 0,
-        id => id,
-    }
-}
-
-/// The request id after `id`, skipping the monitor's own two (see [`fresh_id`]).
-pub fn next_id(id: u16) -> u16 {
-    match id.wrapping_add(1) {
-        0xFFFE..=u16::MAX => 0,
-        n => n,
-    }
 }
 
 /// How long one attempt waits before the command is sent again with the same id (the rig carries
