@@ -9,7 +9,8 @@ use common::Sim;
 use common::tmux::Tmux;
 
 /// Types into `console` (a command line that opens the pty given last) what a person would:
-/// telemetry off, a speed, the status, a typo; each answer must appear on the screen, id 0.
+/// telemetry off, a speed, the status, a typo, Tab, an arrow key, a `µ`, Ctrl-C and Ctrl-U;
+/// each answer must appear on the screen, id 0.
 fn a_person_types_commands_into(name: &str, console: &str) {
     let sim = Sim::start(&[]);
     let tmux = Tmux::start(name, &format!("{console} {}", sim.path));
@@ -29,6 +30,25 @@ fn a_person_types_commands_into(name: &str, console: &str) {
     tmux.wait_for(&["$R1,0,UNKNOWN*"], "a typo is refused, not ignored");
     tmux.keys(&["speed 1800 99999", "Enter"]);
     tmux.wait_for(&["$R1,0,RANGE*"], "a value out of range is refused");
+    // The other keys a person presses. Before, a Tab, an arrow key or a `µ` dropped the line
+    // without an answer: silence, as from a dead rig.
+    tmux.keys(&["speed", "Tab", "1800", "Tab", "2100", "Enter"]);
+    tmux.wait_for_count("$A1,0*", 3, "Tab parts words as a space does");
+    tmux.keys(&["status", "Up", "Enter"]);
+    tmux.wait_for(
+        &["$R1,0,UNREADABLE*"],
+        "a line with an arrow key is answered",
+    );
+    tmux.keys(&["stopµ", "Enter"]);
+    tmux.wait_for_count("$R1,0,UNREADABLE*", 2, "a letter beyond ASCII is answered");
+    // Ctrl-C and Ctrl-U drop the line typed so far: neither `start` nor the speed is read.
+    tmux.keys(&["start", "C-c", "speed 1800 99999", "C-u", "status", "Enter"]);
+    let screen = tmux.wait_for_count("$S1,0,0,0,", 2, "the status after Ctrl-C and Ctrl-U");
+    assert_eq!(
+        screen.matches("$R1,0,RANGE*").count(),
+        1,
+        "the speed erased by Ctrl-U was not read:\n{screen}"
+    );
     // The PC's tools still work on the same rig once the console has let go of it (the
     // console takes a moment to exit after its terminal closes).
     drop(tmux);

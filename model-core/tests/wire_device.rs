@@ -104,7 +104,8 @@ fn every_intact_command_counts_as_host_presence() {
 /// A line typed at a plain console (picocom, tio: words, spaces, Enter; no `$`, id or CRC) is
 /// answered with the frame a `$` command gets, id 0, and counts as the host being there. It is
 /// carried out each time it is typed (no ids, no copies), a typo is refused with the frame's
-/// reason, and what a damaged frame leaves (commas, `*`) gets no answer at all.
+/// reason. A line that is not words (an arrow key, what a damaged frame leaves: commas, `*`)
+/// is refused `UNREADABLE` and is no sign of the host.
 #[test]
 fn a_line_typed_at_a_console_is_answered_like_a_frame() {
     let (mut rig, mut d) = rig_and_device();
@@ -143,15 +144,21 @@ fn a_line_typed_at_a_console_is_answered_like_a_frame() {
             }
         ]
     );
-    // A frame that lost its `$` gets no answer; typing cut by a frame is dropped, and what
-    // follows the frame is a line of its own (`rt`, not `start`).
+    // A frame that lost its `$` is refused, not carried out, and is not the host; typing cut
+    // by a frame is dropped, and what follows the frame is a line of its own (`rt`, not
+    // `start`). The CRLF of the frame ends no second line.
     let mut input = b"C1,9,START*00000000\r\nsta".to_vec();
     input.extend(line("C1,10,PING"));
     input.extend(b"rt\r");
     let got = answers(&mut d, &mut rig, &input);
+    let unreadable = Frame::Reject {
+        id: 0,
+        reason: Reason::Unreadable,
+    };
     assert_eq!(
         got,
         [
+            unreadable,
             Frame::Ack { id: 10 },
             Frame::Reject {
                 id: 0,
@@ -159,6 +166,13 @@ fn a_line_typed_at_a_console_is_answered_like_a_frame() {
             }
         ]
     );
+    assert_eq!(rig.calls.len(), 4, "{:?}", rig.calls);
+    assert_eq!(rig.heartbeats, 9, "the ping and the typed `rt` only");
+    // An arrow key (ESC [ A) typed after a command: refused in a frame, not met with silence,
+    // and no heartbeat (line noise looks the same).
+    let got = answers(&mut d, &mut rig, b"status\x1b[A\r\n");
+    assert_eq!(got, [unreadable]);
+    assert_eq!(rig.heartbeats, 9);
     assert_eq!(rig.calls.len(), 4, "{:?}", rig.calls);
 }
 

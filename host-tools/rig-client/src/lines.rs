@@ -29,6 +29,11 @@ pub fn explain(reason: Reason) -> &'static str {
         Reason::Unsupported => "this rig does not support that command",
         Reason::Version => "the rig speaks another protocol version",
         Reason::Internal => "the rig could not build its answer (a bug)",
+        Reason::Unreadable => {
+            "a line typed at the rig's console was not read: it held a key that types no word \
+             (an arrow, Ctrl, a letter beyond ASCII such as µ, a `,` or `*`) or was over 64 \
+             characters; type it again in letters, digits and spaces"
+        }
     }
 }
 

@@ -71,16 +71,30 @@ impl Tmux {
 
     /// Waits until the screen shows every one of `texts`; fails with the screen otherwise.
     pub fn wait_for(&self, texts: &[&str], what: &str) -> String {
+        self.wait_until(|screen| texts.iter().all(|t| screen.contains(t)))
+            .unwrap_or_else(|screen| panic!("{what}: expected {texts:?} on the screen:\n{screen}"))
+    }
+
+    /// Waits until `text` shows `count` times on the screen (an answer like one seen before);
+    /// fails with the screen otherwise.
+    pub fn wait_for_count(&self, text: &str, count: usize, what: &str) -> String {
+        self.wait_until(|screen| screen.matches(text).count() >= count)
+            .unwrap_or_else(|screen| {
+                panic!("{what}: expected {text:?} {count} times on the screen:\n{screen}")
+            })
+    }
+
+    /// The screen once `done` holds for it, within 10 s; the last screen otherwise.
+    fn wait_until(&self, done: impl Fn(&str) -> bool) -> Result<String, String> {
         let started = Instant::now();
         loop {
             let screen = self.screen();
-            if texts.iter().all(|t| screen.contains(t)) {
-                return screen;
+            if done(&screen) {
+                return Ok(screen);
             }
-            assert!(
-                started.elapsed() < Duration::from_secs(10),
-                "{what}: expected {texts:?} on the screen:\n{screen}"
-            );
+            if started.elapsed() >= Duration::from_secs(10) {
+                return Err(screen);
+            }
             std::thread::sleep(Duration::from_millis(200));
         }
     }

@@ -245,6 +245,13 @@ impl Device {
                     backend.heartbeat();
                     Frame::Reject { id, reason }
                 }
+                // A line that is not words: answered (a person who pressed an arrow key must not
+                // meet silence), but no sign of the host, since line noise or a damaged frame's
+                // remains look the same and must not keep the host-silence watch fed.
+                (_, Some(Err(Reason::Unreadable))) => Frame::Reject {
+                    id: 0,
+                    reason: Reason::Unreadable,
+                },
                 // Typed by a person: carried out as typed (no copies to look for without ids).
                 (_, Some(typed)) => {
                     backend.heartbeat();

@@ -49,10 +49,11 @@ impl Command {
     }
 }
 
-/// The words of a command line as the rig's console reads a typed line: split at commas and
-/// at any ASCII white space (`speed,1800,2100`; `"speed  1800 2100"` given as one argument; a
-/// script saved with CRLF line ends passes `status\r`, and the CR, invisible, made `status` an
-/// unknown command). Every reader of a command's words takes them from here, so the words the
+/// The words of a command line, parted as the rig's console parts a typed line (at spaces and
+/// Tabs), and also at commas, as a frame's fields are, and at any other ASCII white space
+/// (`speed,1800,2100`; `"speed  1800 2100"` given as one argument; a script saved with CRLF
+/// line ends passes `status\r`, and the CR, invisible, made `status` an unknown command). The
+/// rig refuses a typed comma (`UNREADABLE`): only what is left of a damaged frame has one. Every reader of a command's words takes them from here, so the words the
 /// refusal quotes by position are the words the command was judged by.
 pub fn split_words<S: AsRef<str>>(words: &[S]) -> impl Iterator<Item = &str> + Clone {
     words

@@ -291,11 +291,17 @@ pub enum Reason {
     /// The device could not build its answer (a value it holds is outside the wire range:
     /// a bug). Token `INTERNAL`.
     Internal,
+    /// A line typed at a plain console ([`super::console`]) that the rig could not read as
+    /// words: it held a byte no command has (an arrow or function key, a Ctrl key, a letter
+    /// beyond ASCII such as `µ`, a frame's `,` or `*`) or was longer than
+    /// [`super::console::CONSOLE_LINE_MAX`]. Only typed lines get it: the PC's frames never
+    /// do, so an older PC meets it only in a console. Token `UNREADABLE`.
+    Unreadable,
 }
 
 impl Reason {
     /// Every reason.
-    pub const ALL: [Reason; 9] = [
+    pub const ALL: [Reason; 10] = [
         Reason::Malformed,
         Reason::UnknownCommand,
         Reason::UnknownParam,
@@ -305,6 +311,7 @@ impl Reason {
         Reason::Unsupported,
         Reason::Version,
         Reason::Internal,
+        Reason::Unreadable,
     ];
 
     /// The wire token.
@@ -319,6 +326,7 @@ impl Reason {
             Reason::Unsupported => "UNSUPPORTED",
             Reason::Version => "VERSION",
             Reason::Internal => "INTERNAL",
+            Reason::Unreadable => "UNREADABLE",
         }
     }
     /// The reason a wire token names (a REJECT frame's field, a report's `reason`), if any: the
