@@ -32,8 +32,8 @@ def test_a_person_types_commands_at_picocom():
             return subprocess.run(tmux + ["capture-pane", "-p", "-t", "0"],
                                   capture_output=True, text=True).stdout
 
-        def typed(line: str):
-            subprocess.run(tmux + ["send-keys", "-t", "0", line, "Enter"], check=True)
+        def typed(*keys: str):
+            subprocess.run(tmux + ["send-keys", "-t", "0", *keys, "Enter"], check=True)
 
         _wait_for(screen, "$T1,", "telemetry on the console")
         typed("set TELEM_HZ 0")
@@ -42,6 +42,9 @@ def test_a_person_types_commands_at_picocom():
         _wait_for(screen, "$S1,0,0,0,", "the board answers a typed STATUS (idle, no fault)")
         typed("statsu")
         _wait_for(screen, "$R1,0,UNKNOWN*", "a typo is refused, not ignored")
+        # An arrow key (ESC [ A) typed into the line: refused, not met with silence.
+        typed("status", "Up")
+        _wait_for(screen, "$R1,0,UNREADABLE*", "a line with an arrow key is refused")
     finally:
         subprocess.run(tmux + ["kill-server"], capture_output=True)
         s.close()
