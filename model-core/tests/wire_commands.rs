@@ -33,12 +33,13 @@ fn words() -> impl Strategy<Value = Vec<String>> {
 }
 
 /// The rig's verdict on the same words, sent as a command line with a good CRC (upper case,
-/// as a line on the wire is).
+/// as a line on the wire is). A person's words part at commas and at white space (`bowl send
+/// PORT "speed 1800 2100"` as one argument), as the tools that send them part them.
 fn rig_reads(words: &[String]) -> Result<Command, Reason> {
     let mut payload = String::from("C1,7");
     for w in words
         .iter()
-        .flat_map(|w| w.split(','))
+        .flat_map(|w| w.split(|c: char| c == ',' || c.is_ascii_whitespace()))
         .filter(|w| !w.is_empty())
     {
         payload.push(',');
