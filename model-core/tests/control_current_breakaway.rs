@@ -7,7 +7,7 @@ mod plant_rows;
 
 use plant_rows::sensed;
 
-use model_core::control::breakaway::{BackEmfScale, Breakaway};
+use model_core::control::breakaway::{BackEmf, BackEmfScale, Breakaway};
 use model_core::control::{Controller, ControllerConfig, State};
 use model_core::sim::experiments::{commissioned_step, family_plant};
 use model_core::sim::{ClosedLoop, CurrentSense, Plant, PlantParams};
@@ -86,13 +86,25 @@ fn a_held_shaft_is_not_read_as_turning_and_a_turning_one_is_seen() {
     let mut d = 0.0;
     for _ in 0..120 {
         d = (d + 0.004f32).min(0.45);
-        assert!(!b.sample(d, 0.9 * d, (duty_per_rad_s, friction_duty), (true, true), r));
+        assert!(!b.sample(
+            d,
+            0.9 * d,
+            (BackEmf::identified(duty_per_rad_s), friction_duty),
+            (true, true),
+            r
+        ));
     }
     // It breaks away and runs at 0.1 rad/s: the back-EMF takes `0.9 (k/V) w` off the current.
     let mut seen_after = None;
     for k in 0..20 {
         let c = 0.9 * (d - duty_per_rad_s * 0.1);
-        if b.sample(d, c, (duty_per_rad_s, friction_duty), (true, true), r) {
+        if b.sample(
+            d,
+            c,
+            (BackEmf::identified(duty_per_rad_s), friction_duty),
+            (true, true),
+            r,
+        ) {
             seen_after = Some(k + 1);
             break;
         }
@@ -221,14 +233,14 @@ fn the_back_emf_is_learned_at_steady_measured_speeds() {
         ramp.sample(d, 0.05, 0.5 * d / e, dt);
     }
     assert_eq!(
-        ramp.duty_per_rad_s(identified),
+        ramp.back_emf(identified).duty_per_rad_s(1.0),
         identified,
         "a ramp taught it"
     );
     // Two steady steps, 2 s each: the current (as duty) 0.05 of friction, 0.007 duty of noise.
     let mut s = BackEmfScale::NONE;
     assert_eq!(
-        s.duty_per_rad_s(identified),
+        s.back_emf(identified).duty_per_rad_s(1.0),
         identified,
         "nothing learned yet"
     );
@@ -238,7 +250,7 @@ fn the_back_emf_is_learned_at_steady_measured_speeds() {
             s.sample(d, 0.05 + 0.014 * next_noise(), w, dt);
         }
     }
-    let learned = s.duty_per_rad_s(identified);
+    let learned = s.back_emf(identified).duty_per_rad_s(1.0);
     assert!(
         (learned - e).abs() <= 0.01 * e,
         "learned {learned}, true {e}"
@@ -249,7 +261,60 @@ fn the_back_emf_is_learned_at_steady_measured_speeds() {
     for _ in 0..2000 {
         high.sample(0.05 + 0.2 * 2.0, 0.05, 2.0, dt);
     }
-    assert_eq!(high.duty_per_rad_s(identified), identified);
+    assert_eq!(high.back_emf(identified).duty_per_rad_s(1.0), identified);
+}
+
+/// The back-EMF learned through a sense chain whose current per duty is off (`c = h (d - e w)`,
+/// `h` the held ratio a start measures; the supervisor's `g` was 8 % off on seed 52 p21's
+/// rod): read through the start's `h`, the learned slope is the true `e`; the slope of `d - c`
+/// alone is not (it holds `(1 - h) d`: a heavy rod's friction duty made it 15 % high).
+#[test]
+fn the_back_emf_is_read_through_the_starts_held_ratio() {
+    let identified = 0.15;
+    let e = 0.105;
+    let h = 0.92;
+    let friction = 0.45;
+    let mut s = BackEmfScale::NONE;
+    for w in [1.0f32, 2.0, 3.0] {
+        let d = friction + identified * w;
+        for _ in 0..2000 {
+            s.sample(d, h * (d - e * w), w, 1e-3);
+        }
+    }
+    let emf = s.back_emf(identified);
+    let read = emf.duty_per_rad_s(h);
+    assert!((read - e).abs() <= 0.01 * e, "read {read}, true {e}");
+    let plain = emf.duty_per_rad_s(1.0);
+    assert!(plain > 1.1 * e, "without the held ratio {plain}, true {e}");
+}
+
+/// Seed 52's p21 (`bowl sim make-family --seed 52`, plant seed 52021), current sense on both
+/// axes: a heavy rod (0.70 N m of friction, 0.6 duty at 1 rad/s, a back-EMF 0.70 of its
+/// identified slope) whose first tooth came before the current confirmed its breakaway, so it
+/// kept half its kick (0.034 duty). Its back-EMF speed was read through the slope of `d - c`
+/// learned with the supervisor's current per duty 8 % off, and clamped at 1/1.25 of the
+/// identified slope: 14 % low, never past the 1.2x of its model that drops the kick, and the rod
+/// ran 11.4 % past 1 rad/s until its first measurement. Read through the start's held ratio it
+/// reads its speed as it is, and the kick goes once it runs 10 % ahead of its model.
+#[test]
+fn a_heavy_rods_kept_kick_goes_once_its_back_emf_shows_it_ahead() {
+    let rig = sensed(plant_rows::rig_from_table(
+        10.831,
+        0.428,
+        [
+            [
+                1.1348, 0.07595, 0.06984, 0.6984, 0.9312, 0.0231, 0.000789, 0.0020, 0.0,
+            ],
+            [
+                1.6037, 0.00701, 0.00874, 0.0874, 0.1223, 0.0435, 0.000827, 0.0059, 0.0,
+            ],
+        ],
+    ));
+    let os = overshoot_pct(rig, 52021, 1.0, [0.0048, 0.0592]);
+    eprintln!("overshoot {os:?} %");
+    for (axis, os) in os.iter().enumerate() {
+        assert!(*os <= 5.0, "axis {axis}: {os} % past 1 rad/s");
+    }
 }
 
 /// family-60's p16 (tests/rigs/family-60.toml, seed 1016), current sense on both axes: a stiff
@@ -358,7 +423,13 @@ fn a_shaft_held_above_its_friction_duty_reads_its_own_held_ratio() {
         d = (d + 0.008).min(0.08);
         let c = h * d + 0.018 * next_noise();
         assert!(
-            !b.sample(d, c, (duty_per_rad_s, friction_duty), (true, true), r),
+            !b.sample(
+                d,
+                c,
+                (BackEmf::identified(duty_per_rad_s), friction_duty),
+                (true, true),
+                r
+            ),
             "a held shaft released at tick {k}"
         );
         if k >= 500 {
@@ -375,7 +446,13 @@ fn a_shaft_held_above_its_friction_duty_reads_its_own_held_ratio() {
         d += 0.00007;
         w += 0.0007;
         let c = h * (d - duty_per_rad_s * w) + 0.018 * next_noise();
-        if b.sample(d, c, (duty_per_rad_s, friction_duty), (true, true), r) {
+        if b.sample(
+            d,
+            c,
+            (BackEmf::identified(duty_per_rad_s), friction_duty),
+            (true, true),
+            r,
+        ) {
             seen_at = Some(w);
             break;
         }

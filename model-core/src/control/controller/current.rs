@@ -25,8 +25,8 @@ impl Controller {
             let measured = if a.est.is_valid() { a.measured } else { 0.0 };
             a.emf.sample(applied * a.direction, c, measured, self.dt_s);
         }
-        let emf_duty_per_rad_s = a.emf.duty_per_rad_s(a.k.duty_per_rad_s());
-        a.speed_loop.set_back_emf_duty_per_rad_s(emf_duty_per_rad_s);
+        a.speed_loop
+            .set_back_emf(a.emf.back_emf(a.k.duty_per_rad_s()));
         let model = a.speed_loop.model_rad_s().abs();
         let share = if a.steady {
             BACK_EMF_STEADY_SHARE

@@ -7,6 +7,7 @@ use super::{
     CRAWL_READ_MIN_S, FUSED_BAND_SHARE, LoopConstants, LoopInput, PUSH_KEPT, STUCK_PITCHES,
     SpeedLoop, clamp,
 };
+use crate::control::breakaway::{BackEmf, KEPT_KICK_AHEAD_SHARE};
 
 impl SpeedLoop {
     /// The first edge from rest (the loop's view, see `rest` in [`SpeedLoop::step`]): what
@@ -162,10 +163,10 @@ impl SpeedLoop {
     ) -> bool {
         let applied = self.duty * input.direction;
         let was_released = self.breakaway.released();
-        let emf = if self.emf_duty_per_rad_s > 0.0 {
-            self.emf_duty_per_rad_s
+        let emf = if self.emf.identified > 0.0 {
+            self.emf
         } else {
-            k.duty_per_rad_s
+            BackEmf::identified(k.duty_per_rad_s)
         };
         let released = self.breakaway.sample(
             applied,
@@ -204,26 +205,27 @@ impl SpeedLoop {
 
     /// The kick kept at a first edge that came before the current confirmed the breakaway,
     /// on a shaft then behind its model (`first_edge`): kept so that a loaded shaft does not
-    /// stick again. Once the back-EMF speed runs ahead of the model by more than the band
-    /// (it reads low if anything, by the viscous share), the shaft does not need it, and it
-    /// goes before the first measurement would take it. Held to that measurement, a heavy
-    /// rod (time constant 0.56 s) whose first tooth came 60 ms into the start ran on half a
-    /// kick of 0.09 duty to 35 % past 0.5 rad/s (seed 34 p03; docs/control.md, "The kept
-    /// kick the current shows is not needed").
+    /// stick again. Once the back-EMF speed runs ahead of the model by more than
+    /// [`KEPT_KICK_AHEAD_SHARE`], the shaft does not need it, and it goes before the first
+    /// measurement would take it. Held to that measurement, a heavy rod (time constant 0.56 s)
+    /// whose first tooth came 60 ms into the start ran on half a kick of 0.09 duty to 35 % past
+    /// 0.5 rad/s (seed 34 p03; docs/control.md, "The kept kick the current shows is not
+    /// needed"), and one read 14 % low 11.4 % past 1 rad/s (seed 52 p21; "The back-EMF read
+    /// through the held ratio").
     #[cold]
     #[inline(never)]
     fn drop_kept_kick_ahead(&mut self, direction: f32) {
-        if self.breakaway.speed_rad_s() > (1.0 + FUSED_BAND_SHARE) * self.model_rad_s.abs() {
+        if self.breakaway.speed_rad_s() > KEPT_KICK_AHEAD_SHARE * self.model_rad_s.abs() {
             self.integral -= self.kept_kick * direction;
             self.kept_kick = 0.0;
         }
     }
 
-    /// The back-EMF duty per rad/s the current sense learned at measured speeds
-    /// ([`BackEmfScale`](crate::control::breakaway::BackEmfScale)), for the back-EMF speed of the next
-    /// step; the controller sets it before each step on axes with current sense.
-    pub fn set_back_emf_duty_per_rad_s(&mut self, duty_per_rad_s: f32) {
-        self.emf_duty_per_rad_s = duty_per_rad_s;
+    /// The back-EMF the current sense learned at measured speeds
+    /// ([`BackEmfScale`](crate::control::breakaway::BackEmfScale)), for the back-EMF speed of
+    /// the next step; the controller sets it before each step on axes with current sense.
+    pub fn set_back_emf(&mut self, emf: BackEmf) {
+        self.emf = emf;
     }
 
     /// Whether the current showed the breakaway since the last call (once per start).

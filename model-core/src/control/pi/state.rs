@@ -3,6 +3,7 @@
 
 use super::Breakaway;
 use super::LoopConstants;
+use crate::control::breakaway::BackEmf;
 
 /// State of one axis's loop.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -70,9 +71,9 @@ pub struct SpeedLoop {
     pub(super) stepped_down: bool,
     /// The current showed the breakaway in this step (see [`SpeedLoop::take_breakaway`]).
     pub(super) breakaway_news: bool,
-    /// The back-EMF duty per rad/s the current sense learned (0: not given, the identified
-    /// model's); set before each step (see [`SpeedLoop::set_back_emf_duty_per_rad_s`]).
-    pub(super) emf_duty_per_rad_s: f32,
+    /// The back-EMF the current sense learned (`identified` 0: not given, the identified
+    /// model's); set before each step (see [`SpeedLoop::set_back_emf`]).
+    pub(super) emf: BackEmf,
 }
 
 impl SpeedLoop {
@@ -97,7 +98,7 @@ impl SpeedLoop {
         reference_abs_rad_s: 0.0,
         breakaway: Breakaway::NONE,
         breakaway_news: false,
-        emf_duty_per_rad_s: 0.0,
+        emf: BackEmf::identified(0.0),
         correction_duty: 0.0,
         correction_rad_s: 0.0,
         correction_angle_rad: 0.0,
