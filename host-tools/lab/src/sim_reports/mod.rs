@@ -57,6 +57,23 @@ pub fn commissioned(rig: &Rig, cfg: ControllerConfig) -> Result<ClosedLoop, Stri
     }
 }
 
+/// The steady speed full duty (`duty_limit`) gives axis `axis` of `rig` against its friction and
+/// `load_nm` of material, rad/s (0 when it cannot turn): the most any loop can ask of it.
+pub fn full_duty_speed_rad_s(
+    rig: &model_core::sim::PlantParams,
+    axis: usize,
+    duty_limit: f32,
+    load_nm: f32,
+) -> f32 {
+    let m = &rig.axes[axis].motor;
+    let (volts_per_rad_s, friction_duty) = {
+        let (a, fd, _) = m.ideal_model(rig.supply_v);
+        (a, fd)
+    };
+    let load_duty = m.resistance_ohm * load_nm / (m.torque_constant * rig.supply_v);
+    ((duty_limit - friction_duty - load_duty) * rig.supply_v / volts_per_rad_s).max(0.0)
+}
+
 /// Adds each axis's `load_step_nm` (material poured in after commissioning) from now on.
 pub fn pour_material(cl: &mut ClosedLoop) {
     let now = cl.rig.time_s() as f32;
