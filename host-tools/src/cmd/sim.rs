@@ -244,7 +244,7 @@ pub fn run(what: &What) -> Result<()> {
                 !a.no_feedback,
                 outcome,
             )?;
-            say_unsettled(&unsettled);
+            say_notes(&unsettled);
         }
         What::Family(a) if a.rig_file.is_some() => {
             let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
@@ -274,6 +274,9 @@ pub fn run(what: &What) -> Result<()> {
             });
             let out = serde_json::json!({ "plants": plants });
             println!("{}", serde_json::to_string_pretty(&out)?);
+            // A speed the motor cannot reach read as detections late against their bound.
+            let unreachable = sim_reports::unreachable_words(&rigs, a.speed_rad_s, "--speed-rad-s");
+            say_notes(&unreachable);
         }
         What::MakeFamily(a) => print!("{}", family_file::family_toml(a.seed, a.plants)),
         What::Step(a) => {
@@ -320,7 +323,7 @@ pub fn run(what: &What) -> Result<()> {
                 feedback,
                 outcome,
             )?;
-            say_unsettled(&unsettled);
+            say_notes(&unsettled);
         }
         What::Family(a) => {
             if a.plants < 50 && !a.allow_small {
@@ -387,9 +390,9 @@ fn sensed(rigs: Vec<rig_file::Rig>, on: bool) -> Vec<rig_file::Rig> {
     }
 }
 
-/// An axis that never settled is said in words beside its null settling time (it read as the
-/// run's length, 7.998 s, exit 0 and no word).
-fn say_unsettled(words: &[String]) {
+/// Notes on stderr beside a report's JSON: an axis that never settled (its settling time read
+/// as the run's length, 7.998 s, exit 0 and no word), a speed a plant cannot reach.
+fn say_notes(words: &[String]) {
     for w in words {
         eprintln!("note: {w}");
     }

@@ -74,6 +74,31 @@ pub fn full_duty_speed_rad_s(
     ((duty_limit - friction_duty - load_duty) * rig.supply_v / volts_per_rad_s).max(0.0)
 }
 
+/// A line for each axis of `rigs` that full duty, against its friction and material, cannot
+/// take to `speed` (named by `flag`): the speed it reaches instead. Its figures at `speed` are
+/// taken below it, against bounds reckoned for `speed`.
+pub fn unreachable_words(rigs: &[Rig], speed: f32, flag: &str) -> Vec<String> {
+    let mut words = Vec::new();
+    for rig in rigs {
+        let cfg = config_for(rig);
+        for (i, name) in ["precession", "spin"].into_iter().enumerate() {
+            let load = rig.params.axes[i].load_step_nm;
+            let reach = full_duty_speed_rad_s(&rig.params, i, cfg.axes[i].duty_limit, load);
+            // Within the 2 % band of the speed is reaching it (the estimate leaves out the
+            // load's ripple and the coupling).
+            if reach < 0.98 * speed {
+                words.push(format!(
+                    "plant {}'s {name} axis reaches about {reach:.2} rad/s at full duty against \
+                     its friction and material, below {flag} {speed}: it ran at that speed, \
+                     judged against the bounds of {speed} rad/s; ask for at most {reach:.2}",
+                    rig.name
+                ));
+            }
+        }
+    }
+    words
+}
+
 /// Adds each axis's `load_step_nm` (material poured in after commissioning) from now on.
 pub fn pour_material(cl: &mut ClosedLoop) {
     let now = cl.rig.time_s() as f32;
