@@ -89,3 +89,50 @@ fn json_flag_is_taken() {
     let flagged = json(&["sim", "step", "--json"]);
     assert_eq!(plain, flagged);
 }
+
+/// A rig whose motors cannot reach the target (5 V instead of 12): each axis ended 14-20 %
+/// short, yet its settling_time_s read 7.998 s (the run's end) beside exit 0 and no word. Now
+/// the settling times are null and each axis is said, with the speed full duty gives it.
+#[test]
+fn an_axis_that_never_settles_has_no_settling_time_and_is_said() {
+    let dir = common::temp_dir("sim-step-weak");
+    let rig = dir.join("weak.toml");
+    std::fs::write(&rig, "supply_v = 5\n").unwrap();
+    let out = bowl(&["sim", "step", "--rig-file", rig.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(v["fault_code"], 0, "{v}");
+    for axis in v["axes"].as_array().unwrap() {
+        assert!(axis["settling_time_s"].is_null(), "{axis}");
+        assert!(f(axis, "steady_state_error_pct") > 10.0, "{axis}");
+    }
+    assert!(v["worst"]["settling_time_s"].is_null(), "{v}");
+    // Full duty (0.95 of 5 V) against the nominal friction: (0.95 - 0.15) x 5 / 1.675 = 2.39
+    // rad/s on the rod, (0.95 - 0.1) x 5 / 1.65 = 2.58 on the spin.
+    for words in [
+        "the precession axis never settled at --target-rad-s 3 within the 8 s run",
+        "its motor reaches about 2.39 rad/s",
+        "the spin axis never settled",
+        "about 2.58 rad/s",
+        "ask for at most that",
+    ] {
+        assert!(err.contains(words), "{words:?} not in {err}");
+    }
+    // A step it can make is unchanged, and says nothing.
+    let out = bowl(&[
+        "sim",
+        "step",
+        "--rig-file",
+        rig.to_str().unwrap(),
+        "--target-rad-s",
+        "2",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert!(f(&v["worst"], "settling_time_s") < 3.0, "{v}");
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

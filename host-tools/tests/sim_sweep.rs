@@ -75,6 +75,26 @@ fn stability_map_shows_the_low_speed_loop_quiet_at_every_gain() {
     }
 }
 
+/// A pulse count other than the default grid's four (1, 4, 12, 60) printed the header alone,
+/// exit 0; now it is run alone like any other.
+#[test]
+fn stability_runs_any_pulse_count_asked_for() {
+    let rows = csv(&[
+        "sim",
+        "stability",
+        "--pulses-per-rev",
+        "7",
+        "--tick-hz",
+        "100",
+    ]);
+    assert_eq!(rows.len(), 1 + 6 * 2, "{rows:?}");
+    for r in &rows[1..] {
+        assert_eq!((r[0].as_str(), r[1].as_str()), ("100", "7"), "{r:?}");
+        // 7 pulses a revolution measure 0.5 rad/s: the shaft holds it.
+        assert!(r[7].parse::<f64>().unwrap() < 5.0, "{r:?}");
+    }
+}
+
 /// `sim trace --from-rad-s`: the trace starts at the step's command with the shafts settled at
 /// the starting speed (the true speeds, not the reference, say so) and ends at the target.
 #[test]

@@ -215,4 +215,62 @@ fn monitor_commission_and_stability_flags_are_usage_errors() {
         &["sim", "stability", "--tick-hz", "0"],
         &["--tick-hz", "100..=10000"],
     );
+    // No pulses: the CSV was its header alone, exit 0.
+    refused(
+        &["sim", "stability", "--pulses-per-rev", "0"],
+        &["--pulses-per-rev", "0 is not in 1.."],
+    );
+    // One pulse a revolution cannot measure 0.5 rad/s: every row read as a perfect hold
+    // (amplitude 0.000) of a shaft that never turned.
+    refused(
+        &["sim", "stability", "--pulses-per-rev", "1"],
+        &[
+            "--speed-rad-s 0.5 is below the lowest speed of the nominal rig's precession axis, \
+             1.571 rad/s (1 pulse per revolution)",
+        ],
+    );
+}
+
+/// `bowl chart family`'s step is judged as `bowl sim family`'s, before any plant runs: a target
+/// of 10, 0, -1 or NaN rad/s, one below the sensors' floor, or a "step" to the speed it starts
+/// at each drew a chart (never-settled axes, false faults, NaN ripple) and exited 0.
+#[test]
+fn chart_family_speed_flags_are_usage_errors() {
+    let rig = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/rigs/family-small.toml"
+    );
+    let dir = temp_dir("chart-family-flags");
+    let out = dir.join("family.svg");
+    let out = out.to_str().unwrap();
+    let chart = |extra: &[&'static str]| {
+        let mut v = vec!["chart", "family", "--rig-file", rig, "--out", out];
+        v.extend_from_slice(extra);
+        v
+    };
+    let range = "outside the controller's speed range, 0.200 to 4 rad/s";
+    for value in ["10", "0", "-1"] {
+        refused(&chart(&["--target-rad-s", value]), &[range]);
+    }
+    refused(
+        &chart(&["--target-rad-s", "NaN"]),
+        &["--target-rad-s", "`NaN` is not a number"],
+    );
+    refused(
+        &chart(&["--target-rad-s", "0.1"]),
+        &[
+            "--target-rad-s 0.1 is below the lowest speed of plant p00",
+            "0.200 rad/s",
+        ],
+    );
+    refused(
+        &chart(&["--from-rad-s", "1", "--target-rad-s", "1"]),
+        &["--from-rad-s 1 equals --target-rad-s", "0 (from rest)"],
+    );
+    for ext in ["svg", "png", "csv"] {
+        assert!(
+            !dir.join(format!("family.{ext}")).exists(),
+            "family.{ext} written"
+        );
+    }
 }

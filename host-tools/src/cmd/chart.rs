@@ -7,6 +7,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+
+use crate::cmd::sim::flags as sim_flags;
 use clap::Subcommand;
 use lab::chart::{
     bowl, chooser, control, costs, error_table, family, figures, hierarchy, log, plot, qemu_log,
@@ -137,10 +139,10 @@ struct FamilyArgs {
     #[arg(long)]
     rig_file: PathBuf,
     /// Step target, rad/s.
-    #[arg(long, default_value_t = 3.0)]
+    #[arg(long, value_parser = crate::cmd::number32, default_value_t = 3.0, allow_negative_numbers = true)]
     target_rad_s: f32,
     /// Both axes settle at this speed first, then step to the target (0 = from rest), rad/s.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, value_parser = crate::cmd::number32, default_value_t = 0.0, allow_negative_numbers = true)]
     from_rad_s: f32,
     /// Give every plant the typical current sense (`current_sense = true`) where its file gave
     /// none (as `bowl sim family --current-sense`).
@@ -463,7 +465,11 @@ pub fn run(args: &Args) -> Result<()> {
             } else {
                 name
             };
-            let (f, t) = family::chart(&rigs, a.from_rad_s, a.target_rad_s, &name);
+            // Judged as `bowl sim family` judges them: a speed no plant can hold drew a chart
+            // of never-settled axes (NaN ripple at a target of NaN, false faults at 0).
+            let plants: Vec<_> = rigs.iter().map(sim_flags::Plant::of_rig).collect();
+            let (from, target) = sim_flags::step(a.from_rad_s, a.target_rad_s, &plants)?;
+            let (f, t) = family::chart(&rigs, from, target, &name);
             write_all(&a.out, &f, &t)
         }
     }

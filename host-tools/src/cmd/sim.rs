@@ -16,7 +16,7 @@
 use anyhow::{Result, bail};
 use model_core::control::ControllerConfig;
 
-mod flags;
+pub(crate) mod flags;
 use flags::Plant;
 
 use crate::exit_code::usage;
@@ -25,6 +25,7 @@ use model_core::sim::experiments::rig_with_pulses;
 use lab::parallel::parallel;
 use lab::sim_reports::nominal::{
     StepJson, StepOutcome, commission_report, family, stability, step_run_with, sweep, trace,
+    unsettled_words,
 };
 use lab::{family_file, sim_reports};
 
@@ -196,8 +197,9 @@ pub struct StabilityArgs {
     /// Speed of the test, rad/s.
     #[arg(long, value_parser = crate::cmd::number32, default_value_t = 0.5)]
     speed_rad_s: f32,
-    /// Only this pulse count (default: 1, 4, 12 and 60).
-    #[arg(long)]
+    /// Only this pulse count (default: 1, 4, 12 and 60); at least 1, and enough for the
+    /// sensors to measure --speed-rad-s.
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..))]
     pulses_per_rev: Option<u16>,
     /// Control tick rate, Hz (the loop rate axis of the map; the controller runs at 100 to
     /// 10 000).
@@ -234,6 +236,7 @@ pub fn run(what: &What) -> Result<()> {
                 !a.no_feedback,
                 load,
             );
+            let unsettled = unsettled_words(&outcome, &rig.params, &cfg, target, load);
             print_step(
                 "rig file, both axes from --from-rad-s (0 = rest) to the target, commissioned first, true speed",
                 rig.params.axes[1].sensor.pulses_per_rev,
@@ -241,6 +244,7 @@ pub fn run(what: &What) -> Result<()> {
                 !a.no_feedback,
                 outcome,
             )?;
+            say_notes(&unsettled);
         }
         What::Family(a) if a.rig_file.is_some() => {
             let path = a.rig_file.as_deref().unwrap_or(std::path::Path::new(""));
@@ -270,6 +274,9 @@ pub fn run(what: &What) -> Result<()> {
             });
             let out = serde_json::json!({ "plants": plants });
             println!("{}", serde_json::to_string_pretty(&out)?);
+            // A speed the motor cannot reach read as detections late against their bound.
+            let unreachable = sim_reports::unreachable_words(&rigs, a.speed_rad_s, "--speed-rad-s");
+            say_notes(&unreachable);
         }
         What::MakeFamily(a) => print!("{}", family_file::family_toml(a.seed, a.plants)),
         What::Step(a) => {
@@ -308,6 +315,7 @@ pub fn run(what: &What) -> Result<()> {
             })?;
             let feedback = !a.no_feedback;
             let outcome = step_run_with(rig, cfg, a.common.seed, from, target, feedback, [0.0; 2]);
+            let unsettled = unsettled_words(&outcome, &rig, &cfg, target, [0.0; 2]);
             print_step(
                 "nominal rig, both axes from --from-rad-s (0 = rest) to the target, commissioned first, true speed",
                 a.pulses_per_rev,
@@ -315,6 +323,7 @@ pub fn run(what: &What) -> Result<()> {
                 feedback,
                 outcome,
             )?;
+            say_notes(&unsettled);
         }
         What::Family(a) => {
             if a.plants < 50 && !a.allow_small {
@@ -332,7 +341,11 @@ pub fn run(what: &What) -> Result<()> {
         }
         What::Sweep(a) => sweep(a.seed),
         What::Stability(a) => {
-            flags::speed(a.speed_rad_s, "--speed-rad-s", &[])?;
+            // The default grid runs 1 pulse a revolution below its floor on purpose (the
+            // CSV's mean error says the shaft never turned); a pulse count asked for alone
+            // must measure the speed, or every row reads as a perfect hold.
+            let asked: Vec<Plant> = a.pulses_per_rev.map(Plant::nominal).into_iter().collect();
+            flags::speed(a.speed_rad_s, "--speed-rad-s", &asked)?;
             stability(a.common.seed, a.speed_rad_s, a.pulses_per_rev, a.tick_hz)
         }
         What::Trace(a) => {
@@ -377,6 +390,14 @@ fn sensed(rigs: Vec<rig_file::Rig>, on: bool) -> Vec<rig_file::Rig> {
     }
 }
 
+/// Notes on stderr beside a report's JSON: an axis that never settled (its settling time read
+/// as the run's length, 7.998 s, exit 0 and no word), a speed a plant cannot reach.
+fn say_notes(words: &[String]) {
+    for w in words {
+        eprintln!("note: {w}");
+    }
+}
+
 /// A step run that faulted or was never commissioned has no step figures: say so, fail.
 /// Prints a step's report as JSON, then fails if it is no step response.
 fn print_step(
@@ -400,10 +421,17 @@ fn print_step(
 
 fn check_step(o: &StepOutcome) -> Result<()> {
     if !o.commissioned {
-        bail!(
-            "commissioning did not finish (fault code {}): the figures above are not a step response",
-            o.fault_code
+        // The fault that ended it, named as a faulted run's is (it gave the code alone).
+        let why = o.fault.map_or_else(
+            || format!("fault code {}", o.fault_code),
+            |f| {
+                format!(
+                    "it latched {f}, fault code {}, see docs/protocol.md",
+                    o.fault_code
+                )
+            },
         );
+        bail!("commissioning did not finish ({why}): the figures above are not a step response");
     }
     if o.fault_code != 0 {
         bail!(
@@ -431,7 +459,7 @@ mod tests {
         let axis = AxisFigures {
             rise_time_s: 0.5,
             overshoot_pct: 0.0,
-            settling_time_s: 0.0,
+            settling_time_s: Some(0.0),
             steady_state_error_pct: 0.0,
             rms_ripple_pct: 0.0,
         };
@@ -455,7 +483,12 @@ mod tests {
             e.contains("faulted (overspeed-precession, fault code 3"),
             "{e}"
         );
-        let e = check_step(&outcome(6, false)).unwrap_err().to_string();
-        assert!(e.contains("commissioning did not finish"), "{e}");
+        let e = check_step(&outcome(3, false)).unwrap_err().to_string();
+        assert!(
+            e.contains(
+                "commissioning did not finish (it latched overspeed-precession, fault code 3"
+            ),
+            "{e}"
+        );
     }
 }

@@ -37,6 +37,9 @@ const HOLD_MEASURE_S: f32 = 20.0;
 const AMPLITUDE_FLOOR_PCT: f64 = 1e-3;
 /// Where runs that latched a fault are marked (above any measured cycle), percent.
 const FAULT_ROW_PCT: f64 = 3000.0;
+/// A hold whose mean stayed this far off the speed (percent) never reached it: below the lowest
+/// speed its pulses measure the motor is never driven, and its flat 0 % is no limit cycle.
+const NEVER_HELD_ERROR_PCT: f64 = 50.0;
 
 /// How much to run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -347,12 +350,29 @@ pub fn stability_chart(points: &[HoldPoint]) -> (Figure, Table) {
     }
     // A run that latched a fault has no limit cycle to measure (the motors were stopped): its
     // point is a gap in the line and a cross on the fault row instead.
+    let never_held = |p: &HoldPoint| p.mean_error_pct >= NEVER_HELD_ERROR_PCT;
     let drawn = |p: &HoldPoint| match p.fault {
         Some(_) => f64::NAN,
+        None if never_held(p) => f64::NAN,
         None => p.half_peak_to_peak_pct.max(AMPLITUDE_FLOOR_PCT),
     };
+    // A setup whose shaft never reached the speed at any gain gets no line (it was drawn as a
+    // perfect hold along the floor) and a note instead.
+    let unheld: Vec<LoopSetup> = setups
+        .iter()
+        .copied()
+        .filter(|s| {
+            points
+                .iter()
+                .filter(|p| p.setup == *s && p.fault.is_none())
+                .all(never_held)
+        })
+        .collect();
     let mut series = Vec::new();
     for (i, s) in setups.iter().enumerate() {
+        if unheld.contains(s) {
+            continue;
+        }
         let label = format!(
             "N {} ({:.2} pulses/s), {} Hz",
             s.pulses_per_rev,
@@ -417,7 +437,7 @@ pub fn stability_chart(points: &[HoldPoint]) -> (Figure, Table) {
         }
     }
     let nominal = f64::from(ControllerConfig::nominal().axes[1].per_pulse_bandwidth);
-    let fig = Figure {
+    let mut fig = Figure {
         title: format!("Limit cycle holding {HOLD_SPEED_RAD_S} rad/s against the per-pulse gain"),
         x_label: "per-pulse gain: loop bandwidth / pulse rate, rad per pulse (log)".into(),
         y_label: "half peak-to-peak of the true speed, % (log)".into(),
@@ -447,5 +467,16 @@ pub fn stability_chart(points: &[HoldPoint]) -> (Figure, Table) {
             "(the CSV keeps the value).".into(),
         ],
     };
+    for s in &unheld {
+        fig.notes.push(format!(
+            "Not drawn: N {}, {} Hz never reached {HOLD_SPEED_RAD_S} rad/s",
+            s.pulses_per_rev, s.tick_hz
+        ));
+        fig.notes
+            .push("(too slow for its pulses; see the CSV).".into());
+    }
     (fig, table)
 }
+
+#[cfg(test)]
+mod tests;

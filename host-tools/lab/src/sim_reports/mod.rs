@@ -57,6 +57,48 @@ pub fn commissioned(rig: &Rig, cfg: ControllerConfig) -> Result<ClosedLoop, Stri
     }
 }
 
+/// The steady speed full duty (`duty_limit`) gives axis `axis` of `rig` against its friction and
+/// `load_nm` of material, rad/s (0 when it cannot turn): the most any loop can ask of it.
+pub fn full_duty_speed_rad_s(
+    rig: &model_core::sim::PlantParams,
+    axis: usize,
+    duty_limit: f32,
+    load_nm: f32,
+) -> f32 {
+    let m = &rig.axes[axis].motor;
+    let (volts_per_rad_s, friction_duty) = {
+        let (a, fd, _) = m.ideal_model(rig.supply_v);
+        (a, fd)
+    };
+    let load_duty = m.resistance_ohm * load_nm / (m.torque_constant * rig.supply_v);
+    ((duty_limit - friction_duty - load_duty) * rig.supply_v / volts_per_rad_s).max(0.0)
+}
+
+/// A line for each axis of `rigs` that full duty, against its friction and material, cannot
+/// take to `speed` (named by `flag`): the speed it reaches instead. Its figures at `speed` are
+/// taken below it, against bounds reckoned for `speed`.
+pub fn unreachable_words(rigs: &[Rig], speed: f32, flag: &str) -> Vec<String> {
+    let mut words = Vec::new();
+    for rig in rigs {
+        let cfg = config_for(rig);
+        for (i, name) in ["precession", "spin"].into_iter().enumerate() {
+            let load = rig.params.axes[i].load_step_nm;
+            let reach = full_duty_speed_rad_s(&rig.params, i, cfg.axes[i].duty_limit, load);
+            // Within the 2 % band of the speed is reaching it (the estimate leaves out the
+            // load's ripple and the coupling).
+            if reach < 0.98 * speed {
+                words.push(format!(
+                    "plant {}'s {name} axis reaches about {reach:.2} rad/s at full duty against \
+                     its friction and material, below {flag} {speed}: it ran at that speed, \
+                     judged against the bounds of {speed} rad/s; ask for at most {reach:.2}",
+                    rig.name
+                ));
+            }
+        }
+    }
+    words
+}
+
 /// Adds each axis's `load_step_nm` (material poured in after commissioning) from now on.
 pub fn pour_material(cl: &mut ClosedLoop) {
     let now = cl.rig.time_s() as f32;

@@ -18,8 +18,9 @@ pub struct AxisFigures {
     /// Overshoot: the largest excursion past the target in the step's direction, percent of
     /// the target.
     pub overshoot_pct: f32,
-    /// 2 % settling time, s.
-    pub settling_time_s: f32,
+    /// 2 % settling time, s; `None` (null) when the run ended outside the band: the time it
+    /// was last outside would be the end of the run, read as a settling time.
+    pub settling_time_s: Option<f32>,
     /// Steady-state error, percent of the target.
     pub steady_state_error_pct: f32,
     /// RMS ripple of the true speed, percent of the target.
@@ -31,7 +32,7 @@ impl From<StepReport> for AxisFigures {
         Self {
             rise_time_s: r.rise_time_s,
             overshoot_pct: 100.0 * r.overshoot,
-            settling_time_s: r.settling_time_s,
+            settling_time_s: r.settled.then_some(r.settling_time_s),
             steady_state_error_pct: 100.0 * r.steady_state_error,
             rms_ripple_pct: 100.0 * r.rms_ripple,
         }
@@ -52,6 +53,48 @@ pub struct StepOutcome {
     pub fault: Option<&'static str>,
     /// Commissioning ended in Idle (not a fault).
     pub commissioned: bool,
+}
+
+/// A line for each axis of a step run that never settled (its `settling_time_s` is null): how
+/// far short it ended and, where full duty cannot take it to the target, the speed it can reach
+/// (the limit to ask within). Empty when both settled or the run faulted (the fault says why).
+pub fn unsettled_words(
+    o: &StepOutcome,
+    rig: &PlantParams,
+    cfg: &ControllerConfig,
+    target: f32,
+    load_nm: [f32; 2],
+) -> Vec<String> {
+    if o.fault_code != 0 || !o.commissioned {
+        return Vec::new();
+    }
+    let mut words = Vec::new();
+    for (i, (a, name)) in o.axes.iter().zip(["precession", "spin"]).enumerate() {
+        if a.settling_time_s.is_some() {
+            continue;
+        }
+        let mut line = format!(
+            "the {name} axis never settled at --target-rad-s {target} within the {STEP_RUN_S} s \
+             run (it ended {:.1} % off the target), so its settling_time_s is null",
+            a.steady_state_error_pct
+        );
+        let duty = cfg.axes[i].duty_limit;
+        let reach = sim_reports::full_duty_speed_rad_s(rig, i, duty, load_nm[i]);
+        if reach < target {
+            line.push_str(&format!(
+                ": at full duty ({duty} of {} V) its motor reaches about {reach:.2} rad/s against \
+                 its friction{}; ask for at most that, or give the rig more supply_v",
+                rig.supply_v,
+                if load_nm[i] > 0.0 {
+                    " and material"
+                } else {
+                    ""
+                }
+            ));
+        }
+        words.push(line);
+    }
+    words
 }
 
 /// Commissions, runs both axes at `from` (0 = rest), then steps them to `target` (see
@@ -116,7 +159,11 @@ pub fn worst_of(a: &[AxisFigures]) -> AxisFigures {
     for x in &a[1..] {
         w.rise_time_s = w.rise_time_s.max(x.rise_time_s);
         w.overshoot_pct = w.overshoot_pct.max(x.overshoot_pct);
-        w.settling_time_s = w.settling_time_s.max(x.settling_time_s);
+        // An axis that never settled is the worst.
+        w.settling_time_s = w
+            .settling_time_s
+            .zip(x.settling_time_s)
+            .map(|(a, b)| a.max(b));
         w.steady_state_error_pct = w.steady_state_error_pct.max(x.steady_state_error_pct);
         w.rms_ripple_pct = w.rms_ripple_pct.max(x.rms_ripple_pct);
     }
@@ -129,10 +176,16 @@ pub fn median_of(a: &[AxisFigures]) -> AxisFigures {
         v.sort_by(f32::total_cmp);
         v[v.len() / 2]
     };
+    // Never settled sorts after every time.
+    let mut settling: Vec<Option<f32>> = a.iter().map(|x| x.settling_time_s).collect();
+    settling.sort_by(|x, y| match (x, y) {
+        (Some(x), Some(y)) => x.total_cmp(y),
+        (x, y) => x.is_none().cmp(&y.is_none()),
+    });
     AxisFigures {
         rise_time_s: med(|x| x.rise_time_s),
         overshoot_pct: med(|x| x.overshoot_pct),
-        settling_time_s: med(|x| x.settling_time_s),
+        settling_time_s: settling[settling.len() / 2],
         steady_state_error_pct: med(|x| x.steady_state_error_pct),
         rms_ripple_pct: med(|x| x.rms_ripple_pct),
     }
@@ -277,8 +330,10 @@ pub fn sweep(seed: u32) {
     for n in [1u16, 2, 4, 6, 8, 12, 16, 24, 32, 48, 60, 90, 120, 180, 240] {
         let o = step_run(rig_with_pulses(n), seed, 3.0, true);
         println!(
-            "{n},{:.3},{:.3},{:.4},{:.3},{}",
-            o.worst.settling_time_s,
+            "{n},{},{:.3},{:.4},{:.3},{}",
+            o.worst
+                .settling_time_s
+                .map_or_else(|| "never".into(), |s| format!("{s:.3}")),
             o.worst.overshoot_pct,
             o.worst.rms_ripple_pct,
             o.worst.rise_time_s,
@@ -291,10 +346,9 @@ pub fn stability(seed: u32, speed: f32, only: Option<u16>, tick_hz: u32) {
     println!(
         "tick_hz,pulses_per_rev,pulse_rate_hz,per_pulse_bandwidth,scheduled,half_peak_to_peak_pct,fault_code,mean_error_pct"
     );
-    for n in [1u16, 4, 12, 60] {
-        if only.is_some_and(|o| o != n) {
-            continue;
-        }
+    // A count asked for runs alone, whichever it is (any other than these four printed the
+    // header and no row).
+    for n in only.map_or_else(|| vec![1u16, 4, 12, 60], |n| vec![n]) {
         for ppb in [0.1f32, 0.25, 0.5, 1.0, 2.0, 4.0] {
             for scheduled in [true, false] {
                 let (r, fault) = experiments::low_speed_hold_at_rate(

@@ -65,8 +65,13 @@ pub fn speed(x: f32, flag: &str, plants: &[Plant]) -> Result<()> {
             if x < lowest {
                 return Err(usage(format!(
                     "{flag} {x} is below the lowest speed of {}'s {name} axis, {lowest:.3} rad/s \
-                     ({} pulses per revolution): the motor would not move; ask for at least that",
-                    p.label, axis.pulses_per_rev
+                     ({}): the motor would not move; ask for at least that",
+                    p.label,
+                    lab::number::count(
+                        usize::from(axis.pulses_per_rev),
+                        "pulse per revolution",
+                        "pulses per revolution"
+                    )
                 )));
             }
         }
