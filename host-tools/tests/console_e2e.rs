@@ -533,3 +533,47 @@ fn a_fault_and_its_clearing_are_said_as_they_come() {
     let _ = child.kill();
     let _ = child.wait();
 }
+
+/// A frame from the PC that lost its `$` on the way (here written so through the monitor's
+/// socket): the rig answers `$R1,0,UNREADABLE`, id 0, which no tool sent. Before, the monitor
+/// passed it over as another tool's answer and no one said the link garbled a frame; now it is
+/// an event line, a counter and a row of the log.
+#[test]
+fn a_line_the_rig_could_not_read_is_said_and_logged() {
+    let sim = Sim::start(&[]);
+    let dir = common::temp_dir("console-unread-by-rig");
+    let log = dir.join("run.csv");
+    let (mut monitor, lines) = start_monitor(&sim.path, &log, Stdio::null());
+    let mut link = rig_client::link::Link::open(&sim.path, 115_200).unwrap();
+    let line = rig_client::lines::command_line(7, &["ping".into()]).unwrap();
+    link.write_all(&line[1..]).unwrap();
+    let said = wait_line(&lines, "the rig could not read");
+    assert!(
+        said.contains("the rig could not read a line it got (line noise on the link?); 1 so far"),
+        "{said}"
+    );
+    let counters = wait_line(&lines, "unread by the rig");
+    assert!(counters.contains("unread by the rig 1"), "{counters}");
+    // A whole frame is answered as before, and is no such line.
+    link.write_all(&line).unwrap();
+    std::thread::sleep(Duration::from_millis(500));
+    let sent = Command::new("kill")
+        .args(["-INT", &monitor.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    wait_within(&mut monitor, Duration::from_secs(5), "monitor after Ctrl-C");
+    let summary = lines.iter().last().expect("the counters on Ctrl-C");
+    let counters: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    assert_eq!(counters["unread_by_rig"], 1, "{summary}");
+    let logged: Vec<_> = common::csv_rows(&log)
+        .into_iter()
+        .filter(|r| r["event"] == "the rig could not read a line it got (line noise on the link?)")
+        .collect();
+    assert_eq!(
+        logged.len(),
+        1,
+        "{}",
+        std::fs::read_to_string(&log).unwrap()
+    );
+}

@@ -37,6 +37,24 @@ pub fn explain(reason: Reason) -> &'static str {
     }
 }
 
+/// What the monitor and a command left unanswered say of [`unread_by_rig`].
+pub const UNREAD_BY_RIG: &str = "the rig could not read a line it got (line noise on the link?)";
+
+/// Whether `frame` is the rig's answer to a line it got outside a frame and could not read
+/// (`$R1,0,UNREADABLE`). A person's typing gets it too, but no one types at the rig while a
+/// tool holds the port, and the tools' ids skip 0 ([`crate::request::next_id`]): it is one of
+/// their frames that lost its `$` on the way. No tool takes it for its answer, so it is said
+/// on its own, never dropped as another tool's.
+pub fn unread_by_rig(frame: &Frame) -> bool {
+    matches!(
+        frame,
+        Frame::Reject {
+            id: 0,
+            reason: Reason::Unreadable
+        }
+    )
+}
+
 /// The STATUS flags in words, joined by "; " (`None` when none is set): also the monitor's
 /// banner.
 pub fn status_flag_words(flags: u8) -> Option<String> {

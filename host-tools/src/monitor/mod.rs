@@ -12,14 +12,15 @@ mod commands;
 mod fit;
 mod glyphs;
 mod line_edit;
+mod log_file;
 mod tui;
 mod view;
 mod wrap;
 
 pub(crate) use view::View;
 
-use std::fs::{File, OpenOptions};
-use std::io::{BufRead, BufWriter, IsTerminal, Read, Seek, SeekFrom, Write};
+use std::fs::File;
+use std::io::{BufRead, BufWriter, IsTerminal, Write};
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use std::sync::mpsc;
@@ -30,6 +31,7 @@ use model_core::wire::{Decoder, Frame, FrameError};
 use serde_json::json;
 
 use commands::Commands;
+use log_file::open_log;
 use rig_client::decode_stats::stats_json;
 use rig_client::relay::Relay;
 use rig_client::serial::{Holder, Port, ReadOutcome, other_holders, shared_port_warning};
@@ -58,63 +60,6 @@ pub struct Args {
 
 const REDRAW: Duration = Duration::from_millis(100);
 const REOPEN_EVERY: Duration = Duration::from_millis(250);
-
-/// Opens the log to append to it: a new or empty file gets the header; an existing one must be
-/// a log with these very columns (appending telemetry to another CSV, a results file say,
-/// would spoil it, and rows under an older header would sit in the wrong columns).
-fn open_log(path: &PathBuf) -> Result<BufWriter<File>> {
-    let mut file = OpenOptions::new()
-        .create(true)
-        .append(true)
-        .read(true)
-        .open(path)
-        .with_context(|| format!("cannot open the log {}", path.display()))?;
-    // Held while the monitor runs: a second monitor's rows (another rig's) would be mixed into
-    // this one's, a row cut in two where their buffers met. A file system without locks
-    // does without.
-    if let Err(std::fs::TryLockError::WouldBlock) = file.try_lock() {
-        return Err(crate::exit_code::usage(format!(
-            "--log {}: another `bowl monitor` is writing to this log, and the rows of two \
-             monitors would be mixed in it; give each monitor a log of its own",
-            path.display()
-        )));
-    }
-    let len = file.metadata().map(|m| m.len()).unwrap_or(0);
-    // The header line and the last byte are all that is read: a day's log is hundreds of MB.
-    let mut head = Vec::new();
-    let mut last = [b'\n'];
-    (|| -> std::io::Result<()> {
-        (&mut file)
-            .take(telemetry_csv::HEADER.len() as u64 + 2)
-            .read_to_end(&mut head)?;
-        if len > 0 {
-            file.seek(SeekFrom::Start(len - 1))?;
-            file.read_exact(&mut last)?;
-        }
-        Ok(())
-    })()
-    .with_context(|| format!("cannot read the log {}", path.display()))?;
-    let mut w = BufWriter::new(file);
-    if len == 0 {
-        writeln!(w, "{}", telemetry_csv::HEADER)?;
-        return Ok(w);
-    }
-    let first = head.split(|&b| b == b'\n').next().unwrap_or_default();
-    if first.strip_suffix(b"\r").unwrap_or(first) != telemetry_csv::HEADER.as_bytes() {
-        return Err(crate::exit_code::usage(format!(
-            "--log {}: the file exists and is not a telemetry log with this bowl's columns (its \
-             first line is not the header `bowl monitor --log` writes), so nothing was appended \
-             to it; give a new file name (or an earlier log of this bowl to go on with)",
-            path.display()
-        )));
-    }
-    // A log whose last row was cut off (the PC lost power mid-write): the next row starts on
-    // a line of its own, not glued to the stub.
-    if last != [b'\n'] {
-        writeln!(w)?;
-    }
-    Ok(w)
-}
 
 /// Lines typed on stdin (plain mode), read on their own thread.
 fn stdin_lines() -> mpsc::Receiver<String> {
@@ -349,6 +294,12 @@ pub fn run(args: &Args) -> Result<()> {
                         }
                         match commands.on_frame(&frame) {
                             Some(text) => view.event(plain, text),
+                            // No tool's answer: said here, or no one would.
+                            None if rig_client::lines::unread_by_rig(&frame) => {
+                                view.unread_by_rig(plain);
+                                let boot = decoder.stats().restarts;
+                                link_event(&mut log, boot, rig_client::lines::UNREAD_BY_RIG)?;
+                            }
                             // Answers to other tools' commands are theirs to report.
                             None if frame.answer_id().is_some() => {}
                             None => view.on_frame(plain, &frame),
@@ -492,6 +443,7 @@ pub fn run(args: &Args) -> Result<()> {
     watched.and(ended)?;
     let mut summary = stats_json(decoder.stats());
     summary["reconnects"] = json!(view.reconnects);
+    summary["unread_by_rig"] = json!(view.unread_by_rig);
     summary["logged_rows"] = json!(view.logged_rows);
     writeln!(std::io::stdout(), "{summary}")?;
     Ok(())

@@ -94,6 +94,8 @@ pub(crate) struct View {
     pub(crate) events: VecDeque<String>,
     trends: [Trend; 5],
     pub(crate) reconnects: u64,
+    /// Lines the rig got and could not read (`rig_client::lines::unread_by_rig`).
+    pub(crate) unread_by_rig: u64,
     pub(crate) connected: bool,
     pub(crate) logged_rows: u64,
     /// When the latest telemetry frame arrived (or the port was opened, before the first).
@@ -129,6 +131,7 @@ impl View {
                 Trend::new("T Coriolis s"),
             ],
             reconnects: 0,
+            unread_by_rig: 0,
             connected: false,
             logged_rows: 0,
             heard_at: Instant::now(),
@@ -206,6 +209,20 @@ impl View {
         }
     }
 
+    /// The rig could not read a line it got: counted and said each time. Before, its answer
+    /// (`$R1,0,UNREADABLE`, id 0) was passed over as another tool's, and a frame of ours
+    /// garbled on the way to the rig went unsaid. The rig answers only lines the PC sends (a
+    /// heartbeat a second, the commands), so these come no faster than that.
+    pub(crate) fn unread_by_rig(&mut self, plain: bool) {
+        self.unread_by_rig += 1;
+        let text = format!(
+            "{}; {} so far",
+            rig_client::lines::UNREAD_BY_RIG,
+            self.unread_by_rig
+        );
+        self.event(plain, text);
+    }
+
     pub(crate) fn set_connected(&mut self, connected: bool) {
         self.connected = connected;
         if connected {
@@ -244,8 +261,14 @@ impl View {
     pub(crate) fn counters(&self, d: &Decoder) -> String {
         let s = d.stats();
         format!(
-            "frames ok {}  corrupt {}  missing {}  bytes skipped {}  reconnects {}",
-            s.frames_ok, s.frames_corrupt, s.frames_missing, s.bytes_skipped, self.reconnects
+            "frames ok {}  corrupt {}  missing {}  bytes skipped {}  reconnects {}  \
+             unread by the rig {}",
+            s.frames_ok,
+            s.frames_corrupt,
+            s.frames_missing,
+            s.bytes_skipped,
+            self.reconnects,
+            self.unread_by_rig
         )
     }
 
