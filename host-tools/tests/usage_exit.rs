@@ -231,6 +231,28 @@ fn monitor_commission_and_stability_flags_are_usage_errors() {
     );
 }
 
+/// `bowl send --id` with an id whose answers are another's: 0 (the rig's answer to a line it
+/// could not read, `$R1,0,UNREADABLE`, would have been taken for this command's refusal) and
+/// the monitor's two (its heartbeat's ack for this command's). Before, each was sent.
+#[test]
+fn send_ids_whose_answers_are_anothers_are_usage_errors() {
+    let send = |id: &'static str| ["send", "/dev/null-never-opened", "--id", id, "stop"];
+    refused(
+        &send("0"),
+        &["'0'", "lines typed at its console", "give 1 to 65533"],
+    );
+    for id in ["65534", "65535"] {
+        refused(
+            &send(id),
+            &["`bowl monitor`'s own commands", "give 1 to 65533"],
+        );
+    }
+    refused(
+        &send("65536"),
+        &["`65536` is not a request id", "from 1 to 65533"],
+    );
+}
+
 /// `bowl chart family`'s step is judged as `bowl sim family`'s, before any plant runs: a target
 /// of 10, 0, -1 or NaN rad/s, one below the sensors' floor, or a "step" to the speed it starts
 /// at each drew a chart (never-settled axes, false faults, NaN ripple) and exited 0.

@@ -31,13 +31,35 @@ pub struct Args {
     /// you resend). The same id with the same words within 60 s is a resend to the rig: it
     /// answers again ("ok") but does not do it again, even with other commands in between, and
     /// its answer is the same either way, so `bowl send` cannot tell you. Give each new
-    /// command a new id.
-    #[arg(long)]
+    /// command a new id. 1 to 65533: 0 is the id of the rig's answers to a line typed at its
+    /// console, 65534 and 65535 are the monitor's own.
+    #[arg(long, value_parser = own_id)]
     id: Option<u16>,
     /// How long to wait for the answer, ms (1..=60000: the rig remembers a command for 60 s to
     /// know its copies, so resends must end before that).
     #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u64).range(1..=60_000))]
     timeout_ms: u64,
+}
+
+/// The `--id` flag: an id no one else's answer comes with. With 0, the rig's `UNREADABLE` to a
+/// frame of this very command that lost its `$` was taken for the command's refusal; with
+/// 65535, the monitor's heartbeat's ack for this command's.
+fn own_id(text: &str) -> Result<u16, String> {
+    let id: u16 = text.trim().parse().map_err(|_| {
+        format!("`{text}` is not a request id: give a whole number from 1 to 65533")
+    })?;
+    match id {
+        0 => Err(
+            "0 is the id the rig gives its answers to lines typed at its console (and to \
+                  damaged ones), which would pass for this command's: give 1 to 65533"
+                .into(),
+        ),
+        65_534.. => Err(format!(
+            "{id} is the id of `bowl monitor`'s own commands (its heartbeat, its status), whose \
+             answers would pass for this command's: give 1 to 65533"
+        )),
+        id => Ok(id),
+    }
 }
 
 /// Runs `bowl send`; returns the process exit status.
