@@ -11,6 +11,17 @@ const SMALL: &str = concat!(
     "/../tests/rigs/family-small.toml"
 );
 
+/// The small family's step from rest to 0.5 rad/s.
+const SMALL_TO_HALF: [&str; 7] = [
+    "sim",
+    "family",
+    "--rig-file",
+    SMALL,
+    "--target-rad-s",
+    "0.5",
+    "--json",
+];
+
 #[test]
 fn the_small_family_commissions_and_steps_within_the_targets() {
     let v = json(&["sim", "family", "--rig-file", SMALL, "--json"]);
@@ -49,15 +60,7 @@ fn the_small_family_holds_half_a_rad_s_without_fault() {
     // plants. The slowest is p01's spin, 8.8 s: its first pitch overshoots 40 % while the push
     // finds the material it carries, and the revolution-averaged judgement holds that for 6 s.
     // (Before the crawl window read the load, it took 10.8 s.)
-    let v = json(&[
-        "sim",
-        "family",
-        "--rig-file",
-        SMALL,
-        "--target-rad-s",
-        "0.5",
-        "--json",
-    ]);
+    let v = json(&SMALL_TO_HALF);
     for p in v["plants"].as_array().unwrap() {
         assert_eq!(p["commissioning"], "ok", "{p}");
         assert_eq!(p["false_fault"], false, "{p}");
@@ -500,14 +503,7 @@ fn times_in_ticks_are_written_as_whole_ticks() {
     );
     for args in [
         vec!["sim", "step"],
-        vec![
-            "sim",
-            "family",
-            "--rig-file",
-            SMALL,
-            "--target-rad-s",
-            "0.5",
-        ],
+        SMALL_TO_HALF.to_vec(),
         vec![
             "sim",
             "faults",
