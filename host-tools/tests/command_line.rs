@@ -124,6 +124,33 @@ fn every_file_error_names_its_file() {
     }
 }
 
+/// A directory given as the file to write: `bowl chart radial --out DIR` wrote DIR.svg, .png and
+/// .csv beside it without a word; now refused (usage, exit 2) before any work, naming it.
+#[test]
+fn a_directory_to_write_to_is_refused_in_words() {
+    let dir = temp_dir("dir-for-out");
+    let d = dir.to_str().unwrap();
+    for args in [
+        vec!["chart", "radial", "--out", d],
+        vec!["chart", "log", "--csv", "run.csv", "--out", d],
+        vec!["replay", "run.bin", "--csv", d],
+    ] {
+        let out = bowl(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(&format!("{d} is a directory: give the name of a file")),
+            "{args:?}: {err}"
+        );
+    }
+    for ext in ["svg", "png", "csv"] {
+        assert!(
+            !dir.with_extension(ext).exists(),
+            "{ext} written beside {d}"
+        );
+    }
+}
+
 /// A line that brings only damaged frames: the timeout says it is noisy and what to try.
 #[test]
 fn a_timeout_on_a_noisy_line_says_what_to_try() {

@@ -11,6 +11,17 @@ const SMALL: &str = concat!(
     "/../tests/rigs/family-small.toml"
 );
 
+/// The small family's step from rest to 0.5 rad/s.
+const SMALL_TO_HALF: [&str; 7] = [
+    "sim",
+    "family",
+    "--rig-file",
+    SMALL,
+    "--target-rad-s",
+    "0.5",
+    "--json",
+];
+
 #[test]
 fn the_small_family_commissions_and_steps_within_the_targets() {
     let v = json(&["sim", "family", "--rig-file", SMALL, "--json"]);
@@ -49,15 +60,7 @@ fn the_small_family_holds_half_a_rad_s_without_fault() {
     // plants. The slowest is p01's spin, 8.8 s: its first pitch overshoots 40 % while the push
     // finds the material it carries, and the revolution-averaged judgement holds that for 6 s.
     // (Before the crawl window read the load, it took 10.8 s.)
-    let v = json(&[
-        "sim",
-        "family",
-        "--rig-file",
-        SMALL,
-        "--target-rad-s",
-        "0.5",
-        "--json",
-    ]);
+    let v = json(&SMALL_TO_HALF);
     for p in v["plants"].as_array().unwrap() {
         assert_eq!(p["commissioning"], "ok", "{p}");
         assert_eq!(p["false_fault"], false, "{p}");
@@ -416,4 +419,104 @@ fn faults_at_a_speed_the_motor_cannot_reach_say_so() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+/// A family none of whose axes can reach the target: the share of reachable axes that settled
+/// is 0 of 0, written null (it read 0.0, as if every reachable axis had failed), and said.
+#[test]
+fn no_reachable_axis_gives_no_share_and_says_so() {
+    let dir = common::temp_dir("all-saturated");
+    let rig = dir.join("both-saturated.toml");
+    // saturated-spin.toml's spin axis on both axes: neither reaches 4 rad/s at full duty.
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/rigs/saturated-spin.toml"
+    ))
+    .unwrap();
+    let spin = &text[text.find("[plant.spin]").unwrap()..];
+    let head = &text[..text.find("[plant.precession]").unwrap()];
+    let both = format!(
+        "{head}{spin}\n{}",
+        spin.replace("[plant.spin]", "[plant.precession]")
+    );
+    std::fs::write(&rig, both).unwrap();
+    let rig = rig.to_str().unwrap();
+    let args = [
+        "sim",
+        "family",
+        "--rig-file",
+        rig,
+        "--target-rad-s",
+        "4",
+        "--json",
+    ];
+    let out = bowl(&args);
+    let v = common::success_json(&out, "sim family, both axes saturated");
+    let s = &v["summary"];
+    assert_eq!(s["saturated_axes"], 2, "{s}");
+    assert!(
+        s["settled_2pct_within_3_s_share_of_reachable"].is_null(),
+        "{s}"
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("full duty held all 2 axes short of 4 rad/s")
+            && err.contains("settled_2pct_within_3_s_share_of_reachable is null"),
+        "{err}"
+    );
+}
+
+/// Every time `bowl sim` writes that is a count of 1 ms ticks, written as that count (0.785),
+/// not with the binary noise of the tick (0.78499347, 8.258000000000001, 1.0000000474974513).
+#[test]
+fn times_in_ticks_are_written_as_whole_ticks() {
+    fn check(v: &serde_json::Value, what: &str) -> usize {
+        const TIMES: [&str; 8] = [
+            "settling_s",
+            "settling_2pct_s",
+            "settling_5pct_s",
+            "settling_worst_s",
+            "fault_after_step_s",
+            "detected_s",
+            "rise_time_s",
+            "settling_time_s",
+        ];
+        match v {
+            serde_json::Value::Object(m) => m
+                .iter()
+                .map(|(k, x)| match x.as_f64() {
+                    Some(t) if TIMES.contains(&k.as_str()) => {
+                        let decimals = t.to_string().split('.').nth(1).map_or(0, str::len);
+                        assert!(decimals <= 3, "{what}: {k} = {t}: not a whole 1 ms tick");
+                        1
+                    }
+                    _ => check(x, what),
+                })
+                .sum(),
+            serde_json::Value::Array(a) => a.iter().map(|x| check(x, what)).sum(),
+            _ => 0,
+        }
+    }
+    let saturated = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/rigs/saturated-spin.toml"
+    );
+    for args in [
+        vec!["sim", "step"],
+        SMALL_TO_HALF.to_vec(),
+        vec![
+            "sim",
+            "faults",
+            "--rig-file",
+            saturated,
+            "--speed-rad-s",
+            "2",
+        ],
+    ] {
+        let v = json(&args);
+        assert!(
+            check(&v, &format!("{args:?}")) > 0,
+            "{args:?}: no times: {v}"
+        );
+    }
 }

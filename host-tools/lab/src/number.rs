@@ -55,6 +55,19 @@ pub fn f32_digits_opt<S: serde::Serializer>(x: &Option<f64>, s: S) -> Result<S::
     }
 }
 
+/// A time the simulated rig measured in whole control ticks of `dt_s` (the tick as its decimal,
+/// [`from_f32`]), written as that count of ticks times the tick, to 1e-9 s: a product of the
+/// tick read 8258 ticks as 8.258000000000001 s, a sum of `f32` ticks 785 of them as
+/// 0.78499347 s and the rig's clock 1000 as 1.0000000474974513 s. Not finite: as it is.
+pub fn tick_s(t_s: f64, dt_s: f64) -> f64 {
+    if !t_s.is_finite() || dt_s <= 0.0 {
+        return t_s;
+    }
+    // A sum of f32 ticks drifts by far less than half a tick over a run (1e-5 s in 1 s).
+    let ticks = (t_s / dt_s).round();
+    (ticks * dt_s * 1e9).round() / 1e9
+}
+
 /// `n` and the noun, singular for one ("1 release", "12 releases").
 pub fn count(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
@@ -80,7 +93,7 @@ pub fn shares(v: &serde_json::Value) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{count, echo, f32_digits, f32_digits_opt, fixed, from_f32, shares};
+    use super::{count, echo, f32_digits, f32_digits_opt, fixed, from_f32, shares, tick_s};
 
     /// A given value keeps its digits, in scientific notation at the ends of the range.
     #[test]
@@ -92,6 +105,20 @@ mod tests {
         assert_eq!(echo(1e30), "1e30");
         assert_eq!(echo(-1.5e-20), "-1.5e-20");
         assert_eq!(echo(2.5e9), "2.5e9");
+    }
+
+    /// A time in whole ticks is written as the ticks, without the binary noise of the tick.
+    #[test]
+    fn tick_times_are_whole_ticks() {
+        assert_eq!((8258.0 * 0.001f64).to_string(), "8.258000000000001");
+        assert_eq!(tick_s(8258.0 * 0.001, 0.001).to_string(), "8.258");
+        assert_eq!(
+            tick_s(f64::from(0.784_993_47f32), 0.001).to_string(),
+            "0.785"
+        );
+        assert_eq!(tick_s(1.000_000_047_497_451_3, 0.001).to_string(), "1");
+        assert_eq!(tick_s(0.0025, 0.0025).to_string(), "0.0025");
+        assert!(tick_s(f64::INFINITY, 0.001).is_infinite());
     }
 
     /// An f32's value is written with its own digits, not the widening's.

@@ -84,7 +84,7 @@ enum Which {
 #[derive(clap::Args)]
 struct ErrorTableArgs {
     /// The file to write (model-core/src/choose/error_table.bin).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::file_to_write)]
     out: PathBuf,
 }
 
@@ -95,7 +95,7 @@ struct CostArgs {
     #[arg(long)]
     csv: PathBuf,
     /// The Rust file to write (model-core/src/choose/cost_table.rs).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::file_to_write)]
     out: PathBuf,
 }
 
@@ -106,7 +106,7 @@ struct LogArgs {
     #[arg(long)]
     csv: PathBuf,
     /// The SVG file name the charts are named after (FILE-precession.svg, FILE-spin.svg).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::file_to_write)]
     out: PathBuf,
 }
 
@@ -170,7 +170,7 @@ struct ScipyArgs {
     #[arg(long)]
     csv: PathBuf,
     /// The SVG file (PNG beside it; the time chart as FILE-time.svg/png).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::file_to_write)]
     out: PathBuf,
     /// Scene to draw.
     #[arg(long, default_value = "paper")]
@@ -208,7 +208,7 @@ impl ControlArgs {
 #[derive(clap::Args)]
 struct Out {
     /// The SVG file; the PNG and CSV go beside it with the same stem.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::file_to_write)]
     out: PathBuf,
     /// Write only the CSV (no drawing).
     #[arg(long)]

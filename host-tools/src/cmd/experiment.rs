@@ -30,7 +30,7 @@ pub struct Args {
     #[arg(long, default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(50..=12_000_000))]
     pub baud: u32,
     /// The results file to write (traces go to `<stem>_traces/` beside it).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::file_to_write)]
     pub out: Option<PathBuf>,
     /// Print a suggested plan instead of running one.
     #[arg(long)]

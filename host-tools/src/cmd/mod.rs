@@ -59,9 +59,40 @@ pub fn number32(text: &str) -> Result<f32, String> {
     Ok(narrow)
 }
 
+/// The parser of every flag naming a file to write (`--out`, `--csv`, `--log`): a directory
+/// there was taken as a stem, `bowl chart radial --out /tmp/charts` writing /tmp/charts.svg,
+/// .png and .csv beside the directory without a word (or failing late with the system's "Is a
+/// directory"); now refused before any work, as a usage error.
+pub fn file_to_write(text: &str) -> Result<std::path::PathBuf, String> {
+    let path = std::path::PathBuf::from(text);
+    if path.is_dir() || text.ends_with(std::path::is_separator) {
+        let name = text.trim_end_matches(std::path::is_separator);
+        return Err(format!(
+            "{text} is a directory: give the name of a file to write, in it or beside it \
+             (such as {name}/run.svg for a chart, {name}/run.csv for a table)"
+        ));
+    }
+    Ok(path)
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{number, number32};
+    use super::{file_to_write, number, number32};
+
+    #[test]
+    fn a_directory_is_no_file_to_write() {
+        let dir = std::env::temp_dir();
+        let d = dir.to_str().unwrap();
+        let e = file_to_write(d).unwrap_err();
+        assert!(e.starts_with(&format!("{d} is a directory")), "{e}");
+        assert!(
+            file_to_write("new-folder/")
+                .unwrap_err()
+                .contains("is a directory")
+        );
+        let file = dir.join("qa-no-such-chart.svg");
+        assert_eq!(file_to_write(file.to_str().unwrap()), Ok(file));
+    }
 
     #[test]
     fn numbers_out_of_range_are_refused_in_words() {

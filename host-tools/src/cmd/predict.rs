@@ -181,7 +181,7 @@ pub struct Args {
     #[arg(long, requires = "out")]
     batch: Option<std::path::PathBuf>,
     /// Batch mode: write results to this CSV file.
-    #[arg(long, requires = "batch")]
+    #[arg(long, requires = "batch", value_parser = crate::cmd::file_to_write)]
     out: Option<std::path::PathBuf>,
     /// Batch mode: also measure the closed forms' throughput over the file's scenes (the time
     /// alone, ns per scene on one thread and on every core; JSON on standard output).

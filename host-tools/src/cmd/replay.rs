@@ -21,7 +21,7 @@ pub struct Args {
     /// The raw capture (the bytes exactly as they came off the serial line).
     file: PathBuf,
     /// Write the decoded telemetry as CSV, keyed on device time.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::file_to_write)]
     csv: Option<PathBuf>,
 }
 

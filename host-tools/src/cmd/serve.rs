@@ -29,7 +29,7 @@ pub struct Args {
     #[arg(long, requires = "pty")]
     link: Option<PathBuf>,
     /// Run faster than real time and write the rig's output bytes to this file.
-    #[arg(long, requires = "seconds")]
+    #[arg(long, requires = "seconds", value_parser = crate::cmd::file_to_write)]
     capture: Option<PathBuf>,
     /// Simulated seconds to run (with --pty: stop after this many real seconds).
     #[arg(long, value_parser = crate::cmd::number)]

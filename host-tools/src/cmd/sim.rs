@@ -259,6 +259,7 @@ pub fn run(what: &What) -> Result<()> {
                 "summary": summary,
             });
             println!("{}", serde_json::to_string_pretty(&out)?);
+            say_notes(&sim_reports::no_reachable_words(&summary, target));
         }
         What::Faults(a) => {
             if !(0.0..=50.0).contains(&a.drop_pulses_pct) {

@@ -48,7 +48,7 @@ pub struct Args {
     #[arg(long, default_value_t = 115_200, value_parser = clap::value_parser!(u32).range(50..=12_000_000))]
     baud: u32,
     /// Append the telemetry to this CSV file (header written when the file is new).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::cmd::file_to_write)]
     log: Option<PathBuf>,
     /// Stop after this many seconds (default: run until interrupted).
     #[arg(long)]

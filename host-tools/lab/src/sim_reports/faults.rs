@@ -251,7 +251,8 @@ fn inject(mut cl: ClosedLoop, what: Injected, axis: usize, bound_s: f64) -> Faul
         // Until detection: the loop ends there.
         peak = peak.max(cl.rig.speed_rad_s(axis).abs() as f64);
         if cl.ctrl.fault().is_some() {
-            detected = Some(cl.rig.time_s() - t0);
+            let dt = crate::number::from_f32(cl.dt_s());
+            detected = Some(crate::number::tick_s(cl.rig.time_s() - t0, dt));
             pwm_zero = duties == [0.0; 2];
             break;
         }

@@ -27,12 +27,16 @@ pub struct AxisFigures {
     pub rms_ripple_pct: f32,
 }
 
-impl From<StepReport> for AxisFigures {
-    fn from(r: StepReport) -> Self {
+impl AxisFigures {
+    /// The figures of `r`, a run ticking every `dt_s`: its times in whole ticks
+    /// ([`crate::number::tick_s`]: 0.785 s, not the f32 sum's 0.78499347).
+    fn of(r: StepReport, dt_s: f32) -> Self {
+        let dt = crate::number::from_f32(dt_s);
+        let ticks = |t: f32| crate::number::tick_s(f64::from(t), dt) as f32;
         Self {
-            rise_time_s: r.rise_time_s,
+            rise_time_s: ticks(r.rise_time_s),
             overshoot_pct: 100.0 * r.overshoot,
-            settling_time_s: r.settled.then_some(r.settling_time_s),
+            settling_time_s: r.settled.then_some(ticks(r.settling_time_s)),
             steady_state_error_pct: 100.0 * r.steady_state_error,
             rms_ripple_pct: 100.0 * r.rms_ripple,
         }
@@ -118,7 +122,7 @@ pub fn step_run_with(
         feedback,
         load_after_commissioning_nm,
     );
-    let mut out = outcome_json(o);
+    let mut out = outcome_json(o, cfg.tick_hz);
     // The model's overshoot is a fraction of the change; the report's is % of the target.
     let scale = ((target - from) / target).abs();
     for a in out.axes.iter_mut() {
@@ -128,10 +132,13 @@ pub fn step_run_with(
     out
 }
 
-pub fn outcome_json(o: experiments::StepOutcome) -> StepOutcome {
+/// The report of `o`, a run whose controller ticked at `tick_hz`.
+pub fn outcome_json(o: experiments::StepOutcome, tick_hz: u32) -> StepOutcome {
+    // The tick as the harness makes it (model_core::sim::ClosedLoop::new).
+    let dt_s = 1.0 / tick_hz as f32;
     let axes = [
-        AxisFigures::from(o.reports[0]),
-        AxisFigures::from(o.reports[1]),
+        AxisFigures::of(o.reports[0], dt_s),
+        AxisFigures::of(o.reports[1], dt_s),
     ];
     StepOutcome {
         worst: worst_of(&axes),
@@ -232,7 +239,10 @@ pub struct FamilyJson {
 
 pub fn family(seed: u32, plants: u32, feedback: bool) -> FamilyJson {
     let outcomes: Vec<StepOutcome> = (0..plants)
-        .map(|i| outcome_json(experiments::family_step(seed, i, feedback)))
+        .map(|i| {
+            let o = experiments::family_step(seed, i, feedback);
+            outcome_json(o, ControllerConfig::nominal().tick_hz)
+        })
         .collect();
     if std::env::var_os("BOWL_SIM_VERBOSE").is_some() {
         for (i, o) in outcomes.iter().enumerate() {

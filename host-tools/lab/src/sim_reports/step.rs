@@ -9,6 +9,7 @@ use serde::Serialize;
 use std::f64::consts::TAU;
 
 use super::{commissioned, config_for, pour_material};
+use crate::number::tick_s;
 
 /// Step figures of one axis.
 #[derive(Serialize, Debug, Clone, Copy)]
@@ -180,8 +181,8 @@ fn settling_in_band(rec: &Record, i: usize, sp: f64, band: f64) -> Option<f64> {
     match last_out {
         _ if !judged => None,
         Some(k) if k >= last_judged => None,
-        Some(k) => Some((k + 1) as f64 * rec.dt_s),
-        None => Some(half as f64 * rec.dt_s),
+        Some(k) => Some(tick_s((k + 1) as f64 * rec.dt_s, rec.dt_s)),
+        None => Some(tick_s(half as f64 * rec.dt_s, rec.dt_s)),
     }
 }
 
@@ -266,7 +267,7 @@ fn step(mut cl: ClosedLoop, from: f32, target: f32) -> StepRun {
         rec.angle.push([c.rig.angle_rad(0), c.rig.angle_rad(1)]);
         rec.duty.push(c.duties());
         if !fault && c.ctrl.fault().is_some() {
-            fault_at = Some(rec.speed.len() as f64 * rec.dt_s);
+            fault_at = Some(tick_s(rec.speed.len() as f64 * rec.dt_s, rec.dt_s));
         }
         fault |= c.ctrl.fault().is_some();
     });
@@ -346,8 +347,9 @@ pub struct FamilySummary {
     /// Axes full duty could not take to the target (saturated at the end of the run, short of
     /// the band): out of any loop's reach on this plant.
     pub saturated_axes: usize,
-    /// Axes whose 2 % settling took 3 s or less, in % of the axes that were not saturated.
-    pub settled_2pct_within_3_s_share_of_reachable: f64,
+    /// Axes whose 2 % settling took 3 s or less, in % of the axes that were not saturated;
+    /// None (null) when every axis was (0 of 0 is no share; it read 0.0).
+    pub settled_2pct_within_3_s_share_of_reachable: Option<f64>,
     /// Worst settling, s (None if any axis never settled).
     pub settling_worst_s: Option<f64>,
     /// Median ripple, %.
@@ -385,12 +387,11 @@ pub fn summary(plants: &[PlantStep]) -> FamilySummary {
         saturated_axes: axes.iter().filter(|a| a.saturated).count(),
         settled_2pct_within_3_s_share_of_reachable: {
             let reachable: Vec<&AxisStep> = axes.iter().filter(|a| !a.saturated).collect();
-            100.0
-                * reachable
-                    .iter()
-                    .filter(|a| a.settling_2pct_s.is_some_and(|s| s <= 3.0))
-                    .count() as f64
-                / reachable.len().max(1) as f64
+            let settled = reachable
+                .iter()
+                .filter(|a| a.settling_2pct_s.is_some_and(|s| s <= 3.0))
+                .count();
+            (!reachable.is_empty()).then(|| 100.0 * settled as f64 / reachable.len() as f64)
         },
         settling_worst_s: if never > 0 {
             None
@@ -400,4 +401,27 @@ pub fn summary(plants: &[PlantStep]) -> FamilySummary {
         ripple_median_pct: ripple.get(ripple.len() / 2).copied().unwrap_or(0.0),
         ripple_worst_pct: ripple.last().copied().unwrap_or(0.0),
     }
+}
+
+/// Words for a summary whose reachable share is null: no axis the loop could be judged on
+/// (each saturated short of `target`, or none commissioned); empty otherwise.
+pub fn no_reachable_words(s: &FamilySummary, target: f32) -> Vec<String> {
+    if s.settled_2pct_within_3_s_share_of_reachable.is_some() {
+        return Vec::new();
+    }
+    let null = "so settled_2pct_within_3_s_share_of_reachable is null (there is no reachable axis \
+                to count)";
+    let words = if s.axes == 0 {
+        format!(
+            "no plant of the {} was commissioned (see each plant's `commissioning`), {null}",
+            s.plants
+        )
+    } else {
+        format!(
+            "full duty held all {} axes short of {target} rad/s (saturated: no loop can take these \
+             plants there), {null}; ask for a lower --target-rad-s",
+            s.axes
+        )
+    };
+    vec![words]
 }
