@@ -23,6 +23,25 @@ fn overshoot_pct(rig: PlantParams, seed: u32, target: f32, load: [f32; 2]) -> [f
     ]
 }
 
+/// A family plant's row (`plant_rows::rig_from_table`: supply, coupling, both axes) with
+/// current sense on both axes: each axis's overshoot of the commissioned step from rest to
+/// `target` (the plant's `seed`, the material `load` poured in after commissioning) is within
+/// `bound_pct`.
+fn sensed_row_within(
+    supply_v: f32,
+    coupling: f32,
+    axes: [[f32; 9]; 2],
+    (seed, target, load): (u32, f32, [f32; 2]),
+    bound_pct: f32,
+) {
+    let rig = sensed(plant_rows::rig_from_table(supply_v, coupling, axes));
+    let os = overshoot_pct(rig, seed, target, load);
+    eprintln!("overshoot {os:?} %");
+    for (axis, os) in os.iter().enumerate() {
+        assert!(*os <= bound_pct, "axis {axis}: {os} % past {target} rad/s");
+    }
+}
+
 #[test]
 fn the_nominal_rig_reaches_half_a_radian_per_second_without_the_leap() {
     let pulses_only = overshoot_pct(PlantParams::nominal(), 1, 0.5, [0.0; 2]);
@@ -193,7 +212,7 @@ fn a_first_edge_before_the_current_confirms_the_breakaway_keeps_no_kick() {
 // 0.3926 N m is p10's stiction as the rig file gives it, not an approximation of pi / 8.
 #[allow(clippy::approx_constant)]
 fn a_spin_whose_first_edge_beats_the_currents_confirmation_still_gets_the_band() {
-    let rig = sensed(plant_rows::rig_from_table(
+    sensed_row_within(
         12.461,
         0.447,
         [
@@ -204,12 +223,9 @@ fn a_spin_whose_first_edge_beats_the_currents_confirmation_still_gets_the_band()
                 1.2172, 0.05993, 0.02804, 0.2804, 0.3926, 0.0095, 0.000720, 0.0092, 0.0,
             ],
         ],
-    ));
-    let os = overshoot_pct(rig, 1010, 0.5, [0.0141, 0.0655]);
-    eprintln!("overshoot {os:?} %");
-    for (axis, os) in os.iter().enumerate() {
-        assert!(*os <= 25.0, "axis {axis}: {os} % past 0.5 rad/s");
-    }
+        (1010, 0.5, [0.0141, 0.0655]),
+        25.0,
+    );
 }
 
 /// The back-EMF per rad/s learned where the edges measure the speed (breakaway.rs's
@@ -298,7 +314,7 @@ fn the_back_emf_is_read_through_the_starts_held_ratio() {
 /// reads its speed as it is, and the kick goes once it runs 10 % ahead of its model.
 #[test]
 fn a_heavy_rods_kept_kick_goes_once_its_back_emf_shows_it_ahead() {
-    let rig = sensed(plant_rows::rig_from_table(
+    sensed_row_within(
         10.831,
         0.428,
         [
@@ -309,12 +325,9 @@ fn a_heavy_rods_kept_kick_goes_once_its_back_emf_shows_it_ahead() {
                 1.6037, 0.00701, 0.00874, 0.0874, 0.1223, 0.0435, 0.000827, 0.0059, 0.0,
             ],
         ],
-    ));
-    let os = overshoot_pct(rig, 52021, 1.0, [0.0048, 0.0592]);
-    eprintln!("overshoot {os:?} %");
-    for (axis, os) in os.iter().enumerate() {
-        assert!(*os <= 5.0, "axis {axis}: {os} % past 1 rad/s");
-    }
+        (52021, 1.0, [0.0048, 0.0592]),
+        5.0,
+    );
 }
 
 /// family-60's p16 (tests/rigs/family-60.toml, seed 1016), current sense on both axes: a stiff
@@ -325,7 +338,7 @@ fn a_heavy_rods_kept_kick_goes_once_its_back_emf_shows_it_ahead() {
 /// commissioning's steady steps it reads its speed as it is.
 #[test]
 fn a_rod_read_through_its_learned_back_emf_does_not_overshoot() {
-    let rig = sensed(plant_rows::rig_from_table(
+    sensed_row_within(
         11.273,
         0.560,
         [
@@ -336,12 +349,9 @@ fn a_rod_read_through_its_learned_back_emf_does_not_overshoot() {
                 1.6443, 0.05420, 0.03114, 0.3114, 0.4360, 0.0302, 0.000857, 0.0030, 0.0,
             ],
         ],
-    ));
-    let os = overshoot_pct(rig, 1016, 0.5, [0.0070, 0.0676]);
-    eprintln!("overshoot {os:?} %");
-    for (axis, os) in os.iter().enumerate() {
-        assert!(*os <= 10.0, "axis {axis}: {os} % past 0.5 rad/s");
-    }
+        (1016, 0.5, [0.0070, 0.0676]),
+        10.0,
+    );
 }
 
 /// family-60's p13 (tests/rigs/family-60.toml, seed 1013), current sense on both axes: a spin
@@ -471,7 +481,7 @@ fn a_shaft_held_above_its_friction_duty_reads_its_own_held_ratio() {
 /// 0.5 rad/s (main).
 #[test]
 fn a_light_spin_under_heavy_material_is_seen_breaking_away_and_does_not_leap() {
-    let rig = sensed(plant_rows::rig_from_table(
+    sensed_row_within(
         11.351,
         0.497,
         [
@@ -482,10 +492,7 @@ fn a_light_spin_under_heavy_material_is_seen_breaking_away_and_does_not_leap() {
                 1.1269, 0.00640, 0.00271, 0.0271, 0.0379, 0.0134, 0.000458, 0.0058, 0.0,
             ],
         ],
-    ));
-    let os = overshoot_pct(rig, 21027, 0.5, [0.0351, 0.0906]);
-    eprintln!("overshoot {os:?} %");
-    for (axis, os) in os.iter().enumerate() {
-        assert!(*os <= 15.0, "axis {axis}: {os} % past 0.5 rad/s");
-    }
+        (21027, 0.5, [0.0351, 0.0906]),
+        15.0,
+    );
 }
