@@ -343,3 +343,64 @@ fn control_chords_are_not_typed_as_letters() {
     tmux.keys(&["C-j"]);
     tmux.wait_for(&["status -> status (id"], "sent by the newline");
 }
+
+/// Terminals of every size a lab has, and a port whose path is 200 characters long (a link in
+/// a deep directory), resized while the monitor runs: every line fits the width; the banner
+/// keeps the link and state on its first row (the path shortened with `…`, not wrapped over
+/// the screen); a terminal too small for the screen says so and the size it needs (before,
+/// 20 x 5 showed four rows of the path and 40 x 10 lost the values and the command line); a
+/// command typed there still goes; grown back, the screen returns; a long command line shows
+/// its end with the cursor, and the keys' hint is never cut mid-word.
+#[test]
+fn every_terminal_size_fits_or_says_the_size_it_needs() {
+    let dir = common::temp_dir("tui-sizes");
+    let deep = dir.join("lab-bench-".repeat(14));
+    std::fs::create_dir_all(&deep).unwrap();
+    let link = deep.join("rig_port_link");
+    let link = link.to_str().unwrap();
+    assert!(link.len() >= 160, "{}", link.len());
+    let _sim = Sim::start(&["--link", link]);
+    let tmux = Tmux::start("tui-sizes", &format!("{BOWL} monitor {link} ; sleep 30"));
+    let fits = |screen: &str, columns: usize| {
+        assert!(
+            screen.lines().all(|l| l.chars().count() <= columns),
+            "fits {columns} columns:\n{screen}"
+        );
+    };
+    for (columns, rows) in [(80, 24), (100, 30), (60, 15), (40, 12), (250, 70)] {
+        tmux.resize(columns, rows);
+        // The next draws see the new size (SIGWINCH): the screen read is the new one.
+        std::thread::sleep(std::time::Duration::from_millis(1500));
+        let screen = tmux.wait_for(&["LINK OK", "no fault"], "the banner");
+        fits(&screen, usize::from(columns));
+        let first = screen.lines().next().unwrap_or("");
+        assert!(
+            first.contains("_link  LINK OK") && (first.contains('…') || columns > 200),
+            "the path's end and the link on the first row, {columns} x {rows}:\n{screen}"
+        );
+        let hint = screen.lines().last().unwrap_or("");
+        assert!(hint.ends_with("q quit"), "{columns} x {rows}:\n{screen}");
+    }
+    for (columns, rows) in [(40, 10), (20, 5)] {
+        tmux.resize(columns, rows);
+        let size = format!("{columns} x {rows}:");
+        let screen = tmux.wait_for(&[&size, "small"], "the size needed");
+        fits(&screen, usize::from(columns));
+        let flat = screen.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(
+            flat.contains("needs 40 x 11") || flat.contains("40 x 11 here"),
+            "{screen}"
+        );
+    }
+    // Typed while too small: the line is in sight and Enter sends it.
+    tmux.keys(&[":", "status"]);
+    tmux.wait_for(&["command> status_"], "the command line at 20 x 5");
+    tmux.keys(&["Enter"]);
+    tmux.resize(120, 40);
+    tmux.wait_for(&["status -> status (id", "LINK OK"], "the screen again");
+    // A command longer than the row: its end and the cursor show, the start gives way.
+    tmux.resize(40, 12);
+    tmux.keys(&[":", "speed 1800 2100 and then some more words"]);
+    let screen = tmux.wait_for(&["command> …", "more words_"], "the long line's end");
+    fits(&screen, 40);
+}

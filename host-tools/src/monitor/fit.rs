@@ -49,6 +49,41 @@ pub fn rows(
     ]
 }
 
+/// The narrowest terminal the screen is drawn in: the values' sentences and the banner wrap
+/// into a few rows at 40 columns, and below it they would take most of the screen.
+pub const MIN_WIDTH: u16 = 40;
+
+/// What to show instead of the screen in a terminal `width` x `height` that cannot hold the
+/// banner, fault line, values and command line (`needed_rows` of them, wrapped at the width
+/// drawn, at least [`MIN_WIDTH`]): the size it has and the size it needs, in words, in lines of
+/// at most `width` and no more than `height` of them (the shortest form when nothing longer
+/// fits). `None` when the screen fits.
+pub fn too_small(width: u16, height: u16, needed_rows: usize) -> Option<Vec<String>> {
+    let needed = u16::try_from(needed_rows).unwrap_or(u16::MAX);
+    if width >= MIN_WIDTH && height >= needed {
+        return None;
+    }
+    let (w, h) = (width.max(MIN_WIDTH), height.max(needed));
+    let forms = [
+        format!(
+            "The terminal is {width} x {height}: too small for bowl monitor, which needs at \
+             least {w} x {h} here. Make the window larger (the screen comes back), or quit with \
+             q and run bowl monitor --plain."
+        ),
+        format!("Terminal {width} x {height}: too small, bowl monitor needs {w} x {h}. q quits."),
+        format!("needs {w}x{h}"),
+    ];
+    let columns = usize::from(width).max(1);
+    let fits = |lines: &Vec<String>| lines.len() <= usize::from(height);
+    let mut lines = forms
+        .iter()
+        .map(|f| super::wrap::wrap(f, columns))
+        .find(fits)
+        .unwrap_or_else(|| super::wrap::wrap(&forms[2], columns));
+    lines.truncate(usize::from(height));
+    Some(lines)
+}
+
 /// The time axis' labels for a chart `plot_width` columns wide (inside its frame and y labels),
 /// from `start` to `end` s: three when each fits in its third of the width (ratatui right-aligns
 /// the last in its share and cuts it from the left, so `300 s` would read `00 s`), else the two
@@ -73,7 +108,27 @@ pub fn time_labels(start: f64, end: f64, plot_width: u16) -> Vec<String> {
 
 #[cfg(test)]
 mod tests {
-    use super::{rows, time_labels};
+    use super::{rows, time_labels, too_small};
+
+    #[test]
+    fn a_terminal_too_small_says_the_size_it_needs() {
+        assert_eq!(too_small(40, 12, 11), None);
+        assert_eq!(too_small(250, 70, 11), None);
+        let lines = too_small(20, 5, 11).unwrap();
+        assert!(lines.len() <= 5 && lines.iter().all(|l| l.chars().count() <= 20));
+        let text = lines.join(" ");
+        assert!(
+            text.contains("20 x 5") && text.contains("needs 40 x 11"),
+            "{text}"
+        );
+        let text = too_small(80, 8, 11).unwrap().join(" ");
+        assert!(text.contains("needs at least 80 x 11 here"), "{text}");
+        assert!(text.contains("--plain"), "{text}");
+        // Tiny: the size needed is still said, within the screen.
+        assert_eq!(too_small(9, 1, 11).unwrap(), ["needs"]);
+        assert_eq!(too_small(9, 2, 11).unwrap(), ["needs", "40x11"]);
+        assert_eq!(too_small(0, 0, 11).unwrap(), Vec::<String>::new());
+    }
 
     #[test]
     fn a_small_screen_keeps_the_banner_fault_and_command_line() {

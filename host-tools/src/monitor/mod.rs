@@ -13,6 +13,7 @@ mod fit;
 mod glyphs;
 mod line_edit;
 mod log_file;
+mod prompt;
 mod tui;
 mod view;
 mod wrap;

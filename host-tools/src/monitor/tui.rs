@@ -159,7 +159,9 @@ impl Tui {
         let silence = view.silence(Instant::now());
         let (no_color, ascii) = (self.no_color, self.ascii);
         self.terminal.draw(|f| {
-            let width = usize::from(f.area().width).max(20);
+            // Laid out at least MIN_WIDTH wide: a narrower terminal gets the words of
+            // fit::too_small, never the screen cut at its edge.
+            let width = usize::from(f.area().width.max(super::fit::MIN_WIDTH));
             // The fault line and the events are wrapped to the width, never cut: the end of a
             // fault line says what to do.
             let (fault_text, fault_style) = fault_line(view, silence.is_some());
@@ -183,6 +185,21 @@ impl Tui {
                 .into_iter()
                 .map(Line::from)
                 .collect();
+            let must = banner_rows.len() + fault_rows.len() + value_lines.len() + 1;
+            if let Some(words) = super::fit::too_small(f.area().width, f.area().height, must) {
+                let mut lines: Vec<Line> = words.into_iter().map(Line::from).collect();
+                // What is being typed stays in sight, on the last row if there is one spare.
+                if input.is_some() && lines.len() < usize::from(f.area().height) {
+                    let columns = usize::from(f.area().width);
+                    lines.resize(usize::from(f.area().height) - 1, Line::default());
+                    lines.push(super::prompt::line(input, columns));
+                }
+                f.render_widget(Paragraph::new(lines), f.area());
+                if ascii {
+                    super::glyphs::to_ascii(f.buffer_mut());
+                }
+                return;
+            }
             // In a small terminal the charts give way first, never the banner or the fault.
             let heights = super::fit::rows(
                 f.area().height,
@@ -216,26 +233,7 @@ impl Tui {
                     .block(Block::default().borders(Borders::TOP).title("events")),
                 rows[5],
             );
-            let prompt = match input {
-                Some(line) => Line::from(vec![
-                    Span::styled("command> ", Style::default().fg(Color::Yellow)),
-                    Span::raw(line.text.as_str()),
-                    Span::styled("_", Style::default().add_modifier(Modifier::SLOW_BLINK)),
-                    Span::styled(
-                        if line.candidates.is_empty() {
-                            "   Enter send · Esc cancel · Up/Down earlier · Tab complete"
-                                .to_string()
-                        } else {
-                            format!("   Tab: {}", line.candidates.join(" "))
-                        },
-                        Style::default().fg(Color::DarkGray),
-                    ),
-                ]),
-                None => Line::from(Span::styled(
-                    ": command (e.g. status, speed 1800 2100, start, stop) · p pause · q quit",
-                    Style::default().fg(Color::DarkGray),
-                )),
-            };
+            let prompt = super::prompt::line(input, width);
             f.render_widget(Paragraph::new(prompt), rows[6]);
             if no_color {
                 for cell in &mut f.buffer_mut().content {
@@ -262,20 +260,25 @@ impl Drop for Tui {
 }
 
 /// The top line: port, link, rig state and fault, each impossible to miss when it matters.
-fn banner<'a>(
-    port: &'a str,
+fn banner(
+    port: &str,
     view: &View,
     silence: Option<Duration>,
     paused: bool,
     tools: usize,
     width: usize,
-) -> Vec<Line<'a>> {
+) -> Vec<Line<'static>> {
     let alarm = Style::default()
         .fg(Color::White)
         .bg(Color::Red)
         .add_modifier(Modifier::BOLD);
     let mut spans = vec![Span::styled(
-        format!(" bowl monitor {port} "),
+        // A long path (a link in a deep directory) is shortened, so the link and the state
+        // stay on the first rows and the banner leaves the screen to the rest.
+        format!(
+            " bowl monitor {} ",
+            super::wrap::shorten(port, width.saturating_sub(30).max(12))
+        ),
         Style::default().add_modifier(Modifier::BOLD),
     )];
     if let Some(quiet) = silence.filter(|_| view.connected) {

@@ -36,6 +36,22 @@ pub fn wrap(text: &str, width: usize) -> Vec<String> {
     lines
 }
 
+/// `text` in at most `max` characters (at least 3): whole when it fits, else its start and its
+/// end with `…` between (a port's path differs from another's at its end, and its start says
+/// where it lives).
+pub fn shorten(text: &str, max: usize) -> String {
+    let len = text.chars().count();
+    let max = max.max(3);
+    if len <= max {
+        return text.to_string();
+    }
+    let head = (max - 1) / 3;
+    let tail = max - 1 - head;
+    let start: String = text.chars().take(head).collect();
+    let end: String = text.chars().skip(len - tail).collect();
+    format!("{start}…{end}")
+}
+
 /// Styled pieces in lines of at most `width` characters: a piece goes on the next line when it
 /// does not fit, and a piece wider than a line is wrapped itself (never cut at the edge).
 pub fn pack(spans: Vec<Span<'_>>, width: usize) -> Vec<Line<'_>> {
@@ -69,7 +85,16 @@ pub fn pack(spans: Vec<Span<'_>>, width: usize) -> Vec<Line<'_>> {
 
 #[cfg(test)]
 mod tests {
-    use super::{pack, wrap};
+    use super::{pack, shorten, wrap};
+
+    #[test]
+    fn a_long_name_keeps_its_start_and_end() {
+        assert_eq!(shorten("/dev/ttyUSB0", 40), "/dev/ttyUSB0");
+        let long = format!("/tmp/{}/rig_port_link", "lab-bench-".repeat(18));
+        let short = shorten(&long, 30);
+        assert_eq!(short.chars().count(), 30);
+        assert_eq!(short, "/tmp/lab-…bench-/rig_port_link");
+    }
     use ratatui::text::Span;
 
     #[test]
