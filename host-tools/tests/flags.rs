@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{bowl, predict_args, rig_axis_speed, tilted_rig};
+use common::{bowl, bowl_args, predict_args, rig_axis_speed, tilted_rig};
 
 fn run(args: &[&str]) -> (Option<i32>, String, String) {
     let out = bowl(args);
@@ -101,4 +101,42 @@ fn a_drop_share_outside_0_to_50_pct_is_said_in_words() {
     let (code, _, err) = run(&["sim", "faults", "--drop-pulses-pct", "NaN"]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("`NaN` is not a number"), "{err}");
+}
+
+/// A list of negative release azimuths is a value: `--release-azimuth-deg -30,-60` was refused
+/// as "unexpected argument '-3' found" (not a number, so clap read it as flags) while `-30`
+/// alone and `--release-azimuth-deg=-30,-60` were taken.
+#[test]
+fn a_list_of_negative_azimuths_is_a_value() {
+    let extra = |az: &'static str| {
+        let mut v = vec!["--speed-range", "false", "--json"];
+        v.extend(az.split(' '));
+        v
+    };
+    let wall = ["60", "0.02", "0"];
+    let spaced = run(&bowl_args(
+        "1.2",
+        "-2.7",
+        "60",
+        wall,
+        &extra("--release-azimuth-deg -30,-60"),
+    ));
+    assert_eq!(spaced.0, Some(0), "{}", spaced.2);
+    let joined = run(&bowl_args(
+        "1.2",
+        "-2.7",
+        "60",
+        wall,
+        &extra("--release-azimuth-deg=-30,-60"),
+    ));
+    assert_eq!(joined.0, Some(0), "{}", joined.2);
+    assert_eq!(spaced.1, joined.1, "the two spellings give one answer");
+    let v: serde_json::Value = serde_json::from_str(&spaced.1).unwrap();
+    let az: Vec<_> = v["per_release"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["azimuth_deg"].as_f64())
+        .collect();
+    assert_eq!(az, [Some(-30.0), Some(-60.0)], "{v}");
 }

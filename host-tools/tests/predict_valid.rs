@@ -177,3 +177,41 @@ fn a_huge_speeds_friction_is_written_short() {
         .max();
     assert!(longest_digits < Some(32), "{text}");
 }
+
+/// The inverse (`--target-time-s`) is an answer too: the speed it gives for a short T makes
+/// the granule slide, and it said nothing of it (T = 0.2 s: 8.1 rad/s, where `--omega-rad-s
+/// 8.1` says the flat model does not hold). Its entries carry `valid` and `invalid_reason` as
+/// the forward answer at that speed does; the text says it first. A long T holds.
+#[test]
+fn the_inverse_says_whether_the_model_holds_at_its_speed() {
+    let v = json(&[
+        "predict",
+        "--model",
+        "both",
+        "--target-time-s",
+        "0.2",
+        "--json",
+    ]);
+    for e in v["inverse"].as_array().unwrap() {
+        let w = e["omega_rad_s"].as_f64().unwrap().to_string();
+        let model = e["model"].as_str().unwrap();
+        let fwd = json(&["predict", "--model", model, "--omega-rad-s", &w, "--json"]);
+        assert_eq!(e["valid"], false, "{e}");
+        assert_eq!(e["valid"], fwd["results"][0]["valid"], "{e} vs {fwd}");
+        let why = e["invalid_reason"].as_str().unwrap();
+        assert!(why.contains("slides there"), "{why}");
+    }
+    let out = bowl(&["predict", "--model", "flat", "--target-time-s", "0.2"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.starts_with("flat model NOT VALID HERE: "), "{text}");
+    let v = json(&[
+        "predict",
+        "--model",
+        "flat",
+        "--target-time-s",
+        "0.8",
+        "--json",
+    ]);
+    assert_eq!(v["inverse"][0]["valid"], true, "{v}");
+    assert!(v["inverse"][0]["invalid_reason"].is_null(), "{v}");
+}

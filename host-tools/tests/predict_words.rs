@@ -412,29 +412,30 @@ fn the_gave_up_advice_is_true_and_said_once() {
     }
 }
 
+/// A tilted bowl at the rig's 60 deg, w1 = w2 = 2.08 rad/s, 75 mm bottom, released at half
+/// its radius.
+const TILTED_SCENE: [&str; 10] = [
+    "--axes-angle-deg",
+    "60",
+    "--precession-rad-s",
+    "2.08",
+    "--spin-rad-s",
+    "2.08",
+    "--ri-m",
+    "0.0375",
+    "--rim-radius-m",
+    "0.075",
+];
+
 /// One JSON shape for the tilted bowl's models: the bowl model's summary keys and per-release
 /// keys from `--model rolling` (a list of azimuths taken, as the bowl model takes it), `bowl`
 /// and `auto`, a release given up on included (its `regime` null, not missing).
 #[test]
 fn the_tilted_bowls_models_share_one_json_shape() {
-    let scene = [
-        "--axes-angle-deg",
-        "60",
-        "--precession-rad-s",
-        "2.08",
-        "--spin-rad-s",
-        "2.08",
-        "--ri-m",
-        "0.0375",
-        "--rim-radius-m",
-        "0.075",
-        "--release-azimuth-deg",
-        "0,90",
-        "--json",
-    ];
     for model in ["rolling", "bowl", "auto"] {
         let mut args = vec!["predict", "--model", model];
-        args.extend(scene);
+        args.extend(TILTED_SCENE);
+        args.extend(["--release-azimuth-deg", "0,90", "--json"]);
         let v = json(&args);
         for key in [
             "residence_time_mean_s",
@@ -468,6 +469,52 @@ fn the_tilted_bowls_models_share_one_json_shape() {
     let e = &v["per_release"][0];
     assert_eq!(e["outcome"], "gave_up", "{v}");
     assert!(e.get("regime").is_some_and(|r| r.is_null()), "{e}");
+}
+
+/// One release asked for (`--release-azimuth-deg B`): the answer carries its
+/// `residence_time_s` at the top, as issue 15 named it for one B, on every model of the tilted
+/// bowl (the one JSON shape had moved it into `per_release` alone); a list or `all` does not.
+#[test]
+fn one_release_asked_for_carries_its_residence_time_at_the_top() {
+    let mut scene = TILTED_SCENE.to_vec();
+    scene.extend(["--speed-range", "false", "--json"]);
+    for model in ["rolling", "bowl", "auto"] {
+        // A negative azimuth written with `=`, as odd as a single one gets.
+        let mut args = vec!["predict", "--model", model, "--release-azimuth-deg=-30"];
+        args.extend(&scene);
+        let v = json(&args);
+        let one = &v["per_release"][0];
+        assert_eq!(one["azimuth_deg"], -30.0, "{model}: {v}");
+        let t = v["residence_time_s"].as_f64();
+        assert!(
+            t.is_some_and(|t| t > 0.0),
+            "{model}: no residence_time_s in {v}"
+        );
+        assert_eq!(
+            v["residence_time_s"], one["residence_time_s"],
+            "{model}: {v}"
+        );
+        assert_eq!(t, v["residence_time_mean_s"].as_f64(), "{model}: {v}");
+    }
+    // Still inside at --max-time-s: the key is there and null (not left, no time).
+    let mut args = vec!["predict", "--model", "bowl", "--release-azimuth-deg", "0"];
+    args.extend(&scene);
+    args.extend(["--max-time-s", "0.01"]);
+    let v = json(&args);
+    assert_eq!(v["per_release"][0]["left"], false, "{v}");
+    assert!(
+        v.get("residence_time_s").is_some_and(|t| t.is_null()),
+        "{v}"
+    );
+    let mut args = vec![
+        "predict",
+        "--model",
+        "bowl",
+        "--release-azimuth-deg",
+        "0,90",
+    ];
+    args.extend(scene);
+    assert!(json(&args).get("residence_time_s").is_none());
 }
 
 /// Where only some releases leave, the "what speed can do" paragraph says so (6 of 12 left

@@ -303,7 +303,7 @@ pub fn run(args: &Inputs) -> Result<()> {
         ModelChoice::Bowl => return bowl::run(args, &args.rolling, &args.bowl),
     };
     if let Some(target) = args.target_time_s {
-        return run_inverse(&scene, models, target, args.json);
+        return run_inverse(&scene, models, target, args);
     }
     let mut rows = Vec::new();
     for &model in models {
@@ -412,7 +412,11 @@ fn json_result(model: Model, method: MethodChoice, p: &Prediction) -> serde_json
     v
 }
 
-fn run_inverse(scene: &Scene<f64>, models: &[Model], target: f64, json: bool) -> Result<()> {
+/// The bowl speed that gives `target` s, for each of `models`; each answer carries whether the
+/// model holds at that speed (`valid`, `invalid_reason`; the text says it first), judged as the
+/// forward answer at that speed is: the speed for a short T often makes the granule slide, and
+/// the inverse said nothing of it while `--omega-rad-s` at the same speed said NOT VALID.
+fn run_inverse(scene: &Scene<f64>, models: &[Model], target: f64, args: &Inputs) -> Result<()> {
     let mut out = Vec::new();
     for &model in models {
         let w = particle::omega_for_residence_time(scene, model, target).map_err(|e| {
@@ -422,19 +426,29 @@ fn run_inverse(scene: &Scene<f64>, models: &[Model], target: f64, json: bool) ->
                 refusals::inverse(e, target)
             )
         })?;
-        out.push((model, w));
+        let validity = validity::paper_up_to(scene, model, w, args.rolling.sliding_mu());
+        out.push((model, w, validity));
     }
-    if json {
+    if args.json {
         let v: Vec<_> = out
             .iter()
-            .map(|(m, w)| serde_json::json!({"model": model_name(*m), "target_time_s": target, "omega_rad_s": w}))
+            .map(|(m, w, validity)| {
+                let mut r = serde_json::json!({"model": model_name(*m), "target_time_s": target, "omega_rad_s": w});
+                validity.add_to(&mut r);
+                r
+            })
             .collect();
         println!(
             "{}",
             serde_json::json!({ "scene": json_scene(scene), "inverse": v })
         );
     } else {
-        for (m, w) in out {
+        for (m, _, validity) in &out {
+            if let Some(line) = validity.text_line(model_name(*m)) {
+                println!("{line}");
+            }
+        }
+        for (m, w, _) in out {
             println!(
                 "{:<8} omega = {w:.9} rad/s gives T = {target} s",
                 model_name(m)

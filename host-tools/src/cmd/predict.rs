@@ -224,8 +224,10 @@ pub struct RollingArgs {
     #[arg(long, value_parser = crate::cmd::number, visible_alias = "rod-length-m", default_value_t = 0.0)]
     rod_offset_m: f64,
     /// Rolling model: release azimuth from the downhill direction, degrees, or `all` (mean, min
-    /// and max over 0, 30, ..., 330).
-    #[arg(long, default_value = "all")]
+    /// and max over 0, 30, ..., 330), or a list `B1,B2,..`.
+    // Hyphen values: a list of negative azimuths (`-30,-60`) is not a number, so clap's
+    // negative-number rule took it for a flag ("unexpected argument '-3'").
+    #[arg(long, default_value = "all", allow_hyphen_values = true)]
     release_azimuth_deg: String,
     /// Rolling model: the friction coefficient the contact can give (slip beyond it is reported)
     /// [default: 0.4, or with --rig-file its [particle] sliding_mu].

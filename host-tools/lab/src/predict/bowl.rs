@@ -237,6 +237,7 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
         if let (Some(obj), Some(sp)) = (v.as_object_mut(), &speed) {
             obj.insert("speed".into(), sp.json(th_deg));
         }
+        super::release_json::add_single_release(&mut v);
         validity.add_to(&mut v);
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());

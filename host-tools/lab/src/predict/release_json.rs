@@ -21,3 +21,18 @@ pub fn entry(azimuth_deg: f64, residence_time_s: Option<f64>, regime: Value, mor
 pub fn none() -> Value {
     Value::Object(Map::new())
 }
+
+/// Asked for one release (`--release-azimuth-deg B`), the answer also carries that release's
+/// `residence_time_s` at the top (null where it did not leave), beside the mean, min and max a
+/// list or `all` gives: the key issue 15 named for one azimuth, which a reader of a single
+/// release looks for first.
+pub fn add_single_release(v: &mut Value) {
+    let Some(obj) = v.as_object_mut() else {
+        return;
+    };
+    let t = match obj.get("per_release").and_then(Value::as_array) {
+        Some(per) if per.len() == 1 => per[0]["residence_time_s"].clone(),
+        _ => return,
+    };
+    obj.insert("residence_time_s".into(), t);
+}

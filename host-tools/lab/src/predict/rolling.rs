@@ -318,6 +318,7 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
             "max_friction_ratio": sum.max_friction_ratio,
             "rhs_evaluations": sum.evaluations, "per_release": per,
         });
+        super::release_json::add_single_release(&mut v);
         validity.add_to(&mut v);
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());

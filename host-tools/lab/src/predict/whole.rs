@@ -427,6 +427,7 @@ fn report(
             "per_release": a.times.iter().map(|&(d, t)| super::release_json::entry(d, t, Value::Null, super::release_json::none())).collect::<Vec<Value>>(),
             "axes_angle_deg": th_deg,
         });
+        super::release_json::add_single_release(&mut v);
         a.validity.add_to(&mut v);
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
