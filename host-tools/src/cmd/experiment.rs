@@ -20,7 +20,7 @@ pub struct Args {
     /// Run on a simulated rig described by this rig file (its [particle] table is the truth;
     /// with `model = "bowl"` the granules follow the bowl model in its [bowl] table).
     /// One of --rig-file and --port is needed (refused in words naming both when neither).
-    #[arg(long, conflicts_with = "port")]
+    #[arg(long, value_name = "RIG.toml", conflicts_with = "port")]
     pub rig_file: Option<PathBuf>,
     /// Run on the rig on this serial port (or a `bowl serve --pty` pseudo-terminal): releases by
     /// RELEASE, residence times from the rig's gate events.

@@ -56,7 +56,7 @@ pub struct Args {
     /// bowl model takes its `[bowl]` table (tilt, bottom radius, fillet, restitution, granule
     /// radius) and, when its `[particle]` follows the bowl model, the rolling resistance `mu`;
     /// its own wall joins the candidate walls. Implies --bowl-walls.
-    #[arg(long)]
+    #[arg(long, value_name = "RIG.toml")]
     pub rig_file: Option<PathBuf>,
 }
 

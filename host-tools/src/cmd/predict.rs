@@ -177,7 +177,10 @@ pub struct Args {
     /// Print JSON instead of text.
     #[arg(long)]
     json: bool,
-    /// Batch mode: read scenes from this CSV file (see the module docs for the columns).
+    /// Batch mode: read scenes from this CSV file, one per row under a header naming the columns
+    /// `model` (flat or coriolis), `w_rad_s` (the combined bowl speed, rad/s), `mu`, `ri_m` and
+    /// `R_m` (the start and rim radii, m), optionally `g` (m/s^2) and `k2`, and any `label`,
+    /// `id`, `note`, `label_*` or `note_*` columns (carried through).
     #[arg(long, requires = "out")]
     batch: Option<std::path::PathBuf>,
     /// Batch mode: write results to this CSV file.
@@ -203,10 +206,10 @@ pub struct Args {
 /// `--rim-radius-m`, `--g`, `--k2`, `--method`, `--tol`, `--step-s`, `--json`).
 #[derive(clap::Args, Debug, Clone)]
 pub struct RollingArgs {
-    /// Rolling model: precession speed w1 of the bowl's axis about the vertical, rad/s.
+    /// Rolling model: precession speed omega1 of the bowl's axis about the vertical, rad/s.
     #[arg(long, value_parser = crate::cmd::number, allow_negative_numbers = true)]
     precession_rad_s: Option<f64>,
-    /// Rolling model: spin speed w2 of the bowl about its own axis, rad/s (negative: the
+    /// Rolling model: spin speed omega2 of the bowl about its own axis, rad/s (negative: the
     /// other way, e.g. --spin-rad-s -2.7).
     #[arg(long, value_parser = crate::cmd::number, allow_negative_numbers = true)]
     spin_rad_s: Option<f64>,

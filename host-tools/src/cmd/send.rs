@@ -19,9 +19,11 @@ use crate::exit_code;
 pub struct Args {
     /// The serial port or pseudo-terminal of the rig.
     port: String,
-    /// The command and its arguments, e.g. `speed 1800 2100`, `rtime cori 2500`, `start`, `stop`,
-    /// `clear`, `set MU_PPM 29000`, `status`, `params`, `models`, `commission`, `inject sensor2`
-    /// (see docs/protocol.md). A negative number is a value, judged by the protocol's rules.
+    /// The command and its arguments, e.g. `speed 1800 2100` (precession and spin, mrad/s),
+    /// `rtime cori 2500` (a residence time, ms), `start`, `stop`, `clear`, `set MU_PPM 29000`,
+    /// `status`, `params`, `models`, `commission`, `inject sensor2` (see docs/protocol.md). Whole
+    /// numbers in the unit the name or the protocol gives (mrad/s, ms, ppm). A negative number is
+    /// a value, judged by the protocol's rules.
     #[arg(required = true, num_args = 1.., allow_negative_numbers = true)]
     command: Vec<String>,
     /// Baud rate.

@@ -34,8 +34,9 @@ pub struct Args {
     /// Simulated seconds to run (with --pty: stop after this many real seconds).
     #[arg(long, value_parser = crate::cmd::number)]
     seconds: Option<f64>,
-    /// Commands fed to the rig as if from the PC, `AT_MS:WORDS`, e.g. `0:speed,1800,2100`
-    /// `0:start` `5000:inject,sensor2` (repeatable; the answers appear in the output).
+    /// Commands fed to the rig as if from the PC, `AT_MS:WORDS` (AT_MS: the device time to send
+    /// it, ms; WORDS: as `bowl send` takes them, commas or spaces between), e.g. `0:speed,1800,2100`
+    /// (mrad/s) `0:start` `5000:inject,sensor2` (repeatable; the answers appear in the output).
     #[arg(long = "command", value_name = "AT_MS:WORDS")]
     commands: Vec<String>,
     /// Seed of the simulated plant's noise (and of the line noise).
@@ -48,7 +49,7 @@ pub struct Args {
     #[arg(long, value_name = "RIG.toml")]
     rig_file: Option<PathBuf>,
     /// A noisy line: this percentage of the bytes sent is replaced by a different random byte
-    /// (what the PC receives, to try the decoder and the counters; default 0).
+    /// (what the PC receives, to try the decoder and the counters).
     #[arg(long, value_parser = crate::cmd::number, default_value_t = 0.0)]
     line_noise_percent: f64,
 }

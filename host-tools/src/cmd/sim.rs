@@ -52,7 +52,7 @@ pub enum What {
 #[derive(clap::Args)]
 pub struct FaultsArgs {
     /// Rig file or family file (TOML, see docs/rigs/nominal.toml).
-    #[arg(long)]
+    #[arg(long, value_name = "RIG.toml")]
     rig_file: std::path::PathBuf,
     /// Speed both axes run at when each fault is injected, rad/s.
     #[arg(long, value_parser = crate::cmd::number32, default_value_t = 3.0)]
@@ -89,7 +89,7 @@ pub struct TraceArgs {
     #[arg(long)]
     plant: Option<u32>,
     /// A rig file instead (the plant named by --name, or its first).
-    #[arg(long)]
+    #[arg(long, value_name = "RIG.toml")]
     rig_file: Option<std::path::PathBuf>,
     /// The plant's name in --rig-file.
     #[arg(long)]
@@ -158,7 +158,7 @@ pub struct StepArgs {
     accel_rad_s2: Option<f32>,
     /// A rig file (one rig) instead of the nominal rig; its pulses per revolution and load
     /// step apply (`--pulses-per-rev` and `--ripple-nm` are then ignored).
-    #[arg(long)]
+    #[arg(long, value_name = "RIG.toml")]
     rig_file: Option<std::path::PathBuf>,
 }
 
@@ -176,7 +176,7 @@ pub struct FamilyArgs {
     #[arg(long, hide = true)]
     allow_small: bool,
     /// Run the plants of this rig or family file instead of the built-in family.
-    #[arg(long)]
+    #[arg(long, value_name = "RIG.toml")]
     rig_file: Option<std::path::PathBuf>,
     /// With --rig-file: the step.
     #[command(flatten)]
