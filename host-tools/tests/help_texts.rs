@@ -150,3 +150,35 @@ fn every_help_text_names_one_thing_one_way() {
         );
     }
 }
+
+/// `--step-s` said "default: 0.01 / omega" for every model, but the rolling model's rk4 steps
+/// 0.001 s and the bowl model's 0.0001 s (at 1.8 rad/s, 0.01 / omega is 0.0056 s). The step
+/// the help states for each is the one a run without `--step-s` takes.
+#[test]
+fn the_step_predict_help_states_is_the_step_it_takes() {
+    let text = help(&["predict"]);
+    let flag = text.split("--step-s <").nth(1).unwrap();
+    for (model, stated, other) in [("rolling", "0.001", "0.0001"), ("bowl", "0.0001", "0.001")] {
+        let says = format!("the {model} model's {stated} s");
+        let says_rk4 = format!("the {model} model's rk4 {stated} s");
+        assert!(
+            flag.contains(&says) || flag.contains(&says_rk4),
+            "{says}: {flag}"
+        );
+        let release = |step: &[&str]| {
+            let mut args = vec!["predict", "--model", model, "--method", "rk4", "--json"];
+            args.extend(["--precession-rad-s", "1.8", "--spin-rad-s", "1.8"]);
+            args.extend(["--axes-angle-deg", "60", "--release-azimuth-deg", "0"]);
+            args.extend(["--speed-range", "false"]);
+            args.extend_from_slice(step);
+            common::json(&args)["per_release"][0].clone()
+        };
+        let default = release(&[]);
+        assert_eq!(default, release(&["--step-s", stated]), "{model}");
+        assert_ne!(
+            default,
+            release(&["--step-s", other]),
+            "{model}: the step matters"
+        );
+    }
+}

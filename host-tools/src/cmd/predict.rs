@@ -158,10 +158,12 @@ pub struct Args {
     /// With --spin-up-from-rad-s: the spin-up's time constant, s.
     #[arg(long, value_parser = crate::cmd::number, requires = "spin_up_from_rad_s")]
     time_constant_s: Option<f64>,
-    /// Method: closed form or one of the integrators [default: closed; the bowl model: dp54].
+    /// Method: closed form or one of the integrators [default: closed; the rolling
+    /// and bowl models: dp54].
     #[arg(long, value_parser = choice(METHODS))]
     method: Option<MethodChoice>,
-    /// Fixed step of euler / semi-implicit / rk4, s (default: 0.01 / omega).
+    /// Fixed step of euler / semi-implicit / rk4, s (default: 0.01 / omega; with the rolling
+    /// model's rk4 0.001 s, the bowl model's 0.0001 s).
     #[arg(long, value_parser = crate::cmd::number, visible_alias = "step")]
     step_s: Option<f64>,
     /// Relative tolerance of dp54.
