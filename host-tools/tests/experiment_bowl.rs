@@ -385,3 +385,25 @@ fn an_experiment_combines_motor_speeds_at_the_rigs_tilt() {
     let at_60 = (13.0 + 12.0 * 0.5f64).sqrt();
     assert!((w - at_60).abs() > 0.1);
 }
+
+/// `--suggest` on a bowl-model rig refuses in words and says what plan to run: it printed a
+/// plan separating the paper's flat and Coriolis models (D = 14.9), neither of which can
+/// reproduce this rig's times.
+#[test]
+fn suggest_on_a_bowl_rig_says_what_to_run() {
+    let out = bowl(&[
+        "experiment",
+        "--suggest",
+        "--rig-file",
+        rig_path().to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{}", common::stdout(&out));
+    assert!(
+        e.contains("follow the bowl model")
+            && e.contains("plan-bowl.toml")
+            && e.contains("bowl fit RESULTS --rig-file"),
+        "{e}"
+    );
+    assert!(!common::stdout(&out).contains("[[condition]]"));
+}
