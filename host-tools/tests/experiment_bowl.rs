@@ -311,6 +311,48 @@ fn bowl_fit_rig_file_refusals_are_plain_words() {
         "{e}"
     );
     assert!(!e.contains("panicked"), "{e}");
+    // Results from a rig tilted 45 deg fitted with the 60 deg rig file: refused with the tilt
+    // the rows were combined at (it used to name a 20 mm wall that was not there, AIC 17 ahead).
+    let at45 = experiment(
+        &dir,
+        &rig_variant(&dir, "tilt45", &[("axes_angle_deg", "45.0")]),
+        1,
+    );
+    let o = bowl(&[
+        "fit",
+        at45.to_str().unwrap(),
+        "--no-charts",
+        "--rig-file",
+        rig_path().to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{}", common::stdout(&o));
+    assert!(
+        e.contains("results line 2")
+            && e.contains("tilt of 45.0 deg")
+            && e.contains("tilt of 60 deg"),
+        "{e}"
+    );
+    // Without a rig file the default 60 deg is refused too, and --axes-angle-deg 45 fits.
+    let flag = |extra: &[&str]| {
+        let mut args = vec![
+            "fit",
+            at45.to_str().unwrap(),
+            "--no-charts",
+            "--models",
+            "flat",
+        ];
+        args.extend_from_slice(extra);
+        args.push("--bowl-walls");
+        bowl(&args)
+    };
+    let o = flag(&[]);
+    assert!(
+        !o.status.success() && String::from_utf8_lossy(&o.stderr).contains("--axes-angle-deg 45.0"),
+        "{}",
+        common::stdout(&o)
+    );
+    assert!(flag(&["--axes-angle-deg", "45"]).status.success());
 }
 
 /// `bowl experiment` writes a condition given as two motor speeds with the combined bowl speed
@@ -342,4 +384,26 @@ fn an_experiment_combines_motor_speeds_at_the_rigs_tilt() {
     assert!((w - want).abs() < 1e-12, "{w} against {want}");
     let at_60 = (13.0 + 12.0 * 0.5f64).sqrt();
     assert!((w - at_60).abs() > 0.1);
+}
+
+/// `--suggest` on a bowl-model rig refuses in words and says what plan to run: it printed a
+/// plan separating the paper's flat and Coriolis models (D = 14.9), neither of which can
+/// reproduce this rig's times.
+#[test]
+fn suggest_on_a_bowl_rig_says_what_to_run() {
+    let out = bowl(&[
+        "experiment",
+        "--suggest",
+        "--rig-file",
+        rig_path().to_str().unwrap(),
+    ]);
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{}", common::stdout(&out));
+    assert!(
+        e.contains("follow the bowl model")
+            && e.contains("plan-bowl.toml")
+            && e.contains("bowl fit RESULTS --rig-file"),
+        "{e}"
+    );
+    assert!(!common::stdout(&out).contains("[[condition]]"));
 }

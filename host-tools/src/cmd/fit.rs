@@ -9,7 +9,7 @@ use anyhow::Result;
 use lab::fit::models::{BowlBase, CANDIDATES, Equation, Method, Run, Wall, bowl_candidates};
 use lab::fit::stats::AIC_DECISIVE;
 use lab::fit::{
-    DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit_candidates, load, to_json,
+    DEFAULT_AXES_ANGLE_DEG, K2, charts, condition_table, fit_candidates, load, tilt, to_json,
     undecided_why,
 };
 use lab::number::count;
@@ -163,6 +163,18 @@ pub fn run(args: &Args) -> Result<()> {
         .collect();
     if args.bowl_walls || rig.is_some() {
         candidates.extend(bowl_candidates(rig.as_ref().map(|r| r.wall)));
+    }
+    // The paper's radial models see only the combined speed; the others need the runs' tilt.
+    if candidates
+        .iter()
+        .any(|c| !matches!(c.equation, Equation::Paper(_)))
+    {
+        let source = match (&args.rig_file, args.axes_angle_deg) {
+            (_, Some(_)) => tilt::Source::Flag,
+            (Some(path), None) => tilt::Source::RigFile(path),
+            (None, None) => tilt::Source::Default,
+        };
+        tilt::check(&runs, axes_angle_deg, source)?;
     }
     let fit = fit_candidates(runs, excluded, &candidates, args.fit_k2)?;
     if !args.no_charts {

@@ -54,6 +54,19 @@ pub fn check(
     conditions: usize,
     repeats: usize,
 ) -> Result<()> {
+    // The design below is the paper's two models' (flat against Coriolis); on a bowl-model rig
+    // it printed a D of 15 between two models that cannot reproduce its times at all, while
+    // what tells its walls apart is each release's azimuth (docs/experiment.md).
+    if p.bowl.is_some() {
+        bail!(
+            "--suggest designs a plan that tells the paper's flat and Coriolis models apart; \
+             this rig's granules follow the bowl model ([particle] model = \"bowl\"), whose \
+             walls the release azimuth tells apart, not the choice of speeds: spread a few \
+             conditions over the rig's range (up to {max_bowl_rad_s:.3} rad/s) with ten or more \
+             releases each, as docs/experiment/plan-bowl.toml does, and fit the results with \
+             `bowl fit RESULTS --rig-file RIG`"
+        );
+    }
     let mu_max = mu_ceiling();
     // `!(x > 0)` rather than `x <= 0`: NaN fails every comparison and must be refused too.
     if !(mu_guess > 0.0 && mu_guess <= mu_max) {

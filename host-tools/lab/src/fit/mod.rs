@@ -8,6 +8,7 @@ pub mod joint;
 pub mod models;
 pub mod robust;
 pub mod stats;
+pub mod tilt;
 pub mod walls;
 
 use std::path::Path;
@@ -171,6 +172,7 @@ pub fn load(path: &Path) -> Result<(Vec<Run>, Vec<Excluded>)> {
             bowl: BowlRun {
                 speeds_rad_s: Some([row.precession_rad_s, row.spin_rad_s]),
                 azimuth_rad,
+                planned_rad_s: Some(row.bowl_rad_s),
                 ..BowlRun::default()
             },
         });
@@ -338,6 +340,9 @@ pub fn fit_candidates(
             excluded.len(),
             crate::number::count(outliers.len(), "outlier", "outliers")
         );
+    }
+    if let Some(why) = robust::one_measurement(&runs) {
+        bail!("{why}");
     }
     let mut models: Vec<ModelFit> = candidates
         .iter()

@@ -212,6 +212,9 @@ pub struct BowlRun {
     /// `release_azimuth_deg`): the run is then compared with that one release. `None`: with the
     /// mean over the twelve azimuths.
     pub azimuth_rad: Option<f64>,
+    /// The row's target combined speed `bowl_rad_s`, rad/s: the rig combined the motor speeds
+    /// into it at its own tilt, so the two say which tilt the runs had (`fit::tilt`).
+    pub planned_rad_s: Option<f64>,
     /// The bowl's fillet, restitution and granule, shared by every candidate wall.
     pub base: BowlBase,
 }
@@ -221,6 +224,7 @@ impl Default for BowlRun {
         Self {
             speeds_rad_s: None,
             azimuth_rad: None,
+            planned_rad_s: None,
             base: BowlBase::DEFAULT,
         }
     }

@@ -21,6 +21,9 @@
 //!   against 0.4 %) or the runs' own scatter between repeats of a condition (a lack of fit no
 //!   mu can mend: every time 5.5 s, 70 % against none) is marked and never preferred, whatever
 //!   its AIC; when every model is, none is preferred.
+//! * **one measurement**: every run at one condition with the same time to the microsecond (rows
+//!   filled down or pasted over): no scatter between them, so no interval or preference can
+//!   be had; the fit used to report `mu_s` 0.379 [0.379, 0.379] and a wall 64 AIC ahead.
 
 use serde::Serialize;
 
@@ -250,6 +253,30 @@ pub fn cannot_reproduce(models: &[ModelFit], runs: &[Run]) -> Vec<Option<String>
         .collect()
 }
 
+/// Why the runs are one measurement, not several: every run is at one condition with the same
+/// residence time to the microsecond. A gate times each release with its own error, so repeats differ; identical
+/// times leave the timing noise at zero and every interval and AIC difference without meaning.
+pub fn one_measurement(runs: &[Run]) -> Option<String> {
+    let first = runs.first()?;
+    // Across conditions the same time is a lack of fit, said by `cannot_reproduce` (every
+    // time typed as 5.5 s); at one condition it is one release.
+    let same = |r: &Run| {
+        (r.residence_s - first.residence_s).abs() < 0.5e-6 && r.condition == first.condition
+    };
+    if runs.len() < 2 || !runs.iter().all(same) {
+        return None;
+    }
+    Some(format!(
+        "all {} usable runs are at one condition with the same residence time, {} s, to the \
+         microsecond: a gate's \
+         timing differs between releases, so these are one measurement repeated (rows filled \
+         down or pasted twice?) and cannot say how sure a fit is; check the results file \
+         against the rig's record (a simulated rig needs [particle] gate_jitter_s above 0)",
+        runs.len(),
+        first.residence_s
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use model_core::particle::Model;
@@ -433,5 +460,27 @@ mod tests {
             (4, "speed trace r_traces/none.csv missing or empty")
         );
         let _ = std::fs::remove_dir_all(dir);
+    }
+
+    /// Four copies of one release (a row filled down): refused in words, not fitted to a
+    /// zero-width interval and a wall "preferred" by 64 AIC.
+    #[test]
+    fn copies_of_one_run_are_refused() {
+        let mut runs = rig();
+        runs.truncate(4);
+        let t = runs[0].residence_s;
+        for r in &mut runs {
+            r.residence_s = t;
+        }
+        let e = fit_candidates(runs.clone(), Vec::new(), &CANDIDATES[..2], false)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("all 4 usable runs are at one condition with the same residence time")
+                && e.contains("check"),
+            "{e}"
+        );
+        runs[3].residence_s += 1e-6;
+        fit_candidates(runs, Vec::new(), &CANDIDATES[..2], false).unwrap();
     }
 }
