@@ -483,3 +483,5 @@ mod checks;
 // What the bounds cost where they take the incline.
 mod costs;
 use costs::costs;
+// Why the cost grid's sticking row is not taken (docs/model.md §12).
+mod sticking_row;
