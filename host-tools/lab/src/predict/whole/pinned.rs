@@ -128,7 +128,10 @@ fn lines() -> Vec<String> {
                 all.push('\n');
             }
         }
-        out.push(format!("rotation estimate's {name} grid: {:016x}", digest(&all)));
+        out.push(format!(
+            "rotation estimate's {name} grid: {:016x}",
+            digest(&all)
+        ));
     }
     out
 }
@@ -150,7 +153,12 @@ fn the_choices_and_answers_are_the_pinned_ones() {
         .filter(|(g, w)| g != w)
         .map(|(g, w)| format!("now    {g}\npinned {w}"))
         .collect();
-    assert!(moved.is_empty(), "{} moved:\n{}", moved.len(), moved.join("\n"));
+    assert!(
+        moved.is_empty(),
+        "{} moved:\n{}",
+        moved.len(),
+        moved.join("\n")
+    );
 }
 
 /// The choice against the plain incline on the rows where the chooser's own work shows
@@ -160,13 +168,55 @@ fn the_choices_and_answers_are_the_pinned_ones() {
 #[ignore]
 fn choice_against_the_incline() {
     let rows = [
-        ("30 deg, 1.8 rad/s, mu_s 0.2 at 1 % (second order)", 30.0, 1.8, 0.2, 0.01),
-        ("30 deg, 3.6 rad/s, mu_s 0.2 at 5 % (second order)", 30.0, 3.6, 0.2, 0.05),
-        ("45 deg, 3.6 rad/s, mu_s 0.4 at 5 % (second order)", 45.0, 3.6, 0.4, 0.05),
-        ("30 deg, 0.5 rad/s, mu_s 0.4 at 1 % (estimate)", 30.0, 0.5, 0.4, 0.01),
-        ("60 deg, 1.8 rad/s, mu_s 0.4 at 5 % (estimate)", 60.0, 1.8, 0.4, 0.05),
-        ("45 deg, 1.8 rad/s, mu_s 0.6 at 5 % (estimate)", 45.0, 1.8, 0.6, 0.05),
-        ("60 deg, 2 rad/s, mu_s 0.4 at 0.1 % (corrected)", 60.0, 2.0, 0.4, 0.001),
+        (
+            "30 deg, 1.8 rad/s, mu_s 0.2 at 1 % (second order)",
+            30.0,
+            1.8,
+            0.2,
+            0.01,
+        ),
+        (
+            "30 deg, 3.6 rad/s, mu_s 0.2 at 5 % (second order)",
+            30.0,
+            3.6,
+            0.2,
+            0.05,
+        ),
+        (
+            "45 deg, 3.6 rad/s, mu_s 0.4 at 5 % (second order)",
+            45.0,
+            3.6,
+            0.4,
+            0.05,
+        ),
+        (
+            "30 deg, 0.5 rad/s, mu_s 0.4 at 1 % (estimate)",
+            30.0,
+            0.5,
+            0.4,
+            0.01,
+        ),
+        (
+            "60 deg, 1.8 rad/s, mu_s 0.4 at 5 % (estimate)",
+            60.0,
+            1.8,
+            0.4,
+            0.05,
+        ),
+        (
+            "45 deg, 1.8 rad/s, mu_s 0.6 at 5 % (estimate)",
+            45.0,
+            1.8,
+            0.6,
+            0.05,
+        ),
+        (
+            "60 deg, 2 rad/s, mu_s 0.4 at 0.1 % (corrected)",
+            60.0,
+            2.0,
+            0.4,
+            0.001,
+        ),
     ];
     let time = |batches: usize, f: &dyn Fn()| {
         (0..batches)
@@ -185,7 +235,11 @@ fn choice_against_the_incline() {
             ..RollingScene::with_speeds(w, w, f64::to_radians(tilt), 0.075)
         };
         let sh = BowlShape::bare_rim();
-        assert_eq!(choose_level(&s, &sh, tol, false).level, Level::Incline, "{name}");
+        assert_eq!(
+            choose_level(&s, &sh, tol, false).level,
+            Level::Incline,
+            "{name}"
+        );
         for batches in [5, 25] {
             let incline = time(batches, &|| {
                 std::hint::black_box(incline_mean_s(std::hint::black_box(&s)));
