@@ -218,17 +218,6 @@ fn choice_against_the_incline() {
             0.001,
         ),
     ];
-    let time = |batches: usize, f: &dyn Fn()| {
-        (0..batches)
-            .map(|_| {
-                let t0 = std::time::Instant::now();
-                for _ in 0..1000 {
-                    f();
-                }
-                t0.elapsed().as_secs_f64() / 1000.0
-            })
-            .fold(f64::INFINITY, f64::min)
-    };
     for (name, tilt, w, mu_s, tol) in rows {
         let s = RollingScene {
             sliding_friction: mu_s,
@@ -241,10 +230,10 @@ fn choice_against_the_incline() {
             "{name}"
         );
         for batches in [5, 25] {
-            let incline = time(batches, &|| {
+            let incline = per_call_s(batches, &|| {
                 std::hint::black_box(incline_mean_s(std::hint::black_box(&s)));
             });
-            let choice = time(batches, &|| {
+            let choice = per_call_s(batches, &|| {
                 std::hint::black_box(choose_level(std::hint::black_box(&s), &sh, tol, false));
             });
             println!(
@@ -255,4 +244,17 @@ fn choice_against_the_incline() {
             );
         }
     }
+}
+
+/// The time of one call of `f`, s: 1000 calls timed together, best of `batches`.
+pub(super) fn per_call_s(batches: usize, f: &dyn Fn()) -> f64 {
+    (0..batches)
+        .map(|_| {
+            let t0 = std::time::Instant::now();
+            for _ in 0..1000 {
+                f();
+            }
+            t0.elapsed().as_secs_f64() / 1000.0
+        })
+        .fold(f64::INFINITY, f64::min)
 }
