@@ -9,7 +9,7 @@ use crate::Real;
 use crate::particle::rolling::RollingScene;
 
 use super::incline::{Tilt, needed_at, needed_in};
-use super::incline_rotation::{checked_sum, incline_second_order};
+use super::incline_rotation::{Orders, checked_sum};
 
 /// The rotation's effect on the incline's mean `T`: at most
 /// `K (|Omega|^2 + 2 w1^2) T_incline^2 ri / (R - ri)` (relative, [`rotation_estimate`]), where
@@ -105,8 +105,14 @@ pub(crate) fn estimate_of<T: Real>(
     incline_mean_s: T,
     mode: InclineMode,
 ) -> T {
-    let estimate = mode_constant::<T>(mode) * f
-        + T::from_f64(ROTATION_K_ROD) * rod_form(scene, incline_mean_s);
+    // Without a rod offset its term is zero (or, where the path or a speed gives no number,
+    // the form's infinity or NaN too): not computed, a division off the chooser's path.
+    let rod = if scene.rod_length_m == T::ZERO {
+        T::ZERO
+    } else {
+        T::from_f64(ROTATION_K_ROD) * rod_form(scene, incline_mean_s)
+    };
+    let estimate = mode_constant::<T>(mode) * f + rod;
     // A speed whose square overflows times a release at the centre (`inf * 0`) bounds nothing:
     // infinite, so the incline is not taken and no NaN is reported.
     if estimate.is_nan() {
@@ -244,32 +250,77 @@ fn bound_in<T: Real>(
 pub(crate) fn bound_of<T: Real>(
     scene: &RollingScene<T>,
     tilt: Tilt<T>,
-    (times, sum): (&[T; 12], T),
+    times_and_sum: (&[T; 12], T),
     f: T,
     mode: InclineMode,
 ) -> Option<SecondOrder<T>> {
-    let (k4, k4c) = match mode {
-        InclineMode::Rolls => (SECOND_ORDER_K4, CORRECTED_K4),
-        InclineMode::NearAtRim => (SECOND_ORDER_K4_NEAR_RIM, CORRECTED_K4_NEAR_RIM),
-        // A sliding granule the rotation may bring to stick rolls for part of its path: `T` is
-        // not smooth in the speeds there either.
-        InclineMode::Slides if may_stick_in(scene, tilt) => return None,
-        InclineMode::Slides => (SECOND_ORDER_K4_SLIDING, CORRECTED_K4_SLIDING),
-        InclineMode::NearAtRest => return None,
+    Prepared::new(scene, tilt, mode)?.bound(times_and_sum, f)
+}
+
+/// A guess, before the incline is computed, at whether the a-priori estimate will refuse it
+/// (so the chooser prepares the second order early only where it will likely be needed): the
+/// estimate at `T^2 = 2 R / A`, `A` the incline's drive in its mode, as products (no
+/// division). Only the chooser's speed depends on it, never a choice or a number.
+pub(crate) fn likely_refused<T: Real>(
+    scene: &RollingScene<T>,
+    tilt: Tilt<T>,
+    mode: InclineMode,
+    tolerance: T,
+) -> bool {
+    let g = scene.g_m_s2;
+    let drive = if mode == InclineMode::Slides {
+        g * (tilt.sin - scene.sliding_friction * tilt.cos)
+    } else {
+        scene.k2 * g * (tilt.sin - scene.rolling_resistance * tilt.cos)
     };
-    if scene.rod_length_m != T::ZERO {
-        return None;
+    let (ri, rim, w1) = (scene.ri_m.abs(), scene.rim_radius_m, scene.precession_rad_s);
+    let path = rim - ri;
+    let rotation = mode_constant::<T>(mode) * (tilt.combined_speed_sq(scene) + T::TWO * w1 * w1);
+    let rod = T::from_f64(ROTATION_K_ROD) * w1 * w1 * scene.rod_length_m;
+    T::TWO * rim * ri * (rotation * path + rod) > tolerance * drive * path * path
+}
+
+/// The scene's part of [`second_order_bound`]: its constants `K4` by the mode, and the orders
+/// along the incline's path, which need neither the incline's times nor its mean (the chooser
+/// builds it before its incline pass, so the two overlap in the processor).
+pub(crate) struct Prepared<T> {
+    orders: Orders<T>,
+    k4: f64,
+    k4c: f64,
+}
+
+impl<T: Real> Prepared<T> {
+    /// `None` where the incline has no second order bound: near the stick threshold at rest,
+    /// a sliding granule that may stick, a rod offset, or no orders at all.
+    pub(crate) fn new(scene: &RollingScene<T>, tilt: Tilt<T>, mode: InclineMode) -> Option<Self> {
+        let (k4, k4c) = match mode {
+            InclineMode::Rolls => (SECOND_ORDER_K4, CORRECTED_K4),
+            InclineMode::NearAtRim => (SECOND_ORDER_K4_NEAR_RIM, CORRECTED_K4_NEAR_RIM),
+            // A sliding granule the rotation may bring to stick rolls for part of its path:
+            // `T` is not smooth in the speeds there either.
+            InclineMode::Slides if may_stick_in(scene, tilt) => return None,
+            InclineMode::Slides => (SECOND_ORDER_K4_SLIDING, CORRECTED_K4_SLIDING),
+            InclineMode::NearAtRest => return None,
+        };
+        if scene.rod_length_m != T::ZERO {
+            return None;
+        }
+        let orders = Orders::of_mode(scene, tilt, mode == InclineMode::Slides)?;
+        Some(Prepared { orders, k4, k4c })
     }
-    let slides = mode == InclineMode::Slides;
-    let c2 = incline_second_order(scene, (tilt.sin, tilt.cos), slides, times, sum)?;
-    let bound = c2.abs() + T::from_f64(k4) * f * f;
-    let corrected_bound = T::from_f64(k4c) * f * f;
-    (bound.is_finite() && corrected_bound.is_finite()).then_some(SecondOrder {
-        c2,
-        bound,
-        corrected_bound,
-        corrected: false,
-    })
+
+    /// The bounds from the incline's times and their sum, and the rotation's form `f`.
+    pub(crate) fn bound(&self, (times, sum): (&[T; 12], T), f: T) -> Option<SecondOrder<T>> {
+        let c2 = self.orders.relative(times, sum)?;
+        let bound = c2.abs() + T::from_f64(self.k4) * f * f;
+        let corrected_bound = T::from_f64(self.k4c) * f * f;
+        (bound.is_finite() && corrected_bound.is_finite()).then_some(SecondOrder {
+            c2,
+            bound,
+            corrected_bound,
+            corrected: false,
+        })
+    }
 }
 
 /// Whether a granule the incline slides may come to stick on its way out: the least friction

@@ -50,7 +50,7 @@ pub use super::rotation_bound::{
     SECOND_ORDER_K4_NEAR_RIM, SECOND_ORDER_K4_SLIDING, SecondOrder, incline_mode, may_stick,
     rod_form, rotation_constant, rotation_estimate, rotation_form, second_order_bound,
 };
-use super::rotation_bound::{bound_of, estimate_of, form_in, mode_in};
+use super::rotation_bound::{Prepared, estimate_of, form_in, likely_refused, mode_in};
 
 /// A level of the hierarchy, cheapest first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -176,27 +176,39 @@ pub fn choose_level<T: Real>(
         };
     }
     let slides = needed > scene.sliding_friction;
+    let mode = mode_in(scene, tilt);
+    // The second order's scene part (its orders along the path), needed only where the
+    // a-priori estimate refuses the incline: built before the incline's pass where a guess says
+    // it will, so the processor works on it while the pass waits on its square roots (built
+    // after the pass, it was the longest chain of work left; docs/model.md §12).
+    let early = !each_release && likely_refused(scene, tilt, mode, tolerance);
+    let prepared = if early {
+        Prepared::new(scene, tilt, mode)
+    } else {
+        None
+    };
     // The incline: its own friction check is inside it; the rotation decides.
-    // Its times, their sum and their mean (the incline's answer), kept for the checks below.
-    let drive = incline_times_s(scene).map(|times| {
-        let sum = sum_of(&times);
-        (times, sum, mean_from_sum(sum))
-    });
-    let incline = drive.map(|(_, _, t)| t);
-    fails[0] = match drive {
-        Some(_) if each_release => Some(Fails::EachRelease),
-        Some((times, sum, t)) => {
-            let mode = mode_in(scene, tilt);
+    let times = incline_times_s(scene);
+    let sum = times.as_ref().map(sum_of);
+    let incline = sum.map(mean_from_sum);
+    fails[0] = match (&times, sum, incline) {
+        (Some(_), _, _) if each_release => Some(Fails::EachRelease),
+        (Some(times), Some(sum), Some(t)) => {
             // The rotation's form, once for the estimate and the second order's bound.
             let f = form_in(scene, tilt, t);
             rotation_estimate = estimate_of(scene, f, t, mode);
             if rotation_estimate > tolerance {
                 // The a-priori estimate refuses it: the rotation's second order along the
                 // incline's path may still bound it within (docs/model.md §12, "The four
-                // rotation rows"); only here, so the rows taken by the estimate pay nothing.
-                // The plain incline where its bound holds; else its mean corrected by `c2`
-                // where the remainder's bound does.
-                second_order = bound_of(scene, tilt, (&times, sum), f, mode);
+                // rotation rows"); only here (the rows the estimate takes pay only the guess
+                // above). The plain incline where its bound holds; else its mean corrected by
+                // `c2` where the remainder's bound does. Prepared early where the guess said
+                // so (`None` there: no second order), else now.
+                second_order = match prepared {
+                    Some(p) => p.bound((times, sum), f),
+                    None if early => None,
+                    None => Prepared::new(scene, tilt, mode).and_then(|p| p.bound((times, sum), f)),
+                };
                 match &mut second_order {
                     Some(b) if b.bound <= tolerance => None,
                     Some(b) if b.corrected_bound <= tolerance => {
@@ -211,7 +223,7 @@ pub fn choose_level<T: Real>(
                 None
             }
         }
-        None => Some(Fails::NoDrive),
+        _ => Some(Fails::NoDrive),
     };
     if fails[0].is_none() {
         let corrected = second_order.filter(|b| b.corrected);

@@ -472,6 +472,8 @@ fn report(
 }
 
 #[cfg(test)]
+mod pinned;
+#[cfg(test)]
 mod rotation_fit;
 #[cfg(test)]
 mod rotation_orders;

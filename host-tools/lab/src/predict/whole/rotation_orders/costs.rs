@@ -11,17 +11,7 @@ pub(super) fn costs() {
     // What a bound may cost on the rows it is to take: within 1.25x of the plain incline
     // leaves a quarter of the incline's own time (1000 calls, best of 5).
     let s = scene((60.0, 3.6, 3.6, 0.4, 0.0375, 0.075));
-    let time = |f: &dyn Fn()| {
-        (0..5)
-            .map(|_| {
-                let t0 = std::time::Instant::now();
-                for _ in 0..1000 {
-                    f();
-                }
-                t0.elapsed().as_secs_f64() / 1000.0
-            })
-            .fold(f64::INFINITY, f64::min)
-    };
+    let time = |f: &dyn Fn()| super::super::pinned::per_call_s(5, f);
     // The second order as the chooser runs it: from the incline's own times.
     let times = incline_times_s(&s).unwrap();
     let second = time(&|| {
