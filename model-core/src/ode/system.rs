@@ -1,7 +1,8 @@
 //! The project's integrators for a system of `N` first-order equations `y' = f(t, y)` (the
 //! rolling granule of `particle::rolling`, which implements it): adaptive Dormand-Prince 5(4) with its dense
 //! output (the same tableau and step control as the radial model's, `ode/dp54.rs`) and classical
-//! RK4 at a fixed step with cubic Hermite interpolation. Both stop at the first zero of an event
+//! RK4 at a fixed step with cubic Hermite interpolation (shortened where the caller grades it
+//! towards a singularity of its solution: [`rk4_graded`]). Both stop at the first zero of an event
 //! function (the rim), located on the interpolant, so `T` keeps the method's order; a check
 //! after every accepted step can end the run early (lift-off, slip, a held granule).
 
@@ -300,10 +301,27 @@ pub fn rk4<T: Real, const N: usize, S>(
 
 /// [`rk4`] with an event of the time, the state and the step's direction (as [`timed`] makes).
 pub(crate) fn rk4_with<T: Real, const N: usize, S>(
+    f: impl FnMut(T, &[T; N]) -> [T; N],
+    t0: T,
+    y0: [T; N],
+    h: T,
+    event: &impl Fn(T, &[T; N], T, &[T; N]) -> (T, T),
+    check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
+    limits: SystemLimits<T>,
+) -> Result<Run<T, N, S>, SystemError> {
+    rk4_graded(f, t0, y0, h, |_, _, _| h, event, check, limits)
+}
+
+/// [`rk4_with`] whose step from `(t, y)` with the slope `y'` there is `step(t, y, y')` where
+/// that is shorter than `h` (a segment that ends at a singularity of its solution grades its
+/// steps down to it: a slide's end, `particle::rolling::modes`); `h` elsewhere.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn rk4_graded<T: Real, const N: usize, S>(
     mut f: impl FnMut(T, &[T; N]) -> [T; N],
     t0: T,
     y0: [T; N],
     h: T,
+    step: impl Fn(T, &[T; N], &[T; N]) -> T,
     event: &impl Fn(T, &[T; N], T, &[T; N]) -> (T, T),
     mut check: impl FnMut(T, &[T; N]) -> ControlFlow<S>,
     limits: SystemLimits<T>,
@@ -312,6 +330,9 @@ pub(crate) fn rk4_with<T: Real, const N: usize, S>(
         return Err(SystemError::InvalidStep);
     }
     let (mut t, mut y) = (t0, y0);
+    // The time as `anchor + n h`, not a running sum: no rounding accumulates in it. A shortened
+    // step moves the anchor to its end.
+    let (mut anchor, mut n) = (t0, 0u32);
     let mut evaluations = 1u32;
     let mut steps = 0u32;
     let mut k1 = f(t, &y);
@@ -321,12 +342,20 @@ pub(crate) fn rk4_with<T: Real, const N: usize, S>(
             return run_ended(Ended::Horizon { y }, evaluations, steps);
         }
         steps += 1;
-        let k2 = f(t + half * h, &axpy(&y, h, &[(0.5, &k1)]));
-        let k3 = f(t + half * h, &axpy(&y, h, &[(0.5, &k2)]));
-        let k4 = f(t + h, &axpy(&y, h, &[(1.0, &k3)]));
+        let graded = step(t, &y, &k1);
+        // A step below the time's resolution would not advance it.
+        let floor = T::from_f64(16.0) * T::EPSILON * t.abs();
+        let hs = if graded < h && graded.is_finite() {
+            graded.max(floor)
+        } else {
+            h
+        };
+        let k2 = f(t + half * hs, &axpy(&y, hs, &[(0.5, &k1)]));
+        let k3 = f(t + half * hs, &axpy(&y, hs, &[(0.5, &k2)]));
+        let k4 = f(t + hs, &axpy(&y, hs, &[(1.0, &k3)]));
         let y1 = axpy(
             &y,
-            h,
+            hs,
             &[
                 (1.0 / 6.0, &k1),
                 (1.0 / 3.0, &k2),
@@ -334,23 +363,28 @@ pub(crate) fn rk4_with<T: Real, const N: usize, S>(
                 (1.0 / 6.0, &k4),
             ],
         );
-        let k1_next = f(t + h, &y1);
+        let k1_next = f(t + hs, &y1);
         evaluations += 4;
         if !finite(&y1) {
             return Err(SystemError::NotFinite);
         }
-        let (g1, _) = event(t + h, &y1, T::ZERO, &[T::ZERO; N]);
+        let (g1, _) = event(t + hs, &y1, T::ZERO, &[T::ZERO; N]);
         if g1 >= T::ZERO {
             let (te, ye) = event_in_step(
-                |i, th| hermite(y[i], h * k1[i], y1[i], h * k1_next[i], th),
+                |i, th| hermite(y[i], hs * k1[i], y1[i], hs * k1_next[i], th),
                 event,
                 t,
-                h,
+                hs,
             );
             return run_ended(Ended::Event { t: te, y: ye }, evaluations, steps);
         }
-        // The time as a multiple of the step, not a running sum: no rounding accumulates in it.
-        t = t0 + T::from_f64(f64::from(steps)) * h;
+        if hs < h {
+            anchor = t + hs;
+            n = 0;
+        } else {
+            n += 1;
+        }
+        t = anchor + T::from_f64(f64::from(n)) * h;
         y = y1;
         k1 = k1_next;
         if let ControlFlow::Break(why) = check(t, &y) {

@@ -354,7 +354,7 @@ pub fn work_precision() -> Result<(Figure, Table)> {
     let mut table = Table::new(&["scene", "method", "setting", "rhs_evaluations", "rel_error"]);
     let mut series = Vec::new();
     for (si, (name, s, shape)) in scenes.iter().enumerate() {
-        let (reference, _) = bowl_mean_by(s, shape, RollingMethod::Dp54 { rtol: 1e-12 })?;
+        let (reference, _) = bowl_mean_by(s, shape, RollingMethod::Dp54 { rtol: 1e-14 })?;
         let runs = method_runs(3..=11, 2e-3, 8);
         series.extend(method_series(
             name,
@@ -370,7 +370,7 @@ pub fn work_precision() -> Result<(Figure, Table)> {
         series,
         vec![
             SCENE_NOTE.into(),
-            "reference: DP5(4) at rtol 1e-12".into(),
+            "reference: DP5(4) at rtol 1e-14".into(),
             "DP5(4) rtol 1e-3..1e-11; RK4 h 2 ms / 2^k".into(),
             "flights in closed form (not counted)".into(),
         ],

@@ -432,6 +432,8 @@ enum Phase<T> {
 #[cfg(test)]
 mod flight_tests;
 #[cfg(test)]
+mod order_tests;
+#[cfg(test)]
 mod stall_tests;
 #[cfg(test)]
 mod tests;

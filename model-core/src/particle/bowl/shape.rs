@@ -1,7 +1,7 @@
 //! The shape's geometry against a scene: the bare rim, the centre's meridian on the fillet and
 //! the wall, whether the corner is sharp, and the checks of [`BowlShape`]'s values.
 
-use super::wall::Meridian;
+use super::wall::{Meridian, Piece};
 use super::{BowlError, BowlShape};
 use crate::Real;
 use crate::particle::rolling::RollingScene;
@@ -53,6 +53,7 @@ impl<T: Real> BowlShape<T> {
             lip_m: lip,
             top_s: rc * alpha + along,
             pivot_m: a.max(rim * T::from_f64(1e-6)),
+            piece: Piece::Whole,
         })
     }
 

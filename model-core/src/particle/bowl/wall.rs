@@ -58,6 +58,24 @@ pub struct Meridian<T> {
     /// The pivot's radius (the granule's, at least a micrometre of the rim so that a point
     /// granule still has a finite curvature there), m.
     pub pivot_m: T,
+    /// Which piece [`Meridian::at`] follows: all of them ([`Piece::Whole`], as built), or one
+    /// continued past its ends ([`Meridian::on_piece`]).
+    pub piece: Piece,
+}
+
+/// A piece of the centre's meridian on the wall. The path's curvature jumps where they meet
+/// (from `1 / (F - a)` to 0 at the fillet's end, from 0 to `-1 / a` at the lip's edge): a
+/// segment integrated across a meeting point would step over a jump of the normal force.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Piece {
+    /// Every piece, each where it is (the bottom below `s` = 0).
+    Whole,
+    /// The fillet's arc, continued past both its ends.
+    Fillet,
+    /// The cone, continued past both its ends.
+    Cone,
+    /// The pivot about the lip's edge, continued past both its ends.
+    Pivot,
 }
 
 /// A point of the meridian: `(rho, z)`, its unit tangent `(rho', z')` and its derivative
@@ -73,14 +91,78 @@ pub struct Point<T> {
 }
 
 impl<T: Real> Meridian<T> {
-    fn arc_length(&self) -> T {
+    /// Arc length where the fillet's arc ends and the cone starts, m: the path's curvature
+    /// jumps there from `1 / (F - a)` to 0.
+    pub fn arc_length(&self) -> T {
         self.arc_radius_m * self.alpha_rad
     }
 
+    /// The piece that arc length `s` is on (the fillet below its end, the cone up to the
+    /// lip's edge, the pivot beyond it).
+    pub fn piece_at(&self, s: T) -> Piece {
+        if s < self.arc_length() {
+            Piece::Fillet
+        } else if s <= self.top_s {
+            Piece::Cone
+        } else {
+            Piece::Pivot
+        }
+    }
+
+    /// This meridian following only the piece that `s` is on, continued past its ends: a
+    /// segment's right-hand side, smooth up to the event where the granule leaves the piece,
+    /// so that the integrator's interpolant locates it (the stages of a step that crosses it
+    /// are on the same piece as its start).
+    pub fn on_piece(&self, s: T) -> Self {
+        Self {
+            piece: self.piece_at(s),
+            ..*self
+        }
+    }
+
     /// The meridian at arc length `s` (below 0 the bottom continued, so that an integrator's
-    /// stage just past the edge stays defined).
+    /// stage just past the edge stays defined; on one piece, that piece continued).
     pub fn at(&self, s: T) -> Point<T> {
         let rc = self.arc_radius_m;
+        let (sa, ca) = (self.alpha_rad.sin(), self.alpha_rad.cos());
+        let len = self.arc_length();
+        let arc = |s: T| {
+            let th = s / rc;
+            let (st, ct) = (th.sin(), th.cos());
+            Point {
+                pos: [self.rho_b_m + rc * st, self.z0_m + rc * (T::ONE - ct)],
+                tangent: [ct, st],
+                bend: [-st / rc, ct / rc],
+            }
+        };
+        let cone = |s: T| Point {
+            pos: [
+                self.rho_b_m + rc * sa + (s - len) * ca,
+                self.z0_m + rc * (T::ONE - ca) + (s - len) * sa,
+            ],
+            tangent: [ca, sa],
+            bend: [T::ZERO, T::ZERO],
+        };
+        // Over the edge: the centre turns about it (convex), the tangent's angle falling from
+        // alpha at 1/pivot per metre.
+        let pivot = |s: T| {
+            let pv = self.pivot_m;
+            let th = self.alpha_rad - (s - self.top_s) / pv;
+            let (st, ct) = (th.sin(), th.cos());
+            let top = cone(self.top_s).pos;
+            let edge = [top[0] + pv * sa, top[1] - pv * ca];
+            Point {
+                pos: [edge[0] - pv * st, edge[1] + pv * ct],
+                tangent: [ct, st],
+                bend: [st / pv, -ct / pv],
+            }
+        };
+        match self.piece {
+            Piece::Fillet => return arc(s),
+            Piece::Cone => return cone(s),
+            Piece::Pivot => return pivot(s),
+            Piece::Whole => {}
+        }
         if s <= T::ZERO {
             return Point {
                 pos: [self.rho_b_m + s, self.z0_m],
@@ -88,39 +170,10 @@ impl<T: Real> Meridian<T> {
                 bend: [T::ZERO, T::ZERO],
             };
         }
-        let len = self.arc_length();
-        if s < len {
-            let th = s / rc;
-            let (st, ct) = (th.sin(), th.cos());
-            return Point {
-                pos: [self.rho_b_m + rc * st, self.z0_m + rc * (T::ONE - ct)],
-                tangent: [ct, st],
-                bend: [-st / rc, ct / rc],
-            };
-        }
-        let (sa, ca) = (self.alpha_rad.sin(), self.alpha_rad.cos());
-        let d = s.min(self.top_s) - len;
-        let cone = [
-            self.rho_b_m + rc * sa + d * ca,
-            self.z0_m + rc * (T::ONE - ca) + d * sa,
-        ];
-        if s <= self.top_s {
-            return Point {
-                pos: cone,
-                tangent: [ca, sa],
-                bend: [T::ZERO, T::ZERO],
-            };
-        }
-        // Over the edge: the centre turns about it (convex), the tangent's angle falling from
-        // alpha at 1/pivot per metre.
-        let pv = self.pivot_m;
-        let th = self.alpha_rad - (s - self.top_s) / pv;
-        let (st, ct) = (th.sin(), th.cos());
-        let edge = [cone[0] + pv * sa, cone[1] - pv * ca];
-        Point {
-            pos: [edge[0] - pv * st, edge[1] + pv * ct],
-            tangent: [ct, st],
-            bend: [st / pv, -ct / pv],
+        match self.piece_at(s) {
+            Piece::Fillet => arc(s),
+            Piece::Cone => cone(s),
+            _ => pivot(s),
         }
     }
 

@@ -1,11 +1,14 @@
 //! One stay on the wall: roll and slide segments (as on the bottom, `rolling::modes`) with
 //! the wall's events, each located on the integrator's interpolant: back onto the bottom
 //! (`s` = 0), over the lip (the centre's radius reaching the lip's), lift-off (`N` = 0), and the
-//! contact's changes (rolling needing more than `mu_s N`; the slip ending).
+//! contact's changes (rolling needing more than `mu_s N`; the slip ending), and the meridian's
+//! seams where its curvature jumps (the fillet's end, the lip's edge): a segment follows the
+//! piece it starts on, continued past its ends, so that no step straddles a jump of the normal
+//! force.
 
 use core::cell::Cell;
 
-use super::wall::{Contact, Meridian, WallState, slip_of, wall_forces};
+use super::wall::{Contact, Meridian, Piece, WallState, slip_of, wall_forces};
 use crate::Real;
 use crate::ode::system::{SystemError, SystemLimits};
 use crate::particle::rolling::equations::AT_REST_M_S;
@@ -50,7 +53,8 @@ fn events<T: Real>(
     armed: bool,
     refs: (T, T),
     below_edge: bool,
-) -> [T; 5] {
+    on_fillet: bool,
+) -> [T; 6] {
     let (reference, speed_ref) = refs;
     let f = wall_forces(sc, m, t, y, contact);
     let rim = sc.rim_radius_m;
@@ -77,17 +81,24 @@ fn events<T: Real>(
     // Reaching the lip's edge (from the cone onto the pivot about it): the path's curvature
     // jumps from 0 to 1/a there, so the normal force jumps by `|u|^2 / a`; an event on the
     // smooth arc length, not on the force's jump, decides there whether it flies off the edge.
+    // Back from the pivot onto the cone likewise.
     let edge = if below_edge {
         (y[0] - m.top_s) / rim
     } else {
-        -T::ONE
+        (m.top_s - y[0]) / rim
     };
+    // The fillet's end (onto the cone, or back onto the fillet): the path's curvature jumps
+    // there from `1 / (F - a)` to 0, and with it the normal force by `|u|^2 / (F - a)`; a fixed
+    // step across it lost RK4's order (its error in T went as `h`, with where the seam fell in
+    // the step), so each side is a segment of its own.
+    let seam = (y[0] - m.arc_length()) / rim;
     [
         -y[0] / rim,
         (f.rho_m - m.lip_m) / rim,
         -f.normal_m_s2 / reference,
         switch,
         edge,
+        if on_fillet { seam } else { -seam },
     ]
 }
 
@@ -185,7 +196,12 @@ pub fn stay<T: Real>(
             Contact::Roll => [T::ZERO; 3],
         });
         let armed = Cell::new(false);
-        let below_edge = y[0] < m.top_s;
+        // The segment follows the piece of the meridian it starts on (continued past its
+        // ends); where it leaves it is an event.
+        let piece = m.piece_at(y[0]);
+        let below_edge = piece != Piece::Pivot;
+        let on_fillet = piece == Piece::Fillet;
+        let mp = &m.on_piece(y[0]);
         let now = |d: [T; 3]| {
             if rolling {
                 Contact::Roll
@@ -196,23 +212,33 @@ pub fn stay<T: Real>(
         let Some((te, ye)) = segment(
             &mut out.tally,
             mode,
-            |t, y: &WallState<T>| wall_forces(sc, m, t, y, now(dir.get())).derivative,
+            |t, y: &WallState<T>| wall_forces(sc, mp, t, y, now(dir.get())).derivative,
             (t, y),
             method,
             scales,
             |t, y: &WallState<T>| {
-                let e = events(sc, m, t, y, now(dir.get()), armed.get(), refs, below_edge);
-                e[0].max(e[1]).max(e[2]).max(e[3]).max(e[4])
+                let e = events(
+                    sc,
+                    mp,
+                    t,
+                    y,
+                    now(dir.get()),
+                    armed.get(),
+                    refs,
+                    below_edge,
+                    on_fillet,
+                );
+                e.iter().fold(e[0], |a, b| a.max(*b))
             },
             |t, y: &WallState<T>| {
                 if !rolling {
-                    let s = wall_forces(sc, m, t, y, now(dir.get())).slip_m_s;
+                    let s = wall_forces(sc, mp, t, y, now(dir.get())).slip_m_s;
                     follow_slip(&s, &dir, &armed, stuck_m_s(refs.1));
                 }
                 watch.step(t)
             },
             // A slide's slip held to its own tolerance, as on the bottom.
-            (!rolling).then_some(SlipOf::OfState(&|y: &WallState<T>| slip_of(m, y))),
+            (!rolling).then_some(SlipOf::OfState(&|y: &WallState<T>| slip_of(mp, y))),
             remaining,
         )?
         else {
@@ -223,14 +249,26 @@ pub fn stay<T: Real>(
         }
         let e = events(
             sc,
-            m,
+            mp,
             te,
             &ye,
             now(dir.get()),
             armed.get(),
             refs,
             below_edge,
+            on_fillet,
         );
+        // A roll's state keeps its no-slip only to the integrator's error (the wall's state
+        // carries the spin apart from the translation): made exact at the roll's end, so that
+        // what comes next (the contact at a seam or the edge, the bottom's mode) is not decided
+        // by that error against the rest threshold. With it a roll across the fillet's end at
+        // RK4's step went on sliding for microseconds (its drift above `AT_REST_M_S`), by
+        // more the longer the step: an extra change and an error in T of order `h`.
+        let ye = if rolling {
+            no_slip(sc, mp, te, &ye)
+        } else {
+            ye
+        };
         match fired(&e) {
             0 => {
                 let mut back = ye;
@@ -251,7 +289,25 @@ pub fn stay<T: Real>(
                 must_slide = false;
                 t = te;
                 y = ye;
-                y[0] = m.top_s + (m.top_s.abs() + m.pivot_m) * T::from_f64(4.0) * T::EPSILON;
+                let past = (m.top_s.abs() + m.pivot_m) * T::from_f64(4.0) * T::EPSILON;
+                y[0] = if below_edge {
+                    m.top_s + past
+                } else {
+                    m.top_s - past
+                };
+            }
+            5 => {
+                // Across the fillet's end: on in the same contact from just past it (the side
+                // it is moving to), so that the next segment's seam event starts below zero.
+                must_slide = false;
+                t = te;
+                y = ye;
+                let past = (m.arc_length().abs() + m.pivot_m) * T::from_f64(4.0) * T::EPSILON;
+                y[0] = if on_fillet {
+                    m.arc_length() + past
+                } else {
+                    m.arc_length() - past
+                };
             }
             2 => {
                 // Airborne (from the wall, or from the lip's edge: the flight decides whether
@@ -262,7 +318,11 @@ pub fn stay<T: Real>(
             _ => {
                 must_slide = rolling;
                 t = te;
-                y = if rolling { ye } else { no_slip(sc, m, te, &ye) };
+                y = if rolling {
+                    ye
+                } else {
+                    no_slip(sc, mp, te, &ye)
+                };
             }
         }
     }

@@ -6,7 +6,7 @@
 use core::ops::ControlFlow;
 
 use super::report::{Mode, Tally};
-use super::slip::{SlipOf, slip_error};
+use super::slip::{GRADED_SPAN, SlipOf, graded_step, slip_error};
 use crate::Real;
 use crate::ode::system::{self, Ended, SystemError};
 use crate::particle::rolling::{RollingError, RollingMethod, RollingScene, SystemLimits};
@@ -42,7 +42,8 @@ pub(crate) fn scene_scales<T: Real>(scene: &RollingScene<T>) -> ((T, T), (T, T))
 /// Integrates one segment in `mode` from `(t0, y0)` with the method, stopping at the first
 /// event, and adds its cost and its time to `tally`: the event's time and state, or `None` at
 /// the horizon. `slip`: a slide's slip, held to [`slip_error`]'s tolerance besides the
-/// components' (`None` where the contact does not slip).
+/// components' by DP5(4), and near which RK4 grades its steps ([`graded_step`]) (`None` where
+/// the contact does not slip).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn segment<T: Real, const N: usize>(
     tally: &mut Tally<T>,
@@ -80,7 +81,12 @@ pub(crate) fn segment<T: Real, const N: usize>(
             )
         }
         RollingMethod::Rk4 { step_s } => {
-            system::rk4_with(rhs, t0, y0, step_s, &event, check, limits)
+            // A slide's steps graded near its slip's zeros ([`graded_step`]).
+            let span = T::from_f64(GRADED_SPAN) * length / speed;
+            let graded = |_: T, y: &[T; N], dy: &[T; N]| {
+                slip.map_or(step_s, |slip| graded_step(slip, step_s, span, y, dy))
+            };
+            system::rk4_graded(rhs, t0, y0, step_s, graded, &event, check, limits)
         }
     }
     .map_err(RollingError::Integration)?;
