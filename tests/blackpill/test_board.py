@@ -238,6 +238,23 @@ def test_parameters_survive_a_reset():
         s.close()
 
 
+def test_telemetry_rate_alone_survives_a_reset():
+    # The protocol device keeps the rate, the record keeps it too: a SET of it alone was
+    # acknowledged, shown by STATUS, and lost at the next reset.
+    s = Session(fresh_flash("telem-rate"))
+    try:
+        s.wait_until_s(0.3)
+        check(s.bowl("set", "TELEM_HZ", "10").startswith("ok"), "SET TELEM_HZ 10 refused")
+        s.wait_emulated(1.2)  # the save runs at the next persistence tick
+        s.call(lambda m: m.reset("pin"))
+        s.wait_emulated(0.3)
+        st = s.status()
+        check(st.get("reset_count") == "1" and st.get("telemetry_hz") == "10",
+              f"TELEM_HZ 10 not restored from flash after the reset: {st}")
+    finally:
+        s.close()
+
+
 MODEL_FIELDS = ("back_emf_uv_per_rad_s", "friction_ppm", "time_constant_us")
 
 
