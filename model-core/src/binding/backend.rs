@@ -388,6 +388,15 @@ impl<I: Injector> Backend for ControllerBackend<I> {
         self.params[id.index()]
     }
 
+    fn telemetry_hz_set(&mut self, hz: u8) {
+        // Only a change is saved: the board sets its stored rate at every boot.
+        let stored = &mut self.params[ParamId::TelemetryHz.index()];
+        if *stored != i32::from(hz) {
+            *stored = i32::from(hz);
+            self.params_dirty = true;
+        }
+    }
+
     fn heartbeat(&mut self) {
         self.ctrl.host_heartbeat();
     }

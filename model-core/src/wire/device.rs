@@ -57,6 +57,11 @@ pub trait Backend {
     fn set_param(&mut self, id: ParamId, value: i32) -> Result<(), Reason>;
     /// The current value of a parameter (never asked for [`ParamId::TelemetryHz`]).
     fn param(&self, id: ParamId) -> i32;
+    /// [`Device`] took a new telemetry rate (it owns the rate, but a backend that saves the
+    /// parameters saves the rate with them, so it must hear of a change to it alone).
+    fn telemetry_hz_set(&mut self, hz: u8) {
+        let _ = hz;
+    }
     /// The PC is there: called for every command that arrives intact (its CRC checks out),
     /// before it is answered, whatever the answer (a query, a refusal, a copy, PING). Feeds the
     /// host-silence watch (`LINK_TIMEOUT_MS`).
@@ -367,7 +372,9 @@ impl Device {
             Command::SetParam {
                 id: ParamId::TelemetryHz,
                 value,
-            } => self.set_telemetry_hz(value),
+            } => self.set_telemetry_hz(value).map(|()| {
+                backend.telemetry_hz_set(self.telemetry_hz);
+            }),
             Command::SetParam { id: param, value } => backend.set_param(param, value),
             Command::GetStatus => {
                 let t = backend.telemetry();

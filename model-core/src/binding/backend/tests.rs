@@ -345,3 +345,21 @@ fn set_while_running_follows_each_parameters_role() {
         }
     }
 }
+
+/// TELEM_HZ is kept by the protocol device, not the backend, yet it is saved with the other
+/// parameters: a SET of it alone must ask for a save, or the board comes back from a reset at
+/// the old rate while every other parameter set the same way survives.
+#[test]
+fn a_new_telemetry_rate_alone_asks_to_be_saved() {
+    let mut s = station();
+    assert!(!s.rig.take_params_to_save());
+    let f = command(&mut s, "C1,7,SET,TELEM_HZ,10");
+    assert_eq!(f, Frame::Ack { id: 7 });
+    assert!(s.rig.take_params_to_save(), "a new rate is saved");
+    let saved = split_persisted(&s.params_to_persist());
+    assert_eq!(saved.params[ParamId::TelemetryHz.index()], 10);
+    // The same rate again changes nothing: no flash write for it.
+    let f = command(&mut s, "C1,8,SET,TELEM_HZ,10");
+    assert_eq!(f, Frame::Ack { id: 8 });
+    assert!(!s.rig.take_params_to_save());
+}
