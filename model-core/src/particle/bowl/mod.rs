@@ -430,6 +430,8 @@ enum Phase<T> {
 }
 
 #[cfg(test)]
+mod corner_tests;
+#[cfg(test)]
 mod flight_tests;
 #[cfg(test)]
 mod order_tests;

@@ -33,6 +33,7 @@
 
 use super::super::rolling::RollingScene;
 use super::super::rolling::equations::{AT_REST_M_S, cross, frame};
+use super::super::rolling::slide::at_rest_direction;
 use crate::Real;
 
 /// The wall state `[s, ex, ey, sdot, phidot, sx, sy, sz]`.
@@ -302,12 +303,19 @@ pub fn wall_forces<T: Real>(
         }
         Contact::Slide(d) => {
             let sl = dot(&slip, &slip).sqrt();
-            let dir = if sl > T::from_f64(AT_REST_M_S) && dot(&slip, &d) > T::ZERO {
-                [slip[0] / sl, slip[1] / sl, slip[2] / sl]
-            } else {
-                d
-            };
             let k = sc.sliding_friction * n_pos;
+            let dir = if sl > T::from_f64(AT_REST_M_S) {
+                if dot(&slip, &d) > T::ZERO {
+                    [slip[0] / sl, slip[1] / sl, slip[2] / sl]
+                } else {
+                    d
+                }
+            } else {
+                // At rest: along the free slip's acceleration `-needed / (1 - k2)` where the
+                // friction cannot hold it (as on the bottom).
+                let free: [T; 3] = core::array::from_fn(|i| -needed[i] / one_m);
+                at_rest_direction(k2, free, k, d)
+            };
             ([-k * dir[0], -k * dir[1], -k * dir[2]], [T::ZERO; 3])
         }
     };

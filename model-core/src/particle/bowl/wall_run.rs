@@ -13,7 +13,8 @@ use crate::Real;
 use crate::ode::system::{SystemError, SystemLimits};
 use crate::particle::rolling::equations::AT_REST_M_S;
 use crate::particle::rolling::modes::{
-    Mode, SlipOf, StallWatch, Tally, fired, follow_slip, scene_scales, segment, stuck_m_s,
+    Chatter, Mode, Settle, SlipOf, StallWatch, Tally, fired, follow_slip, scene_scales, segment,
+    stuck_m_s,
 };
 use crate::particle::rolling::{RollingError, RollingMethod, RollingScene};
 
@@ -50,7 +51,7 @@ fn events<T: Real>(
     t: T,
     y: &WallState<T>,
     contact: Contact<T>,
-    armed: bool,
+    (armed, fresh_end): (bool, T),
     refs: (T, T),
     below_edge: bool,
     on_fillet: bool,
@@ -73,7 +74,8 @@ fn events<T: Real>(
             let stuck = if armed {
                 reversed.max(stuck_m_s(speed_ref) - norm(&s))
             } else {
-                reversed - stuck_m_s(speed_ref)
+                // (in a chatter, by more than the rest threshold: `Chatter`).
+                reversed - fresh_end
             };
             stuck / speed_ref
         }
@@ -177,10 +179,20 @@ pub fn stay<T: Real>(
     let (mut t, mut y) = (t0, y0);
     let mut must_slide = false;
     let mut previous: Option<Mode> = None;
-    // One watch over the whole stay (as the bottom's `run_from`).
-    let watch = StallWatch::new(stall_steps, scales, t0);
+    // One watch over the whole stay (as the bottom's `run_from`), at the wall's own length: the
+    // tightest of the bottom's radius, the fillet's arc and the pivot over the lip. Through a
+    // fillet of `F - a` = 1.2 mm at 1 m/s the normal force is 50 g, and a slide starting there
+    // from no slip takes steps of 7e-10 s (the explicit step's stability limit against the
+    // friction's turning of the slip) for hundreds of steps before its slip grows: real
+    // progress, which the bottom's scale (R over the scene's speed, 0.07 s) called a stall
+    // (docs/model.md §10).
+    let length = scales.0.min(m.arc_radius_m).min(m.pivot_m);
+    let watch = StallWatch::new(stall_steps, (length, scales.1), t0);
+    let mut chatter = Chatter::new();
     loop {
         let remaining = out.tally.remaining(limits, max_switches)?;
+        let steps_before = out.tally.steps;
+        let fresh_end = chatter.fresh_end_m_s(refs.1);
         let Some(contact) = next_contact(sc, m, t, &y, must_slide) else {
             out.end = WallEnd::LiftsOff(t, y);
             return Ok(out);
@@ -209,7 +221,8 @@ pub fn stay<T: Real>(
                 Contact::Slide(d)
             }
         };
-        let Some((te, ye)) = segment(
+        let settle = Settle::new();
+        let Some((te, ye, settled)) = segment(
             &mut out.tally,
             mode,
             |t, y: &WallState<T>| wall_forces(sc, mp, t, y, now(dir.get())).derivative,
@@ -223,7 +236,7 @@ pub fn stay<T: Real>(
                     t,
                     y,
                     now(dir.get()),
-                    armed.get(),
+                    (armed.get(), fresh_end),
                     refs,
                     below_edge,
                     on_fillet,
@@ -231,11 +244,16 @@ pub fn stay<T: Real>(
                 e.iter().fold(e[0], |a, b| a.max(*b))
             },
             |t, y: &WallState<T>| {
-                if !rolling {
-                    let s = wall_forces(sc, mp, t, y, now(dir.get())).slip_m_s;
-                    follow_slip(&s, &dir, &armed, stuck_m_s(refs.1));
+                watch.check(t)?;
+                if rolling {
+                    return core::ops::ControlFlow::Continue(());
                 }
-                watch.step(t)
+                let s = wall_forces(sc, mp, t, y, now(dir.get())).slip_m_s;
+                follow_slip(&s, &dir, &armed, stuck_m_s(refs.1));
+                settle.step(&s, || {
+                    let f = wall_forces(sc, mp, t, &no_slip(sc, mp, t, y), Contact::Roll);
+                    norm(&f.needed_m_s2) <= sc.sliding_friction * f.normal_m_s2
+                })
             },
             // A slide's slip held to its own tolerance, as on the bottom.
             (!rolling).then_some(SlipOf::OfState(&|y: &WallState<T>| slip_of(mp, y))),
@@ -253,7 +271,7 @@ pub fn stay<T: Real>(
             te,
             &ye,
             now(dir.get()),
-            armed.get(),
+            (armed.get(), fresh_end),
             refs,
             below_edge,
             on_fillet,
@@ -269,7 +287,13 @@ pub fn stay<T: Real>(
         } else {
             ye
         };
-        match fired(&e) {
+        // A settled slide ends as at its slip's end (a change of contact).
+        let which = if settled { 3 } else { fired(&e) };
+        chatter.after(
+            out.tally.steps - steps_before,
+            !rolling && which == 3 && !settle.left_rest(),
+        );
+        match which {
             0 => {
                 let mut back = ye;
                 back[0] = T::ZERO;

@@ -28,7 +28,7 @@ use core::cell::Cell;
 
 pub use report::{Mode, ModesOutcome, ModesReport, Regime, Tally};
 pub(crate) use segments::{fired, max3, scene_scales, segment};
-pub(crate) use slip::{SlipOf, follow_slip, stuck_m_s};
+pub(crate) use slip::{Chatter, Settle, SlipOf, follow_slip, stuck_m_s};
 pub use stall::STALL_STEP;
 pub(crate) use stall::StallWatch;
 
@@ -157,7 +157,7 @@ fn slide_events<T: Real>(
     t: T,
     y: &SlideState<T>,
     dir: [T; 2],
-    armed: bool,
+    (armed, fresh_end): (bool, T),
     refs: (T, T),
 ) -> [T; 3] {
     let (reference, speed_ref) = refs;
@@ -169,7 +169,14 @@ fn slide_events<T: Real>(
         let speed = (slip[0] * slip[0] + slip[1] * slip[1]).sqrt();
         reversed.max(stuck_m_s(speed_ref) - speed)
     } else {
-        reversed
+        // Not yet armed (a slide from no slip): its end where the slip has turned against the
+        // friction by more than the stuck threshold, as on the wall (`bowl::wall_run`), not at
+        // its first rounding. Where rolling's need grazed `mu_s N` and fell back, the slide
+        // from no slip reversed at once and ended where it began, rolling found the need at
+        // `mu_s N` to rounding and slid again at the same instant, without end (a 54 deg wall
+        // with a 3.9 mm fillet at 10 deg tilt, -2.2 and 0.33 rad/s, mu_s 0.055: a stall at
+        // 1.3127 s, docs/model.md §10). In a chatter further ([`Chatter`]).
+        reversed - fresh_end
     };
     [
         (y[0] * y[0] + y[1] * y[1]) / (rim * rim) - T::ONE,
@@ -204,8 +211,10 @@ pub(crate) fn run_from<T: Real>(
     // One watch over the whole run: a stall can be one segment's steps or a run of segments
     // that each end where they start.
     let watch = StallWatch::new(stall_steps, scales, t0);
+    let mut chatter = Chatter::new();
     loop {
         let remaining = report.tally.remaining(limits, MAX_SWITCHES)?;
+        let steps_before = report.tally.steps;
         let (ended, which) = match next_mode(scene, t, &y, must_slide) {
             Next::LiftsOff => {
                 report.outcome = ModesOutcome::LiftsOff { time_s: t };
@@ -214,7 +223,7 @@ pub(crate) fn run_from<T: Real>(
             }
             Next::Roll(yr) => {
                 report.tally.enter(&mut previous, Mode::Roll);
-                let Some((te, ye)) = segment(
+                let Some((te, ye, _)) = segment(
                     &mut report.tally,
                     Mode::Roll,
                     |t, y: &[T; 5]| forces(scene, t, y).derivative,
@@ -222,7 +231,7 @@ pub(crate) fn run_from<T: Real>(
                     method,
                     scales,
                     |t, y: &[T; 5]| max3(roll_events(scene, t, y, reference)),
-                    |t, _| watch.step(t),
+                    |t, _| watch.check(t),
                     None,
                     remaining,
                 )?
@@ -230,6 +239,7 @@ pub(crate) fn run_from<T: Real>(
                     return Ok(report);
                 };
                 let which = fired(&roll_events(scene, te, &ye, reference));
+                chatter.after(report.tally.steps - steps_before, false);
                 ((te, from_rolling(&ye), ye[2], ye[3]), which)
             }
             Next::Slide(ys, dir0) => {
@@ -237,10 +247,12 @@ pub(crate) fn run_from<T: Real>(
                 let dir = Cell::new(dir0);
                 let slip0 = slip_m_s(&ys);
                 let stuck = stuck_m_s(refs.1);
+                let fresh_end = chatter.fresh_end_m_s(refs.1);
                 let armed = Cell::new(
                     slip0[0] * slip0[0] + slip0[1] * slip0[1] > T::from_f64(4.0) * stuck * stuck,
                 );
-                let Some((te, ye)) = segment(
+                let settle = Settle::new();
+                let Some((te, ye, settled)) = segment(
                     &mut report.tally,
                     Mode::Slide,
                     |t, y: &SlideState<T>| slide_forces(scene, t, y, dir.get()).derivative,
@@ -248,11 +260,26 @@ pub(crate) fn run_from<T: Real>(
                     method,
                     scales,
                     |t, y: &SlideState<T>| {
-                        max3(slide_events(scene, t, y, dir.get(), armed.get(), refs))
+                        max3(slide_events(
+                            scene,
+                            t,
+                            y,
+                            dir.get(),
+                            (armed.get(), fresh_end),
+                            refs,
+                        ))
                     },
                     |t, y: &SlideState<T>| {
-                        follow_slip(&slip_m_s(y), &dir, &armed, stuck);
-                        watch.step(t)
+                        let s = slip_m_s(y);
+                        follow_slip(&s, &dir, &armed, stuck);
+                        watch.check(t)?;
+                        settle.step(&s, || {
+                            let (ft, normal) =
+                                needed_friction_m_s2(scene, t, &from_rolling(&to_rolling(y)));
+                            ft[0] * ft[0] + ft[1] * ft[1]
+                                <= (scene.sliding_friction * normal)
+                                    * (scene.sliding_friction * normal)
+                        })
                     },
                     Some(SlipOf::Linear(slip_m_s::<T>)),
                     remaining,
@@ -260,15 +287,22 @@ pub(crate) fn run_from<T: Real>(
                 else {
                     return Ok(report);
                 };
-                let events = slide_events(scene, te, &ye, dir.get(), armed.get(), refs);
+                let events =
+                    slide_events(scene, te, &ye, dir.get(), (armed.get(), fresh_end), refs);
+                // A settled slide ends as at its slip's end.
+                let which = if settled { 1 } else { fired(&events) };
+                chatter.after(
+                    report.tally.steps - steps_before,
+                    which == 1 && !settle.left_rest(),
+                );
                 let mut ye = ye;
-                if fired(&events) == 1 {
+                if which == 1 {
                     // The slip is zero here to the location's accuracy: make it
                     // exactly so (rolling), keeping the translation.
                     ye[4] = -ye[3];
                     ye[5] = ye[2];
                 }
-                ((te, ye, ye[2], ye[3]), fired(&events))
+                ((te, ye, ye[2], ye[3]), which)
             }
         };
         let (te, ye, ux, uy) = ended;

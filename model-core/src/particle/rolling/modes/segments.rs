@@ -6,7 +6,7 @@
 use core::ops::ControlFlow;
 
 use super::report::{Mode, Tally};
-use super::slip::{GRADED_SPAN, SlipOf, graded_step, slip_error};
+use super::slip::{GRADED_SPAN, SlipOf, Stop, graded_step, slip_error};
 use crate::Real;
 use crate::ode::system::{self, Ended, SystemError};
 use crate::particle::rolling::{RollingError, RollingMethod, RollingScene, SystemLimits};
@@ -41,7 +41,9 @@ pub(crate) fn scene_scales<T: Real>(scene: &RollingScene<T>) -> ((T, T), (T, T))
 
 /// Integrates one segment in `mode` from `(t0, y0)` with the method, stopping at the first
 /// event, and adds its cost and its time to `tally`: the event's time and state, or `None` at
-/// the horizon. `slip`: a slide's slip, held to [`slip_error`]'s tolerance besides the
+/// the horizon; the flag says the check stopped it there with the slide settled
+/// ([`super::slip::Settle`]: the slip at rest, as where the slip-end event fires). `slip`: a
+/// slide's slip, held to [`slip_error`]'s tolerance besides the
 /// components' by DP5(4), and near which RK4 grades its steps ([`graded_step`]) (`None` where
 /// the contact does not slip).
 #[allow(clippy::too_many_arguments)]
@@ -53,10 +55,10 @@ pub(crate) fn segment<T: Real, const N: usize>(
     method: RollingMethod<T>,
     scales: (T, T),
     event: impl Fn(T, &[T; N]) -> T,
-    check: impl FnMut(T, &[T; N]) -> ControlFlow<()>,
+    check: impl FnMut(T, &[T; N]) -> ControlFlow<Stop>,
     slip: Option<SlipOf<'_, T, N>>,
     limits: SystemLimits<T>,
-) -> Result<Option<(T, [T; N])>, RollingError> {
+) -> Result<Option<(T, [T; N], bool)>, RollingError> {
     let (length, speed) = scales;
     let event = system::timed(event);
     let run = match method {
@@ -95,13 +97,23 @@ pub(crate) fn segment<T: Real, const N: usize>(
     match run.ended {
         Ended::Event { t, y } => {
             tally.spend(mode, t - t0);
-            Ok(Some((t, y)))
+            Ok(Some((t, y, false)))
+        }
+        Ended::Stopped {
+            t,
+            y,
+            why: Stop::Settled,
+        } => {
+            tally.spend(mode, t - t0);
+            Ok(Some((t, y, true)))
         }
         Ended::Horizon { .. } => {
             tally.spend(mode, limits.horizon_s - t0);
             Ok(None)
         }
-        // The check gave up on the run (a stall: [`StallWatch`]).
-        Ended::Stopped { .. } => Err(RollingError::Integration(SystemError::Stalled)),
+        // The check gave up on the run (a stall: [`super::StallWatch`]).
+        Ended::Stopped {
+            why: Stop::Stalled, ..
+        } => Err(RollingError::Integration(SystemError::Stalled)),
     }
 }

@@ -4,6 +4,7 @@
 //! side is stiff, and the components' own tolerances say nothing of the slip's direction.
 
 use core::cell::Cell;
+use core::ops::ControlFlow;
 
 use crate::Real;
 use crate::particle::rolling::equations::AT_REST_M_S;
@@ -38,6 +39,129 @@ pub(crate) fn follow_slip<T: Real, const N: usize>(
     }
     if speed > T::from_f64(AT_REST_M_S) && dot(s, &d) > T::ZERO {
         dir.set(core::array::from_fn(|i| s[i] / speed));
+    }
+}
+
+/// Why a segment's check after an accepted step stopped it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Stop {
+    /// The steps no longer advance the time ([`super::StallWatch`]).
+    Stalled,
+    /// A slide's slip has come down to rest and stays there ([`Settle`]): the slide has ended.
+    Settled,
+}
+
+/// How many accepted steps in a row, each ending with the slip at rest ([`SETTLED_M_S`]) where
+/// rolling needs no more than `mu_s N`, end a slide as settled ([`Settle`]).
+pub(crate) const SETTLE_STEPS: u32 = 8;
+
+/// The slip at and below which a slide's slip is at rest for [`Settle`], m/s: twice
+/// [`AT_REST_M_S`], where the friction's direction stops following the slip.
+pub(crate) const SETTLED_M_S: f64 = 2.0 * AT_REST_M_S;
+
+/// Watches a slide for a slip at rest that stays there while the friction could hold it.
+/// Below [`AT_REST_M_S`] the friction keeps its last direction instead of following the slip;
+/// where the contact's free acceleration has a part across that direction (a granule in the
+/// wall's corner, rolling's need near `mu_s N`) the slip then neither reverses along it (the
+/// slip-end event) nor falls to the stuck threshold: it hovers at the rest threshold, in and
+/// out of it at every step, the steps shrinking to 1e-11 s at the switch of the right-hand
+/// side, until the step cap (a 77 deg sharp corner at 19 deg tilt, 1.6 and -0.73 rad/s,
+/// mu_s 0.10: 690 000 steps in 0.03 s, docs/model.md §10). A slip at rest that the friction
+/// can hold is no slip: after [`SETTLE_STEPS`] such steps in a row the slide ends there and
+/// the granule rolls. A slide whose slip passes through zero ends at its reversal within a
+/// step, and a slide from no slip that rolling's need keeps above `mu_s N` grows its slip:
+/// neither changes.
+pub(crate) struct Settle {
+    above: Cell<bool>,
+    run: Cell<u32>,
+}
+
+impl Settle {
+    pub(crate) fn new() -> Self {
+        Self {
+            above: Cell::new(false),
+            run: Cell::new(0),
+        }
+    }
+
+    /// Whether the slip has been above [`SETTLED_M_S`] in this slide.
+    pub(crate) fn left_rest(&self) -> bool {
+        self.above.get()
+    }
+
+    /// After an accepted step of a slide whose slip is `s` (`holds`: whether the friction can
+    /// hold rolling there, asked only while the slip is at rest): break once it has settled.
+    pub(crate) fn step<T: Real, const N: usize>(
+        &self,
+        s: &[T; N],
+        holds: impl FnOnce() -> bool,
+    ) -> ControlFlow<Stop> {
+        let speed = dot(s, s).sqrt();
+        if speed > T::from_f64(SETTLED_M_S) {
+            self.above.set(true);
+            self.run.set(0);
+            return ControlFlow::Continue(());
+        }
+        if !holds() {
+            self.run.set(0);
+            return ControlFlow::Continue(());
+        }
+        let run = self.run.get() + 1;
+        self.run.set(run);
+        if run >= SETTLE_STEPS {
+            ControlFlow::Break(Stop::Settled)
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
+
+/// How many fresh slides in a row (from no slip) that end at once, their slip never out of
+/// rest, make a chatter ([`Chatter`]).
+pub(crate) const CHATTER_ENDS: u32 = 8;
+
+/// A segment of more than this many accepted steps is no chatter ([`Chatter`]).
+const CHATTER_STEPS: u32 = 2;
+
+/// Watches a run's changes of mode for a chatter at the stick threshold: rolling's need at
+/// `mu_s N` to rounding, a slide from no slip whose slip, held to the friction's direction at
+/// the switch while it is at rest, turns against that direction (the needed friction turning
+/// away from it, or dipping under `mu_s N`) within a step and ends, then rolling that needs
+/// `mu_s N` again a step later: a change of mode at every step, on the bottom (a 75 deg wall's
+/// corner at 6 deg tilt, -0.61 and -2.9 rad/s, mu_s 0.065: 100 000 changes in 0.02 ms) and
+/// on the fillet (a slide restarted from no slip every 1e-13 s until the stall watch). There
+/// rolling and sliding give the same friction, `mu_s N`, to the threshold's width; once
+/// [`CHATTER_ENDS`] such slides end in a row, each in at most [`CHATTER_STEPS`] steps, a fresh
+/// slide ends only where its slip has turned against the friction by [`AT_REST_M_S`] (the
+/// friction can hold it: it rolls) or left rest (then its friction follows it as any slide's):
+/// the mode the friction can hold, not one decided anew at every step. A run without such a
+/// chatter keeps the stuck threshold, and its answer, to the bit.
+pub(crate) struct Chatter {
+    ends: u32,
+}
+
+impl Chatter {
+    pub(crate) fn new() -> Self {
+        Self { ends: 0 }
+    }
+
+    /// How far a fresh slide's slip must turn against its friction for it to end, m/s.
+    pub(crate) fn fresh_end_m_s<T: Real>(&self, speed_ref: T) -> T {
+        if self.ends >= CHATTER_ENDS {
+            T::from_f64(AT_REST_M_S)
+        } else {
+            stuck_m_s(speed_ref)
+        }
+    }
+
+    /// After a segment of `steps` accepted steps; `fresh_end`: a slide that ended at its slip's
+    /// end without its slip leaving rest.
+    pub(crate) fn after(&mut self, steps: u32, fresh_end: bool) {
+        if fresh_end {
+            self.ends = self.ends.saturating_add(1);
+        } else if steps > CHATTER_STEPS {
+            self.ends = 0;
+        }
     }
 }
 

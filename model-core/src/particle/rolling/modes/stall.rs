@@ -5,6 +5,7 @@
 use core::cell::Cell;
 use core::ops::ControlFlow;
 
+use super::slip::Stop;
 use crate::Real;
 
 /// A step that advances the time by less than this fraction of the scene's time scale (its
@@ -35,17 +36,30 @@ impl<T: Real> StallWatch<T> {
 
     /// After an accepted step to `t`: break once the run of tiny steps is long enough.
     pub(crate) fn step(&self, t: T) -> ControlFlow<()> {
+        if self.tiny_run(t) {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+
+    /// [`Self::step`] as a segment's check.
+    pub(crate) fn check(&self, t: T) -> ControlFlow<Stop> {
+        if self.tiny_run(t) {
+            ControlFlow::Break(Stop::Stalled)
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+
+    fn tiny_run(&self, t: T) -> bool {
         let Some(n) = self.steps else {
-            return ControlFlow::Continue(());
+            return false;
         };
         let tiny = (t - self.last_t.get()).abs() < self.dt;
         self.last_t.set(t);
         let run = if tiny { self.run.get() + 1 } else { 0 };
         self.run.set(run);
-        if run >= n {
-            ControlFlow::Break(())
-        } else {
-            ControlFlow::Continue(())
-        }
+        run >= n
     }
 }
