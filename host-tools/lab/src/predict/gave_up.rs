@@ -19,8 +19,9 @@ pub enum Settings {
         method: RollingMethod<f64>,
         max_time_s: f64,
     },
-    /// `--model auto`: the chooser sets the tolerance and tightens it for such releases itself.
-    Chooser,
+    /// `--model auto`: the chooser sets the tolerance and tightens it for such releases itself;
+    /// `--max-time-s` as the bowl model's.
+    Chooser { max_time_s: f64 },
 }
 
 /// What happened to one release, without advice.
@@ -69,7 +70,12 @@ fn advice(failed: &[(f64, BowlError)], settings: &Settings) -> String {
     };
     let nothing = "no setting gets those releases through";
     match settings {
-        Settings::Chooser => {
+        // The step cap is met by long runs under the chooser too: said "no setting gets
+        // through" with `--max-time-s 3000` on a granule held in the corner, where 3 s answers.
+        Settings::Chooser { max_time_s } if is(SystemError::StepLimit) => {
+            format!("a shorter --max-time-s (now {max_time_s} s) may get through")
+        }
+        Settings::Chooser { .. } => {
             format!("the chooser already tightens its tolerance for such releases, so {nothing}")
         }
         Settings::Bowl {
@@ -128,5 +134,21 @@ mod tests {
             "{s}"
         );
         assert!(!s.contains("--method dp54"), "{s}");
+    }
+
+    /// Under the chooser a stall gets "no setting", the step cap the shorter horizon (it said
+    /// "no setting" for both).
+    #[test]
+    fn the_chooser_advises_a_shorter_horizon_for_the_step_cap() {
+        let cap = BowlError::Scene(RollingError::Integration(SystemError::StepLimit));
+        let chooser = Settings::Chooser { max_time_s: 3000.0 };
+        let s = sentence(&[(90.0, cap)], 12, &chooser);
+        assert!(
+            s.contains("a shorter --max-time-s (now 3000 s) may get through"),
+            "{s}"
+        );
+        assert!(!s.contains("no setting"), "{s}");
+        let s = sentence(&[(90.0, STALL)], 12, &chooser);
+        assert!(s.contains("no setting gets those releases through"), "{s}");
     }
 }

@@ -281,7 +281,9 @@ pub(crate) fn run_level(
         why.push(super::gave_up::sentence(
             &failed,
             times.len(),
-            &super::gave_up::Settings::Chooser,
+            &super::gave_up::Settings::Chooser {
+                max_time_s: limits.horizon_s,
+            },
         ));
     }
     why.dedup();
