@@ -21,7 +21,6 @@ import json
 import subprocess
 import sys
 
-BOWL, PY = sys.argv[1], sys.argv[2]
 BASE = dict(rim=0.075, ri=0.0375, a=0.003, mu_r=0.029, mu_s=0.4, rod=0.0)
 AZ = [0, 90, 180, 270]
 # name, tilt deg, w1 = w2 rad/s, wall angle deg, wall height m, fillet m, horizon s
@@ -98,42 +97,49 @@ def label(name, th, w):
     return f"{name} ({th} deg, {w} rad/s)"
 
 
-results = []
-print("| scene | MuJoCo T per release (s) | MuJoCo regime (mean) | bowl model e 0: T per release (s)"
-      " | regime (mean) | mean T, model / MuJoCo - 1 | e 0.15: regime (mean) |"
-      " mean T, model / MuJoCo - 1 | e 0.5: mean T, model / MuJoCo - 1 |")
-print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-for name, th, w, alpha, h, fillet, horizon in SCENES:
-    mj = mujoco_run(th, w, alpha, h, fillet, horizon)
-    us = ours(th, w, alpha, h, fillet, horizon, 0.0)
-    us15 = ours(th, w, alpha, h, fillet, horizon, 0.15)
-    us5 = ours(th, w, alpha, h, fillet, horizon, 0.5)
-    m_mj = mean(mj)
+def main():
+    global BOWL, PY
+    BOWL, PY = sys.argv[1], sys.argv[2]
+    results = []
+    print("| scene | MuJoCo T per release (s) | MuJoCo regime (mean) | bowl model e 0: T per release (s)"
+          " | regime (mean) | mean T, model / MuJoCo - 1 | e 0.15: regime (mean) |"
+          " mean T, model / MuJoCo - 1 | e 0.5: mean T, model / MuJoCo - 1 |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    for name, th, w, alpha, h, fillet, horizon in SCENES:
+        mj = mujoco_run(th, w, alpha, h, fillet, horizon)
+        us = ours(th, w, alpha, h, fillet, horizon, 0.0)
+        us15 = ours(th, w, alpha, h, fillet, horizon, 0.15)
+        us5 = ours(th, w, alpha, h, fillet, horizon, 0.5)
+        m_mj = mean(mj)
 
-    def diff(rows):
-        m = mean(rows)
-        if m_mj and m:
-            return f"{m:.4f} s, {100 * (m / m_mj - 1):+.1f} %"
-        return "both held" if m_mj is None and all(r[0] is None for r in rows) else "differ"
+        def diff(rows):
+            m = mean(rows)
+            if m_mj and m:
+                return f"{m:.4f} s, {100 * (m / m_mj - 1):+.1f} %"
+            return "both held" if m_mj is None and all(r[0] is None for r in rows) else "differ"
 
-    print(f"| {label(name, th, w)} | {times(mj)} | {fmt_regime(avg_regime(mj))} | {times(us)} | "
-          f"{fmt_regime(avg_regime(us))} | {diff(us)} | {fmt_regime(avg_regime(us15))} | "
-          f"{diff(us15)} | {diff(us5)} |", flush=True)
-    results.append((label(name, th, w), mj, us, us15))
+        print(f"| {label(name, th, w)} | {times(mj)} | {fmt_regime(avg_regime(mj))} | {times(us)} | "
+              f"{fmt_regime(avg_regime(us))} | {diff(us)} | {fmt_regime(avg_regime(us15))} | "
+              f"{diff(us15)} | {diff(us5)} |", flush=True)
+        results.append((label(name, th, w), mj, us, us15))
 
-print()
-print("| scene | MuJoCo per release | bowl model e 0 | same | bowl model e 0.15 | same |")
-print("| --- | --- | --- | --- | --- | --- |")
-total = same0 = same15 = 0
-for name, mj, us, us15 in results:
-    c_mj = [category(r) for r in mj]
-    c0 = [category(r) for r in us]
-    c15 = [category(r) for r in us15]
-    s0 = sum(a == b for a, b in zip(c_mj, c0))
-    s15 = sum(a == b for a, b in zip(c_mj, c15))
-    total += len(c_mj)
-    same0 += s0
-    same15 += s15
-    print(f"| {name} | {'; '.join(c_mj)} | {'; '.join(c0)} | {s0}/{len(c_mj)} | "
-          f"{'; '.join(c15)} | {s15}/{len(c_mj)} |", flush=True)
-print(f"| all | | | {same0}/{total} | | {same15}/{total} |")
+    print()
+    print("| scene | MuJoCo per release | bowl model e 0 | same | bowl model e 0.15 | same |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    total = same0 = same15 = 0
+    for name, mj, us, us15 in results:
+        c_mj = [category(r) for r in mj]
+        c0 = [category(r) for r in us]
+        c15 = [category(r) for r in us15]
+        s0 = sum(a == b for a, b in zip(c_mj, c0))
+        s15 = sum(a == b for a, b in zip(c_mj, c15))
+        total += len(c_mj)
+        same0 += s0
+        same15 += s15
+        print(f"| {name} | {'; '.join(c_mj)} | {'; '.join(c0)} | {s0}/{len(c_mj)} | "
+              f"{'; '.join(c15)} | {s15}/{len(c_mj)} |", flush=True)
+    print(f"| all | | | {same0}/{total} | | {same15}/{total} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -26,13 +26,13 @@ MU = 0.4
 DT = 1e-5
 
 
-def xml(impratio, tc, noslip):
+def xml(impratio, tc, noslip, dampratio=1.0):
     return f"""
 <mujoco>
   <option timestep="{DT}" gravity="0 0 0" cone="elliptic" integrator="implicitfast"
           impratio="{impratio}" noslip_iterations="{noslip}"/>
   <default>
-    <geom condim="6" friction="{MU} 0 0" solref="{tc} 1" solimp="0.99 0.999 0.0001"/>
+    <geom condim="6" friction="{MU} 0 0" solref="{tc} {dampratio}" solimp="0.99 0.999 0.0001"/>
   </default>
   <worldbody>
     <geom type="plane" size="1 1 0.1"/>
@@ -44,8 +44,8 @@ def xml(impratio, tc, noslip):
 </mujoco>"""
 
 
-def mujoco_impact(vx, vz, swy, impratio, tc, noslip):
-    m = mujoco.MjModel.from_xml_string(xml(impratio, tc, noslip))
+def mujoco_impact(vx, vz, swy, impratio, tc, noslip, dampratio=1.0):
+    m = mujoco.MjModel.from_xml_string(xml(impratio, tc, noslip, dampratio))
     d = mujoco.MjData(m)
     d.qvel[0:3] = [vx, 0.0, -vz]
     d.qvel[3:6] = [0.0, swy / A, 0.0]
