@@ -130,7 +130,10 @@ pub(crate) fn at_rest_direction<T: Real, const N: usize>(
     last: [T; N],
 ) -> [T; N] {
     let a = free.iter().fold(T::ZERO, |acc, v| acc + *v * *v).sqrt();
-    let along = free.iter().zip(&last).fold(T::ZERO, |acc, (f, l)| acc + *f * *l);
+    let along = free
+        .iter()
+        .zip(&last)
+        .fold(T::ZERO, |acc, (f, l)| acc + *f * *l);
     let last_size = last.iter().fold(T::ZERO, |acc, v| acc + *v * *v).sqrt();
     if along > T::from_f64(AT_REST_ALONG) * a * last_size {
         last
