@@ -2,7 +2,7 @@
 //! rolling granule of `particle::rolling`, which implements it): adaptive Dormand-Prince 5(4) with its dense
 //! output (the same tableau and step control as the radial model's, `ode/dp54.rs`) and classical
 //! RK4 at a fixed step with cubic Hermite interpolation (shortened where the caller grades it
-//! towards a singularity of its solution: [`rk4_graded`]). Both stop at the first zero of an event
+//! towards a singularity of its solution: `rk4_graded`). Both stop at the first zero of an event
 //! function (the rim), located on the interpolant, so `T` keeps the method's order; a check
 //! after every accepted step can end the run early (lift-off, slip, a held granule).
 
