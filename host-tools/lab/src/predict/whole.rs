@@ -204,6 +204,11 @@ pub(crate) fn run_level(
                 && friction_needed_at_rim(scene) > mu_s
             {
                 tight
+            } else if incline_mode(scene) == InclineMode::Slides && may_stick(scene) {
+                // A sliding granule the rotation may bring to stick: near its stick 1e-6
+                // takes more steps than 1e-7 (docs/model.md §12, the cost grids after the
+                // twentieth session).
+                start.min(1e-7)
             } else {
                 start
             };
