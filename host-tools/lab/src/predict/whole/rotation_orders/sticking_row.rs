@@ -13,12 +13,13 @@
 //! row at 1 % are counted on every drawn scene: how many they would take beyond a tolerance.
 //!
 //! `cargo test --release` with §12's `--config` flags `-p lab
-//! whole::rotation_orders::sticking_row -- --ignored --nocapture` (about 2 min; prints a
+//! whole::rotation_orders::sticking_row -- --ignored --nocapture` (a few seconds; prints a
 //! `STICK,...` line per scene and the counts; asserts the row's constants take some scene
 //! beyond its tolerance).
 
 use super::*;
 use model_core::choose::whole::may_stick;
+use model_core::sim::prng::Prng;
 
 /// One drawn scene: the incline's plain and corrected errors against the disc.
 struct Drawn {
@@ -34,15 +35,11 @@ struct Drawn {
     need_at_rest: f64,
 }
 
-/// `n` scenes of the class, drawn from `seed` (a linear congruential generator: the same
-/// scenes on every machine).
-fn draw(mut seed: u64, n: usize) -> Vec<Drawn> {
-    let mut u = move || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((seed >> 11) as f64) / ((1u64 << 53) as f64)
-    };
+/// `n` scenes of the class, drawn from `seed` (the project's seeded generator: the same scenes
+/// on every machine).
+fn draw(seed: u32, n: usize) -> Vec<Drawn> {
+    let mut rng = Prng::new(seed);
+    let mut u = move || f64::from(rng.unit());
     let mut out = Vec::new();
     while out.len() < n {
         let tilt: f64 = 40.0 + 40.0 * u();
