@@ -479,3 +479,56 @@ fn a_hardware_stop_latches_in_its_tick_and_asks_for_the_supply_cut() {
     cl.ctrl.hardware_stop();
     assert_eq!(cl.ctrl.fault(), Some(Fault::SensorLostOrStall(1)));
 }
+
+/// A speed that wanders about the reached band's edge (a tooth map a few percent off at low
+/// speed) stays running: it used to flip between running and changing speed at every tick.
+#[test]
+fn a_speed_wandering_about_the_band_edge_stays_running() {
+    use model_core::control::supervisor::{REACHED_FLOOR_RAD_S, REACHED_SHARE, closed_loop_state};
+    let r = [0.5f32, -1.0];
+    let edge = |k: usize| {
+        let side = if k.is_multiple_of(2) { 0.99 } else { 1.01 };
+        [
+            r[0] + side * (REACHED_SHARE * 0.5 + REACHED_FLOOR_RAD_S),
+            r[1] - side * (REACHED_SHARE * 1.0 + REACHED_FLOOR_RAD_S),
+        ]
+    };
+    let mut state = State::ChangingSpeed;
+    let mut states = Vec::new();
+    for k in 0..20 {
+        state = closed_loop_state(state, r, r, edge(k));
+        states.push(state);
+    }
+    assert_eq!(states[0], State::Running, "inside the band is running");
+    assert!(
+        states.iter().all(|&s| s == State::Running),
+        "flickered: {states:?}"
+    );
+    // Straying past twice the band is changing speed again, and coming back inside the band
+    // (not only inside twice the band) is needed to be running again.
+    let far = [
+        r[0] + 2.1 * (REACHED_SHARE * 0.5 + REACHED_FLOOR_RAD_S),
+        r[1],
+    ];
+    assert_eq!(
+        closed_loop_state(State::Running, r, r, far),
+        State::ChangingSpeed
+    );
+    let back = [
+        r[0] + 1.5 * (REACHED_SHARE * 0.5 + REACHED_FLOOR_RAD_S),
+        r[1],
+    ];
+    assert_eq!(
+        closed_loop_state(State::ChangingSpeed, r, r, back),
+        State::ChangingSpeed
+    );
+    assert_eq!(
+        closed_loop_state(State::Running, r, r, back),
+        State::Running
+    );
+    // A ramp that has not ended is changing speed however close the speed is.
+    assert_eq!(
+        closed_loop_state(State::Running, [0.5, -1.0], [0.6, -1.0], r),
+        State::ChangingSpeed
+    );
+}

@@ -30,7 +30,7 @@ use super::supervisor::{
     DRIVEN_BELOW_MODEL_DUTY, DROPPING_WATCH_PITCHES, Fault, PAIR_RUNAWAY_MARGIN_RAD_S,
     PAIR_RUNAWAY_RATIO, PAIR_RUNAWAY_STEADY_S, REVOLUTION_RUNAWAY_DUTY,
     REVOLUTION_RUNAWAY_MARGIN_RAD_S, REVOLUTION_RUNAWAY_RATIO, SETTLED_AFTER_S, State,
-    WATCH_PITCHES, edge_runaway,
+    WATCH_PITCHES, closed_loop_state, edge_runaway,
 };
 
 /// Why a command was refused. A refused command changes nothing.
@@ -330,17 +330,11 @@ impl Controller {
                 }
             }
             _ => {
-                let reached = (0..2).all(|i| {
-                    ramped[i] == target[i]
-                        && (self.axes[i].measured - ramped[i]).abs()
-                            <= 0.05 * ramped[i].abs() + 0.05
-                });
-                self.state = if reached {
+                let measured = [self.axes[0].measured, self.axes[1].measured];
+                self.state = closed_loop_state(self.state, ramped, target, measured);
+                if self.state == State::Running {
                     self.reached = true;
-                    State::Running
-                } else {
-                    State::ChangingSpeed
-                };
+                }
             }
         }
     }

@@ -39,6 +39,43 @@ pub enum State {
     Fault = 5,
 }
 
+/// The band, as a share of the reference, within which a reference counts as reached (plus
+/// [`REACHED_FLOOR_RAD_S`]): [`State::ChangingSpeed`] becomes [`State::Running`] inside it.
+pub const REACHED_SHARE: f32 = 0.05;
+/// The band's floor, rad/s: a reference near zero is reached within this much.
+pub const REACHED_FLOOR_RAD_S: f32 = 0.05;
+/// How many times the band a running axis may stray before the state goes back to
+/// [`State::ChangingSpeed`]. One band both ways made a speed that wanders about the band's edge
+/// (an axis settled within 5 % whose tooth map is still a few percent off at low speed,
+/// docs/control.md "The wheels learned in commissioning") flip between running and changing speed at every tick.
+pub const LEAVE_RUNNING_BANDS: f32 = 2.0;
+
+/// The closed loop's state after a tick that is not stopping: [`State::Running`] once both
+/// ramps have ended at their targets and both measured speeds are within the reached band of
+/// them, and while they stay within [`LEAVE_RUNNING_BANDS`] bands; [`State::ChangingSpeed`]
+/// otherwise (a new target restarts the ramp, so a change of speed always shows).
+pub fn closed_loop_state(
+    was: State,
+    ramped_rad_s: [f32; 2],
+    target_rad_s: [f32; 2],
+    measured_rad_s: [f32; 2],
+) -> State {
+    let bands = if was == State::Running {
+        LEAVE_RUNNING_BANDS
+    } else {
+        1.0
+    };
+    let reached = (0..2).all(|i| {
+        let band = bands * (REACHED_SHARE * ramped_rad_s[i].abs() + REACHED_FLOOR_RAD_S);
+        ramped_rad_s[i] == target_rad_s[i] && (measured_rad_s[i] - ramped_rad_s[i]).abs() <= band
+    });
+    if reached {
+        State::Running
+    } else {
+        State::ChangingSpeed
+    }
+}
+
 /// A latched fault. [`Fault::code`] is the number telemetry carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
