@@ -1,5 +1,6 @@
 //! `bowl`: the PC side of the bowl granulation rig.
 
+use std::ffi::OsString;
 use std::process::ExitCode;
 
 use anyhow::Result;
@@ -58,7 +59,7 @@ enum Command {
 fn main() -> ExitCode {
     restore_default_sigpipe();
     let cli = match negative_numbers(Cli::command())
-        .try_get_matches()
+        .try_get_matches_from(negative_values_joined(std::env::args_os()))
         .and_then(|m| Cli::from_arg_matches(&m))
     {
         Ok(cli) => cli,
@@ -101,6 +102,51 @@ fn negative_numbers(command: clap::Command) -> clap::Command {
     names
         .iter()
         .fold(command, |c, name| c.mut_subcommand(name, negative_numbers))
+}
+
+/// A negative value clap would read as short flags, joined to its flag: clap takes `-3`, `-0.5`
+/// and `-2.5e3` after a flag as values, but not `-2.5e-3`, `-.5` or `-inf` (its negative numbers
+/// have no sign in the exponent and a digit first): `--spin-rad-s -1e-3` said "unexpected
+/// argument '-1' found". Such a value after a `--flag` becomes `--flag=VALUE`, and the flag's own
+/// parser judges it in words. Values clap already takes are left as they are.
+fn negative_values_joined(args: impl IntoIterator<Item = OsString>) -> Vec<OsString> {
+    let mut out: Vec<OsString> = Vec::new();
+    for arg in args {
+        let flag = out
+            .last()
+            .and_then(|p| p.to_str())
+            .filter(|p| p.len() > 2 && p.starts_with("--") && !p.contains('='));
+        if let (Some(flag), Some(value)) = (flag, arg.to_str())
+            && value.starts_with('-')
+            && !value.starts_with("--")
+            && value.split(',').all(|v| v.trim().parse::<f64>().is_ok())
+            && !value.split(',').all(clap_takes_as_number)
+        {
+            let joined = format!("{flag}={value}");
+            *out.last_mut().expect("a flag was seen") = joined.into();
+        } else {
+            out.push(arg);
+        }
+    }
+    out
+}
+
+/// Whether clap reads `text` as a number, not as flags: a `-`, then digits with at most one `.`
+/// (not first) and at most one `e` followed by digits only (clap_lex's `is_number`).
+fn clap_takes_as_number(text: &str) -> bool {
+    let Some(rest) = text.strip_prefix('-') else {
+        return true;
+    };
+    let (mantissa, exponent) = match rest.split_once(['e', 'E']) {
+        Some((m, e)) => (m, Some(e)),
+        None => (rest, None),
+    };
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    let mantissa_ok = match mantissa.split_once('.') {
+        Some((whole, frac)) => digits(whole) && (frac.is_empty() || digits(frac)),
+        None => digits(mantissa),
+    };
+    mantissa_ok && exponent.is_none_or(digits)
 }
 
 /// `bowl ... | head`: when the reader goes away, end quietly the way Unix tools do (the default

@@ -140,3 +140,33 @@ fn a_list_of_negative_azimuths_is_a_value() {
         .collect();
     assert_eq!(az, [Some(-30.0), Some(-60.0)], "{v}");
 }
+
+/// A negative value with a signed exponent, a leading dot or no finite value is a value too:
+/// `--spin-rad-s -1e-3` was refused as "unexpected argument '-1' found" (clap reads only
+/// unsigned exponents as numbers), where `--spin-rad-s=-1e-3` was taken.
+#[test]
+fn a_negative_value_in_any_spelling_is_a_value() {
+    fn scene<'a>(spin: &'a str, az: &'a str) -> Vec<&'a str> {
+        predict_args(
+            &tilted_rig("bowl", "1.2"),
+            &["--spin-rad-s", spin, "--release-azimuth-deg", az],
+        )
+    }
+    let (code, out, err) = run(&scene("-2.7e-0", "0"));
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains("w2 -2.7 rad/s"), "{out}");
+    let (code, exp, err) = run(&scene("-27e-1", "-.5e+1,-1e1"));
+    assert_eq!(code, Some(0), "{err}");
+    let (code, plain, err) = run(&scene("-2.7", "-5,-10"));
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(exp, plain, "one answer for both spellings");
+    let (code, _, err) = run(&["predict", "--omega-rad-s", "-1e-3"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        !err.contains("unexpected argument") && err.contains("0 or more"),
+        "{err}"
+    );
+    let (code, _, err) = run(&scene("-inf", "0"));
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("-inf is out of range"), "{err}");
+}
