@@ -104,6 +104,45 @@ fn rk4_keeps_its_order_from_a_release_at_rest() {
     assert_rk4_at_its_order(0, 2e-3, 1e-11);
 }
 
+/// The lift-off scene at the chart's finest steps, h = 31, 16 and 8 us, run as `bowl predict`
+/// runs it (the stall watch on): no release is given up, every release counts the reference's
+/// changes, and the error in the mean T falls 8x per halving or is below 1e-12 s (the
+/// reference's own). Before, a slide ended as settled after 8 accepted steps with its slip at
+/// rest, and RK4's steps graded towards the stick on the fillet were so short that 8 of them
+/// came before it: the error went 9.7e-13, 4.8e-11, 1.3e-10 s; and at 16 and 8 us the stall
+/// watch took the graded steps from the release at rest (below 1e-9 of the scene's time scale
+/// for more than 16 steps) for a stall and gave up on five releases (120 to 240 deg).
+#[test]
+fn rk4_at_its_finest_steps_ends_no_slide_early_and_gives_up_on_nothing() {
+    let (sc, shape) = scenes()[1];
+    let mut sums = [0.0; 4];
+    for beta in AZIMUTHS_DEG {
+        let (t, changes) = run(1, beta, RollingMethod::Dp54 { rtol: 1e-13 });
+        sums[0] += t;
+        for k in 0..3 {
+            let step_s = 3.125e-5 / f64::from(1u32 << k);
+            let m = RollingMethod::Rk4 { step_s };
+            let r = residence_or_stall(&sc, &shape, beta.to_radians(), m, limits())
+                .unwrap_or_else(|e| panic!("given up at {beta} deg, h = {step_s} s: {e:?}"));
+            let BowlOutcome::Leaves {
+                residence_time_s, ..
+            } = r.outcome
+            else {
+                panic!("{beta} deg, h = {step_s} s: {:?}", r.outcome);
+            };
+            sums[k + 1] += residence_time_s;
+            assert_eq!(r.switches, changes, "changes at {beta} deg, h = {step_s} s");
+        }
+    }
+    let errors: [f64; 3] = core::array::from_fn(|k| (sums[k + 1] - sums[0]).abs() / 12.0);
+    for k in 0..2 {
+        assert!(
+            errors[k + 1] <= (errors[k] / 8.0).max(1e-12),
+            "errors {errors:?} s at 31, 16, 8 us"
+        );
+    }
+}
+
 /// A segment's meridian follows its own piece past its ends: on the fillet's piece the arc
 /// goes on beyond the fillet's end (the same curvature, so a step that crosses the end sees no
 /// jump), while the whole meridian turns into the cone there; at the end itself both agree.

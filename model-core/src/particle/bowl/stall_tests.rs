@@ -18,7 +18,8 @@ fn the_stall_watch_breaks_on_steps_that_do_not_advance_the_time() {
     use crate::particle::rolling::modes::{STALL_STEP, StallWatch};
     let (length, speed) = (0.075, 0.27);
     let tiny = 0.5 * STALL_STEP * length / speed;
-    let watch = StallWatch::new(Some(STALL_STEPS), (length, speed), 1.0);
+    let dp54 = RollingMethod::Dp54 { rtol: 1e-9 };
+    let watch = StallWatch::new(Some(STALL_STEPS), (length, speed), 1.0, dp54);
     let mut t = 1.0;
     for _ in 0..3 {
         for _ in 1..STALL_STEPS {
@@ -35,7 +36,7 @@ fn the_stall_watch_breaks_on_steps_that_do_not_advance_the_time() {
     }
     assert!(watch.step(t + tiny).is_break());
     assert!(
-        StallWatch::new(None, (length, speed), 1.0)
+        StallWatch::new(None, (length, speed), 1.0, dp54)
             .step(1.0)
             .is_continue()
     );

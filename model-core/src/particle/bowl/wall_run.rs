@@ -187,7 +187,7 @@ pub fn stay<T: Real>(
     // progress, which the bottom's scale (R over the scene's speed, 0.07 s) called a stall
     // (docs/model.md §10).
     let length = scales.0.min(m.arc_radius_m).min(m.pivot_m);
-    let watch = StallWatch::new(stall_steps, (length, scales.1), t0);
+    let watch = StallWatch::new(stall_steps, (length, scales.1), t0, method);
     let mut chatter = Chatter::new();
     loop {
         let remaining = out.tally.remaining(limits, max_switches)?;
@@ -221,7 +221,7 @@ pub fn stay<T: Real>(
                 Contact::Slide(d)
             }
         };
-        let settle = Settle::new();
+        let settle = Settle::new(sc.k2);
         let Some((te, ye, settled)) = segment(
             &mut out.tally,
             mode,
@@ -250,9 +250,10 @@ pub fn stay<T: Real>(
                 }
                 let s = wall_forces(sc, mp, t, y, now(dir.get())).slip_m_s;
                 follow_slip(&s, &dir, &armed, stuck_m_s(refs.1));
-                settle.step(&s, || {
+                settle.step(t, &s, || {
                     let f = wall_forces(sc, mp, t, &no_slip(sc, mp, t, y), Contact::Roll);
-                    norm(&f.needed_m_s2) <= sc.sliding_friction * f.normal_m_s2
+                    let limit = sc.sliding_friction * f.normal_m_s2;
+                    (norm(&f.needed_m_s2) <= limit).then_some(limit)
                 })
             },
             // A slide's slip held to its own tolerance, as on the bottom.

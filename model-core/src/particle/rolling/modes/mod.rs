@@ -210,7 +210,7 @@ pub(crate) fn run_from<T: Real>(
     let mut must_slide = false;
     // One watch over the whole run: a stall can be one segment's steps or a run of segments
     // that each end where they start.
-    let watch = StallWatch::new(stall_steps, scales, t0);
+    let watch = StallWatch::new(stall_steps, scales, t0, method);
     let mut chatter = Chatter::new();
     loop {
         let remaining = report.tally.remaining(limits, MAX_SWITCHES)?;
@@ -251,7 +251,7 @@ pub(crate) fn run_from<T: Real>(
                 let armed = Cell::new(
                     slip0[0] * slip0[0] + slip0[1] * slip0[1] > T::from_f64(4.0) * stuck * stuck,
                 );
-                let settle = Settle::new();
+                let settle = Settle::new(scene.k2);
                 let Some((te, ye, settled)) = segment(
                     &mut report.tally,
                     Mode::Slide,
@@ -273,12 +273,11 @@ pub(crate) fn run_from<T: Real>(
                         let s = slip_m_s(y);
                         follow_slip(&s, &dir, &armed, stuck);
                         watch.check(t)?;
-                        settle.step(&s, || {
+                        settle.step(t, &s, || {
                             let (ft, normal) =
                                 needed_friction_m_s2(scene, t, &from_rolling(&to_rolling(y)));
-                            ft[0] * ft[0] + ft[1] * ft[1]
-                                <= (scene.sliding_friction * normal)
-                                    * (scene.sliding_friction * normal)
+                            let limit = scene.sliding_friction * normal;
+                            (ft[0] * ft[0] + ft[1] * ft[1] <= limit * limit).then_some(limit)
                         })
                     },
                     Some(SlipOf::Linear(slip_m_s::<T>)),

@@ -51,9 +51,20 @@ pub(crate) enum Stop {
     Settled,
 }
 
-/// How many accepted steps in a row, each ending with the slip at rest ([`SETTLED_M_S`]) where
-/// rolling needs no more than `mu_s N`, end a slide as settled ([`Settle`]).
-pub(crate) const SETTLE_STEPS: u32 = 8;
+/// How long a slide's slip must stay at rest ([`SETTLED_M_S`]) where rolling needs no more
+/// than `mu_s N` to end the slide as settled ([`Settle`]): this many times the time the whole
+/// friction takes to sweep the slip across that band, `SETTLED_M_S (1 - k2) / (mu_s N)` (the
+/// slip answers a friction `f` at `f / (m (1 - k2))`). A slip falling straight to its zero
+/// crosses the band in at most `K / (K - |A|)` such times (`K` the friction's deceleration of
+/// it, `A` its acceleration without friction), so it reaches its zero, the slip-end event,
+/// before it counts as settled unless `|A|` is within 1/8 of `K`; a slip that hovers in the
+/// band stays there. Counted in accepted steps instead (8 of them), the rule depended on the
+/// step: RK4's steps graded towards a stick (`graded_step`) are so short there that at
+/// h = 16 and 8 us eight of them fell within the band before the stick, and the slide ended
+/// early by a step-dependent amount (its relative error in the mean T on the lift-off scene of
+/// the bowl's work-precision chart rose from 6.5e-12 at 31 us to 3.3e-10 and 8.8e-10, docs/model.md
+/// §10).
+pub(crate) const SETTLE_SWEEPS: f64 = 8.0;
 
 /// The slip at and below which a slide's slip is at rest for [`Settle`], m/s: twice
 /// [`AT_REST_M_S`], where the friction's direction stops following the slip.
@@ -67,20 +78,26 @@ pub(crate) const SETTLED_M_S: f64 = 2.0 * AT_REST_M_S;
 /// out of it at every step, the steps shrinking to 1e-11 s at the switch of the right-hand
 /// side, until the step cap (a 77 deg sharp corner at 19 deg tilt, 1.6 and -0.73 rad/s,
 /// mu_s 0.10: 690 000 steps in 0.03 s, docs/model.md §10). A slip at rest that the friction
-/// can hold is no slip: after [`SETTLE_STEPS`] such steps in a row the slide ends there and
-/// the granule rolls. A slide whose slip passes through zero ends at its reversal within a
-/// step, and a slide from no slip that rolling's need keeps above `mu_s N` grows its slip:
-/// neither changes.
-pub(crate) struct Settle {
+/// can hold is no slip: once it has stayed at rest for [`SETTLE_SWEEPS`] of the friction's
+/// sweeps of the band (a time, not a count of steps: the answer must not depend on the step)
+/// the slide ends there and the granule rolls. A slide whose slip passes through zero ends at
+/// its reversal within a step, and a slide from no slip that rolling's need keeps above
+/// `mu_s N` grows its slip: neither changes.
+pub(crate) struct Settle<T> {
     above: Cell<bool>,
-    run: Cell<u32>,
+    /// The end of the first accepted step of the current stay at rest.
+    since: Cell<Option<T>>,
+    /// `1 - k2`: the slip answers a friction `f` at `f / (m (1 - k2))`.
+    one_minus_k2: T,
 }
 
-impl Settle {
-    pub(crate) fn new() -> Self {
+impl<T: Real> Settle<T> {
+    /// A watch for a granule of `k2` (`m rp^2 / (I + m rp^2)`).
+    pub(crate) fn new(k2: T) -> Self {
         Self {
             above: Cell::new(false),
-            run: Cell::new(0),
+            since: Cell::new(None),
+            one_minus_k2: T::ONE - k2,
         }
     }
 
@@ -89,26 +106,30 @@ impl Settle {
         self.above.get()
     }
 
-    /// After an accepted step of a slide whose slip is `s` (`holds`: whether the friction can
-    /// hold rolling there, asked only while the slip is at rest): break once it has settled.
-    pub(crate) fn step<T: Real, const N: usize>(
+    /// After an accepted step to `t` of a slide whose slip is `s`; `holds`, asked only while
+    /// the slip is at rest: `mu_s N` (m/s^2) where the friction can hold rolling there, `None`
+    /// where rolling needs more. Breaks once the slip has settled.
+    pub(crate) fn step<const N: usize>(
         &self,
+        t: T,
         s: &[T; N],
-        holds: impl FnOnce() -> bool,
+        holds: impl FnOnce() -> Option<T>,
     ) -> ControlFlow<Stop> {
         let speed = dot(s, s).sqrt();
         if speed > T::from_f64(SETTLED_M_S) {
             self.above.set(true);
-            self.run.set(0);
+            self.since.set(None);
             return ControlFlow::Continue(());
         }
-        if !holds() {
-            self.run.set(0);
+        let Some(friction) = holds() else {
+            self.since.set(None);
             return ControlFlow::Continue(());
-        }
-        let run = self.run.get() + 1;
-        self.run.set(run);
-        if run >= SETTLE_STEPS {
+        };
+        let since = self.since.get().unwrap_or(t);
+        self.since.set(Some(since));
+        // The friction's deceleration of the slip; with none (`mu_s N` = 0) nothing settles.
+        let sweep = T::from_f64(SETTLED_M_S) * self.one_minus_k2 / friction;
+        if friction > T::ZERO && t - since >= T::from_f64(SETTLE_SWEEPS) * sweep {
             ControlFlow::Break(Stop::Settled)
         } else {
             ControlFlow::Continue(())
@@ -278,7 +299,7 @@ fn slip_speed_rate<T: Real, const N: usize>(
 /// within `span` of the zero (`tau` = the slip over its rate of change, the time from or to
 /// the zero), the graded mesh of weakly singular problems: each step's error then stays within
 /// RK4's `h^4` for any exponent `p >= 0`, for about `4 span / h` steps more per zero. Never
-/// below `sqrt(eps) h`.
+/// below [`graded_floor`].
 pub(crate) fn graded_step<T: Real, const N: usize>(
     slip: SlipOf<'_, T, N>,
     h: T,
@@ -296,5 +317,10 @@ pub(crate) fn graded_step<T: Real, const N: usize>(
     if tau.is_nan() || tau >= span {
         return h;
     }
-    (h * ((tau / span).ln() * T::from_f64(0.75)).exp()).max(h * T::EPSILON.sqrt())
+    (h * ((tau / span).ln() * T::from_f64(0.75)).exp()).max(graded_floor(h))
+}
+
+/// The shortest step RK4 grades down to at `h` ([`graded_step`]): `sqrt(eps) h`.
+pub(crate) fn graded_floor<T: Real>(h: T) -> T {
+    h * T::EPSILON.sqrt()
 }
