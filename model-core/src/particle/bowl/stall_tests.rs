@@ -4,6 +4,15 @@
 use super::tests::{FINE, shape};
 use super::*;
 
+/// The cost grids' bowl (75 mm, its default release radius) at `tilt` deg, both speeds `w`
+/// rad/s, and `mu_s`.
+fn rig(tilt: f64, w: f64, mu_s: f64) -> RollingScene<f64> {
+    RollingScene {
+        sliding_friction: mu_s,
+        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
+    }
+}
+
 /// The stall watch (`residence_or_stall`, docs/model.md §12) breaks after
 /// [`STALL_STEPS`] accepted steps in a row that each advance the time by less than
 /// [`crate::particle::rolling::modes::STALL_STEP`] of the scene's time scale, and a real step
@@ -39,10 +48,6 @@ fn the_stall_watch_breaks_on_steps_that_do_not_advance_the_time() {
             .step(1.0)
             .is_continue()
     );
-    let rig = |tilt: f64, w: f64, mu_s: f64| RollingScene {
-        sliding_friction: mu_s,
-        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
-    };
     let wall = shape(60.0, 0.02, 0.0);
     let capped = |max_steps| SystemLimits {
         horizon_s: 10.0,
@@ -165,10 +170,6 @@ fn a_loose_tolerance_is_not_dearer_on_the_wall() {
 /// held by the wall as at rtol 1e-10.
 #[test]
 fn a_granule_at_the_seam_or_a_fresh_slide_does_not_stall() {
-    let rig = |tilt: f64, w: f64, mu_s: f64| RollingScene {
-        sliding_friction: mu_s,
-        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
-    };
     let lim = SystemLimits {
         horizon_s: 10.0,
         max_steps: 50_000,
@@ -198,17 +199,13 @@ fn a_granule_at_the_seam_or_a_fresh_slide_does_not_stall() {
 /// by the wall at both tolerances, as at 1e-10, and the looser run is the cheaper.
 #[test]
 fn a_small_growing_slip_is_cheaper_at_a_looser_tolerance_with_the_wall() {
-    let rig = |tilt: f64, w: f64| RollingScene {
-        sliding_friction: 0.2,
-        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
-    };
     let wall = shape(60.0, 0.02, 0.0);
     let lim = SystemLimits {
         horizon_s: 10.0,
         max_steps: 200_000,
     };
     // The bound on each: now 0.79 and 0.42 of the tighter run's evaluations.
-    for (s, bound) in [(rig(30.0, 1.8), 0.9), (rig(45.0, 3.6), 0.6)] {
+    for (s, bound) in [(rig(30.0, 1.8, 0.2), 0.9), (rig(45.0, 3.6, 0.2), 0.6)] {
         let b = f64::to_radians(30.0);
         let evaluations = |rtol: f64| {
             let r = residence(&s, &wall, b, RollingMethod::Dp54 { rtol }, lim);
