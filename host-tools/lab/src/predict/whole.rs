@@ -200,15 +200,13 @@ pub(crate) fn run_level(
             // The last rung: 1e-10, or the asked tolerance where that is tighter.
             let tight = start.min(1e-10);
             let mu_s = scene.sliding_friction;
+            // A sliding granule the rotation may bring to stick starts at 1e-6 as well: its
+            // slides no longer creep at 1e-6 (`slide::friction_direction`; docs/model.md §12,
+            // "A slip below the tolerance").
             let mut rung = if friction_needed_at_release(scene) <= mu_s
                 && friction_needed_at_rim(scene) > mu_s
             {
                 tight
-            } else if incline_mode(scene) == InclineMode::Slides && may_stick(scene) {
-                // A sliding granule the rotation may bring to stick: near its stick 1e-6
-                // takes more steps than 1e-7 (docs/model.md §12, the cost grids after the
-                // twentieth session).
-                start.min(1e-7)
             } else {
                 start
             };

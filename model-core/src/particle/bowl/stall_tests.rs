@@ -4,6 +4,15 @@
 use super::tests::{FINE, shape};
 use super::*;
 
+/// The cost grids' bowl (75 mm, its default release radius) at `tilt` deg, both speeds `w`
+/// rad/s, and `mu_s`.
+fn rig(tilt: f64, w: f64, mu_s: f64) -> RollingScene<f64> {
+    RollingScene {
+        sliding_friction: mu_s,
+        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
+    }
+}
+
 /// The stall watch (`residence_or_stall`, docs/model.md §12) breaks after
 /// [`STALL_STEPS`] accepted steps in a row that each advance the time by less than
 /// [`crate::particle::rolling::modes::STALL_STEP`] of the scene's time scale, and a real step
@@ -40,10 +49,6 @@ fn the_stall_watch_breaks_on_steps_that_do_not_advance_the_time() {
             .step(1.0)
             .is_continue()
     );
-    let rig = |tilt: f64, w: f64, mu_s: f64| RollingScene {
-        sliding_friction: mu_s,
-        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
-    };
     let wall = shape(60.0, 0.02, 0.0);
     let capped = |max_steps| SystemLimits {
         horizon_s: 10.0,
@@ -166,10 +171,6 @@ fn a_loose_tolerance_is_not_dearer_on_the_wall() {
 /// held by the wall as at rtol 1e-10.
 #[test]
 fn a_granule_at_the_seam_or_a_fresh_slide_does_not_stall() {
-    let rig = |tilt: f64, w: f64, mu_s: f64| RollingScene {
-        sliding_friction: mu_s,
-        ..RollingScene::with_speeds(w, w, tilt.to_radians(), 0.075)
-    };
     let lim = SystemLimits {
         horizon_s: 10.0,
         max_steps: 50_000,
@@ -187,5 +188,39 @@ fn a_granule_at_the_seam_or_a_fresh_slide_does_not_stall() {
                 "{deg} deg at {rtol:e}: {r:?}"
             );
         }
+    }
+}
+
+/// A slide whose slip grows from below the run's absolute tolerance (`rolling::slide::
+/// friction_direction`), on the bottom and on the wall: a granule the 60 deg wall holds (30 deg,
+/// 1.8 rad/s, mu_s 0.2, release at 30 deg) took 242 439 evaluations at rtol 1e-6 against
+/// 11 167 at 1e-7, its slides on the bottom creeping at DP5(4)'s stability limit while the
+/// friction followed a slip of 1e-7 m/s; one at 45 deg, 3.6 rad/s (release at 30 deg) 153 866
+/// against 191 430, its slides on the wall doing the same (docs/model.md §12). Each is held
+/// by the wall at both tolerances, as at 1e-10, and the looser run is the cheaper.
+#[test]
+fn a_small_growing_slip_is_cheaper_at_a_looser_tolerance_with_the_wall() {
+    let wall = shape(60.0, 0.02, 0.0);
+    let lim = SystemLimits {
+        horizon_s: 10.0,
+        max_steps: 200_000,
+    };
+    // The bound on each: now 0.79 and 0.42 of the tighter run's evaluations.
+    for (s, bound) in [(rig(30.0, 1.8, 0.2), 0.9), (rig(45.0, 3.6, 0.2), 0.6)] {
+        let b = f64::to_radians(30.0);
+        let evaluations = |rtol: f64| {
+            let r = residence(&s, &wall, b, RollingMethod::Dp54 { rtol }, lim);
+            match r {
+                Ok(r) if matches!(r.outcome, BowlOutcome::Inside { .. }) => r.evaluations,
+                other => panic!("{s:?} at {rtol:e}: {other:?}"),
+            }
+        };
+        evaluations(1e-10);
+        let (loose, tight) = (evaluations(1e-6), evaluations(1e-7));
+        assert!(
+            f64::from(loose) < bound * f64::from(tight),
+            "{:.0} deg: {loose} evaluations at 1e-6, {tight} at 1e-7",
+            s.axes_angle_rad.to_degrees()
+        );
     }
 }

@@ -33,7 +33,7 @@
 
 use super::super::rolling::RollingScene;
 use super::super::rolling::equations::{AT_REST_M_S, cross, frame};
-use super::super::rolling::slide::at_rest_direction;
+use super::super::rolling::slide::friction_direction;
 use crate::Real;
 
 /// The wall state `[s, ex, ey, sdot, phidot, sx, sy, sz]`.
@@ -228,6 +228,20 @@ pub fn wall_forces<T: Real>(
     y: &WallState<T>,
     contact: Contact<T>,
 ) -> WallForces<T> {
+    wall_forces_slaved(sc, m, t, y, contact, T::ZERO)
+}
+
+/// [`wall_forces`] whose slide's friction, while the slip is at most `slaved_m_s` and grows,
+/// opposes the slip's free acceleration (`rolling::slide::friction_direction`, as on the
+/// bottom).
+pub(crate) fn wall_forces_slaved<T: Real>(
+    sc: &RollingScene<T>,
+    m: &Meridian<T>,
+    t: T,
+    y: &WallState<T>,
+    contact: Contact<T>,
+    slaved_m_s: T,
+) -> WallForces<T> {
     let [s, ex0, ey0, sd, pd, sx, sy, sz] = *y;
     // The azimuth's unit vector, renormalised against the integrator's drift.
     let en = (ex0 * ex0 + ey0 * ey0).sqrt().max(T::EPSILON);
@@ -302,20 +316,10 @@ pub fn wall_forces<T: Real>(
             }
         }
         Contact::Slide(d) => {
-            let sl = dot(&slip, &slip).sqrt();
             let k = sc.sliding_friction * n_pos;
-            let dir = if sl > T::from_f64(AT_REST_M_S) {
-                if dot(&slip, &d) > T::ZERO {
-                    [slip[0] / sl, slip[1] / sl, slip[2] / sl]
-                } else {
-                    d
-                }
-            } else {
-                // At rest: along the free slip's acceleration `-needed / (1 - k2)` where the
-                // friction cannot hold it (as on the bottom).
-                let free: [T; 3] = core::array::from_fn(|i| -needed[i] / one_m);
-                at_rest_direction(k2, free, k, d)
-            };
+            // The free slip's acceleration is `-needed / (1 - k2)` (as on the bottom).
+            let free: [T; 3] = core::array::from_fn(|i| -needed[i] / one_m);
+            let dir = friction_direction(k2, slip, free, k, d, slaved_m_s);
             ([-k * dir[0], -k * dir[1], -k * dir[2]], [T::ZERO; 3])
         }
     };

@@ -8,7 +8,7 @@
 
 use core::cell::Cell;
 
-use super::wall::{Contact, Meridian, Piece, WallState, slip_of, wall_forces};
+use super::wall::{Contact, Meridian, Piece, WallState, slip_of, wall_forces, wall_forces_slaved};
 use crate::Real;
 use crate::ode::system::{SystemError, SystemLimits};
 use crate::particle::rolling::equations::AT_REST_M_S;
@@ -172,6 +172,12 @@ pub fn stay<T: Real>(
     stall_steps: Option<u32>,
 ) -> Result<WallStay<T>, RollingError> {
     let (refs, scales) = scene_scales(sc);
+    // A growing slip below the velocities' absolute tolerance: its friction opposes its free
+    // acceleration (`rolling::slide::friction_direction`, as on the bottom).
+    let slaved = match method {
+        RollingMethod::Dp54 { rtol } => rtol * scales.1,
+        RollingMethod::Rk4 { .. } => T::ZERO,
+    };
     let mut out = WallStay {
         end: WallEnd::Horizon,
         tally: Tally::new(),
@@ -225,7 +231,9 @@ pub fn stay<T: Real>(
         let Some((te, ye, settled)) = segment(
             &mut out.tally,
             mode,
-            |t, y: &WallState<T>| wall_forces(sc, mp, t, y, now(dir.get())).derivative,
+            |t, y: &WallState<T>| {
+                wall_forces_slaved(sc, mp, t, y, now(dir.get()), slaved).derivative
+            },
             (t, y),
             method,
             scales,

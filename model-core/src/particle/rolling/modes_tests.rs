@@ -346,3 +346,98 @@ fn a_loose_tolerance_is_not_dearer_on_a_slide_from_rest() {
     }
     assert!(last_steps < 400, "{last_steps} steps at 1e-6");
 }
+
+/// A roll that gives way at the stick threshold (30 deg, 3.6 rad/s, mu_s 0.2 on a bare rim,
+/// the releases at 90 and 270 deg: rolling needs `mu_s N` at 0.238 s, and the slip then grows
+/// as the square of the time since): while the slip was small the friction followed its
+/// direction, a stiff relaxation at `mu_s N / |slip|` that held DP5(4) at its stability limit,
+/// steps of about the slip over `mu_s g`, for 2 400 to 3 900 steps at every rtol from 1e-6 to
+/// 1e-10, and more at 1e-6 (3 957 and 3 808) than at 1e-7 (2 734 and 2 396): the chooser's
+/// first rung cost 2.9 ms where 1e-7 cost 2.0 (docs/model.md §12). With the friction against
+/// the slip's free acceleration while the slip is below the run's absolute tolerance
+/// (`slide::friction_direction`), the looser run is the cheaper, and each is within its
+/// tolerance of the run at 1e-12.
+#[test]
+fn a_roll_giving_way_at_the_stick_threshold_is_cheaper_at_a_looser_tolerance() {
+    let s = RollingScene {
+        sliding_friction: 0.2,
+        ..RollingScene::with_speeds(3.6, 3.6, 30f64.to_radians(), 0.075)
+    };
+    let limits = SystemLimits {
+        horizon_s: 10.0,
+        max_steps: 200_000,
+    };
+    for deg in [90.0, 270.0] {
+        let beta = f64::to_radians(deg);
+        let reference = time(&residence_roll_or_slide(&s, beta, FINE).expect("reference"));
+        let run = |rtol: f64| {
+            let r = modes::roll_or_slide_within(&s, beta, RollingMethod::Dp54 { rtol }, limits)
+                .expect("leaves");
+            assert!(
+                (time(&r) - reference).abs() <= 100.0 * rtol * reference,
+                "{deg} deg at {rtol:e}: T {} against {reference}",
+                time(&r)
+            );
+            assert_eq!(
+                r.tally.switches, 1,
+                "{deg} deg at {rtol:e}: rolls, then slides"
+            );
+            r.tally.evaluations
+        };
+        let (loose, tight) = (run(1e-6), run(1e-7));
+        assert!(
+            f64::from(loose) < 0.75 * f64::from(tight),
+            "{deg} deg: {loose} evaluations at 1e-6, {tight} at 1e-7"
+        );
+    }
+}
+
+/// The friction's direction in a slide (`slide::friction_direction`): against the slip's free
+/// acceleration `A` while the slip is at most the slaved threshold, goes along `A` and the
+/// friction cannot hold it; against the slip itself once it is above, or where the friction
+/// can hold it (the slip then shrinks, and its end is found as before); the last direction
+/// where the slip has turned against it.
+#[test]
+fn a_small_growing_slip_takes_the_friction_against_its_free_acceleration() {
+    use super::slide::friction_direction;
+    let k2 = 5.0 / 7.0;
+    // `A` along x, 7 m/s^2: the friction can hold up to `mu_s N / (1 - k2)`.
+    let free = [7.0, 0.0];
+    let slip = [1e-6, 2e-7];
+    let unit = |v: [f64; 2]| {
+        let n = v[0].hypot(v[1]);
+        [v[0] / n, v[1] / n]
+    };
+    let close = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]) < 1e-15;
+    let last = unit(slip);
+    // Grows (`(1 - k2) |A|` = 2 > 1.9): within the threshold, against `A`.
+    assert_eq!(
+        friction_direction(k2, slip, free, 1.9, last, 1e-5),
+        [1.0, 0.0]
+    );
+    // Above the threshold, or with none: against the slip.
+    assert!(close(
+        friction_direction(k2, slip, free, 1.9, last, 1e-7),
+        unit(slip)
+    ));
+    assert!(close(
+        friction_direction(k2, slip, free, 1.9, last, 0.0),
+        unit(slip)
+    ));
+    // The friction can hold it: against the slip, within the threshold too.
+    assert!(close(
+        friction_direction(k2, slip, free, 2.1, last, 1e-5),
+        unit(slip)
+    ));
+    // A slip against `A` is not slaved to it.
+    let back = [-1e-6, 2e-7];
+    assert!(close(
+        friction_direction(k2, back, free, 1.9, unit(back), 1e-5),
+        unit(back)
+    ));
+    // Turned against the last direction: the last.
+    assert_eq!(
+        friction_direction(k2, slip, free, 1.9, [-1.0, 0.0], 0.0),
+        [-1.0, 0.0]
+    );
+}

@@ -34,7 +34,8 @@ pub(crate) use stall::StallWatch;
 
 use super::equations::{AT_REST_M_S, forces};
 use super::slide::{
-    SlideState, from_rolling, needed_friction_m_s2, slide_forces, slip_m_s, to_rolling,
+    SlideState, from_rolling, needed_friction_m_s2, slide_forces, slide_forces_slaved, slip_m_s,
+    to_rolling,
 };
 use super::{RollingError, RollingMethod, RollingScene, SystemLimits, default_limits, release};
 use crate::Real;
@@ -198,6 +199,12 @@ pub(crate) fn run_from<T: Real>(
 ) -> Result<ModesReport<T>, RollingError> {
     let (refs, scales) = scene_scales(scene);
     let reference = refs.0;
+    // A growing slip below the velocities' absolute tolerance: the friction opposes its free
+    // acceleration (`slide::friction_direction`; RK4 has no tolerance, and keeps the slip's).
+    let slaved = match method {
+        RollingMethod::Dp54 { rtol } => rtol * scales.1,
+        RollingMethod::Rk4 { .. } => T::ZERO,
+    };
     let mut report = ModesReport {
         outcome: ModesOutcome::Inside {
             horizon_s: limits.horizon_s,
@@ -255,7 +262,9 @@ pub(crate) fn run_from<T: Real>(
                 let Some((te, ye, settled)) = segment(
                     &mut report.tally,
                     Mode::Slide,
-                    |t, y: &SlideState<T>| slide_forces(scene, t, y, dir.get()).derivative,
+                    |t, y: &SlideState<T>| {
+                        slide_forces_slaved(scene, t, y, dir.get(), slaved).derivative
+                    },
                     (t, ys),
                     method,
                     scales,
