@@ -261,3 +261,22 @@ fn a_sliding_scene_takes_the_incline_corrected_by_its_second_order() {
     );
     within(&v, r, 0.01);
 }
+
+/// A tight tolerance is written with its digits: `--tolerance 1e-9` read "chooser (tolerance
+/// 0.00 %)" and "more than the tolerance 0.00 %" in the text and in the JSON's reasons.
+#[test]
+fn a_tight_tolerance_is_said_with_its_digits() {
+    let a = args("60", "2.0", "0.4", &["--tolerance", "1e-9"]);
+    let text: Vec<&str> = a.iter().copied().filter(|s| *s != "--json").collect();
+    let out = common::bowl(&text);
+    assert_eq!(out.status.code(), Some(0));
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert!(s.contains("chooser (tolerance 1.0e-7 %)"), "{s}");
+    assert!(s.contains("more than the tolerance 1.0e-7 %"), "{s}");
+    assert!(!s.contains("0.00 %"), "{s}");
+    let v = json(&a);
+    assert!(
+        reasons(&v).contains("more than the tolerance 1.0e-7 %"),
+        "{v}"
+    );
+}

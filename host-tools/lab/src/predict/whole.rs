@@ -60,9 +60,9 @@ pub fn fails_words(f: &Fails<f64>, tolerance: f64) -> String {
              contact gives mu_s = {mu_s}"
         ),
         Fails::Rotation { estimate } => format!(
-            "the bowl's rotation changes T by up to {:.2} %, more than the tolerance {:.2} %",
+            "the bowl's rotation changes T by up to {:.2} %, more than the tolerance {}",
             100.0 * estimate,
-            100.0 * tolerance
+            super::choice::percent(tolerance)
         ),
         Fails::EachRelease => {
             "single releases are wanted, and the incline does not follow a release's turning path"
@@ -443,9 +443,9 @@ fn report(
         println!("{line}");
     }
     println!(
-        "chooser (tolerance {:.2} %): the {} model, the least of incline < rolling < \
+        "chooser (tolerance {}): the {} model, the least of incline < rolling < \
          rolling-or-sliding < bowl that meets it at this scene (tilt {th_deg} deg, |Omega| {:.3} rad/s)",
-        100.0 * tolerance,
+        super::choice::percent(tolerance),
         a.level.name(),
         scene.combined_speed_rad_s()
     );
