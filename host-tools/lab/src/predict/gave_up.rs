@@ -66,10 +66,16 @@ pub fn sentence(failed: &[(f64, BowlError)], releases: usize, settings: &Setting
         }
     }
     let at: Vec<String> = failed.iter().map(|(d, _)| format!("{d}")).collect();
+    // With every release given up there are no others to give times over.
+    let rest = if failed.len() < releases {
+        "so they have no residence time and the times given are over the others"
+    } else {
+        "so no release has a residence time"
+    };
     format!(
-        "the integration gave up on {} of {releases} releases (at {} deg: {}), so they have no \
-         residence time and the times given are over the others; {}",
+        "the integration gave up on {} of {} (at {} deg: {}), {rest}; {}",
         failed.len(),
+        crate::number::count(releases, "release", "releases"),
         at.join(", "),
         kinds.join("; "),
         advice(failed, settings)
@@ -187,6 +193,22 @@ mod tests {
         }
         let s = sentence(&[(150.0, STALL)], 12, &bowl(1e-12));
         assert!(s.contains("no setting gets those releases through"), "{s}");
+    }
+
+    /// Every release given up: no "times given over the others" (there are none), and one
+    /// release is not "1 of 1 releases".
+    #[test]
+    fn every_release_given_up_says_none_has_a_time() {
+        let s = sentence(&[(0.0, STALL)], 1, &Settings::Chooser { max_time_s: 3.0 });
+        assert!(
+            s.contains("gave up on 1 of 1 release (at 0 deg: the steps stopped advancing"),
+            "{s}"
+        );
+        assert!(s.contains("so no release has a residence time;"), "{s}");
+        assert!(!s.contains("over the others"), "{s}");
+        let s = sentence(&[(0.0, STALL)], 12, &Settings::Chooser { max_time_s: 3.0 });
+        assert!(s.contains("1 of 12 releases (at 0 deg"), "{s}");
+        assert!(s.contains("over the others"), "{s}");
     }
 
     /// RK4 at the step cap is told a larger step or a shorter horizon, never a smaller step
