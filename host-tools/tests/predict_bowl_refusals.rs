@@ -27,7 +27,11 @@ fn bad_bowl_input_is_said_in_words() {
         (
             ["90", "0.08", "0.07"],
             vec![],
-            "already touches the corner between bottom and wall",
+            // The values and the limit: the words named the flags alone.
+            "--ri-m 0.0375 m: the granule released there already touches the corner between \
+             bottom and wall (--fillet-radius-m 0.07 m, widened by the granule's radius \
+             --particle-radius-m 0.003 m, starts 0.00500 m from the axis); give --ri-m below \
+             0.00500 m, or a smaller fillet or granule",
         ),
         // A fillet above its wall, or with no wall: the granule climbed the arc past the lip
         // and the time was a taller bowl's, without a word.
@@ -46,7 +50,8 @@ fn bad_bowl_input_is_said_in_words() {
         (
             ["60", "0.08", "0"],
             vec!["--particle-radius-m", "0.07"],
-            "give a smaller --ri-m, --fillet-radius-m or --particle-radius-m",
+            "--particle-radius-m 0.07 m, starts 0.03415 m from the axis); give --ri-m below \
+             0.03415 m",
         ),
         (
             ["60", "0.02", "0"],
