@@ -280,3 +280,55 @@ fn a_tight_tolerance_is_said_with_its_digits() {
         "{v}"
     );
 }
+
+/// A granule that lifts off hands the rolling level over to one that follows the flight: the
+/// chooser took the rolling model there ("rolling model NOT VALID HERE: the normal force
+/// reaches zero", "none of the 12 releases leaves") where the bowl model has every release
+/// fly out. Now the answer is valid and the bowl model's, within the tolerance.
+#[test]
+fn a_lift_off_is_followed_by_the_next_level() {
+    let scene = [
+        "--axes-angle-deg",
+        "60",
+        "--precession-rad-s",
+        "-4.537765650449775",
+        "--spin-rad-s",
+        "5",
+        "--rod-offset-m",
+        "0.4",
+        "--rim-radius-m",
+        "0.10511622245212189",
+        "--ri-m",
+        "0.03247409994652675",
+        "--particle-radius-m",
+        "0.004",
+        "--mu",
+        "0",
+        "--sliding-mu",
+        "1.04",
+        "--json",
+    ];
+    let auto = json(
+        &[
+            &["predict", "--model", "auto", "--tolerance", "0.01"],
+            &scene[..],
+        ]
+        .concat(),
+    );
+    assert_eq!(auto["chosen"], "rolling-or-sliding", "{auto}");
+    assert_eq!(auto["valid"], true, "{auto}");
+    assert!(
+        reasons(&auto).contains("it lifts off at 0 deg (the normal force reaches zero at t = "),
+        "{auto}"
+    );
+    let full = json(
+        &[
+            &["predict", "--model", "bowl", "--speed-range", "false"],
+            &scene[..],
+        ]
+        .concat(),
+    );
+    assert_eq!(auto["releases_leaving"], 12, "{auto}");
+    assert_eq!(full["releases_leaving"], 12, "{full}");
+    within(&auto, full["residence_time_mean_s"].as_f64().unwrap(), 0.01);
+}

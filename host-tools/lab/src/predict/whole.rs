@@ -160,9 +160,15 @@ pub(crate) fn run_level(
                     RollingOutcome::Leaves {
                         residence_time_s, ..
                     } => times.push((deg, Some(residence_time_s))),
-                    RollingOutcome::LiftsOff { .. } => {
-                        why.push("the normal force reaches zero (it would fly)".to_string());
-                        times.push((deg, None));
+                    // A lift-off hands over too: the rolling model ends there, and was taken
+                    // as the answer (not valid, "none of the 12 releases leaves") where the
+                    // next level follows the flight and every release leaves.
+                    RollingOutcome::LiftsOff { time_s } => {
+                        return Ok(Err(format!(
+                            "it lifts off at {deg} deg (the normal force reaches zero at t = {} \
+                             s), and the rolling model does not follow a flight",
+                            crate::number::fixed(time_s, 4)
+                        )));
                     }
                     _ => times.push((deg, None)),
                 }
