@@ -47,6 +47,14 @@ fn bad_bowl_input_is_said_in_words() {
             vec![],
             "--fillet-radius-m 0.005 m with no wall (--wall-height-m 0, a bare rim)",
         ),
+        // A fillet wider than the bottom: "give a smaller --ri-m" was no way out at --ri-m 0.
+        (
+            ["45", "0.06", "0.2"],
+            vec!["--ri-m", "0"],
+            "--fillet-radius-m 0.2 m, widened by the granule's radius --particle-radius-m 0.003 \
+             m, reaches the bowl's axis: the corner takes the whole bottom (--rim-radius-m 0.075 \
+             m) and the granule has nowhere to start; give a smaller fillet",
+        ),
         (
             ["60", "0.08", "0"],
             vec!["--particle-radius-m", "0.07"],

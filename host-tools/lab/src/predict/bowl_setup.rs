@@ -177,6 +177,15 @@ pub(super) fn scene_and_shape(
                 crate::number::fixed(m.rho_b_m, 5),
                 crate::number::fixed(m.rho_b_m, 5)
             ),
+            // No release radius is inside it: "a smaller --ri-m" was advised at --ri-m 0.
+            Some(m) if m.rho_b_m <= 0.0 => anyhow::anyhow!(
+                "--fillet-radius-m {} m, widened by the granule's radius --particle-radius-m {} \
+                 m, reaches the bowl's axis: the corner takes the whole bottom (--rim-radius-m \
+                 {} m) and the granule has nowhere to start; give a smaller fillet",
+                crate::number::echo(wall.fillet_m),
+                crate::number::echo(scene.particle_radius_m),
+                crate::number::echo(scene.rim_radius_m)
+            ),
             _ => anyhow::anyhow!(words(e)),
         },
         e => anyhow::anyhow!(words(e)),
