@@ -85,6 +85,34 @@ fn inverse_gives_a_speed_that_gives_the_target() {
     assert!((t - 0.6).abs() < 1e-12, "{t}");
 }
 
+/// A fixed step too small for the granule's time names the step, the cap, the time and the step
+/// that reaches the exit (it said "took too many steps: give a larger --step-s or a looser
+/// --tol", --tol being no flag of a fixed step); the step it names does reach the exit.
+#[test]
+fn a_step_too_small_for_the_exit_names_the_step_that_reaches_it() {
+    let scene = [
+        "predict",
+        "--model",
+        "flat",
+        "--omega-rad-s",
+        "3",
+        "--method",
+        "euler",
+    ];
+    let out = bowl(&[&scene[..], &["--step-s", "1e-9"]].concat());
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains(
+            "took more than 1000000 steps of 1e-9 s (--step-s): the granule takes 0.784 s to \
+             leave (the closed form), so give --step-s of at least 7.9e-7 s, or --method closed"
+        ),
+        "{err}"
+    );
+    let v = json(&[&scene[..], &["--step-s", "7.9e-7", "--json"]].concat());
+    assert_eq!(v["results"][0]["outcome"], "leaves", "{v}");
+}
+
 #[test]
 fn bad_scene_is_a_clear_error() {
     let out = bowl(&["predict", "--k2", "1.5"]);

@@ -27,7 +27,11 @@ fn bad_bowl_input_is_said_in_words() {
         (
             ["90", "0.08", "0.07"],
             vec![],
-            "already touches the corner between bottom and wall",
+            // The values and the limit: the words named the flags alone.
+            "--ri-m 0.0375 m: the granule released there already touches the corner between \
+             bottom and wall (--fillet-radius-m 0.07 m, widened by the granule's radius \
+             --particle-radius-m 0.003 m, starts 0.00500 m from the axis); give --ri-m below \
+             0.00500 m, or a smaller fillet or granule",
         ),
         // A fillet above its wall, or with no wall: the granule climbed the arc past the lip
         // and the time was a taller bowl's, without a word.
@@ -43,10 +47,19 @@ fn bad_bowl_input_is_said_in_words() {
             vec![],
             "--fillet-radius-m 0.005 m with no wall (--wall-height-m 0, a bare rim)",
         ),
+        // A fillet wider than the bottom: "give a smaller --ri-m" was no way out at --ri-m 0.
+        (
+            ["45", "0.06", "0.2"],
+            vec!["--ri-m", "0"],
+            "--fillet-radius-m 0.2 m, widened by the granule's radius --particle-radius-m 0.003 \
+             m, reaches the bowl's axis: the corner takes the whole bottom (--rim-radius-m 0.075 \
+             m) and the granule has nowhere to start; give a smaller fillet",
+        ),
         (
             ["60", "0.08", "0"],
             vec!["--particle-radius-m", "0.07"],
-            "give a smaller --ri-m, --fillet-radius-m or --particle-radius-m",
+            "--particle-radius-m 0.07 m, starts 0.03415 m from the axis); give --ri-m below \
+             0.03415 m",
         ),
         (
             ["60", "0.02", "0"],
@@ -123,4 +136,83 @@ fn bad_bowl_input_is_said_in_words() {
     assert!(
         String::from_utf8_lossy(&out.stderr).contains("the bowl model needs --precession-rad-s")
     );
+}
+
+/// A tilt of 90 deg and a release radius at the rim are refused with the values given (the
+/// words named neither: "--axes-angle-deg must be at least 0 and below 90 degrees"), through
+/// the bowl, rolling and chooser models alike.
+#[test]
+fn a_refused_tilt_or_release_radius_is_echoed() {
+    for model in ["bowl", "rolling", "auto"] {
+        for (flag, value, want) in [
+            (
+                "--axes-angle-deg",
+                "90",
+                "--axes-angle-deg 90: the angle between the bowl's axis and the vertical must \
+                 be at least 0 and below 90 degrees",
+            ),
+            (
+                "--ri-m",
+                "0.075",
+                "--ri-m 0.075 m is not inside the bottom's radius --rim-radius-m 0.075 m",
+            ),
+        ] {
+            let args = bowl_args("1", "1", "60", ["90", "0", "0"], &[flag, value]);
+            let mut args: Vec<&str> = args.clone();
+            let m = args.iter().position(|a| *a == "--model").unwrap();
+            args[m + 1] = model;
+            if model == "rolling" {
+                // The rolling model has no wall.
+                for f in [
+                    "--wall-angle-deg",
+                    "--wall-height-m",
+                    "--fillet-radius-m",
+                    "--restitution",
+                    "--max-time-s",
+                ] {
+                    if let Some(i) = args.iter().position(|a| *a == f) {
+                        args.drain(i..i + 2);
+                    }
+                }
+            }
+            let out = bowl(&args);
+            assert_eq!(out.status.code(), Some(1), "{args:?}");
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(err.contains(want), "{args:?}: {err}");
+        }
+    }
+}
+
+/// The rolling model's step cap names the tolerance or step given, and never advises the method
+/// in use: at `--tol 1e-16` with dp54 it said "try --method dp54 with a looser --tol".
+#[test]
+fn the_step_cap_names_the_setting_that_met_it() {
+    let out = bowl(&[
+        "predict",
+        "--model",
+        "rolling",
+        "--axes-angle-deg",
+        "5",
+        "--rim-radius-m",
+        "0.075",
+        "--ri-m",
+        "0.0229",
+        "--sliding-mu",
+        "0.2",
+        "--precession-rad-s",
+        "3.3",
+        "--spin-rad-s",
+        "3.3",
+        "--release-azimuth-deg",
+        "150",
+        "--tol",
+        "1e-16",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("took more than 2000000 steps at --tol 1e-16: give a looser --tol"),
+        "{err}"
+    );
+    assert!(!err.contains("--method dp54"), "{err}");
 }

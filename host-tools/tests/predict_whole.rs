@@ -261,3 +261,74 @@ fn a_sliding_scene_takes_the_incline_corrected_by_its_second_order() {
     );
     within(&v, r, 0.01);
 }
+
+/// A tight tolerance is written with its digits: `--tolerance 1e-9` read "chooser (tolerance
+/// 0.00 %)" and "more than the tolerance 0.00 %" in the text and in the JSON's reasons.
+#[test]
+fn a_tight_tolerance_is_said_with_its_digits() {
+    let a = args("60", "2.0", "0.4", &["--tolerance", "1e-9"]);
+    let text: Vec<&str> = a.iter().copied().filter(|s| *s != "--json").collect();
+    let out = common::bowl(&text);
+    assert_eq!(out.status.code(), Some(0));
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert!(s.contains("chooser (tolerance 1.0e-7 %)"), "{s}");
+    assert!(s.contains("more than the tolerance 1.0e-7 %"), "{s}");
+    assert!(!s.contains("0.00 %"), "{s}");
+    let v = json(&a);
+    assert!(
+        reasons(&v).contains("more than the tolerance 1.0e-7 %"),
+        "{v}"
+    );
+}
+
+/// A granule that lifts off hands the rolling level over to one that follows the flight: the
+/// chooser took the rolling model there ("rolling model NOT VALID HERE: the normal force
+/// reaches zero", "none of the 12 releases leaves") where the bowl model has every release
+/// fly out. Now the answer is valid and the bowl model's, within the tolerance.
+#[test]
+fn a_lift_off_is_followed_by_the_next_level() {
+    let scene = [
+        "--axes-angle-deg",
+        "60",
+        "--precession-rad-s",
+        "-4.537765650449775",
+        "--spin-rad-s",
+        "5",
+        "--rod-offset-m",
+        "0.4",
+        "--rim-radius-m",
+        "0.10511622245212189",
+        "--ri-m",
+        "0.03247409994652675",
+        "--particle-radius-m",
+        "0.004",
+        "--mu",
+        "0",
+        "--sliding-mu",
+        "1.04",
+        "--json",
+    ];
+    let auto = json(
+        &[
+            &["predict", "--model", "auto", "--tolerance", "0.01"],
+            &scene[..],
+        ]
+        .concat(),
+    );
+    assert_eq!(auto["chosen"], "rolling-or-sliding", "{auto}");
+    assert_eq!(auto["valid"], true, "{auto}");
+    assert!(
+        reasons(&auto).contains("it lifts off at 0 deg (the normal force reaches zero at t = "),
+        "{auto}"
+    );
+    let full = json(
+        &[
+            &["predict", "--model", "bowl", "--speed-range", "false"],
+            &scene[..],
+        ]
+        .concat(),
+    );
+    assert_eq!(auto["releases_leaving"], 12, "{auto}");
+    assert_eq!(full["releases_leaving"], 12, "{full}");
+    within(&auto, full["residence_time_mean_s"].as_f64().unwrap(), 0.01);
+}

@@ -403,7 +403,7 @@ fn the_gave_up_advice_is_true_and_said_once() {
         let v = json(&args);
         let why = v["invalid_reason"].as_str().unwrap_or_default();
         assert!(
-            why.contains("gave up on 1 of 1 releases (at 90 deg"),
+            why.contains("gave up on 1 of 1 release (at 90 deg"),
             "{why}"
         );
         assert!(

@@ -18,6 +18,7 @@ mod paper_text;
 mod refusals;
 mod release_json;
 mod rolling;
+mod rolling_words;
 mod speed_range;
 mod spin_up;
 mod target;

@@ -162,6 +162,32 @@ pub(super) fn scene_and_shape(
              the bottom is not modelled)",
             crate::number::echo(wall.angle_deg)
         ),
+        // The values and the radius the release must stay inside: the words named the flags
+        // alone, so a user could not tell by how much.
+        BowlError::FilletReachesRelease => match shape.meridian(&scene) {
+            // At or past the axis no release radius is inside it: the plain words say what to change.
+            Some(m) if m.rho_b_m > 0.0 && m.rho_b_m.is_finite() => anyhow::anyhow!(
+                "--ri-m {} m: the granule released there already touches the corner between \
+                 bottom and wall (--fillet-radius-m {} m, widened by the granule's radius \
+                 --particle-radius-m {} m, starts {} m from the axis); give --ri-m below {} m, \
+                 or a smaller fillet or granule (the granule starts on the flat bottom)",
+                crate::number::echo(scene.ri_m),
+                crate::number::echo(wall.fillet_m),
+                crate::number::echo(scene.particle_radius_m),
+                crate::number::fixed(m.rho_b_m, 5),
+                crate::number::fixed(m.rho_b_m, 5)
+            ),
+            // No release radius is inside it: "a smaller --ri-m" was advised at --ri-m 0.
+            Some(m) if m.rho_b_m <= 0.0 => anyhow::anyhow!(
+                "--fillet-radius-m {} m, widened by the granule's radius --particle-radius-m {} \
+                 m, reaches the bowl's axis: the corner takes the whole bottom (--rim-radius-m \
+                 {} m) and the granule has nowhere to start; give a smaller fillet",
+                crate::number::echo(wall.fillet_m),
+                crate::number::echo(scene.particle_radius_m),
+                crate::number::echo(scene.rim_radius_m)
+            ),
+            _ => anyhow::anyhow!(words(e)),
+        },
         e => anyhow::anyhow!(words(e)),
     })?;
     if wall.height_m > 0.0 && wall.height_m < scene.particle_radius_m {

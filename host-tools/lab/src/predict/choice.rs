@@ -129,7 +129,9 @@ pub fn plan_words(plan: &Plan<f64>) -> String {
 
 /// `x` in percent: three decimals, or two significant digits below 0.01 % (a tolerance of
 /// 1e-6 must not read as 0.000 %).
-fn percent(x: f64) -> String {
+/// A relative value as a percentage that keeps its digits at the small end (a tolerance of
+/// 1e-9 printed with two decimals read "0.00 %").
+pub(crate) fn percent(x: f64) -> String {
     let p = 100.0 * x;
     if p != 0.0 && p.abs() < 0.01 {
         format!("{p:.1e} %")

@@ -55,8 +55,18 @@ pub fn predict(scene: &Scene<f64>, model: Model, how: &MethodSettings) -> Result
         .ok_or_else(|| anyhow!("closed forms are not integrated (a bug in bowl)"))?;
     let closed =
         particle::residence(scene, model).map_err(|e| anyhow!(super::refusals::scene(e)))?;
-    let report = particle::integrate_constant(scene, model, m)
-        .map_err(|e| anyhow!(super::refusals::ode(e)))?;
+    let report = particle::integrate_constant(scene, model, m).map_err(|e| {
+        anyhow!(match (e, m, Ends::from(closed)) {
+            (
+                particle::OdeError::StepLimit,
+                Method::Euler { step_s: h }
+                | Method::SemiImplicitEuler { step_s: h }
+                | Method::Rk4 { step_s: h },
+                Ends::Leaves(c),
+            ) => step_cap_words(h, c.residence_time_s, scene),
+            _ => super::refusals::ode(e),
+        })
+    })?;
     let outcome = match report.outcome {
         OdeOutcome::Leaves {
             residence_time_s,
@@ -212,6 +222,31 @@ impl StepCheck {
             )
         })
     }
+}
+
+/// A fixed step that meets the step cap before the granule leaves: the step, the cap, the time
+/// it needs (the closed form's) and the step that gets there. It said "took too many steps: give
+/// a larger --step-s or a looser --tol" to `--omega-rad-s 1e-6 --method rk4 --step-s 0.001`,
+/// where the granule takes 738 779 s (7e8 steps).
+fn step_cap_words(step_s: f64, residence_s: f64, scene: &Scene<f64>) -> String {
+    let profile = ode::ConstantOmega(scene.omega_rad_s);
+    let cap = ode::Limits::for_scene(scene, &profile).max_steps;
+    let echo = crate::number::echo;
+    // Two significant figures, rounded up (so the step given does reach the exit), printed
+    // through their own decimal: 0.74, not 0.7387791926933908.
+    let least = residence_s / f64::from(cap);
+    let unit = 10f64.powf(least.log10().floor() - 1.0);
+    let at_least: f64 = format!("{:.1e}", (least / unit).ceil() * unit)
+        .parse()
+        .unwrap_or(least);
+    format!(
+        "the integration took more than {cap} steps of {} s (--step-s): the granule takes {} s \
+         to leave (the closed form), so give --step-s of at least {} s, or --method closed \
+         (exact)",
+        echo(step_s),
+        crate::number::fixed(residence_s, 3),
+        echo(at_least)
+    )
 }
 
 /// `T` of a chosen plan over a varying speed, s: 0 for a particle already at the rim, infinite

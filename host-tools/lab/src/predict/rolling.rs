@@ -3,13 +3,14 @@
 //! and max over the twelve azimuths 0, 30, ..., 330 degrees.
 
 use anyhow::{Result, bail};
-use model_core::ode::system::SystemError;
 use model_core::particle::rolling::hierarchy::{Wanted, tolerance_from_resistance_uncertainty};
 use model_core::particle::rolling::{
-    self, AZIMUTHS_DEG, RollingError, RollingInput, RollingMethod, RollingOutcome, RollingScene,
+    self, AZIMUTHS_DEG, RollingMethod, RollingOutcome, RollingScene,
 };
 use serde_json::json;
 
+pub use super::rolling_words::words;
+use super::rolling_words::{given_words, run_words};
 use super::{Inputs, MethodChoice, validity};
 
 /// Inputs of the rolling model (the shared ones: `--mu` is its rolling resistance, `--ri-m`,
@@ -87,7 +88,9 @@ impl RollingInputs {
             ri_m: args.ri_m,
             rim_radius_m: args.rim_radius_m,
         };
-        scene.validate().map_err(|e| anyhow::anyhow!(words(e)))?;
+        scene
+            .validate()
+            .map_err(|e| anyhow::anyhow!(given_words(e, &scene, th_deg)))?;
         super::refusals::gravity(scene.g_m_s2, "--g")?;
         fits(&scene)?;
         Ok((scene, th_deg))
@@ -122,63 +125,6 @@ pub fn fits(scene: &RollingScene<f64>) -> Result<()> {
         );
     }
     Ok(())
-}
-
-pub fn words(e: RollingError) -> String {
-    match e {
-        RollingError::InvalidPrecession => "--precession-rad-s must be a finite number".into(),
-        RollingError::InvalidSpin => "--spin-rad-s must be a finite number".into(),
-        RollingError::InvalidAxesAngle => {
-            "--axes-angle-deg must be at least 0 and below 90 degrees".into()
-        }
-        RollingError::InvalidResistance => "--mu must be 0 or more".into(),
-        RollingError::InvalidSlidingFriction => "--sliding-mu must be 0 or more".into(),
-        RollingError::InvalidGravity => "--g must be 0 or more".into(),
-        RollingError::InvalidK2 => {
-            "--k2 must lie between 0 and 1 (5/7 for a solid sphere, 3/5 for a hollow one)".into()
-        }
-        RollingError::InvalidParticleRadius => "--particle-radius-m must be 0 or more".into(),
-        RollingError::InvalidRodLength => {
-            "--rod-offset-m (the horizontal offset L of the bowl's centre from the precession \
-             axis, m) must be 0 or more"
-                .into()
-        }
-        RollingError::InvalidStartRadius => "--ri-m must be 0 or more".into(),
-        RollingError::InvalidRimRadius => {
-            "--rim-radius-m must be finite and larger than --ri-m (the granule starts inside the bowl)"
-                .into()
-        }
-        RollingError::InvalidAzimuth => "--release-azimuth-deg must be a finite number".into(),
-        RollingError::ExtremeMagnitude(input) => super::refusals::extreme_magnitude(match input {
-            RollingInput::Precession => "--precession-rad-s",
-            RollingInput::Spin => "--spin-rad-s",
-            RollingInput::Resistance => "--mu",
-            RollingInput::SlidingFriction => "--sliding-mu",
-            RollingInput::Gravity => "--g",
-            RollingInput::ParticleRadius => "--particle-radius-m",
-            RollingInput::RodLength => "--rod-offset-m",
-            RollingInput::StartRadius => "--ri-m",
-            RollingInput::RimRadius => "--rim-radius-m",
-        }),
-        RollingError::Integration(SystemError::StepLimit) => {
-            "the integration took too many steps: try --method dp54 with a looser --tol, or a \
-             larger --step-s"
-                .into()
-        }
-        RollingError::Integration(SystemError::NotFinite) => {
-            "the integration diverged (a state became infinite): give a smaller --step-s or a \
-             tighter --tol"
-                .into()
-        }
-        RollingError::Integration(SystemError::InvalidStep) => {
-            "--step-s and --tol must be positive numbers".into()
-        }
-        RollingError::Integration(SystemError::Stalled) => {
-            "the integration stalled at a roll/slide switch (steps that do not advance the \
-             time): give a tighter --tol"
-                .into()
-        }
-    }
 }
 
 /// One release's outcome, as JSON and in words.
@@ -368,7 +314,7 @@ fn over_azimuths(
     let mut reports = Vec::with_capacity(betas.len());
     for &deg in betas {
         let rep = rolling::residence(scene, deg.to_radians(), method)
-            .map_err(|e| anyhow::anyhow!(words(e)))?;
+            .map_err(|e| anyhow::anyhow!(run_words(e, method)))?;
         tally.add(&rep);
         reports.push(rep);
     }

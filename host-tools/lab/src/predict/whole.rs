@@ -60,9 +60,9 @@ pub fn fails_words(f: &Fails<f64>, tolerance: f64) -> String {
              contact gives mu_s = {mu_s}"
         ),
         Fails::Rotation { estimate } => format!(
-            "the bowl's rotation changes T by up to {:.2} %, more than the tolerance {:.2} %",
+            "the bowl's rotation changes T by up to {:.2} %, more than the tolerance {}",
             100.0 * estimate,
-            100.0 * tolerance
+            super::choice::percent(tolerance)
         ),
         Fails::EachRelease => {
             "single releases are wanted, and the incline does not follow a release's turning path"
@@ -160,9 +160,15 @@ pub(crate) fn run_level(
                     RollingOutcome::Leaves {
                         residence_time_s, ..
                     } => times.push((deg, Some(residence_time_s))),
-                    RollingOutcome::LiftsOff { .. } => {
-                        why.push("the normal force reaches zero (it would fly)".to_string());
-                        times.push((deg, None));
+                    // A lift-off hands over too: the rolling model ends there, and was taken
+                    // as the answer (not valid, "none of the 12 releases leaves") where the
+                    // next level follows the flight and every release leaves.
+                    RollingOutcome::LiftsOff { time_s } => {
+                        return Ok(Err(format!(
+                            "it lifts off at {deg} deg (the normal force reaches zero at t = {} \
+                             s), and the rolling model does not follow a flight",
+                            crate::number::fixed(time_s, 4)
+                        )));
                     }
                     _ => times.push((deg, None)),
                 }
@@ -441,9 +447,9 @@ fn report(
         println!("{line}");
     }
     println!(
-        "chooser (tolerance {:.2} %): the {} model, the least of incline < rolling < \
+        "chooser (tolerance {}): the {} model, the least of incline < rolling < \
          rolling-or-sliding < bowl that meets it at this scene (tilt {th_deg} deg, |Omega| {:.3} rad/s)",
-        100.0 * tolerance,
+        super::choice::percent(tolerance),
         a.level.name(),
         scene.combined_speed_rad_s()
     );
