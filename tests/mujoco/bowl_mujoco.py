@@ -21,10 +21,16 @@ impact_mujoco.py). The regime of each step: the centre more than 0.1 mm off the 
 else slide if MuJoCo's last contact force is at the friction cone (|f_t| >= 0.8 mu_s f_n),
 roll if inside it (see the loop for why not the slip speed).
 
-Usage: bowl_mujoco.py W1 W2 TH_DEG R RI A MU_R MU_S ALPHA_DEG H L HORIZON F BETA_DEG [BETA_DEG ...]
+Usage: bowl_mujoco.py [--trace DT_S] [--dampratio D] [--torque] [--friction-tc S]
+                      W1 W2 TH_DEG R RI A MU_R MU_S ALPHA_DEG H L HORIZON F BETA_DEG [BETA_DEG ...]
 prints one line per azimuth: beta_deg T_s (or 'held' if still inside at the horizon)
 roll_share slide_share fly_share how (flight: its centre passed the lip while off the surface;
-contact: while touching; held)
+contact: while touching; held). --trace prints each release's path every DT_S seconds (and
+at each change of mode) first: t, rho and z in the bowl frame, the speed relative to the bowl
+(its radial and axial parts), the gap to the surface, the mode; --dampratio the contact's
+damping ratio (sweep.py's for a restitution; default 1); --torque the rolling resistance as a
+torque (run's `torque`, as sweep.py runs it); --friction-tc the friction's own time constant
+(run's `friction_tc`).
 """
 import sys
 
@@ -66,7 +72,8 @@ def ring(staves, p0, p1, thick, extend=1.2):
         )
 
 
-def model_xml(th, rim, a, mu_r, mu_s, alpha, h, rod, fillet=0.0, dampratio=1.0, torque=False):
+def model_xml(th, rim, a, mu_r, mu_s, alpha, h, rod, fillet=0.0, dampratio=1.0, torque=False,
+              friction_tc=None):
     lip = rim + (h / np.tan(alpha) if h > 0 else 0.0)
     staves = []
     if h > 0 and fillet > 0:
@@ -101,6 +108,26 @@ def model_xml(th, rim, a, mu_r, mu_s, alpha, h, rod, fillet=0.0, dampratio=1.0, 
     # `torque`); with `torque` the contact has sliding friction alone (condim 3).
     friction = f'condim="3" friction="{mu_s} 0 0"' if torque else \
         f'condim="6" friction="{mu_s} 0 {mu_r * a}"'
+    ball = f'<geom name="ball" type="sphere" size="{a}" mass="0.001"/>'
+    pairs = ""
+    if friction_tc:
+        # The friction's own time constant (solreffriction, which only an explicit contact pair
+        # takes): with the normal's (0.5 ms) the friction is still relaxing towards a stick
+        # when an impact with e 0.5 is over, and a sticking impact gets half to 70 % of
+        # Routh's tangential impulse at any timestep, stiffness, impratio or noslip (docs/model.md
+        # §10, the sweep's scene 8); at 0.1 ms it gets Routh's. Every bowl geom is paired with
+        # the ball, whose own collisions are off (no contact twice).
+        names = [f"w{i}" for i in range(len(staves) + 1)]
+        staves = [g.replace("<geom ", f'<geom name="{n}" ', 1)
+                  for g, n in zip(staves, names[1:])]
+        ball = ball.replace("<geom ", '<geom contype="0" conaffinity="0" ', 1)
+        cond = "3" if torque else "6"
+        fr = f"{mu_s} {mu_s} 0 0 0" if torque else f"{mu_s} {mu_s} 0 {mu_r * a} {mu_r * a}"
+        pairs = "<contact>" + "".join(
+            f'<pair geom1="{n}" geom2="ball" condim="{cond}" friction="{fr}" '
+            f'solref="0.0005 {dampratio}" solimp="0.99 0.999 0.0001" '
+            f'solreffriction="{friction_tc} 1"/>' for n in names) + "</contact>"
+    bottom_name = ' name="w0"' if friction_tc else ""
     return f"""
 <mujoco>
   <compiler angle="radian"/>
@@ -115,15 +142,16 @@ def model_xml(th, rim, a, mu_r, mu_s, alpha, h, rod, fillet=0.0, dampratio=1.0, 
       <body name="bowl" pos="{-rod} 0 0" euler="0 {-th} 0">
         <inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
         <joint name="spin" type="hinge" axis="0 0 1"/>
-        <geom type="cylinder" size="{bottom_r} 0.005" pos="0 0 -0.005"/>
+        <geom{bottom_name} type="cylinder" size="{bottom_r} 0.005" pos="0 0 -0.005"/>
         {''.join(staves)}
       </body>
     </body>
     <body name="ball">
       <freejoint/>
-      <geom name="ball" type="sphere" size="{a}" mass="0.001"/>
+      {ball}
     </body>
   </worldbody>
+  {pairs}
 </mujoco>"""
 
 
@@ -158,7 +186,7 @@ def surface_gap(q, rim, a, alpha, h, lip, fillet):
 
 
 def run(w1, w2, th, rim, ri, a, mu_r, mu_s, alpha, h, rod, horizon, beta, fillet=0.0,
-        dampratio=1.0, dt=DT, torque=False):
+        dampratio=1.0, dt=DT, torque=False, trace=None, trace_every_s=1e-3, friction_tc=None):
     """dampratio: the contact's damping ratio (1: critically damped, e 0.13-0.15; sweep.py
     sets it for a restitution); dt: the timestep (a finer one checks the reference).
 
@@ -169,9 +197,14 @@ def run(w1, w2, th, rim, ri, a, mu_r, mu_s, alpha, h, rod, horizon, beta, fillet
     sliding sphere then gets less than mu_s N (38 deg, mu_s 0.21, mu_r 0.018: 2.7 % more
     acceleration than g (sin th - mu_s cos th); 0.3 % with mu_r 0) and a rolling one creeps (20
     deg, mu_r 0.046: slips 5 % of its speed, 2.4 % more than k2 g (sin th - mu_r cos th)); with
-    the torque both closed forms hold to 1e-4."""
+    the torque both closed forms hold to 1e-4.
+
+    trace: a list that gets a row every trace_every_s (and at every change of mode): t, the
+    centre's radius from the bowl's axis rho and height z in the bowl frame, its speed relative
+    to the bowl, the gap to the surface, the mode (fly, roll or slide), and the velocity's
+    radial and axial components, to see where a release parts from the model's."""
     m = mujoco.MjModel.from_xml_string(model_xml(th, rim, a, mu_r, mu_s, alpha, h, rod, fillet,
-                                                 dampratio, torque))
+                                                 dampratio, torque, friction_tc))
     m.opt.timestep = dt
     cone = CONE_TORQUE if torque else CONE
     d = mujoco.MjData(m)
@@ -203,6 +236,7 @@ def run(w1, w2, th, rim, ri, a, mu_r, mu_s, alpha, h, rod, horizon, beta, fillet
     force = np.zeros(6)
     sliding = False  # released at rest on the bottom: rolling until a contact says otherwise
     touching = True
+    last_mode, next_row = None, 0.0
     while t < horizon:
         d.qpos[0], d.qpos[1] = w1 * t, w2 * t
         d.qvel[0], d.qvel[1] = w1, w2
@@ -245,7 +279,17 @@ def run(w1, w2, th, rim, ri, a, mu_r, mu_s, alpha, h, rod, horizon, beta, fillet
             d.xfrc_applied[ball, 3:6] = tq
         if verdicts:
             sliding = any(verdicts)
-        touching = surface_gap(q, rim, a, alpha, h, lip, fillet) <= GAP_M
+        gap = surface_gap(q, rim, a, alpha, h, lip, fillet)
+        touching = gap <= GAP_M
+        if trace is not None:
+            mode = "fly" if not touching else ("slide" if sliding else "roll")
+            if mode != last_mode or t >= next_row:
+                u = rot.T @ (d.qvel[jq:jq + 3] - odot - np.cross(w, x - o))
+                rho = np.hypot(q[0], q[1])
+                er = np.array([q[0], q[1], 0.0]) / rho
+                trace.append((t, float(rho), float(q[2]), float(np.linalg.norm(u)), float(gap),
+                              mode, float(u @ er), float(u[2])))
+                last_mode, next_row = mode, t + trace_every_s
         if not touching:
             shares["fly"] += dt
             continue
@@ -254,11 +298,36 @@ def run(w1, w2, th, rim, ri, a, mu_r, mu_s, alpha, h, rod, horizon, beta, fillet
 
 
 def main():
-    v = [float(s) for s in sys.argv[1:]]
+    args = sys.argv[1:]
+    every, dampratio, torque, ftc = None, 1.0, False, None
+    options = "--trace DT_S, --dampratio D, --torque, --friction-tc S"
+    while args and args[0].startswith("--"):
+        if args[0] == "--torque":
+            torque, args = True, args[1:]
+            continue
+        if len(args) < 2:
+            sys.exit(f"{args[0]} needs a value (the options: {options})")
+        if args[0] == "--trace":
+            every = float(args[1])
+        elif args[0] == "--dampratio":
+            dampratio = float(args[1])
+        elif args[0] == "--friction-tc":
+            ftc = float(args[1])
+        else:
+            sys.exit(f"unknown option {args[0]}: the options are {options}")
+        args = args[2:]
+    v = [float(s) for s in args]
     w1, w2, th, rim, ri, a, mu_r, mu_s, alpha, h, rod, horizon, fillet = v[:13]
     for beta in v[13:]:
+        trace = [] if every else None
         t, sh, touching = run(w1, w2, np.radians(th), rim, ri, a, mu_r, mu_s, np.radians(alpha),
-                              h, rod, horizon, np.radians(beta), fillet)
+                              h, rod, horizon, np.radians(beta), fillet, dampratio=dampratio,
+                              torque=torque, trace=trace, trace_every_s=every or 1e-3,
+                              friction_tc=ftc)
+        for row in trace or []:
+            print(f"  {row[0]:.5f} rho {1e3 * row[1]:.3f} mm z {1e3 * row[2]:.3f} mm "
+                  f"speed {row[3]:.4f} m/s (radial {row[6]:+.4f}, up {row[7]:+.4f}) "
+                  f"gap {1e3 * row[4]:.4f} mm {row[5]}")
         total = sum(sh.values()) or 1.0
         how = "held" if t is None else ("contact" if touching else "flight")
         print(beta, "held" if t is None else f"{t:.6f}",
