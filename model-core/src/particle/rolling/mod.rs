@@ -18,6 +18,7 @@ pub mod modes;
 pub mod slide;
 
 mod integrate;
+pub(crate) mod rest;
 pub use integrate::{
     AZIMUTHS_DEG, AzimuthSummary, AzimuthTally, over_azimuths_within, residence,
     residence_over_azimuths, residence_within,
@@ -282,6 +283,9 @@ pub struct RollingReport<T> {
     pub evaluations: u32,
     /// Accepted steps.
     pub steps: u32,
+    /// Time held at rest on the way by the rolling resistance (`rest`), s: up to the outcome,
+    /// or the horizon.
+    pub held_s: T,
 }
 
 /// The horizon of a release, s: a granule still in the bowl after this long is reported as such.
@@ -361,5 +365,7 @@ pub fn at_rest_threshold_m_s<T: Real>() -> T {
 
 #[cfg(test)]
 mod modes_tests;
+#[cfg(test)]
+mod rest_tests;
 #[cfg(test)]
 mod tests;
