@@ -175,3 +175,35 @@ fn just_above_it_starts_from_rest_at_the_incline_s_acceleration() {
     );
     assert_eq!(r.tally.regime.held_s, 0.0);
 }
+
+/// A bowl tilted 2 deg that only spins (3 rad/s) turns gravity in its frame: a granule released
+/// at rest at 30 mm, 180 deg (uphill of the axis at the start), is held while
+/// `|D| = |g sin th (-cos psi, sin psi) + w2^2 (ri, 0)|` is within `mu_r g cos th`, and starts
+/// where they meet, `cos psi = (g^2 sin^2 th + w2^4 ri^2 - mu_r^2 g^2 cos^2 th) /
+/// (2 g sin th w2^2 ri)`, `t = psi / w2` (0.313 s). Before, such a scene counted as still and
+/// the release as held for ever.
+#[test]
+fn a_spinning_tilted_bowl_lets_a_held_granule_go_when_gravity_turns() {
+    let s = RollingScene {
+        precession_rad_s: 0.0,
+        spin_rad_s: 3.0,
+        axes_angle_rad: 2f64.to_radians(),
+        ri_m: 0.03,
+        sliding_friction: 0.4,
+        ..stopping()
+    };
+    let (g, th, w2, ri) = (s.g_m_s2, s.axes_angle_rad, s.spin_rad_s, s.ri_m);
+    let (grav, cent, res) = (
+        g * th.sin(),
+        w2 * w2 * ri,
+        s.rolling_resistance * g * th.cos(),
+    );
+    let start = ((grav * grav + cent * cent - res * res) / (2.0 * grav * cent)).acos() / w2;
+    let beta = 180f64.to_radians();
+    let r = residence(&s, beta, TIGHT).unwrap();
+    left(r.outcome);
+    assert!((r.held_s - start).abs() < 1e-10, "{} vs {start}", r.held_s);
+    let m = residence_roll_or_slide(&s, beta, TIGHT).unwrap();
+    left_modes(m.outcome);
+    assert!((m.tally.regime.held_s - start).abs() < 1e-10);
+}
