@@ -431,3 +431,44 @@ fn the_walls_agree_with_a_rigid_body_simulation() {
         }
     }
 }
+
+/// A release that rolls to rest and is held there (5 deg tilt, w1 = w2 = 3.2979 rad/s, 75 mm
+/// bowl, bare rim, released at 22.86 mm and 150 deg) stops at 0.160 s and is held 86 ms. Both
+/// models said "roll 100 %" and stepped over the rest; now the regime shows the hold (about
+/// 10.6 % of its 0.811 s), and both models give the same T.
+#[test]
+fn a_release_held_at_rest_on_the_way_says_so() {
+    let mut times = Vec::new();
+    for model in ["rolling", "bowl"] {
+        let v = json(&[
+            "predict",
+            "--model",
+            model,
+            "--wall-height-m",
+            "0",
+            "--axes-angle-deg",
+            "5",
+            "--precession-rad-s",
+            "3.2979",
+            "--spin-rad-s",
+            "3.2979",
+            "--rim-radius-m",
+            "0.075",
+            "--ri-m",
+            "0.02286",
+            "--sliding-mu",
+            "0.2",
+            "--release-azimuth-deg",
+            "150",
+            "--json",
+        ]);
+        let rel = &v["per_release"][0];
+        let held = rel["regime"]["held"].as_f64().unwrap_or(0.0);
+        assert!((0.105..0.108).contains(&held), "{model}: {rel}");
+        let roll = rel["regime"]["roll"].as_f64().unwrap_or(0.0);
+        assert!((roll + held - 1.0).abs() < 1e-12, "{model}: {rel}");
+        times.push(rel["residence_time_s"].as_f64().unwrap());
+    }
+    assert!((times[0] - 0.810_827).abs() < 1e-6, "{times:?}");
+    assert!((times[0] - times[1]).abs() < 1e-9, "{times:?}");
+}

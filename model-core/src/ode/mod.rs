@@ -18,7 +18,7 @@
 //! stable for every step (accuracy, not stability, limits it).
 
 mod dp54;
-mod event;
+pub(crate) mod event;
 mod fixed;
 mod release;
 pub mod system;

@@ -156,8 +156,9 @@ pub fn regimes(omega_rad_s: f64) -> Result<(Figure, Table)> {
                 };
                 sl += r.regime.slide_s;
                 fl += r.flight_s;
-                held += r.held_s;
-                total += r.regime.slide_s + r.regime.roll_s + r.flight_s + r.held_s;
+                held += r.held_s + r.regime.held_s;
+                total +=
+                    r.regime.slide_s + r.regime.roll_s + r.flight_s + r.held_s + r.regime.held_s;
                 left += usize::from(matches!(r.outcome, BowlOutcome::Leaves { .. }));
             }
             let share = |x: f64| if total > 0.0 { x / total } else { f64::NAN };

@@ -72,14 +72,16 @@ fn regime(r: &BowlReport<f64>) -> Value {
     if r.outcome == BowlOutcome::Held {
         return json!({"held": 1.0});
     }
-    let total = r.regime.roll_s + r.regime.slide_s + r.flight_s + r.held_s;
+    // Held: at rest on the bottom (the rolling resistance) or in a vertical wall's corner.
+    let held = r.regime.held_s + r.held_s;
+    let total = r.regime.roll_s + r.regime.slide_s + r.flight_s + held;
     let mut m = serde_json::Map::new();
     if total > 0.0 {
         for (name, t) in [
             ("roll", r.regime.roll_s),
             ("slide", r.regime.slide_s),
             ("fly", r.flight_s),
-            ("held", r.held_s),
+            ("held", held),
         ] {
             if t > 0.0 {
                 m.insert(name.into(), json!(t / total));

@@ -127,6 +127,15 @@ pub fn fits(scene: &RollingScene<f64>) -> Result<()> {
     Ok(())
 }
 
+/// The rolling model's regime over `total_s`, of which it was held at rest `held_s`.
+fn roll_or_held(total_s: f64, held_s: f64) -> serde_json::Value {
+    if held_s > 0.0 && total_s > 0.0 {
+        json!({"roll": 1.0 - held_s / total_s, "held": held_s / total_s})
+    } else {
+        json!({"roll": 1.0})
+    }
+}
+
 /// One release's outcome, as JSON and in words.
 fn outcome(o: &RollingOutcome<f64>, sliding_mu: f64) -> (serde_json::Value, String) {
     match *o {
@@ -245,13 +254,20 @@ pub fn run(args: &Inputs, r: &RollingInputs) -> Result<()> {
             .zip(&reports)
             .map(|(&deg, rep)| {
                 let (more, _) = outcome(&rep.outcome, r.sliding_mu);
+                // The model rolls until it ends (the rim, lift-off, the horizon), but for the
+                // time it is held at rest on the way.
                 let (t, regime) = match rep.outcome {
                     RollingOutcome::Leaves {
                         residence_time_s, ..
-                    } => (Some(residence_time_s), json!({"roll": 1.0})),
+                    } => (
+                        Some(residence_time_s),
+                        roll_or_held(residence_time_s, rep.held_s),
+                    ),
                     RollingOutcome::Held => (None, json!({"held": 1.0})),
-                    // The model rolls until it ends (lift-off, the horizon).
-                    _ => (None, json!({"roll": 1.0})),
+                    RollingOutcome::LiftsOff { time_s } => (None, roll_or_held(time_s, rep.held_s)),
+                    RollingOutcome::NotLeftBy { horizon_s } => {
+                        (None, roll_or_held(horizon_s, rep.held_s))
+                    }
                 };
                 super::release_json::entry(deg, t, regime, more)
             })

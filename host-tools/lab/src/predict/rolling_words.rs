@@ -108,3 +108,28 @@ pub(super) fn run_words(e: RollingError, method: RollingMethod<f64>) -> String {
         (e, _) => words(e),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The step cap names the tolerance given and never advises the method in use: at
+    /// `--tol 1e-16` with dp54 it said "try --method dp54 with a looser --tol". (The scene that
+    /// met the cap end to end, a release that rolls to rest, now answers at 1e-16: its rest is
+    /// an event, `predict_bowl_refusals`.)
+    #[test]
+    fn the_step_cap_names_the_setting_that_met_it() {
+        let cap = RollingError::Integration(SystemError::StepLimit);
+        let err = run_words(cap, RollingMethod::Dp54 { rtol: 1e-16 });
+        assert!(
+            err.contains("took more than 2000000 steps at --tol 1e-16: give a looser --tol"),
+            "{err}"
+        );
+        assert!(!err.contains("--method dp54"), "{err}");
+        let err = run_words(cap, RollingMethod::Rk4 { step_s: 1e-9 });
+        assert!(
+            err.contains("steps of --step-s 1e-9 s: give a larger --step-s"),
+            "{err}"
+        );
+    }
+}

@@ -98,6 +98,7 @@ impl<T: Real> BowlReport<T> {
     fn add(&mut self, stay: &Tally<T>) {
         self.regime.roll_s += stay.regime.roll_s;
         self.regime.slide_s += stay.regime.slide_s;
+        self.regime.held_s += stay.regime.held_s;
         self.switches = self.switches.saturating_add(stay.switches);
         self.evaluations = self.evaluations.saturating_add(stay.evaluations);
         self.steps = self.steps.saturating_add(stay.steps);
@@ -165,6 +166,7 @@ fn residence_watching<T: Real>(
         regime: Regime {
             roll_s: T::ZERO,
             slide_s: T::ZERO,
+            held_s: T::ZERO,
         },
         on_wall_s: T::ZERO,
         held_s: T::ZERO,

@@ -113,31 +113,92 @@ pub(crate) fn at_contact<T: Real>(
     (f, c, e, normal)
 }
 
-/// The right-hand side and the contact forces at `(t, y)`.
-pub fn forces<T: Real>(s: &RollingScene<T>, t: T, y: &State<T>) -> Forces<T> {
+/// `D`, the in-plane drive of the rolling equations (m/s^2), and the rolling resistance's
+/// largest force `mu_r N/m` at `(t, y)`, with the frame and `N/m` they came from.
+fn drive<T: Real>(
+    s: &RollingScene<T>,
+    t: T,
+    y: &State<T>,
+) -> ([T; 2], T, Frame<T>, [T; 3], [T; 3], T) {
     let [x, yy, ux, uy, sig] = *y;
     let (f, c, e, normal) = at_contact(s, t, [x, yy], [ux, uy]);
     let o = f.omega;
     let a = s.particle_radius_m;
-    let k2 = s.k2;
-    let spin_coupling = (T::ONE - k2) / k2;
+    let spin_coupling = (T::ONE - s.k2) / s.k2;
     let d = [
         f.gravity[0] - f.carrier[0] - e[0] - c[0] + spin_coupling * (sig * o[0] - a * f.alpha[1]),
         f.gravity[1] - f.carrier[1] - e[1] - c[1] + spin_coupling * (sig * o[1] + a * f.alpha[0]),
     ];
     let resistance = s.rolling_resistance * normal.max(T::ZERO);
+    (d, resistance, f, c, e, normal)
+}
+
+/// How far the drive exceeds what the rolling resistance can hold of a granule at rest at
+/// `(t, y)` (its velocity taken as zero), `|D| - mu_r N/m`, m/s^2: it stays at rest while this
+/// is at most zero (the held segment of a run, `super::rest`).
+pub(crate) fn rest_margin_m_s2<T: Real>(s: &RollingScene<T>, t: T, y: &State<T>) -> T {
+    let (d, resistance, ..) = drive(s, t, &[y[0], y[1], T::ZERO, T::ZERO, y[4]]);
+    (d[0] * d[0] + d[1] * d[1]).sqrt() - resistance
+}
+
+/// The direction a roll's resistance opposes at the start of a roll from `(t, y)` (`super::rest`):
+/// the velocity's, or at rest `D/|D|` (where the granule starts), zero if there is no drive.
+pub(crate) fn start_direction<T: Real>(s: &RollingScene<T>, t: T, y: &State<T>) -> [T; 2] {
+    let speed = (y[2] * y[2] + y[3] * y[3]).sqrt();
+    if speed > T::from_f64(AT_REST_M_S) {
+        return [y[2] / speed, y[3] / speed];
+    }
+    let (d, ..) = drive(s, t, y);
+    let d_norm = (d[0] * d[0] + d[1] * d[1]).sqrt();
+    if d_norm > T::ZERO {
+        [d[0] / d_norm, d[1] / d_norm]
+    } else {
+        [T::ZERO, T::ZERO]
+    }
+}
+
+/// The right-hand side and the contact forces at `(t, y)`.
+pub fn forces<T: Real>(s: &RollingScene<T>, t: T, y: &State<T>) -> Forces<T> {
+    forces_with(s, t, y, None)
+}
+
+/// [`forces`] of a roll whose velocity had the unit direction `last` at its last accepted step
+/// (`super::rest`): the resistance opposes the velocity while it goes along `last`, and `last`
+/// itself once the velocity is at rest or has turned against it, so the right-hand side stays
+/// smooth through the step in which the velocity reaches zero and the integrator's interpolant
+/// locates that instant (as a slide's friction, `super::slide::slide_forces`).
+pub(crate) fn forces_along<T: Real>(
+    s: &RollingScene<T>,
+    t: T,
+    y: &State<T>,
+    last: [T; 2],
+) -> Forces<T> {
+    forces_with(s, t, y, Some(last))
+}
+
+fn forces_with<T: Real>(
+    s: &RollingScene<T>,
+    t: T,
+    y: &State<T>,
+    last: Option<[T; 2]>,
+) -> Forces<T> {
+    let [_, _, ux, uy, _] = *y;
+    let (d, resistance, f, c, e, normal) = drive(s, t, y);
+    let o = f.omega;
+    let k2 = s.k2;
     let speed = (ux * ux + uy * uy).sqrt();
     let gyro = (T::ONE + k2) * o[2];
-    let (dir, held) = if speed > T::from_f64(AT_REST_M_S) {
-        ([ux / speed, uy / speed], false)
-    } else {
-        let d_norm = (d[0] * d[0] + d[1] * d[1]).sqrt();
-        if d_norm <= resistance || d_norm == T::ZERO {
-            // Held: the resistance balances D; it cannot exceed it.
-            ([T::ZERO, T::ZERO], true)
-        } else {
-            ([d[0] / d_norm, d[1] / d_norm], false)
-        }
+    let d_norm = (d[0] * d[0] + d[1] * d[1]).sqrt();
+    let at_rest = speed <= T::from_f64(AT_REST_M_S);
+    let (dir, held) = match last {
+        // A roll that starts from rest starts along D.
+        Some(_) if at_rest && d_norm > resistance => ([d[0] / d_norm, d[1] / d_norm], false),
+        // One that the resistance stops goes through rest along its last direction.
+        Some(l) if at_rest || ux * l[0] + uy * l[1] <= T::ZERO => (l, false),
+        _ if !at_rest => ([ux / speed, uy / speed], false),
+        // Held: the resistance balances D; it cannot exceed it.
+        _ if d_norm <= resistance || d_norm == T::ZERO => ([T::ZERO, T::ZERO], true),
+        _ => ([d[0] / d_norm, d[1] / d_norm], false),
     };
     let (dux, duy) = if held && speed <= T::from_f64(AT_REST_M_S) {
         (T::ZERO, T::ZERO)

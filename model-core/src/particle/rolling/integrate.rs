@@ -3,13 +3,17 @@
 
 use core::ops::ControlFlow;
 
-use super::equations::{State, forces};
+use core::cell::Cell;
+
+use super::equations::{State, forces, forces_along, start_direction};
+use super::modes::MAX_SWITCHES;
+use super::rest;
 use super::{
     RollingError, RollingMethod, RollingOutcome, RollingReport, RollingScene, default_limits,
     release,
 };
 use crate::Real;
-use crate::ode::system::{self, Ended, SystemLimits};
+use crate::ode::system::{self, Ended, SystemError, SystemLimits};
 
 /// The rim in the state scaled by `1/R`: `|(x, y)|^2 - 1` and its derivative along `dy`.
 fn rim_event<T: Real>(y: &State<T>, dy: &State<T>) -> (T, T) {
@@ -47,6 +51,7 @@ pub fn residence_within<T: Real>(
             outcome: RollingOutcome::Held,
             evaluations: 1,
             steps: 0,
+            held_s: T::ZERO,
         });
     }
     let mut max_ratio = T::ZERO;
@@ -63,20 +68,129 @@ pub fn residence_within<T: Real>(
         }
         ControlFlow::Continue(())
     };
-    let rhs = |t: T, y: &State<T>| forces(scene, t, y).derivative;
-    // The integrators' event is a plain function: lengths are integrated in units of R so the
-    // rim is the fixed |(x, y)| = 1.
+    let (mut evaluations, mut steps) = (1u32, 0u32);
+    let speed_scale = speed_scale(scene);
+    let mut held_s = T::ZERO;
+    let (mut t, mut y) = (T::ZERO, y0);
+    // Rolls and holds at rest in turn (`rest`), each ended by a located event.
+    let mut from_hold = false;
+    for _ in 0..MAX_SWITCHES {
+        if !from_hold
+            && y[2] == T::ZERO
+            && y[3] == T::ZERO
+            && let Some(rest) = rest::held_at(scene, t, &y)
+        {
+            let held = rest::hold(scene, t, &rest, limits.horizon_s, |_| -T::ONE);
+            evaluations = evaluations.saturating_add(held.evaluations);
+            let outcome = match held.t {
+                None => RollingOutcome::NotLeftBy {
+                    horizon_s: limits.horizon_s,
+                },
+                Some(t1) if forces(scene, t1, &rest).normal_m_s2 <= T::ZERO => {
+                    RollingOutcome::LiftsOff { time_s: t1 }
+                }
+                Some(t1) => {
+                    held_s += t1 - t;
+                    (t, y, from_hold) = (t1, rest, true);
+                    continue;
+                }
+            };
+            return Ok(RollingReport {
+                outcome,
+                evaluations,
+                steps,
+                held_s: held_s + held.t.unwrap_or(limits.horizon_s) - t,
+            });
+        }
+        from_hold = false;
+        let remaining = SystemLimits {
+            max_steps: limits.max_steps.saturating_sub(steps),
+            ..limits
+        };
+        if remaining.max_steps == 0 {
+            break;
+        }
+        let (run, last) = roll(scene, (t, y), method, remaining, &mut watch)?;
+        evaluations = evaluations.saturating_add(run.evaluations);
+        steps = steps.saturating_add(run.steps);
+        let outcome = match run.ended {
+            // The first of the two events: the one nearer zero (each is located to rounding).
+            Ended::Event { t: te, y: ye }
+                if rim_event(&ye, &[T::ZERO; 5]).0
+                    >= rest::turned([ye[2], ye[3]], last) / speed_scale =>
+            {
+                RollingOutcome::Leaves {
+                    residence_time_s: te,
+                    exit_speed_m_s: (ye[2] * ye[2] + ye[3] * ye[3]).sqrt() * rim,
+                    max_friction_ratio: max_ratio,
+                    first_slip_s: first_slip,
+                }
+            }
+            Ended::Event { t: te, y: ye } => {
+                // The velocity came to rest (or turned by more than a right angle in a step):
+                // held there with no velocity at all, or rolling on.
+                let ye = ye.map(|v| v * rim);
+                (t, y) = (te, rest::held_at(scene, te, &ye).unwrap_or(ye));
+                continue;
+            }
+            Ended::Stopped { why, .. } => RollingOutcome::LiftsOff { time_s: why },
+            Ended::Horizon { .. } => RollingOutcome::NotLeftBy {
+                horizon_s: limits.horizon_s,
+            },
+        };
+        return Ok(RollingReport {
+            outcome,
+            evaluations,
+            steps,
+            held_s,
+        });
+    }
+    Err(RollingError::Integration(SystemError::StepLimit))
+}
+
+/// The speed scale of a roll's state in units of the rim's radius, 1/s.
+fn speed_scale<T: Real>(scene: &RollingScene<T>) -> T {
+    scene.combined_speed_rad_s().max(T::ONE)
+}
+
+/// One roll from `(t0, y0)` (m, m/s) to the rim, a rest ([`rest::rest_event`]), the watch's
+/// stop (lift-off) or the horizon; the event's state in units of the rim's radius, and the
+/// velocity's direction at the last accepted step (the rest event's).
+fn roll<T: Real>(
+    scene: &RollingScene<T>,
+    (t0, y0): (T, State<T>),
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+    watch: &mut impl FnMut(T, &State<T>) -> ControlFlow<T>,
+) -> Result<(system::Run<T, 5, T>, [T; 2]), RollingError> {
+    let rim = scene.rim_radius_m;
+    let last = Cell::new(start_direction(scene, t0, &y0));
+    // Lengths in units of R: the rim is then the fixed |(x, y)| = 1.
     let scale = T::ONE / rim;
     let scaled = |y: &State<T>| -> State<T> { y.map(|v| v * scale) };
-    let rhs_scaled = |t: T, y: &State<T>| -> State<T> {
-        let unscaled = y.map(|v| v * rim);
-        scaled(&rhs(t, &unscaled))
+    let speed_scale = speed_scale(scene);
+    let rhs = |t: T, y: &State<T>| -> State<T> {
+        scaled(&forces_along(scene, t, &y.map(|v| v * rim), last.get()).derivative)
     };
-    let watch_scaled = |t: T, y: &State<T>| watch(t, &y.map(|v| v * rim));
-    let event: system::EventFn<T, 5> = rim_event;
-    let run = match method {
+    let check = |t: T, y: &State<T>| {
+        rest::follow_velocity([y[2], y[3]], &last);
+        watch(t, &y.map(|v| v * rim))
+    };
+    // The first of the rim and the rest, each with its own slope.
+    let event = |_: T, y: &State<T>, _: T, dy: &State<T>| {
+        let at_rim = rim_event(y, dy);
+        let at_rest = (
+            rest::turned([y[2], y[3]], last.get()) / speed_scale,
+            rest::turned([dy[2], dy[3]], last.get()) / speed_scale,
+        );
+        if at_rim.0 >= at_rest.0 {
+            at_rim
+        } else {
+            at_rest
+        }
+    };
+    match method {
         RollingMethod::Dp54 { rtol } => {
-            let speed_scale = scene.combined_speed_rad_s().max(T::ONE);
             let atol = [
                 rtol,
                 rtol,
@@ -85,46 +199,24 @@ pub fn residence_within<T: Real>(
                 rtol * speed_scale,
             ];
             let h0 = T::from_f64(1e-3) / speed_scale;
-            system::dp54(
-                rhs_scaled,
-                T::ZERO,
+            system::dp54_with(
+                rhs,
+                t0,
                 scaled(&y0),
-                rtol,
-                atol,
+                (rtol, atol),
                 h0,
-                event,
-                watch_scaled,
+                &event,
+                check,
+                |_, _, _| T::ZERO,
                 limits,
             )
         }
-        RollingMethod::Rk4 { step_s } => system::rk4(
-            rhs_scaled,
-            T::ZERO,
-            scaled(&y0),
-            step_s,
-            event,
-            watch_scaled,
-            limits,
-        ),
+        RollingMethod::Rk4 { step_s } => {
+            system::rk4_with(rhs, t0, scaled(&y0), step_s, &event, check, limits)
+        }
     }
-    .map_err(RollingError::Integration)?;
-    let outcome = match run.ended {
-        Ended::Event { t, y } => RollingOutcome::Leaves {
-            residence_time_s: t,
-            exit_speed_m_s: (y[2] * y[2] + y[3] * y[3]).sqrt() * rim,
-            max_friction_ratio: max_ratio,
-            first_slip_s: first_slip,
-        },
-        Ended::Stopped { why, .. } => RollingOutcome::LiftsOff { time_s: why },
-        Ended::Horizon { .. } => RollingOutcome::NotLeftBy {
-            horizon_s: limits.horizon_s,
-        },
-    };
-    Ok(RollingReport {
-        outcome,
-        evaluations: run.evaluations,
-        steps: run.steps,
-    })
+    .map(|run| (run, last.get()))
+    .map_err(RollingError::Integration)
 }
 
 /// Residence times over the release azimuths `beta = 0, 30, ..., 330` degrees.

@@ -18,6 +18,7 @@ pub mod modes;
 pub mod slide;
 
 mod integrate;
+pub(crate) mod rest;
 pub use integrate::{
     AZIMUTHS_DEG, AzimuthSummary, AzimuthTally, over_azimuths_within, residence,
     residence_over_azimuths, residence_within,
@@ -160,10 +161,16 @@ impl<T: Real> RollingScene<T> {
             .sqrt()
     }
 
-    /// Whether the forces in the bowl's frame are constant in time (no precession, or a
-    /// precession about the bowl's own axis with the bowl on it): then a held granule stays.
+    /// Whether the forces in the bowl's frame are constant in time (no precession and a bowl
+    /// that does not spin or spins about the vertical, or a precession about the bowl's own
+    /// axis with the bowl on it): then a held granule stays. A tilted bowl that only spins is
+    /// not: gravity turns in its frame at the spin (`gB` in [`equations`]), and a granule held
+    /// at its release can be let go as it turns (2 deg tilt, 3 rad/s, ri 30 mm, released at
+    /// 180 deg: "held" before, now it starts at 0.313 s and leaves at 1.155 s), which a held
+    /// segment (`rest`) finds.
     pub(crate) fn stationary(&self) -> bool {
-        self.precession_rad_s == T::ZERO
+        (self.precession_rad_s == T::ZERO
+            && (self.spin_rad_s == T::ZERO || self.axes_angle_rad == T::ZERO))
             || (self.axes_angle_rad == T::ZERO && self.rod_length_m == T::ZERO)
     }
 }
@@ -282,6 +289,9 @@ pub struct RollingReport<T> {
     pub evaluations: u32,
     /// Accepted steps.
     pub steps: u32,
+    /// Time held at rest on the way by the rolling resistance (`rest`), s: up to the outcome,
+    /// or the horizon.
+    pub held_s: T,
 }
 
 /// The horizon of a release, s: a granule still in the bowl after this long is reported as such.
@@ -361,5 +371,7 @@ pub fn at_rest_threshold_m_s<T: Real>() -> T {
 
 #[cfg(test)]
 mod modes_tests;
+#[cfg(test)]
+mod rest_tests;
 #[cfg(test)]
 mod tests;

@@ -27,12 +27,13 @@ mod stall;
 use core::cell::Cell;
 
 pub use report::{Mode, ModesOutcome, ModesReport, Regime, Tally};
-pub(crate) use segments::{fired, max3, scene_scales, segment};
+pub(crate) use segments::{fired, max3, max4, scene_scales, segment};
 pub(crate) use slip::{Chatter, Settle, SlipOf, follow_slip, stuck_m_s};
 pub use stall::STALL_STEP;
 pub(crate) use stall::StallWatch;
 
-use super::equations::{AT_REST_M_S, forces};
+use super::equations::{AT_REST_M_S, forces, forces_along, start_direction};
+use super::rest;
 use super::slide::{
     SlideState, from_rolling, needed_friction_m_s2, slide_forces, slide_forces_slaved, slip_m_s,
     to_rolling,
@@ -135,16 +136,32 @@ fn next_mode<T: Real>(
     Next::Slide(no_slip, [-ft[0] / need, -ft[1] / need])
 }
 
-/// The rolling state's roll -> slide, rim and lift-off events, each made dimensionless and
-/// negative inside: the run stops where the first of them reaches zero.
-fn roll_events<T: Real>(scene: &RollingScene<T>, t: T, y: &[T; 5], reference: T) -> [T; 3] {
+/// The rolling state's rim, roll -> slide, lift-off and rest events (the rest: the velocity
+/// turned against `last`, its direction at the last accepted step, [`rest::rest_event`]), each
+/// made dimensionless and negative inside: the run stops where the first of them reaches zero.
+fn roll_events<T: Real>(
+    scene: &RollingScene<T>,
+    t: T,
+    y: &[T; 5],
+    last: [T; 2],
+    refs: (T, T),
+) -> [T; 4] {
+    let (reference, speed_ref) = refs;
     let (ft, normal) = needed_friction_m_s2(scene, t, &from_rolling(y));
     let rim = scene.rim_radius_m;
     [
         (y[0] * y[0] + y[1] * y[1]) / (rim * rim) - T::ONE,
         ((ft[0] * ft[0] + ft[1] * ft[1]).sqrt() - scene.sliding_friction * normal) / reference,
         -normal / reference,
+        rest::turned([y[2], y[3]], last) / speed_ref,
     ]
+}
+
+/// How far the friction rolling needs at `(t, y)` exceeds what the contact gives,
+/// `|f_t| - mu_s N`, m/s^2.
+fn slide_margin<T: Real>(scene: &RollingScene<T>, t: T, y: &[T; 5]) -> T {
+    let (ft, normal) = needed_friction_m_s2(scene, t, &from_rolling(y));
+    (ft[0] * ft[0] + ft[1] * ft[1]).sqrt() - scene.sliding_friction * normal
 }
 
 /// The sliding state's rim, slip-end and lift-off events (as [`roll_events`]). The slip ends
@@ -215,6 +232,8 @@ pub(crate) fn run_from<T: Real>(
     let (mut t, mut y) = (t0, y0);
     let mut previous: Option<Mode> = None;
     let mut must_slide = false;
+    // The hold just ended (the roll that follows starts from rest without holding again).
+    let mut from_hold = false;
     // One watch over the whole run: a stall can be one segment's steps or a run of segments
     // that each end where they start.
     let watch = StallWatch::new(stall_steps, scales, t0, method);
@@ -222,31 +241,63 @@ pub(crate) fn run_from<T: Real>(
     loop {
         let remaining = report.tally.remaining(limits, MAX_SWITCHES)?;
         let steps_before = report.tally.steps;
+        let held_before = core::mem::take(&mut from_hold);
         let (ended, which) = match next_mode(scene, t, &y, must_slide) {
             Next::LiftsOff => {
                 report.outcome = ModesOutcome::LiftsOff { time_s: t };
                 report.end_state = y;
                 return Ok(report);
             }
+            Next::Roll(yr) if !held_before && yr[2] == T::ZERO && yr[3] == T::ZERO => {
+                let Some(rest) = rest::held_at(scene, t, &yr) else {
+                    (y, from_hold) = (from_rolling(&yr), true);
+                    continue;
+                };
+                // Held at rest (`rest`) while the rolling resistance and static friction hold it.
+                report.tally.enter(&mut previous, Mode::Held);
+                let held = rest::hold(scene, t, &rest, limits.horizon_s, |t| {
+                    slide_margin(scene, t, &rest) / reference
+                });
+                report.tally.evaluations =
+                    report.tally.evaluations.saturating_add(held.evaluations);
+                let Some(te) = held.t else {
+                    report.tally.spend(Mode::Held, limits.horizon_s - t);
+                    report.end_state = from_rolling(&rest);
+                    return Ok(report);
+                };
+                report.tally.spend(Mode::Held, te - t);
+                (t, y, must_slide, from_hold) = (te, from_rolling(&rest), false, true);
+                continue;
+            }
             Next::Roll(yr) => {
                 report.tally.enter(&mut previous, Mode::Roll);
+                let last = Cell::new(start_direction(scene, t, &yr));
                 let Some((te, ye, _)) = segment(
                     &mut report.tally,
                     Mode::Roll,
-                    |t, y: &[T; 5]| forces(scene, t, y).derivative,
+                    |t, y: &[T; 5]| forces_along(scene, t, y, last.get()).derivative,
                     (t, yr),
                     method,
                     scales,
-                    |t, y: &[T; 5]| max3(roll_events(scene, t, y, reference)),
-                    |t, _| watch.check(t),
+                    |t, y: &[T; 5]| max4(roll_events(scene, t, y, last.get(), refs)),
+                    |t, y: &[T; 5]| {
+                        rest::follow_velocity([y[2], y[3]], &last);
+                        watch.check(t)
+                    },
                     None,
                     remaining,
                 )?
                 else {
                     return Ok(report);
                 };
-                let which = fired(&roll_events(scene, te, &ye, reference));
+                let which = fired(&roll_events(scene, te, &ye, last.get(), refs));
                 chatter.after(report.tally.steps - steps_before, false);
+                if which == 3 {
+                    // At rest: held there with no velocity at all, or rolling on.
+                    let ye = rest::held_at(scene, te, &ye).unwrap_or(ye);
+                    (t, y, must_slide) = (te, from_rolling(&ye), false);
+                    continue;
+                }
                 ((te, from_rolling(&ye), ye[2], ye[3]), which)
             }
             Next::Slide(ys, dir0) => {

@@ -16,6 +16,8 @@ pub enum Mode {
     Roll,
     /// Sliding: the contact point slips.
     Slide,
+    /// At rest, held there by the rolling resistance (and static friction).
+    Held,
 }
 
 /// The time a release spent in each mode, s.
@@ -25,16 +27,23 @@ pub struct Regime<T> {
     pub roll_s: T,
     /// Sliding, s.
     pub slide_s: T,
+    /// Held at rest on the bottom by the rolling resistance, s.
+    pub held_s: T,
 }
 
 impl<T: Real> Regime<T> {
-    /// Each mode's share of the time (0 and 0 for a release that never moved).
-    pub fn shares(&self) -> (T, T) {
-        let total = self.roll_s + self.slide_s;
+    /// Each mode's share of the time, rolling, sliding and held (0s for a release that never
+    /// moved).
+    pub fn shares(&self) -> (T, T, T) {
+        let total = self.roll_s + self.slide_s + self.held_s;
         if total > T::ZERO {
-            (self.roll_s / total, self.slide_s / total)
+            (
+                self.roll_s / total,
+                self.slide_s / total,
+                self.held_s / total,
+            )
         } else {
-            (T::ZERO, T::ZERO)
+            (T::ZERO, T::ZERO, T::ZERO)
         }
     }
 }
@@ -87,6 +96,7 @@ impl<T: Real> Tally<T> {
             regime: Regime {
                 roll_s: T::ZERO,
                 slide_s: T::ZERO,
+                held_s: T::ZERO,
             },
             switches: 0,
             evaluations: 0,
@@ -120,10 +130,11 @@ impl<T: Real> Tally<T> {
     }
 
     /// Adds `dt` to the time in `mode`.
-    pub(super) fn spend(&mut self, mode: Mode, dt: T) {
+    pub(crate) fn spend(&mut self, mode: Mode, dt: T) {
         match mode {
             Mode::Roll => self.regime.roll_s += dt,
             Mode::Slide => self.regime.slide_s += dt,
+            Mode::Held => self.regime.held_s += dt,
         }
     }
 }

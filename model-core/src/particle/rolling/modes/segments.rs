@@ -15,6 +15,10 @@ pub(crate) fn max3<T: Real>(v: [T; 3]) -> T {
     v[0].max(v[1]).max(v[2])
 }
 
+pub(crate) fn max4<T: Real>(v: [T; 4]) -> T {
+    max3([v[0], v[1], v[2]]).max(v[3])
+}
+
 /// The event of the three that fired: the one closest to zero from below (the others are
 /// still negative where the first reaches zero).
 pub(crate) fn fired<T: Real>(v: &[T]) -> usize {

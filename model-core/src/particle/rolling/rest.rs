@@ -1,0 +1,121 @@
+//! A rolling granule that comes to rest and is held there by the rolling resistance
+//! (docs/model.md §9): its own segment of a run, between two located events, so that no step
+//! straddles the switch of the equations at rest (issue 30).
+//!
+//! * roll -> held where the velocity relative to the bowl turns against its direction at the
+//!   last accepted step ([`rest_event`]; the resistance holds that direction once the velocity
+//!   is at rest or reversed, [`super::equations::forces_along`], so the crossing is smooth and
+//!   located on the step's interpolant) and the resistance can hold the granule there
+//!   (`|D| <= mu_r N/m`): the velocity is then zero exactly;
+//! * held -> roll where `|D| - mu_r N/m` ([`rest_margin_m_s2`]) reaches zero from below: the
+//!   roll restarts from rest along `D/|D|`. While held nothing of the state moves (the position
+//!   is fixed in the bowl and the spin's rate `-(Ox ux + Oy uy)` is zero); only the forces
+//!   change with time, so the segment is sampled in time ([`HOLD_STEPS`]) and the crossing
+//!   located between two samples.
+
+use core::cell::Cell;
+
+use super::RollingScene;
+use super::equations::{AT_REST_M_S, State, rest_margin_m_s2};
+use crate::Real;
+use crate::ode::event::locate;
+
+/// Samples of a held segment per unit of the scene's time scale `1 / max(|Omega|, 1 rad/s)`:
+/// the forces on a granule at rest change with the bowl's turn, by about a radian per time
+/// scale, so the margin is sampled every 1/16 rad of it.
+pub const HOLD_STEPS: f64 = 16.0;
+
+/// The roll -> held event of a roll whose velocity `u` had the direction `last` at the last
+/// accepted step: `-(u . last)`, zero where the velocity stops or turns across `last` (and
+/// linear in `u`: its slope along a step is that of the step's velocity change).
+pub(crate) fn turned<T: Real>(u: [T; 2], last: [T; 2]) -> T {
+    -(u[0] * last[0] + u[1] * last[1])
+}
+
+/// After an accepted step of a roll whose velocity is `u`: the direction `last` follows the
+/// velocity while it still goes along it (the velocity at rest or reversed is the event).
+pub(crate) fn follow_velocity<T: Real>(u: [T; 2], last: &Cell<[T; 2]>) {
+    let d = last.get();
+    let speed = (u[0] * u[0] + u[1] * u[1]).sqrt();
+    if speed > T::from_f64(AT_REST_M_S) && u[0] * d[0] + u[1] * d[1] > T::ZERO {
+        last.set([u[0] / speed, u[1] / speed]);
+    }
+}
+
+/// The speed, in units of the scene's (its radius times `max(|Omega|, 1 rad/s)`), below which
+/// a roll's velocity at its rest event is a rest: at a located rest only the integration's
+/// error is left of it (at most `rtol` of that scale), while a velocity that turned by more
+/// than a right angle within one step keeps its size.
+pub const REST_SPEED: f64 = 1e-4;
+
+/// A rolling state at `t` as the granule at rest, if it is at rest ([`REST_SPEED`]) and the
+/// rolling resistance holds it there.
+pub(crate) fn held_at<T: Real>(scene: &RollingScene<T>, t: T, y: &State<T>) -> Option<State<T>> {
+    let speed = (y[2] * y[2] + y[3] * y[3]).sqrt();
+    let scale = scene.rim_radius_m * scene.combined_speed_rad_s().max(T::ONE);
+    let rest = [y[0], y[1], T::ZERO, T::ZERO, y[4]];
+    (speed <= T::from_f64(REST_SPEED) * scale && rest_margin_m_s2(scene, t, &rest) <= T::ZERO)
+        .then_some(rest)
+}
+
+/// How a held segment ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct HoldEnd<T> {
+    /// When it ended, s (`None`: still held at the horizon).
+    pub(crate) t: Option<T>,
+    /// Right-hand sides (forces) it evaluated.
+    pub(crate) evaluations: u32,
+}
+
+/// The granule held at rest in `y` from `t0` until the first of `|D| - mu_r N/m` and the
+/// caller's `other` event (dimensionless, negative while held; `super::modes`: rolling's need
+/// of friction reaching `mu_s N`) reaches zero, located to rounding between samples
+/// [`HOLD_STEPS`] apart, or the horizon.
+pub(crate) fn hold<T: Real>(
+    scene: &RollingScene<T>,
+    t0: T,
+    y: &State<T>,
+    horizon_s: T,
+    other: impl Fn(T) -> T,
+) -> HoldEnd<T> {
+    let reference = scene.g_m_s2 + T::ONE;
+    let event = |t: T| (rest_margin_m_s2(scene, t, y) / reference).max(other(t));
+    let h = T::ONE / (T::from_f64(HOLD_STEPS) * scene.combined_speed_rad_s().max(T::ONE));
+    let mut evaluations = 0u32;
+    let mut t = t0;
+    while t < horizon_s {
+        let t1 = (t + h).min(horizon_s);
+        evaluations = evaluations.saturating_add(1);
+        if event(t1) >= T::ZERO {
+            let span = t1 - t;
+            let count = Cell::new(0u32);
+            let g = |th: T| {
+                count.set(count.get() + 1);
+                let e = T::EPSILON.sqrt();
+                let slope =
+                    (event(t + (th + e) * span) - event(t + (th - e) * span)) / (T::TWO * e);
+                (event(t + th * span), slope)
+            };
+            let theta = locate(g, T::ZERO);
+            evaluations = evaluations.saturating_add(count.get().saturating_mul(3));
+            // The end where the margin has reached zero: never before it, so the roll that
+            // follows starts where the drive can move the granule.
+            let mut te = t + theta * span;
+            for _ in 0..8 {
+                if event(te) >= T::ZERO {
+                    break;
+                }
+                te = (te + T::from_f64(4.0) * T::EPSILON * te.abs().max(span)).min(t1);
+            }
+            return HoldEnd {
+                t: Some(te),
+                evaluations,
+            };
+        }
+        t = t1;
+    }
+    HoldEnd {
+        t: None,
+        evaluations,
+    }
+}
