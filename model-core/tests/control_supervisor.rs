@@ -506,26 +506,16 @@ fn a_speed_wandering_about_the_band_edge_stays_running() {
     );
     // Straying past twice the band is changing speed again, and coming back inside the band
     // (not only inside twice the band) is needed to be running again.
-    let far = [
-        r[0] + 2.1 * (REACHED_SHARE * 0.5 + REACHED_FLOOR_RAD_S),
-        r[1],
-    ];
-    assert_eq!(
-        closed_loop_state(State::Running, r, r, far),
-        State::ChangingSpeed
-    );
-    let back = [
-        r[0] + 1.5 * (REACHED_SHARE * 0.5 + REACHED_FLOOR_RAD_S),
-        r[1],
-    ];
-    assert_eq!(
-        closed_loop_state(State::ChangingSpeed, r, r, back),
-        State::ChangingSpeed
-    );
-    assert_eq!(
-        closed_loop_state(State::Running, r, r, back),
-        State::Running
-    );
+    let off = |bands: f32| {
+        [
+            r[0] + bands * (REACHED_SHARE * 0.5 + REACHED_FLOOR_RAD_S),
+            r[1],
+        ]
+    };
+    let after = |was: State, bands: f32| closed_loop_state(was, r, r, off(bands));
+    assert_eq!(after(State::Running, 2.1), State::ChangingSpeed);
+    assert_eq!(after(State::ChangingSpeed, 1.5), State::ChangingSpeed);
+    assert_eq!(after(State::Running, 1.5), State::Running);
     // A ramp that has not ended is changing speed however close the speed is.
     assert_eq!(
         closed_loop_state(State::Running, [0.5, -1.0], [0.6, -1.0], r),
