@@ -74,7 +74,10 @@ pub fn residence_within<T: Real>(
     let (mut t, mut y) = (T::ZERO, y0);
     // Rolls and holds at rest in turn (`rest`), each ended by a located event.
     let mut from_hold = false;
+    // The roll restarts from the edge of holding ([`rest::start_speed_m_s`]).
+    let mut restart = false;
     for _ in 0..MAX_SWITCHES {
+        let restarts = core::mem::take(&mut restart);
         if !from_hold
             && y[2] == T::ZERO
             && y[3] == T::ZERO
@@ -91,7 +94,7 @@ pub fn residence_within<T: Real>(
                 }
                 Some(t1) => {
                     held_s += t1 - t;
-                    (t, y, from_hold) = (t1, rest, true);
+                    (t, y, from_hold, restart) = (t1, rest, true, true);
                     continue;
                 }
             };
@@ -110,7 +113,8 @@ pub fn residence_within<T: Real>(
         if remaining.max_steps == 0 {
             break;
         }
-        let (run, last) = roll(scene, (t, y), method, remaining, &mut watch)?;
+        let start = restarts.then(|| rest::start_speed_m_s(scene));
+        let (run, last) = roll(scene, (t, y), method, start, remaining, &mut watch)?;
         evaluations = evaluations.saturating_add(run.evaluations);
         steps = steps.saturating_add(run.steps);
         let outcome = match run.ended {
@@ -133,7 +137,16 @@ pub fn residence_within<T: Real>(
                 (t, y) = (te, rest::held_at(scene, te, &ye).unwrap_or(ye));
                 continue;
             }
-            Ended::Stopped { why, .. } => RollingOutcome::LiftsOff { time_s: why },
+            Ended::Stopped {
+                t: te,
+                y: ye,
+                why: None,
+            } => {
+                // A restart from a hold under way: the roll goes on at the scene's tolerances.
+                (t, y) = (te, ye.map(|v| v * rim));
+                continue;
+            }
+            Ended::Stopped { why: Some(t), .. } => RollingOutcome::LiftsOff { time_s: t },
             Ended::Horizon { .. } => RollingOutcome::NotLeftBy {
                 horizon_s: limits.horizon_s,
             },
@@ -153,16 +166,23 @@ fn speed_scale<T: Real>(scene: &RollingScene<T>) -> T {
     scene.combined_speed_rad_s().max(T::ONE)
 }
 
+/// A roll's run; a stop by its check carries the lift-off's time, or `None` where a restart
+/// from a hold got under way.
+type Roll<T> = system::Run<T, 5, Option<T>>;
+
 /// One roll from `(t0, y0)` (m, m/s) to the rim, a rest ([`rest::rest_event`]), the watch's
-/// stop (lift-off) or the horizon; the event's state in units of the rim's radius, and the
-/// velocity's direction at the last accepted step (the rest event's).
+/// stop (lift-off, `Some` of its time) or the horizon; the event's state in units of the rim's
+/// radius, and the velocity's direction at the last accepted step (the rest event's). `start`:
+/// a restart from a hold, stopped (`None`) once its speed reaches this (m/s), its velocity
+/// held to `rtol` of it ([`rest::start_speed_m_s`]).
 fn roll<T: Real>(
     scene: &RollingScene<T>,
     (t0, y0): (T, State<T>),
     method: RollingMethod<T>,
+    start: Option<T>,
     limits: SystemLimits<T>,
     watch: &mut impl FnMut(T, &State<T>) -> ControlFlow<T>,
-) -> Result<(system::Run<T, 5, T>, [T; 2]), RollingError> {
+) -> Result<(Roll<T>, [T; 2]), RollingError> {
     let rim = scene.rim_radius_m;
     let last = Cell::new(start_direction(scene, t0, &y0));
     // Lengths in units of R: the rim is then the fixed |(x, y)| = 1.
@@ -172,9 +192,17 @@ fn roll<T: Real>(
     let rhs = |t: T, y: &State<T>| -> State<T> {
         scaled(&forces_along(scene, t, &y.map(|v| v * rim), last.get()).derivative)
     };
+    // The start speed in the scaled state.
+    let start = start.map(|s| s * scale);
     let check = |t: T, y: &State<T>| {
         rest::follow_velocity([y[2], y[3]], &last);
-        watch(t, &y.map(|v| v * rim))
+        if let ControlFlow::Break(t) = watch(t, &y.map(|v| v * rim)) {
+            return ControlFlow::Break(Some(t));
+        }
+        match start {
+            Some(s) if y[2] * y[2] + y[3] * y[3] >= s * s => ControlFlow::Break(None),
+            _ => ControlFlow::Continue(()),
+        }
     };
     // The first of the rim and the rest, each with its own slope.
     let event = |_: T, y: &State<T>, _: T, dy: &State<T>| {
@@ -191,13 +219,8 @@ fn roll<T: Real>(
     };
     match method {
         RollingMethod::Dp54 { rtol } => {
-            let atol = [
-                rtol,
-                rtol,
-                rtol * speed_scale,
-                rtol * speed_scale,
-                rtol * speed_scale,
-            ];
+            let speed = start.unwrap_or(speed_scale);
+            let atol = [rtol, rtol, rtol * speed, rtol * speed, rtol * speed];
             let h0 = T::from_f64(1e-3) / speed_scale;
             system::dp54_with(
                 rhs,

@@ -48,6 +48,21 @@ pub(crate) fn follow_velocity<T: Real>(u: [T; 2], last: &Cell<[T; 2]>) {
 /// than a right angle within one step keeps its size.
 pub const REST_SPEED: f64 = 1e-4;
 
+/// The speed, m/s ([`REST_SPEED`] of the scene's), up to which a roll that restarts from a hold
+/// is a stretch of its own, its velocity held to `rtol` of this speed instead of the scene's.
+/// It restarts where `|D| - mu_r N/m` crosses zero, so its speed grows only as the square of
+/// the time since, and a velocity error `du` shifts the whole run by `du / (du/dt)`: large
+/// while `du/dt` is still near zero. There the resistance's direction `u/|u|` is stiff (its
+/// rate `k2 mu_r (N/m) / |u|`); at the scene's tolerance (`rtol` of its speed, far above the
+/// speed itself) the steps ran at that stiffness's limit, the direction wobbled by tens of
+/// degrees, the drive along the velocity fell short of the resistance and the speed hovered at
+/// [`AT_REST_M_S`] for 0.3 ms, then fired a rest event of its own: a release held on the way
+/// was 3.3e-5 s off at rtol 1e-8 (3.92 deg tilt, 0.971 and 3.206 rad/s, 150 deg; `rest_tests`).
+/// Above this speed the wobble at the scene's tolerance is below `rtol / REST_SPEED` rad.
+pub(crate) fn start_speed_m_s<T: Real>(scene: &RollingScene<T>) -> T {
+    T::from_f64(REST_SPEED) * scene.rim_radius_m * scene.combined_speed_rad_s().max(T::ONE)
+}
+
 /// A rolling state at `t` as the granule at rest, if it is at rest ([`REST_SPEED`]) and the
 /// rolling resistance holds it there.
 pub(crate) fn held_at<T: Real>(scene: &RollingScene<T>, t: T, y: &State<T>) -> Option<State<T>> {

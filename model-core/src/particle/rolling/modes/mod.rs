@@ -25,10 +25,11 @@ mod slip;
 mod stall;
 
 use core::cell::Cell;
+use core::ops::ControlFlow;
 
 pub use report::{Mode, ModesOutcome, ModesReport, Regime, Tally};
 pub(crate) use segments::{fired, max3, max4, scene_scales, segment};
-pub(crate) use slip::{Chatter, Settle, SlipOf, follow_slip, stuck_m_s};
+pub(crate) use slip::{Chatter, Settle, SlipOf, Stop, follow_slip, stuck_m_s};
 pub use stall::STALL_STEP;
 pub(crate) use stall::StallWatch;
 
@@ -234,6 +235,9 @@ pub(crate) fn run_from<T: Real>(
     let mut must_slide = false;
     // The hold just ended (the roll that follows starts from rest without holding again).
     let mut from_hold = false;
+    // The hold just ended where the drive began to exceed the resistance (the roll that
+    // follows restarts from the edge of holding: [`rest::start_speed_m_s`]).
+    let mut restart = false;
     // One watch over the whole run: a stall can be one segment's steps or a run of segments
     // that each end where they start.
     let watch = StallWatch::new(stall_steps, scales, t0, method);
@@ -242,6 +246,7 @@ pub(crate) fn run_from<T: Real>(
         let remaining = report.tally.remaining(limits, MAX_SWITCHES)?;
         let steps_before = report.tally.steps;
         let held_before = core::mem::take(&mut from_hold);
+        let restarts = core::mem::take(&mut restart);
         let (ended, which) = match next_mode(scene, t, &y, must_slide) {
             Next::LiftsOff => {
                 report.outcome = ModesOutcome::LiftsOff { time_s: t };
@@ -266,23 +271,33 @@ pub(crate) fn run_from<T: Real>(
                     return Ok(report);
                 };
                 report.tally.spend(Mode::Held, te - t);
-                (t, y, must_slide, from_hold) = (te, from_rolling(&rest), false, true);
+                (t, y, must_slide) = (te, from_rolling(&rest), false);
+                (from_hold, restart) = (true, true);
                 continue;
             }
             Next::Roll(yr) => {
                 report.tally.enter(&mut previous, Mode::Roll);
                 let last = Cell::new(start_direction(scene, t, &yr));
-                let Some((te, ye, _)) = segment(
+                // A restart from a hold: up to its start speed, a stretch of its own with the
+                // velocity held to `rtol` of that speed (`rest::start_speed_m_s`).
+                let start = restarts.then(|| rest::start_speed_m_s(scene));
+                let Some((te, ye, started)) = segment(
                     &mut report.tally,
                     Mode::Roll,
                     |t, y: &[T; 5]| forces_along(scene, t, y, last.get()).derivative,
                     (t, yr),
                     method,
-                    scales,
+                    start.map_or(scales, |speed| (scales.0, speed)),
                     |t, y: &[T; 5]| max4(roll_events(scene, t, y, last.get(), refs)),
                     |t, y: &[T; 5]| {
                         rest::follow_velocity([y[2], y[3]], &last);
-                        watch.check(t)
+                        watch.check(t)?;
+                        match start {
+                            Some(s) if y[2] * y[2] + y[3] * y[3] >= s * s => {
+                                ControlFlow::Break(Stop::Started)
+                            }
+                            _ => ControlFlow::Continue(()),
+                        }
                     },
                     None,
                     remaining,
@@ -290,6 +305,11 @@ pub(crate) fn run_from<T: Real>(
                 else {
                     return Ok(report);
                 };
+                if started {
+                    // Under way: the roll goes on at the scene's own tolerances.
+                    (t, y, must_slide) = (te, from_rolling(&ye), false);
+                    continue;
+                }
                 let which = fired(&roll_events(scene, te, &ye, last.get(), refs));
                 chatter.after(report.tally.steps - steps_before, false);
                 if which == 3 {

@@ -46,7 +46,8 @@ pub(crate) fn scene_scales<T: Real>(scene: &RollingScene<T>) -> ((T, T), (T, T))
 /// Integrates one segment in `mode` from `(t0, y0)` with the method, stopping at the first
 /// event, and adds its cost and its time to `tally`: the event's time and state, or `None` at
 /// the horizon; the flag says the check stopped it there with the slide settled
-/// ([`super::slip::Settle`]: the slip at rest, as where the slip-end event fires). `slip`: a
+/// ([`super::slip::Settle`]: the slip at rest, as where the slip-end event fires) or a roll
+/// restarted from a hold under way ([`Stop::Started`]). `slip`: a
 /// slide's slip, held to [`slip_error`]'s tolerance besides the
 /// components' by DP5(4), and near which RK4 grades its steps ([`graded_step`]) (`None` where
 /// the contact does not slip).
@@ -106,7 +107,7 @@ pub(crate) fn segment<T: Real, const N: usize>(
         Ended::Stopped {
             t,
             y,
-            why: Stop::Settled,
+            why: Stop::Settled | Stop::Started,
         } => {
             tally.spend(mode, t - t0);
             Ok(Some((t, y, true)))

@@ -49,6 +49,9 @@ pub(crate) enum Stop {
     Stalled,
     /// A slide's slip has come down to rest and stays there ([`Settle`]): the slide has ended.
     Settled,
+    /// A roll restarted from a hold has reached its start speed
+    /// (`crate::particle::rolling::rest::start_speed_m_s`): it goes on as any roll.
+    Started,
 }
 
 /// How long a slide's slip must stay at rest ([`SETTLED_M_S`]) where rolling needs no more
