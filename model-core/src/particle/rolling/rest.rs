@@ -67,9 +67,8 @@ pub(crate) fn start_speed_m_s<T: Real>(scene: &RollingScene<T>) -> T {
 /// rolling resistance holds it there.
 pub(crate) fn held_at<T: Real>(scene: &RollingScene<T>, t: T, y: &State<T>) -> Option<State<T>> {
     let speed = (y[2] * y[2] + y[3] * y[3]).sqrt();
-    let scale = scene.rim_radius_m * scene.combined_speed_rad_s().max(T::ONE);
     let rest = [y[0], y[1], T::ZERO, T::ZERO, y[4]];
-    (speed <= T::from_f64(REST_SPEED) * scale && rest_margin_m_s2(scene, t, &rest) <= T::ZERO)
+    (speed <= start_speed_m_s(scene) && rest_margin_m_s2(scene, t, &rest) <= T::ZERO)
         .then_some(rest)
 }
 
