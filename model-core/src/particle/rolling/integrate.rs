@@ -8,6 +8,7 @@ use core::cell::Cell;
 use super::equations::{State, forces, forces_along, start_direction};
 use super::modes::MAX_SWITCHES;
 use super::rest;
+use super::rest_loop::{self, AfterHold, AfterPiece, AfterRoll, RollPieces, Rolled};
 use super::{
     RollingError, RollingMethod, RollingOutcome, RollingReport, RollingScene, default_limits,
     release,
@@ -43,8 +44,6 @@ pub fn residence_within<T: Real>(
     limits: SystemLimits<T>,
 ) -> Result<RollingReport<T>, RollingError> {
     let y0 = release(scene, beta_rad)?;
-    // Lengths in units of R: the event is then |r|^2 - 1 = 0 with a fixed target.
-    let rim = scene.rim_radius_m;
     let start = forces(scene, T::ZERO, &y0);
     if start.held && scene.stationary() {
         return Ok(RollingReport {
@@ -54,111 +53,133 @@ pub fn residence_within<T: Real>(
             held_s: T::ZERO,
         });
     }
-    let mut max_ratio = T::ZERO;
-    let mut first_slip = None;
-    let mut watch = |t: T, y: &State<T>| -> ControlFlow<T> {
-        let f = forces(scene, t, y);
-        if f.normal_m_s2 <= T::ZERO {
-            return ControlFlow::Break(t);
-        }
-        let ratio = f.friction_m_s2 / f.normal_m_s2;
-        max_ratio = max_ratio.max(ratio);
-        if first_slip.is_none() && ratio > scene.sliding_friction {
-            first_slip = Some(t);
-        }
-        ControlFlow::Continue(())
+    let mut plain = PlainRoll {
+        scene,
+        method,
+        limits,
+        pieces: 1,
+        evaluations: 1,
+        steps: 0,
+        held_s: T::ZERO,
+        max_ratio: T::ZERO,
+        first_slip: None,
     };
-    let (mut evaluations, mut steps) = (1u32, 0u32);
-    let speed_scale = speed_scale(scene);
-    let mut held_s = T::ZERO;
-    let (mut t, mut y) = (T::ZERO, y0);
     // Rolls and holds at rest in turn (`rest`), each ended by a located event.
-    let mut from_hold = false;
-    // The roll restarts from the edge of holding ([`rest::start_speed_m_s`]).
-    let mut restart = false;
-    for _ in 0..MAX_SWITCHES {
-        let restarts = core::mem::take(&mut restart);
-        if !from_hold
-            && y[2] == T::ZERO
-            && y[3] == T::ZERO
-            && let Some(rest) = rest::held_at(scene, t, &y)
-        {
-            let held = rest::hold(scene, t, &rest, limits.horizon_s, |_| -T::ONE);
-            evaluations = evaluations.saturating_add(held.evaluations);
-            let outcome = match held.t {
-                None => RollingOutcome::NotLeftBy {
-                    horizon_s: limits.horizon_s,
-                },
-                Some(t1) if forces(scene, t1, &rest).normal_m_s2 <= T::ZERO => {
-                    RollingOutcome::LiftsOff { time_s: t1 }
-                }
-                Some(t1) => {
-                    held_s += t1 - t;
-                    (t, y, from_hold, restart) = (t1, rest, true, true);
-                    continue;
-                }
-            };
-            return Ok(RollingReport {
-                outcome,
-                evaluations,
-                steps,
-                held_s: held_s + held.t.unwrap_or(limits.horizon_s) - t,
-            });
+    rest_loop::roll_with_rests(scene, &mut plain, (T::ZERO, y0))
+}
+
+/// The rolling model's pieces of [`rest_loop::roll_with_rests`], and what they have cost and
+/// seen so far.
+struct PlainRoll<'a, T> {
+    scene: &'a RollingScene<T>,
+    method: RollingMethod<T>,
+    limits: SystemLimits<T>,
+    /// Pieces (rolls and holds) begun: at most [`MAX_SWITCHES`].
+    pieces: u32,
+    evaluations: u32,
+    steps: u32,
+    held_s: T,
+    /// The largest friction ratio `|f_t| / N` rolling needed so far.
+    max_ratio: T,
+    /// When rolling first needed more friction than there is, s.
+    first_slip: Option<T>,
+}
+
+impl<T: Real> PlainRoll<'_, T> {
+    fn report(&self, outcome: RollingOutcome<T>, held_s: T) -> RollingReport<T> {
+        RollingReport {
+            outcome,
+            evaluations: self.evaluations,
+            steps: self.steps,
+            held_s,
         }
-        from_hold = false;
+    }
+}
+
+impl<T: Real> RollPieces<T> for PlainRoll<'_, T> {
+    type End = RollingReport<T>;
+
+    fn next(&mut self, _: T, y: &State<T>) -> AfterPiece<T, Self::End> {
+        // A granule that rests and restarts at every step is reported as a step limit, not
+        // followed forever.
+        self.pieces += 1;
+        if self.pieces > MAX_SWITCHES {
+            return Err(RollingError::Integration(SystemError::StepLimit));
+        }
+        Ok(ControlFlow::Continue(*y))
+    }
+
+    fn hold(&mut self, t: T, rest: &State<T>) -> AfterHold<T, Self::End> {
+        let (scene, horizon_s) = (self.scene, self.limits.horizon_s);
+        let held = rest::hold(scene, t, rest, horizon_s, |_| -T::ONE);
+        self.evaluations = self.evaluations.saturating_add(held.evaluations);
+        let outcome = match held.t {
+            None => RollingOutcome::NotLeftBy { horizon_s },
+            Some(t1) if forces(scene, t1, rest).normal_m_s2 <= T::ZERO => {
+                RollingOutcome::LiftsOff { time_s: t1 }
+            }
+            Some(t1) => {
+                self.held_s += t1 - t;
+                return Ok(ControlFlow::Continue(t1));
+            }
+        };
+        let held_s = self.held_s + held.t.unwrap_or(horizon_s) - t;
+        Ok(ControlFlow::Break(self.report(outcome, held_s)))
+    }
+
+    fn roll(&mut self, t: T, y: &State<T>, start: Option<T>) -> AfterRoll<T, Self::End> {
+        let (scene, limits) = (self.scene, self.limits);
+        let rim = scene.rim_radius_m;
         let remaining = SystemLimits {
-            max_steps: limits.max_steps.saturating_sub(steps),
+            max_steps: limits.max_steps.saturating_sub(self.steps),
             ..limits
         };
         if remaining.max_steps == 0 {
-            break;
+            return Err(RollingError::Integration(SystemError::StepLimit));
         }
-        let start = restarts.then(|| rest::start_speed_m_s(scene));
-        let (run, last) = roll(scene, (t, y), method, start, remaining, &mut watch)?;
-        evaluations = evaluations.saturating_add(run.evaluations);
-        steps = steps.saturating_add(run.steps);
+        let (max_ratio, first_slip) = (&mut self.max_ratio, &mut self.first_slip);
+        let mut watch = |t: T, y: &State<T>| -> ControlFlow<T> {
+            let f = forces(scene, t, y);
+            if f.normal_m_s2 <= T::ZERO {
+                return ControlFlow::Break(t);
+            }
+            let ratio = f.friction_m_s2 / f.normal_m_s2;
+            *max_ratio = max_ratio.max(ratio);
+            if first_slip.is_none() && ratio > scene.sliding_friction {
+                *first_slip = Some(t);
+            }
+            ControlFlow::Continue(())
+        };
+        let (run, last) = roll(scene, (t, *y), self.method, start, remaining, &mut watch)?;
+        self.evaluations = self.evaluations.saturating_add(run.evaluations);
+        self.steps = self.steps.saturating_add(run.steps);
         let outcome = match run.ended {
             // The first of the two events: the one nearer zero (each is located to rounding).
             Ended::Event { t: te, y: ye }
                 if rim_event(&ye, &[T::ZERO; 5]).0
-                    >= rest::turned([ye[2], ye[3]], last) / speed_scale =>
+                    >= rest::turned([ye[2], ye[3]], last) / speed_scale(scene) =>
             {
                 RollingOutcome::Leaves {
                     residence_time_s: te,
                     exit_speed_m_s: (ye[2] * ye[2] + ye[3] * ye[3]).sqrt() * rim,
-                    max_friction_ratio: max_ratio,
-                    first_slip_s: first_slip,
+                    max_friction_ratio: self.max_ratio,
+                    first_slip_s: self.first_slip,
                 }
             }
-            Ended::Event { t: te, y: ye } => {
-                // The velocity came to rest (or turned by more than a right angle in a step):
-                // held there with no velocity at all, or rolling on.
-                let ye = ye.map(|v| v * rim);
-                (t, y) = (te, rest::held_at(scene, te, &ye).unwrap_or(ye));
-                continue;
-            }
+            // The velocity came to rest (or turned by more than a right angle in a step).
+            Ended::Event { t: te, y: ye } => return Ok(Rolled::Rest(te, ye.map(|v| v * rim))),
             Ended::Stopped {
                 t: te,
                 y: ye,
                 why: None,
-            } => {
-                // A restart from a hold under way: the roll goes on at the scene's tolerances.
-                (t, y) = (te, ye.map(|v| v * rim));
-                continue;
-            }
+            } => return Ok(Rolled::Started(te, ye.map(|v| v * rim))),
             Ended::Stopped { why: Some(t), .. } => RollingOutcome::LiftsOff { time_s: t },
             Ended::Horizon { .. } => RollingOutcome::NotLeftBy {
                 horizon_s: limits.horizon_s,
             },
         };
-        return Ok(RollingReport {
-            outcome,
-            evaluations,
-            steps,
-            held_s,
-        });
+        Ok(Rolled::Ended(self.report(outcome, self.held_s)))
     }
-    Err(RollingError::Integration(SystemError::StepLimit))
 }
 
 /// The speed scale of a roll's state in units of the rim's radius, 1/s.
@@ -170,11 +191,11 @@ fn speed_scale<T: Real>(scene: &RollingScene<T>) -> T {
 /// from a hold got under way.
 type Roll<T> = system::Run<T, 5, Option<T>>;
 
-/// One roll from `(t0, y0)` (m, m/s) to the rim, a rest ([`rest::rest_event`]), the watch's
-/// stop (lift-off, `Some` of its time) or the horizon; the event's state in units of the rim's
-/// radius, and the velocity's direction at the last accepted step (the rest event's). `start`:
-/// a restart from a hold, stopped (`None`) once its speed reaches this (m/s), its velocity
-/// held to `rtol` of it ([`rest::start_speed_m_s`]).
+/// One roll from `(t0, y0)` (m, m/s) to the rim, a rest (the velocity turned against its last
+/// direction, [`rest::turned`]), the watch's stop (lift-off, `Some` of its time) or the
+/// horizon; the event's state in units of the rim's radius, and the velocity's direction at the
+/// last accepted step (the rest event's). `start`: a restart from a hold, stopped (`None`) once
+/// its speed reaches this (m/s), its velocity held to `rtol` of it ([`rest::start_speed_m_s`]).
 fn roll<T: Real>(
     scene: &RollingScene<T>,
     (t0, y0): (T, State<T>),

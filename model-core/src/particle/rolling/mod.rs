@@ -19,6 +19,7 @@ pub mod slide;
 
 mod integrate;
 pub(crate) mod rest;
+mod rest_loop;
 pub use integrate::{
     AZIMUTHS_DEG, AzimuthSummary, AzimuthTally, over_azimuths_within, residence,
     residence_over_azimuths, residence_within,
@@ -371,6 +372,8 @@ pub fn at_rest_threshold_m_s<T: Real>() -> T {
 
 #[cfg(test)]
 mod modes_tests;
+#[cfg(test)]
+mod rest_loop_tests;
 #[cfg(test)]
 mod rest_tests;
 #[cfg(test)]

@@ -9,7 +9,7 @@ use super::*;
 /// The scene a QA round found the rest stepped over in: 5 deg tilt, w1 = w2 = 3.2979 rad/s, a
 /// 75 mm bowl, released at 22.86 mm; its 150 deg release stops at about 0.16 s and is held
 /// there for about 86 ms before it rolls on.
-fn stopping() -> RollingScene<f64> {
+pub(super) fn stopping() -> RollingScene<f64> {
     RollingScene {
         precession_rad_s: 3.2979,
         spin_rad_s: 3.2979,

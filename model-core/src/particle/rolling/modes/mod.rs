@@ -14,27 +14,30 @@
 //! * the rim (the centre's contact point at radius `R`) and lift-off (`N` reaching zero) in
 //!   either mode.
 //!
-//! The run of modes on the bottom is here; what it gives and costs is `report.rs`, the parts the
+//! The run of modes on the bottom is here; the roll mode's pieces of the rolling model's loop
+//! through rests (`rest_loop`) are `roll.rs`; what it gives and costs is `report.rs`, the parts the
 //! wall's run (`bowl::wall_run`) shares with it are `segments.rs` (one segment between events)
 //! and `slip.rs` (a slide's slip: its direction, its end, its error), and the watch that gives up
 //! on a stalled run is `stall.rs`.
 
 mod report;
+mod roll;
 mod segments;
 mod slip;
 mod stall;
 
 use core::cell::Cell;
-use core::ops::ControlFlow;
 
 pub use report::{Mode, ModesOutcome, ModesReport, Regime, Tally};
-pub(crate) use segments::{fired, max3, max4, scene_scales, segment};
-pub(crate) use slip::{Chatter, Settle, SlipOf, Stop, follow_slip, stuck_m_s};
+pub(crate) use segments::{fired, max3, scene_scales, segment};
+pub(crate) use slip::{Chatter, Settle, SlipOf, follow_slip, stuck_m_s};
 pub use stall::STALL_STEP;
 pub(crate) use stall::StallWatch;
 
-use super::equations::{AT_REST_M_S, forces, forces_along, start_direction};
-use super::rest;
+use roll::{RollEnd, RollRun};
+
+use super::equations::{AT_REST_M_S, forces};
+use super::rest_loop::roll_with_rests;
 use super::slide::{
     SlideState, from_rolling, needed_friction_m_s2, slide_forces, slide_forces_slaved, slip_m_s,
     to_rolling,
@@ -137,40 +140,13 @@ fn next_mode<T: Real>(
     Next::Slide(no_slip, [-ft[0] / need, -ft[1] / need])
 }
 
-/// The rolling state's rim, roll -> slide, lift-off and rest events (the rest: the velocity
-/// turned against `last`, its direction at the last accepted step, [`rest::rest_event`]), each
-/// made dimensionless and negative inside: the run stops where the first of them reaches zero.
-fn roll_events<T: Real>(
-    scene: &RollingScene<T>,
-    t: T,
-    y: &[T; 5],
-    last: [T; 2],
-    refs: (T, T),
-) -> [T; 4] {
-    let (reference, speed_ref) = refs;
-    let (ft, normal) = needed_friction_m_s2(scene, t, &from_rolling(y));
-    let rim = scene.rim_radius_m;
-    [
-        (y[0] * y[0] + y[1] * y[1]) / (rim * rim) - T::ONE,
-        ((ft[0] * ft[0] + ft[1] * ft[1]).sqrt() - scene.sliding_friction * normal) / reference,
-        -normal / reference,
-        rest::turned([y[2], y[3]], last) / speed_ref,
-    ]
-}
-
-/// How far the friction rolling needs at `(t, y)` exceeds what the contact gives,
-/// `|f_t| - mu_s N`, m/s^2.
-fn slide_margin<T: Real>(scene: &RollingScene<T>, t: T, y: &[T; 5]) -> T {
-    let (ft, normal) = needed_friction_m_s2(scene, t, &from_rolling(y));
-    (ft[0] * ft[0] + ft[1] * ft[1]).sqrt() - scene.sliding_friction * normal
-}
-
-/// The sliding state's rim, slip-end and lift-off events (as [`roll_events`]). The slip ends
-/// where it turns against its last direction (it passes through zero in a step) or, once it
-/// has been above twice [`slip::STUCK`] roundings (`armed`), where it falls below that: a slip
-/// that shrinks while its direction turns (the needed friction near `mu_s N`) makes the
-/// equations stiff as it vanishes (the direction turns at a rate `|f| / |v_c|`), so the steps
-/// shrink with it and it would never be reached by steps alone.
+/// The sliding state's rim, slip-end and lift-off events (as the roll mode's,
+/// `roll::roll_events`). The slip ends where it turns against its last direction (it passes
+/// through zero in a step) or, once it has been above twice [`slip::STUCK`] roundings
+/// (`armed`), where it falls below that: a slip that shrinks while its direction turns (the
+/// needed friction near `mu_s N`) makes the equations stiff as it vanishes (the direction turns
+/// at a rate `|f| / |v_c|`), so the steps shrink with it and it would never be reached by steps
+/// alone.
 fn slide_events<T: Real>(
     scene: &RollingScene<T>,
     t: T,
@@ -216,7 +192,6 @@ pub(crate) fn run_from<T: Real>(
     stall_steps: Option<u32>,
 ) -> Result<ModesReport<T>, RollingError> {
     let (refs, scales) = scene_scales(scene);
-    let reference = refs.0;
     // A growing slip below the velocities' absolute tolerance: the friction opposes its free
     // acceleration (`slide::friction_direction`; RK4 has no tolerance, and keeps the slip's).
     let slaved = match method {
@@ -233,11 +208,6 @@ pub(crate) fn run_from<T: Real>(
     let (mut t, mut y) = (t0, y0);
     let mut previous: Option<Mode> = None;
     let mut must_slide = false;
-    // The hold just ended (the roll that follows starts from rest without holding again).
-    let mut from_hold = false;
-    // The hold just ended where the drive began to exceed the resistance (the roll that
-    // follows restarts from the edge of holding: [`rest::start_speed_m_s`]).
-    let mut restart = false;
     // One watch over the whole run: a stall can be one segment's steps or a run of segments
     // that each end where they start.
     let watch = StallWatch::new(stall_steps, scales, t0, method);
@@ -245,80 +215,31 @@ pub(crate) fn run_from<T: Real>(
     loop {
         let remaining = report.tally.remaining(limits, MAX_SWITCHES)?;
         let steps_before = report.tally.steps;
-        let held_before = core::mem::take(&mut from_hold);
-        let restarts = core::mem::take(&mut restart);
         let (ended, which) = match next_mode(scene, t, &y, must_slide) {
             Next::LiftsOff => {
                 report.outcome = ModesOutcome::LiftsOff { time_s: t };
                 report.end_state = y;
                 return Ok(report);
             }
-            Next::Roll(yr) if !held_before && yr[2] == T::ZERO && yr[3] == T::ZERO => {
-                let Some(rest) = rest::held_at(scene, t, &yr) else {
-                    (y, from_hold) = (from_rolling(&yr), true);
-                    continue;
-                };
-                // Held at rest (`rest`) while the rolling resistance and static friction hold it.
-                report.tally.enter(&mut previous, Mode::Held);
-                let held = rest::hold(scene, t, &rest, limits.horizon_s, |t| {
-                    slide_margin(scene, t, &rest) / reference
-                });
-                report.tally.evaluations =
-                    report.tally.evaluations.saturating_add(held.evaluations);
-                let Some(te) = held.t else {
-                    report.tally.spend(Mode::Held, limits.horizon_s - t);
-                    report.end_state = from_rolling(&rest);
-                    return Ok(report);
-                };
-                report.tally.spend(Mode::Held, te - t);
-                (t, y, must_slide) = (te, from_rolling(&rest), false);
-                (from_hold, restart) = (true, true);
-                continue;
-            }
             Next::Roll(yr) => {
-                report.tally.enter(&mut previous, Mode::Roll);
-                let last = Cell::new(start_direction(scene, t, &yr));
-                // A restart from a hold: up to its start speed, a stretch of its own with the
-                // velocity held to `rtol` of that speed (`rest::start_speed_m_s`).
-                let start = restarts.then(|| rest::start_speed_m_s(scene));
-                let Some((te, ye, started)) = segment(
-                    &mut report.tally,
-                    Mode::Roll,
-                    |t, y: &[T; 5]| forces_along(scene, t, y, last.get()).derivative,
-                    (t, yr),
+                let mut run = RollRun {
+                    scene,
                     method,
-                    start.map_or(scales, |speed| (scales.0, speed)),
-                    |t, y: &[T; 5]| max4(roll_events(scene, t, y, last.get(), refs)),
-                    |t, y: &[T; 5]| {
-                        rest::follow_velocity([y[2], y[3]], &last);
-                        watch.check(t)?;
-                        match start {
-                            Some(s) if y[2] * y[2] + y[3] * y[3] >= s * s => {
-                                ControlFlow::Break(Stop::Started)
-                            }
-                            _ => ControlFlow::Continue(()),
-                        }
-                    },
-                    None,
-                    remaining,
-                )?
-                else {
-                    return Ok(report);
+                    limits,
+                    scales: (refs, scales),
+                    watch: &watch,
+                    chatter: &mut chatter,
+                    report: &mut report,
+                    previous: &mut previous,
                 };
-                if started {
-                    // Under way: the roll goes on at the scene's own tolerances.
-                    (t, y, must_slide) = (te, from_rolling(&ye), false);
-                    continue;
+                match roll_with_rests(scene, &mut run, (t, yr))? {
+                    RollEnd::Report => return Ok(report),
+                    RollEnd::Judge(te, ye) => {
+                        (t, y, must_slide) = (te, ye, false);
+                        continue;
+                    }
+                    RollEnd::Event(ended, which) => (ended, which),
                 }
-                let which = fired(&roll_events(scene, te, &ye, last.get(), refs));
-                chatter.after(report.tally.steps - steps_before, false);
-                if which == 3 {
-                    // At rest: held there with no velocity at all, or rolling on.
-                    let ye = rest::held_at(scene, te, &ye).unwrap_or(ye);
-                    (t, y, must_slide) = (te, from_rolling(&ye), false);
-                    continue;
-                }
-                ((te, from_rolling(&ye), ye[2], ye[3]), which)
             }
             Next::Slide(ys, dir0) => {
                 report.tally.enter(&mut previous, Mode::Slide);
