@@ -17,6 +17,8 @@ pub mod flight;
 pub mod wall;
 pub mod wall_run;
 
+mod wall_rest;
+
 mod shape;
 
 use crate::Real;
@@ -316,7 +318,8 @@ fn residence_watching<T: Real>(
                 )
                 .map_err(BowlError::Scene)?;
                 report.add(&w.tally);
-                report.on_wall_s += w.tally.regime.roll_s + w.tally.regime.slide_s;
+                report.on_wall_s +=
+                    w.tally.regime.roll_s + w.tally.regime.slide_s + w.tally.regime.held_s;
                 match w.end {
                     WallEnd::Lip(tl, speed) => {
                         report.outcome = BowlOutcome::Leaves {
@@ -486,3 +489,5 @@ mod order_tests;
 mod stall_tests;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod wall_rest_tests;

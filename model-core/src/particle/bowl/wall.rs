@@ -203,6 +203,10 @@ pub struct WallForces<T> {
     pub normal_m_s2: T,
     /// The friction rolling would need without resistance, per unit mass, m/s^2.
     pub needed_m_s2: [T; 3],
+    /// The centre's acceleration along the surface rolling without resistance, m/s^2: at rest
+    /// `k2 D` of the bottom's equations (the resistance holds it while `|D| <= mu_r N/m`,
+    /// `super::wall_rest`).
+    pub drive_m_s2: [T; 3],
     /// The contact point's slip velocity, m/s.
     pub slip_m_s: [T; 3],
     /// The centre's radius from the bowl's axis, m.
@@ -228,19 +232,22 @@ pub fn wall_forces<T: Real>(
     y: &WallState<T>,
     contact: Contact<T>,
 ) -> WallForces<T> {
-    wall_forces_slaved(sc, m, t, y, contact, T::ZERO)
+    wall_forces_slaved(sc, m, t, y, contact, (T::ZERO, [T::ZERO; 3]))
 }
 
 /// [`wall_forces`] whose slide's friction, while the slip is at most `slaved_m_s` and grows,
 /// opposes the slip's free acceleration (`rolling::slide::friction_direction`, as on the
-/// bottom).
+/// bottom), and whose roll's resistance, once the velocity is at rest or has turned against
+/// `last` (its unit direction at the last accepted step; zero: none), opposes `last`, as the
+/// bottom's (`rolling::equations::forces_along`): the velocity passes smoothly through zero
+/// and the rest is an event located on the step (`super::wall_rest`).
 pub(crate) fn wall_forces_slaved<T: Real>(
     sc: &RollingScene<T>,
     m: &Meridian<T>,
     t: T,
     y: &WallState<T>,
     contact: Contact<T>,
-    slaved_m_s: T,
+    (slaved_m_s, last): (T, [T; 3]),
 ) -> WallForces<T> {
     let [s, ex0, ey0, sd, pd, sx, sy, sz] = *y;
     // The azimuth's unit vector, renormalised against the integrator's drift.
@@ -289,22 +296,28 @@ pub(crate) fn wall_forces_slaved<T: Real>(
     let slip: [T; 3] = core::array::from_fn(|i| u[i] - sn[i]);
     let n_pos = normal.max(T::ZERO);
     let speed = dot(&u, &u).sqrt();
+    let drive: [T; 3] = core::array::from_fn(|i| needed[i] + b_t[i]);
     // The friction, and the resistance's part of the torque (rolling only).
     let (fm, resist) = match contact {
         Contact::Roll => {
             let r = sc.rolling_resistance * n_pos;
-            let dir = if speed > T::from_f64(AT_REST_M_S) {
+            let at_rest = speed <= T::from_f64(AT_REST_M_S);
+            let an = dot(&drive, &drive).sqrt();
+            let along = last != [T::ZERO; 3];
+            let dir = if along && at_rest && an > k2 * r {
+                // A roll from rest starts along the drive.
+                [drive[0] / an, drive[1] / an, drive[2] / an]
+            } else if along && (at_rest || dot(&u, &last) <= T::ZERO) {
+                // One that the resistance stops goes through rest along its last direction.
+                last
+            } else if !at_rest {
                 [u[0] / speed, u[1] / speed, u[2] / speed]
-            } else {
+            } else if an <= k2 * r || an == T::ZERO {
                 // At rest: the resistance opposes where it would start to move (and holds
                 // it while it can: then nothing moves).
-                let acc: [T; 3] = core::array::from_fn(|i| needed[i] + b_t[i]);
-                let an = dot(&acc, &acc).sqrt();
-                if an <= k2 * r || an == T::ZERO {
-                    [T::ZERO; 3]
-                } else {
-                    [acc[0] / an, acc[1] / an, acc[2] / an]
-                }
+                [T::ZERO; 3]
+            } else {
+                [drive[0] / an, drive[1] / an, drive[2] / an]
             };
             let held = speed <= T::from_f64(AT_REST_M_S) && dir == [T::ZERO; 3];
             if held {
@@ -336,6 +349,7 @@ pub(crate) fn wall_forces_slaved<T: Real>(
         derivative: [sd, -pd * ey, pd * ex, sdd, pdd, dsig[0], dsig[1], dsig[2]],
         normal_m_s2: normal,
         needed_m_s2: needed,
+        drive_m_s2: drive,
         slip_m_s: slip,
         rho_m: rho,
         velocity_m_s: u,

@@ -4,18 +4,23 @@
 //! contact's changes (rolling needing more than `mu_s N`; the slip ending), and the meridian's
 //! seams where its curvature jumps (the fillet's end, the lip's edge): a segment follows the
 //! piece it starts on, continued past its ends, so that no step straddles a jump of the normal
-//! force.
+//! force. A roll that comes to rest where the resistance holds it is held, a segment of its own
+//! ([`super::wall_rest`]).
 
 use core::cell::Cell;
 
-use super::wall::{Contact, Meridian, Piece, WallState, slip_of, wall_forces, wall_forces_slaved};
+use super::wall::{
+    Contact, Meridian, Piece, WallState, slip_of, to_space, wall_forces, wall_forces_slaved,
+};
+use super::wall_rest::{self, Let};
 use crate::Real;
 use crate::ode::system::{SystemError, SystemLimits};
 use crate::particle::rolling::equations::AT_REST_M_S;
 use crate::particle::rolling::modes::{
-    Chatter, Mode, Settle, SlipOf, StallWatch, Tally, fired, follow_slip, scene_scales, segment,
-    stuck_m_s,
+    Chatter, Mode, Settle, SlipOf, StallWatch, Stop, Tally, fired, follow_slip, scene_scales,
+    segment, stuck_m_s,
 };
+use crate::particle::rolling::rest::{follow_velocity, start_speed_m_s, turned};
 use crate::particle::rolling::{RollingError, RollingMethod, RollingScene};
 
 /// How a stay on the wall ended.
@@ -50,12 +55,12 @@ fn events<T: Real>(
     m: &Meridian<T>,
     t: T,
     y: &WallState<T>,
-    contact: Contact<T>,
+    (contact, last): (Contact<T>, [T; 3]),
     (armed, fresh_end): (bool, T),
     refs: (T, T),
     below_edge: bool,
     on_fillet: bool,
-) -> [T; 6] {
+) -> [T; 7] {
     let (reference, speed_ref) = refs;
     let f = wall_forces(sc, m, t, y, contact);
     let rim = sc.rim_radius_m;
@@ -94,6 +99,13 @@ fn events<T: Real>(
     // step across it lost RK4's order (its error in T went as `h`, with where the seam fell in
     // the step), so each side is a segment of its own.
     let seam = (y[0] - m.arc_length()) / rim;
+    // A roll's rest: its velocity turned against its direction at the last accepted step
+    // (`super::wall_rest`; none without one).
+    let rest = if matches!(contact, Contact::Roll) && last != [T::ZERO; 3] {
+        turned(f.velocity_m_s, last) / speed_ref
+    } else {
+        -T::ONE
+    };
     [
         -y[0] / rim,
         (f.rho_m - m.lip_m) / rim,
@@ -101,6 +113,7 @@ fn events<T: Real>(
         switch,
         edge,
         if on_fillet { seam } else { -seam },
+        rest,
     ]
 }
 
@@ -131,6 +144,28 @@ fn next_contact<T: Real>(
         -nd[1] / need,
         -nd[2] / need,
     ]))
+}
+
+/// The direction a roll from `(t, y)` starts with as its last (`super::wall_rest`): the
+/// velocity's, or at rest the drive's (where it would start), zero if there is none.
+fn start_direction<T: Real>(
+    sc: &RollingScene<T>,
+    m: &Meridian<T>,
+    t: T,
+    y: &WallState<T>,
+) -> [T; 3] {
+    let u = to_space(m, y)[1];
+    let speed = norm(&u);
+    if speed > T::from_f64(AT_REST_M_S) {
+        return u.map(|c| c / speed);
+    }
+    let d = wall_forces(sc, m, t, y, Contact::Roll).drive_m_s2;
+    let dn = norm(&d);
+    if dn > T::ZERO {
+        d.map(|c| c / dn)
+    } else {
+        [T::ZERO; 3]
+    }
 }
 
 /// Makes the slip of a wall state exactly zero (its spin's tangential part follows the
@@ -195,7 +230,11 @@ pub fn stay<T: Real>(
     let length = scales.0.min(m.arc_radius_m).min(m.pivot_m);
     let watch = StallWatch::new(stall_steps, (length, scales.1), t0, method);
     let mut chatter = Chatter::new();
+    // The hold just ended where the drive began to exceed the resistance: the roll that follows
+    // restarts from rest, a stretch of its own ([`start_speed_m_s`], as on the bottom).
+    let mut restart = false;
     loop {
+        let restarts = core::mem::take(&mut restart);
         let remaining = out.tally.remaining(limits, max_switches)?;
         let steps_before = out.tally.steps;
         let fresh_end = chatter.fresh_end_m_s(refs.1);
@@ -228,22 +267,32 @@ pub fn stay<T: Real>(
             }
         };
         let settle = Settle::new(sc.k2);
+        // A roll's velocity direction at its last accepted step: the resistance keeps it
+        // through rest, where the rest event fires (`super::wall_rest`).
+        let last = Cell::new(if rolling {
+            start_direction(sc, mp, t, &y)
+        } else {
+            [T::ZERO; 3]
+        });
+        // A restart from a hold: up to its start speed, its velocity held to `rtol` of that
+        // speed instead of the scene's (`rest::start_speed_m_s`).
+        let start = (rolling && restarts).then(|| start_speed_m_s(sc));
         let Some((te, ye, settled)) = segment(
             &mut out.tally,
             mode,
             |t, y: &WallState<T>| {
-                wall_forces_slaved(sc, mp, t, y, now(dir.get()), slaved).derivative
+                wall_forces_slaved(sc, mp, t, y, now(dir.get()), (slaved, last.get())).derivative
             },
             (t, y),
             method,
-            scales,
+            start.map_or(scales, |speed| (scales.0, speed)),
             |t, y: &WallState<T>| {
                 let e = events(
                     sc,
                     mp,
                     t,
                     y,
-                    now(dir.get()),
+                    (now(dir.get()), last.get()),
                     (armed.get(), fresh_end),
                     refs,
                     below_edge,
@@ -254,7 +303,12 @@ pub fn stay<T: Real>(
             |t, y: &WallState<T>| {
                 watch.check(t)?;
                 if rolling {
-                    return core::ops::ControlFlow::Continue(());
+                    let u = to_space(mp, y)[1];
+                    follow_velocity(u, &last);
+                    return match start {
+                        Some(s) if norm(&u) >= s => core::ops::ControlFlow::Break(Stop::Started),
+                        _ => core::ops::ControlFlow::Continue(()),
+                    };
                 }
                 let s = wall_forces(sc, mp, t, y, now(dir.get())).slip_m_s;
                 follow_slip(&s, &dir, &armed, stuck_m_s(refs.1));
@@ -274,12 +328,17 @@ pub fn stay<T: Real>(
         if watch.step(te).is_break() {
             return Err(RollingError::Integration(SystemError::Stalled));
         }
+        if rolling && settled {
+            // A restart from a hold under way: the roll goes on at the scene's tolerances.
+            (t, y, must_slide) = (te, no_slip(sc, mp, te, &ye), false);
+            continue;
+        }
         let e = events(
             sc,
             mp,
             te,
             &ye,
-            now(dir.get()),
+            (now(dir.get()), last.get()),
             (armed.get(), fresh_end),
             refs,
             below_edge,
@@ -347,6 +406,30 @@ pub fn stay<T: Real>(
                 // it goes over or falls back in).
                 out.end = WallEnd::LiftsOff(te, ye);
                 return Ok(out);
+            }
+            6 => {
+                // At rest: held there with no velocity at all, or rolling on.
+                (t, y, must_slide) = (te, ye, false);
+                let Some(rest) = wall_rest::held_at(sc, mp, te, &ye) else {
+                    continue;
+                };
+                out.tally.enter(&mut previous, Mode::Held);
+                let held = wall_rest::hold(sc, mp, te, &rest, limits.horizon_s, refs.0);
+                out.tally.evaluations = out.tally.evaluations.saturating_add(held.evaluations);
+                let Some((t1, y1, why)) = held.end else {
+                    out.tally.spend(Mode::Held, limits.horizon_s - te);
+                    return Ok(out);
+                };
+                out.tally.spend(Mode::Held, t1 - te);
+                (t, y) = (t1, y1);
+                match why {
+                    Let::Rolls => restart = true,
+                    Let::Slides => must_slide = true,
+                    Let::LiftsOff => {
+                        out.end = WallEnd::LiftsOff(t1, y1);
+                        return Ok(out);
+                    }
+                }
             }
             _ => {
                 must_slide = rolling;
