@@ -30,7 +30,7 @@ use core::cell::Cell;
 
 pub use report::{Mode, ModesOutcome, ModesReport, Regime, Tally};
 pub(crate) use segments::{fired, max3, scene_scales, segment};
-pub(crate) use slip::{Chatter, Settle, SlipOf, follow_slip, stuck_m_s};
+pub(crate) use slip::{Chatter, Settle, SlipOf, Stop, follow_slip, stuck_m_s};
 pub use stall::STALL_STEP;
 pub(crate) use stall::StallWatch;
 
