@@ -5,11 +5,8 @@
 //! resistance and sliding friction. The held-out sweep's scene 20 (docs/model.md §10) turned on
 //! how much speed a granule keeps climbing a 36 deg wall; these hold the climb itself.
 
-use core::ops::ControlFlow;
-
-use super::tests::shape;
+use super::tests::{run_on_wall, shape};
 use super::wall::{Contact, Meridian, WallState, wall_forces};
-use crate::ode::system::{self, Ended, SystemLimits};
 use crate::particle::rolling::RollingScene;
 
 const G: f64 = 9.81;
@@ -29,35 +26,6 @@ fn still(th_deg: f64, mu_r: f64, mu_s: f64) -> RollingScene<f64> {
         ri_m: 0.05,
         rim_radius_m: 0.1,
     }
-}
-
-/// Integrates the wall's equations in one contact from `y0` for `t1` s (DP5(4), rtol 1e-12).
-fn run(
-    sc: &RollingScene<f64>,
-    m: &Meridian<f64>,
-    y0: WallState<f64>,
-    c: Contact<f64>,
-    t1: f64,
-) -> WallState<f64> {
-    let out = system::dp54(
-        |t, y: &WallState<f64>| wall_forces(sc, m, t, y, c).derivative,
-        0.0,
-        y0,
-        1e-12,
-        [1e-13; 8],
-        1e-5,
-        |_, _| (-1.0, 0.0),
-        |_, _| ControlFlow::<()>::Continue(()),
-        SystemLimits {
-            horizon_s: t1,
-            max_steps: 2_000_000,
-        },
-    )
-    .unwrap();
-    let Ended::Horizon { y } = out.ended else {
-        panic!("{:?}", out.ended)
-    };
-    y
 }
 
 /// Rolling up and down the downhill meridian of a still cone (tilt 20 deg, walls at 50 and 75
@@ -84,7 +52,7 @@ fn rolling_on_a_still_tilted_cone_is_rolling_on_an_incline() {
             };
             // Up: stop short of the apex, where the resistance turns; down: 50 ms.
             let t1 = if v0 > 0.0 { 0.8 * v0 / decel } else { 0.05 };
-            let y = run(&sc, &m, y0, Contact::Roll, t1);
+            let y = run_on_wall(&sc, &m, y0, Contact::Roll, t1, |_| ());
             let s_closed = s0 + v0 * t1 - 0.5 * decel * t1 * t1;
             let v_closed = v0 - decel * t1;
             assert!(
@@ -127,7 +95,7 @@ fn sliding_up_a_still_tilted_cone_is_sliding_up_an_incline() {
         let spin_rate = 2.5 * mu_s * G * b.cos();
         // The slip `v - |s|` is gone at `v0 / (decel + spin_rate)`: stop at 80 % of that.
         let t1 = 0.8 * v0 / (decel + spin_rate);
-        let y = run(&sc, &m, y0, Contact::Slide([-ca, 0.0, sa]), t1);
+        let y = run_on_wall(&sc, &m, y0, Contact::Slide([-ca, 0.0, sa]), t1, |_| ());
         let s_closed = s0 + v0 * t1 - 0.5 * decel * t1 * t1;
         assert!(
             (y[0] - s_closed).abs() < 1e-9 * 0.05,
