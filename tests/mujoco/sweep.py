@@ -16,7 +16,7 @@ impact on a still plane with the bowl's contact settings is bisected for the rat
 
 Usage (in the venv compare.sh makes; `compare.sh sweep [ARGS]` does that and builds `bowl`):
   sweep.py BOWL_BINARY [--seed N] [--scenes N] [--jobs N] [--only I,J,..] [--dt S] [--out JSON]
-           [--cache JSONL] [--cone] [--friction-tc S] [--max-time-s S]
+           [--cache JSONL] [--cone] [--friction-tc S] [--impact-vn V] [--max-time-s S]
 prints the scenes, a Markdown table per scene and the summary per target. --only reruns some
 scenes (e.g. with a finer --dt to check the reference); --out keeps the raw results; --cache
 keeps every finished MuJoCo release (keyed on all it depends on) and skips it when rerun.
@@ -93,11 +93,12 @@ def dampratio_for(e):
 
 
 def mujoco_release(job):
-    s, beta, dr, dt, torque, ftc = job
+    s, beta, dr, dt, torque, ftc, ivn = job
     t, sh, touching = bowl_mujoco.run(
         s["w1"], s["w2"], math.radians(s["th"]), s["rim"], s["ri"], s["a"], s["mu_r"],
         s["mu_s"], math.radians(s["alpha"]), s["h"], s["rod"], s["horizon"],
-        math.radians(beta), s["fillet"], dampratio=dr, dt=dt, torque=torque, friction_tc=ftc)
+        math.radians(beta), s["fillet"], dampratio=dr, dt=dt, torque=torque, friction_tc=ftc,
+        impact_vn=ivn)
     total = sum(sh.values()) or 1.0
     how = "held" if t is None else ("contact" if touching else "flight")
     return [key(job), t, {k: v / total for k, v in sh.items()}, how]
@@ -105,10 +106,12 @@ def mujoco_release(job):
 
 def key(job):
     """What a release's MuJoCo answer depends on, for the cache (the friction's time constant
-    only where it is set, so the runs without it keep their keys)."""
-    s, beta, dr, dt, torque, ftc = job
+    and the impacts' normal speed only where they are set, so the runs without them keep their
+    keys)."""
+    s, beta, dr, dt, torque, ftc, ivn = job
     return json.dumps([s, beta, dr, dt, torque, bowl_mujoco.CONE_TORQUE if torque else
-                       bowl_mujoco.CONE] + ([ftc] if ftc else []), sort_keys=True)
+                       bowl_mujoco.CONE] + ([ftc] if ftc else [])
+                      + ([{"impact_vn": ivn}] if ivn is not None else []), sort_keys=True)
 
 
 def model(bowl, s):
@@ -182,6 +185,10 @@ def main():
                    help="the contact friction's own time constant, s (bowl_mujoco.run's "
                         "friction_tc; 1e-4 gives a sticking impact Routh's tangential impulse; "
                         "default: the normal's, 0.5 ms)")
+    p.add_argument("--impact-vn", type=float, default=0.0,
+                   help="the rolling resistance only while the contact's normal speed is at "
+                        "most this, m/s, not in impacts (bowl_mujoco.run's impact_vn; the "
+                        "model's impact has none; default: in every sticking contact)")
     p.add_argument("--max-time-s", type=float, default=0.0,
                    help="caps every scene's horizon (both MuJoCo and the model): for scenes "
                         "that clearly hold, where MuJoCo takes 2-3 s of run per release")
@@ -196,7 +203,8 @@ def main():
         for s in scenes:
             s["horizon"] = min(s["horizon"], args.max_time_s)
     ratios = {s["i"]: dampratio_for(s["e"]) for s in scenes}
-    jobs = [(s, b, ratios[s["i"]], args.dt, not args.cone, args.friction_tc or None)
+    ivn = args.impact_vn if args.impact_vn > 0 else None
+    jobs = [(s, b, ratios[s["i"]], args.dt, not args.cone, args.friction_tc or None, ivn)
             for s in scenes for b in AZ]
     done = {}
     if args.cache and os.path.exists(args.cache):

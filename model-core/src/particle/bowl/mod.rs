@@ -484,6 +484,8 @@ mod corner_tests;
 #[cfg(test)]
 mod flight_tests;
 #[cfg(test)]
+mod incline_tests;
+#[cfg(test)]
 mod order_tests;
 #[cfg(test)]
 mod stall_tests;

@@ -100,6 +100,37 @@ fn the_walls_equations_are_the_bottoms_on_the_bottom() {
     }
 }
 
+/// The wall's equations in one contact from `y0` to `horizon_s` (DP5(4), rtol 1e-12), with
+/// `on_step` at each accepted step: the state at the horizon.
+pub(super) fn run_on_wall(
+    sc: &RollingScene<f64>,
+    m: &Meridian<f64>,
+    y0: WallState<f64>,
+    contact: Contact<f64>,
+    horizon_s: f64,
+    mut on_step: impl FnMut(&WallState<f64>),
+) -> WallState<f64> {
+    let run = system::dp54(
+        |t, y: &WallState<f64>| wall_forces(sc, m, t, y, contact).derivative,
+        0.0,
+        y0,
+        1e-12,
+        [1e-13; 8],
+        1e-5,
+        |_, _| (-1.0, 0.0),
+        |_, y: &WallState<f64>| {
+            on_step(y);
+            ControlFlow::<()>::Continue(())
+        },
+        limits(horizon_s),
+    )
+    .unwrap();
+    let Ended::Horizon { y } = run.ended else {
+        panic!("{:?}", run.ended)
+    };
+    y
+}
+
 /// Energy and angular momentum on the curved wall: in a still bowl with its axis vertical a
 /// frictionless granule keeps `|u|^2/2 + g z` and `rho^2 phi'`; a rolling one without
 /// resistance keeps `|u|^2/2 + ((1 - k2)/(2 k2)) |s|^2 + g z`. Integrated across the fillet and
@@ -145,36 +176,15 @@ fn the_wall_keeps_energy_and_angular_momentum() {
             let rho = m.at(y[0]).pos[0];
             rho * rho * y[4]
         };
-        let highest = core::cell::Cell::new(0.0f64);
-        let lowest = core::cell::Cell::new(0.0f64);
-        let run = system::dp54(
-            |t, y: &WallState<f64>| wall_forces(&sc, &m, t, y, contact).derivative,
-            0.0,
-            y0,
-            1e-12,
-            [1e-13; 8],
-            1e-5,
-            |_, _| (-1.0, 0.0),
-            |_, y: &WallState<f64>| {
-                highest.set(highest.get().max(y[0]));
-                lowest.set(lowest.get().min(y[0]));
-                ControlFlow::<()>::Continue(())
-            },
-            limits(0.3),
-        )
-        .unwrap();
-        let Ended::Horizon { y } = run.ended else {
-            panic!("{:?}", run.ended)
-        };
+        let (mut highest, mut lowest) = (0.0f64, 0.0f64);
+        let y = run_on_wall(&sc, &m, y0, contact, 0.3, |y| {
+            highest = highest.max(y[0]);
+            lowest = lowest.min(y[0]);
+        });
         // Up the fillet onto the cone, and back down onto the bottom (polar there).
         let arc = m.arc_radius_m * m.alpha_rad;
-        assert!(
-            highest.get() > arc && lowest.get() < 0.0,
-            "{} {}",
-            highest.get(),
-            lowest.get()
-        );
-        assert!(m.rho_b_m + lowest.get() > 0.01);
+        assert!(highest > arc && lowest < 0.0, "{highest} {lowest}");
+        assert!(m.rho_b_m + lowest > 0.01);
         let scale = 9.81 * 0.1;
         assert!(
             (energy(&y) - energy(&y0)).abs() < 1e-8 * scale,
