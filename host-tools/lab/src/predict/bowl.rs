@@ -4,7 +4,7 @@
 
 use anyhow::{Result, bail};
 use model_core::ode::system::SystemLimits;
-use model_core::particle::bowl::{self, BowlError, BowlOutcome, BowlReport, BowlShape};
+use model_core::particle::bowl::{self, BowlError, BowlOutcome, BowlReport, BowlShape, HeldAt};
 use model_core::particle::rolling::{MAX_STEPS, RollingMethod, RollingScene};
 use serde_json::{Value, json};
 
@@ -89,6 +89,28 @@ fn regime(r: &BowlReport<f64>) -> Value {
         }
     }
     Value::Object(m)
+}
+
+/// Where a release still inside at the horizon is held at rest, in the text's words: the
+/// same wherever its last mode is `held` (before, only a vertical wall's sharp corner said
+/// "held by the wall"; one the rolling resistance held on the fillet said "still inside").
+fn held_words(at: Option<HeldAt>) -> Option<&'static str> {
+    at.map(|at| match at {
+        HeldAt::Bottom => "held at rest on the bottom",
+        HeldAt::Fillet => "held on the fillet",
+        HeldAt::Wall => "held by the wall",
+    })
+}
+
+/// The JSON's `held_at`: `bottom`, `fillet`, `wall` or null.
+fn held_at_name(at: Option<HeldAt>) -> Value {
+    at.map_or(Value::Null, |at| {
+        json!(match at {
+            HeldAt::Bottom => "bottom",
+            HeldAt::Fillet => "fillet",
+            HeldAt::Wall => "wall",
+        })
+    })
 }
 
 fn outcome_name(o: &BowlOutcome<f64>) -> &'static str {
@@ -199,6 +221,7 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
                         regime(rep),
                         json!({
                             "outcome": outcome_name(&rep.outcome),
+                            "held_at": held_at_name(rep.held_at),
                             "exit_speed_relative_m_s": v, "on_wall_s": rep.on_wall_s,
                             "flight_s": rep.flight_s, "landings": rep.landings,
                             "left_in_flight": t.is_some() && rep.left_in_flight,
@@ -284,10 +307,10 @@ pub fn run(args: &Inputs, r: &rolling::RollingInputs, b: &BowlInputs) -> Result<
             BowlOutcome::LiftsOff { time_s } => {
                 format!("lifts off at t = {} s (no landing found)", fixed(time_s, 4))
             }
-            BowlOutcome::Inside { horizon_s } if rep.held_s > 0.0 => {
-                format!("held by the wall: still inside after {horizon_s} s")
-            }
-            BowlOutcome::Inside { horizon_s } => format!("still inside after {horizon_s} s"),
+            BowlOutcome::Inside { horizon_s } => match held_words(rep.held_at) {
+                Some(held) => format!("{held}: still inside after {horizon_s} s"),
+                None => format!("still inside after {horizon_s} s"),
+            },
         };
         println!(
             "release at {deg} deg: {what}; regime {}",

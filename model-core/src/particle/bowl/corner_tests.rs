@@ -163,6 +163,52 @@ fn a_lift_off_that_grazes_the_lip_lands_where_it_comes_back() {
     }
 }
 
+/// At the stick threshold on the bottom (47.37 deg tilt, 1.156 and -1.884 rad/s, mu_r 0,
+/// mu_s 0.3144 against the incline's 0.3106, e 0, a 45 deg wall 5 mm high with a sharp
+/// corner, release 206.5 deg; the proptest below drew it): rolling gave way to a slide whose
+/// slip grew along its free acceleration so slowly that the acceleration turned away from it
+/// before the slip was out of rest, and it hovered at 1e-7 m/s, steps of 5e-8 s, until the step
+/// cap ("the integration gave up"). Now it leaves, as at 1e-11 (`modes::SLAVED`).
+#[test]
+fn a_slip_at_the_stick_threshold_on_the_bottom_grows() {
+    for v in [
+        [
+            47.36839095647851,
+            1.1557130297963807,
+            -1.883825544930276,
+            0.12093377010701539,
+            0.06554321874718937,
+            0.0023484384981479083,
+            0.0,
+            0.31438239320246647,
+            0.0,
+            45.0,
+            0.005,
+            0.0,
+            1.0,
+            206.51871101821536,
+        ],
+        [
+            47.369844987226124,
+            1.1564855082298258,
+            -1.8842653595651289,
+            0.12092254651862412,
+            0.06545846802304166,
+            0.002346696941417944,
+            0.0,
+            0.31441098778350807,
+            0.0,
+            45.0,
+            0.005,
+            0.0,
+            1.0,
+            206.47129681949914,
+        ],
+    ] {
+        answers_as_at_a_tighter_tolerance(&v, true);
+    }
+}
+
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig::with_cases(200))]
     /// Random flared walls (the sweep's ranges, docs/model.md §10, "In the corner"): no release

@@ -17,18 +17,22 @@ pub mod flight;
 pub mod wall;
 pub mod wall_run;
 
+mod report;
+
 mod wall_rest;
 
 mod shape;
 
 use crate::Real;
 use crate::ode::system::{SystemError, SystemLimits};
-use crate::particle::rolling::modes::{MAX_SWITCHES, ModesOutcome, Regime, Tally, run_from};
+use crate::particle::rolling::modes::{MAX_SWITCHES, Mode, ModesOutcome, run_from};
 use crate::particle::rolling::slide::SlideState;
 use crate::particle::rolling::{RollingError, RollingMethod, RollingScene};
 use flight::{Flight, FlightEnd, REST_SPEED, Surface, fly, impact, launch};
 use wall::{WallState, from_space, onto_bottom, onto_wall, to_space};
 use wall_run::{WallEnd, stay};
+
+pub use report::{BowlReport, HeldAt};
 
 /// The bowl's wall. SI units; angles in radians.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -68,44 +72,6 @@ pub enum BowlError {
 
 /// What happens to one granule in the bowl: as on the bottom alone.
 pub type BowlOutcome<T> = ModesOutcome<T>;
-
-/// One release in the bowl.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BowlReport<T> {
-    /// The outcome.
-    pub outcome: BowlOutcome<T>,
-    /// Time rolling and sliding (bottom and wall), s.
-    pub regime: Regime<T>,
-    /// Time on the fillet and the wall, s.
-    pub on_wall_s: T,
-    /// Time held at rest in a vertical wall's sharp corner, up to the horizon, s.
-    pub held_s: T,
-    /// Time in flight, s.
-    pub flight_s: T,
-    /// Whether it left in flight (its centre passed the lip while flying, e.g. off the lip's
-    /// edge) rather than in contact (rolling or sliding over the lip or a bare rim).
-    pub left_in_flight: bool,
-    /// Landings (impacts after a flight).
-    pub landings: u32,
-    /// Changes of contact (roll/slide) and of surface (bottom/wall).
-    pub switches: u32,
-    /// Right-hand sides.
-    pub evaluations: u32,
-    /// Accepted steps.
-    pub steps: u32,
-}
-
-impl<T: Real> BowlReport<T> {
-    /// Adds a stay's time in each mode, changes and cost.
-    fn add(&mut self, stay: &Tally<T>) {
-        self.regime.roll_s += stay.regime.roll_s;
-        self.regime.slide_s += stay.regime.slide_s;
-        self.regime.held_s += stay.regime.held_s;
-        self.switches = self.switches.saturating_add(stay.switches);
-        self.evaluations = self.evaluations.saturating_add(stay.evaluations);
-        self.steps = self.steps.saturating_add(stay.steps);
-    }
-}
 
 /// One release at azimuth `beta_rad` (from the downhill direction, as the rolling model's), at
 /// rest on the bottom at `ri`, followed (rolling, sliding, flying) until it leaves over the lip
@@ -161,24 +127,7 @@ fn residence_watching<T: Real>(
         rim_radius_m: meridian.map_or(sc.rim_radius_m, |m| m.rho_b_m),
         ..*sc
     };
-    let mut report = BowlReport {
-        outcome: BowlOutcome::Inside {
-            horizon_s: limits.horizon_s,
-        },
-        regime: Regime {
-            roll_s: T::ZERO,
-            slide_s: T::ZERO,
-            held_s: T::ZERO,
-        },
-        on_wall_s: T::ZERO,
-        held_s: T::ZERO,
-        flight_s: T::ZERO,
-        left_in_flight: false,
-        landings: 0,
-        switches: 0,
-        evaluations: 0,
-        steps: 0,
-    };
+    let mut report = BowlReport::new(limits.horizon_s);
     // Where the granule is: on the bottom (the first stay from the release, with its
     // held-at-rest check), on the wall, or in flight; each stay ends in the next.
     let mut phase = Phase::Bottom(T::ZERO, None);
@@ -231,8 +180,14 @@ fn residence_watching<T: Real>(
                         ));
                         continue;
                     }
-                    // Still on the bottom at the horizon: the report's outcome says so.
-                    ModesOutcome::Inside { .. } => return Ok(report),
+                    // Still on the bottom at the horizon: the report's outcome says so, and
+                    // whether it is held there.
+                    ModesOutcome::Inside { .. } => {
+                        if on_bottom.tally.last == Some(Mode::Held) {
+                            report.held_at = Some(HeldAt::Bottom);
+                        }
+                        return Ok(report);
+                    }
                     ModesOutcome::Held => {
                         report.outcome = ModesOutcome::Held;
                         return Ok(report);
@@ -263,6 +218,7 @@ fn residence_watching<T: Real>(
                             // only a flight could take it out: held by the wall for the rest
                             // of the time.
                             report.held_s = limits.horizon_s - te;
+                            report.held_at = Some(HeldAt::Wall);
                             return Ok(report);
                         }
                         let mut back = y;
@@ -333,7 +289,14 @@ fn residence_watching<T: Real>(
                         let [q, u, sg] = to_space(&m, &yw);
                         Phase::Flight(launch(sc, tl, q, u, sg))
                     }
-                    WallEnd::Horizon => return Ok(report),
+                    WallEnd::Horizon => {
+                        // A sharp corner's stand-in fillet is the wall's corner.
+                        report.held_at = w.held_at_s.map(|s| match m.piece_at(s) {
+                            wall::Piece::Fillet if !shape.sharp_corner(sc) => HeldAt::Fillet,
+                            _ => HeldAt::Wall,
+                        });
+                        return Ok(report);
+                    }
                     WallEnd::Bottom(tb, yw) => {
                         report.switches += 1;
                         Phase::Bottom(tb, Some(just_onto_bottom(onto_bottom(&m, &yw))))

@@ -43,6 +43,9 @@ pub struct WallStay<T> {
     pub end: WallEnd<T>,
     /// Time rolling and sliding on the wall, changes of contact, cost.
     pub tally: Tally<T>,
+    /// Where it was held at rest to the horizon (its arc length `s` along the meridian, m), if
+    /// it was: the report says on the fillet or by the wall.
+    pub held_at_s: Option<T>,
 }
 
 fn norm<T: Real>(v: &[T; 3]) -> T {
@@ -216,6 +219,7 @@ pub fn stay<T: Real>(
     let mut out = WallStay {
         end: WallEnd::Horizon,
         tally: Tally::new(),
+        held_at_s: None,
     };
     let (mut t, mut y) = (t0, y0);
     let mut must_slide = false;
@@ -418,6 +422,7 @@ pub fn stay<T: Real>(
                 out.tally.evaluations = out.tally.evaluations.saturating_add(held.evaluations);
                 let Some((t1, y1, why)) = held.end else {
                     out.tally.spend(Mode::Held, limits.horizon_s - te);
+                    out.held_at_s = Some(rest[0]);
                     return Ok(out);
                 };
                 out.tally.spend(Mode::Held, t1 - te);

@@ -355,7 +355,9 @@ fn a_loose_tolerance_is_not_dearer_on_a_slide_from_rest() {
 /// 1e-10, and more at 1e-6 (3 957 and 3 808) than at 1e-7 (2 734 and 2 396): the chooser's
 /// first rung cost 2.9 ms where 1e-7 cost 2.0 (docs/model.md §12). With the friction against
 /// the slip's free acceleration while the slip is below the run's absolute tolerance
-/// (`slide::friction_direction`), the looser run is the cheaper, and each is within its
+/// (`slide::friction_direction`), the looser run was the cheaper (7 982 right-hand sides at
+/// 1e-6, 16 409 at 1e-7, 23 498 at 1e-9 at 90 deg); with it up to 1e-4 of the scene's speed
+/// at every tolerance (`modes::SLAVED`) 818, 902 and 1 094, each within 100 times its
 /// tolerance of the run at 1e-12.
 #[test]
 fn a_roll_giving_way_at_the_stick_threshold_is_cheaper_at_a_looser_tolerance() {
@@ -384,10 +386,10 @@ fn a_roll_giving_way_at_the_stick_threshold_is_cheaper_at_a_looser_tolerance() {
             );
             r.tally.evaluations
         };
-        let (loose, tight) = (run(1e-6), run(1e-7));
+        let (loose, tight, tighter) = (run(1e-6), run(1e-7), run(1e-9));
         assert!(
-            f64::from(loose) < 0.75 * f64::from(tight),
-            "{deg} deg: {loose} evaluations at 1e-6, {tight} at 1e-7"
+            loose <= tight && tight <= tighter && tighter < 1_500,
+            "{deg} deg: {loose} evaluations at 1e-6, {tight} at 1e-7, {tighter} at 1e-9"
         );
     }
 }

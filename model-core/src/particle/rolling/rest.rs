@@ -67,6 +67,23 @@ pub(crate) fn start_speed_m_s<T: Real>(scene: &RollingScene<T>) -> T {
     T::from_f64(REST_SPEED) * scene.rim_radius_m * scene.combined_speed_rad_s().max(T::ONE)
 }
 
+/// The speed, m/s ([`SLOW`] times [`start_speed_m_s`]), half of which a roll on the bottom
+/// that has been above it slows to on its way to a rest: from there it goes on as a stretch of
+/// its own, its velocity held to `rtol` of this speed (`rest_loop`), as a restart from a hold
+/// does. Near its rest the resistance's direction `u/|u|` turns fast and the step that
+/// reaches the rest at the scene's tolerance spans it: at rtol 1e-6 the velocity at the located
+/// rest (where it turned across its direction at the last step) was 9e-5 m/s off, not held,
+/// and the resistance took 4.7e-4 s more to stop it; the time held was that far off the run at
+/// 1e-12 (470x rtol; 2 deg tilt, 0.3 and 3 rad/s, a 45 deg wall 15 mm high with a 5 mm fillet,
+/// release 90 deg, issue 30). Now 5.9e-6 s, and within 4x rtol at 3e-7 to 1e-10.
+pub(crate) fn slow_speed_m_s<T: Real>(scene: &RollingScene<T>) -> T {
+    T::from_f64(SLOW) * start_speed_m_s(scene)
+}
+
+/// See [`slow_speed_m_s`]: 16 left the rtol 1e-6 run 7.7e-5 s off (the rest located in the
+/// step before the speed fell to 8 times the start speed), 64 and 256 alike 6e-6 and 4e-6.
+pub const SLOW: f64 = 64.0;
+
 /// A rolling state at `t` as the granule at rest, if it is at rest ([`REST_SPEED`]) and the
 /// rolling resistance holds it there.
 pub(crate) fn held_at<T: Real>(scene: &RollingScene<T>, t: T, y: &State<T>) -> Option<State<T>> {

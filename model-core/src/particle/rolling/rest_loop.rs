@@ -9,7 +9,9 @@
 //! * a granule at rest that the resistance holds: a held segment ([`rest::hold`]) until the
 //!   drive exceeds the resistance (the roll that follows does not hold again at once);
 //! * from a hold's end: a restart stretch up to [`rest::start_speed_m_s`]
-//!   (the roll mode's `Stop::Started`), then the roll at the scene's own tolerances.
+//!   (the roll mode's `Stop::Started`), then the roll at the scene's own tolerances;
+//! * a roll that slows on its way to a rest ([`Rolled::Slowed`], the roll mode's): a stretch
+//!   of its own up to [`rest::slow_speed_m_s`], which ends at the rest or back at that speed.
 
 use core::ops::ControlFlow;
 
@@ -25,6 +27,10 @@ pub(crate) enum Rolled<T, E> {
     /// A restart stretch reached its start speed at `t`, in `y` (m, m/s): the roll goes on
     /// at the scene's tolerances.
     Started(T, State<T>),
+    /// A roll slowed to half the slow speed ([`rest::slow_speed_m_s`]) at `t`, in `y` (m,
+    /// m/s): it goes on to its rest as a stretch of its own up to that speed, as a restart
+    /// does (the rolling model's roll does not end so).
+    Slowed(T, State<T>),
     /// Anything else (the rim, lift-off, a change of mode, the horizon): the loop's end.
     Ended(E),
 }
@@ -66,8 +72,11 @@ pub(crate) fn roll_with_rests<T: Real, P: RollPieces<T>>(
     // The hold just ended where the drive began to exceed the resistance: the roll that
     // follows starts from rest without holding again, and restarts from the edge of holding.
     let mut from_hold = false;
+    // The roll slowed on its way to a rest: the rest of the way a stretch of its own.
+    let mut slowed = false;
     loop {
         let restarts = core::mem::take(&mut from_hold);
+        let stretch = restarts || core::mem::take(&mut slowed);
         if !restarts
             && y[2] == T::ZERO
             && y[3] == T::ZERO
@@ -78,11 +87,19 @@ pub(crate) fn roll_with_rests<T: Real, P: RollPieces<T>>(
                 ControlFlow::Break(end) => return Ok(end),
             }
         } else {
-            let start = restarts.then(|| rest::start_speed_m_s(scene));
+            let start = match (restarts, stretch) {
+                (true, _) => Some(rest::start_speed_m_s(scene)),
+                (false, true) => Some(rest::slow_speed_m_s(scene)),
+                (false, false) => None,
+            };
             (t, y) = match pieces.roll(t, &y, start)? {
                 // Held there with no velocity at all, or rolling on.
                 Rolled::Rest(te, ye) => (te, rest::held_at(scene, te, &ye).unwrap_or(ye)),
                 Rolled::Started(te, ye) => (te, ye),
+                Rolled::Slowed(te, ye) => {
+                    slowed = true;
+                    (te, ye)
+                }
                 Rolled::Ended(end) => return Ok(end),
             };
         }

@@ -27,10 +27,11 @@ mod slip;
 mod stall;
 
 use core::cell::Cell;
+use core::ops::ControlFlow;
 
 pub use report::{Mode, ModesOutcome, ModesReport, Regime, Tally};
 pub(crate) use segments::{fired, max3, scene_scales, segment};
-pub(crate) use slip::{Chatter, Settle, SlipOf, Stop, follow_slip, stuck_m_s};
+pub(crate) use slip::{Chatter, Settle, SlipOf, Stop, follow_slip, lags_its_growth, stuck_m_s};
 pub use stall::STALL_STEP;
 pub(crate) use stall::StallWatch;
 
@@ -45,6 +46,19 @@ use super::slide::{
 use super::{RollingError, RollingMethod, RollingScene, SystemLimits, default_limits, release};
 use crate::Real;
 use crate::ode::system::SystemError;
+
+/// The slip, in units of the scene's speed, up to which a slide on the bottom whose rolling
+/// needs more than `mu_s N` and whose slip grows has its friction against the slip's free
+/// acceleration `A` rather than the slip (`slide::friction_direction`'s slaved slip), at every
+/// DP5(4) tolerance. The real slip turns to `A` within `|s| / (|A| sin phi)` and lags it by
+/// `|s|` times `A`'s turning rate over `|A|`: below this, 1e-4 rad for `A` turning at the
+/// scene's rate. Held to the slip's own direction from the rest threshold (1e-7 m/s) up, a
+/// slip at the stick threshold (rolling's need 1e-5 of it above `mu_s N`) grew along `A` so
+/// slowly that `A` turned further than that excess allows before the slip was out of rest, and
+/// the friction against it then shrank it back: it hovered at 1e-7 m/s in steps of 5e-8 s
+/// until the step cap (47.4 deg tilt, 1.16 and -1.88 rad/s, mu_s 0.314 at the threshold
+/// 0.311, a 45 deg wall 5 mm high, release 206.5 deg: 2 million steps in 0.09 s, issue 30).
+pub const SLAVED: f64 = 1e-4;
 
 /// The most changes of mode one release may take: a granule at the stick-slip threshold can
 /// switch at every step; beyond this it is reported as a step limit, not followed forever.
@@ -192,11 +206,13 @@ pub(crate) fn run_from<T: Real>(
     stall_steps: Option<u32>,
 ) -> Result<ModesReport<T>, RollingError> {
     let (refs, scales) = scene_scales(scene);
-    // A growing slip below the velocities' absolute tolerance: the friction opposes its free
-    // acceleration (`slide::friction_direction`; RK4 has no tolerance, and keeps the slip's).
+    // A growing slip below the velocities' absolute tolerance, or below [`SLAVED`] of the
+    // scene's speed: the friction opposes its free acceleration (`slide::friction_direction`;
+    // RK4 has no tolerance, and keeps the slip's), and where it leaves that band lagging the
+    // acceleration's direction it is turned to it ([`lags_its_growth`]).
     let slaved = match method {
-        RollingMethod::Dp54 { rtol } => rtol * scales.1,
-        RollingMethod::Rk4 { .. } => T::ZERO,
+        RollingMethod::Dp54 { rtol } => Some((rtol * scales.1).max(T::from_f64(SLAVED) * scales.1)),
+        RollingMethod::Rk4 { .. } => None,
     };
     let mut report = ModesReport {
         outcome: ModesOutcome::Inside {
@@ -251,11 +267,13 @@ pub(crate) fn run_from<T: Real>(
                     slip0[0] * slip0[0] + slip0[1] * slip0[1] > T::from_f64(4.0) * stuck * stuck,
                 );
                 let settle = Settle::new(scene.k2);
+                let realign = Cell::new(None);
                 let Some((te, ye, settled)) = segment(
                     &mut report.tally,
                     Mode::Slide,
                     |t, y: &SlideState<T>| {
-                        slide_forces_slaved(scene, t, y, dir.get(), slaved).derivative
+                        slide_forces_slaved(scene, t, y, dir.get(), slaved.unwrap_or(T::ZERO))
+                            .derivative
                     },
                     (t, ys),
                     method,
@@ -274,6 +292,21 @@ pub(crate) fn run_from<T: Real>(
                         let s = slip_m_s(y);
                         follow_slip(&s, &dir, &armed, stuck);
                         watch.check(t)?;
+                        let turned = slaved.and_then(|band| {
+                            lags_its_growth(scene.k2, &s, band, || {
+                                let (ft, normal) =
+                                    needed_friction_m_s2(scene, t, &from_rolling(&to_rolling(y)));
+                                let one = T::ONE - scene.k2;
+                                (
+                                    [-ft[0] / one, -ft[1] / one],
+                                    scene.sliding_friction * normal,
+                                )
+                            })
+                        });
+                        if turned.is_some() {
+                            realign.set(turned);
+                            return ControlFlow::Break(Stop::Realign);
+                        }
                         settle.step(t, &s, || {
                             let (ft, normal) =
                                 needed_friction_m_s2(scene, t, &from_rolling(&to_rolling(y)));
@@ -287,6 +320,18 @@ pub(crate) fn run_from<T: Real>(
                 else {
                     return Ok(report);
                 };
+                if let (true, Some(turned)) = (settled, realign.get()) {
+                    // The slip turned to its growth's direction: its spin set so that the
+                    // contact slips by `turned`, the translation kept (`slip_m_s`).
+                    let mut ye = ye;
+                    ye[5] = ye[2] - turned[0];
+                    ye[4] = turned[1] - ye[3];
+                    (t, y, must_slide) = (te, ye, false);
+                    if watch.step(te).is_break() {
+                        return Err(RollingError::Integration(SystemError::Stalled));
+                    }
+                    continue;
+                }
                 let events =
                     slide_events(scene, te, &ye, dir.get(), (armed.get(), fresh_end), refs);
                 // A settled slide ends as at its slip's end.

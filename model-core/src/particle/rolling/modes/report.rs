@@ -87,6 +87,8 @@ pub struct Tally<T> {
     pub evaluations: u32,
     /// Accepted steps.
     pub steps: u32,
+    /// The mode entered last (`None`: none yet): at the horizon, whether the granule is held.
+    pub last: Option<Mode>,
 }
 
 impl<T: Real> Tally<T> {
@@ -101,6 +103,7 @@ impl<T: Real> Tally<T> {
             switches: 0,
             evaluations: 0,
             steps: 0,
+            last: None,
         }
     }
 
@@ -127,6 +130,7 @@ impl<T: Real> Tally<T> {
             self.switches += 1;
         }
         *previous = Some(mode);
+        self.last = Some(mode);
     }
 
     /// Adds `dt` to the time in `mode`.

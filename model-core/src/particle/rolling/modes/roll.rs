@@ -84,18 +84,36 @@ impl<T: Real> RollPieces<T> for RollRun<'_, T> {
         let steps_before = tally.steps;
         tally.enter(self.previous, Mode::Roll);
         let last = Cell::new(start_direction(scene, t, y));
-        // A restart from a hold: up to its start speed, a stretch of its own with the velocity
-        // held to `rtol` of that speed (`rest::start_speed_m_s`).
+        // A roll at the scene's tolerances, once above the slow speed (after an accepted step),
+        // ends where it slows to half of it and goes on to its rest as a stretch of its own
+        // (`rest::slow_speed_m_s`).
+        let speed_ref = refs.1;
+        let speed = |y: &[T; 5]| (y[2] * y[2] + y[3] * y[3]).sqrt();
+        let slow = rest::slow_speed_m_s(scene);
+        let armed = Cell::new(start.is_none() && speed(y) > slow);
+        let slows = |y: &[T; 5]| armed.get().then(|| (slow / T::TWO - speed(y)) / speed_ref);
+        // A restart from a hold, or a roll slowing to its rest: up to `start`, a stretch of its
+        // own with the velocity held to `rtol` of that speed and the position to `rtol` of the
+        // distance the scene's speed covers in the time that speed takes over the scene's length
+        // (so that its first trial step is the scene's, 1e-3 of that time: from the speed alone
+        // it was 1e-3 of the bowl's radius over 1e-4 of the scene's speed, 0.75 s, and a slowing
+        // stretch taken in one such step came to rest 1.2e-6 s early at every rtol 1e-7..1e-9).
         let Some((te, ye, started)) = segment(
             tally,
             Mode::Roll,
             |t, y: &[T; 5]| forces_along(scene, t, y, last.get()).derivative,
             (t, *y),
             self.method,
-            start.map_or(scales, |speed| (scales.0, speed)),
-            |t, y: &[T; 5]| max4(roll_events(scene, t, y, last.get(), refs)),
+            start.map_or(scales, |speed| (scales.0 * speed / scales.1, speed)),
+            |t, y: &[T; 5]| {
+                let e = max4(roll_events(scene, t, y, last.get(), refs));
+                slows(y).map_or(e, |s| e.max(s))
+            },
             |t, y: &[T; 5]| {
                 rest::follow_velocity([y[2], y[3]], &last);
+                if start.is_none() && speed(y) > slow {
+                    armed.set(true);
+                }
                 watch.check(t)?;
                 match start {
                     Some(s) if y[2] * y[2] + y[3] * y[3] >= s * s => {
@@ -113,9 +131,13 @@ impl<T: Real> RollPieces<T> for RollRun<'_, T> {
         if started {
             return Ok(Rolled::Started(te, ye));
         }
-        let which = fired(&roll_events(scene, te, &ye, last.get(), refs));
+        let events = roll_events(scene, te, &ye, last.get(), refs);
+        let which = fired(&events);
         self.chatter
             .after(self.report.tally.steps - steps_before, false);
+        if slows(&ye).is_some_and(|s| s > events[which]) {
+            return Ok(Rolled::Slowed(te, ye));
+        }
         if which == 3 {
             return Ok(Rolled::Rest(te, ye));
         }

@@ -107,7 +107,7 @@ pub(crate) fn segment<T: Real, const N: usize>(
         Ended::Stopped {
             t,
             y,
-            why: Stop::Settled | Stop::Started,
+            why: Stop::Settled | Stop::Started | Stop::Realign,
         } => {
             tally.spend(mode, t - t0);
             Ok(Some((t, y, true)))

@@ -52,6 +52,37 @@ pub(crate) enum Stop {
     /// A roll restarted from a hold has reached its start speed
     /// (`crate::particle::rolling::rest::start_speed_m_s`): it goes on as any roll.
     Started,
+    /// A slip leaving the slaved band lags its free acceleration's direction so far that the
+    /// friction against it would shrink it back ([`lags_its_growth`]): the slide goes on from
+    /// the slip turned to that direction.
+    Realign,
+}
+
+/// Whether a slip `s` leaving the slaved band (above `band`, up to twice it; `run_from`'s
+/// [`super::SLAVED`]) of a slide whose rolling needs more than `mu_s N` has fallen so far
+/// behind the direction of its free acceleration `A` that the friction against it (`mu_s N /
+/// (1 - k2)` along it) exceeds `A`'s part along it, so that it would shrink back into the band:
+/// in the band the friction opposes `A` and the slip grows along `A` as `A` was, at the rate
+/// by which rolling's need exceeds `mu_s N`, near the stick threshold so slowly that `A` turns
+/// by more than `sqrt(2 (1 - mu_s N / ((1 - k2) |A|)))` rad before the slip leaves the band.
+/// The real slip turns to `A` within `|s| / (|A| sin phi)`; so does this one, at once. `need`,
+/// asked only for a slip leaving the band: `A` and `mu_s N` (m/s^2). The slip turned to `A`,
+/// keeping its size, where it lags.
+pub(crate) fn lags_its_growth<T: Real, const N: usize>(
+    k2: T,
+    s: &[T; N],
+    band: T,
+    need: impl FnOnce() -> ([T; N], T),
+) -> Option<[T; N]> {
+    let speed = dot(s, s).sqrt();
+    if speed <= band || speed > T::TWO * band {
+        return None;
+    }
+    let (free, fric) = need();
+    let a = dot(&free, &free).sqrt();
+    let one = T::ONE - k2;
+    (one * a > fric && one * dot(&free, s) < fric * speed)
+        .then(|| core::array::from_fn(|i| free[i] / a * speed))
 }
 
 /// How long a slide's slip must stay at rest ([`SETTLED_M_S`]) where rolling needs no more
