@@ -5,7 +5,7 @@
 //! seams where its curvature jumps (the fillet's end, the lip's edge): a segment follows the
 //! piece it starts on, continued past its ends, so that no step straddles a jump of the normal
 //! force. A roll that comes to rest where the resistance holds it is held, a segment of its own
-//! ([`super::wall_rest`]).
+//! (`wall_rest`).
 
 use core::cell::Cell;
 
