@@ -224,3 +224,47 @@ fn a_small_growing_slip_is_cheaper_at_a_looser_tolerance_with_the_wall() {
         );
     }
 }
+
+/// A roll that gives way where rolling needs barely more than `mu_s N` (1.00004 times it at the
+/// release: 51.3 deg tilt, 1.886 and -1.334 rad/s, mu_r 0.029, mu_s 0.362, the 60 deg wall 20 mm
+/// high, release at 180 deg): the slip at rest grew 28 deg off its free acceleration, shrank back
+/// into rest wherever it left it, and DP5(4) stalled at 0.35 ms at rtol 1e-12 and 1e-13 ("the
+/// steps stopped advancing the time at a roll/slide switch"). Both answer since a growing slip
+/// the friction cannot hold takes the friction against its free acceleration up to 1e-4 of the
+/// scene's speed at every tolerance (`slide::friction_direction`), within 1e-8 of the run at
+/// 1e-11 (an 8.1 ms slide, then a roll to the corner and a flight over the lip).
+#[test]
+fn a_slide_from_a_roll_barely_past_the_threshold_answers_at_a_tight_tolerance() {
+    let s = RollingScene {
+        precession_rad_s: 1.885933756828308,
+        spin_rad_s: -1.3343454897403717,
+        sliding_friction: 0.36206411306729797,
+        ri_m: 0.0375,
+        ..RollingScene::with_speeds(1.0, 1.0, 51.32191002368927f64.to_radians(), 0.075)
+    };
+    let wall = shape(60.0, 0.02, 0.0);
+    let lim = SystemLimits {
+        horizon_s: 10.0,
+        max_steps: 200_000,
+    };
+    let b = f64::to_radians(180.0);
+    let leaves =
+        |rtol: f64| match residence_or_stall(&s, &wall, b, RollingMethod::Dp54 { rtol }, lim) {
+            Ok(BowlReport {
+                outcome:
+                    BowlOutcome::Leaves {
+                        residence_time_s, ..
+                    },
+                ..
+            }) => residence_time_s,
+            other => panic!("at {rtol:e}: {other:?}"),
+        };
+    let reference = leaves(1e-11);
+    for rtol in [1e-12, 1e-13] {
+        let t = leaves(rtol);
+        assert!(
+            (t - reference).abs() <= 1e-8 * reference,
+            "at {rtol:e}: T {t} against {reference}"
+        );
+    }
+}
