@@ -150,10 +150,13 @@ impl<T: Real> RollPieces<T> for PlainRoll<'_, T> {
             }
             ControlFlow::Continue(())
         };
-        let (run, last) = roll(scene, (t, *y), self.method, start, remaining, &mut watch)?;
+        let (run, last, slowed) = roll(scene, (t, *y), self.method, start, remaining, &mut watch)?;
         self.evaluations = self.evaluations.saturating_add(run.evaluations);
         self.steps = self.steps.saturating_add(run.steps);
         let outcome = match run.ended {
+            Ended::Event { t: te, y: ye } if slowed => {
+                return Ok(Rolled::Slowed(te, ye.map(|v| v * rim)));
+            }
             // The first of the two events: the one nearer zero (each is located to rounding).
             Ended::Event { t: te, y: ye }
                 if rim_event(&ye, &[T::ZERO; 5]).0
@@ -194,8 +197,10 @@ type Roll<T> = system::Run<T, 5, Option<T>>;
 /// One roll from `(t0, y0)` (m, m/s) to the rim, a rest (the velocity turned against its last
 /// direction, [`rest::turned`]), the watch's stop (lift-off, `Some` of its time) or the
 /// horizon; the event's state in units of the rim's radius, and the velocity's direction at the
-/// last accepted step (the rest event's). `start`: a restart from a hold, stopped (`None`) once
-/// its speed reaches this (m/s), its velocity held to `rtol` of it ([`rest::start_speed_m_s`]).
+/// last accepted step (the rest event's), and whether it ended slowing to its rest
+/// ([`rest::Slowing`]). `start`: a restart from a hold or a roll slowing to its rest, stopped
+/// (`None`) once its speed reaches this (m/s), its velocity held to `rtol` of it
+/// ([`rest::start_speed_m_s`], [`rest::slow_speed_m_s`]).
 fn roll<T: Real>(
     scene: &RollingScene<T>,
     (t0, y0): (T, State<T>),
@@ -203,7 +208,7 @@ fn roll<T: Real>(
     start: Option<T>,
     limits: SystemLimits<T>,
     watch: &mut impl FnMut(T, &State<T>) -> ControlFlow<T>,
-) -> Result<(Roll<T>, [T; 2]), RollingError> {
+) -> Result<(Roll<T>, [T; 2], bool), RollingError> {
     let rim = scene.rim_radius_m;
     let last = Cell::new(start_direction(scene, t0, &y0));
     // Lengths in units of R: the rim is then the fixed |(x, y)| = 1.
@@ -215,8 +220,16 @@ fn roll<T: Real>(
     };
     // The start speed in the scaled state.
     let start = start.map(|s| s * scale);
+    // A roll at the scene's tolerances ends where it slows to its rest and goes on as a
+    // stretch of its own, as the bowl model's (`rest::slow_speed_m_s`).
+    let slowing = rest::Slowing::new(
+        rest::slow_speed_m_s(scene) * scale,
+        start,
+        [y0[2], y0[3]].map(|v| v * scale),
+    );
     let check = |t: T, y: &State<T>| {
         rest::follow_velocity([y[2], y[3]], &last);
+        slowing.follow([y[2], y[3]]);
         if let ControlFlow::Break(t) = watch(t, &y.map(|v| v * rim)) {
             return ControlFlow::Break(Some(t));
         }
@@ -232,10 +245,21 @@ fn roll<T: Real>(
             rest::turned([y[2], y[3]], last.get()) / speed_scale,
             rest::turned([dy[2], dy[3]], last.get()) / speed_scale,
         );
-        if at_rim.0 >= at_rest.0 {
+        let first = if at_rim.0 >= at_rest.0 {
             at_rim
         } else {
             at_rest
+        };
+        // Slowing: `slow/2 - |u|`, its slope `-(u . du) / |u|`.
+        let speed = (y[2] * y[2] + y[3] * y[3]).sqrt();
+        let slope = if speed > T::ZERO {
+            -(y[2] * dy[2] + y[3] * dy[3]) / speed / speed_scale
+        } else {
+            T::ZERO
+        };
+        match slowing.event([y[2], y[3]]) {
+            Some(s) if s / speed_scale > first.0 => (s / speed_scale, slope),
+            _ => first,
         }
     };
     match method {
@@ -259,7 +283,19 @@ fn roll<T: Real>(
             system::rk4_with(rhs, t0, scaled(&y0), step_s, &event, check, limits)
         }
     }
-    .map(|run| (run, last.get()))
+    .map(|run| {
+        // Where the roll ended by slowing to its rest (that event the nearest zero).
+        let slowed = match &run.ended {
+            Ended::Event { y, .. } => slowing.event([y[2], y[3]]).is_some_and(|s| {
+                s / speed_scale
+                    > rim_event(y, &[T::ZERO; 5])
+                        .0
+                        .max(rest::turned([y[2], y[3]], last.get()) / speed_scale)
+            }),
+            _ => false,
+        };
+        (run, last.get(), slowed)
+    })
     .map_err(RollingError::Integration)
 }
 

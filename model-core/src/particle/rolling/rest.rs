@@ -84,6 +84,46 @@ pub(crate) fn slow_speed_m_s<T: Real>(scene: &RollingScene<T>) -> T {
 /// step before the speed fell to 8 times the start speed), 64 and 256 alike 6e-6 and 4e-6.
 pub const SLOW: f64 = 64.0;
 
+/// A roll's watch for slowing to its rest ([`slow_speed_m_s`]), in the roll's own units of
+/// speed, shared by both runs that roll (`rest_loop`): a roll at the scene's tolerances (not a
+/// stretch) is armed once its speed is above the slow speed (at its start or after an
+/// accepted step), and from then its event `slow/2 - |u|` ends it where it slows to half that.
+pub(crate) struct Slowing<T> {
+    slow: T,
+    /// A stretch of its own already (`start`): it does not end so.
+    watched: bool,
+    armed: Cell<bool>,
+}
+
+impl<T: Real> Slowing<T> {
+    /// For a roll that starts with velocity `u`; `slow`: [`slow_speed_m_s`] in the roll's
+    /// units; `start`: the roll's stretch speed, if it is one.
+    pub(crate) fn new(slow: T, start: Option<T>, u: [T; 2]) -> Self {
+        let watched = start.is_none();
+        let armed = Cell::new(watched && dot(&u, &u).sqrt() > slow);
+        Self {
+            slow,
+            watched,
+            armed,
+        }
+    }
+
+    /// After an accepted step to velocity `u`.
+    pub(crate) fn follow(&self, u: [T; 2]) {
+        if self.watched && dot(&u, &u).sqrt() > self.slow {
+            self.armed.set(true);
+        }
+    }
+
+    /// The event at velocity `u`, once armed: `slow/2 - |u|`, zero where the roll slowed to
+    /// half the slow speed.
+    pub(crate) fn event(&self, u: [T; 2]) -> Option<T> {
+        self.armed
+            .get()
+            .then(|| self.slow / T::TWO - dot(&u, &u).sqrt())
+    }
+}
+
 /// A rolling state at `t` as the granule at rest, if it is at rest ([`REST_SPEED`]) and the
 /// rolling resistance holds it there.
 pub(crate) fn held_at<T: Real>(scene: &RollingScene<T>, t: T, y: &State<T>) -> Option<State<T>> {

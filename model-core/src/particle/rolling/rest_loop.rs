@@ -10,7 +10,7 @@
 //!   drive exceeds the resistance (the roll that follows does not hold again at once);
 //! * from a hold's end: a restart stretch up to [`rest::start_speed_m_s`]
 //!   (the roll mode's `Stop::Started`), then the roll at the scene's own tolerances;
-//! * a roll that slows on its way to a rest ([`Rolled::Slowed`], the roll mode's): a stretch
+//! * a roll that slows on its way to a rest ([`Rolled::Slowed`], [`rest::Slowing`]): a stretch
 //!   of its own up to [`rest::slow_speed_m_s`], which ends at the rest or back at that speed.
 
 use core::ops::ControlFlow;
@@ -29,7 +29,7 @@ pub(crate) enum Rolled<T, E> {
     Started(T, State<T>),
     /// A roll slowed to half the slow speed ([`rest::slow_speed_m_s`]) at `t`, in `y` (m,
     /// m/s): it goes on to its rest as a stretch of its own up to that speed, as a restart
-    /// does (the rolling model's roll does not end so).
+    /// does.
     Slowed(T, State<T>),
     /// Anything else (the rim, lift-off, a change of mode, the horizon): the loop's end.
     Ended(E),

@@ -252,19 +252,36 @@ fn a_restart_from_a_hold_is_as_accurate_as_asked() {
     }
 }
 
-/// A release that rolls to rest on the bottom on its way to the wall (2 deg tilt, 0.3 and
-/// 3 rad/s, a 45 deg wall 15 mm high with a 5 mm fillet, ri 30 mm, release 90 deg, 5 s; docs/
-/// model.md §10), to 1 s, before it reaches the wall: its time held is within 10x rtol of the run at 1e-12 at every rtol 1e-6 to
-/// 1e-10. Before, at 1e-6 it was 4.7e-4 s off (470x): the rest was located in a step that
+/// The scene of a release that rolls to rest on the bottom (2 deg tilt, 0.3 and 3 rad/s, a 75
+/// mm bowl, ri 30 mm; release 90 deg).
+fn slowing_to_rest() -> RollingScene<f64> {
+    RollingScene {
+        ri_m: 0.03,
+        ..RollingScene::with_speeds(0.3, 3.0, 2f64.to_radians(), 0.075)
+    }
+}
+
+/// `held(rtol)`, the time held at a tolerance, is about 0.369 s at 1e-12 and within 10x rtol of
+/// that at every rtol 1e-6 to 1e-10.
+fn held_as_long(held: impl Fn(f64) -> f64) {
+    let exact = held(1e-12);
+    assert!((exact - 0.369).abs() < 1e-3, "{exact}");
+    for rtol in [1e-6, 3e-7, 1e-7, 1e-8, 1e-9, 1e-10] {
+        let off = (held(rtol) - exact).abs();
+        assert!(off < 10.0 * rtol, "rtol {rtol:e}: held {off:e} s off");
+    }
+}
+
+/// A release that rolls to rest on the bottom on its way to the wall ([`slowing_to_rest`], a
+/// 45 deg wall 15 mm high with a 5 mm fillet; docs/model.md §10), to 1 s, before it reaches the
+/// wall: its time held is within 10x rtol of the run at 1e-12 at every rtol 1e-6 to 1e-10.
+/// Before, at 1e-6 it was 4.7e-4 s off (470x): the rest was located in a step that
 /// spanned it with the velocity 9e-5 m/s off, not held, and the resistance took that long to
 /// stop it (`rest::slow_speed_m_s`).
 #[test]
 fn a_rest_on_the_bottom_is_held_as_long_at_a_loose_tolerance() {
     use crate::particle::bowl::{BowlShape, residence};
-    let sc = RollingScene {
-        ri_m: 0.03,
-        ..RollingScene::with_speeds(0.3, 3.0, 2f64.to_radians(), 0.075)
-    };
+    let sc = slowing_to_rest();
     let shape = BowlShape {
         wall_angle_rad: 45f64.to_radians(),
         wall_height_m: 0.015,
@@ -275,15 +292,29 @@ fn a_rest_on_the_bottom_is_held_as_long_at_a_loose_tolerance() {
         horizon_s: 1.0,
         max_steps: MAX_STEPS,
     };
-    let held = |rtol| {
+    held_as_long(|rtol| {
         let method = RollingMethod::Dp54 { rtol };
         let r = residence(&sc, &shape, 90f64.to_radians(), method, limits).unwrap();
         r.regime.held_s
+    });
+}
+
+/// The same release in the rolling model (`bowl predict --model rolling`, no wall: the rim at
+/// 75 mm), to 5 s: its time held is within 10x rtol of the run at 1e-12 at every rtol 1e-6 to
+/// 1e-10, as the bowl model's. Before, its roll did not go on to the rest as a stretch of its
+/// own (`rest::slow_speed_m_s`) and at 1e-6 it was held 4.9e-4 s too little (490x); now
+/// 6.2e-6 s, and within 4x rtol at 3e-7 to 1e-10.
+#[test]
+fn a_rest_in_the_rolling_model_is_held_as_long_at_a_loose_tolerance() {
+    let sc = slowing_to_rest();
+    let limits = SystemLimits {
+        horizon_s: 5.0,
+        max_steps: MAX_STEPS,
     };
-    let exact = held(1e-12);
-    assert!((exact - 0.369).abs() < 1e-3, "{exact}");
-    for rtol in [1e-6, 3e-7, 1e-7, 1e-8, 1e-9, 1e-10] {
-        let off = (held(rtol) - exact).abs();
-        assert!(off < 10.0 * rtol, "rtol {rtol:e}: held {off:e} s off");
-    }
+    held_as_long(|rtol| {
+        let method = RollingMethod::Dp54 { rtol };
+        residence_within(&sc, 90f64.to_radians(), method, limits)
+            .unwrap()
+            .held_s
+    });
 }

@@ -88,10 +88,8 @@ impl<T: Real> RollPieces<T> for RollRun<'_, T> {
         // ends where it slows to half of it and goes on to its rest as a stretch of its own
         // (`rest::slow_speed_m_s`).
         let speed_ref = refs.1;
-        let speed = |y: &[T; 5]| (y[2] * y[2] + y[3] * y[3]).sqrt();
-        let slow = rest::slow_speed_m_s(scene);
-        let armed = Cell::new(start.is_none() && speed(y) > slow);
-        let slows = |y: &[T; 5]| armed.get().then(|| (slow / T::TWO - speed(y)) / speed_ref);
+        let slowing = rest::Slowing::new(rest::slow_speed_m_s(scene), start, [y[2], y[3]]);
+        let slows = |y: &[T; 5]| slowing.event([y[2], y[3]]).map(|s| s / speed_ref);
         // A restart from a hold, or a roll slowing to its rest: up to `start`, a stretch of its
         // own with the velocity held to `rtol` of that speed and the position to `rtol` of the
         // distance the scene's speed covers in the time that speed takes over the scene's length
@@ -111,9 +109,7 @@ impl<T: Real> RollPieces<T> for RollRun<'_, T> {
             },
             |t, y: &[T; 5]| {
                 rest::follow_velocity([y[2], y[3]], &last);
-                if start.is_none() && speed(y) > slow {
-                    armed.set(true);
-                }
+                slowing.follow([y[2], y[3]]);
                 watch.check(t)?;
                 match start {
                     Some(s) if y[2] * y[2] + y[3] * y[3] >= s * s => {
