@@ -1,6 +1,7 @@
 //! The order of the pieces of the rolling loop through rests (`rest_loop`), which both rolling
-//! runs take from it: a held rest holds, a hold's end restarts with its own stretch and does not
-//! hold again at once, and a rest the resistance cannot hold rolls on.
+//! runs take from it: a held rest holds, a hold's end restarts with its own stretches (to the
+//! start speed, then the slow speed) and does not hold again at once, a release from rest that
+//! is not held restarts so too, and a rest the resistance cannot hold rolls on.
 
 // The scripted pieces keep their answers and log on the heap, in the tests only.
 extern crate std;
@@ -10,7 +11,7 @@ use std::vec;
 use std::vec::Vec;
 
 use super::equations::State;
-use super::rest::start_speed_m_s;
+use super::rest::{slow_speed_m_s, start_speed_m_s};
 use super::rest_loop::{AfterHold, AfterPiece, AfterRoll, RollPieces, Rolled, roll_with_rests};
 use super::*;
 
@@ -59,12 +60,14 @@ fn a_held_rest_holds_then_restarts_by_its_own_stretch_and_an_unheld_one_rolls_on
     let s = sticky();
     let at = |u: [f64; 2]| [0.02, 0.01, u[0], u[1], 0.5];
     let still = at([0.0, 0.0]);
+    let start = start_speed_m_s(&s);
     let mut pieces = Scripted {
         holds: vec![
             ControlFlow::Continue(1.0),
             ControlFlow::Break("held to the end"),
         ],
         rolls: vec![
+            Rolled::Started(1.05, at([1.1 * start, 0.0])),
             Rolled::Started(1.1, at([0.01, 0.0])),
             // Turned by more than a right angle in a step, at a speed far above a rest's.
             Rolled::Rest(1.2, at([-0.05, 0.0])),
@@ -75,13 +78,14 @@ fn a_held_rest_holds_then_restarts_by_its_own_stretch_and_an_unheld_one_rolls_on
     };
     let end = roll_with_rests(&s, &mut pieces, (0.0, still)).unwrap();
     assert_eq!(end, "held to the end");
-    let start = start_speed_m_s(&s);
     assert_eq!(
         pieces.log,
         [
             Piece::Hold(0.0, still),
             // From the hold's end, not held again there: the restart stretch.
             Piece::Roll(1.0, still, Some(start)),
+            // On up to the slow speed, a stretch still.
+            Piece::Roll(1.05, at([1.1 * start, 0.0]), Some(slow_speed_m_s(&s))),
             // Under way: at the scene's own tolerances.
             Piece::Roll(1.1, at([0.01, 0.0]), None),
             Piece::Roll(1.2, at([-0.05, 0.0]), None),
@@ -102,4 +106,26 @@ fn an_end_in_any_piece_ends_the_loop_there() {
     };
     assert_eq!(roll_with_rests(&s, &mut pieces, (0.0, moving)), Ok("left"));
     assert_eq!(pieces.log, [Piece::Roll(0.0, moving, None)]);
+}
+
+/// A release from rest that the resistance does not hold starts as a hold's end does (before,
+/// as a roll at the scene's tolerances, which hovered near rest at the stick threshold:
+/// `rest_tests::a_release_that_barely_starts_is_its_own_stretch`).
+#[test]
+fn a_release_from_rest_not_held_restarts_by_its_own_stretch() {
+    let s = RollingScene {
+        rolling_resistance: 0.0,
+        ..super::rest_tests::stopping()
+    };
+    let still = [0.02, 0.01, 0.0, 0.0, 0.5];
+    let mut pieces = Scripted {
+        holds: Vec::new(),
+        rolls: vec![Rolled::Ended("left")],
+        log: Vec::new(),
+    };
+    assert_eq!(roll_with_rests(&s, &mut pieces, (0.0, still)), Ok("left"));
+    assert_eq!(
+        pieces.log,
+        [Piece::Roll(0.0, still, Some(start_speed_m_s(&s)))]
+    );
 }

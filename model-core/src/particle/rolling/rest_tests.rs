@@ -318,3 +318,32 @@ fn a_rest_in_the_rolling_model_is_held_as_long_at_a_loose_tolerance() {
             .held_s
     });
 }
+
+/// The chart's near-stick scene (`bowl chart rolling-work-precision`: 30 deg, 2 rad/s combined,
+/// mu_r 0.55 against `tan 30 = 0.577`): the drive barely beats the resistance at the release.
+/// Before, the roll from rest ran at the scene's tolerance on the velocity (`rtol` of its speed
+/// scale, about the speed itself at first): at rtol 1e-6 the 150 deg release hovered at
+/// 5e-6 m/s for 1.1 s (T 2.18340 s against 1.54798, 313 827 steps) and at 1e-4 and 1e-7 it hit
+/// the step cap. Now the release from rest is a restart stretch, then a stretch up to the slow
+/// speed (`rest_loop`): within 10x rtol from 1e-4 to 1e-7, cheaper than at 1e-12.
+#[test]
+fn a_release_that_barely_starts_is_its_own_stretch() {
+    let s = RollingScene {
+        rolling_resistance: 0.55,
+        ..RollingScene::equal_speeds(2.0, 30f64.to_radians(), 0.075)
+    };
+    let beta = 150f64.to_radians();
+    let run = |rtol| residence(&s, beta, RollingMethod::Dp54 { rtol }).unwrap();
+    let tight = run(1e-12);
+    let exact = left(tight.outcome);
+    assert!((exact - 1.54798).abs() < 1e-5, "{exact}");
+    for rtol in [1e-6, 1e-4, 1e-5, 1e-7] {
+        let r = run(rtol);
+        let t = left(r.outcome);
+        assert!(
+            (t / exact - 1.0).abs() < 10.0 * rtol,
+            "rtol {rtol}: {t} {exact}"
+        );
+        assert!(r.evaluations < tight.evaluations, "rtol {rtol}: {r:?}");
+    }
+}
