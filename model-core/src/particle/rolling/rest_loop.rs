@@ -75,6 +75,7 @@ pub(crate) fn roll_with_rests<T: Real, P: RollPieces<T>>(
     let mut from_hold = false;
     // The roll slowed on its way to a rest: the rest of the way a stretch of its own.
     let mut slowed = false;
+    let slow = rest::slow_speed_m_s(scene);
     loop {
         let after_hold = core::mem::take(&mut from_hold);
         let still = y[2] == T::ZERO && y[3] == T::ZERO;
@@ -82,7 +83,8 @@ pub(crate) fn roll_with_rests<T: Real, P: RollPieces<T>>(
         // as a hold's end does, a restart stretch of its own: as a roll at the scene's tolerance
         // it hovered at 5e-6 m/s for 1.1 s (see `rest_tests`).
         let restarts = after_hold || still;
-        let stretch = restarts || core::mem::take(&mut slowed);
+        // Taken every time round, so that a slowing never carries past the piece it was for.
+        let slowing = core::mem::take(&mut slowed);
         if !after_hold
             && still
             && let Some(at_rest) = rest::held_at(scene, t, &y)
@@ -92,10 +94,12 @@ pub(crate) fn roll_with_rests<T: Real, P: RollPieces<T>>(
                 ControlFlow::Break(end) => return Ok(end),
             }
         } else {
-            let start = match (restarts, stretch) {
-                (true, _) => Some(rest::start_speed_m_s(scene)),
-                (false, true) => Some(rest::slow_speed_m_s(scene)),
-                (false, false) => None,
+            let start = if restarts {
+                Some(rest::start_speed_m_s(scene))
+            } else if slowing {
+                Some(slow)
+            } else {
+                None
             };
             (t, y) = match pieces.roll(t, &y, start)? {
                 // Held there with no velocity at all, or rolling on.
@@ -103,9 +107,7 @@ pub(crate) fn roll_with_rests<T: Real, P: RollPieces<T>>(
                 // From the start speed on to the slow speed, a stretch again: at a loose
                 // `rtol` the scene's tolerance on the velocity is as large as the start speed.
                 Rolled::Started(te, ye) => {
-                    slowed = restarts
-                        && ye[2] * ye[2] + ye[3] * ye[3]
-                            < rest::slow_speed_m_s(scene) * rest::slow_speed_m_s(scene);
+                    slowed = restarts && ye[2] * ye[2] + ye[3] * ye[3] < slow * slow;
                     (te, ye)
                 }
                 Rolled::Slowed(te, ye) => {
