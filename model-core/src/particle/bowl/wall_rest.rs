@@ -25,7 +25,7 @@
 use super::wall::{Contact, Meridian, WallState, to_space, wall_forces};
 use crate::Real;
 use crate::particle::rolling::RollingScene;
-use crate::particle::rolling::equations::frame;
+use crate::particle::rolling::equations::{dot, frame};
 use crate::particle::rolling::modes::fired;
 use crate::particle::rolling::rest::{hold_while, start_speed_m_s};
 
@@ -45,10 +45,6 @@ pub(super) enum Let {
 pub(super) struct WallHold<T> {
     pub(super) end: Option<(T, WallState<T>, Let)>,
     pub(super) evaluations: u32,
-}
-
-fn dot<T: Real>(a: &[T; 3], b: &[T; 3]) -> T {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// The surface's unit normal (towards the centre) at a wall state.

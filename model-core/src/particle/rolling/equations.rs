@@ -78,6 +78,12 @@ pub(crate) fn frame<T: Real>(s: &RollingScene<T>, t: T) -> Frame<T> {
     }
 }
 
+/// The dot product of two vectors of any length (the rest's and the slip's directions, the
+/// wall's normal).
+pub(crate) fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
+    a.iter().zip(b).fold(T::ZERO, |acc, (x, y)| acc + *x * *y)
+}
+
 pub(crate) fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
     [
         a[1] * b[2] - a[2] * b[1],

@@ -16,7 +16,7 @@
 use core::cell::Cell;
 
 use super::RollingScene;
-use super::equations::{AT_REST_M_S, State, rest_margin_m_s2};
+use super::equations::{AT_REST_M_S, State, dot, rest_margin_m_s2};
 use crate::Real;
 use crate::ode::event::locate;
 
@@ -31,10 +31,6 @@ pub const HOLD_STEPS: f64 = 16.0;
 /// (On the wall, `bowl::wall_run`, the same of the centre's velocity in space.)
 pub(crate) fn turned<T: Real, const N: usize>(u: [T; N], last: [T; N]) -> T {
     -dot(&u, &last)
-}
-
-fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
-    a.iter().zip(b).fold(T::ZERO, |acc, (x, y)| acc + *x * *y)
 }
 
 /// After an accepted step of a roll whose velocity is `u`: the direction `last` follows the

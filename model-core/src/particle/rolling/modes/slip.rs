@@ -7,7 +7,7 @@ use core::cell::Cell;
 use core::ops::ControlFlow;
 
 use crate::Real;
-use crate::particle::rolling::equations::AT_REST_M_S;
+use crate::particle::rolling::equations::{AT_REST_M_S, dot};
 
 /// The slip below which a slide has ended, in units of the scene's speed: a few roundings of
 /// it, so that the end is located as exactly as the slip's zero itself (a slip that falls
@@ -16,10 +16,6 @@ pub(super) const STUCK: f64 = 64.0;
 
 pub(crate) fn stuck_m_s<T: Real>(speed_ref: T) -> T {
     T::from_f64(STUCK) * T::EPSILON * speed_ref
-}
-
-fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
-    a.iter().zip(b).fold(T::ZERO, |acc, (x, y)| acc + *x * *y)
 }
 
 /// After an accepted step of a slide with the slip `s` (`stuck`: [`stuck_m_s`]): arms the
